@@ -136,6 +136,12 @@ def model_terms(params, upper, base, q, qd, M, h, G, J_leg, J_joint, lengths):
     J_leg : (6, 6) out, leg-length rates = J_leg qd.
     J_joint : (6, 5, 6) out, joint axis rates = J_joint[leg] qd.
     lengths : (6,) out, leg lengths (m).
+
+    Notes
+    -----
+    Written with scalar loops and a handful of scratch arrays: the simulator calls it four
+    times per integration step, and small-matrix products (BLAS calls) and temporaries
+    would dominate its cost.
     """
     m = params[P_MASS]
     m_u, m_l = params[P_M_UPPER], params[P_M_LOWER]
@@ -145,89 +151,166 @@ def model_terms(params, upper, base, q, qd, M, h, G, J_leg, J_joint, lengths):
 
     R = rotation(q[3], q[4], q[5])
     E = euler_rate_map(q[4], q[5])
-    omega = E @ qd[3:]
-    r, L, u = leg_geometry(upper, base, q)
+    omega = np.empty(3)
+    for k in range(3):
+        omega[k] = E[k, 0] * qd[3] + E[k, 1] * qd[4] + E[k, 2] * qd[5]
 
     Mn = np.zeros((6, 6))
     hn = np.zeros(6)
     Gn = np.zeros(6)
-    Jl = np.zeros((6, 6))
-    Jj = np.zeros((6, 5, 6))
+    # per-leg scratch
+    r = np.empty(3)
+    ui = np.empty(3)
+    JA = np.empty((3, 6))
+    Judot = np.empty((3, 6))
+    Jw = np.empty((3, 6))
+    Jcl = np.empty((3, 6))
+    Jcu = np.empty((3, 6))
+    vA = np.empty(3)
+    udot = np.empty(3)
+    aA = np.empty(3)
+    udd = np.empty(3)
+    acl = np.empty(3)
+    acu = np.empty(3)
+    wd = np.empty(3)
+    w_rel = np.empty(3)
 
-    # platform
-    Ib = np.diag(params[P_IXX:P_IZZ + 1].copy())
-    Iw = R @ Ib @ R.T
+    # platform: M = diag(m, m, m, R Ib R^T), h = [0, omega x (Iw omega)]
     for k in range(3):
         Mn[k, k] = m
-    Mn[3:, 3:] = Iw
-    hn[3:] = _cross(omega, Iw @ omega)
+    for a in range(3):
+        for b in range(3):
+            Mn[3 + a, 3 + b] = (R[a, 0] * params[P_IXX] * R[b, 0]
+                                + R[a, 1] * params[P_IYY] * R[b, 1]
+                                + R[a, 2] * params[P_IZZ] * R[b, 2])
+    Iwo0 = Mn[3, 3] * omega[0] + Mn[3, 4] * omega[1] + Mn[3, 5] * omega[2]
+    Iwo1 = Mn[4, 3] * omega[0] + Mn[4, 4] * omega[1] + Mn[4, 5] * omega[2]
+    Iwo2 = Mn[5, 3] * omega[0] + Mn[5, 4] * omega[1] + Mn[5, 5] * omega[2]
+    hn[3] = omega[1] * Iwo2 - omega[2] * Iwo1
+    hn[4] = omega[2] * Iwo0 - omega[0] * Iwo2
+    hn[5] = omega[0] * Iwo1 - omega[1] * Iwo0
     Gn[2] = -m * g
 
-    JA = np.zeros((3, 6))
     for i in range(6):
-        l = L[i]
+        # leg geometry: r = R upper_i, leg vector A - B, unit u
+        s = 0.0
+        for k in range(3):
+            r[k] = R[k, 0] * upper[i, 0] + R[k, 1] * upper[i, 1] + R[k, 2] * upper[i, 2]
+            ui[k] = q[k] + r[k] - base[i, k]
+            s += ui[k] * ui[k]
+        l = math.sqrt(s)
+        for k in range(3):
+            ui[k] /= l
         lengths[i] = l
-        ui = u[i]
-        ri = r[i]
         # J_A = [I, -[r]x]: velocity of the upper joint point from the twist
-        JA[:, :] = 0.0
+        for k in range(3):
+            for c in range(6):
+                JA[k, c] = 0.0
         JA[0, 0] = 1.0
         JA[1, 1] = 1.0
         JA[2, 2] = 1.0
-        JA[0, 4] = ri[2]
-        JA[0, 5] = -ri[1]
-        JA[1, 3] = -ri[2]
-        JA[1, 5] = ri[0]
-        JA[2, 3] = ri[1]
-        JA[2, 4] = -ri[0]
-        vA = qd[:3] + _cross(omega, ri)
-        ld = ui @ vA
-        udot = (vA - ld * ui) / l
-        aA = _cross(omega, _cross(omega, ri))
-        P = np.eye(3) - np.outer(ui, ui)
-        udd = (P @ aA - l * (udot @ udot) * ui - 2.0 * ld * udot) / l
-        Judot = P @ JA / l
-        Jw = np.zeros((3, 6))
+        JA[0, 4] = r[2]
+        JA[0, 5] = -r[1]
+        JA[1, 3] = -r[2]
+        JA[1, 5] = r[0]
+        JA[2, 3] = r[1]
+        JA[2, 4] = -r[0]
+        vA[0] = qd[0] + (omega[1] * r[2] - omega[2] * r[1])
+        vA[1] = qd[1] + (omega[2] * r[0] - omega[0] * r[2])
+        vA[2] = qd[2] + (omega[0] * r[1] - omega[1] * r[0])
+        ld = ui[0] * vA[0] + ui[1] * vA[1] + ui[2] * vA[2]
+        for k in range(3):
+            udot[k] = (vA[k] - ld * ui[k]) / l
+        # aA = omega x (omega x r)
+        wr0 = omega[1] * r[2] - omega[2] * r[1]
+        wr1 = omega[2] * r[0] - omega[0] * r[2]
+        wr2 = omega[0] * r[1] - omega[1] * r[0]
+        aA[0] = omega[1] * wr2 - omega[2] * wr1
+        aA[1] = omega[2] * wr0 - omega[0] * wr2
+        aA[2] = omega[0] * wr1 - omega[1] * wr0
+        uu = udot[0] * udot[0] + udot[1] * udot[1] + udot[2] * udot[2]
+        ua = ui[0] * aA[0] + ui[1] * aA[1] + ui[2] * aA[2]
+        for k in range(3):
+            # P aA with P = I - u u^T
+            udd[k] = ((aA[k] - ui[k] * ua) - l * uu * ui[k] - 2.0 * ld * udot[k]) / l
         for c in range(6):
-            Jw[:, c] = _cross(ui, JA[:, c]) / l
-        Jcl = d_l * Judot
-        Jcu = JA - d_u * Judot
-        acl = d_l * udd
-        acu = aA - d_u * udd
-        wd = _cross(ui, udd)
-        Mn += m_l * (Jcl.T @ Jcl) + m_u * (Jcu.T @ Jcu) + I_leg * (Jw.T @ Jw)
-        hn += m_l * (Jcl.T @ acl) + m_u * (Jcu.T @ acu) + I_leg * (Jw.T @ wd)
-        for c in range(6):
-            Gn[c] -= g * (m_l * Jcl[2, c] + m_u * Jcu[2, c])
-        Jl[i, :] = ui @ JA
-        # leg frame for the joint axes
+            uJ = ui[0] * JA[0, c] + ui[1] * JA[1, c] + ui[2] * JA[2, c]
+            J_leg[i, c] = uJ
+            for k in range(3):
+                Judot[k, c] = (JA[k, c] - ui[k] * uJ) / l
+            Jw[0, c] = (ui[1] * JA[2, c] - ui[2] * JA[1, c]) / l
+            Jw[1, c] = (ui[2] * JA[0, c] - ui[0] * JA[2, c]) / l
+            Jw[2, c] = (ui[0] * JA[1, c] - ui[1] * JA[0, c]) / l
+            for k in range(3):
+                Jcl[k, c] = d_l * Judot[k, c]
+                Jcu[k, c] = JA[k, c] - d_u * Judot[k, c]
+        for k in range(3):
+            acl[k] = d_l * udd[k]
+            acu[k] = aA[k] - d_u * udd[k]
+        wd[0] = ui[1] * udd[2] - ui[2] * udd[1]
+        wd[1] = ui[2] * udd[0] - ui[0] * udd[2]
+        wd[2] = ui[0] * udd[1] - ui[1] * udd[0]
+        for a in range(6):
+            for b in range(6):
+                s = 0.0
+                for k in range(3):
+                    s += (m_l * Jcl[k, a] * Jcl[k, b] + m_u * Jcu[k, a] * Jcu[k, b]
+                          + I_leg * Jw[k, a] * Jw[k, b])
+                Mn[a, b] += s
+            s = 0.0
+            for k in range(3):
+                s += m_l * Jcl[k, a] * acl[k] + m_u * Jcu[k, a] * acu[k] + I_leg * Jw[k, a] * wd[k]
+            hn[a] += s
+            Gn[a] -= g * (m_l * Jcl[2, a] + m_u * Jcu[2, a])
+        # leg frame for the joint axes: e1 = unit(z x u), e2 = u x e1
         nx, ny = -ui[1], ui[0]
         nn = math.sqrt(nx * nx + ny * ny)
-        e1 = np.array([nx / nn, ny / nn, 0.0])
-        e2 = _cross(ui, e1)
+        e10, e11 = nx / nn, ny / nn
+        e20 = -ui[2] * e11
+        e21 = ui[2] * e10
+        e22 = ui[0] * e11 - ui[1] * e10
         for c in range(6):
-            w_leg = Jw[:, c]
-            w_rel = -w_leg
+            for k in range(3):
+                w_rel[k] = -Jw[k, c]
             if c >= 3:
                 w_rel[c - 3] += 1.0
-            Jj[i, 0, c] = e1 @ w_leg
-            Jj[i, 1, c] = e2 @ w_leg
-            Jj[i, 2, c] = e1 @ w_rel
-            Jj[i, 3, c] = e2 @ w_rel
-            Jj[i, 4, c] = ui @ w_rel
+            J_joint[i, 0, c] = e10 * Jw[0, c] + e11 * Jw[1, c]
+            J_joint[i, 1, c] = e20 * Jw[0, c] + e21 * Jw[1, c] + e22 * Jw[2, c]
+            J_joint[i, 2, c] = e10 * w_rel[0] + e11 * w_rel[1]
+            J_joint[i, 3, c] = e20 * w_rel[0] + e21 * w_rel[1] + e22 * w_rel[2]
+            J_joint[i, 4, c] = ui[0] * w_rel[0] + ui[1] * w_rel[1] + ui[2] * w_rel[2]
 
-    # map the twist equations to q coordinates: nu = T qd, nu_dot = T qdd + [0, Edot rates]
-    bias = np.zeros(6)
-    bias[3:] = euler_rate_map_derivative_product(q[4], q[5], qd[3:])
-    hn += Mn @ bias
-    T = np.eye(6)
-    T[3:, 3:] = E
-    M[:, :] = T.T @ Mn @ T
-    h[:] = T.T @ hn
-    G[:] = T.T @ Gn
-    J_leg[:, :] = Jl @ T
+    # map the twist equations to q coordinates: nu = T qd, nu_dot = T qdd + [0, Edot rates],
+    # T = blockdiag(I, E); M = T^T Mn T, h = T^T (hn + Mn bias), G = T^T Gn, J = J T
+    bias = euler_rate_map_derivative_product(q[4], q[5], qd[3:])
+    for a in range(6):
+        hn[a] += Mn[a, 3] * bias[0] + Mn[a, 4] * bias[1] + Mn[a, 5] * bias[2]
+    MT = np.empty((6, 6))  # Mn T
+    for a in range(6):
+        for b in range(3):
+            MT[a, b] = Mn[a, b]
+            MT[a, 3 + b] = Mn[a, 3] * E[0, b] + Mn[a, 4] * E[1, b] + Mn[a, 5] * E[2, b]
+    for b in range(6):
+        for a in range(3):
+            M[a, b] = MT[a, b]
+            M[3 + a, b] = E[0, a] * MT[3, b] + E[1, a] * MT[4, b] + E[2, a] * MT[5, b]
+    for a in range(3):
+        h[a] = hn[a]
+        G[a] = Gn[a]
+        h[3 + a] = E[0, a] * hn[3] + E[1, a] * hn[4] + E[2, a] * hn[5]
+        G[3 + a] = E[0, a] * Gn[3] + E[1, a] * Gn[4] + E[2, a] * Gn[5]
     for i in range(6):
-        J_joint[i] = Jj[i] @ T
+        x0 = J_leg[i, 3]
+        x1 = J_leg[i, 4]
+        x2 = J_leg[i, 5]
+        for b in range(3):
+            J_leg[i, 3 + b] = x0 * E[0, b] + x1 * E[1, b] + x2 * E[2, b]
+        for j in range(N_JOINTS):
+            x0 = J_joint[i, j, 3]
+            x1 = J_joint[i, j, 4]
+            x2 = J_joint[i, j, 5]
+            for b in range(3):
+                J_joint[i, j, 3 + b] = x0 * E[0, b] + x1 * E[1, b] + x2 * E[2, b]
 
 
 @njit(cache=True)
