@@ -1,0 +1,350 @@
+"""Measured experiments in the interchange format: reading, validation, writing.
+
+One table per experiment (CSV or Parquet) with the columns
+
+    t, x, y, z, rx, ry, rz, l1..l6, f1..f6
+
+time (s); pose of the reference point in the paper frame (m, rad; absolute, z down); leg
+lengths (m); actuator forces along the legs (N, positive extends the leg). Either the pose or
+the leg lengths may be missing: forward or inverse kinematics fill them in from the platform
+description. Several files are several experiments.
+
+Validation happens here, at the boundary, so that identification code can trust its input:
+required columns, finite values, strictly increasing time, a uniform sample period, and at
+least :data:`MIN_SAMPLES` samples. A non-uniform time base is resampled onto a uniform grid
+(linear interpolation at the median sample period) with a :class:`DataWarning`, because
+every identification method here assumes a fixed sample period.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import warnings
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from stewartid.errors import DataError, KinematicsError
+from stewartid.platform import Platform
+
+#: All columns of the interchange format, in order.
+COLUMNS = ("t", "x", "y", "z", "rx", "ry", "rz", "l1", "l2", "l3", "l4", "l5", "l6",
+           "f1", "f2", "f3", "f4", "f5", "f6")
+POSE_COLUMNS = COLUMNS[1:7]
+LENGTH_COLUMNS = COLUMNS[7:13]
+FORCE_COLUMNS = COLUMNS[13:19]
+
+#: Fewest samples an experiment may have (a handful of periods of the slowest method's window).
+MIN_SAMPLES = 64
+
+#: Largest relative deviation of a sample period from the median before the time base counts
+#: as non-uniform (tolerates the rounding of t in text files written with enough digits).
+UNIFORM_TOLERANCE = 1e-3
+
+SUFFIXES = {".csv": "csv", ".parquet": "parquet", ".pq": "parquet"}
+
+
+class DataWarning(UserWarning):
+    """A data set was usable only after a correction (for instance resampling)."""
+
+
+@dataclass(frozen=True)
+class Dataset:
+    """One experiment: measured pose, leg lengths and actuator forces on a uniform time base.
+
+    Attributes
+    ----------
+    t : ndarray, shape (N,)
+        Time (s), strictly increasing with a uniform period.
+    pose : ndarray, shape (N, 6)
+        Pose q = [x, y, z, rx, ry, rz] of the reference point, paper frame (m, rad; absolute,
+        z down).
+    lengths : ndarray, shape (N, 6)
+        Leg lengths (m).
+    forces : ndarray, shape (N, 6)
+        Actuator forces along the legs (N, positive extends the leg).
+    name : str
+        Label of the experiment (file stem when read from a file).
+    """
+
+    t: np.ndarray
+    pose: np.ndarray
+    lengths: np.ndarray
+    forces: np.ndarray
+    name: str = "exp"
+
+    def __post_init__(self) -> None:
+        n = np.shape(self.t)[0] if np.ndim(self.t) == 1 else -1
+        if n < 0:
+            raise DataError(f"{self.name}: t must be one-dimensional; got shape {np.shape(self.t)}.")
+        for field in ("pose", "lengths", "forces"):
+            value = np.asarray(getattr(self, field), dtype=float)
+            if value.shape != (n, 6):
+                raise DataError(f"{self.name}: {field} must have shape ({n}, 6) to match t; "
+                                f"got {value.shape}.")
+            object.__setattr__(self, field, value)
+        object.__setattr__(self, "t", np.asarray(self.t, dtype=float))
+
+    @property
+    def sample_rate(self) -> float:
+        """Sample rate (Hz), from the mean period."""
+        return float((len(self.t) - 1) / (self.t[-1] - self.t[0]))
+
+    @property
+    def duration(self) -> float:
+        """Record length t[-1] - t[0] (s)."""
+        return float(self.t[-1] - self.t[0])
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    def to_frame(self) -> pd.DataFrame:
+        """The experiment as a table with the interchange columns."""
+        data = np.column_stack([self.t, self.pose, self.lengths, self.forces])
+        return pd.DataFrame(data, columns=list(COLUMNS))
+
+
+def _format_of(path: Path, format: str | None) -> str:
+    if format is not None:
+        if format not in ("csv", "parquet"):
+            raise DataError(f"unknown data format {format!r} for {path}; expected 'csv' or "
+                            "'parquet'.")
+        return format
+    try:
+        return SUFFIXES[path.suffix.lower()]
+    except KeyError:
+        raise DataError(f"{path}: unknown file type {path.suffix!r}; expected one of "
+                        f"{', '.join(SUFFIXES)} (or pass format='csv'|'parquet').") from None
+
+
+def _check_time(t: np.ndarray, where: str) -> bool:
+    """Validate the time column; return True when it is uniform."""
+    if len(t) < MIN_SAMPLES:
+        raise DataError(f"{where}: only {len(t)} samples; at least {MIN_SAMPLES} are needed "
+                        "(record a longer experiment).")
+    dt = np.diff(t)
+    if np.any(dt <= 0):
+        bad = int(np.argmax(dt <= 0)) + 1
+        raise DataError(f"{where}: column 't' must be strictly increasing; row {bad} has "
+                        f"t = {t[bad]!r} after t = {t[bad - 1]!r} (sort the rows and drop "
+                        "duplicate time stamps).")
+    period = float(np.median(dt))
+    return bool(np.max(np.abs(dt - period)) <= UNIFORM_TOLERANCE * period)
+
+
+def _resample(t: np.ndarray, columns: dict[str, np.ndarray], where: str
+              ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    period = float(np.median(np.diff(t)))
+    n = int(np.floor((t[-1] - t[0]) / period + 1e-9)) + 1
+    grid = t[0] + period * np.arange(n)
+    warnings.warn(f"{where}: time base is not uniform (sample periods from "
+                  f"{np.min(np.diff(t)):.6g} s to {np.max(np.diff(t)):.6g} s); resampled "
+                  f"linearly onto {n} samples at the median period {period:.6g} s.",
+                  DataWarning, stacklevel=3)
+    return grid, {k: np.interp(grid, t, v) for k, v in columns.items()}
+
+
+def dataset_from_frame(frame: pd.DataFrame, platform: Platform | None = None,
+                       name: str = "exp", where: str | None = None) -> Dataset:
+    """Validate a table in the interchange format and build a :class:`Dataset`.
+
+    Parameters
+    ----------
+    frame : DataFrame
+        Columns ``t``, ``f1..f6`` and at least one of the groups ``x..rz`` or ``l1..l6``.
+        Unknown extra columns are ignored.
+    platform : Platform, optional
+        Needed only when the pose or the leg lengths are missing.
+    name : str
+        Experiment label.
+    where : str, optional
+        Source named in error messages (file path); ``name`` by default.
+
+    Raises
+    ------
+    DataError
+        Missing columns, non-finite or non-numeric values, non-increasing time, too few samples.
+    """
+    where = where or name
+    present = set(frame.columns)
+    missing = [c for c in ("t", *FORCE_COLUMNS) if c not in present]
+    if missing:
+        raise DataError(f"{where}: missing required column(s) {', '.join(missing)}; expected "
+                        f"columns {', '.join(COLUMNS)}.")
+    has_pose = all(c in present for c in POSE_COLUMNS)
+    has_lengths = all(c in present for c in LENGTH_COLUMNS)
+    if not (has_pose or has_lengths):
+        lacking = [c for c in POSE_COLUMNS + LENGTH_COLUMNS if c not in present]
+        raise DataError(f"{where}: needs either the pose columns x, y, z, rx, ry, rz or the leg "
+                        f"lengths l1..l6; missing {', '.join(lacking)}.")
+    wanted = ["t", *(POSE_COLUMNS if has_pose else ()), *(LENGTH_COLUMNS if has_lengths else ()),
+              *FORCE_COLUMNS]
+    columns: dict[str, np.ndarray] = {}
+    for c in wanted:
+        values = pd.to_numeric(frame[c], errors="coerce").to_numpy(dtype=float)
+        finite = np.isfinite(values)
+        if not np.all(finite):
+            row = int(np.argmin(finite))
+            raise DataError(f"{where}: column {c!r} has a missing, non-numeric or non-finite "
+                            f"value at row {row} ({frame[c].iloc[row]!r}); clean or drop that "
+                            "row.")
+        columns[c] = values
+    t = columns.pop("t")
+    if not _check_time(t, where):
+        t, columns = _resample(t, columns, where)
+    forces = np.column_stack([columns[c] for c in FORCE_COLUMNS])
+    pose = np.column_stack([columns[c] for c in POSE_COLUMNS]) if has_pose else None
+    lengths = np.column_stack([columns[c] for c in LENGTH_COLUMNS]) if has_lengths else None
+    if pose is None or lengths is None:
+        if platform is None:
+            group = "pose (x..rz)" if pose is None else "leg lengths (l1..l6)"
+            raise DataError(f"{where}: the {group} is missing and no platform description was "
+                            "given to compute it; pass platform=... (CLI: --platform).")
+        from stewartid.kinematics import forward_kinematics, leg_lengths
+
+        if pose is None:
+            try:
+                pose = _forward_kinematics_tracked(platform, lengths, forward_kinematics)
+            except KinematicsError as exc:
+                raise DataError(f"{where}: cannot compute the pose from l1..l6: {exc}") from exc
+        else:
+            lengths = leg_lengths(platform, pose)
+    return Dataset(t=t, pose=pose, lengths=lengths, forces=forces, name=name)
+
+
+def _forward_kinematics_tracked(platform: Platform, lengths: np.ndarray, solve) -> np.ndarray:
+    # Start every sample at the neutral pose but refine from the previous solution in blocks:
+    # consecutive samples are close, so Newton converges in a couple of iterations even for
+    # large excursions that would stall from neutral.
+    pose = np.empty_like(lengths)
+    block = 2048
+    start = platform.neutral_pose
+    for i in range(0, len(lengths), block):
+        chunk = lengths[i:i + block]
+        pose[i:i + block] = solve(platform, chunk, initial=start)
+        start = pose[i + len(chunk) - 1]
+    return pose
+
+
+def read_dataset(path: str | Path, platform: Platform | None = None,
+                 format: str | None = None) -> Dataset:
+    """Read and validate one experiment from a CSV or Parquet file.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.csv`` or ``.parquet`` file in the interchange format.
+    platform : Platform, optional
+        Platform description, used when the pose or the leg lengths are missing.
+    format : {'csv', 'parquet'}, optional
+        Overrides the file suffix.
+
+    Returns
+    -------
+    Dataset
+        Named after the file stem.
+
+    Raises
+    ------
+    DataError
+        The file cannot be parsed or fails validation; the message names file and column.
+    """
+    path = Path(path)
+    kind = _format_of(path, format)
+    if not path.is_file():
+        raise DataError(f"{path}: no such data file.")
+    try:
+        frame = pd.read_csv(path, skipinitialspace=True) if kind == "csv" else \
+            pd.read_parquet(path)
+    except (ValueError, OSError, pd.errors.ParserError) as exc:
+        raise DataError(f"{path}: cannot be read as {kind}: {exc}") from exc
+    frame.columns = [str(c).strip() for c in frame.columns]
+    return dataset_from_frame(frame, platform, name=path.stem, where=str(path))
+
+
+def expand_paths(paths: Iterable[str | Path]) -> list[Path]:
+    """Data files named by ``paths``; a directory stands for its ``*.csv`` and ``*.parquet``."""
+    out: list[Path] = []
+    for p in map(Path, paths):
+        if p.is_dir():
+            found = sorted(f for f in p.iterdir() if f.suffix.lower() in SUFFIXES)
+            if not found:
+                raise DataError(f"{p}: directory holds no .csv or .parquet data files.")
+            out.extend(found)
+        else:
+            out.append(p)
+    return out
+
+
+def read_datasets(paths: str | Path | Sequence[str | Path],
+                  platform: Platform | None = None) -> list[Dataset]:
+    """Read several experiments (one file each; a directory means all data files in it).
+
+    Returns
+    -------
+    list of Dataset
+        In the order given (directory contents sorted by name).
+    """
+    if isinstance(paths, str | Path):
+        paths = [paths]
+    files = expand_paths(paths)
+    if not files:
+        raise DataError("no data files given; pass one or more .csv/.parquet files.")
+    return [read_dataset(f, platform) for f in files]
+
+
+def write_dataset(dataset: Dataset, path: str | Path, format: str | None = None) -> Path:
+    """Write an experiment in the interchange format, atomically.
+
+    The table goes to a temporary file in the target directory which is then renamed over
+    ``path``, so readers never see a half-written file.
+
+    Parameters
+    ----------
+    dataset : Dataset
+    path : str or Path
+    format : {'csv', 'parquet'}, optional
+        By default from the suffix of ``path``.
+
+    Returns
+    -------
+    Path
+        The written file.
+    """
+    path = Path(path)
+    kind = _format_of(path, format)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    frame = dataset.to_frame()
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        if kind == "csv":
+            # repr-exact floats so a CSV round trip is lossless
+            frame.to_csv(tmp, index=False, float_format="%.17g")
+        else:
+            frame.to_parquet(tmp, index=False)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+__all__ = [
+    "COLUMNS",
+    "FORCE_COLUMNS",
+    "LENGTH_COLUMNS",
+    "MIN_SAMPLES",
+    "POSE_COLUMNS",
+    "DataWarning",
+    "Dataset",
+    "dataset_from_frame",
+    "expand_paths",
+    "read_dataset",
+    "read_datasets",
+    "write_dataset",
+]
