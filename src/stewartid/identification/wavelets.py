@@ -1,0 +1,289 @@
+"""Mother wavelets and the continuous wavelet transform at chosen (scale, shift) points.
+
+The transform follows Zhang (2020), Section 3:
+
+    W_psi f (a, b) = (1 / a) * integral f(t) psi((t - b) / a) dt,
+
+with scale ``a`` > 0 and shift ``b`` in seconds. Only the (a, b) points an identification
+needs are evaluated, as a sparse matrix of sampled wavelets applied to the signals (no general
+CWT). Each mother wavelet provides its first and second integrals and its first two
+derivatives analytically, so that integration by parts moves derivatives between the signal
+and the wavelet:
+
+    W_psi f'  (a, b) = -(1 / a)   W_psi' f  (a, b)
+    W_psi f'' (a, b) =  (1 / a^2) W_psi'' f (a, b)
+    W_psi F   (a, b) = -a         W_psi1 f  (a, b)        (F' = f, psi1' = psi)
+
+valid whenever the wavelet and its integrals vanish at the ends of the integration range
+(exactly for the compactly supported wavelets, to the truncation level for the Gaussian ones).
+Vanishing moments of order 0 and 1 make the transform of a constant and of a straight line
+zero, which is what removes gravity and Coulomb friction inside a constant-direction interval.
+
+References
+----------
+Zhang, C. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
+Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+
+import numpy as np
+from numpy.polynomial import Polynomial
+from scipy import sparse
+
+from stewartid.errors import ConfigError
+
+#: Derivative orders a wavelet can be evaluated at: -2 and -1 are its second and first
+#: integrals (psi2, psi1), 0 the wavelet, 1 and 2 its derivatives.
+DERIVATIVE_ORDERS = (-2, -1, 0, 1, 2)
+
+
+class MotherWavelet(ABC):
+    """A real mother wavelet psi with two analytic integrals and two analytic derivatives.
+
+    Attributes
+    ----------
+    name : str
+        Short name used in settings and result files.
+    half_width : float
+        Effective support is [-half_width, half_width] in units of the scale: the wavelet is
+        zero (compact) or truncated (Gaussian family) beyond it.
+    compact : bool
+        True when the wavelet is exactly zero outside its support.
+    """
+
+    name: str = ""
+    half_width: float = 1.0
+    compact: bool = True
+
+    def __call__(self, x: np.ndarray, derivative: int = 0) -> np.ndarray:
+        """Evaluate psi or one of its integrals/derivatives at ``x`` (dimensionless).
+
+        Parameters
+        ----------
+        x : ndarray, any shape
+            (t - b) / a.
+        derivative : int
+            One of :data:`DERIVATIVE_ORDERS`: -2 (second integral), -1 (first integral psi1),
+            0 (psi), 1 (psi'), 2 (psi'').
+
+        Returns
+        -------
+        ndarray, shape of ``x``
+            Zero outside [-half_width, half_width].
+        """
+        if derivative not in DERIVATIVE_ORDERS:
+            raise ConfigError(
+                f"wavelet derivative order must be one of {DERIVATIVE_ORDERS}; got {derivative}."
+            )
+        x = np.asarray(x, dtype=float)
+        out = self._evaluate(x, derivative)
+        return np.where(np.abs(x) <= self.half_width, out, 0.0)
+
+    @abstractmethod
+    def _evaluate(self, x: np.ndarray, derivative: int) -> np.ndarray:
+        """Untruncated analytic expression."""
+
+    def to_dict(self) -> dict:
+        """Settings that rebuild this wavelet with :func:`make_wavelet`."""
+        return {"name": self.name}
+
+    def __repr__(self) -> str:
+        args = ", ".join(f"{k}={v!r}" for k, v in self.to_dict().items() if k != "name")
+        return f"{type(self).__name__}({args})"
+
+
+class MexicanHat(MotherWavelet):
+    """Mexican hat psi(t) = (1 - t^2) exp(-t^2 / 2), the paper's example wavelet.
+
+    Its first integral is psi1(t) = t exp(-t^2 / 2) (Zhang 2020, Section 3) and its second
+    integral -exp(-t^2 / 2); moments of order 0 and 1 vanish on the whole line. Not compactly
+    supported: it is truncated at +-``truncation`` scales, where psi, psi1 and psi2 are of the
+    order of exp(-truncation^2 / 2) (3.7e-6 at 5).
+
+    Unnormalised (psi(0) = 1); PyWavelets' ``'mexh'`` is this function times
+    2 / (sqrt(3) pi^(1/4)).
+
+    Parameters
+    ----------
+    truncation : float
+        Half-width of the effective support, in scales.
+    """
+
+    name = "mexican_hat"
+    compact = False
+
+    def __init__(self, truncation: float = 5.0):
+        if not (isinstance(truncation, (int, float)) and 2.0 <= truncation <= 20.0):
+            raise ConfigError(
+                f"The 'truncation' parameter of MexicanHat must be a number in [2, 20] "
+                f"(scales); got {truncation!r}."
+            )
+        self.truncation = float(truncation)
+        self.half_width = self.truncation
+
+    def _evaluate(self, x: np.ndarray, derivative: int) -> np.ndarray:
+        x2 = x * x
+        e = np.exp(-0.5 * x2)
+        if derivative == -2:
+            return -e
+        if derivative == -1:
+            return x * e
+        if derivative == 0:
+            return (1.0 - x2) * e
+        if derivative == 1:
+            return (x2 - 3.0) * x * e
+        return (-x2 * x2 + 6.0 * x2 - 3.0) * e
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "truncation": self.truncation}
+
+
+class PolynomialWavelet(MotherWavelet):
+    """Compactly supported wavelet psi = g'' with g(x) = (1 - x^2)^p on [-1, 1].
+
+    The modulating-function (weak-form) wavelet: zero outside [-1, 1], a polynomial inside.
+    Its integrals are psi1 = g' and psi2 = g, so moments of order 0 and 1 vanish exactly
+    (integral of g'' = [g'] = 0, integral of x g'' = [x g' - g] = 0), and psi, its integrals
+    and its derivatives up to order p - 3 vanish at +-1: the wavelet can span a whole
+    constant-direction interval with no truncation error, and with p >= 5 the derivatives
+    psi' and psi'' used to move differentiation onto the wavelet are continuous.
+
+    Normalised to unit L2 norm on [-1, 1].
+
+    Parameters
+    ----------
+    order : int
+        The exponent p, 5 <= p <= 20.
+    """
+
+    name = "polynomial"
+    compact = True
+    half_width = 1.0
+
+    def __init__(self, order: int = 8):
+        if not (isinstance(order, (int, np.integer)) and 5 <= order <= 20):
+            raise ConfigError(
+                f"The 'order' parameter of PolynomialWavelet must be an integer in [5, 20] "
+                f"(exponent p of (1 - x^2)^p); got {order!r}."
+            )
+        self.order = int(order)
+        g = Polynomial([1.0, 0.0, -1.0]) ** self.order
+        psi = g.deriv(2)
+        norm = math.sqrt((psi * psi).integ()(1.0) - (psi * psi).integ()(-1.0))
+        g = g / norm
+        self._polynomials = {k: g.deriv(k + 2) for k in (0, 1, 2)}
+        self._polynomials[-1] = g.deriv(1)
+        self._polynomials[-2] = g
+
+    def _evaluate(self, x: np.ndarray, derivative: int) -> np.ndarray:
+        return self._polynomials[derivative](x)
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "order": self.order}
+
+
+_WAVELETS = {"mexican_hat": MexicanHat, "polynomial": PolynomialWavelet}
+
+
+def make_wavelet(wavelet: str | MotherWavelet | dict = "polynomial", **options) -> MotherWavelet:
+    """A mother wavelet from its name (``"polynomial"``, ``"mexican_hat"``) or settings dict.
+
+    Parameters
+    ----------
+    wavelet : str or MotherWavelet or dict
+        A name, an instance (returned as is), or the output of ``MotherWavelet.to_dict()``.
+    **options
+        Passed to the wavelet's constructor (``order=``, ``truncation=``).
+    """
+    if isinstance(wavelet, MotherWavelet):
+        return wavelet
+    if isinstance(wavelet, dict):
+        options = {**{k: v for k, v in wavelet.items() if k != "name"}, **options}
+        wavelet = wavelet.get("name", "")
+    if wavelet not in _WAVELETS:
+        raise ConfigError(
+            f"unknown wavelet {wavelet!r}; expected one of {sorted(_WAVELETS)}."
+        )
+    return _WAVELETS[wavelet](**options)
+
+
+def _quadrature_weights(t: np.ndarray) -> np.ndarray:
+    """Trapezoid weights (s) of a strictly increasing time base, shape (N,)."""
+    w = np.empty_like(t)
+    dt = np.diff(t)
+    w[0], w[-1] = dt[0] / 2, dt[-1] / 2
+    w[1:-1] = (dt[:-1] + dt[1:]) / 2
+    return w
+
+
+def transform_matrix(t: np.ndarray, scales: np.ndarray, shifts: np.ndarray,
+                     wavelet: MotherWavelet, derivative: int = 0) -> sparse.csr_matrix:
+    """Sparse matrix W with (W @ f)[k] = W_psi f (scales[k], shifts[k]) for samples f of t.
+
+    Row k holds (1 / a_k) psi^(derivative)((t - b_k) / a_k) times trapezoid weights, on the
+    samples inside the wavelet's support only.
+
+    Parameters
+    ----------
+    t : ndarray, shape (N,)
+        Strictly increasing sample times (s).
+    scales, shifts : ndarray, shape (K,)
+        Scales a (s, > 0) and shifts b (s).
+    wavelet : MotherWavelet
+    derivative : int
+        Evaluate psi2, psi1, psi, psi' or psi'' (see :data:`DERIVATIVE_ORDERS`).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (K, N)
+    """
+    t = np.asarray(t, dtype=float)
+    a = np.atleast_1d(np.asarray(scales, dtype=float))
+    b = np.atleast_1d(np.asarray(shifts, dtype=float))
+    if a.shape != b.shape or a.ndim != 1:
+        raise ConfigError(f"scales and shifts must be 1-D of equal length; got {a.shape} "
+                          f"and {b.shape}.")
+    if np.any(a <= 0) or not np.all(np.isfinite(a)) or not np.all(np.isfinite(b)):
+        raise ConfigError("wavelet scales must be finite and positive and shifts finite.")
+    weights = _quadrature_weights(t)
+    start = np.searchsorted(t, b - wavelet.half_width * a, side="left")
+    stop = np.searchsorted(t, b + wavelet.half_width * a, side="right")
+    counts = stop - start
+    indptr = np.concatenate([[0], np.cumsum(counts)])
+    # column indices and the row each nonzero belongs to, built without a Python loop
+    rows = np.repeat(np.arange(len(a)), counts)
+    cols = np.arange(indptr[-1]) - np.repeat(indptr[:-1], counts) + np.repeat(start, counts)
+    x = (t[cols] - b[rows]) / a[rows]
+    values = wavelet(x, derivative) * weights[cols] / a[rows]
+    return sparse.csr_matrix((values, cols, indptr), shape=(len(a), len(t)))
+
+
+def wavelet_transform(signal: np.ndarray, t: np.ndarray, scales: np.ndarray,
+                      shifts: np.ndarray, wavelet: str | MotherWavelet = "mexican_hat",
+                      derivative: int = 0) -> np.ndarray:
+    """Continuous wavelet transform of sampled signals at chosen (a, b) points.
+
+    Parameters
+    ----------
+    signal : ndarray, shape (N,) or (N, C)
+        Samples of one or C signals at times ``t`` (any unit u).
+    t : ndarray, shape (N,)
+        Strictly increasing times (s).
+    scales, shifts : ndarray, shape (K,)
+        Scales a (s) and shifts b (s).
+    wavelet : str or MotherWavelet
+    derivative : int
+        Use psi's integral (-1, -2) or derivative (1, 2) instead of psi.
+
+    Returns
+    -------
+    ndarray, shape (K,) or (K, C)
+        W f (a_k, b_k) in u (the 1/a normalisation makes the transform of f = 1 equal to the
+        wavelet's integral, zero).
+    """
+    matrix = transform_matrix(t, scales, shifts, make_wavelet(wavelet), derivative)
+    return matrix @ np.asarray(signal, dtype=float)
