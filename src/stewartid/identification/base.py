@@ -25,9 +25,9 @@ from typing import Any
 import numpy as np
 
 from stewartid.dataset import Dataset, read_datasets
+from stewartid.dynamics import ModelTerms
 from stewartid.errors import ConfigError, IdentificationError
 from stewartid.identification.results import IdentificationResult
-from stewartid.identification.terms import measured_terms
 from stewartid.platform import Platform, load_platform
 
 #: Names of the generalized coordinates, paper order.
@@ -126,7 +126,7 @@ def prepare(datasets: Sequence[Dataset], platform: Platform, gravity: bool = Tru
     """
     out = []
     for d in datasets:
-        terms = measured_terms(platform, d.pose)
+        terms = ModelTerms(platform, d.pose)
         y = np.einsum("nji,nj->ni", terms.leg_jacobian, d.forces)
         if gravity:
             y = y - terms.gravity
@@ -237,7 +237,8 @@ def _symmetric_map(p: int, symmetric: bool) -> np.ndarray:
 def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | None = None,
                         symmetric: bool = False, regressor_names: Sequence[str] | None = None,
                         shared_names: Sequence[str] | None = None,
-                        max_condition: float = 1e8) -> LeastSquaresSolution:
+                        max_condition: float = 1e8,
+                        autocorrelated: bool = False) -> LeastSquaresSolution:
     """Least squares for y(k) = theta phi(k) + sum_s c_s S_s(k), with standard errors.
 
     Every channel i of ``y`` shares the regressor rows ``phi``; the shared terms S_s are
@@ -267,6 +268,11 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
     max_condition : float
         Largest acceptable condition number of the equilibrated regression; above it the
         problem counts as rank deficient and an IdentificationError names the regressors.
+    autocorrelated : bool
+        The rows are consecutive samples of a time series whose residuals are correlated
+        (filtered signals): inflate each channel's variance by its integrated
+        autocorrelation time tau = 1 + 2 sum_k rho_k (summed while rho_k > 0), i.e. count
+        K / tau independent equations. Without it the standard errors assume white residuals.
 
     Returns
     -------
@@ -345,6 +351,8 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
     sigma = np.maximum(sigma, 1e-12 * scale_y)
     theta, c, residual, N, Tf, condition, scale = solve(1.0 / sigma ** 2)
     sigma2 = np.sum(residual ** 2, axis=0) / dof
+    if autocorrelated:
+        sigma2 = sigma2 * np.array([integrated_autocorrelation(r) for r in residual.T])
     weighted_variance = float(np.mean(sigma2 / sigma ** 2))
     Ns_inv = np.linalg.inv(N / np.outer(scale, scale)) / np.outer(scale, scale)
     cov_full = weighted_variance * (Tf @ Ns_inv @ Tf.T)
@@ -353,6 +361,25 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
         theta=theta, theta_std=std[:6 * p].reshape(6, p), shared=c, shared_std=std[6 * p:],
         condition_number=condition, residual_rms=np.sqrt(np.mean(residual ** 2, axis=0)),
         n_equations=K)
+
+
+def integrated_autocorrelation(x: np.ndarray, max_lag: int | None = None) -> float:
+    """Integrated autocorrelation time tau = 1 + 2 sum_{k>=1} rho_k of a series (samples).
+
+    The sum stops at the first non-positive autocorrelation (initial positive sequence), so
+    white noise gives tau close to 1 and a signal smoothed over w samples about w.
+    """
+    x = np.asarray(x, dtype=float) - np.mean(x)
+    n = len(x)
+    if n < 4 or not np.any(x):
+        return 1.0
+    nfft = 1 << int(np.ceil(np.log2(2 * n)))
+    spectrum = np.fft.rfft(x, nfft)
+    acf = np.fft.irfft(np.abs(spectrum) ** 2, nfft)[: (max_lag or n // 4) + 1]
+    rho = acf[1:] / acf[0]
+    stop = np.flatnonzero(rho <= 0)
+    rho = rho[: stop[0]] if len(stop) else rho
+    return float(max(1.0, 1.0 + 2.0 * np.sum(rho)))
 
 
 def _unknown_names(names: list[str], snames: list[str], T: np.ndarray, p: int) -> list[str]:
@@ -454,6 +481,7 @@ __all__ = [
     "IdentificationResult",
     "LeastSquaresSolution",
     "check_parameter",
+    "integrated_autocorrelation",
     "prepare",
     "regressor_names",
     "resolve_datasets",
