@@ -1,0 +1,418 @@
+"""Method B: wavelet transform on constant-direction intervals (Zhang 2020).
+
+In a constant-direction interval (no joint reverses, :mod:`.intervals`) the Coulomb friction
+of every joint is constant, and so is what remains of gravity after the pose-dependent G(q)
+has been subtracted. The linearised equation of motion
+
+    Mt q_ddot + Bt q_dot + c = y,        y = J_lq(q)^T f_a - G(q),   c constant,
+
+transformed with a wavelet psi whose moments of order 0 and 1 vanish and whose support lies
+inside the interval, loses the constant:
+
+    [Mt Bt] [W_psi q_ddot ; W_psi q_dot](a, b) = W_psi y (a, b).
+
+Stacking the equations of many (a, b) points from all intervals of all experiments gives a
+least-squares problem for the 72 entries of Mt and Bt.
+
+Variants (``variant``):
+
+``"position"`` (default)
+    No numerical differentiation: integration by parts moves both derivatives onto the
+    wavelet, W_psi q_ddot = W_psi'' q / a^2 and W_psi q_dot = -W_psi' q / a.
+``"paper"``
+    Zhang's equations: W_psi q_ddot and W_psi q_dot = -a W_psi1 q_ddot, with the
+    acceleration from a Savitzky-Golay differentiator (``differentiation_window``).
+``"derivative"``
+    W_psi q_ddot and W_psi q_dot with both signals from the Savitzky-Golay differentiator.
+
+Wavelets (``wavelet``): ``"polynomial"`` (default), psi = g'' with g = (1 - x^2)^p on [-1, 1],
+compactly supported, so the largest scale spans a whole interval (the modulating-function
+idea); ``"mexican_hat"``, the paper's Gaussian wavelet, truncated at +-``truncation`` scales,
+so its scales are limited to a tenth of the interval at the default truncation of 5. Measured
+on the independent example data set (docs/benchmarks.md), the polynomial wavelet with the
+position-only variant is the most accurate; it is the default.
+
+Scales and shifts are chosen per interval: for every fraction s of ``scale_fractions`` the
+scale is a = s T / (2 h) (T the interval length, h the wavelet's half-width in scales), and
+``shifts_per_scale`` shifts spread evenly over the positions that keep the support inside the
+interval.
+
+Couplings (the paper's Mt(2,4) case): an off-diagonal entry and its transpose are estimated
+from different equations (Mt(5,1) from the pitch equation under surge, Mt(1,5) from the surge
+equation under pitch). The rotational equations under translational excitation are the
+sensitive ones, because joints that barely move (and so are left out of the interval
+detection) switch friction at odd times. With ``pair_selection="std_error"`` (default) both
+entries of every symmetric pair take the estimate with the smaller standard error, computed
+from the data alone; ``symmetric=True`` imposes symmetry in the least-squares solve instead.
+
+Standard errors are cluster-robust over intervals: the equations of one interval share
+samples (overlapping wavelets) and the same friction state, so their residuals are
+correlated; treating them as independent would understate the uncertainty.
+
+References
+----------
+Zhang, C. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
+Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.signal import savgol_filter
+
+from stewartid.dataset import Dataset
+from stewartid.errors import IdentificationError
+from stewartid.identification.base import (
+    COORDINATES,
+    BaseIdentifier,
+    Experiment,
+    check_parameter,
+    prepare,
+    regressor_names,
+    solve_least_squares,
+)
+from stewartid.identification.intervals import constant_direction_intervals, joint_rates
+from stewartid.identification.results import IdentificationResult
+from stewartid.identification.wavelets import MotherWavelet, make_wavelet, transform_matrix
+from stewartid.platform import Platform
+
+VARIANTS = ("position", "paper", "derivative")
+PAIR_SELECTIONS = ("std_error", "none")
+
+
+def differentiate(x: np.ndarray, period: float, window: float, derivative: int) -> np.ndarray:
+    """Savitzky-Golay derivative (cubic, window ``window`` s) along axis 0.
+
+    Parameters
+    ----------
+    x : ndarray, shape (N, C)
+    period : float
+        Sample period (s).
+    window : float
+        Window length (s), rounded to an odd number of samples (at least 5).
+    derivative : int
+        1 or 2.
+
+    Returns
+    -------
+    ndarray, shape (N, C)
+        Units of x per s^derivative.
+    """
+    n = max(5, int(round(window / period)) | 1)
+    if n > len(x):
+        n = len(x) if len(x) % 2 else len(x) - 1
+    return savgol_filter(x, n, 3, deriv=derivative, delta=period, axis=0, mode="interp")
+
+
+def wavelet_points(intervals: np.ndarray, wavelet: MotherWavelet,
+                   scale_fractions: tuple[float, ...], shifts_per_scale: int,
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(a, b) points whose wavelet support lies inside an interval.
+
+    Parameters
+    ----------
+    intervals : ndarray, shape (M, 2)
+        [start, stop] (s).
+    wavelet : MotherWavelet
+    scale_fractions : tuple of float
+        Support length as a fraction of the interval length, each in (0, 1].
+    shifts_per_scale : int
+        Shifts per scale and interval (one if the support fills the interval).
+
+    Returns
+    -------
+    scales, shifts : ndarray, shape (K,)
+        a and b (s).
+    interval_index : ndarray of int, shape (K,)
+        Row of ``intervals`` each point belongs to.
+    """
+    scales, shifts, owner = [], [], []
+    for m, (start, stop) in enumerate(intervals):
+        length = stop - start
+        for fraction in scale_fractions:
+            a = fraction * length / (2.0 * wavelet.half_width)
+            free = length - 2.0 * a * wavelet.half_width
+            count = shifts_per_scale if free > 1e-9 * length else 1
+            b = start + a * wavelet.half_width + np.linspace(0.0, max(free, 0.0), count)
+            scales.append(np.full(count, a))
+            shifts.append(b)
+            owner.append(np.full(count, m))
+    if not scales:
+        return np.zeros(0), np.zeros(0), np.zeros(0, dtype=int)
+    return np.concatenate(scales), np.concatenate(shifts), np.concatenate(owner)
+
+
+class WaveletIdentifier(BaseIdentifier):
+    """Identify Mt and Bt by the wavelet method of Zhang (2020) (Method B).
+
+    Parameters
+    ----------
+    wavelet : {"polynomial", "mexican_hat"}
+        Mother wavelet (see the module docstring).
+    wavelet_order : int
+        Exponent p of the polynomial wavelet, 5..20.
+    truncation : float
+        Half-width (scales) at which the Mexican hat is cut.
+    variant : {"position", "paper", "derivative"}
+        How W q_ddot and W q_dot are obtained (see the module docstring).
+    scale_fractions : tuple of float
+        Wavelet support as fractions of each interval's length, each in (0, 1].
+    shifts_per_scale : int
+        Shifts per scale and interval.
+    margin : float
+        Time (s) cut from both ends of every constant-direction interval.
+    ignore_below : float
+        Joints whose rate RMS is below this fraction of the largest of their kind are left
+        out of the interval detection (they barely move, and their sign flips at odd times).
+    min_interval : float or None
+        Shortest usable interval (s); None: half the median interval of each experiment.
+    min_support_samples : int
+        Fewest samples the smallest wavelet's support may cover; intervals too short for it
+        are dropped.
+    differentiation_window : float
+        Savitzky-Golay window (s) for the joint rates of the interval detection and, in the
+        ``"paper"`` and ``"derivative"`` variants, for q_dot and q_ddot.
+    symmetric : bool
+        Impose Mt = Mt^T and Bt = Bt^T in the solve.
+    pair_selection : {"std_error", "none"}
+        For each symmetric pair of off-diagonal entries, use the estimate with the smaller
+        standard error for both (ignored with ``symmetric``).
+    gravity : bool
+        Subtract the model's pose-dependent gravity G(q) before identification.
+
+    Attributes
+    ----------
+    M_, B_ : ndarray, shape (6, 6)
+    std_errors_ : dict of ndarray (6, 6)
+    condition_number_ : float
+    result_ : IdentificationResult
+        ``diagnostics`` holds, per experiment, the intervals and the (a, b) points used, the
+        joints left out, and which member of each symmetric pair was taken.
+
+    References
+    ----------
+    Zhang, C. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
+    Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
+    """
+
+    method = "wavelet"
+
+    def __init__(self, wavelet: str = "polynomial", wavelet_order: int = 8,
+                 truncation: float = 5.0, variant: str = "position",
+                 scale_fractions: tuple[float, ...] = (1.0, 0.8, 0.6),
+                 shifts_per_scale: int = 5, margin: float = 0.02, ignore_below: float = 0.01,
+                 min_interval: float | None = None, min_support_samples: int = 32,
+                 differentiation_window: float = 0.05, symmetric: bool = False,
+                 pair_selection: str = "std_error", gravity: bool = True):
+        self.wavelet = wavelet
+        self.wavelet_order = wavelet_order
+        self.truncation = truncation
+        self.variant = variant
+        self.scale_fractions = scale_fractions
+        self.shifts_per_scale = shifts_per_scale
+        self.margin = margin
+        self.ignore_below = ignore_below
+        self.min_interval = min_interval
+        self.min_support_samples = min_support_samples
+        self.differentiation_window = differentiation_window
+        self.symmetric = symmetric
+        self.pair_selection = pair_selection
+        self.gravity = gravity
+
+    # ------------------------------------------------------------------ settings
+    def _validate_params(self) -> None:
+        name = type(self).__name__
+        check_parameter(name, "wavelet", self.wavelet,
+                        self.wavelet in ("polynomial", "mexican_hat"),
+                        "'polynomial' or 'mexican_hat'")
+        check_parameter(name, "variant", self.variant, self.variant in VARIANTS,
+                        f"one of {VARIANTS}")
+        fractions = np.atleast_1d(np.asarray(self.scale_fractions, dtype=float))
+        check_parameter(name, "scale_fractions", self.scale_fractions,
+                        fractions.size > 0 and bool(np.all((fractions > 0) & (fractions <= 1))),
+                        "a non-empty sequence of fractions in (0, 1]")
+        check_parameter(name, "shifts_per_scale", self.shifts_per_scale,
+                        isinstance(self.shifts_per_scale, int | np.integer)
+                        and 1 <= self.shifts_per_scale <= 1000, "an integer in [1, 1000]")
+        check_parameter(name, "margin", self.margin,
+                        isinstance(self.margin, int | float) and self.margin >= 0,
+                        "a float in [0, inf) (s)")
+        check_parameter(name, "ignore_below", self.ignore_below,
+                        isinstance(self.ignore_below, int | float)
+                        and 0 <= self.ignore_below < 1, "a float in [0, 1)")
+        check_parameter(name, "min_interval", self.min_interval,
+                        self.min_interval is None or (isinstance(self.min_interval, int | float)
+                                                      and self.min_interval > 0),
+                        "None or a float in (0, inf) (s)")
+        check_parameter(name, "min_support_samples", self.min_support_samples,
+                        isinstance(self.min_support_samples, int | np.integer)
+                        and self.min_support_samples >= 8, "an integer >= 8")
+        check_parameter(name, "differentiation_window", self.differentiation_window,
+                        isinstance(self.differentiation_window, int | float)
+                        and self.differentiation_window > 0, "a float in (0, inf) (s)")
+        check_parameter(name, "pair_selection", self.pair_selection,
+                        self.pair_selection in PAIR_SELECTIONS, f"one of {PAIR_SELECTIONS}")
+        make_wavelet(self.wavelet, **self._wavelet_options())
+
+    def _wavelet_options(self) -> dict:
+        if self.wavelet == "polynomial":
+            return {"order": self.wavelet_order}
+        return {"truncation": self.truncation}
+
+    # ------------------------------------------------------------------ equations
+    def _experiment_equations(self, experiment: Experiment, wavelet: MotherWavelet,
+                              platform: Platform):
+        """Wavelet equations of one experiment: regressors (K, 12), targets (K, 6), info."""
+        t, q, period = experiment.t, experiment.q, experiment.period
+        q_dot = differentiate(q, period, self.differentiation_window, 1)
+        rates = joint_rates(platform, q, q_dot, experiment.joint_jacobians,
+                            experiment.leg_jacobian)
+        found = constant_direction_intervals(t, rates, margin=self.margin,
+                                             ignore_below=self.ignore_below)
+        lengths = found[:, 1] - found[:, 0]
+        shortest = (self.min_interval if self.min_interval is not None
+                    else 0.5 * float(np.median(lengths)) if len(lengths) else 0.0)
+        smallest = min(self.scale_fractions)
+        # the smallest wavelet support must cover min_support_samples samples
+        needed = self.min_support_samples * period / smallest
+        intervals = found[lengths >= max(shortest, needed)]
+        info = {"name": experiment.name, "intervals_found": int(len(found)),
+                "longest_interval": float(lengths.max()) if len(lengths) else 0.0,
+                "shortest_usable": float(max(shortest, needed)),
+                "intervals": intervals}
+        scales, shifts, owner = wavelet_points(intervals, wavelet,
+                                               tuple(self.scale_fractions),
+                                               int(self.shifts_per_scale))
+        info["scales"], info["shifts"] = scales, shifts
+        if len(scales) == 0:
+            return np.zeros((0, 12)), np.zeros((0, 6)), owner, info
+        y = transform_matrix(t, scales, shifts, wavelet, 0) @ experiment.generalized_force
+        a = scales[:, None]
+        if self.variant == "position":
+            # constants vanish analytically; removing the mean keeps rounding and the
+            # Mexican hat's truncation error proportional to the motion, not the offset
+            qc = q - q.mean(axis=0)
+            w_acc = (transform_matrix(t, scales, shifts, wavelet, 2) @ qc) / a ** 2
+            w_vel = -(transform_matrix(t, scales, shifts, wavelet, 1) @ qc) / a
+        else:
+            q_ddot = differentiate(q, period, self.differentiation_window, 2)
+            w_acc = transform_matrix(t, scales, shifts, wavelet, 0) @ q_ddot
+            if self.variant == "paper":
+                w_vel = -a * (transform_matrix(t, scales, shifts, wavelet, -1) @ q_ddot)
+            else:
+                w_vel = transform_matrix(t, scales, shifts, wavelet, 0) @ q_dot
+        return np.hstack([w_acc, w_vel]), y, owner, info
+
+    def _fit(self, datasets: list[Dataset], platform: Platform) -> IdentificationResult:
+        wavelet = make_wavelet(self.wavelet, **self._wavelet_options())
+        experiments = prepare(datasets, platform, gravity=self.gravity)
+        phi, target, cluster, infos = [], [], [], []
+        offset = 0
+        for experiment in experiments:
+            x, y, owner, info = self._experiment_equations(experiment, wavelet, platform)
+            phi.append(x)
+            target.append(y)
+            cluster.append(owner + offset)
+            offset += len(info["intervals"])
+            infos.append(info)
+        phi, target, cluster = np.vstack(phi), np.vstack(target), np.concatenate(cluster)
+        if len(phi) == 0:
+            longest = max(info["longest_interval"] for info in infos)
+            needed = min(info["shortest_usable"] for info in infos)
+            raise IdentificationError(
+                f"no constant-direction interval long enough for the smallest wavelet scale "
+                f"in any experiment (longest {longest:.3g} s, at least {needed:.3g} s needed); "
+                "excite with a slower single-frequency sine, lower 'margin' or "
+                "'min_support_samples', raise 'ignore_below' to leave idle joints out, or "
+                "record at a higher sample rate.")
+        names = regressor_names("q_ddot", "q_dot")
+        solution = solve_least_squares(phi, target, symmetric=bool(self.symmetric),
+                                       regressor_names=names)
+        theta = solution.theta
+        std = solution.theta_std
+        if not self.symmetric:
+            std = cluster_robust_std(phi, target - phi @ theta.T, cluster)
+        M, B = theta[:, :6].copy(), theta[:, 6:12].copy()
+        std_M, std_B = std[:, :6].copy(), std[:, 6:12].copy()
+        chosen = {}
+        if not self.symmetric and self.pair_selection == "std_error":
+            chosen["M"] = select_symmetric_pairs(M, std_M)
+            chosen["B"] = select_symmetric_pairs(B, std_B)
+        residual = target - phi @ theta.T
+        diagnostics = {
+            "wavelet": wavelet.to_dict(),
+            "n_equations": int(len(phi)),
+            "n_intervals": int(offset),
+            "experiments": [
+                {"name": info["name"], "intervals_found": info["intervals_found"],
+                 "intervals": info["intervals"].tolist(),
+                 "scales": info["scales"].tolist(), "shifts": info["shifts"].tolist()}
+                for info in infos],
+            "pair_choice": chosen,
+            "coordinates": list(COORDINATES),
+        }
+        return IdentificationResult(
+            M=M, B=B, std_errors_M=std_M, std_errors_B=std_B,
+            condition_number=solution.condition_number,
+            residual_rms=np.sqrt(np.mean(residual ** 2, axis=0)), method=self.method,
+            settings={k: (list(v) if isinstance(v, tuple) else v)
+                      for k, v in self.get_params().items()},
+            diagnostics=diagnostics)
+
+
+def cluster_robust_std(phi: np.ndarray, residual: np.ndarray, cluster: np.ndarray
+                       ) -> np.ndarray:
+    """Cluster-robust standard errors of per-channel ordinary least squares.
+
+    Parameters
+    ----------
+    phi : ndarray, shape (K, p)
+        Regressors.
+    residual : ndarray, shape (K, C)
+        Residuals of each channel.
+    cluster : ndarray of int, shape (K,)
+        Cluster (interval) of each row; residuals may correlate within a cluster.
+
+    Returns
+    -------
+    ndarray, shape (C, p)
+        Standard error of each coefficient, with the small-sample factor G / (G - 1).
+    """
+    K, p = phi.shape
+    scale = np.linalg.norm(phi, axis=0)
+    scale = np.where(scale > 0, scale, 1.0)
+    xs = phi / scale
+    bread = np.linalg.pinv(xs.T @ xs)
+    labels, index = np.unique(cluster, return_inverse=True)
+    groups = len(labels)
+    out = np.empty((residual.shape[1], p))
+    for c in range(residual.shape[1]):
+        scores = np.zeros((groups, p))
+        np.add.at(scores, index, xs * residual[:, c:c + 1])
+        meat = scores.T @ scores
+        factor = groups / max(groups - 1, 1) * (K - 1) / max(K - p, 1)
+        cov = factor * bread @ meat @ bread
+        out[c] = np.sqrt(np.clip(np.diag(cov), 0.0, None)) / scale
+    return out
+
+
+def select_symmetric_pairs(matrix: np.ndarray, std: np.ndarray) -> list[dict]:
+    """For every off-diagonal pair, copy the estimate with the smaller standard error.
+
+    Both ``matrix`` and ``std`` are modified in place (6, 6). Returns, per pair, which entry
+    was kept (1-based), as a list of {"pair": [[i, j], [j, i]], "kept": [i, j]}.
+    """
+    choice = []
+    n = matrix.shape[0]
+    for i in range(n):
+        for j in range(i + 1, n):
+            keep, drop = ((i, j), (j, i)) if std[i, j] <= std[j, i] else ((j, i), (i, j))
+            matrix[drop] = matrix[keep]
+            std[drop] = std[keep]
+            choice.append({"pair": [[i + 1, j + 1], [j + 1, i + 1]],
+                           "kept": [keep[0] + 1, keep[1] + 1]})
+    return choice
+
+
+__all__ = ["PAIR_SELECTIONS", "VARIANTS", "WaveletIdentifier", "cluster_robust_std",
+           "differentiate", "select_symmetric_pairs", "wavelet_points"]
