@@ -1,0 +1,384 @@
+"""Figures of a comparison run (matplotlib, Agg backend), each written as PNG and SVG.
+
+Signal figures take :class:`ExperimentTrace` objects (one simulated experiment, with the
+model's force components already evaluated); comparison figures take a
+:class:`~stewartid.reporting.results.ComparisonResults`. Every function returns the written
+paths. matplotlib is imported inside the functions so that importing this module is cheap.
+"""
+
+from __future__ import annotations
+
+import io
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stewartid.published import PAPER_ENTRIES, entry_label
+from stewartid.reporting.files import write_bytes_atomic
+from stewartid.reporting.results import ComparisonResults, method_name
+
+#: Coordinate names and the display unit/scale of a displacement in each.
+COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
+_DISPLAY = (("mm", 1e3),) * 3 + (("mrad", 1e3),) * 3
+_FORCE_UNITS = ("N",) * 3 + ("N·m",) * 3
+
+#: One colour per method, the same in every figure.
+METHOD_COLOURS = {"fourier": "#1f77b4", "wavelet": "#d62728", "wavelet_position": "#ff7f0e",
+                  "least_squares": "#2ca02c"}
+
+#: Force components of a budget, in plotting order, with display names.
+FORCE_COMPONENTS = {
+    "inertial": "inertial M(q) q̈ + h",
+    "viscous": "viscous joint friction",
+    "coulomb": "Coulomb joint friction",
+    "gravity": "gravity G(q) − G(q₀)",
+    "actuators": "actuators Jᵀ f − G(q₀)",
+}
+
+
+@dataclass(frozen=True)
+class ExperimentTrace:
+    """Signals of one experiment, ready to plot.
+
+    Attributes
+    ----------
+    name : str
+        Experiment name, e.g. ``"exp1"``.
+    excited : int
+        Index (0-5) of the excited coordinate.
+    t : ndarray, shape (N,)
+        Time (s).
+    pose : ndarray, shape (N, 6)
+        Measured pose (m, rad).
+    neutral : ndarray, shape (6,)
+        Neutral pose (m, rad); displacements are plotted relative to it.
+    reference : ndarray, shape (N, 6), optional
+        Commanded pose (m, rad).
+    joint_rates : ndarray, shape (N, 36), optional
+        30 rotational joint-axis rates (rad/s) then 6 actuator rates (m/s).
+    intervals : ndarray, shape (M, 2), optional
+        Constant-direction intervals [start, stop] (s).
+    forces : dict of ndarray, shape (N, 6)
+        Generalized force components (N, N·m), keys from :data:`FORCE_COMPONENTS`.
+    """
+
+    name: str
+    excited: int
+    t: np.ndarray
+    pose: np.ndarray
+    neutral: np.ndarray
+    reference: np.ndarray | None = None
+    joint_rates: np.ndarray | None = None
+    intervals: np.ndarray | None = None
+    forces: dict[str, np.ndarray] = field(default_factory=dict)
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    plt.rcParams.update({"font.size": 10, "axes.titlesize": 11, "axes.labelsize": 10,
+                         "legend.fontsize": 9, "svg.fonttype": "none",
+                         "axes.grid": True, "grid.alpha": 0.3})
+    return plt
+
+
+def save_figure(figure: Any, directory: str | Path, stem: str, dpi: int = 120) -> list[Path]:
+    """Write ``figure`` as ``stem.png`` and ``stem.svg`` in ``directory`` (atomic) and close it."""
+    import matplotlib.pyplot as plt
+
+    directory = Path(directory)
+    paths = []
+    # metadata dates off: the same run gives byte-identical SVG files
+    metadata = {"png": {"Software": None}, "svg": {"Date": None}}
+    for kind in ("png", "svg"):
+        buffer = io.BytesIO()
+        figure.savefig(buffer, format=kind, dpi=dpi, bbox_inches="tight",
+                       metadata=metadata[kind])
+        paths.append(write_bytes_atomic(directory / f"{stem}.{kind}", buffer.getvalue()))
+    plt.close(figure)
+    return paths
+
+
+def _shade_intervals(axis: Any, intervals: np.ndarray | None, label: bool) -> None:
+    if intervals is None:
+        return
+    for k, (start, stop) in enumerate(intervals):
+        axis.axvspan(start, stop, color="#9ecae1", alpha=0.35, lw=0,
+                     label="constant-direction interval" if (label and k == 0) else None)
+
+
+def plot_excitation(traces: Sequence[ExperimentTrace], directory: str | Path,
+                    stem: str = "excitation") -> list[Path]:
+    """Commanded and measured motion of the excited coordinate in each experiment, with the
+    tracking error, one panel per experiment."""
+    plt = _pyplot()
+    count = len(traces)
+    columns = min(3, count)
+    rows = int(np.ceil(count / columns))
+    figure, axes = plt.subplots(rows, columns, figsize=(4.6 * columns, 3.2 * rows),
+                                squeeze=False, constrained_layout=True)
+    for axis, trace in zip(axes.flat, traces, strict=False):
+        k = trace.excited
+        unit, scale = _DISPLAY[k]
+        measured = (trace.pose[:, k] - trace.neutral[k]) * scale
+        axis.plot(trace.t, measured, color="k", lw=1.2, label="measured")
+        if trace.reference is not None:
+            commanded = (trace.reference[:, k] - trace.neutral[k]) * scale
+            axis.plot(trace.t, commanded, color="#d62728", lw=1.0, ls="--", label="commanded")
+            error_axis = axis.twinx()
+            error_axis.plot(trace.t, measured - commanded, color="#2ca02c", lw=0.8,
+                            label="tracking error")
+            error_axis.set_ylabel(f"tracking error ({unit})", color="#2ca02c")
+            error_axis.tick_params(axis="y", colors="#2ca02c")
+            error_axis.grid(False)
+            handles = axis.get_legend_handles_labels()
+            extra = error_axis.get_legend_handles_labels()
+            axis.legend(handles[0] + extra[0], handles[1] + extra[1], loc="lower left",
+                        framealpha=0.9)
+        else:
+            axis.legend(loc="lower left")
+        axis.set_title(f"{trace.name}: {COORDINATES[k]} excited")
+        axis.set_xlabel("time (s)")
+        axis.set_ylabel(f"{COORDINATES[k]} − neutral ({unit})")
+    for axis in list(axes.flat)[count:]:
+        axis.set_visible(False)
+    figure.suptitle("Excitation: one sine per experiment, commanded and measured")
+    return save_figure(figure, directory, stem)
+
+
+def plot_joint_rates(trace: ExperimentTrace, directory: str | Path,
+                     stem: str = "joint_velocities") -> list[Path]:
+    """Rates of the 30 rotational joint axes and the 6 actuators of one experiment, with the
+    constant-direction intervals shaded."""
+    if trace.joint_rates is None:
+        raise ValueError(f"trace {trace.name!r} has no joint rates to plot")
+    plt = _pyplot()
+    figure, (top, bottom) = plt.subplots(2, 1, figsize=(9, 6), sharex=True,
+                                         constrained_layout=True)
+    rotational = trace.joint_rates[:, :30]
+    axis_colours = plt.cm.viridis(np.linspace(0, 0.9, 5))
+    names = ("lower gimbal 1", "lower gimbal 2", "upper gimbal 1", "upper gimbal 2", "revolute")
+    for axis_index in range(5):
+        columns = rotational[:, axis_index::5] * 1e3
+        for leg in range(6):
+            top.plot(trace.t, columns[:, leg], color=axis_colours[axis_index], lw=0.8,
+                     label=names[axis_index] + " (6 legs)" if leg == 0 else None)
+    _shade_intervals(top, trace.intervals, label=True)
+    top.axhline(0, color="k", lw=0.6)
+    top.set_ylabel("joint axis rate (mrad/s)")
+    top.set_title(f"{trace.name}: joint velocities; shaded: no joint reverses "
+                  f"({0 if trace.intervals is None else len(trace.intervals)} intervals)")
+    top.legend(loc="upper right", ncol=2, framealpha=0.9)
+    for leg in range(6):
+        bottom.plot(trace.t, trace.joint_rates[:, 30 + leg] * 1e3, lw=0.9, label=f"leg {leg + 1}")
+    _shade_intervals(bottom, trace.intervals, label=False)
+    bottom.axhline(0, color="k", lw=0.6)
+    bottom.set_ylabel("actuator rate (mm/s)")
+    bottom.set_xlabel("time (s)")
+    bottom.legend(loc="upper right", ncol=3, framealpha=0.9)
+    return save_figure(figure, directory, stem)
+
+
+def plot_force_budget(trace: ExperimentTrace, directory: str | Path,
+                      channels: Sequence[int] | None = None,
+                      stem: str = "force_budget") -> list[Path]:
+    """Generalized force components of one experiment in the excited equation and its most
+    coupled one: inertial, viscous, Coulomb, gravity variation and the actuators' total."""
+    plt = _pyplot()
+    if channels is None:
+        coupled = {0: 4, 1: 3, 2: 2, 3: 1, 4: 0, 5: 5}[trace.excited]
+        channels = sorted({trace.excited, coupled})
+    figure, axes = plt.subplots(len(channels), 1, figsize=(9, 3.2 * len(channels)),
+                                sharex=True, squeeze=False, constrained_layout=True)
+    styles = {"inertial": ("#1f77b4", "-"), "viscous": ("#ff7f0e", "-"),
+              "coulomb": ("#d62728", "-"), "gravity": ("#9467bd", "-"),
+              "actuators": ("k", ":")}
+    for axis, channel in zip(axes[:, 0], channels, strict=True):
+        big = max(np.max(np.abs(f[:, channel])) for f in trace.forces.values())
+        scale, prefix = (1e-3, "k") if big >= 1e4 else (1.0, "")
+        for name, label in FORCE_COMPONENTS.items():
+            if name not in trace.forces:
+                continue
+            colour, style = styles[name]
+            axis.plot(trace.t, trace.forces[name][:, channel] * scale, color=colour, ls=style,
+                      lw=1.5 if name == "actuators" else 1.0, label=label)
+        axis.set_ylabel(f"{COORDINATES[channel]} equation ({prefix}{_FORCE_UNITS[channel]})")
+        axis.set_title(f"{trace.name} ({COORDINATES[trace.excited]} excited): "
+                       f"{COORDINATES[channel]} equation")
+        axis.legend(loc="upper right", ncol=2, framealpha=0.9)
+    axes[-1, 0].set_xlabel("time (s)")
+    return save_figure(figure, directory, stem)
+
+
+def plot_scalogram(t: np.ndarray, signal: np.ndarray, points: np.ndarray,
+                   directory: str | Path, wavelet: Any = "mexican_hat",
+                   signal_label: str = "signal", intervals: np.ndarray | None = None,
+                   stem: str = "scalogram", max_rate_hz: float = 100.0) -> list[Path]:
+    """|W_ψ f(a, b)| of one signal over scales and shifts, with the (a, b) points an
+    identification used marked on it.
+
+    Parameters
+    ----------
+    t : ndarray, shape (N,)
+        Time (s).
+    signal : ndarray, shape (N,)
+        The transformed signal (any unit u; the colour bar is in u).
+    points : ndarray, shape (K, 2)
+        (a, b) pairs used (s, s).
+    wavelet : str or MotherWavelet
+        The mother wavelet (see :func:`stewartid.identification.wavelets.make_wavelet`).
+    intervals : ndarray, shape (M, 2), optional
+        Constant-direction intervals, drawn as bars under the map.
+    max_rate_hz : float
+        The signal is decimated to at most this rate for the map (the map is smooth at the
+        scales shown); the (a, b) points are not affected.
+    """
+    from stewartid.identification.wavelets import make_wavelet, wavelet_transform
+
+    plt = _pyplot()
+    t = np.asarray(t, dtype=float)
+    signal = np.asarray(signal, dtype=float)
+    points = np.asarray(points, dtype=float).reshape(-1, 2)
+    step = max(1, int(round(1.0 / (max_rate_hz * np.median(np.diff(t))))))
+    t_map, f_map = t[::step], signal[::step]
+    mother = make_wavelet(wavelet) if isinstance(wavelet, str | dict) else wavelet
+    a_low = points[:, 0].min() / 2 if len(points) else 0.02 * (t[-1] - t[0])
+    a_high = points[:, 0].max() * 2 if len(points) else 0.2 * (t[-1] - t[0])
+    a_low = max(a_low, 4 * (t_map[1] - t_map[0]))
+    scales = np.geomspace(a_low, a_high, 48)
+    shifts = np.linspace(t[0], t[-1], 240)
+    grid_a, grid_b = np.meshgrid(scales, shifts, indexing="ij")
+    values = wavelet_transform(f_map, t_map, grid_a.ravel(), grid_b.ravel(), mother)
+    magnitude = np.abs(values).reshape(grid_a.shape)
+    # wavelets that stick out of the record are cut off: blank them rather than mislead
+    inside = ((grid_b - mother.half_width * grid_a >= t[0])
+              & (grid_b + mother.half_width * grid_a <= t[-1]))
+    magnitude = np.where(inside, magnitude, np.nan)
+    figure, axis = plt.subplots(figsize=(9, 4.2), constrained_layout=True)
+    mesh = axis.pcolormesh(shifts, scales, magnitude, shading="auto", cmap="magma")
+    colourbar = figure.colorbar(mesh, ax=axis)
+    colourbar.set_label(f"|W_ψ f(a, b)| ({signal_label.split('(')[-1].rstrip(')')})"
+                        if "(" in signal_label else "|W_ψ f(a, b)|")
+    if len(points):
+        axis.scatter(points[:, 1], points[:, 0], s=14, facecolor="none", edgecolor="#4dd0e1",
+                     lw=1.0, label=f"(a, b) used ({len(points)})")
+    if intervals is not None:
+        for k, (start, stop) in enumerate(intervals):
+            axis.plot([start, stop], [a_low * 1.02] * 2, color="#9ecae1", lw=4,
+                      solid_capstyle="butt",
+                      label="constant-direction interval" if k == 0 else None)
+    axis.set_yscale("log")
+    axis.set_xlabel("shift b (s)")
+    axis.set_ylabel("scale a (s)")
+    axis.set_title(f"Scalogram of {signal_label} ({mother.name} wavelet)")
+    axis.legend(loc="upper right", framealpha=0.9)
+    return save_figure(figure, directory, stem)
+
+
+def _grouped_bars(axis: Any, labels: Sequence[str], series: Sequence[tuple[str, np.ndarray,
+                  dict]], log: bool, base: float = 0.0) -> None:
+    """Bars of several series side by side per label, drawn from ``base``."""
+    width = 0.84 / max(len(series), 1)
+    x = np.arange(len(labels))
+    for k, (label, values, style) in enumerate(series):
+        offset = (k - (len(series) - 1) / 2) * width
+        axis.bar(x + offset, np.asarray(values) - base, width, bottom=base, label=label,
+                 **style)
+    axis.set_xticks(x, labels, rotation=60, ha="right")
+    axis.set_xlim(-0.6, len(labels) - 0.4)
+    if log:
+        axis.set_yscale("log")
+
+
+def plot_errors(results: ComparisonResults, directory: str | Path,
+                stem: str = "errors") -> list[Path]:
+    """ε (%) per entry, every method against the others and against the paper's published ε,
+    one panel per Coulomb level (log scale)."""
+    plt = _pyplot()
+    levels = results.coulomb_levels
+    figure, axes = plt.subplots(len(levels), 1, figsize=(14, 3.6 * len(levels)),
+                                squeeze=False, constrained_layout=True)
+    labels = [entry_label(k) for k in PAPER_ENTRIES]
+    floor = 1e-3  # ε below this (%) is drawn at the floor so the log axis stays readable
+    for axis, level in zip(axes[:, 0], levels, strict=True):
+        series = []
+        for method in results.methods:
+            run = results.run(method, level)
+            if run is None:
+                continue
+            eps = np.maximum([results.eps(run, k) for k in PAPER_ENTRIES], floor)
+            colour = METHOD_COLOURS.get(method, "grey")
+            series.append((method_name(method), eps, {"color": colour}))
+            if results.published_entry(method, level, PAPER_ENTRIES[0]) is not None:
+                paper = np.maximum([results.published_entry(method, level, k).eps
+                                    for k in PAPER_ENTRIES], floor)
+                series.append((f"{method_name(method)}, paper", paper,
+                               {"facecolor": "white", "edgecolor": colour, "hatch": "///",
+                                "lw": 0.8}))
+        _grouped_bars(axis, labels, series, log=True)
+        axis.axhline(1.0, color="k", lw=0.8, ls="--", label="1 %")
+        axis.set_ylabel("ε (%)")
+        axis.set_title(f"Coulomb friction {level:g} N·m per joint axis")
+        axis.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), framealpha=0.9)
+    figure.suptitle("Relative error per entry, ours (filled) and the paper's (hatched)")
+    return save_figure(figure, directory, stem)
+
+
+def plot_identified_vs_nominal(results: ComparisonResults, coulomb: float,
+                               directory: str | Path, stem: str | None = None) -> list[Path]:
+    """Identified value divided by nominal, per entry and method, at one Coulomb level; the
+    nominal values are printed under the entry names (1 = exact)."""
+    plt = _pyplot()
+    figure, axes = plt.subplots(1, 2, figsize=(13, 4.6), constrained_layout=True)
+    for axis, matrix in zip(axes, ("M", "B"), strict=True):
+        keys = [k for k in PAPER_ENTRIES if k[0] == matrix]
+        labels = [f"{entry_label(k)}\n{results.nominal(k):,.0f}" for k in keys]
+        series = []
+        for method in results.methods:
+            run = results.run(method, coulomb)
+            if run is None:
+                continue
+            ratio = np.array([run.value(k) / results.nominal(k) for k in keys])
+            series.append((method_name(method), ratio,
+                           {"color": METHOD_COLOURS.get(method, "grey")}))
+            if results.published_entry(method, coulomb, keys[0]) is not None:
+                paper = np.array([results.published_entry(method, coulomb, k).value
+                                  / results.nominal(k) for k in keys])
+                series.append((f"{method_name(method)}, paper", paper,
+                               {"facecolor": "white", "hatch": "///", "lw": 0.8,
+                                "edgecolor": METHOD_COLOURS.get(method, "grey")}))
+        _grouped_bars(axis, labels, series, log=False, base=1.0)
+        axis.axhline(1.0, color="k", lw=1.0, label="nominal")
+        values = np.concatenate([s[1] for s in series]) if series else np.ones(1)
+        spread = max(0.05, float(np.max(np.abs(values - 1.0))) * 1.15)
+        axis.set_ylim(1 - spread, 1 + spread)
+        name = "Mt" if matrix == "M" else "Bt"
+        axis.set_ylabel(f"identified / nominal {name} (−)")
+        axis.set_title(f"{name} at Coulomb {coulomb:g} N·m (nominal value under each entry)")
+        axis.tick_params(axis="x", labelrotation=0, labelsize=8)
+        for tick in axis.get_xticklabels():
+            tick.set_horizontalalignment("center")
+    handles, names = axes[0].get_legend_handles_labels()
+    figure.legend(handles, names, loc="outside lower center", ncol=min(len(names), 4))
+    return save_figure(figure, directory, stem or f"identified_vs_nominal_coulomb{coulomb:g}")
+
+
+__all__ = [
+    "COORDINATES",
+    "FORCE_COMPONENTS",
+    "METHOD_COLOURS",
+    "ExperimentTrace",
+    "plot_errors",
+    "plot_excitation",
+    "plot_force_budget",
+    "plot_identified_vs_nominal",
+    "plot_joint_rates",
+    "plot_scalogram",
+    "save_figure",
+]
