@@ -1,0 +1,113 @@
+"""Leg-length servo controller: PID with anti-windup, gravity feed-forward, inner force loop.
+
+Each leg has a PID on its length error e = l_cmd - l (m), whose output is the force demand
+
+    f_d = f_ff + K_p e + K_i z + K_d (l_cmd' - l'),      z' = e  (unless winding up),
+
+clamped to the force range of the cylinder. ``f_ff`` is the optional gravity feed-forward,
+the leg forces that hold the commanded pose at rest: J_lq(q_cmd)^-T G(q_cmd). Anti-windup
+by conditional integration: z stops integrating while f_d is saturated and e would push it
+further. The controller is continuous-time (an analogue-equivalent servo amplifier), which
+keeps the closed loop an ODE that a fixed-step integrator resolves to its stated order.
+
+In ``ideal`` actuator mode the clamped demand is the leg force. In ``hydraulic`` mode an
+inner loop drives the servo-valve in proportion to the force error: u = k_f (f_d - f),
+with f from the chamber pressures, saturated to [-1, 1] (full opening).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from stewartid import _kernels
+from stewartid.platform import Platform
+from stewartid.simulation.hydraulics import force_limits
+
+# indices into the packed controller parameter vector
+C_KP, C_KI, C_KD, C_KF, C_FMIN, C_FMAX = range(6)
+N_CONTROLLER_PARAMETERS = 6
+
+
+def controller_parameters(platform: Platform) -> np.ndarray:
+    """Pack the ``[controller]`` section and the force limits for the compiled plant.
+
+    Returns
+    -------
+    ndarray, shape (6,)
+        [K_p (N/m), K_i (N/(m s)), K_d (N s/m), k_f (1/N), f_min (N), f_max (N)].
+    """
+    c = platform.controller
+    f_min, f_max = force_limits(platform.hydraulics)
+    return np.array([c.proportional_gain, c.integral_gain, c.derivative_gain,
+                     c.force_loop_gain, f_min, f_max])
+
+
+@njit(cache=True)
+def pid_force(cp: np.ndarray, error: float, error_rate: float, integral: float,
+              feedforward: float) -> tuple[float, float]:
+    """Force demand (N) and integrator rate (m) of one leg.
+
+    Returns
+    -------
+    (f_d, z_dot) : the clamped demand and the (anti-windup gated) integrator input.
+    """
+    f = feedforward + cp[C_KP] * error + cp[C_KI] * integral + cp[C_KD] * error_rate
+    z_dot = error
+    if f > cp[C_FMAX]:
+        f = cp[C_FMAX]
+        if error > 0.0:
+            z_dot = 0.0
+    elif f < cp[C_FMIN]:
+        f = cp[C_FMIN]
+        if error < 0.0:
+            z_dot = 0.0
+    return f, z_dot
+
+
+@njit(cache=True)
+def valve_command(cp: np.ndarray, demand: float, force: float) -> float:
+    """Inner force loop: valve opening (fraction, in [-1, 1]) for a force error (N)."""
+    u = cp[C_KF] * (demand - force)
+    if u > 1.0:
+        return 1.0
+    if u < -1.0:
+        return -1.0
+    return u
+
+
+@njit(cache=True)
+def command_tables(params, upper, base, q_cmd, qd_cmd, feedforward):
+    """Leg-length commands, their rates and the gravity feed-forward along a trajectory.
+
+    Parameters
+    ----------
+    params, upper, base : packed platform (see ``_kernels.model_terms``).
+    q_cmd, qd_cmd : (N, 6) commanded poses (m, rad) and rates.
+    feedforward : bool
+        Compute J_lq^-T G at the commanded pose (zeros otherwise).
+
+    Returns
+    -------
+    lengths, rates, forces : (N, 6) each; m, m/s, N.
+    """
+    n = q_cmd.shape[0]
+    lengths = np.empty((n, 6))
+    rates = np.empty((n, 6))
+    forces = np.zeros((n, 6))
+    M = np.empty((6, 6))
+    h = np.empty(6)
+    G = np.empty(6)
+    J = np.empty((6, 6))
+    Jj = np.empty((6, 5, 6))
+    for k in range(n):
+        _kernels.model_terms(params, upper, base, q_cmd[k], qd_cmd[k], M, h, G, J, Jj,
+                             lengths[k])
+        for i in range(6):
+            s = 0.0
+            for c in range(6):
+                s += J[i, c] * qd_cmd[k, c]
+            rates[k, i] = s
+        if feedforward:
+            forces[k] = np.linalg.solve(J.T.copy(), G)
+    return lengths, rates, forces

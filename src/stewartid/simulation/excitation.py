@@ -1,0 +1,222 @@
+"""Excitation trajectories of the platform pose: sines, multi-sines and a smooth fade-in.
+
+A trajectory is a sum of sines on the pose coordinates, added to a base pose (the neutral
+pose by default) and multiplied by a fade-in window, so that pose, velocity and acceleration
+all start at the base pose / zero and the plant is not shocked at t = 0. Everything is
+analytic: :meth:`Excitation.evaluate` returns q, q_dot and q_ddot exactly.
+
+The paper's set (Zhang 2020, Section 4): six experiments, experiment k excites DOF k alone
+with a sine at 0.5 Hz; see :func:`paper_experiments` for the default amplitudes and why.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from stewartid.errors import ConfigError
+from stewartid.platform import Platform
+
+#: Names of the pose coordinates, in order (the DOF index of a :class:`Sine`).
+DOF_NAMES = ("x", "y", "z", "rx", "ry", "rz")
+
+#: Default sine amplitudes of the paper's experiments: 20 mm in translation, 10 mrad in
+#: rotation. Small enough that the motion is linear (M(q) changes by < 1 % over the
+#: motion) and far inside the 1 m stroke; large enough that at 0.5 Hz the inertial forces
+#: (e.g. 14 224 kg x 0.02 m x (pi rad/s)^2 = 2.8 kN along x, 50 214 kg m^2 x 0.01 rad x pi^2
+#: = 5.0 kN m about x) and viscous forces (4140 N s/m x 0.063 m/s = 260 N along x) dominate
+#: the generalized Coulomb force of 5 N m per joint axis (about 30 N along x, 75 N m about
+#: x), as in the paper's experiments.
+DEFAULT_AMPLITUDES = (0.02, 0.02, 0.02, 0.01, 0.01, 0.01)
+#: Default fade-in duration (s): one period at the paper's 0.5 Hz.
+DEFAULT_FADE_IN = 2.0
+
+
+@dataclasses.dataclass(frozen=True)
+class Sine:
+    """One sine on one pose coordinate: offset + amplitude * sin(2 pi f t + phase).
+
+    Attributes
+    ----------
+    dof : int
+        Pose coordinate 0..5 (x, y, z, rx, ry, rz).
+    amplitude : float
+        m for x, y, z; rad for rx, ry, rz.
+    frequency_hz : float
+        Hz.
+    phase : float
+        rad.
+    offset : float
+        Constant added to the base pose (m or rad); not faded.
+    """
+
+    dof: int
+    amplitude: float
+    frequency_hz: float
+    phase: float = 0.0
+    offset: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.dof, int | np.integer) and 0 <= self.dof < 6):
+            raise ConfigError(f"Sine dof must be an integer 0..5 (x, y, z, rx, ry, rz); "
+                              f"got {self.dof!r}.")
+        if not (math.isfinite(self.frequency_hz) and self.frequency_hz > 0):
+            raise ConfigError(f"Sine frequency_hz must be > 0 Hz; got {self.frequency_hz!r}.")
+        for name in ("amplitude", "phase", "offset"):
+            if not math.isfinite(getattr(self, name)):
+                raise ConfigError(f"Sine {name} must be finite; got {getattr(self, name)!r}.")
+
+
+def _fade(t: np.ndarray, duration: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Quintic smoothstep window w(t) from 0 to 1 over ``duration``, with w' and w''.
+
+    w, w' and w'' vanish at t = 0, so the faded trajectory starts at rest with zero
+    acceleration (no force step for the plant), and w' = w'' = 0 at the end of the fade.
+    """
+    if duration <= 0:
+        one = np.ones_like(t)
+        return one, np.zeros_like(t), np.zeros_like(t)
+    s = np.clip(t / duration, 0.0, 1.0)
+    inside = (t > 0) & (t < duration)
+    w = s ** 3 * (10 - 15 * s + 6 * s ** 2)
+    dw = np.where(inside, 30 * s ** 2 * (1 - s) ** 2 / duration, 0.0)
+    ddw = np.where(inside, 60 * s * (1 - s) * (1 - 2 * s) / duration ** 2, 0.0)
+    return w, dw, ddw
+
+
+@dataclasses.dataclass(frozen=True)
+class Excitation:
+    """A pose trajectory: base pose + fade-in window x sum of sines (plus constant offsets).
+
+    Attributes
+    ----------
+    sines : tuple of Sine
+        Components; several on one DOF make a multi-sine.
+    base_pose : tuple of 6 float
+        Pose about which the platform moves (m, rad), usually the neutral pose.
+    fade_in : float
+        Duration (s) of the quintic fade-in window; 0 for none.
+    name : str
+        Label of the experiment.
+    """
+
+    sines: tuple[Sine, ...]
+    base_pose: tuple[float, ...]
+    fade_in: float = DEFAULT_FADE_IN
+    name: str = "exp"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "sines", tuple(self.sines))
+        base = tuple(float(v) for v in np.asarray(self.base_pose, dtype=float).ravel())
+        if len(base) != 6:
+            raise ConfigError(f"base_pose must have 6 values (m, rad); got {len(base)}.")
+        object.__setattr__(self, "base_pose", base)
+        if not (math.isfinite(self.fade_in) and self.fade_in >= 0):
+            raise ConfigError(f"fade_in must be >= 0 s; got {self.fade_in!r}.")
+
+    @property
+    def max_frequency(self) -> float:
+        """Highest sine frequency (Hz), 0 without sines."""
+        return max((s.frequency_hz for s in self.sines), default=0.0)
+
+    def evaluate(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Pose, velocity and acceleration at times ``t``.
+
+        Parameters
+        ----------
+        t : ndarray, shape (N,)
+            Times (s).
+
+        Returns
+        -------
+        q, q_dot, q_ddot : ndarray, shape (N, 6)
+            m, rad; m/s, rad/s; m/s^2, rad/s^2.
+        """
+        t = np.asarray(t, dtype=float)
+        n = t.shape[0]
+        q = np.tile(np.asarray(self.base_pose), (n, 1))
+        qd = np.zeros((n, 6))
+        qdd = np.zeros((n, 6))
+        w, dw, ddw = _fade(t, self.fade_in)
+        for s in self.sines:
+            om = 2 * math.pi * s.frequency_hz
+            arg = om * t + s.phase
+            y = s.amplitude * np.sin(arg)
+            dy = s.amplitude * om * np.cos(arg)
+            ddy = -om * om * y
+            q[:, s.dof] += s.offset + w * y
+            qd[:, s.dof] += dw * y + w * dy
+            qdd[:, s.dof] += ddw * y + 2 * dw * dy + w * ddy
+        return q, qd, qdd
+
+
+def sine_excitation(platform: Platform, dof: int, amplitude: float, frequency_hz: float,
+                    phase: float = 0.0, offset: float = 0.0, fade_in: float = DEFAULT_FADE_IN,
+                    name: str | None = None) -> Excitation:
+    """A single sine on one DOF about the platform's neutral pose.
+
+    Parameters
+    ----------
+    platform : Platform
+    dof : int
+        0..5 for x, y, z, rx, ry, rz.
+    amplitude : float
+        m or rad.
+    frequency_hz : float
+        Hz.
+    phase, offset : float
+        rad; m or rad.
+    fade_in : float
+        s.
+    name : str, optional
+        Label; ``"<dof name>_sine"`` by default.
+    """
+    return Excitation((Sine(dof, amplitude, frequency_hz, phase, offset),),
+                      tuple(platform.neutral_pose), fade_in,
+                      name or f"{DOF_NAMES[dof]}_sine")
+
+
+def multisine_excitation(platform: Platform, sines: Sequence[Sine],
+                         fade_in: float = DEFAULT_FADE_IN, name: str = "multisine") -> Excitation:
+    """Several sines, on one or more DOFs, about the neutral pose."""
+    return Excitation(tuple(sines), tuple(platform.neutral_pose), fade_in, name)
+
+
+def paper_experiments(platform: Platform, frequency_hz: float = 0.5,
+                      amplitudes: Sequence[float] = DEFAULT_AMPLITUDES,
+                      fade_in: float = DEFAULT_FADE_IN) -> list[Excitation]:
+    """The paper's six experiments: experiment k excites DOF k with a sine (names exp1..exp6).
+
+    Parameters
+    ----------
+    platform : Platform
+    frequency_hz : float
+        Sine frequency (Hz); 0.5 in the paper.
+    amplitudes : sequence of 6 float
+        Per DOF (m, m, m, rad, rad, rad); see :data:`DEFAULT_AMPLITUDES` for the reasoning.
+    fade_in : float
+        Fade-in duration (s).
+
+    Returns
+    -------
+    list of Excitation
+        Six trajectories, each starting at rest at the neutral pose.
+    """
+    amplitudes = tuple(float(a) for a in amplitudes)
+    if len(amplitudes) != 6:
+        raise ConfigError(f"amplitudes must have 6 values (one per DOF); got {len(amplitudes)}.")
+    return [sine_excitation(platform, k, amplitudes[k], frequency_hz, fade_in=fade_in,
+                            name=f"exp{k + 1}") for k in range(6)]
+
+
+def excitation_to_dict(excitation: Excitation) -> dict:
+    """Plain-data description of an excitation (for meta.json)."""
+    return {
+        "name": excitation.name,
+        "base_pose": list(excitation.base_pose),
+        "fade_in": excitation.fade_in,
+        "sines": [dataclasses.asdict(s) for s in excitation.sines],
+    }

@@ -1,0 +1,342 @@
+"""Virtual experiments: run the closed-loop plant along excitations and record data sets.
+
+:func:`simulate_experiment` runs one trajectory; :func:`simulate_experiments` runs the
+paper's six (experiment k excites DOF k) and returns a :class:`SimulationResult` with the
+measured data sets, the true states and a metadata dictionary; :func:`write_experiments`
+writes them as ``exp1.csv ... exp6.csv`` + ``meta.json``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stewartid.dataset import Dataset, write_dataset
+from stewartid.dynamics import COULOMB_SMOOTHING, ModelTerms
+from stewartid.errors import ConfigError, StewartidError
+from stewartid.platform import Platform
+from stewartid.simulation import plant
+from stewartid.simulation.controller import command_tables, controller_parameters
+from stewartid.simulation.excitation import (
+    DEFAULT_AMPLITUDES,
+    DEFAULT_FADE_IN,
+    Excitation,
+    excitation_to_dict,
+    paper_experiments,
+)
+from stewartid.simulation.hydraulics import hydraulic_parameters, static_state
+from stewartid.simulation.sensors import SensorNoise, measure_legs, measured_pose
+
+#: Default integration step (s); see ``plant.py`` for its justification.
+DEFAULT_STEP = 2.5e-4
+
+
+@dataclasses.dataclass(frozen=True)
+class ExperimentRecord:
+    """True signals of one simulated experiment, at the recorded samples.
+
+    Attributes
+    ----------
+    name : str
+    t : ndarray, shape (N,)
+        s.
+    q, q_dot, q_ddot : ndarray, shape (N, 6)
+        True pose, rate and acceleration (m, rad and their derivatives).
+    lengths, length_rates : ndarray, shape (N, 6)
+        True leg lengths (m) and rates (m/s).
+    forces, demands : ndarray, shape (N, 6)
+        Actual actuator forces and controller force demands (N).
+    command_lengths : ndarray, shape (N, 6)
+        Commanded leg lengths (m).
+    pressures : ndarray, shape (N, 6, 2)
+        Chamber pressures p_A, p_B (Pa); constant in ideal actuator mode.
+    spools : ndarray, shape (N, 6)
+        Valve spool positions (fraction of full opening).
+    """
+
+    name: str
+    t: np.ndarray
+    q: np.ndarray
+    q_dot: np.ndarray
+    q_ddot: np.ndarray
+    lengths: np.ndarray
+    length_rates: np.ndarray
+    forces: np.ndarray
+    demands: np.ndarray
+    command_lengths: np.ndarray
+    pressures: np.ndarray
+    spools: np.ndarray
+
+    def tracking_error(self) -> np.ndarray:
+        """RMS of the leg-length tracking error per leg (m), shape (6,)."""
+        return np.sqrt(np.mean((self.command_lengths - self.lengths) ** 2, axis=0))
+
+
+@dataclasses.dataclass(frozen=True)
+class SimulationResult:
+    """Output of :func:`simulate_experiments`.
+
+    Attributes
+    ----------
+    datasets : list of Dataset
+        Measured data, one per experiment, as they would be written to files.
+    meta : dict
+        Full configuration, seed, nominal matrices, package version (JSON-ready).
+    states : list of ExperimentRecord
+        True signals, one per experiment.
+    """
+
+    datasets: list[Dataset]
+    meta: dict
+    states: list[ExperimentRecord]
+
+
+def _check_timing(duration_s: float, sample_rate: float, max_frequency: float) -> None:
+    if not (math.isfinite(duration_s) and duration_s > 0):
+        raise ConfigError(f"duration must be > 0 s; got {duration_s!r}.")
+    nyquist = sample_rate / 2
+    if not max_frequency < nyquist:
+        raise ConfigError(
+            f"excitation frequency {max_frequency!r} Hz is not below the Nyquist limit "
+            f"{nyquist:g} Hz of the {sample_rate:g} Hz sampling; lower the frequency or raise "
+            "[sensors] sample_rate."
+        )
+
+
+def initial_state(platform: Platform, q0: np.ndarray, feedforward_force: np.ndarray,
+                  hp: np.ndarray, cp: np.ndarray) -> np.ndarray:
+    """Closed-loop equilibrium at rest at pose ``q0``: no start-up transient.
+
+    Leg forces hold the pose against gravity; the valves feed the leakage; the PID integrators
+    hold the force demand that the inner loop needs.
+    """
+    t = ModelTerms(platform, q0)
+    J, G = t.leg_jacobian[0], t.gravity[0]
+    f0 = np.linalg.solve(J.T, G)
+    y = np.zeros(plant.N_STATES)
+    y[plant.S_Q:plant.S_Q + 6] = q0
+    hydraulic = platform.hydraulics.mode == "hydraulic"
+    demand = f0.copy()
+    for i in range(6):
+        if hydraulic:
+            xv, pa, pb = static_state(hp, float(f0[i]), float(t.leg_lengths[0, i]))
+            y[plant.S_XV + i] = xv
+            y[plant.S_PA + i] = pa
+            y[plant.S_PB + i] = pb
+            demand[i] = f0[i] + xv / cp[3]
+    ki = cp[1]
+    if ki > 0:
+        y[plant.S_Z:plant.S_Z + 6] = (demand - feedforward_force) / ki
+    return y
+
+
+def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: float,
+                        noise: SensorNoise | None = None,
+                        rng: np.random.Generator | None = None,
+                        step: float = DEFAULT_STEP,
+                        coulomb_smoothing: float = COULOMB_SMOOTHING,
+                        ) -> tuple[Dataset, ExperimentRecord]:
+    """Run the closed-loop plant along one excitation.
+
+    Parameters
+    ----------
+    platform : Platform
+        Plant description, including ``[hydraulics]``, ``[controller]`` and ``[sensors]``.
+    excitation : Excitation
+        Commanded pose trajectory.
+    duration_s : float
+        Record length (s); samples at ``platform.sensors.sample_rate``.
+    noise : SensorNoise, optional
+        Sensor errors; those of ``[sensors]`` by default.
+    rng : numpy.random.Generator, optional
+        Noise source; a fresh ``default_rng(0)`` by default.
+    step : float
+        Largest integration step (s); rounded down to divide the sample period.
+    coulomb_smoothing : float
+        Regularisation rate of the Coulomb friction (rad/s).
+
+    Returns
+    -------
+    dataset : Dataset
+        Measured signals (pose from forward kinematics of the measured lengths).
+    record : ExperimentRecord
+        True signals.
+
+    Raises
+    ------
+    ConfigError
+        On a non-positive duration, a frequency at or above the Nyquist limit, or an
+        actuator that cannot hold the platform.
+    StewartidError
+        If a leg leaves its stroke or the integration diverges.
+    """
+    fs = platform.sensors.sample_rate
+    _check_timing(duration_s, fs, excitation.max_frequency)
+    if not (step > 0 and math.isfinite(step)):
+        raise ConfigError(f"integration step must be > 0 s; got {step!r}.")
+    noise = SensorNoise.from_sensors(platform.sensors) if noise is None else noise
+    rng = np.random.default_rng(0) if rng is None else rng
+    n_out = int(math.floor(duration_s * fs + 1e-9)) + 1
+    substeps = max(1, math.ceil(1.0 / (fs * step) - 1e-9))
+    h = 1.0 / (fs * substeps)
+    t_half = np.arange(2 * substeps * (n_out - 1) + 1) * (h / 2)
+    q_cmd, qd_cmd, _ = excitation.evaluate(t_half)
+    params = platform.parameters()
+    upper = np.ascontiguousarray(platform.upper_joints)
+    base = np.ascontiguousarray(platform.base_joints)
+    cmd_len, cmd_rate, cmd_force = command_tables(
+        params, upper, base, q_cmd, qd_cmd, bool(platform.controller.gravity_feedforward))
+    hp = hydraulic_parameters(platform.hydraulics, platform.neutral_leg_length)
+    cp = controller_parameters(platform)
+    y0 = initial_state(platform, q_cmd[0], cmd_force[0], hp, cp)
+    hydraulic = platform.hydraulics.mode == "hydraulic"
+    status, where, leg, states, qdd, lengths, rates, forces, demands = plant.integrate(
+        y0, h, substeps, n_out, cmd_len, cmd_rate, cmd_force, params, upper, base, hp, cp,
+        hydraulic, float(coulomb_smoothing))
+    if status == plant.STATUS_STROKE:
+        raise StewartidError(
+            f"{excitation.name}: leg {leg + 1} left its {platform.hydraulics.stroke} m stroke "
+            f"at t = {where / fs:.3f} s; lower the excitation amplitude or lengthen [hydraulics] "
+            "stroke.")
+    if status == plant.STATUS_NONFINITE:
+        raise StewartidError(
+            f"{excitation.name}: the closed loop diverged at t = {where / fs:.3f} s; lower "
+            "the integration step or the controller gains.")
+    t = np.arange(n_out) / fs
+    record = ExperimentRecord(
+        name=excitation.name, t=t, q=states[:, plant.S_Q:plant.S_Q + 6],
+        q_dot=states[:, plant.S_QD:plant.S_QD + 6], q_ddot=qdd, lengths=lengths,
+        length_rates=rates, forces=forces, demands=demands,
+        command_lengths=cmd_len[::2 * substeps],
+        pressures=np.stack([states[:, plant.S_PA:plant.S_PA + 6],
+                            states[:, plant.S_PB:plant.S_PB + 6]], axis=-1),
+        spools=states[:, plant.S_XV:plant.S_XV + 6])
+    measured_lengths, measured_forces = measure_legs(lengths, forces, noise, rng)
+    pose = measured_pose(platform, measured_lengths)
+    dataset = Dataset(t=t, pose=pose, lengths=measured_lengths, forces=measured_forces,
+                      name=excitation.name)
+    return dataset, record
+
+
+def simulate_experiments(platform: Platform, coulomb: float | None = None,
+                         viscous: float | None = None, frequency_hz: float = 0.5,
+                         duration_s: float = 20.0,
+                         amplitudes: Sequence[float] = DEFAULT_AMPLITUDES,
+                         noise: SensorNoise | None = None, seed: int = 0,
+                         actuator: str | None = None, fade_in: float = DEFAULT_FADE_IN,
+                         step: float = DEFAULT_STEP,
+                         progress: Callable[[int, int, str], Any] | None = None,
+                         ) -> SimulationResult:
+    """The paper's six virtual experiments (experiment k excites DOF k with a sine).
+
+    Parameters
+    ----------
+    platform : Platform
+    coulomb, viscous : float, optional
+        Override the platform's Coulomb (N m per joint axis) and gimbal viscous
+        (N m s/rad) friction.
+    frequency_hz : float
+        Sine frequency (Hz), 0.5 in the paper.
+    duration_s : float
+        Length of each record (s).
+    amplitudes : sequence of 6 float
+        Sine amplitudes per DOF (m, rad).
+    noise : SensorNoise, optional
+        Sensor errors; the platform's ``[sensors]`` section by default.
+    seed : int
+        Seed of the sensor noise (one independent stream per experiment).
+    actuator : {"hydraulic", "ideal"}, optional
+        Override ``[hydraulics] mode``.
+    fade_in : float
+        Fade-in duration (s).
+    step : float
+        Largest integration step (s).
+    progress : callable, optional
+        Called as ``progress(done, total, name)`` after each experiment.
+
+    Returns
+    -------
+    SimulationResult
+    """
+    import stewartid
+    from stewartid.linearization import gravity_stiffness, nominal_matrices
+
+    updates: dict[str, Any] = {}
+    if coulomb is not None:
+        updates["friction__coulomb"] = float(coulomb)
+    if viscous is not None:
+        updates["friction__gimbal_viscous"] = float(viscous)
+    if actuator is not None:
+        updates["hydraulics__mode"] = actuator
+    if updates:
+        platform = platform.replace(**updates)
+    noise = SensorNoise.from_sensors(platform.sensors) if noise is None else noise
+    _check_timing(duration_s, platform.sensors.sample_rate, frequency_hz)
+    if not (isinstance(seed, int | np.integer) and seed >= 0):
+        raise ConfigError(f"seed must be an integer >= 0; got {seed!r}.")
+    excitations = paper_experiments(platform, frequency_hz, amplitudes, fade_in)
+    streams = np.random.SeedSequence(int(seed)).spawn(len(excitations))
+    datasets, records = [], []
+    for k, (excitation, stream) in enumerate(zip(excitations, streams, strict=True)):
+        dataset, record = simulate_experiment(platform, excitation, duration_s, noise,
+                                              np.random.default_rng(stream), step)
+        datasets.append(dataset)
+        records.append(record)
+        if progress is not None:
+            progress(k + 1, len(excitations), excitation.name)
+    M, B = nominal_matrices(platform)
+    meta = {
+        "platform": platform.to_dict(),
+        "platform_name": platform.name,
+        "excitation": {
+            "frequency_hz": frequency_hz, "duration_s": duration_s,
+            "amplitudes": list(map(float, amplitudes)), "fade_in": fade_in,
+            "experiments": [excitation_to_dict(e) for e in excitations],
+        },
+        "integration": {"method": "RK4", "step": 1.0 / (platform.sensors.sample_rate * max(
+            1, math.ceil(1.0 / (platform.sensors.sample_rate * step) - 1e-9))),
+            "coulomb_smoothing": COULOMB_SMOOTHING},
+        "noise": dataclasses.asdict(noise),
+        "seed": int(seed),
+        "tracking_error_rms": [r.tracking_error().tolist() for r in records],
+        "nominal": {"M": M.tolist(), "B": B.tolist()},
+        "K_G": gravity_stiffness(platform).tolist(),
+        "version": stewartid.__version__,
+    }
+    return SimulationResult(datasets, meta, records)
+
+
+def write_experiments(result: SimulationResult, out: str | Path, format: str = "csv",
+                      force: bool = False) -> list[Path]:
+    """Write ``exp1..expN.<format>`` and ``meta.json`` into the folder ``out``.
+
+    Raises
+    ------
+    ConfigError
+        If ``out`` already holds results (``meta.json`` or ``exp*`` files) and not ``force``,
+        or if ``format`` is unknown.
+    """
+    if format not in ("csv", "parquet"):
+        raise ConfigError(f"format must be 'csv' or 'parquet'; got {format!r}.")
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise ConfigError(f"output path {str(out)!r} exists and is not a folder.")
+    if out.is_dir() and not force:
+        existing = sorted(p.name for p in out.iterdir()
+                          if p.name == "meta.json" or p.name.startswith("exp"))
+        if existing:
+            raise ConfigError(
+                f"output folder {str(out)!r} already holds results ({existing[0]}); choose "
+                "another folder or pass --force to overwrite.")
+    out.mkdir(parents=True, exist_ok=True)
+    paths = [write_dataset(d, out / f"{d.name}.{format}", format=format)
+             for d in result.datasets]
+    meta = out / "meta.json"
+    meta.write_text(json.dumps(result.meta, indent=1) + "\n", encoding="utf-8")
+    return [*paths, meta]

@@ -1,0 +1,195 @@
+"""Hydraulic leg actuators: servo-valve, orifice flows, chamber pressures, actuator force.
+
+Per leg (all six legs alike, parameters from the ``[hydraulics]`` section):
+
+* Servo-valve spool, second order: x_v'' = w_v^2 (u - x_v) - 2 zeta_v w_v x_v', with u the
+  valve command (fraction of full opening, saturated to [-1, 1]).
+* Critically lapped four-edge valve with turbulent orifices:
+  x_v >= 0: Q_A = K x_v phi(p_s - p_A), Q_B = -K x_v phi(p_B - p_r);
+  x_v < 0:  Q_A = K x_v phi(p_A - p_r), Q_B = -K x_v phi(p_s - p_B),
+  K = Q_rated / sqrt(dp_rated / 2). phi(dp) = dp / (dp^2 + p_t^2)^(1/4) is sign(dp)
+  sqrt(|dp|) for |dp| >> p_t and laminar (linear) below the transition pressure p_t, which
+  keeps the flow law differentiable where a chamber pressure crosses p_s or p_r.
+* Chambers with compressible oil and stroke-dependent volumes, internal leakage C_i:
+  p_A' = beta / V_A (Q_A - A_A x' - C_i (p_A - p_B)),
+  p_B' = beta / V_B (Q_B + A_B x' + C_i (p_A - p_B)),
+  V_A = V_0 + A_A (S/2 + x), V_B = V_0 + A_B (S/2 - x); x = leg length - mid-stroke length
+  (the neutral leg length).
+* Actuator force along the leg (N, positive extends): f = p_A A_A - p_B A_B.
+
+The hydraulic natural frequency of a leg of effective mass m is
+w_h = sqrt(beta (A_A^2 / V_A + A_B^2 / V_B) / m) (:func:`hydraulic_natural_frequency`); it
+and the valve bandwidth set the integration step of the plant (see ``plant.py``).
+
+References
+----------
+H. E. Merritt, *Hydraulic Control Systems*, Wiley, 1967 (orifice and chamber equations).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from scipy.optimize import fsolve
+
+from stewartid.errors import ConfigError
+from stewartid.platform import Hydraulics
+
+# indices into the packed hydraulic parameter vector
+H_AREA_A, H_AREA_B, H_SUPPLY, H_RETURN, H_BULK, H_DEAD, H_STROKE, H_MID = range(8)
+H_GAIN, H_TRANSITION, H_VALVE_OMEGA, H_VALVE_ZETA, H_LEAK = range(8, 13)
+N_HYDRAULIC_PARAMETERS = 13
+
+
+def hydraulic_parameters(hydraulics: Hydraulics, mid_stroke_length: float) -> np.ndarray:
+    """Pack the ``[hydraulics]`` section for the compiled plant.
+
+    Parameters
+    ----------
+    hydraulics : Hydraulics
+    mid_stroke_length : float
+        Leg length (m) at which the piston is at mid-stroke (the neutral leg length).
+
+    Returns
+    -------
+    ndarray, shape (13,)
+        [A_A, A_B, p_s, p_r, beta, V_0, S, l_mid, K, p_t, w_v, zeta_v, C_i] (SI units).
+    """
+    h = hydraulics
+    gain = h.valve_rated_flow / math.sqrt(h.valve_rated_pressure_drop / 2.0)
+    return np.array([
+        h.piston_area, h.annulus_area, h.supply_pressure, h.return_pressure, h.bulk_modulus,
+        h.dead_volume, h.stroke, mid_stroke_length, gain, h.orifice_transition_pressure,
+        2.0 * math.pi * h.valve_bandwidth, h.valve_damping, h.leakage,
+    ])
+
+
+@njit(cache=True)
+def orifice(dp: float, transition: float) -> float:
+    """Regularised signed square root: dp / (dp^2 + p_t^2)^(1/4) (Pa^0.5)."""
+    return dp / math.sqrt(math.sqrt(dp * dp + transition * transition))
+
+
+@njit(cache=True)
+def valve_flows(hp: np.ndarray, xv: float, pA: float, pB: float) -> tuple[float, float]:
+    """Flows into chamber A and chamber B (m^3/s) at spool position ``xv`` (fraction)."""
+    K = hp[H_GAIN]
+    pt = hp[H_TRANSITION]
+    if xv >= 0.0:
+        qa = K * xv * orifice(hp[H_SUPPLY] - pA, pt)
+        qb = -K * xv * orifice(pB - hp[H_RETURN], pt)
+    else:
+        qa = K * xv * orifice(pA - hp[H_RETURN], pt)
+        qb = -K * xv * orifice(hp[H_SUPPLY] - pB, pt)
+    return qa, qb
+
+
+@njit(cache=True)
+def chamber_volumes(hp: np.ndarray, length: float) -> tuple[float, float]:
+    """Oil volumes (m^3) of chambers A and B at leg length ``length`` (m)."""
+    x = length - hp[H_MID]
+    half = 0.5 * hp[H_STROKE]
+    return hp[H_DEAD] + hp[H_AREA_A] * (half + x), hp[H_DEAD] + hp[H_AREA_B] * (half - x)
+
+
+@njit(cache=True)
+def pressure_rates(hp: np.ndarray, xv: float, pA: float, pB: float, length: float,
+                   length_rate: float) -> tuple[float, float]:
+    """Time derivatives of the chamber pressures (Pa/s)."""
+    qa, qb = valve_flows(hp, xv, pA, pB)
+    va, vb = chamber_volumes(hp, length)
+    leak = hp[H_LEAK] * (pA - pB)
+    dpa = hp[H_BULK] / va * (qa - hp[H_AREA_A] * length_rate - leak)
+    dpb = hp[H_BULK] / vb * (qb + hp[H_AREA_B] * length_rate + leak)
+    return dpa, dpb
+
+
+@njit(cache=True)
+def actuator_force(hp: np.ndarray, pA: float, pB: float) -> float:
+    """Force along the leg (N, positive extends): p_A A_A - p_B A_B."""
+    return pA * hp[H_AREA_A] - pB * hp[H_AREA_B]
+
+
+def force_limits(hydraulics: Hydraulics) -> tuple[float, float]:
+    """Smallest and largest force (N) the cylinder can exert at standstill.
+
+    Returns
+    -------
+    (f_min, f_max) : tuple of float
+        f_max = p_s A_A - p_r A_B (extending), f_min = p_r A_A - p_s A_B (retracting).
+    """
+    h = hydraulics
+    return (h.return_pressure * h.piston_area - h.supply_pressure * h.annulus_area,
+            h.supply_pressure * h.piston_area - h.return_pressure * h.annulus_area)
+
+
+def static_state(hp: np.ndarray, force: float, length: float) -> tuple[float, float, float]:
+    """Spool position and chamber pressures that hold ``force`` at rest.
+
+    Solves Q_A = C_i (p_A - p_B), Q_B = -C_i (p_A - p_B) (the valve feeds the leakage) and
+    p_A A_A - p_B A_B = force.
+
+    Parameters
+    ----------
+    hp : ndarray, shape (13,)
+        Packed parameters (:func:`hydraulic_parameters`).
+    force : float
+        N, positive extends.
+    length : float
+        Leg length (m).
+
+    Returns
+    -------
+    (x_v, p_A, p_B) : tuple of float
+        Fraction of full opening, Pa, Pa.
+
+    Raises
+    ------
+    ConfigError
+        If the cylinder cannot hold ``force`` with the given supply pressure.
+    """
+    ps, pr = hp[H_SUPPLY], hp[H_RETURN]
+    aa, ab = hp[H_AREA_A], hp[H_AREA_B]
+    f_min, f_max = pr * aa - ps * ab, ps * aa - pr * ab
+    if not f_min < force < f_max:
+        raise ConfigError(
+            f"the actuators cannot hold the static leg force {force:.4g} N: with the "
+            f"[hydraulics] supply pressure and areas they reach [{f_min:.4g}, {f_max:.4g}] N; "
+            "raise supply_pressure or bore_diameter."
+        )
+    scale_p = ps
+    # with the spool open (x_v > 0) both edges pass the same leakage flow, so
+    # p_s - p_A = p_B - p_r in the turbulent regime: a close first guess
+    pb0 = (aa * (ps + pr) - force) / (aa + ab)
+    pa0 = (force + pb0 * ab) / aa
+
+    def residual(z: np.ndarray) -> np.ndarray:
+        xv, pa, pb = z[0] * 1e-3, z[1] * scale_p, z[2] * scale_p
+        qa, qb = valve_flows(hp, xv, pa, pb)
+        leak = hp[H_LEAK] * (pa - pb)
+        qscale = hp[H_GAIN] * 1e-3 * math.sqrt(ps)
+        return np.array([(qa - leak) / qscale, (qb + leak) / qscale,
+                         (pa * aa - pb * ab - force) / (ps * aa)])
+
+    z, info, ok, msg = fsolve(residual, [0.0, pa0 / scale_p, pb0 / scale_p], full_output=True,
+                              xtol=1e-13)
+    if ok != 1 or np.max(np.abs(residual(z))) > 1e-9:
+        raise ConfigError(f"no static hydraulic equilibrium for leg force {force:.4g} N "
+                          f"({msg}); check the [hydraulics] section.")
+    return float(z[0] * 1e-3), float(z[1] * scale_p), float(z[2] * scale_p)
+
+
+def hydraulic_natural_frequency(hydraulics: Hydraulics, effective_mass: float,
+                                piston_position: float = 0.0) -> float:
+    """Hydraulic natural frequency w_h (rad/s) of one leg moving a mass ``effective_mass`` (kg).
+
+    w_h = sqrt(beta (A_A^2 / V_A + A_B^2 / V_B) / m), with chamber volumes at
+    ``piston_position`` (m from mid-stroke).
+    """
+    h = hydraulics
+    va = h.dead_volume + h.piston_area * (h.stroke / 2 + piston_position)
+    vb = h.dead_volume + h.annulus_area * (h.stroke / 2 - piston_position)
+    stiffness = h.bulk_modulus * (h.piston_area ** 2 / va + h.annulus_area ** 2 / vb)
+    return math.sqrt(stiffness / effective_mass)

@@ -1,0 +1,244 @@
+"""The compiled closed loop: rigid-body plant, joint friction, actuators and leg servos.
+
+State vector y (42 values): q (6), q_dot (6), PID integrators z (6, m s), valve spools x_v
+(6, fraction) and their rates (6, 1/s), chamber pressures p_A (6, Pa) and p_B (6, Pa). In
+``ideal`` actuator mode the valve and pressure states are frozen and the leg forces are the
+controller's demands.
+
+Integration: classical fixed-step Runge-Kutta (RK4) inside one numba loop; the commanded
+leg lengths, their rates and the gravity feed-forward are tabulated beforehand on the
+half-step grid that RK4 samples. Step choice: the fastest dynamics of the hydraulic loop are
+the spool (80 Hz, w_v = 503 rad/s, damping 0.7: eigenvalues |lambda| = 503 rad/s), the
+inner force loop and the hydraulic resonance of the legs (15-25 Hz); RK4 is stable for
+|lambda h| < 2.78 and accurate to O((lambda h)^4). The default step of 0.25 ms
+(|lambda h| = 0.13 for the spool) is 20x inside the stability limit; the step-halving test
+(``tests/test_simulation.py``) shows the recorded signals change by far less than the sensor
+resolution when it is halved. The regularised Coulomb friction adds a damping Fc / s per
+joint axis near zero rate (s = 1e-4 rad/s: 5e4 N m s/rad at Fc = 5 N m, about ten times the
+viscous gimbal friction, |lambda| < 100 rad/s), which the same step resolves.
+
+Friction: viscous on the four gimbal axes of each leg, Coulomb on all five rotational axes,
+regularised as Fc w / sqrt(w^2 + s^2) (:func:`stewartid._kernels.joint_friction`). Within
+|w| < s a joint behaves as a very stiff viscous damper: it sticks (creeps at a rate below
+s, 1e-4 rad/s) until the applied torque exceeds Fc, then slips with the full Coulomb torque
+opposing the motion, so the stick-slip transitions are resolved without event detection.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from stewartid import _kernels
+from stewartid.simulation.controller import pid_force, valve_command
+from stewartid.simulation.hydraulics import H_MID, H_STROKE, actuator_force, pressure_rates
+
+# state layout
+S_Q, S_QD, S_Z, S_XV, S_VV, S_PA, S_PB = 0, 6, 12, 18, 24, 30, 36
+N_STATES = 42
+H_VALVE_OMEGA, H_VALVE_ZETA = 10, 11
+
+#: Status codes returned by :func:`integrate`.
+STATUS_OK, STATUS_STROKE, STATUS_NONFINITE = 0, 1, 2
+
+
+@njit(cache=True)
+def _solve_spd(M: np.ndarray, b: np.ndarray, L: np.ndarray, out: np.ndarray) -> None:
+    """Solve M x = b for a symmetric positive definite 6x6 M by Cholesky (no allocation)."""
+    n = 6
+    for i in range(n):
+        for j in range(i + 1):
+            s = M[i, j]
+            for k in range(j):
+                s -= L[i, k] * L[j, k]
+            if i == j:
+                L[i, i] = math.sqrt(s)
+            else:
+                L[i, j] = s / L[j, j]
+    for i in range(n):
+        s = b[i]
+        for k in range(i):
+            s -= L[i, k] * out[k]
+        out[i] = s / L[i, i]
+    for i in range(n - 1, -1, -1):
+        s = out[i]
+        for k in range(i + 1, n):
+            s -= L[k, i] * out[k]
+        out[i] = s / L[i, i]
+
+
+@njit(cache=True)
+def rhs(y, dy, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, hydraulic,
+        smoothing, M, h, G, J, Jj, lengths, rates, force, demand, work, chol, qdd):
+    """Closed-loop state derivative (written into ``dy``) at one instant.
+
+    ``cmd_*`` are the (6,) commanded leg lengths (m), rates (m/s) and feed-forward (N) at
+    this instant; the remaining arrays are scratch outputs: model terms, leg lengths and
+    rates, the actual leg forces ``force`` and the controller's ``demand`` (N).
+    """
+    q = y[S_Q:S_Q + 6]
+    qd = y[S_QD:S_QD + 6]
+    _kernels.model_terms(params, upper, base, q, qd, M, h, G, J, Jj, lengths)
+    for i in range(6):
+        s = 0.0
+        for c in range(6):
+            s += J[i, c] * qd[c]
+        rates[i] = s
+    for i in range(6):
+        f_d, z_dot = pid_force(cp, cmd_length[i] - lengths[i], cmd_rate[i] - rates[i],
+                               y[S_Z + i], cmd_force[i])
+        demand[i] = f_d
+        dy[S_Z + i] = z_dot
+        if hydraulic:
+            xv = y[S_XV + i]
+            vv = y[S_VV + i]
+            pa = y[S_PA + i]
+            pb = y[S_PB + i]
+            f = actuator_force(hp, pa, pb)
+            u = valve_command(cp, f_d, f)
+            w = hp[H_VALVE_OMEGA]
+            dy[S_XV + i] = vv
+            dy[S_VV + i] = w * w * (u - xv) - 2.0 * hp[H_VALVE_ZETA] * w * vv
+            dpa, dpb = pressure_rates(hp, xv, pa, pb, lengths[i], rates[i])
+            dy[S_PA + i] = dpa
+            dy[S_PB + i] = dpb
+            force[i] = f
+        else:
+            dy[S_XV + i] = 0.0
+            dy[S_VV + i] = 0.0
+            dy[S_PA + i] = 0.0
+            dy[S_PB + i] = 0.0
+            force[i] = f_d
+    # generalized forces: J^T f - h - G - friction
+    for c in range(6):
+        s = -h[c] - G[c]
+        for i in range(6):
+            s += J[i, c] * force[i]
+        work[c] = s
+    viscous = params[_kernels.P_VISCOUS]
+    coulomb = params[_kernels.P_COULOMB]
+    for i in range(6):
+        for j in range(_kernels.N_JOINTS):
+            w = 0.0
+            for c in range(6):
+                w += Jj[i, j, c] * qd[c]
+            tau = 0.0
+            if coulomb > 0.0:
+                tau = coulomb * w / math.sqrt(w * w + smoothing * smoothing)
+            if j < 4:
+                tau += viscous * w
+            for c in range(6):
+                work[c] -= tau * Jj[i, j, c]
+    _solve_spd(M, work, chol, qdd)
+    for c in range(6):
+        dy[S_Q + c] = qd[c]
+        dy[S_QD + c] = qdd[c]
+
+
+@njit(cache=True)
+def integrate(y0, step, substeps, n_out, cmd_length, cmd_rate, cmd_force, params, upper, base,
+              hp, cp, hydraulic, smoothing):
+    """Integrate the closed loop with RK4 and record every ``substeps`` steps.
+
+    Parameters
+    ----------
+    y0 : (42,) initial state.
+    step : float
+        Integration step h (s).
+    substeps : int
+        Steps per recorded sample (output period = substeps * h).
+    n_out : int
+        Number of recorded samples (the first at t = 0).
+    cmd_length, cmd_rate, cmd_force : (2 * substeps * (n_out - 1) + 1, 6)
+        Commands on the half-step grid t = k h / 2.
+    params, upper, base : packed platform.
+    hp, cp : packed hydraulic and controller parameters.
+    hydraulic : bool
+        Hydraulic actuators (True) or ideal force actuators (False).
+    smoothing : float
+        Coulomb regularisation rate (rad/s).
+
+    Returns
+    -------
+    status : int
+        0 ok, 1 a leg left its stroke, 2 the state became non-finite.
+    where : int
+        Recorded sample at which integration stopped (n_out if it finished), or the leg for
+        status 1 is ``leg`` below.
+    leg : int
+        Leg index for status 1, else -1.
+    states : (n_out, 42) recorded states.
+    qdd, lengths, rates, force, demand : (n_out, 6) recorded accelerations, leg lengths,
+        leg rates, actual leg forces and force demands.
+    """
+    n = N_STATES
+    states = np.zeros((n_out, n))
+    rec_qdd = np.zeros((n_out, 6))
+    rec_len = np.zeros((n_out, 6))
+    rec_rate = np.zeros((n_out, 6))
+    rec_force = np.zeros((n_out, 6))
+    rec_demand = np.zeros((n_out, 6))
+    M = np.empty((6, 6))
+    h = np.empty(6)
+    G = np.empty(6)
+    J = np.empty((6, 6))
+    Jj = np.empty((6, 5, 6))
+    lengths = np.empty(6)
+    rates = np.empty(6)
+    force = np.empty(6)
+    demand = np.empty(6)
+    work = np.empty(6)
+    chol = np.zeros((6, 6))
+    qdd = np.empty(6)
+    y = y0.copy()
+    yt = np.empty(n)
+    k1 = np.empty(n)
+    k2 = np.empty(n)
+    k3 = np.empty(n)
+    k4 = np.empty(n)
+    half_stroke = 0.5 * hp[H_STROKE]
+    total = substeps * (n_out - 1)
+    for s in range(total + 1):
+        g = 2 * s
+        rhs(y, k1, cmd_length[g], cmd_rate[g], cmd_force[g], params, upper, base, hp, cp,
+            hydraulic, smoothing, M, h, G, J, Jj, lengths, rates, force, demand, work, chol,
+            qdd)
+        if s % substeps == 0:
+            r = s // substeps
+            states[r] = y
+            for c in range(6):
+                rec_qdd[r, c] = qdd[c]
+                rec_len[r, c] = lengths[c]
+                rec_rate[r, c] = rates[c]
+                rec_force[r, c] = force[c]
+                rec_demand[r, c] = demand[c]
+            for i in range(6):
+                if abs(lengths[i] - hp[H_MID]) > half_stroke:
+                    return STATUS_STROKE, r, i, states, rec_qdd, rec_len, rec_rate, \
+                        rec_force, rec_demand
+            for c in range(n):
+                if not math.isfinite(y[c]):
+                    return STATUS_NONFINITE, r, -1, states, rec_qdd, rec_len, rec_rate, \
+                        rec_force, rec_demand
+        if s == total:
+            break
+        for c in range(n):
+            yt[c] = y[c] + 0.5 * step * k1[c]
+        rhs(yt, k2, cmd_length[g + 1], cmd_rate[g + 1], cmd_force[g + 1], params, upper, base,
+            hp, cp, hydraulic, smoothing, M, h, G, J, Jj, lengths, rates, force, demand, work,
+            chol, qdd)
+        for c in range(n):
+            yt[c] = y[c] + 0.5 * step * k2[c]
+        rhs(yt, k3, cmd_length[g + 1], cmd_rate[g + 1], cmd_force[g + 1], params, upper, base,
+            hp, cp, hydraulic, smoothing, M, h, G, J, Jj, lengths, rates, force, demand, work,
+            chol, qdd)
+        for c in range(n):
+            yt[c] = y[c] + step * k3[c]
+        rhs(yt, k4, cmd_length[g + 2], cmd_rate[g + 2], cmd_force[g + 2], params, upper, base,
+            hp, cp, hydraulic, smoothing, M, h, G, J, Jj, lengths, rates, force, demand, work,
+            chol, qdd)
+        for c in range(n):
+            y[c] += step / 6.0 * (k1[c] + 2.0 * k2[c] + 2.0 * k3[c] + k4[c])
+    return STATUS_OK, n_out, -1, states, rec_qdd, rec_len, rec_rate, rec_force, rec_demand

@@ -1,0 +1,83 @@
+"""Sensors: sampling, leg-length and actuator-force measurement errors, forward kinematics.
+
+A measurement is quantise(true + bias + noise): Gaussian noise of standard deviation
+``*_noise`` drawn from a seeded generator, a constant ``*_bias`` and rounding to a multiple
+of ``*_resolution`` (none when 0). The force sensor stands for the two pressure transducers
+of a leg (f = p_A A_A - p_B A_B); its errors are given in newtons. The measured pose is the
+forward kinematics of the measured leg lengths, as on a real hexapod without pose sensors.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from stewartid.errors import ConfigError
+from stewartid.kinematics import forward_kinematics
+from stewartid.platform import Platform, Sensors
+
+
+@dataclasses.dataclass(frozen=True)
+class SensorNoise:
+    """Measurement errors of the leg-length and force sensors (all zero: ideal sensors).
+
+    Attributes
+    ----------
+    length_noise, length_bias, length_resolution : float
+        m (standard deviation, offset, quantisation step).
+    force_noise, force_bias, force_resolution : float
+        N.
+    """
+
+    length_noise: float = 0.0
+    length_bias: float = 0.0
+    length_resolution: float = 0.0
+    force_noise: float = 0.0
+    force_bias: float = 0.0
+    force_resolution: float = 0.0
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):
+            value = float(getattr(self, f.name))
+            if not np.isfinite(value) or ("bias" not in f.name and value < 0):
+                raise ConfigError(f"sensor {f.name} must be a finite value >= 0; got {value!r}.")
+            object.__setattr__(self, f.name, value)
+
+    @classmethod
+    def from_sensors(cls, sensors: Sensors) -> SensorNoise:
+        """The errors declared in a platform's ``[sensors]`` section."""
+        return cls(**{f.name: getattr(sensors, f.name) for f in dataclasses.fields(cls)})
+
+    @property
+    def is_ideal(self) -> bool:
+        """True when every error is zero."""
+        return all(getattr(self, f.name) == 0.0 for f in dataclasses.fields(self))
+
+
+def measure(true: np.ndarray, noise: float, bias: float, resolution: float,
+            rng: np.random.Generator) -> np.ndarray:
+    """quantise(true + bias + N(0, noise^2)) element-wise; same shape as ``true``."""
+    out = np.asarray(true, dtype=float) + bias
+    if noise > 0:
+        out = out + rng.normal(0.0, noise, size=out.shape)
+    if resolution > 0:
+        out = resolution * np.round(out / resolution)
+    return out
+
+
+def measure_legs(lengths: np.ndarray, forces: np.ndarray, noise: SensorNoise,
+                 rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """Measured leg lengths (m) and forces (N), both (N, 6), from the true ones."""
+    return (measure(lengths, noise.length_noise, noise.length_bias, noise.length_resolution,
+                    rng),
+            measure(forces, noise.force_noise, noise.force_bias, noise.force_resolution, rng))
+
+
+def measured_pose(platform: Platform, lengths: np.ndarray) -> np.ndarray:
+    """The forward-kinematics block: pose (N, 6) from measured leg lengths (N, 6).
+
+    Newton from the neutral pose for every sample (the motion is small), to a residual of
+    1e-12 m on the leg lengths.
+    """
+    return forward_kinematics(platform, lengths, tolerance=1e-12)
