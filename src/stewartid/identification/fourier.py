@@ -1,0 +1,232 @@
+"""Method A: first-harmonic Fourier identification (Tian et al.), as compared in Zhang (2020).
+
+Each experiment excites the platform with a sine of frequency f (one DOF at a time in the
+classical protocol, any combination here). Over a whole period the first-harmonic
+coefficients
+
+    x_c = (2/N) sum x(t) cos(w t),   x_s = (2/N) sum x(t) sin(w t),   w = 2 pi f,
+
+of the linear model y = Mt q_ddot + Bt q_dot + G0 + Fc turn it into algebraic equations
+
+    y_c = Mt qdd_c + Bt qd_c,   y_s = Mt qdd_s + Bt qd_s
+
+in all six channels: constants (static load, offsets) drop out because the period is whole.
+With one single-DOF experiment per DOF this gives column k of Mt and Bt from experiment k;
+stacking the equations of every period of every experiment gives a least-squares problem for
+the 72 unknowns whose period-to-period scatter yields the standard errors.
+
+Coulomb friction is the method's weakness: a square wave of level Fc in phase with the
+velocity has the first harmonic (4/pi) Fc sin(w t + phase of velocity), which is
+indistinguishable from viscous friction and lands in Bt as (4/pi) Fc / (w A).
+
+With two or more excitation frequencies a stiffness matrix K can be identified alongside
+(``stiffness=True``): y = Mt q_ddot + Bt q_dot + K (q - q0), with the harmonic coefficients
+of each frequency as separate equations (at a single frequency K q = -K q_ddot / w^2 is
+indistinguishable from inertia).
+
+References
+----------
+Tian, Y. et al., identification of the dynamic parameters of a Stewart platform from
+single-DOF sine excitation (Method A in the comparison of Zhang 2020).
+Zhang, H. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
+Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from stewartid.dataset import Dataset
+from stewartid.errors import DataError, IdentificationError
+from stewartid.identification.base import (
+    BaseIdentifier,
+    check_parameter,
+    prepare,
+    regressor_names,
+    solve_least_squares,
+)
+from stewartid.identification.results import IdentificationResult
+from stewartid.identification.signals import (
+    DEFAULT_ORDER,
+    default_window,
+    differentiate,
+    estimate_frequency,
+    savgol_gain,
+    trim,
+)
+from stewartid.platform import Platform
+
+
+def harmonic_coefficients(x: np.ndarray, t: np.ndarray, frequencies_hz: Sequence[float]
+                          ) -> np.ndarray:
+    """In-phase and quadrature coefficients of ``x`` at ``frequencies_hz`` over a segment.
+
+    Least-squares fit of x(t) = c0 + sum_f [x_c cos(2 pi f t) + x_s sin(2 pi f t)]. Over a
+    whole number of periods of a single frequency this equals the Fourier coefficients
+    (2/N) sum x cos, (2/N) sum x sin exactly (the columns are orthogonal); for several
+    frequencies it removes the residual leakage between them.
+
+    Parameters
+    ----------
+    x : ndarray, shape (N, m)
+    t : ndarray, shape (N,)
+        Time (s).
+    frequencies_hz : sequence of float
+
+    Returns
+    -------
+    ndarray, shape (2 * F, m)
+        Rows (cos f1, sin f1, cos f2, sin f2, ...).
+    """
+    columns = [np.ones_like(t)]
+    for f in frequencies_hz:
+        columns += [np.cos(2 * np.pi * f * t), np.sin(2 * np.pi * f * t)]
+    design = np.column_stack(columns)
+    coefficients, *_ = np.linalg.lstsq(design, x, rcond=None)
+    return coefficients[1:]
+
+
+class FourierIdentifier(BaseIdentifier):
+    """Method A: first-harmonic Fourier identification of Mt and Bt over whole periods.
+
+    Parameters
+    ----------
+    frequency_hz : float or sequence of float, optional
+        Excitation frequency (Hz), or several. Detected from each experiment's motion when
+        not given (the dominant sine).
+    window : float, optional
+        Savitzky-Golay window (s) for q_dot, q_ddot; 0.2 periods of the highest frequency by
+        default (see :mod:`stewartid.identification.signals`).
+    order : int
+        Savitzky-Golay polynomial order.
+    gravity : bool
+        Subtract the model's pose-dependent gravity term G(q) (recommended; without it the
+        legs' gravity stiffness biases Mt by -K_G / w^2).
+    stiffness : bool
+        Identify a stiffness matrix K as well (needs two or more frequencies).
+    symmetric : bool
+        Impose Mt = Mt^T and Bt = Bt^T.
+    periods_per_segment : int
+        Whole periods of the lowest frequency per equation block; every block of every
+        experiment contributes two equations per frequency and channel.
+
+    Attributes
+    ----------
+    M_, B_ : ndarray, shape (6, 6)
+    std_errors_ : dict of ndarray (6, 6)
+    condition_number_ : float
+    stiffness_ : ndarray, shape (6, 6) or None
+    frequencies_ : list of list of float
+        Frequencies used per experiment (Hz).
+    result_ : IdentificationResult
+
+    References
+    ----------
+    Zhang (2020), doi:10.3390/math8020257, Section 4 (Method A).
+    """
+
+    method = "fourier"
+
+    def __init__(self, frequency_hz: float | Sequence[float] | None = None,
+                 window: float | None = None, order: int = DEFAULT_ORDER, gravity: bool = True,
+                 stiffness: bool = False, symmetric: bool = False,
+                 periods_per_segment: int = 1):
+        self.frequency_hz = frequency_hz
+        self.window = window
+        self.order = order
+        self.gravity = gravity
+        self.stiffness = stiffness
+        self.symmetric = symmetric
+        self.periods_per_segment = periods_per_segment
+
+    def _validate_params(self) -> None:
+        owner = type(self).__name__
+        freqs = self._given_frequencies()
+        check_parameter(owner, "frequency_hz", self.frequency_hz,
+                        freqs is None or (len(freqs) > 0 and all(
+                            np.isfinite(f) and f > 0 for f in freqs)),
+                        "a positive float, a sequence of them, or None")
+        check_parameter(owner, "window", self.window,
+                        self.window is None or (np.isfinite(self.window) and self.window > 0),
+                        "a positive float (s) or None")
+        check_parameter(owner, "order", self.order,
+                        isinstance(self.order, int | np.integer) and self.order >= 3,
+                        "an int >= 3")
+        check_parameter(owner, "periods_per_segment", self.periods_per_segment,
+                        isinstance(self.periods_per_segment, int | np.integer)
+                        and self.periods_per_segment >= 1, "an int >= 1")
+        if self.stiffness and freqs is not None and len(freqs) < 2:
+            raise IdentificationError(
+                "a stiffness matrix cannot be separated from inertia at a single excitation "
+                f"frequency ({freqs[0]} Hz); give two or more frequencies in frequency_hz or "
+                "switch stiffness off.")
+
+    def _given_frequencies(self) -> list[float] | None:
+        if self.frequency_hz is None:
+            return None
+        if np.ndim(self.frequency_hz) == 0:
+            return [float(self.frequency_hz)]
+        return [float(f) for f in self.frequency_hz]
+
+    def _fit(self, datasets: list[Dataset], platform: Platform) -> IdentificationResult:
+        experiments = prepare(datasets, platform, gravity=self.gravity)
+        rows_motion, rows_force, used = [], [], []
+        for exp in experiments:
+            freqs = self._given_frequencies() or [estimate_frequency(exp.q, exp.sample_rate)]
+            window = self.window or default_window(max(freqs))
+            q0 = exp.q.mean(axis=0)
+            q, qd, qdd = differentiate(exp.q - q0, exp.sample_rate, window, self.order)
+            cut = trim(window, exp.sample_rate, self.order)
+            segment = self.periods_per_segment * exp.sample_rate / min(freqs)
+            usable = len(exp.t) - 2 * cut
+            n_segments = int(np.floor(usable / segment + 1e-9))
+            if n_segments < 1:
+                raise DataError(
+                    f"{exp.name}: {usable / exp.sample_rate:.3g} s usable after the "
+                    f"differentiation window, less than {self.periods_per_segment} period(s) of "
+                    f"{min(freqs):.4g} Hz; record longer or lower periods_per_segment.")
+            # undo the differentiator's amplitude bias at each frequency (exact: the filter
+            # has zero phase)
+            gains = np.ones((2 * len(freqs), 18))
+            for k, f in enumerate(freqs):
+                for d, columns in ((2, slice(0, 6)), (1, slice(6, 12)), (0, slice(12, 18))):
+                    gains[2 * k:2 * k + 2, columns] = savgol_gain(f, exp.sample_rate, window,
+                                                                  self.order, d)
+            blocks = []
+            for s in range(n_segments):
+                start = cut + int(round(s * segment))
+                stop = cut + int(round((s + 1) * segment))
+                sl = slice(start, stop)
+                t = exp.t[sl]
+                signals = np.concatenate([qdd[sl], qd[sl], q[sl], exp.generalized_force[sl]],
+                                         axis=1)
+                coefficients = harmonic_coefficients(signals, t, freqs)
+                coefficients[:, :18] /= gains
+                rows_motion.append(coefficients[:, :18])
+                rows_force.append(coefficients[:, 18:])
+                blocks.append([float(t[0]), float(t[-1] + 1.0 / exp.sample_rate)])
+            used.append({"name": exp.name, "frequencies_hz": freqs, "window_s": window,
+                         "segments": blocks})
+        motion = np.concatenate(rows_motion)
+        force = np.concatenate(rows_force)
+        groups = ["q_ddot", "q_dot"] + (["q"] if self.stiffness else [])
+        phi = motion[:, :6 * len(groups)]
+        solution = solve_least_squares(phi, force, symmetric=self.symmetric,
+                                       regressor_names=regressor_names(*groups))
+        theta, std = solution.theta, solution.theta_std
+        stiffness = theta[:, 12:18] if self.stiffness else None
+        self.stiffness_ = stiffness
+        self.frequencies_ = [u["frequencies_hz"] for u in used]
+        diagnostics = {"experiments": used, "n_equations": int(solution.n_equations)}
+        if stiffness is not None:
+            diagnostics["K"] = stiffness
+            diagnostics["std_errors_K"] = std[:, 12:18]
+        return IdentificationResult(
+            M=theta[:, :6], B=theta[:, 6:12], std_errors_M=std[:, :6], std_errors_B=std[:, 6:12],
+            condition_number=solution.condition_number, residual_rms=solution.residual_rms,
+            method=self.method, settings=self.get_params(), diagnostics=diagnostics)
+
+
+__all__ = ["FourierIdentifier", "harmonic_coefficients"]
