@@ -1,0 +1,87 @@
+"""Time-domain least squares with Coulomb terms against the linear model it assumes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from linear_model_data import AMPLITUDES, make_experiment, random_matrices
+from stewartid.errors import IdentificationError
+from stewartid.identification.base import integrated_autocorrelation, solve_least_squares
+from stewartid.identification.least_squares import (
+    JOINT_TYPES,
+    LeastSquaresIdentifier,
+    coulomb_regressors,
+)
+
+
+def _coulomb(levels):
+    def force(t, q, qd, J):
+        return np.einsum("nsi,s->ni", coulomb_regressors(J, qd, 0.0), levels)
+    return force
+
+
+def test_recovers_mt_bt_offsets_and_coulomb_levels(paper):
+    M, B = random_matrices(np.random.default_rng(3))
+    levels = np.array([30.0, 20.0, 10.0])
+    offset = np.array([50.0, -20.0, 300.0, 5.0, -8.0, 2.0])
+    data = []
+    for k in range(6):
+        # a second, slower sine in another DOF: joints switch at different times
+        extra = [((k + 2) % 6, AMPLITUDES[(k + 2) % 6] / 3, 2 * np.pi * 0.37, 0.5)]
+        data.append(make_experiment(paper, M, B, k, extra=extra, offset=offset,
+                                    coulomb=_coulomb(levels), periods=5))
+    est = LeastSquaresIdentifier(coulomb_smoothing=0.0).fit(data, paper)
+    assert est.M_ == pytest.approx(M, abs=2e-3 * np.abs(M).max())
+    assert est.B_ == pytest.approx(B, abs=2e-3 * np.abs(B).max())
+    got = np.array([est.coulomb_[name] for name in JOINT_TYPES])
+    assert got == pytest.approx(levels, rel=0.02)
+    # the offsets share part of their column space with the Coulomb terms (mean sign)
+    assert est.offsets_ == pytest.approx(np.tile(offset, (6, 1)), abs=0.03 * 300.0)
+
+
+def test_symmetric_constraint(paper):
+    M, B = random_matrices(np.random.default_rng(4))
+    data = [make_experiment(paper, M, B, k) for k in range(6)]
+    est = LeastSquaresIdentifier(coulomb=False, symmetric=True).fit(data, paper)
+    assert est.M_ == pytest.approx(est.M_.T)
+    assert est.M_ == pytest.approx(M, abs=1e-4 * np.abs(M).max())
+
+
+def test_solver_standard_errors_match_scatter():
+    rng = np.random.default_rng(0)
+    theta = rng.normal(size=(6, 13))
+    errors = []
+    for _ in range(40):
+        phi = np.column_stack([rng.normal(size=(300, 12)), np.ones(300)])
+        y = phi @ theta.T + rng.normal(size=(300, 6)) * np.array([1, 1, 1, 10, 10, 10])
+        sol = solve_least_squares(phi, y)
+        errors.append((sol.theta - theta) / sol.theta_std)
+    assert np.std(errors) == pytest.approx(1.0, abs=0.1)
+
+
+def test_solver_names_the_unexcited_dof():
+    rng = np.random.default_rng(1)
+    phi = rng.normal(size=(100, 12))
+    phi[:, 4] = 0.0
+    names = [f"{g}[{c}]" for g in ("q_ddot", "q_dot") for c in ("x", "y", "z", "rx", "ry", "rz")]
+    with pytest.raises(IdentificationError, match="DOF ry was never excited"):
+        solve_least_squares(phi, rng.normal(size=(100, 6)), regressor_names=names)
+
+
+def test_integrated_autocorrelation():
+    rng = np.random.default_rng(2)
+    white = rng.normal(size=20000)
+    assert integrated_autocorrelation(white) == pytest.approx(1.0, abs=0.2)
+    smooth = np.convolve(white, np.ones(20) / 20, mode="valid")
+    assert integrated_autocorrelation(smooth) == pytest.approx(20.0, rel=0.2)
+
+
+@pytest.mark.slow
+def test_example_c10_least_squares(example_dir, example_platform, example_truth):
+    est = LeastSquaresIdentifier().fit([example_dir], example_platform)
+    for level in est.coulomb_.values():
+        assert level == pytest.approx(example_truth["coulomb"], rel=0.1)
+    table = est.result_.comparison_table(example_truth["Mt"], example_truth["Bt"])
+    diag = table[table.i == table.j]
+    assert diag["error_percent"].max() < 1.0
