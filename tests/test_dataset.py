@@ -1,0 +1,124 @@
+"""Interchange format: round trips and every bad-input case."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from stewartid.dataset import (
+    COLUMNS,
+    Dataset,
+    DataWarning,
+    read_dataset,
+    read_datasets,
+    write_dataset,
+)
+from stewartid.errors import DataError
+from stewartid.kinematics import leg_lengths
+
+
+@pytest.fixture()
+def dataset(paper):
+    t = np.arange(400) / 200.0
+    pose = np.tile(paper.neutral_pose, (len(t), 1))
+    pose[:, 0] += 0.01 * np.sin(2 * np.pi * t)
+    pose[:, 4] += 0.004 * np.cos(2 * np.pi * 0.5 * t)
+    forces = np.random.default_rng(0).normal(3e4, 100.0, size=(len(t), 6))
+    return Dataset(t=t, pose=pose, lengths=leg_lengths(paper, pose), forces=forces, name="run")
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_round_trip(tmp_path, dataset, suffix):
+    path = write_dataset(dataset, tmp_path / f"run{suffix}")
+    back = read_dataset(path)
+    assert back.name == "run"
+    for field in ("t", "pose", "lengths", "forces"):
+        assert np.array_equal(getattr(back, field), getattr(dataset, field))
+    assert back.sample_rate == pytest.approx(200.0)
+    assert not list(tmp_path.glob(".*.tmp"))
+
+
+def _write(tmp_path, frame, name="bad.csv"):
+    path = tmp_path / name
+    frame.to_csv(path, index=False)
+    return path
+
+
+def test_pose_from_leg_lengths_by_forward_kinematics(tmp_path, dataset, paper):
+    frame = dataset.to_frame().drop(columns=["x", "y", "z", "rx", "ry", "rz"])
+    back = read_dataset(_write(tmp_path, frame, "legs.csv"), paper)
+    assert back.pose == pytest.approx(dataset.pose, abs=1e-9)
+    with pytest.raises(DataError, match="pose .* is missing and no platform"):
+        read_dataset(tmp_path / "legs.csv")
+
+
+def test_lengths_from_pose(tmp_path, dataset, paper):
+    frame = dataset.to_frame().drop(columns=[f"l{k}" for k in range(1, 7)])
+    back = read_dataset(_write(tmp_path, frame, "pose.csv"), paper)
+    assert back.lengths == pytest.approx(dataset.lengths, abs=1e-12)
+
+
+def test_missing_columns(tmp_path, dataset):
+    with pytest.raises(DataError, match=r"bad.csv: missing required column\(s\) f3"):
+        read_dataset(_write(tmp_path, dataset.to_frame().drop(columns=["f3"])))
+    frame = dataset.to_frame().drop(columns=["x", "l2"])
+    with pytest.raises(DataError, match="needs either the pose columns .* missing x, l2"):
+        read_dataset(_write(tmp_path, frame))
+
+
+def test_non_finite_value(tmp_path, dataset):
+    frame = dataset.to_frame()
+    frame.loc[17, "f2"] = np.nan
+    with pytest.raises(DataError, match="column 'f2' has a missing.* at row 17"):
+        read_dataset(_write(tmp_path, frame))
+    frame = dataset.to_frame().astype(object)
+    frame.loc[3, "rx"] = "abc"
+    with pytest.raises(DataError, match="column 'rx'"):
+        read_dataset(_write(tmp_path, frame))
+
+
+def test_time_not_increasing(tmp_path, dataset):
+    frame = dataset.to_frame()
+    frame.loc[10, "t"] = frame.loc[9, "t"]
+    with pytest.raises(DataError, match="'t' must be strictly increasing; row 10"):
+        read_dataset(_write(tmp_path, frame))
+
+
+def test_non_uniform_time_is_resampled_with_a_warning(tmp_path, dataset):
+    frame = dataset.to_frame()
+    frame["t"] = frame["t"] + 0.002 * np.sin(np.arange(len(frame)))
+    with pytest.warns(DataWarning, match="not uniform .* resampled"):
+        back = read_dataset(_write(tmp_path, frame))
+    assert np.allclose(np.diff(back.t), np.diff(back.t)[0])
+
+
+def test_too_few_samples(tmp_path, dataset):
+    with pytest.raises(DataError, match="only 10 samples; at least 64"):
+        read_dataset(_write(tmp_path, dataset.to_frame().iloc[:10]))
+
+
+def test_unknown_suffix_and_missing_file(tmp_path, dataset):
+    with pytest.raises(DataError, match="unknown file type '.txt'"):
+        write_dataset(dataset, tmp_path / "x.txt")
+    with pytest.raises(DataError, match="no such data file"):
+        read_dataset(tmp_path / "absent.csv")
+
+
+def test_read_directory(example_dir):
+    data = read_datasets([example_dir])
+    assert [d.name for d in data] == [f"exp{k}" for k in range(1, 7)]
+    assert data[0].sample_rate == pytest.approx(1000.0)
+    assert list(data[0].to_frame().columns) == list(COLUMNS)
+
+
+def test_shape_check():
+    with pytest.raises(DataError, match=r"pose must have shape \(100, 6\)"):
+        Dataset(t=np.arange(100.0), pose=np.zeros((99, 6)), lengths=np.zeros((100, 6)),
+                forces=np.zeros((100, 6)))
+
+
+def test_frame_with_extra_columns_is_accepted(tmp_path, dataset):
+    frame = dataset.to_frame()
+    frame["comment"] = "x"
+    assert len(read_dataset(_write(tmp_path, pd.DataFrame(frame)))) == len(dataset)
