@@ -42,11 +42,27 @@ def test_margin_min_duration_and_ignored_joints():
     np.testing.assert_array_equal(active_joints(rates, 0.01), [True, False])
 
 
-def test_exact_zero_rate_belongs_to_no_interval():
+def test_touching_zero_is_not_a_reversal():
     t = np.arange(10.0)
     rates = np.array([1, 1, 1, 0, 1, 1, -1, -1, -1, -1.0])[:, None]
     np.testing.assert_allclose(constant_direction_intervals(t, rates, margin=0.0),
-                               [[0, 2], [4, 5], [6, 9]])
+                               [[0, 5], [6, 9]])
+
+
+def test_hysteresis_keeps_noisy_crossings_outside_the_intervals():
+    rng = np.random.default_rng(0)
+    clean = np.c_[np.sin(2 * np.pi * T), 0.3 * np.sin(2 * np.pi * T + 0.01)]
+    noise = np.c_[0.01 * rng.standard_normal((len(T), 2)), 1e-3 * rng.standard_normal(len(T))]
+    rates = np.c_[clean, np.zeros(len(T))] + noise  # third joint: pure noise
+    plain = constant_direction_intervals(T, rates, margin=0.0)
+    assert len(plain) > 100
+    got = constant_direction_intervals(T, rates, margin=0.0, hysteresis=[0.04, 0.04, 0.004])
+    assert len(got) == 8
+    crossings = np.arange(0.0, 4.01, 0.5)
+    for start, stop in got:
+        # every interval lies between two consecutive true zero crossings
+        k = np.searchsorted(crossings, start)
+        assert crossings[k - 1] <= start and stop <= crossings[k] + 1e-9
 
 
 def test_joint_rates_layout_and_actuator_rates(paper):

@@ -112,8 +112,8 @@ def active_joints(rates: np.ndarray, ignore_below: float = 0.0) -> np.ndarray:
 
 
 def constant_direction_intervals(t: np.ndarray, rates: np.ndarray, margin: float = 0.02,
-                                 min_duration: float = 0.0,
-                                 ignore_below: float = 0.0) -> np.ndarray:
+                                 min_duration: float = 0.0, ignore_below: float = 0.0,
+                                 hysteresis: np.ndarray | float = 0.0) -> np.ndarray:
     """Time intervals in which every (active) joint rate keeps its sign.
 
     Parameters
@@ -131,12 +131,19 @@ def constant_direction_intervals(t: np.ndarray, rates: np.ndarray, margin: float
     ignore_below : float
         Leave out joints whose rate RMS is below this fraction of the largest of their kind
         (see :func:`active_joints`).
+    hysteresis : float or ndarray, shape (J,)
+        Rate thresholds (units of ``rates``) for noisy measurements: a joint's direction
+        counts as known only while |rate| exceeds its threshold, and a reversal is confirmed
+        when the rate passes the opposite threshold. The interval before a reversal ends at
+        the last sample where the old direction was still confirmed, the next one starts at
+        the confirmation, so the unknown crossing time stays outside both. Joints that never
+        exceed their threshold are left out. 0 (default): plain signs.
 
     Returns
     -------
     ndarray, shape (M, 2)
-        [start, stop] times (s) of the intervals, in time order. A sample where a rate is
-        exactly zero belongs to no interval. The first and last runs are kept: a record that
+        [start, stop] times (s) of the intervals, in time order. A rate that touches zero
+        without changing sign does not end an interval. The first and last runs are kept: a record that
         starts or ends mid-interval still gives a usable, shorter, interval.
     """
     t = np.asarray(t, dtype=float)
@@ -150,19 +157,38 @@ def constant_direction_intervals(t: np.ndarray, rates: np.ndarray, margin: float
         raise IdentificationError(
             f"margin and min_duration must be >= 0 s; got {margin!r} and {min_duration!r}."
         )
-    used = rates[:, active_joints(rates, ignore_below)]
-    if used.shape[1] == 0 or len(t) < 2:
+    mask = active_joints(rates, ignore_below)
+    threshold = np.broadcast_to(np.asarray(hysteresis, dtype=float), (rates.shape[1],))
+    if np.any(threshold < 0):
+        raise IdentificationError("hysteresis thresholds must be >= 0.")
+    confirmed = np.abs(rates) > threshold
+    mask &= confirmed.any(axis=0)
+    used, confirmed, threshold = rates[:, mask], confirmed[:, mask], threshold[mask]
+    n = len(t)
+    if used.shape[1] == 0 or n < 2:
         return np.empty((0, 2))
-    signs = np.sign(used)
-    valid = np.all(signs != 0, axis=1)
-    same = np.all(signs[1:] == signs[:-1], axis=1) & valid[1:] & valid[:-1]
-    # runs of valid samples with no sign change between neighbours
-    breaks = np.flatnonzero(~same) + 1
+    index = np.arange(n)[:, None]
+    # last sample (up to each one) at which each joint's direction was confirmed
+    last = np.maximum.accumulate(np.where(confirmed, index, -1), axis=0)
+    state = np.where(last >= 0, np.sign(np.take_along_axis(used, np.maximum(last, 0), 0)),
+                     0.0)
+    valid = np.all(state != 0, axis=1)
+    changed = np.zeros_like(state, dtype=bool)
+    changed[1:] = state[1:] != state[:-1]
+    breaks = np.flatnonzero(changed.any(axis=1) | ~valid)
     starts = np.concatenate([[0], breaks])
-    stops = np.concatenate([breaks, [len(t)]]) - 1
-    keep = valid[starts]
-    starts, stops = starts[keep], stops[keep]
-    out = np.column_stack([t[starts] + margin, t[stops] - margin])
+    ends = np.concatenate([breaks, [n]])  # exclusive
+    out = []
+    for k1, k2 in zip(starts, ends, strict=True):
+        if k2 - k1 < 1 or not valid[k1]:
+            continue
+        stop = k2 - 1
+        if k2 < n and valid[k2]:
+            # end where the reversing joints last confirmed their old direction
+            stop = int(last[k2 - 1, changed[k2]].min())
+        if stop > k1:
+            out.append((t[k1] + margin, t[stop] - margin))
+    out = np.array(out, dtype=float).reshape(-1, 2)
     duration = out[:, 1] - out[:, 0]
     return out[(duration > 0) & (duration >= min_duration)]
 

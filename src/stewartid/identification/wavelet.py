@@ -104,6 +104,28 @@ def differentiate(x: np.ndarray, period: float, window: float, derivative: int) 
     return savgol_filter(x, n, 3, deriv=derivative, delta=period, axis=0, mode="interp")
 
 
+def rate_noise(rates: np.ndarray, period: float, window: float) -> np.ndarray:
+    """Noise level of each joint rate: robust standard deviation of what a four times wider
+    Savitzky-Golay smoother removes.
+
+    Parameters
+    ----------
+    rates : ndarray, shape (N, J)
+    period, window : float
+        Sample period and the differentiation window (s).
+
+    Returns
+    -------
+    ndarray, shape (J,)
+        1.4826 * median absolute deviation (units of ``rates``).
+    """
+    n = max(7, int(round(4 * window / period)) | 1)
+    if n > len(rates):
+        n = len(rates) if len(rates) % 2 else len(rates) - 1
+    residual = rates - savgol_filter(rates, n, 3, axis=0, mode="interp")
+    return 1.4826 * np.median(np.abs(residual - np.median(residual, axis=0)), axis=0)
+
+
 def wavelet_points(intervals: np.ndarray, wavelet: MotherWavelet,
                    scale_fractions: tuple[float, ...], shifts_per_scale: int,
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -172,6 +194,11 @@ class WaveletIdentifier(BaseIdentifier):
     differentiation_window : float
         Savitzky-Golay window (s) for the joint rates of the interval detection and, in the
         ``"paper"`` and ``"derivative"`` variants, for q_dot and q_ddot.
+    hysteresis : float
+        A joint's direction counts as known only while its rate exceeds this many times the
+        rate's noise level (estimated from the data, :func:`rate_noise`); reversals inside the
+        noise band are kept out of every interval (see
+        :func:`~stewartid.identification.intervals.constant_direction_intervals`).
     symmetric : bool
         Impose Mt = Mt^T and Bt = Bt^T in the solve.
     pair_selection : {"std_error", "none"}
@@ -202,7 +229,8 @@ class WaveletIdentifier(BaseIdentifier):
                  scale_fractions: tuple[float, ...] = (1.0, 0.8, 0.6),
                  shifts_per_scale: int = 5, margin: float = 0.02, ignore_below: float = 0.01,
                  min_interval: float | None = None, min_support_samples: int = 32,
-                 differentiation_window: float = 0.05, symmetric: bool = False,
+                 differentiation_window: float = 0.05, hysteresis: float = 4.0,
+                 symmetric: bool = False,
                  pair_selection: str = "std_error", gravity: bool = True):
         self.wavelet = wavelet
         self.wavelet_order = wavelet_order
@@ -215,6 +243,7 @@ class WaveletIdentifier(BaseIdentifier):
         self.min_interval = min_interval
         self.min_support_samples = min_support_samples
         self.differentiation_window = differentiation_window
+        self.hysteresis = hysteresis
         self.symmetric = symmetric
         self.pair_selection = pair_selection
         self.gravity = gravity
@@ -250,6 +279,9 @@ class WaveletIdentifier(BaseIdentifier):
         check_parameter(name, "differentiation_window", self.differentiation_window,
                         isinstance(self.differentiation_window, int | float)
                         and self.differentiation_window > 0, "a float in (0, inf) (s)")
+        check_parameter(name, "hysteresis", self.hysteresis,
+                        isinstance(self.hysteresis, int | float) and self.hysteresis >= 0,
+                        "a float in [0, inf)")
         check_parameter(name, "pair_selection", self.pair_selection,
                         self.pair_selection in PAIR_SELECTIONS, f"one of {PAIR_SELECTIONS}")
         make_wavelet(self.wavelet, **self._wavelet_options())
@@ -267,8 +299,10 @@ class WaveletIdentifier(BaseIdentifier):
         q_dot = differentiate(q, period, self.differentiation_window, 1)
         rates = joint_rates(platform, q, q_dot, experiment.joint_jacobians,
                             experiment.leg_jacobian)
+        thresholds = self.hysteresis * rate_noise(rates, period, self.differentiation_window)
         found = constant_direction_intervals(t, rates, margin=self.margin,
-                                             ignore_below=self.ignore_below)
+                                             ignore_below=self.ignore_below,
+                                             hysteresis=thresholds)
         lengths = found[:, 1] - found[:, 0]
         shortest = (self.min_interval if self.min_interval is not None
                     else 0.5 * float(np.median(lengths)) if len(lengths) else 0.0)
@@ -415,4 +449,4 @@ def select_symmetric_pairs(matrix: np.ndarray, std: np.ndarray) -> list[dict]:
 
 
 __all__ = ["PAIR_SELECTIONS", "VARIANTS", "WaveletIdentifier", "cluster_robust_std",
-           "differentiate", "select_symmetric_pairs", "wavelet_points"]
+           "differentiate", "rate_noise", "select_symmetric_pairs", "wavelet_points"]
