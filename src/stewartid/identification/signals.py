@@ -79,11 +79,23 @@ def differentiate(x: np.ndarray, sample_rate: float, window: float,
         raise DataError(f"record of {len(x)} samples is shorter than the differentiation "
                         f"window ({n} samples = {window:.3g} s); record longer or shorten "
                         "the window.")
+    from scipy.signal import oaconvolve, savgol_coeffs
+
     delta = 1.0 / sample_rate
-    smooth = savgol_filter(x, n, order, deriv=0, delta=delta, axis=0, mode="interp")
-    velocity = savgol_filter(x, n, order, deriv=1, delta=delta, axis=0, mode="interp")
-    acceleration = savgol_filter(x, n, order, deriv=2, delta=delta, axis=0, mode="interp")
-    return smooth, velocity, acceleration
+    half = n // 2
+    out = []
+    for deriv in (0, 1, 2):
+        # interior by FFT convolution (long windows), the two edge half-windows by the end
+        # polynomials of scipy's savgol_filter(mode="interp")
+        taps = savgol_coeffs(n, order, deriv=deriv, delta=delta, use="conv")
+        taps = taps.reshape((n,) + (1,) * (x.ndim - 1))
+        y = oaconvolve(x, taps, mode="same", axes=0)
+        head = savgol_filter(x[:n], n, order, deriv=deriv, delta=delta, axis=0, mode="interp")
+        tail = savgol_filter(x[-n:], n, order, deriv=deriv, delta=delta, axis=0, mode="interp")
+        y[:half] = head[:half]
+        y[len(x) - half:] = tail[n - half:]
+        out.append(y)
+    return out[0], out[1], out[2]
 
 
 def savgol_gain(frequency_hz: float, sample_rate: float, window: float,
