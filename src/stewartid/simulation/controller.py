@@ -100,6 +100,7 @@ def command_tables(params, upper, base, q_cmd, qd_cmd, feedforward):
     G = np.empty(6)
     J = np.empty((6, 6))
     Jj = np.empty((6, 5, 6))
+    A = np.empty((6, 7))
     for k in range(n):
         _kernels.model_terms(params, upper, base, q_cmd[k], qd_cmd[k], M, h, G, J, Jj,
                              lengths[k])
@@ -109,5 +110,35 @@ def command_tables(params, upper, base, q_cmd, qd_cmd, feedforward):
                 s += J[i, c] * qd_cmd[k, c]
             rates[k, i] = s
         if feedforward:
-            forces[k] = np.linalg.solve(J.T.copy(), G)
+            _solve_transposed(J, G, A, forces[k])
     return lengths, rates, forces
+
+
+@njit(cache=True)
+def _solve_transposed(J, b, A, x):
+    """Solve J^T x = b (6x6) by Gaussian elimination with partial pivoting, into ``x``.
+
+    A (6, 7) is scratch; a LAPACK call per sample would cost more than the model itself.
+    """
+    n = 6
+    for i in range(n):
+        for j in range(n):
+            A[i, j] = J[j, i]
+        A[i, n] = b[i]
+    for c in range(n):
+        p = c
+        for r in range(c + 1, n):
+            if abs(A[r, c]) > abs(A[p, c]):
+                p = r
+        if p != c:
+            for j in range(n + 1):
+                A[c, j], A[p, j] = A[p, j], A[c, j]
+        for r in range(c + 1, n):
+            f = A[r, c] / A[c, c]
+            for j in range(c, n + 1):
+                A[r, j] -= f * A[c, j]
+    for i in range(n - 1, -1, -1):
+        s = A[i, n]
+        for j in range(i + 1, n):
+            s -= A[i, j] * x[j]
+        x[i] = s / A[i, i]

@@ -218,7 +218,7 @@ def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: 
                             states[:, plant.S_PB:plant.S_PB + 6]], axis=-1),
         spools=states[:, plant.S_XV:plant.S_XV + 6])
     measured_lengths, measured_forces = measure_legs(lengths, forces, noise, rng)
-    pose = measured_pose(platform, measured_lengths)
+    pose = measured_pose(platform, measured_lengths, q_cmd[::2 * substeps])
     dataset = Dataset(t=t, pose=pose, lengths=measured_lengths, forces=measured_forces,
                       name=excitation.name)
     return dataset, record

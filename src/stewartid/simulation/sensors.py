@@ -74,10 +74,11 @@ def measure_legs(lengths: np.ndarray, forces: np.ndarray, noise: SensorNoise,
             measure(forces, noise.force_noise, noise.force_bias, noise.force_resolution, rng))
 
 
-def measured_pose(platform: Platform, lengths: np.ndarray) -> np.ndarray:
+def measured_pose(platform: Platform, lengths: np.ndarray,
+                  initial: np.ndarray | None = None) -> np.ndarray:
     """The forward-kinematics block: pose (N, 6) from measured leg lengths (N, 6).
 
-    Newton from the neutral pose for every sample (the motion is small), to a residual of
-    1e-12 m on the leg lengths.
+    Newton iterations to a residual of 1e-12 m on the leg lengths, started from ``initial``
+    (N, 6), e.g. the commanded poses that the controller knows, or from the neutral pose.
     """
-    return forward_kinematics(platform, lengths, tolerance=1e-12)
+    return forward_kinematics(platform, lengths, initial=initial, tolerance=1e-12)

@@ -1,0 +1,76 @@
+"""``stewartid simulate``: the paper's six virtual experiments written to a folder."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+
+def simulate(
+    out: Annotated[Path, typer.Option("--out", help="Output folder for exp1..exp6 and "
+                                      "meta.json.")],
+    platform: Annotated[str, typer.Option("--platform", help="'paper' for the preset, or a "
+                                          "platform TOML file.")] = "paper",
+    coulomb: Annotated[float | None, typer.Option("--coulomb", help="Coulomb friction per "
+                                                  "joint axis (N m); default: the platform's.")
+                       ] = None,
+    viscous: Annotated[float | None, typer.Option("--viscous", help="Viscous friction per "
+                                                  "gimbal axis (N m s/rad).")] = None,
+    frequency: Annotated[float, typer.Option("--frequency", help="Excitation sine frequency "
+                                             "(Hz).")] = 0.5,
+    duration: Annotated[float, typer.Option("--duration", help="Record length of each "
+                                            "experiment (s).")] = 20.0,
+    length_noise: Annotated[float | None, typer.Option(
+        "--length-noise", help="Leg-length sensor noise, standard deviation (m); default: "
+        "[sensors] length_noise.")] = None,
+    force_noise: Annotated[float | None, typer.Option(
+        "--force-noise", help="Force sensor noise, standard deviation (N); default: "
+        "[sensors] force_noise.")] = None,
+    actuator: Annotated[str | None, typer.Option(
+        "--actuator", help="'hydraulic' or 'ideal'; default: [hydraulics] mode.")] = None,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the sensor noise.")] = 0,
+    format: Annotated[str, typer.Option("--format", help="'csv' or 'parquet'.")] = "csv",
+    force: Annotated[bool, typer.Option("--force", help="Overwrite results already in "
+                                        "--out.")] = False,
+) -> None:
+    """Simulate the six experiments (experiment k excites DOF k) on the hydraulic plant."""
+    import dataclasses
+
+    from rich.progress import Progress
+
+    from stewartid.errors import ConfigError
+    from stewartid.platform import load_platform
+    from stewartid.simulation import SensorNoise, simulate_experiments, write_experiments
+
+    description = load_platform(platform)
+    if format not in ("csv", "parquet"):
+        raise ConfigError(f"--format must be 'csv' or 'parquet'; got {format!r}.")
+    if out.exists() and not force and out.is_dir() and any(
+            p.name == "meta.json" or p.name.startswith("exp") for p in out.iterdir()):
+        raise ConfigError(f"output folder {str(out)!r} already holds results; choose another "
+                          "folder or pass --force to overwrite.")
+    for name, value in (("--coulomb", coulomb), ("--viscous", viscous),
+                        ("--length-noise", length_noise), ("--force-noise", force_noise)):
+        if value is not None and not value >= 0:
+            raise ConfigError(f"{name} must be >= 0; got {value!r}.")
+    if not duration > 0:
+        raise ConfigError(f"--duration must be > 0 s; got {duration!r}.")
+    noise = SensorNoise.from_sensors(description.sensors)
+    if length_noise is not None:
+        noise = dataclasses.replace(noise, length_noise=length_noise)
+    if force_noise is not None:
+        noise = dataclasses.replace(noise, force_noise=force_noise)
+    with Progress(transient=True) as bar:
+        task = bar.add_task("simulating", total=6)
+
+        def progress(done: int, total: int, name: str) -> None:
+            bar.update(task, completed=done, description=f"simulated {name}")
+
+        result = simulate_experiments(description, coulomb=coulomb, viscous=viscous,
+                                      frequency_hz=frequency, duration_s=duration,
+                                      noise=noise, seed=seed, actuator=actuator,
+                                      progress=progress)
+    paths = write_experiments(result, out, format=format, force=force)
+    typer.echo(f"wrote {len(paths) - 1} experiments and meta.json to {out}")
