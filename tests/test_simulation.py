@@ -156,3 +156,24 @@ def test_least_squares_on_simulated_data_recovers_nominal_matrices(paper, actuat
     M0, B0 = nominal_matrices(paper)
     assert np.max(scaled_error(M, M0)) < tolerance
     assert np.max(scaled_error(B, B0)) < tolerance
+
+
+def test_cli_writes_files_and_refuses_bad_input(tmp_path):
+    from typer.testing import CliRunner
+
+    from stewartid.cli import app
+
+    runner = CliRunner()
+    out = tmp_path / "run"
+    ok = runner.invoke(app, ["simulate", "--out", str(out), "--duration", "0.3",
+                             "--coulomb", "5", "--format", "parquet"])
+    assert ok.exit_code == 0, ok.output
+    assert sorted(p.name for p in out.iterdir())[:2] == ["exp1.parquet", "exp2.parquet"]
+    for args, match in ((["--out", str(out), "--duration", "0.3"], "already holds results"),
+                        (["--out", str(tmp_path / "a"), "--duration", "-1"], "duration"),
+                        (["--out", str(tmp_path / "b"), "--frequency", "900"], "Nyquist"),
+                        (["--out", str(tmp_path / "c"), "--platform", "missing.toml"],
+                         "not found")):
+        bad = runner.invoke(app, ["simulate", *args])
+        assert bad.exit_code == 2 and match in bad.output
+        assert len(bad.output.strip().splitlines()) == 1
