@@ -105,6 +105,12 @@ def save_figure(figure: Any, directory: str | Path, stem: str, dpi: int = 120) -
     return paths
 
 
+def _every(t: np.ndarray, max_points: int = 4000) -> slice:
+    """Sample step that keeps at most about ``max_points`` points of a line: the figures show
+    0.5 Hz motion, and thinner lines keep the SVG files small and fast to write."""
+    return slice(None, None, max(1, int(np.ceil(len(t) / max_points))))
+
+
 def _shade_intervals(axis: Any, intervals: np.ndarray | None, label: bool) -> None:
     if intervals is None:
         return
@@ -126,13 +132,15 @@ def plot_excitation(traces: Sequence[ExperimentTrace], directory: str | Path,
     for axis, trace in zip(axes.flat, traces, strict=False):
         k = trace.excited
         unit, scale = _DISPLAY[k]
-        measured = (trace.pose[:, k] - trace.neutral[k]) * scale
-        axis.plot(trace.t, measured, color="k", lw=1.2, label="measured")
+        step = _every(trace.t)
+        t = trace.t[step]
+        measured = (trace.pose[step, k] - trace.neutral[k]) * scale
+        axis.plot(t, measured, color="k", lw=1.2, label="measured")
         if trace.reference is not None:
-            commanded = (trace.reference[:, k] - trace.neutral[k]) * scale
-            axis.plot(trace.t, commanded, color="#d62728", lw=1.0, ls="--", label="commanded")
+            commanded = (trace.reference[step, k] - trace.neutral[k]) * scale
+            axis.plot(t, commanded, color="#d62728", lw=1.0, ls="--", label="commanded")
             error_axis = axis.twinx()
-            error_axis.plot(trace.t, measured - commanded, color="#2ca02c", lw=0.8,
+            error_axis.plot(t, measured - commanded, color="#2ca02c", lw=0.6,
                             label="tracking error")
             error_axis.set_ylabel(f"tracking error ({unit})", color="#2ca02c")
             error_axis.tick_params(axis="y", colors="#2ca02c")
@@ -161,13 +169,15 @@ def plot_joint_rates(trace: ExperimentTrace, directory: str | Path,
     plt = _pyplot()
     figure, (top, bottom) = plt.subplots(2, 1, figsize=(9, 6), sharex=True,
                                          constrained_layout=True)
-    rotational = trace.joint_rates[:, :30]
+    step = _every(trace.t)
+    t = trace.t[step]
+    rotational = trace.joint_rates[step, :30]
     axis_colours = plt.cm.viridis(np.linspace(0, 0.9, 5))
     names = ("lower gimbal 1", "lower gimbal 2", "upper gimbal 1", "upper gimbal 2", "revolute")
     for axis_index in range(5):
         columns = rotational[:, axis_index::5] * 1e3
         for leg in range(6):
-            top.plot(trace.t, columns[:, leg], color=axis_colours[axis_index], lw=0.8,
+            top.plot(t, columns[:, leg], color=axis_colours[axis_index], lw=0.8,
                      label=names[axis_index] + " (6 legs)" if leg == 0 else None)
     _shade_intervals(top, trace.intervals, label=True)
     top.axhline(0, color="k", lw=0.6)
@@ -176,7 +186,7 @@ def plot_joint_rates(trace: ExperimentTrace, directory: str | Path,
                   f"({0 if trace.intervals is None else len(trace.intervals)} intervals)")
     top.legend(loc="upper right", ncol=2, framealpha=0.9)
     for leg in range(6):
-        bottom.plot(trace.t, trace.joint_rates[:, 30 + leg] * 1e3, lw=0.9, label=f"leg {leg + 1}")
+        bottom.plot(t, trace.joint_rates[step, 30 + leg] * 1e3, lw=0.9, label=f"leg {leg + 1}")
     _shade_intervals(bottom, trace.intervals, label=False)
     bottom.axhline(0, color="k", lw=0.6)
     bottom.set_ylabel("actuator rate (mm/s)")
@@ -196,18 +206,25 @@ def plot_force_budget(trace: ExperimentTrace, directory: str | Path,
         channels = sorted({trace.excited, coupled})
     figure, axes = plt.subplots(len(channels), 1, figsize=(9, 3.2 * len(channels)),
                                 sharex=True, squeeze=False, constrained_layout=True)
-    styles = {"inertial": ("#1f77b4", "-"), "viscous": ("#ff7f0e", "-"),
-              "coulomb": ("#d62728", "-"), "gravity": ("#9467bd", "-"),
-              "actuators": ("k", ":")}
+    styles = {"inertial": ("#1f77b4", 1.4), "viscous": ("#ff7f0e", 1.4),
+              "coulomb": ("#d62728", 1.4), "gravity": ("#9467bd", 1.4),
+              "actuators": ("#b0b0b0", 0.6)}
+    step = _every(trace.t, 6000)
+    t = trace.t[step]
     for axis, channel in zip(axes[:, 0], channels, strict=True):
         big = max(np.max(np.abs(f[:, channel])) for f in trace.forces.values())
         scale, prefix = (1e-3, "k") if big >= 1e4 else (1.0, "")
         for name, label in FORCE_COMPONENTS.items():
             if name not in trace.forces:
                 continue
-            colour, style = styles[name]
-            axis.plot(trace.t, trace.forces[name][:, channel] * scale, color=colour, ls=style,
-                      lw=1.5 if name == "actuators" else 1.0, label=label)
+            colour, width = styles[name]
+            # the measured total goes behind the model's terms
+            axis.plot(t, trace.forces[name][step, channel] * scale, color=colour, lw=width,
+                      label=label, zorder=1 if name == "actuators" else 2)
+        model = sum(trace.forces[name][step, channel] for name in
+                    ("inertial", "viscous", "coulomb", "gravity") if name in trace.forces)
+        axis.plot(t, model * scale, color="k", lw=1.0, ls="--", label="sum of model terms",
+                  zorder=3)
         axis.set_ylabel(f"{COORDINATES[channel]} equation ({prefix}{_FORCE_UNITS[channel]})")
         axis.set_title(f"{trace.name} ({COORDINATES[trace.excited]} excited): "
                        f"{COORDINATES[channel]} equation")
@@ -261,7 +278,8 @@ def plot_scalogram(t: np.ndarray, signal: np.ndarray, points: np.ndarray,
               & (grid_b + mother.half_width * grid_a <= t[-1]))
     magnitude = np.where(inside, magnitude, np.nan)
     figure, axis = plt.subplots(figsize=(9, 4.2), constrained_layout=True)
-    mesh = axis.pcolormesh(shifts, scales, magnitude, shading="auto", cmap="magma")
+    mesh = axis.pcolormesh(shifts, scales, magnitude, shading="auto", cmap="magma",
+                           rasterized=True)
     colourbar = figure.colorbar(mesh, ax=axis)
     colourbar.set_label(f"|W_ψ f(a, b)| ({signal_label.split('(')[-1].rstrip(')')})"
                         if "(" in signal_label else "|W_ψ f(a, b)|")
@@ -277,7 +295,8 @@ def plot_scalogram(t: np.ndarray, signal: np.ndarray, points: np.ndarray,
     axis.set_xlabel("shift b (s)")
     axis.set_ylabel("scale a (s)")
     axis.set_title(f"Scalogram of {signal_label} ({mother.name} wavelet)")
-    axis.legend(loc="upper right", framealpha=0.9)
+    if axis.get_legend_handles_labels()[0]:
+        axis.legend(loc="upper right", framealpha=0.9)
     return save_figure(figure, directory, stem)
 
 
