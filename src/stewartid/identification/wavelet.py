@@ -73,35 +73,17 @@ from stewartid.identification.base import (
 )
 from stewartid.identification.intervals import constant_direction_intervals, joint_rates
 from stewartid.identification.results import IdentificationResult
-from stewartid.identification.wavelets import MotherWavelet, make_wavelet, transform_matrix
+from stewartid.identification.signals import default_window, differentiate, estimate_frequency
+from stewartid.identification.wavelets import (
+    MotherWavelet,
+    PolynomialWavelet,
+    make_wavelet,
+    transform_matrix,
+)
 from stewartid.platform import Platform
 
 VARIANTS = ("position", "paper", "derivative")
 PAIR_SELECTIONS = ("std_error", "none")
-
-
-def differentiate(x: np.ndarray, period: float, window: float, derivative: int) -> np.ndarray:
-    """Savitzky-Golay derivative (cubic, window ``window`` s) along axis 0.
-
-    Parameters
-    ----------
-    x : ndarray, shape (N, C)
-    period : float
-        Sample period (s).
-    window : float
-        Window length (s), rounded to an odd number of samples (at least 5).
-    derivative : int
-        1 or 2.
-
-    Returns
-    -------
-    ndarray, shape (N, C)
-        Units of x per s^derivative.
-    """
-    n = max(5, int(round(window / period)) | 1)
-    if n > len(x):
-        n = len(x) if len(x) % 2 else len(x) - 1
-    return savgol_filter(x, n, 3, deriv=derivative, delta=period, axis=0, mode="interp")
 
 
 def rate_noise(rates: np.ndarray, period: float, window: float) -> np.ndarray:
@@ -191,14 +173,21 @@ class WaveletIdentifier(BaseIdentifier):
     min_support_samples : int
         Fewest samples the smallest wavelet's support may cover; intervals too short for it
         are dropped.
-    differentiation_window : float
+    differentiation_window : float or None
         Savitzky-Golay window (s) for the joint rates of the interval detection and, in the
-        ``"paper"`` and ``"derivative"`` variants, for q_dot and q_ddot.
+        ``"paper"`` and ``"derivative"`` variants, for q_dot and q_ddot. None (default): a
+        fifth of the period of the experiment's dominant frequency, estimated from the data,
+        which keeps measurement noise out of the joint rates without moving their zeros.
     hysteresis : float
         A joint's direction counts as known only while its rate exceeds this many times the
         rate's noise level (estimated from the data, :func:`rate_noise`); reversals inside the
         noise band are kept out of every interval (see
         :func:`~stewartid.identification.intervals.constant_direction_intervals`).
+    odd_companion : bool
+        With the polynomial wavelet, also use its odd companion g''' at every (a, b) (see
+        :class:`~stewartid.identification.wavelets.PolynomialWavelet`): the acceleration
+        regressor then carries signal at the centre of each interval, which keeps Mt
+        unbiased under position noise.
     symmetric : bool
         Impose Mt = Mt^T and Bt = Bt^T in the solve.
     pair_selection : {"std_error", "none"}
@@ -229,7 +218,8 @@ class WaveletIdentifier(BaseIdentifier):
                  scale_fractions: tuple[float, ...] = (1.0, 0.8, 0.6),
                  shifts_per_scale: int = 5, margin: float = 0.02, ignore_below: float = 0.01,
                  min_interval: float | None = None, min_support_samples: int = 32,
-                 differentiation_window: float = 0.05, hysteresis: float = 4.0,
+                 differentiation_window: float | None = None, hysteresis: float = 4.0,
+                 odd_companion: bool = False,
                  symmetric: bool = False,
                  pair_selection: str = "std_error", gravity: bool = True):
         self.wavelet = wavelet
@@ -244,6 +234,7 @@ class WaveletIdentifier(BaseIdentifier):
         self.min_support_samples = min_support_samples
         self.differentiation_window = differentiation_window
         self.hysteresis = hysteresis
+        self.odd_companion = odd_companion
         self.symmetric = symmetric
         self.pair_selection = pair_selection
         self.gravity = gravity
@@ -277,8 +268,10 @@ class WaveletIdentifier(BaseIdentifier):
                         isinstance(self.min_support_samples, int | np.integer)
                         and self.min_support_samples >= 8, "an integer >= 8")
         check_parameter(name, "differentiation_window", self.differentiation_window,
-                        isinstance(self.differentiation_window, int | float)
-                        and self.differentiation_window > 0, "a float in (0, inf) (s)")
+                        self.differentiation_window is None
+                        or (isinstance(self.differentiation_window, int | float)
+                            and self.differentiation_window > 0),
+                        "None or a float in (0, inf) (s)")
         check_parameter(name, "hysteresis", self.hysteresis,
                         isinstance(self.hysteresis, int | float) and self.hysteresis >= 0,
                         "a float in [0, inf)")
@@ -296,10 +289,14 @@ class WaveletIdentifier(BaseIdentifier):
                               platform: Platform):
         """Wavelet equations of one experiment: regressors (K, 12), targets (K, 6), info."""
         t, q, period = experiment.t, experiment.q, experiment.period
-        q_dot = differentiate(q, period, self.differentiation_window, 1)
+        rate = 1.0 / period
+        window = self.differentiation_window
+        if window is None:
+            window = default_window(estimate_frequency(q, rate))
+        _, q_dot, q_ddot = differentiate(q, rate, window)
         rates = joint_rates(platform, q, q_dot, experiment.joint_jacobians,
                             experiment.leg_jacobian)
-        thresholds = self.hysteresis * rate_noise(rates, period, self.differentiation_window)
+        thresholds = self.hysteresis * rate_noise(rates, period, window)
         found = constant_direction_intervals(t, rates, margin=self.margin,
                                              ignore_below=self.ignore_below,
                                              hysteresis=thresholds)
@@ -313,29 +310,36 @@ class WaveletIdentifier(BaseIdentifier):
         info = {"name": experiment.name, "intervals_found": int(len(found)),
                 "longest_interval": float(lengths.max()) if len(lengths) else 0.0,
                 "shortest_usable": float(max(shortest, needed)),
-                "intervals": intervals}
+                "intervals": intervals, "differentiation_window": float(window)}
         scales, shifts, owner = wavelet_points(intervals, wavelet,
                                                tuple(self.scale_fractions),
                                                int(self.shifts_per_scale))
         info["scales"], info["shifts"] = scales, shifts
         if len(scales) == 0:
             return np.zeros((0, 12)), np.zeros((0, 6)), owner, info
-        y = transform_matrix(t, scales, shifts, wavelet, 0) @ experiment.generalized_force
+        wavelets = [wavelet]
+        if self.odd_companion and isinstance(wavelet, PolynomialWavelet):
+            wavelets.append(PolynomialWavelet(wavelet.order, odd=True))
         a = scales[:, None]
-        if self.variant == "position":
-            # constants vanish analytically; removing the mean keeps rounding and the
-            # Mexican hat's truncation error proportional to the motion, not the offset
-            qc = q - q.mean(axis=0)
-            w_acc = (transform_matrix(t, scales, shifts, wavelet, 2) @ qc) / a ** 2
-            w_vel = -(transform_matrix(t, scales, shifts, wavelet, 1) @ qc) / a
-        else:
-            q_ddot = differentiate(q, period, self.differentiation_window, 2)
-            w_acc = transform_matrix(t, scales, shifts, wavelet, 0) @ q_ddot
-            if self.variant == "paper":
-                w_vel = -a * (transform_matrix(t, scales, shifts, wavelet, -1) @ q_ddot)
+        qc = q - q.mean(axis=0)
+        rows, targets = [], []
+        for psi in wavelets:
+            def transform(signal, derivative, psi=psi):
+                return transform_matrix(t, scales, shifts, psi, derivative) @ signal
+
+            targets.append(transform(experiment.generalized_force, 0))
+            if self.variant == "position":
+                # constants vanish analytically; removing the mean keeps rounding and the
+                # Mexican hat's truncation error proportional to the motion, not the offset
+                w_acc = transform(qc, 2) / a ** 2
+                w_vel = -transform(qc, 1) / a
             else:
-                w_vel = transform_matrix(t, scales, shifts, wavelet, 0) @ q_dot
-        return np.hstack([w_acc, w_vel]), y, owner, info
+                w_acc = transform(q_ddot, 0)
+                w_vel = (-a * transform(q_ddot, -1) if self.variant == "paper"
+                         else transform(q_dot, 0))
+            rows.append(np.hstack([w_acc, w_vel]))
+        owner = np.tile(owner, len(wavelets))
+        return np.vstack(rows), np.vstack(targets), owner, info
 
     def _fit(self, datasets: list[Dataset], platform: Platform) -> IdentificationResult:
         wavelet = make_wavelet(self.wavelet, **self._wavelet_options())
@@ -449,4 +453,4 @@ def select_symmetric_pairs(matrix: np.ndarray, std: np.ndarray) -> list[dict]:
 
 
 __all__ = ["PAIR_SELECTIONS", "VARIANTS", "WaveletIdentifier", "cluster_robust_std",
-           "differentiate", "rate_noise", "select_symmetric_pairs", "wavelet_points"]
+           "rate_noise", "select_symmetric_pairs", "wavelet_points"]

@@ -152,38 +152,47 @@ class PolynomialWavelet(MotherWavelet):
     constant-direction interval with no truncation error, and with p >= 5 the derivatives
     psi' and psi'' used to move differentiation onto the wavelet are continuous.
 
+    With ``odd=True`` the wavelet is the odd companion psi = g''' (integrals g'' and g'),
+    whose moments of order 0, 1 and 2 vanish. An even wavelet centred in a half period of a
+    sine hardly sees the (antisymmetric) acceleration and strongly sees the (symmetric)
+    velocity; the odd one does the opposite. Using both at every (a, b) raises the
+    signal-to-noise ratio of the acceleration regressor by two orders of magnitude with
+    measured positions, which keeps Mt unbiased under sensor noise.
+
     Normalised to unit L2 norm on [-1, 1].
 
     Parameters
     ----------
     order : int
         The exponent p, 5 <= p <= 20.
+    odd : bool
+        The odd companion g''' instead of g''.
     """
 
     name = "polynomial"
     compact = True
     half_width = 1.0
 
-    def __init__(self, order: int = 8):
+    def __init__(self, order: int = 8, odd: bool = False):
         if not (isinstance(order, (int, np.integer)) and 5 <= order <= 20):
             raise ConfigError(
                 f"The 'order' parameter of PolynomialWavelet must be an integer in [5, 20] "
                 f"(exponent p of (1 - x^2)^p); got {order!r}."
             )
         self.order = int(order)
+        self.odd = bool(odd)
+        lowest = 1 if self.odd else 0  # psi2 = g^(lowest), psi = g^(lowest + 2)
         g = Polynomial([1.0, 0.0, -1.0]) ** self.order
-        psi = g.deriv(2)
+        psi = g.deriv(lowest + 2)
         norm = math.sqrt((psi * psi).integ()(1.0) - (psi * psi).integ()(-1.0))
         g = g / norm
-        self._polynomials = {k: g.deriv(k + 2) for k in (0, 1, 2)}
-        self._polynomials[-1] = g.deriv(1)
-        self._polynomials[-2] = g
+        self._polynomials = {k: g.deriv(k + 2 + lowest) for k in DERIVATIVE_ORDERS}
 
     def _evaluate(self, x: np.ndarray, derivative: int) -> np.ndarray:
         return self._polynomials[derivative](x)
 
     def to_dict(self) -> dict:
-        return {"name": self.name, "order": self.order}
+        return {"name": self.name, "order": self.order, "odd": self.odd}
 
 
 _WAVELETS = {"mexican_hat": MexicanHat, "polynomial": PolynomialWavelet}
