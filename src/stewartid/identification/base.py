@@ -11,7 +11,7 @@ the identifiers see y = J_lq^T f_a - G(q) = Mt q_ddot + Bt q_dot + Fc + (small o
 
 References
 ----------
-Zhang, H. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
+Zhang, C. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
 Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
 """
 

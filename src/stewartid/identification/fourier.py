@@ -28,7 +28,7 @@ References
 ----------
 Tian, Y. et al., identification of the dynamic parameters of a Stewart platform from
 single-DOF sine excitation (Method A in the comparison of Zhang 2020).
-Zhang, H. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
+Zhang, C. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
 Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
 """
 
