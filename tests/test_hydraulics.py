@@ -17,6 +17,7 @@ from stewartid.simulation.hydraulics import (
     static_state,
     valve_flows,
 )
+from stewartid.simulation.stability import closed_loop_poles
 
 
 @pytest.fixture(scope="module")
@@ -37,11 +38,17 @@ def test_rated_flow_at_rated_drop(paper, hp):
     assert qa == pytest.approx(h.valve_rated_flow, rel=1e-3)
 
 
-def test_static_state_holds_the_force_at_rest(paper, hp):
-    xv, pa, pb = static_state(hp, 30495.0, paper.neutral_leg_length)
-    assert actuator_force(hp, pa, pb) == pytest.approx(30495.0, rel=1e-9)
-    dpa, dpb = pressure_rates(hp, xv, pa, pb, paper.neutral_leg_length, 0.0)
-    assert abs(dpa) < 1e-3 * pa and abs(dpb) < 1e-3 * pb
+@pytest.mark.parametrize("force", [30495.0, 3.0e4, 1.2e5, 0.0, -4.0e4])
+def test_static_state_holds_the_force_at_rest(paper, hp, force):
+    """Closed form: the chambers hold the force and the valve feeds exactly the leakage."""
+    length = paper.neutral_leg_length + 0.013
+    xv, pa, pb = static_state(hp, force, length)
+    assert actuator_force(hp, pa, pb) == pytest.approx(force, abs=1e-9 * 1e5)
+    dpa, dpb = pressure_rates(hp, xv, pa, pb, length, 0.0)
+    # a pressure drift below 1 Pa/s against ~1e7 Pa chambers
+    assert abs(dpa) < 1.0 and abs(dpb) < 1.0
+    # the valve opens toward the higher-pressure chamber's supply edge
+    assert np.sign(xv) == np.sign(pa - pb)
 
 
 def test_unholdable_force_is_refused(hp, paper):
@@ -57,3 +64,26 @@ def test_natural_frequency_matches_linearised_chambers(paper, hp):
     dpa, dpb = pressure_rates(hp, 0.0, 1e7, 1e7, l0, eps)
     stiffness = -(dpa * h.piston_area - dpb * h.annulus_area) / eps
     assert hydraulic_natural_frequency(h, m) == pytest.approx(np.sqrt(stiffness / m), rel=1e-6)
+
+
+def test_default_servo_loop_is_stable_and_damped(paper):
+    """Poles of the loop linearised at rest: all in the left half-plane, damping >= 0.15.
+
+    The least-damped pair (the inner force loop with the 80 Hz valve, ~44 Hz) sets the gain
+    margin on force_loop_gain: about 1.9 (the loop goes unstable near 1.9e-5 1/N).
+    """
+    poles = closed_loop_poles(paper)
+    assert np.max(poles.real) < 0
+    oscillating = poles[np.abs(poles.imag) > 1.0]
+    assert np.min(-oscillating.real / np.abs(oscillating)) > 0.15
+    doubled = closed_loop_poles(paper.replace(
+        controller__force_loop_gain=2 * paper.controller.force_loop_gain))
+    fast = doubled[np.argmax(doubled.real)]
+    assert fast.real > 0 and 55 < abs(fast.imag) / (2 * np.pi) < 75
+
+
+def test_ideal_actuator_loop_has_frozen_hydraulic_states(paper):
+    poles = closed_loop_poles(paper.replace(hydraulics__mode="ideal"))
+    # 24 valve/pressure states do not move: exact zeros; the 18 others are stable
+    assert np.sum(poles == 0) == 24
+    assert np.max(poles[poles != 0].real) < 0

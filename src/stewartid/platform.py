@@ -161,7 +161,7 @@ class Controller:
                                      "pose against gravity", check="any", default=True)
     force_loop_gain: float = spec("1/N", "inner force loop (hydraulic mode): valve opening, "
                                   "as a fraction of full opening, per newton of force error",
-                                  default=2.0e-5)
+                                  default=1.0e-5)
 
 
 @dataclasses.dataclass(frozen=True)

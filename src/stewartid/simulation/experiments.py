@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from stewartid.dataset import Dataset, write_dataset
-from stewartid.dynamics import COULOMB_SMOOTHING, ModelTerms
+from stewartid.dynamics import COULOMB_SMOOTHING
 from stewartid.errors import ConfigError, StewartidError
 from stewartid.platform import Platform
 from stewartid.simulation import plant
@@ -30,8 +30,9 @@ from stewartid.simulation.excitation import (
     excitation_to_dict,
     paper_experiments,
 )
-from stewartid.simulation.hydraulics import hydraulic_parameters, static_state
+from stewartid.simulation.hydraulics import hydraulic_parameters
 from stewartid.simulation.sensors import SensorNoise, measure_legs, measured_pose
+from stewartid.simulation.stability import initial_state, loop_poles, require_stable
 
 #: Default integration step (s); see ``plant.py`` for its justification.
 DEFAULT_STEP = 2.5e-4
@@ -109,33 +110,6 @@ def _check_timing(duration_s: float, sample_rate: float, max_frequency: float) -
         )
 
 
-def initial_state(platform: Platform, q0: np.ndarray, feedforward_force: np.ndarray,
-                  hp: np.ndarray, cp: np.ndarray) -> np.ndarray:
-    """Closed-loop equilibrium at rest at pose ``q0``: no start-up transient.
-
-    Leg forces hold the pose against gravity; the valves feed the leakage; the PID integrators
-    hold the force demand that the inner loop needs.
-    """
-    t = ModelTerms(platform, q0)
-    J, G = t.leg_jacobian[0], t.gravity[0]
-    f0 = np.linalg.solve(J.T, G)
-    y = np.zeros(plant.N_STATES)
-    y[plant.S_Q:plant.S_Q + 6] = q0
-    hydraulic = platform.hydraulics.mode == "hydraulic"
-    demand = f0.copy()
-    for i in range(6):
-        if hydraulic:
-            xv, pa, pb = static_state(hp, float(f0[i]), float(t.leg_lengths[0, i]))
-            y[plant.S_XV + i] = xv
-            y[plant.S_PA + i] = pa
-            y[plant.S_PB + i] = pb
-            demand[i] = f0[i] + xv / cp[3]
-    ki = cp[1]
-    if ki > 0:
-        y[plant.S_Z:plant.S_Z + 6] = (demand - feedforward_force) / ki
-    return y
-
-
 def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: float,
                         noise: SensorNoise | None = None,
                         rng: np.random.Generator | None = None,
@@ -171,8 +145,9 @@ def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: 
     Raises
     ------
     ConfigError
-        On a non-positive duration, a frequency at or above the Nyquist limit, or an
-        actuator that cannot hold the platform.
+        On a non-positive duration, a frequency at or above the Nyquist limit, an
+        actuator that cannot hold the platform, or a servo loop that is unstable at the
+        start pose (:func:`stewartid.simulation.stability.require_stable`).
     StewartidError
         If a leg leaves its stroke or the integration diverges.
     """
@@ -196,6 +171,9 @@ def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: 
     cp = controller_parameters(platform)
     y0 = initial_state(platform, q_cmd[0], cmd_force[0], hp, cp)
     hydraulic = platform.hydraulics.mode == "hydraulic"
+    require_stable(loop_poles(y0, cmd_len[0], cmd_rate[0], cmd_force[0], params, upper, base,
+                              hp, cp, hydraulic, float(coulomb_smoothing)),
+                   platform, excitation.name)
     status, where, leg, states, qdd, lengths, rates, forces, demands = plant.integrate(
         y0, h, substeps, n_out, cmd_len, cmd_rate, cmd_force, params, upper, base, hp, cp,
         hydraulic, float(coulomb_smoothing))

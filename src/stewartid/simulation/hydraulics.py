@@ -32,7 +32,6 @@ import math
 
 import numpy as np
 from numba import njit
-from scipy.optimize import fsolve
 
 from stewartid.errors import ConfigError
 from stewartid.platform import Hydraulics
@@ -128,8 +127,12 @@ def force_limits(hydraulics: Hydraulics) -> tuple[float, float]:
 def static_state(hp: np.ndarray, force: float, length: float) -> tuple[float, float, float]:
     """Spool position and chamber pressures that hold ``force`` at rest.
 
-    Solves Q_A = C_i (p_A - p_B), Q_B = -C_i (p_A - p_B) (the valve feeds the leakage) and
-    p_A A_A - p_B A_B = force.
+    At rest the valve only feeds the leakage: Q_A = C_i (p_A - p_B) = -Q_B. Both metering
+    edges pass the same flow through the same opening, so they see the same pressure drop
+    (the regularised orifice law is strictly monotonic): p_s - p_A = p_B - p_r for x_v >= 0
+    and p_A - p_r = p_s - p_B for x_v < 0, i.e. p_A + p_B = p_s + p_r in both cases. With
+    p_A A_A - p_B A_B = force this gives the pressures in closed form, and the spool
+    position follows from the leakage flow.
 
     Parameters
     ----------
@@ -138,7 +141,8 @@ def static_state(hp: np.ndarray, force: float, length: float) -> tuple[float, fl
     force : float
         N, positive extends.
     length : float
-        Leg length (m).
+        Leg length (m); the equilibrium does not depend on it (no flow into the chambers
+        at rest), it is kept for a uniform per-leg signature.
 
     Returns
     -------
@@ -159,26 +163,12 @@ def static_state(hp: np.ndarray, force: float, length: float) -> tuple[float, fl
             f"[hydraulics] supply pressure and areas they reach [{f_min:.4g}, {f_max:.4g}] N; "
             "raise supply_pressure or bore_diameter."
         )
-    scale_p = ps
-    # with the spool open (x_v > 0) both edges pass the same leakage flow, so
-    # p_s - p_A = p_B - p_r in the turbulent regime: a close first guess
-    pb0 = (aa * (ps + pr) - force) / (aa + ab)
-    pa0 = (force + pb0 * ab) / aa
-
-    def residual(z: np.ndarray) -> np.ndarray:
-        xv, pa, pb = z[0] * 1e-3, z[1] * scale_p, z[2] * scale_p
-        qa, qb = valve_flows(hp, xv, pa, pb)
-        leak = hp[H_LEAK] * (pa - pb)
-        qscale = hp[H_GAIN] * 1e-3 * math.sqrt(ps)
-        return np.array([(qa - leak) / qscale, (qb + leak) / qscale,
-                         (pa * aa - pb * ab - force) / (ps * aa)])
-
-    z, info, ok, msg = fsolve(residual, [0.0, pa0 / scale_p, pb0 / scale_p], full_output=True,
-                              xtol=1e-13)
-    if ok != 1 or np.max(np.abs(residual(z))) > 1e-9:
-        raise ConfigError(f"no static hydraulic equilibrium for leg force {force:.4g} N "
-                          f"({msg}); check the [hydraulics] section.")
-    return float(z[0] * 1e-3), float(z[1] * scale_p), float(z[2] * scale_p)
+    pa = (force + (ps + pr) * ab) / (aa + ab)
+    pb = ps + pr - pa
+    leak = hp[H_LEAK] * (pa - pb)
+    drop = ps - pa if pa >= pb else pa - pr
+    xv = leak / (hp[H_GAIN] * orifice(drop, hp[H_TRANSITION]))
+    return float(xv), float(pa), float(pb)
 
 
 def hydraulic_natural_frequency(hydraulics: Hydraulics, effective_mass: float,

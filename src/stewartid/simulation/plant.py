@@ -242,3 +242,43 @@ def integrate(y0, step, substeps, n_out, cmd_length, cmd_rate, cmd_force, params
         for c in range(n):
             y[c] += step / 6.0 * (k1[c] + 2.0 * k2[c] + 2.0 * k3[c] + k4[c])
     return STATUS_OK, n_out, -1, states, rec_qdd, rec_len, rec_rate, rec_force, rec_demand
+
+
+@njit(cache=True)
+def linearize(y0, scales, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp,
+              hydraulic, smoothing):
+    """State matrix A = d(dy/dt)/dy (42, 42) of the closed loop at ``y0``, commands frozen.
+
+    Central differences with the per-state step ``scales`` (42,); the right-hand side is
+    smooth (regularised orifices and Coulomb friction), so the truncation error is
+    O(scale^2).
+    """
+    n = N_STATES
+    M = np.empty((6, 6))
+    h = np.empty(6)
+    G = np.empty(6)
+    J = np.empty((6, 6))
+    Jj = np.empty((6, 5, 6))
+    lengths = np.empty(6)
+    rates = np.empty(6)
+    force = np.empty(6)
+    demand = np.empty(6)
+    work = np.empty(6)
+    chol = np.zeros((6, 6))
+    qdd = np.empty(6)
+    plus = np.empty(n)
+    minus = np.empty(n)
+    y = y0.copy()
+    A = np.empty((n, n))
+    for j in range(n):
+        e = scales[j]
+        y[j] = y0[j] + e
+        rhs(y, plus, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, hydraulic,
+            smoothing, M, h, G, J, Jj, lengths, rates, force, demand, work, chol, qdd)
+        y[j] = y0[j] - e
+        rhs(y, minus, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, hydraulic,
+            smoothing, M, h, G, J, Jj, lengths, rates, force, demand, work, chol, qdd)
+        y[j] = y0[j]
+        for i in range(n):
+            A[i, j] = (plus[i] - minus[i]) / (2.0 * e)
+    return A

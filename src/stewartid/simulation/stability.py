@@ -1,0 +1,149 @@
+"""Closed-loop equilibrium at rest and the poles of the loop linearised about it.
+
+A servo whose linearised loop has a pole in the right half-plane does not track its command:
+any disturbance (here, the excitation itself) grows into a limit cycle bounded only by the
+valve and orifice non-linearities. Such a plant produces data that no linear rigid-body model
+explains (leg forces of tens of kN at the loop's natural frequency), so every experiment is
+checked before it is integrated (:func:`require_stable`).
+
+The poles come from the state matrix of the compiled right-hand side
+(:func:`stewartid.simulation.plant.linearize`, central differences) at the equilibrium of
+:func:`initial_state`; they are nearly independent of the pose over the excitation range, so
+the start pose is representative.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stewartid.dynamics import COULOMB_SMOOTHING, ModelTerms
+from stewartid.errors import ConfigError
+from stewartid.platform import Platform
+from stewartid.simulation import plant
+from stewartid.simulation.controller import command_tables, controller_parameters
+from stewartid.simulation.hydraulics import hydraulic_parameters, static_state
+
+#: Largest growth rate (1/s) accepted as numerically zero: an e-fold in 1000 s, far longer
+#: than any record, and well above the finite-difference error of the frozen states.
+GROWTH_TOLERANCE = 1e-3
+
+
+def initial_state(platform: Platform, q0: np.ndarray, feedforward_force: np.ndarray,
+                  hp: np.ndarray, cp: np.ndarray) -> np.ndarray:
+    """Closed-loop equilibrium at rest at pose ``q0``: no start-up transient.
+
+    Leg forces hold the pose against gravity; the valves feed the leakage; the PID integrators
+    hold the force demand that the inner loop needs.
+
+    Parameters
+    ----------
+    platform : Platform
+    q0 : ndarray, shape (6,)
+        Pose (m, rad).
+    feedforward_force : ndarray, shape (6,)
+        Gravity feed-forward of the controller at ``q0`` (N).
+    hp, cp : ndarray
+        Packed hydraulic and controller parameters.
+
+    Returns
+    -------
+    ndarray, shape (42,)
+        State vector (layout in :mod:`stewartid.simulation.plant`).
+    """
+    t = ModelTerms(platform, q0)
+    J, G = t.leg_jacobian[0], t.gravity[0]
+    f0 = np.linalg.solve(J.T, G)
+    y = np.zeros(plant.N_STATES)
+    y[plant.S_Q:plant.S_Q + 6] = q0
+    hydraulic = platform.hydraulics.mode == "hydraulic"
+    demand = f0.copy()
+    for i in range(6):
+        if hydraulic:
+            xv, pa, pb = static_state(hp, float(f0[i]), float(t.leg_lengths[0, i]))
+            y[plant.S_XV + i] = xv
+            y[plant.S_PA + i] = pa
+            y[plant.S_PB + i] = pb
+            demand[i] = f0[i] + xv / cp[3]
+    ki = cp[1]
+    if ki > 0:
+        y[plant.S_Z:plant.S_Z + 6] = (demand - feedforward_force) / ki
+    return y
+
+
+def _difference_steps(y0: np.ndarray) -> np.ndarray:
+    """Finite-difference step per state: ~1e-7 of each block's natural scale."""
+    steps = np.empty(plant.N_STATES)
+    steps[plant.S_Q:plant.S_Q + 6] = 1e-7       # m, rad
+    steps[plant.S_QD:plant.S_QD + 6] = 1e-7     # m/s, rad/s: below the Coulomb smoothing
+    steps[plant.S_Z:plant.S_Z + 6] = 1e-9       # m s
+    steps[plant.S_XV:plant.S_XV + 6] = 1e-7     # fraction of full opening
+    steps[plant.S_VV:plant.S_VV + 6] = 1e-5     # 1/s
+    steps[plant.S_PA:plant.S_PA + 12] = 1e-7 * np.maximum(np.abs(y0[plant.S_PA:]), 1e5)
+    return steps
+
+
+def loop_poles(y0: np.ndarray, cmd_length: np.ndarray, cmd_rate: np.ndarray,
+               cmd_force: np.ndarray, params: np.ndarray, upper: np.ndarray,
+               base: np.ndarray, hp: np.ndarray, cp: np.ndarray, hydraulic: bool,
+               smoothing: float = COULOMB_SMOOTHING) -> np.ndarray:
+    """Eigenvalues (1/s) of the closed loop linearised at state ``y0`` (packed arguments).
+
+    Returns
+    -------
+    ndarray, shape (42,), complex
+        Poles; the frozen valve and pressure states of ideal actuators give exact zeros.
+    """
+    A = plant.linearize(y0, _difference_steps(y0), cmd_length, cmd_rate, cmd_force, params,
+                        upper, base, hp, cp, hydraulic, float(smoothing))
+    return np.linalg.eigvals(A)
+
+
+def closed_loop_poles(platform: Platform, pose: np.ndarray | None = None) -> np.ndarray:
+    """Poles (1/s) of the servo loop linearised at rest at ``pose`` (neutral by default).
+
+    Parameters
+    ----------
+    platform : Platform
+        With its ``[hydraulics]`` (including ``mode``), ``[controller]`` and friction.
+    pose : ndarray, shape (6,), optional
+        m, rad.
+
+    Returns
+    -------
+    ndarray, shape (42,), complex
+        Sorted by decreasing real part. A pole s = sigma + i w has natural frequency |s|,
+        damping ratio -sigma / |s| and oscillates at w / (2 pi) Hz.
+    """
+    q0 = platform.neutral_pose if pose is None else np.asarray(pose, dtype=float)
+    q0 = np.ascontiguousarray(q0, dtype=float).reshape(1, 6)
+    params = platform.parameters()
+    upper = np.ascontiguousarray(platform.upper_joints)
+    base = np.ascontiguousarray(platform.base_joints)
+    cmd_len, cmd_rate, cmd_force = command_tables(
+        params, upper, base, q0, np.zeros_like(q0), bool(platform.controller.gravity_feedforward))
+    hp = hydraulic_parameters(platform.hydraulics, platform.neutral_leg_length)
+    cp = controller_parameters(platform)
+    y0 = initial_state(platform, q0[0], cmd_force[0], hp, cp)
+    poles = loop_poles(y0, cmd_len[0], cmd_rate[0], cmd_force[0], params, upper, base, hp, cp,
+                       platform.hydraulics.mode == "hydraulic")
+    return poles[np.argsort(-poles.real)]
+
+
+def require_stable(poles: np.ndarray, platform: Platform, where: str) -> None:
+    """Raise if a pole grows faster than :data:`GROWTH_TOLERANCE`.
+
+    Raises
+    ------
+    ConfigError
+        Naming the unstable mode (frequency, growth rate) and the gains to lower.
+    """
+    worst = poles[np.argmax(poles.real)]
+    if worst.real <= GROWTH_TOLERANCE:
+        return
+    c = platform.controller
+    raise ConfigError(
+        f"{where}: the leg servo loop is unstable (a mode at {abs(worst.imag) / (2 * np.pi):.1f}"
+        f" Hz grows at {worst.real:.3g} 1/s) and would settle into a limit cycle; lower "
+        f"[controller] force_loop_gain (now {c.force_loop_gain:g} 1/N) or the PID gains "
+        f"(proportional_gain {c.proportional_gain:g} N/m)."
+    )
