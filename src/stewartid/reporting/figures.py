@@ -26,7 +26,7 @@ _DISPLAY = (("mm", 1e3),) * 3 + (("mrad", 1e3),) * 3
 _FORCE_UNITS = ("N",) * 3 + ("N·m",) * 3
 
 #: One colour per method, the same in every figure.
-METHOD_COLOURS = {"fourier": "#1f77b4", "wavelet": "#d62728", "wavelet_position": "#ff7f0e",
+METHOD_COLOURS = {"fourier": "#1f77b4", "wavelet": "#d62728", "wavelet_paper": "#ff7f0e",
                   "least_squares": "#2ca02c"}
 
 #: Force components of a budget, in plotting order, with display names.

@@ -26,7 +26,7 @@ from stewartid.published import (
 METHOD_NAMES = {
     "fourier": "Method A (Fourier)",
     "wavelet": "Method B (wavelet)",
-    "wavelet_position": "Method B, positions only",
+    "wavelet_paper": "Method B, paper's equations (Mexican hat)",
     "least_squares": "Time-domain least squares",
 }
 
