@@ -198,3 +198,21 @@ def test_cli_writes_files_and_refuses_bad_input(tmp_path):
         bad = runner.invoke(app, ["simulate", *args])
         assert bad.exit_code == 2 and match in bad.output
         assert len(bad.output.strip().splitlines()) == 1
+
+
+def test_cli_noise_flag_switches_on_reference_noise(tmp_path):
+    """``--noise``: 20 um on the leg lengths, 0.5 % of the static leg force on the forces."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from stewartid.cli import app
+
+    out = tmp_path / "noisy"
+    result = CliRunner().invoke(app, ["simulate", "--out", str(out), "--noise",
+                                      "--duration", "1.5", "--actuator", "ideal"])
+    assert result.exit_code == 0, result.output
+    noise = json.loads((out / "meta.json").read_text())["noise"]
+    assert noise["length_noise"] == 20e-6
+    # the paper platform's static leg load is ~30.5 kN (MODEL.md)
+    assert noise["force_noise"] == pytest.approx(0.005 * 30_495, rel=1e-3)

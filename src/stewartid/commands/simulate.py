@@ -7,6 +7,21 @@ from typing import Annotated
 
 import typer
 
+#: Reference sensor noise of ``--noise``: leg-length standard deviation (m) and force
+#: standard deviation as a fraction of the static leg force at neutral.
+REFERENCE_LENGTH_NOISE_M = 20e-6
+REFERENCE_FORCE_NOISE = 0.005
+
+
+def static_leg_force(platform) -> float:
+    """Mean actuator force (N) holding the platform at rest at neutral."""
+    import numpy as np
+
+    from stewartid.dynamics import inverse_dynamics
+
+    zero = np.zeros(6)
+    return float(np.mean(np.abs(inverse_dynamics(platform, platform.neutral_pose, zero, zero))))
+
 
 def simulate(
     out: Annotated[Path, typer.Option("--out", help="Output folder for exp1..exp6 and "
@@ -22,6 +37,10 @@ def simulate(
                                              "(Hz).")] = 0.5,
     duration: Annotated[float, typer.Option("--duration", help="Record length of each "
                                             "experiment (s).")] = 20.0,
+    noise_on: Annotated[bool, typer.Option(
+        "--noise", help="Switch on the reference sensor noise: 20 um on the leg lengths and "
+        "0.5 % of the static leg force on the forces (--length-noise/--force-noise override "
+        "either).")] = False,
     length_noise: Annotated[float | None, typer.Option(
         "--length-noise", help="Leg-length sensor noise, standard deviation (m); default: "
         "[sensors] length_noise.")] = None,
@@ -58,6 +77,9 @@ def simulate(
     if not duration > 0:
         raise ConfigError(f"--duration must be > 0 s; got {duration!r}.")
     noise = SensorNoise.from_sensors(description.sensors)
+    if noise_on:
+        noise = dataclasses.replace(noise, length_noise=REFERENCE_LENGTH_NOISE_M,
+                                    force_noise=REFERENCE_FORCE_NOISE * static_leg_force(description))
     if length_noise is not None:
         noise = dataclasses.replace(noise, length_noise=length_noise)
     if force_noise is not None:
