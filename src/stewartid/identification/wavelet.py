@@ -58,6 +58,7 @@ Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
 from __future__ import annotations
 
 import numpy as np
+from scipy import sparse
 from scipy.signal import savgol_filter
 
 from stewartid.dataset import Dataset
@@ -73,7 +74,13 @@ from stewartid.identification.base import (
 )
 from stewartid.identification.intervals import constant_direction_intervals, joint_rates
 from stewartid.identification.results import IdentificationResult
-from stewartid.identification.signals import default_window, differentiate, estimate_frequency
+from stewartid.identification.signals import (
+    DEFAULT_ORDER,
+    default_window,
+    differentiate,
+    estimate_frequency,
+    window_samples,
+)
 from stewartid.identification.wavelets import (
     MotherWavelet,
     PolynomialWavelet,
@@ -83,6 +90,9 @@ from stewartid.identification.wavelets import (
 from stewartid.platform import Platform
 
 VARIANTS = ("position", "paper", "derivative")
+#: Polynomial degree up to which every transform row integrates exactly (moment-corrected
+#: quadrature, see :func:`~stewartid.identification.wavelets.transform_matrix`).
+EXACT_DEGREE = 3
 PAIR_SELECTIONS = ("std_error", "none")
 
 
@@ -106,6 +116,86 @@ def rate_noise(rates: np.ndarray, period: float, window: float) -> np.ndarray:
         n = len(rates) if len(rates) % 2 else len(rates) - 1
     residual = rates - savgol_filter(rates, n, 3, axis=0, mode="interp")
     return 1.4826 * np.median(np.abs(residual - np.median(residual, axis=0)), axis=0)
+
+
+def position_noise_covariance(q: np.ndarray) -> np.ndarray:
+    """Covariance of white measurement noise on the pose, from second differences.
+
+    For a smooth motion sampled fast, q[n+1] - 2 q[n] + q[n-1] is the noise e[n+1] - 2 e[n]
+    + e[n-1] (covariance 6 Sigma for white noise) plus q_ddot dt^2, which is negligible
+    (1e-6 m at 1 kHz for 0.1 m at 0.5 Hz). The pose of a hexapod is the forward kinematics
+    of the measured leg lengths, so its noise is correlated across the six coordinates; the
+    full covariance is returned.
+
+    Parameters
+    ----------
+    q : ndarray, shape (N, 6)
+        Measured poses (m, rad).
+
+    Returns
+    -------
+    ndarray, shape (6, 6)
+        Sigma (m^2, m rad, rad^2) per sample.
+    """
+    d2 = q[2:] - 2.0 * q[1:-1] + q[:-2]
+    d2 = d2 - np.median(d2, axis=0)
+    return d2.T @ d2 / (6.0 * max(len(d2), 1))
+
+
+def joint_rate_noise(covariance: np.ndarray, sample_rate: float, window: float,
+                     joint_jacobians: np.ndarray, leg_jacobian: np.ndarray) -> np.ndarray:
+    """Standard deviation of each Savitzky-Golay joint rate caused by pose noise.
+
+    The velocity filter is a linear combination of samples with coefficients c, so white
+    pose noise of covariance Sigma gives q_dot noise of covariance |c|^2 Sigma, and the joint
+    rates J q_dot the standard deviations |c| sqrt(diag(J Sigma J^T)) (Jacobians averaged over
+    the record; the motion is small).
+
+    Parameters
+    ----------
+    covariance : ndarray, shape (6, 6)
+        Pose noise per sample (:func:`position_noise_covariance`).
+    sample_rate, window : float
+        Hz and the differentiation window (s).
+    joint_jacobians : ndarray, shape (N, 6, 5, 6)
+    leg_jacobian : ndarray, shape (N, 6, 6)
+
+    Returns
+    -------
+    ndarray, shape (36,)
+        Columns as :data:`~stewartid.identification.intervals.JOINT_RATE_NAMES`.
+    """
+    from scipy.signal import savgol_coeffs
+
+    n = window_samples(window, sample_rate, DEFAULT_ORDER)
+    gain = np.linalg.norm(savgol_coeffs(n, DEFAULT_ORDER, deriv=1, delta=1.0 / sample_rate))
+    jac = np.concatenate([joint_jacobians.mean(axis=0).reshape(30, 6),
+                          leg_jacobian.mean(axis=0)], axis=0)
+    variance = np.einsum("ij,jk,ik->i", jac, covariance, jac)
+    return gain * np.sqrt(np.clip(variance, 0.0, None))
+
+
+def generalized_force_sensitivity(platform: Platform, q: np.ndarray, forces: np.ndarray,
+                                  gravity: bool = True, step: float = 1e-6) -> np.ndarray:
+    """K = d(J_lq(q)^T f - G(q)) / dq at the mean pose and mean leg forces, shape (6, 6).
+
+    Pose noise enters the generalized force through the Jacobian (the static leg load times
+    the change of the leg directions) and through G(q); K maps it there, so the
+    errors-in-variables correction can account for noise shared by regressors and targets.
+    Central differences of ``step`` (m, rad).
+    """
+    from stewartid.dynamics import ModelTerms
+
+    q0, f0 = q.mean(axis=0), forces.mean(axis=0)
+    poses = np.repeat(q0[None], 12, axis=0)
+    for j in range(6):
+        poses[2 * j, j] += step
+        poses[2 * j + 1, j] -= step
+    terms = ModelTerms(platform, poses)
+    y = np.einsum("nji,j->ni", terms.leg_jacobian, f0)
+    if gravity:
+        y = y - terms.gravity
+    return ((y[0::2] - y[1::2]) / (2 * step)).T
 
 
 def wavelet_points(intervals: np.ndarray, wavelet: MotherWavelet,
@@ -213,13 +303,13 @@ class WaveletIdentifier(BaseIdentifier):
 
     method = "wavelet"
 
-    def __init__(self, wavelet: str = "polynomial", wavelet_order: int = 8,
+    def __init__(self, wavelet: str = "polynomial", wavelet_order: int = 6,
                  truncation: float = 5.0, variant: str = "position",
                  scale_fractions: tuple[float, ...] = (1.0, 0.8, 0.6),
                  shifts_per_scale: int = 5, margin: float = 0.02, ignore_below: float = 0.01,
                  min_interval: float | None = None, min_support_samples: int = 32,
                  differentiation_window: float | None = None, hysteresis: float = 4.0,
-                 odd_companion: bool = False,
+                 odd_companion: bool = False, noise_correction: bool = True,
                  symmetric: bool = False,
                  pair_selection: str = "std_error", gravity: bool = True):
         self.wavelet = wavelet
@@ -235,6 +325,7 @@ class WaveletIdentifier(BaseIdentifier):
         self.differentiation_window = differentiation_window
         self.hysteresis = hysteresis
         self.odd_companion = odd_companion
+        self.noise_correction = noise_correction
         self.symmetric = symmetric
         self.pair_selection = pair_selection
         self.gravity = gravity
@@ -296,7 +387,9 @@ class WaveletIdentifier(BaseIdentifier):
         _, q_dot, q_ddot = differentiate(q, rate, window)
         rates = joint_rates(platform, q, q_dot, experiment.joint_jacobians,
                             experiment.leg_jacobian)
-        thresholds = self.hysteresis * rate_noise(rates, period, window)
+        noise = position_noise_covariance(q)
+        thresholds = self.hysteresis * joint_rate_noise(
+            noise, rate, window, experiment.joint_jacobians, experiment.leg_jacobian)
         found = constant_direction_intervals(t, rates, margin=self.margin,
                                              ignore_below=self.ignore_below,
                                              hysteresis=thresholds)
@@ -315,45 +408,72 @@ class WaveletIdentifier(BaseIdentifier):
                                                tuple(self.scale_fractions),
                                                int(self.shifts_per_scale))
         info["scales"], info["shifts"] = scales, shifts
+        info["noise_covariance"] = noise
         if len(scales) == 0:
-            return np.zeros((0, 12)), np.zeros((0, 6)), owner, info
+            return np.zeros((0, 12)), np.zeros((0, 6)), owner, np.zeros((0, 3, 3)), info
         wavelets = [wavelet]
         if self.odd_companion and isinstance(wavelet, PolynomialWavelet):
             wavelets.append(PolynomialWavelet(wavelet.order, odd=True))
         a = scales[:, None]
         qc = q - q.mean(axis=0)
-        rows, targets = [], []
+        rows, targets, products = [], [], []
         for psi in wavelets:
-            def transform(signal, derivative, psi=psi):
-                return transform_matrix(t, scales, shifts, psi, derivative) @ signal
+            def matrix(derivative, psi=psi):
+                return transform_matrix(t, scales, shifts, psi, derivative,
+                                        exact_degree=EXACT_DEGREE)
 
-            targets.append(transform(experiment.generalized_force, 0))
+            w0 = matrix(0)
+            targets.append(w0 @ experiment.generalized_force)
             if self.variant == "position":
-                # constants vanish analytically; removing the mean keeps rounding and the
-                # Mexican hat's truncation error proportional to the motion, not the offset
-                w_acc = transform(qc, 2) / a ** 2
-                w_vel = -transform(qc, 1) / a
+                # constants vanish analytically (and, with the moment correction, to
+                # rounding); removing the mean also keeps the Mexican hat's truncation error
+                # proportional to the motion, not the offset
+                w2 = sparse.diags(1.0 / scales ** 2) @ matrix(2)
+                w1 = sparse.diags(-1.0 / scales) @ matrix(1)
+                w_acc, w_vel = w2 @ qc, w1 @ qc
+                # inner products of the rows acting on q (acc, vel) and on y (target): the
+                # covariances of the transformed white pose noise
+                operators = (w2, w1, w0)
+                products.append(np.stack([
+                    np.stack([np.asarray(u.multiply(v).sum(axis=1)).ravel()
+                              for v in operators], axis=-1) for u in operators], axis=-2))
             else:
-                w_acc = transform(q_ddot, 0)
-                w_vel = (-a * transform(q_ddot, -1) if self.variant == "paper"
-                         else transform(q_dot, 0))
+                w_acc = w0 @ q_ddot
+                w_vel = (-a * (matrix(-1) @ q_ddot) if self.variant == "paper"
+                         else w0 @ q_dot)
+                products.append(np.zeros((len(scales), 3, 3)))
             rows.append(np.hstack([w_acc, w_vel]))
         owner = np.tile(owner, len(wavelets))
-        return np.vstack(rows), np.vstack(targets), owner, info
+        return (np.vstack(rows), np.vstack(targets), owner, np.concatenate(products),
+                info)
 
     def _fit(self, datasets: list[Dataset], platform: Platform) -> IdentificationResult:
         wavelet = make_wavelet(self.wavelet, **self._wavelet_options())
         experiments = prepare(datasets, platform, gravity=self.gravity)
-        phi, target, cluster, infos = [], [], [], []
+        phi, target, cluster, infos, noise_xx, noise_xy = [], [], [], [], [], []
         offset = 0
-        for experiment in experiments:
-            x, y, owner, info = self._experiment_equations(experiment, wavelet, platform)
+        for dataset, experiment in zip(datasets, experiments, strict=True):
+            x, y, owner, products, info = self._experiment_equations(experiment, wavelet,
+                                                                     platform)
             phi.append(x)
             target.append(y)
             cluster.append(owner + offset)
             offset += len(info["intervals"])
             infos.append(info)
+            if len(x) and self.noise_correction and self.variant == "position":
+                sigma = info["noise_covariance"]
+                sens = generalized_force_sensitivity(platform, dataset.pose, dataset.forces,
+                                                     self.gravity)
+                # per row: E[e_x e_x^T] (12, 12) and E[e_x e_y^T] (12, 6)
+                noise_xx.append(np.einsum("kuv,ij->kuivj", products[:, :2, :2], sigma
+                                          ).reshape(len(x), 12, 12))
+                noise_xy.append(np.einsum("ku,ij->kuij", products[:, :2, 2],
+                                          sigma @ sens.T).reshape(len(x), 12, 6))
+            else:
+                noise_xx.append(np.zeros((len(x), 12, 12)))
+                noise_xy.append(np.zeros((len(x), 12, 6)))
         phi, target, cluster = np.vstack(phi), np.vstack(target), np.concatenate(cluster)
+        noise_xx, noise_xy = np.concatenate(noise_xx), np.concatenate(noise_xy)
         if len(phi) == 0:
             longest = max(info["longest_interval"] for info in infos)
             needed = min(info["shortest_usable"] for info in infos)
@@ -369,7 +489,8 @@ class WaveletIdentifier(BaseIdentifier):
         theta = solution.theta
         std = solution.theta_std
         if not self.symmetric:
-            std = cluster_robust_std(phi, target - phi @ theta.T, cluster)
+            theta, std = bias_compensated_least_squares(phi, target, cluster, noise_xx,
+                                                        noise_xy)
         M, B = theta[:, :6].copy(), theta[:, 6:12].copy()
         std_M, std_B = std[:, :6].copy(), std[:, 6:12].copy()
         chosen = {}
@@ -377,7 +498,9 @@ class WaveletIdentifier(BaseIdentifier):
             chosen["M"] = select_symmetric_pairs(M, std_M)
             chosen["B"] = select_symmetric_pairs(B, std_B)
         residual = target - phi @ theta.T
+        noise = [info["noise_covariance"] for info in infos]
         diagnostics = {
+            "position_noise_std": [np.sqrt(np.diag(c)).tolist() for c in noise],
             "wavelet": wavelet.to_dict(),
             "n_equations": int(len(phi)),
             "n_intervals": int(offset),
@@ -396,6 +519,66 @@ class WaveletIdentifier(BaseIdentifier):
             settings={k: (list(v) if isinstance(v, tuple) else v)
                       for k, v in self.get_params().items()},
             diagnostics=diagnostics)
+
+
+def bias_compensated_least_squares(phi: np.ndarray, target: np.ndarray, cluster: np.ndarray,
+                                   noise_xx: np.ndarray, noise_xy: np.ndarray
+                                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Errors-in-variables least squares with cluster-robust standard errors.
+
+    With measured regressors X = X0 + E and targets Y = Y0 + E_y, ordinary least squares
+    is biased towards zero by E[E^T E] (attenuation) and shifted by E[E^T E_y]. With the
+    noise second moments known per row, the bias-compensated estimator (Stoica &
+    Soderstrom 1982, "Bias correction in least-squares identification")
+
+        theta_i = (X^T X - sum_k C_k)^-1 (X^T y_i - sum_k D_k[:, i])
+
+    is consistent. Its covariance is the sandwich A^-1 (sum_c s_c s_c^T) A^-1 with the
+    mean-zero estimating-equation scores of each cluster
+    s_c = X_c^T (y_c - X_c theta) + C_c theta - D_c, clusters being the intervals (their
+    equations share samples; intervals do not overlap, so clusters are independent).
+
+    Parameters
+    ----------
+    phi : ndarray, shape (K, p)
+    target : ndarray, shape (K, C)
+    cluster : ndarray of int, shape (K,)
+    noise_xx : ndarray, shape (K, p, p)
+        E[e_k e_k^T] of each row's regressor noise (C_k).
+    noise_xy : ndarray, shape (K, p, C)
+        E[e_k e_y,k^T] between regressor and target noise (D_k).
+
+    Returns
+    -------
+    theta : ndarray, shape (C, p)
+    std : ndarray, shape (C, p)
+        Cluster-robust standard errors with the small-sample factor G / (G - 1).
+    """
+    K, p = phi.shape
+    scale = np.linalg.norm(phi, axis=0)
+    scale = np.where(scale > 0, scale, 1.0)
+    xs = phi / scale
+    cxx = noise_xx / np.outer(scale, scale)
+    cxy = noise_xy / scale[None, :, None]
+    labels, index = np.unique(cluster, return_inverse=True)
+    groups = len(labels)
+    cluster_xx = np.zeros((groups, p, p))
+    cluster_xy = np.zeros((groups, p, target.shape[1]))
+    np.add.at(cluster_xx, index, cxx)
+    np.add.at(cluster_xy, index, cxy)
+    normal = xs.T @ xs - cluster_xx.sum(axis=0)
+    bread = np.linalg.inv(normal)
+    theta_s = (bread @ (xs.T @ target - cluster_xy.sum(axis=0))).T       # (C, p)
+    residual = target - xs @ theta_s.T
+    std = np.empty_like(theta_s)
+    factor = groups / max(groups - 1, 1) * (K - 1) / max(K - p, 1)
+    for c in range(target.shape[1]):
+        scores = np.zeros((groups, p))
+        np.add.at(scores, index, xs * residual[:, c:c + 1])
+        scores += cluster_xx @ theta_s[c] - cluster_xy[:, :, c]
+        cov = factor * bread @ (scores.T @ scores) @ bread.T
+        std[c] = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    return theta_s / scale, std / scale
 
 
 def cluster_robust_std(phi: np.ndarray, residual: np.ndarray, cluster: np.ndarray
@@ -452,5 +635,7 @@ def select_symmetric_pairs(matrix: np.ndarray, std: np.ndarray) -> list[dict]:
     return choice
 
 
-__all__ = ["PAIR_SELECTIONS", "VARIANTS", "WaveletIdentifier", "cluster_robust_std",
+__all__ = ["EXACT_DEGREE", "PAIR_SELECTIONS", "VARIANTS", "WaveletIdentifier",
+           "bias_compensated_least_squares", "cluster_robust_std",
+           "generalized_force_sensitivity", "joint_rate_noise", "position_noise_covariance",
            "rate_noise", "select_symmetric_pairs", "wavelet_points"]
