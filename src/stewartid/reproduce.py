@@ -51,7 +51,7 @@ COULOMB_LEVELS = (0.0, 5.0, 30.0)
 FREQUENCY_HZ = 0.5
 #: Record length per experiment (s): full run and ``--quick``. The full run holds 7 periods
 #: at 0.5 Hz after the 2 s fade-in; the quick one 2, enough for every method to run.
-FULL_DURATION_S = 16.0
+FULL_DURATION_S = 20.0
 QUICK_DURATION_S = 6.0
 
 #: Identification methods: key -> (module, class, keyword arguments).
