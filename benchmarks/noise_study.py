@@ -1,0 +1,153 @@
+"""Sensor-noise study: each method's errors against the standard errors it predicts.
+
+Data: the independent simulator's example data set (``tests/data/example_c10``, truth in
+``truth.json``) with sensor noise added as on a real hexapod: white noise on the measured
+leg lengths (the pose is then the forward kinematics of the noisy lengths) and on the leg
+forces (a fraction of each leg's mean force). For every method and seed the script prints
+the largest error over the paper's 20 entries (%), and the median and RMS over those entries
+of |error| / predicted standard error (a ratio of order one means the standard errors are
+honest).
+
+Usage::
+
+    python benchmarks/noise_study.py [--seeds 4] [--length-noise 20e-6] [--force-noise 0.005]
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+from stewartid.dataset import Dataset, read_datasets
+from stewartid.identification.fourier import FourierIdentifier
+from stewartid.identification.least_squares import LeastSquaresIdentifier
+from stewartid.identification.wavelet import WaveletIdentifier
+from stewartid.kinematics import forward_kinematics
+from stewartid.platform import load_platform
+from stewartid.published import PAPER_ENTRIES
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "tests" / "data" / "example_c10"
+#: Method B twice: default interval margin (0.05 excitation periods, needed at high Coulomb
+#: friction) and the short 0.02 s margin (longer intervals, far less noise-sensitive).
+METHODS = {"fourier": FourierIdentifier, "ls": LeastSquaresIdentifier,
+           "wavelet": WaveletIdentifier,
+           "wavelet_m002": functools.partial(WaveletIdentifier, margin=0.02)}
+
+
+def load_example(folder: Path = EXAMPLE):
+    """Platform, datasets and true (Mt, Bt) of the example data set."""
+    platform = load_platform(folder / "platform.toml")
+    truth = json.loads((folder / "truth.json").read_text())
+    datasets = read_datasets(sorted(folder.glob("exp*.csv")), platform)
+    return platform, datasets, np.array(truth["Mt"]), np.array(truth["Bt"])
+
+
+def add_noise(platform, datasets, length_noise: float, force_noise: float, seed: int):
+    """Copies of ``datasets`` with noisy lengths (m), their forward-kinematics pose, and
+    force noise of ``force_noise`` times each leg's mean |force| (N)."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for d in datasets:
+        lengths = d.lengths + length_noise * rng.standard_normal(d.lengths.shape)
+        level = force_noise * np.abs(d.forces).mean(axis=0)
+        forces = d.forces + level * rng.standard_normal(d.forces.shape)
+        pose = forward_kinematics(platform, lengths, initial=d.pose) if length_noise else d.pose
+        out.append(Dataset(t=d.t, pose=pose, lengths=lengths, forces=forces, name=d.name))
+    return out
+
+
+def entry_ratios(estimator, M, B, reference=None) -> tuple[np.ndarray, np.ndarray]:
+    """Relative errors (%) against (M, B) and |estimate - reference| / standard error over
+    the 20 paper entries; ``reference`` (an estimator fitted to noise-free data) isolates the
+    noise-induced error from the method's own bias (Method A's Coulomb bias); None: truth."""
+    errors, ratios = [], []
+    for matrix, i, j in PAPER_ENTRIES:
+        est = (estimator.M_ if matrix == "M" else estimator.B_)[i, j]
+        true = (M if matrix == "M" else B)[i, j]
+        ref = true if reference is None else (reference.M_ if matrix == "M"
+                                              else reference.B_)[i, j]
+        std = estimator.std_errors_[matrix][i, j]
+        errors.append(100 * abs(est - true) / abs(true))
+        ratios.append(abs(est - ref) / std if std > 0 else np.inf)
+    return np.array(errors), np.array(ratios)
+
+
+def study(methods=tuple(METHODS), seeds=(0, 1, 2, 3), length_noise=20e-6, force_noise=0.005,
+          stride=1, datasets=None):
+    """Rows (method, noise, seed, largest error %, median and RMS of |err| / SE, seconds).
+
+    Two ratios per row: against the truth (``ratios``) and against the same method's
+    noise-free estimate (``noise_ratios``, the noise-induced error the standard errors are
+    meant to predict).
+
+    ``stride`` keeps every stride-th sample of the records (shorter runs for tests).
+    """
+    platform, clean, M, B = load_example()
+    if stride > 1:
+        clean = [Dataset(t=d.t[::stride], pose=d.pose[::stride], lengths=d.lengths[::stride],
+                         forces=d.forces[::stride], name=d.name) for d in clean]
+    rows = []
+    references = {}
+    cases = [("none", [None])] + ([("noisy", list(seeds))] if length_noise or force_noise
+                                  else [])
+    for label, case_seeds in cases:
+        for seed in case_seeds:
+            data = clean if seed is None else add_noise(platform, clean, length_noise,
+                                                        force_noise, seed)
+            for method in methods:
+                start = time.perf_counter()
+                estimator = METHODS[method]().fit(data, platform)
+                seconds = time.perf_counter() - start
+                if seed is None:
+                    references[method] = estimator
+                errors, ratios = entry_ratios(estimator, M, B)
+                _, noise_ratios = entry_ratios(estimator, M, B, references.get(method))
+                rows.append({"method": method, "noise": label, "seed": seed,
+                             "max_error_percent": float(errors.max()),
+                             "median_ratio": float(np.median(ratios)),
+                             "rms_ratio": float(np.sqrt(np.mean(ratios ** 2))),
+                             "rms_noise_ratio": float(np.sqrt(np.mean(noise_ratios ** 2))),
+                             "ratios": ratios, "noise_ratios": noise_ratios,
+                             "errors": errors, "seconds": seconds})
+    return rows
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seeds", type=int, default=4)
+    parser.add_argument("--length-noise", type=float, default=20e-6, help="m")
+    parser.add_argument("--force-noise", type=float, default=0.005,
+                        help="fraction of each leg's mean force")
+    parser.add_argument("--methods", default=",".join(METHODS))
+    args = parser.parse_args()
+    rows = study(tuple(args.methods.split(",")), tuple(range(args.seeds)), args.length_noise,
+                 args.force_noise)
+    print(f"length noise {args.length_noise * 1e6:g} um, force noise "
+          f"{100 * args.force_noise:g} % of the mean leg force")
+    print("| method | noise | seed | largest error (%) | median err/SE | RMS err/SE | "
+          "RMS noise-induced err/SE | time (s) |")
+    print("|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        seed = "-" if r["seed"] is None else r["seed"]
+        noise_ratio = "-" if r["seed"] is None else f"{r['rms_noise_ratio']:.2f}"
+        print(f"| {r['method']} | {r['noise']} | {seed} | {r['max_error_percent']:.2f} | "
+              f"{r['median_ratio']:.2f} | {r['rms_ratio']:.2f} | {noise_ratio} | "
+              f"{r['seconds']:.1f} |")
+    for method in dict.fromkeys(r["method"] for r in rows):
+        noisy = [r for r in rows if r["method"] == method and r["noise"] == "noisy"]
+        if noisy:
+            ratios = np.concatenate([r["ratios"] for r in noisy])
+            induced = np.concatenate([r["noise_ratios"] for r in noisy])
+            print(f"{method}: over {len(noisy)} seeds, RMS err/SE "
+                  f"{np.sqrt(np.mean(ratios ** 2)):.2f} (median {np.median(ratios):.2f}), "
+                  f"RMS noise-induced err/SE {np.sqrt(np.mean(induced ** 2)):.2f}, "
+                  f"largest error {max(r['max_error_percent'] for r in noisy):.2f} %")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,69 @@
+"""Sensor noise: every method's errors against the standard errors it predicts.
+
+The independent simulator's example data set (tests/data/example_c10, truth in truth.json)
+with 20 um of white noise on the measured leg lengths (the pose is the forward kinematics of
+the noisy lengths, as on a real hexapod) and 0.5 % force noise, over three seeds. The
+predicted standard errors must be of the order of the actual errors (ratio RMS over the 20
+entries of the paper's tables and the seeds within [0.2, 5]); the noise-induced error is the
+difference from the same method's noise-free estimate (Method A's Coulomb bias is a bias,
+which no standard error predicts, so Method A is checked on that one only). Method B is
+checked with the 0.02 s interval margin; with the default margin (0.05 periods) its
+errors under noise are reported only (see docs/benchmarks.md).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+from noise_study import study  # noqa: E402
+
+SEEDS = (0, 1, 2)
+
+
+@pytest.fixture(scope="module")
+def rows():
+    # every other sample (500 Hz): the same physics at half the cost
+    return study(seeds=SEEDS, length_noise=20e-6, force_noise=0.005, stride=2)
+
+
+def _rms(values):
+    values = np.concatenate(values)
+    return float(np.sqrt(np.mean(values ** 2)))
+
+
+def _noisy(rows, method):
+    out = [r for r in rows if r["method"] == method and r["noise"] == "noisy"]
+    assert len(out) == len(SEEDS)
+    return out
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("method", ["fourier", "ls", "wavelet_m002"])
+def test_standard_errors_predict_the_noise_induced_error(rows, method):
+    ratio = _rms([r["noise_ratios"] for r in _noisy(rows, method)])
+    assert 0.2 <= ratio <= 5.0, f"{method}: RMS |noise-induced error| / SE = {ratio:.3g}"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("method", ["ls", "wavelet_m002"])
+def test_standard_errors_predict_the_error_against_truth(rows, method):
+    ratio = _rms([r["ratios"] for r in _noisy(rows, method)])
+    assert 0.2 <= ratio <= 5.0, f"{method}: RMS |error| / SE = {ratio:.3g}"
+
+
+@pytest.mark.slow
+def test_wavelet_noise_free_within_one_percent_and_noisy_error_reported(rows, capsys):
+    clean = [r for r in rows if r["method"] == "wavelet" and r["noise"] == "none"]
+    assert clean[0]["max_error_percent"] <= 1.0
+    for method in ("wavelet", "wavelet_m002"):
+        noisy = _noisy(rows, method)
+        largest = max(r["max_error_percent"] for r in noisy)
+        assert np.isfinite(largest)
+        with capsys.disabled():
+            print(f"\n{method} under 20 um / 0.5 % sensor noise: largest error {largest:.1f} %"
+                  f" over the paper's 20 entries and {len(noisy)} seeds")
