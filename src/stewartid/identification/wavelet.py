@@ -286,9 +286,14 @@ class WaveletIdentifier(BaseIdentifier):
         :func:`~stewartid.identification.intervals.constant_direction_intervals`).
     odd_companion : bool
         With the polynomial wavelet, also use its odd companion g''' at every (a, b) (see
-        :class:`~stewartid.identification.wavelets.PolynomialWavelet`): the acceleration
-        regressor then carries signal at the centre of each interval, which keeps Mt
-        unbiased under position noise.
+        :class:`~stewartid.identification.wavelets.PolynomialWavelet`); use with
+        ``wavelet_order`` >= 8.
+    noise_correction : bool
+        Errors-in-variables correction of the least squares (position variant, not with
+        ``symmetric``): the pose noise covariance is estimated from the data
+        (:func:`position_noise_covariance`) and its contribution to the normal equations
+        removed (:func:`bias_compensated_least_squares`); standard errors from the
+        corrected sandwich.
     symmetric : bool
         Impose Mt = Mt^T and Bt = Bt^T in the solve.
     pair_selection : {"std_error", "none"}

@@ -177,9 +177,11 @@ class PolynomialWavelet(MotherWavelet):
     With ``odd=True`` the wavelet is the odd companion psi = g''' (integrals g'' and g'),
     whose moments of order 0, 1 and 2 vanish. An even wavelet centred in a half period of a
     sine hardly sees the (antisymmetric) acceleration and strongly sees the (symmetric)
-    velocity; the odd one does the opposite. Using both at every (a, b) raises the
-    signal-to-noise ratio of the acceleration regressor by two orders of magnitude with
-    measured positions, which keeps Mt unbiased under sensor noise.
+    velocity; the odd one does the opposite. Its psi'' = g^(5) has only p - 5 continuous
+    derivatives at +-1, so the sampled transform needs p >= 8 (or the moment correction of
+    :func:`transform_matrix`) to be accurate. Measured on whole constant-direction
+    intervals under leg-length noise, it does not raise the acceleration regressor's
+    signal-to-noise ratio over the even wavelet (both are limited by the vanishing moments).
 
     Normalised to unit L2 norm on [-1, 1].
 
