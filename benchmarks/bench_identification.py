@@ -1,4 +1,4 @@
-"""Time to identify six experiments of 20 s at 1 kHz with every available method.
+"""Time to identify six experiments of 20 s at 1 kHz with every registered method.
 
 Data: the linear model itself (helper of the test suite) on the paper's platform, one sine
 per DOF at 0.5 Hz. Run: ``python benchmarks/bench_identification.py``.
@@ -6,7 +6,6 @@ per DOF at 0.5 Hz. Run: ``python benchmarks/bench_identification.py``.
 
 from __future__ import annotations
 
-import importlib
 import sys
 import time
 from pathlib import Path
@@ -16,13 +15,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 from linear_model_data import make_experiment, random_matrices  # noqa: E402
+from stewartid.identification.registry import registered_methods  # noqa: E402
 from stewartid.platform import load_platform  # noqa: E402
-
-METHODS = {
-    "fourier": ("stewartid.identification.fourier", "FourierIdentifier"),
-    "ls": ("stewartid.identification.least_squares", "LeastSquaresIdentifier"),
-    "wavelet": ("stewartid.identification.wavelet", "WaveletIdentifier"),
-}
 
 
 def main() -> None:
@@ -32,18 +26,13 @@ def main() -> None:
                             sample_rate=1000.0) for k in range(6)]
     print(f"{len(data)} experiments x {data[0].duration + 1e-3:.0f} s at "
           f"{data[0].sample_rate:.0f} Hz")
-    for method, (module, name) in METHODS.items():
-        try:
-            cls = getattr(importlib.import_module(module), name)
-        except (ImportError, AttributeError) as exc:
-            print(f"{method:8s} skipped ({exc})")
-            continue
-        cls().fit(data[:6], platform)  # warm-up: numba caches, imports
+    for spec in registered_methods():
+        spec.create().fit(data[:6], platform)  # warm-up: numba caches, imports
         start = time.perf_counter()
-        est = cls().fit(data, platform)
+        est = spec.create().fit(data, platform)
         elapsed = time.perf_counter() - start
         error = np.max(np.abs(est.M_ - M)) / np.max(np.abs(M))
-        print(f"{method:8s} {elapsed:6.2f} s   max |dM| / max|M| = {error:.1e}")
+        print(f"{spec.name:13s} {elapsed:6.2f} s   max |dM| / max|M| = {error:.1e}")
 
 
 if __name__ == "__main__":

@@ -24,19 +24,18 @@ from pathlib import Path
 import numpy as np
 
 from stewartid.dataset import Dataset, read_datasets
-from stewartid.identification.fourier import FourierIdentifier
-from stewartid.identification.least_squares import LeastSquaresIdentifier
-from stewartid.identification.wavelet import WaveletIdentifier
+from stewartid.identification.registry import create_identifier
 from stewartid.kinematics import forward_kinematics
 from stewartid.platform import load_platform
-from stewartid.published import PAPER_ENTRIES
+from stewartid.reference.published import PAPER_ENTRIES, relative_error_percent
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "tests" / "data" / "example_c10"
 #: Method B twice: default interval margin (0.05 excitation periods, needed at high Coulomb
 #: friction) and the short 0.02 s margin (longer intervals, far less noise-sensitive).
-METHODS = {"fourier": FourierIdentifier, "ls": LeastSquaresIdentifier,
-           "wavelet": WaveletIdentifier,
-           "wavelet_m002": functools.partial(WaveletIdentifier, margin=0.02)}
+METHODS = {"fourier": functools.partial(create_identifier, "fourier"),
+           "ls": functools.partial(create_identifier, "ls"),
+           "wavelet": functools.partial(create_identifier, "wavelet"),
+           "wavelet_m002": functools.partial(create_identifier, "wavelet", margin=0.02)}
 
 
 def load_example(folder: Path = EXAMPLE):
@@ -72,7 +71,7 @@ def entry_ratios(estimator, M, B, reference=None) -> tuple[np.ndarray, np.ndarra
         ref = true if reference is None else (reference.M_ if matrix == "M"
                                               else reference.B_)[i, j]
         std = estimator.std_errors_[matrix][i, j]
-        errors.append(100 * abs(est - true) / abs(true))
+        errors.append(relative_error_percent(est, true))
         ratios.append(abs(est - ref) / std if std > 0 else np.inf)
     return np.array(errors), np.array(ratios)
 

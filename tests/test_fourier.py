@@ -8,8 +8,9 @@ import pytest
 from linear_model_data import AMPLITUDES, make_experiment, random_matrices
 from stewartid.errors import ConfigError, IdentificationError
 from stewartid.identification.fourier import FourierIdentifier, harmonic_coefficients
-from stewartid.identification.results import PAPER_ENTRIES, IdentificationResult
-from stewartid.identification.signals import (
+from stewartid.identification.result import IdentificationResult
+from stewartid.reference.published import PAPER_ENTRIES
+from stewartid.signals.differentiation import (
     differentiate,
     estimate_frequency,
     kernel_filter,

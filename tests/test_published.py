@@ -9,7 +9,7 @@ import pytest
 
 from stewartid.errors import DataError
 from stewartid.linearization import nominal_matrices
-from stewartid.published import (
+from stewartid.reference.published import (
     PAPER_ENTRIES,
     entry_label,
     entry_unit,

@@ -10,15 +10,16 @@ import os
 import numpy as np
 import pytest
 
+from stewartid.io import write_text_atomic
 from stewartid.linearization import nominal_matrices
-from stewartid.published import load_published
+from stewartid.reference.published import load_published
+from stewartid.reporting.comparison import ComparisonResults, MethodRun
 from stewartid.reporting.figures import (
     ExperimentTrace,
     plot_errors,
     plot_force_budget,
     plot_joint_rates,
 )
-from stewartid.reporting.files import write_text_atomic
 from stewartid.reporting.report import (
     FigureEntry,
     fourier_summary,
@@ -26,7 +27,6 @@ from stewartid.reporting.report import (
     render_markdown,
     wavelet_summary,
 )
-from stewartid.reporting.results import ComparisonResults, MethodRun
 from stewartid.reporting.tables import build_tables, paper_table, to_csv, to_markdown
 
 

@@ -14,7 +14,8 @@ from typer.testing import CliRunner
 from stewartid.cli import app
 from stewartid.errors import ConfigError
 from stewartid.linearization import nominal_matrices
-from stewartid.reproduce import METHODS, load_results, make_settings
+from stewartid.reproduction.document import load_results
+from stewartid.reproduction.settings import default_methods, make_settings
 
 LEVELS = (0, 5, 30)
 TABLES = ["summary", "table3", "table4", "table5", "table6"] + [
@@ -64,7 +65,7 @@ def test_results_json_holds_finite_values_in_range(quick_run, paper):
     np.testing.assert_allclose(document["nominal"]["M"], M0, rtol=1e-12)
     np.testing.assert_allclose(document["nominal"]["B"], B0, rtol=1e-12)
     runs = {(r["method"], r["coulomb"]) for r in document["runs"]}
-    assert runs == {(m, float(c)) for m in METHODS for c in LEVELS}
+    assert runs == {(m, float(c)) for m in default_methods() for c in LEVELS}
     for run in document["runs"]:
         M, B = np.asarray(run["M"]), np.asarray(run["B"])
         assert M.shape == B.shape == (6, 6)

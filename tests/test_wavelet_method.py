@@ -9,7 +9,7 @@ import pytest
 from stewartid.dataset import Dataset
 from stewartid.dynamics import ModelTerms
 from stewartid.errors import ConfigError, IdentificationError
-from stewartid.identification.results import max_error_percent
+from stewartid.identification.result import max_error_percent
 from stewartid.identification.wavelet import WaveletIdentifier, select_symmetric_pairs
 from stewartid.kinematics import leg_lengths
 from stewartid.linearization import nominal_matrices

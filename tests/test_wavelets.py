@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from stewartid.errors import ConfigError
-from stewartid.identification.wavelets import (
+from stewartid.signals.wavelets import (
     MexicanHat,
     PolynomialWavelet,
     make_wavelet,

@@ -94,33 +94,6 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True)
-def leg_geometry(upper: np.ndarray, base: np.ndarray, q: np.ndarray):
-    """Leg vectors of one pose.
-
-    Returns
-    -------
-    r : (6, 3) lever arms reference point -> upper joint, world frame (m)
-    lengths : (6,) leg lengths (m)
-    u : (6, 3) unit leg vectors, base joint -> upper joint
-    """
-    R = rotation(q[3], q[4], q[5])
-    r = np.empty((6, 3))
-    u = np.empty((6, 3))
-    lengths = np.empty(6)
-    for i in range(6):
-        for k in range(3):
-            r[i, k] = R[k, 0] * upper[i, 0] + R[k, 1] * upper[i, 1] + R[k, 2] * upper[i, 2]
-        s = 0.0
-        for k in range(3):
-            u[i, k] = q[k] + r[i, k] - base[i, k]
-            s += u[i, k] * u[i, k]
-        lengths[i] = math.sqrt(s)
-        for k in range(3):
-            u[i, k] /= lengths[i]
-    return r, lengths, u
-
-
-@njit(cache=True)
 def model_terms(params, upper, base, q, qd, M, h, G, J_leg, J_joint, lengths):
     """Evaluate every model term at one sample, in q coordinates (written into the outputs).
 

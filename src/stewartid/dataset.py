@@ -18,8 +18,7 @@ every identification method here assumes a fixed sample period.
 
 from __future__ import annotations
 
-import os
-import tempfile
+import io
 import warnings
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
@@ -29,10 +28,11 @@ import numpy as np
 import pandas as pd
 
 from stewartid.errors import DataError, KinematicsError
-from stewartid.platform import Platform
+from stewartid.io import write_bytes_atomic, write_text_atomic
+from stewartid.platform import COORDINATES, Platform
 
 #: All columns of the interchange format, in order.
-COLUMNS = ("t", "x", "y", "z", "rx", "ry", "rz", "l1", "l2", "l3", "l4", "l5", "l6",
+COLUMNS = ("t", *COORDINATES, "l1", "l2", "l3", "l4", "l5", "l6",
            "f1", "f2", "f3", "f4", "f5", "f6")
 POSE_COLUMNS = COLUMNS[1:7]
 LENGTH_COLUMNS = COLUMNS[7:13]
@@ -300,8 +300,8 @@ def read_datasets(paths: str | Path | Sequence[str | Path],
 def write_dataset(dataset: Dataset, path: str | Path, format: str | None = None) -> Path:
     """Write an experiment in the interchange format, atomically.
 
-    The table goes to a temporary file in the target directory which is then renamed over
-    ``path``, so readers never see a half-written file.
+    Through :func:`stewartid.io.write_bytes_atomic`, so readers never see a half-written
+    file.
 
     Parameters
     ----------
@@ -317,21 +317,13 @@ def write_dataset(dataset: Dataset, path: str | Path, format: str | None = None)
     """
     path = Path(path)
     kind = _format_of(path, format)
-    path.parent.mkdir(parents=True, exist_ok=True)
     frame = dataset.to_frame()
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
-        if kind == "csv":
-            # repr-exact floats so a CSV round trip is lossless
-            frame.to_csv(tmp, index=False, float_format="%.17g")
-        else:
-            frame.to_parquet(tmp, index=False)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    if kind == "csv":
+        # repr-exact floats so a CSV round trip is lossless
+        return write_text_atomic(path, frame.to_csv(index=False, float_format="%.17g"))
+    buffer = io.BytesIO()
+    frame.to_parquet(buffer, index=False)
+    return write_bytes_atomic(path, buffer.getvalue())
 
 
 __all__ = [

@@ -26,3 +26,15 @@ class KinematicsError(StewartidError, ArithmeticError):
 
 class IdentificationError(StewartidError, ValueError):
     """The identification problem cannot be solved as posed (no usable interval, rank loss)."""
+
+
+class OutputExistsError(ConfigError):
+    """An output folder already holds results and overwriting was not asked for."""
+
+
+class NotFittedError(StewartidError, ValueError, AttributeError):
+    """A learned attribute (ending in ``_``) was read before ``fit``.
+
+    Like scikit-learn's ``NotFittedError`` it is both a ValueError and an AttributeError, so
+    ``hasattr(estimator, "M_")`` is False before fitting.
+    """

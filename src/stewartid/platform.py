@@ -26,6 +26,10 @@ from stewartid.errors import ConfigError
 #: Standard gravity used throughout the model (m/s^2), as in the paper's model.
 GRAVITY = 9.81
 
+#: Names of the six generalized coordinates of the pose q, in the paper's order (m, m, m,
+#: rad, rad, rad): the one definition used by data files, identifiers, tables and figures.
+COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
+
 
 @dataclasses.dataclass(frozen=True)
 class Geometry:

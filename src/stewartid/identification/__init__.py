@@ -1,14 +1,18 @@
 """Identification of the inertial and viscous matrices Mt, Bt of a Stewart platform.
 
-One module per method over a small shared base:
+One module per method over a small shared base; each method registers itself in
+:mod:`~stewartid.identification.registry`:
 
-- :mod:`~stewartid.identification.base`: measured experiments (Jacobians and gravity at every
-  measured pose), the shared least-squares solver, the estimator base class;
-- :mod:`~stewartid.identification.results`: the result object and the paper's table layout;
-- :mod:`~stewartid.identification.signals`: noise-aware differentiation;
+- :mod:`~stewartid.identification.registry`: the one list of methods and presets;
+- :mod:`~stewartid.identification.base`: the estimator base class (scikit-learn contract);
+- :mod:`~stewartid.identification.preparation`: measured experiments with Jacobians and
+  gravity at every measured pose;
+- :mod:`~stewartid.identification.solvers`: weighted and errors-in-variables least squares;
+- :mod:`~stewartid.identification.intervals`: constant-direction intervals, (a, b) points;
+- :mod:`~stewartid.identification.noise`: measurement noise estimated from the data;
+- :mod:`~stewartid.identification.result`: the result object and its JSON file;
+- :mod:`~stewartid.identification.wavelet`: Method B (Zhang 2020);
 - :mod:`~stewartid.identification.fourier`: Method A (Tian et al.), first-harmonic Fourier;
-- :mod:`~stewartid.identification.wavelet`: Method B (Zhang 2020), wavelet transform on
-  constant-direction intervals;
 - :mod:`~stewartid.identification.least_squares`: time-domain least squares with Coulomb terms.
 
 Submodules are imported on first use so that ``import stewartid.identification`` stays light.
@@ -21,12 +25,15 @@ from typing import Any
 
 _EXPORTS = {
     "BaseIdentifier": "base",
-    "Experiment": "base",
-    "prepare": "base",
-    "solve_least_squares": "base",
-    "IdentificationResult": "results",
-    "PAPER_ENTRIES": "results",
-    "comparison_table": "results",
+    "Experiment": "preparation",
+    "prepare": "preparation",
+    "solve_least_squares": "solvers",
+    "IdentificationResult": "result",
+    "comparison_table": "result",
+    "MethodSpec": "registry",
+    "create_identifier": "registry",
+    "method_spec": "registry",
+    "registered_methods": "registry",
     "FourierIdentifier": "fourier",
     "LeastSquaresIdentifier": "least_squares",
     "WaveletIdentifier": "wavelet",

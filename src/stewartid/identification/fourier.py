@@ -40,15 +40,13 @@ import numpy as np
 
 from stewartid.dataset import Dataset
 from stewartid.errors import DataError, IdentificationError
-from stewartid.identification.base import (
-    BaseIdentifier,
-    check_parameter,
-    prepare,
-    regressor_names,
-    solve_least_squares,
-)
-from stewartid.identification.results import IdentificationResult
-from stewartid.identification.signals import (
+from stewartid.identification.base import BaseIdentifier, check_parameter
+from stewartid.identification.preparation import prepare
+from stewartid.identification.registry import register_method
+from stewartid.identification.result import IdentificationResult
+from stewartid.identification.solvers import regressor_names, solve_least_squares
+from stewartid.platform import Platform
+from stewartid.signals.differentiation import (
     DEFAULT_ORDER,
     default_window,
     differentiate,
@@ -56,7 +54,6 @@ from stewartid.identification.signals import (
     savgol_gain,
     trim,
 )
-from stewartid.platform import Platform
 
 
 def harmonic_coefficients(x: np.ndarray, t: np.ndarray, frequencies_hz: Sequence[float]
@@ -89,6 +86,13 @@ def harmonic_coefficients(x: np.ndarray, t: np.ndarray, frequencies_hz: Sequence
     return coefficients[1:]
 
 
+@register_method(
+    name="fourier", letter="A", color="#1f77b4",
+    display_name="Method A (Fourier)",
+    description="first-harmonic Fourier coefficients over whole periods of a sine excitation "
+                "(the paper's Method A)",
+    reference="Tian et al., single-DOF sine excitation, Method A in Zhang, C. Mathematics "
+              "8(2), 257 (2020). doi:10.3390/math8020257")
 class FourierIdentifier(BaseIdentifier):
     """Method A: first-harmonic Fourier identification of Mt and Bt over whole periods.
 
@@ -99,7 +103,7 @@ class FourierIdentifier(BaseIdentifier):
         not given (the dominant sine).
     window : float, optional
         Savitzky-Golay window (s) for q_dot, q_ddot; 0.2 periods of the highest frequency by
-        default (see :mod:`stewartid.identification.signals`).
+        default (see :mod:`stewartid.signals.differentiation`).
     order : int
         Savitzky-Golay polynomial order.
     gravity : bool
@@ -127,8 +131,6 @@ class FourierIdentifier(BaseIdentifier):
     ----------
     Zhang (2020), doi:10.3390/math8020257, Section 4 (Method A).
     """
-
-    method = "fourier"
 
     def __init__(self, frequency_hz: float | Sequence[float] | None = None,
                  window: float | None = None, order: int = DEFAULT_ORDER, gravity: bool = True,
@@ -171,7 +173,8 @@ class FourierIdentifier(BaseIdentifier):
             return [float(self.frequency_hz)]
         return [float(f) for f in self.frequency_hz]
 
-    def _fit(self, datasets: list[Dataset], platform: Platform) -> IdentificationResult:
+    def _fit(self, datasets: list[Dataset], platform: Platform
+             ) -> tuple[IdentificationResult, dict]:
         experiments = prepare(datasets, platform, gravity=self.gravity)
         rows_motion, rows_force, used = [], [], []
         for exp in experiments:
@@ -218,8 +221,6 @@ class FourierIdentifier(BaseIdentifier):
                                        regressor_names=regressor_names(*groups))
         theta, std = solution.theta, solution.theta_std
         stiffness = theta[:, 12:18] if self.stiffness else None
-        self.stiffness_ = stiffness
-        self.frequencies_ = [u["frequencies_hz"] for u in used]
         diagnostics = {"experiments": used, "n_equations": int(solution.n_equations)}
         if stiffness is not None:
             diagnostics["K"] = stiffness
@@ -227,7 +228,8 @@ class FourierIdentifier(BaseIdentifier):
         return IdentificationResult(
             M=theta[:, :6], B=theta[:, 6:12], std_errors_M=std[:, :6], std_errors_B=std[:, 6:12],
             condition_number=solution.condition_number, residual_rms=solution.residual_rms,
-            method=self.method, settings=self.get_params(), diagnostics=diagnostics)
+            method=self.method, settings=self.get_params(), diagnostics=diagnostics), {
+            "stiffness_": stiffness, "frequencies_": [u["frequencies_hz"] for u in used]}
 
 
 __all__ = ["FourierIdentifier", "harmonic_coefficients"]

@@ -9,7 +9,8 @@ The joints of a 6-6 platform with two-part legs are, per leg, five rotational ax
 lower gimbal, two at the upper gimbal, the revolute about the leg; order of
 :data:`stewartid.kinematics.JOINT_AXES`) and the actuator. :func:`joint_rates` returns their
 rates from a pose/velocity history, :func:`constant_direction_intervals` the intervals, and
-:func:`check_intervals` tells whether a trajectory design yields enough of them.
+:func:`check_intervals` tells whether a trajectory design yields enough of them, and
+:func:`wavelet_points` places the wavelets' (a, b) points inside them.
 
 Joints that barely move deserve care: a rate whose amplitude is a tiny fraction of the
 others' crosses zero at odd times (noise, second-order motion), which would cut every interval
@@ -25,13 +26,16 @@ Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
 from stewartid.errors import DataError, IdentificationError
 from stewartid.kinematics import JOINT_AXES
 from stewartid.platform import Platform
+
+if TYPE_CHECKING:
+    from stewartid.signals.wavelets import MotherWavelet
 
 #: Names of the 36 joint rates returned by :func:`joint_rates`: 30 rotational axes
 #: (leg-major, axes as JOINT_AXES) followed by the 6 actuators.
@@ -256,3 +260,45 @@ def check_intervals(t: np.ndarray, rates: np.ndarray, min_duration: float,
                    "smaller wavelet scale, a smaller margin, or ignore idle joints "
                    "(ignore_below).")
     return IntervalCheck(ok, count, longest, coverage, message)
+
+
+def wavelet_points(intervals: np.ndarray, wavelet: MotherWavelet,
+                   scale_fractions: tuple[float, ...], shifts_per_scale: int,
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(a, b) points whose wavelet support lies inside an interval.
+
+    Parameters
+    ----------
+    intervals : ndarray, shape (M, 2)
+        [start, stop] (s).
+    wavelet : MotherWavelet
+    scale_fractions : tuple of float
+        Support length as a fraction of the interval length, each in (0, 1].
+    shifts_per_scale : int
+        Shifts per scale and interval (one if the support fills the interval).
+
+    Returns
+    -------
+    scales, shifts : ndarray, shape (K,)
+        a and b (s).
+    interval_index : ndarray of int, shape (K,)
+        Row of ``intervals`` each point belongs to.
+    """
+    scales, shifts, owner = [], [], []
+    for m, (start, stop) in enumerate(intervals):
+        length = stop - start
+        for fraction in scale_fractions:
+            a = fraction * length / (2.0 * wavelet.half_width)
+            free = length - 2.0 * a * wavelet.half_width
+            count = shifts_per_scale if free > 1e-9 * length else 1
+            b = start + a * wavelet.half_width + np.linspace(0.0, max(free, 0.0), count)
+            scales.append(np.full(count, a))
+            shifts.append(b)
+            owner.append(np.full(count, m))
+    if not scales:
+        return np.zeros(0), np.zeros(0), np.zeros(0, dtype=int)
+    return np.concatenate(scales), np.concatenate(shifts), np.concatenate(owner)
+
+
+__all__ = ["JOINT_RATE_NAMES", "IntervalCheck", "active_joints", "check_intervals",
+           "constant_direction_intervals", "joint_rates", "wavelet_points"]

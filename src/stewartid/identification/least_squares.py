@@ -9,10 +9,10 @@ with y = J_lq^T f_a - G(q), c_e a constant per channel and experiment (residual 
 force-sensor offsets), J_j the joint-rate Jacobian of joint axis j at the measured pose, and
 one Coulomb level per joint type (lower gimbal, upper gimbal, revolute). The 72 entries of Mt
 and Bt, the offsets and the three Coulomb levels are solved together by
-:func:`~stewartid.identification.base.solve_least_squares`.
+:func:`~stewartid.identification.solvers.solve_least_squares`.
 
 By default (``differentiation="kernel"``) both sides of the equation are filtered with one
-smooth compact kernel h (:func:`~stewartid.identification.signals.kernel_filter`): velocity and
+smooth compact kernel h (:func:`~stewartid.signals.differentiation.kernel_filter`): velocity and
 acceleration become q * h' and q * h'' (no numerical differentiation), and y, the offsets and
 the Coulomb regressors are filtered with h itself, so the equation holds exactly in the
 filtered signals, including across the friction switches where a differentiating filter
@@ -34,15 +34,13 @@ from __future__ import annotations
 import numpy as np
 
 from stewartid.dataset import Dataset
-from stewartid.identification.base import (
-    BaseIdentifier,
-    check_parameter,
-    prepare,
-    regressor_names,
-    solve_least_squares,
-)
-from stewartid.identification.results import IdentificationResult
-from stewartid.identification.signals import (
+from stewartid.identification.base import BaseIdentifier, check_parameter
+from stewartid.identification.preparation import prepare
+from stewartid.identification.registry import register_method
+from stewartid.identification.result import IdentificationResult
+from stewartid.identification.solvers import regressor_names, solve_least_squares
+from stewartid.platform import Platform
+from stewartid.signals.differentiation import (
     DEFAULT_ORDER,
     default_window,
     differentiate,
@@ -50,7 +48,6 @@ from stewartid.identification.signals import (
     kernel_filter,
     trim,
 )
-from stewartid.platform import Platform
 
 #: Joint types and their axes in the order of the joint-rate Jacobians.
 JOINT_TYPES = {"lower_gimbal": (0, 1), "upper_gimbal": (2, 3), "revolute": (4,)}
@@ -80,6 +77,13 @@ def coulomb_regressors(joint_jacobians: np.ndarray, q_dot: np.ndarray, smoothing
     return out
 
 
+@register_method(
+    name="ls", color="#2ca02c",
+    display_name="Time-domain least squares",
+    description="time-domain least squares of the inverse-dynamics model with Coulomb "
+                "regressors and per-experiment offsets",
+    reference="Khalil, W., Dombre, E. Modeling, Identification and Control of Robots, "
+              "ch. 12 (2002)")
 class LeastSquaresIdentifier(BaseIdentifier):
     """Time-domain least squares for Mt, Bt, per-experiment offsets and Coulomb levels.
 
@@ -117,8 +121,6 @@ class LeastSquaresIdentifier(BaseIdentifier):
     result_ : IdentificationResult
     """
 
-    method = "ls"
-
     def __init__(self, window: float | None = None, order: int = DEFAULT_ORDER,
                  gravity: bool = True, coulomb: bool = True, coulomb_smoothing: float = 1e-4,
                  symmetric: bool = False, decimate: int = 1,
@@ -149,7 +151,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
                         isinstance(self.decimate, int | np.integer) and self.decimate >= 1,
                         "an int >= 1")
 
-    def _fit(self, datasets: list[Dataset], platform: Platform) -> IdentificationResult:
+    def _fit(self, datasets: list[Dataset], platform: Platform
+             ) -> tuple[IdentificationResult, dict]:
         experiments = prepare(datasets, platform, gravity=self.gravity)
         n_exp = len(experiments)
         phis, ys, shared, used = [], [], [], []
@@ -196,17 +199,17 @@ class LeastSquaresIdentifier(BaseIdentifier):
             shared_names=[f"coulomb[{t}]" for t in JOINT_TYPES] if self.coulomb else None,
             autocorrelated=True)
         theta, std = solution.theta, solution.theta_std
-        self.offsets_ = theta[:, 12:].T.copy()
+        offsets = theta[:, 12:].T.copy()
         levels = dict(zip(JOINT_TYPES, solution.shared.tolist(), strict=False))
         levels_std = dict(zip(JOINT_TYPES, solution.shared_std.tolist(), strict=False))
-        self.coulomb_, self.coulomb_std_ = levels, levels_std
-        diagnostics = {"experiments": used, "offsets": self.offsets_,
+        diagnostics = {"experiments": used, "offsets": offsets,
                        "coulomb": levels, "coulomb_std": levels_std,
                        "n_equations": int(solution.n_equations)}
         return IdentificationResult(
             M=theta[:, :6], B=theta[:, 6:12], std_errors_M=std[:, :6], std_errors_B=std[:, 6:12],
             condition_number=solution.condition_number, residual_rms=solution.residual_rms,
-            method=self.method, settings=self.get_params(), diagnostics=diagnostics)
+            method=self.method, settings=self.get_params(), diagnostics=diagnostics), {
+            "offsets_": offsets, "coulomb_": levels, "coulomb_std_": levels_std}
 
 
 __all__ = ["JOINT_TYPES", "LeastSquaresIdentifier", "coulomb_regressors"]

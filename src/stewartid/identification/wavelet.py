@@ -59,190 +59,61 @@ from __future__ import annotations
 
 import numpy as np
 from scipy import sparse
-from scipy.signal import savgol_filter
 
 from stewartid.dataset import Dataset
 from stewartid.errors import IdentificationError
-from stewartid.identification.base import (
-    COORDINATES,
-    BaseIdentifier,
-    Experiment,
-    check_parameter,
-    prepare,
+from stewartid.identification.base import BaseIdentifier, check_parameter
+from stewartid.identification.intervals import (
+    constant_direction_intervals,
+    joint_rates,
+    wavelet_points,
+)
+from stewartid.identification.noise import (
+    generalized_force_sensitivity,
+    joint_rate_noise,
+    position_noise_covariance,
+)
+from stewartid.identification.preparation import Experiment, prepare
+from stewartid.identification.registry import Preset, register_method
+from stewartid.identification.result import IdentificationResult
+from stewartid.identification.solvers import (
+    bias_compensated_least_squares,
     regressor_names,
     solve_least_squares,
 )
-from stewartid.identification.intervals import constant_direction_intervals, joint_rates
-from stewartid.identification.results import IdentificationResult
-from stewartid.identification.signals import (
-    DEFAULT_ORDER,
-    default_window,
-    differentiate,
-    estimate_frequency,
-    window_samples,
-)
-from stewartid.identification.wavelets import (
+from stewartid.platform import COORDINATES, Platform
+from stewartid.signals.differentiation import default_window, differentiate, estimate_frequency
+from stewartid.signals.wavelets import (
     MotherWavelet,
     PolynomialWavelet,
     make_wavelet,
     transform_matrix,
 )
-from stewartid.platform import Platform
 
+#: Citation of the method.
+REFERENCE = ("Zhang, C. A Parameter Identification Method for Stewart Manipulator Based on "
+             "Wavelet Transform. Mathematics 8(2), 257 (2020). doi:10.3390/math8020257")
 VARIANTS = ("position", "paper", "derivative")
 #: Polynomial degree up to which every transform row integrates exactly (moment-corrected
-#: quadrature, see :func:`~stewartid.identification.wavelets.transform_matrix`).
+#: quadrature, see :func:`~stewartid.signals.wavelets.transform_matrix`).
 EXACT_DEGREE = 5
 #: Default interval margin, in periods of the estimated excitation frequency.
 MARGIN_PERIODS = 0.05
 PAIR_SELECTIONS = ("std_error", "none")
 
 
-def rate_noise(rates: np.ndarray, period: float, window: float) -> np.ndarray:
-    """Noise level of each joint rate: robust standard deviation of what a four times wider
-    Savitzky-Golay smoother removes.
-
-    Parameters
-    ----------
-    rates : ndarray, shape (N, J)
-    period, window : float
-        Sample period and the differentiation window (s).
-
-    Returns
-    -------
-    ndarray, shape (J,)
-        1.4826 * median absolute deviation (units of ``rates``).
-    """
-    n = max(7, int(round(4 * window / period)) | 1)
-    if n > len(rates):
-        n = len(rates) if len(rates) % 2 else len(rates) - 1
-    residual = rates - savgol_filter(rates, n, 3, axis=0, mode="interp")
-    return 1.4826 * np.median(np.abs(residual - np.median(residual, axis=0)), axis=0)
-
-
-def position_noise_covariance(q: np.ndarray, smooth: np.ndarray | None = None) -> np.ndarray:
-    """Covariance of white measurement noise on the pose, from second differences.
-
-    For a smooth motion, q[n+1] - 2 q[n] + q[n-1] is the noise e[n+1] - 2 e[n] + e[n-1]
-    (covariance 6 Sigma for white noise) plus q_ddot dt^2. The latter is removed by taking
-    the differences of q minus a smoothed copy (a low-pass smoother leaves the noise's second
-    differences almost untouched), so noise-free data give a covariance near zero. The pose
-    of a hexapod is the forward kinematics of the measured leg lengths, so its noise is
-    correlated across the six coordinates; the full covariance is returned.
-
-    Parameters
-    ----------
-    q : ndarray, shape (N, 6)
-        Measured poses (m, rad).
-    smooth : ndarray, shape (N, 6), optional
-        A low-pass smoothed copy of ``q`` (e.g. the Savitzky-Golay output); None: raw
-        second differences.
-
-    Returns
-    -------
-    ndarray, shape (6, 6)
-        Sigma (m^2, m rad, rad^2) per sample.
-    """
-    r = q if smooth is None else q - smooth
-    d2 = r[2:] - 2.0 * r[1:-1] + r[:-2]
-    d2 = d2 - np.median(d2, axis=0)
-    return d2.T @ d2 / (6.0 * max(len(d2), 1))
-
-
-def joint_rate_noise(covariance: np.ndarray, sample_rate: float, window: float,
-                     joint_jacobians: np.ndarray, leg_jacobian: np.ndarray) -> np.ndarray:
-    """Standard deviation of each Savitzky-Golay joint rate caused by pose noise.
-
-    The velocity filter is a linear combination of samples with coefficients c, so white
-    pose noise of covariance Sigma gives q_dot noise of covariance |c|^2 Sigma, and the joint
-    rates J q_dot the standard deviations |c| sqrt(diag(J Sigma J^T)) (Jacobians averaged over
-    the record; the motion is small).
-
-    Parameters
-    ----------
-    covariance : ndarray, shape (6, 6)
-        Pose noise per sample (:func:`position_noise_covariance`).
-    sample_rate, window : float
-        Hz and the differentiation window (s).
-    joint_jacobians : ndarray, shape (N, 6, 5, 6)
-    leg_jacobian : ndarray, shape (N, 6, 6)
-
-    Returns
-    -------
-    ndarray, shape (36,)
-        Columns as :data:`~stewartid.identification.intervals.JOINT_RATE_NAMES`.
-    """
-    from scipy.signal import savgol_coeffs
-
-    n = window_samples(window, sample_rate, DEFAULT_ORDER)
-    gain = np.linalg.norm(savgol_coeffs(n, DEFAULT_ORDER, deriv=1, delta=1.0 / sample_rate))
-    jac = np.concatenate([joint_jacobians.mean(axis=0).reshape(30, 6),
-                          leg_jacobian.mean(axis=0)], axis=0)
-    variance = np.einsum("ij,jk,ik->i", jac, covariance, jac)
-    return gain * np.sqrt(np.clip(variance, 0.0, None))
-
-
-def generalized_force_sensitivity(platform: Platform, q: np.ndarray, forces: np.ndarray,
-                                  gravity: bool = True, step: float = 1e-6) -> np.ndarray:
-    """K = d(J_lq(q)^T f - G(q)) / dq at the mean pose and mean leg forces, shape (6, 6).
-
-    Pose noise enters the generalized force through the Jacobian (the static leg load times
-    the change of the leg directions) and through G(q); K maps it there, so the
-    errors-in-variables correction can account for noise shared by regressors and targets.
-    Central differences of ``step`` (m, rad).
-    """
-    from stewartid.dynamics import ModelTerms
-
-    q0, f0 = q.mean(axis=0), forces.mean(axis=0)
-    poses = np.repeat(q0[None], 12, axis=0)
-    for j in range(6):
-        poses[2 * j, j] += step
-        poses[2 * j + 1, j] -= step
-    terms = ModelTerms(platform, poses)
-    y = np.einsum("nji,j->ni", terms.leg_jacobian, f0)
-    if gravity:
-        y = y - terms.gravity
-    return ((y[0::2] - y[1::2]) / (2 * step)).T
-
-
-def wavelet_points(intervals: np.ndarray, wavelet: MotherWavelet,
-                   scale_fractions: tuple[float, ...], shifts_per_scale: int,
-                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(a, b) points whose wavelet support lies inside an interval.
-
-    Parameters
-    ----------
-    intervals : ndarray, shape (M, 2)
-        [start, stop] (s).
-    wavelet : MotherWavelet
-    scale_fractions : tuple of float
-        Support length as a fraction of the interval length, each in (0, 1].
-    shifts_per_scale : int
-        Shifts per scale and interval (one if the support fills the interval).
-
-    Returns
-    -------
-    scales, shifts : ndarray, shape (K,)
-        a and b (s).
-    interval_index : ndarray of int, shape (K,)
-        Row of ``intervals`` each point belongs to.
-    """
-    scales, shifts, owner = [], [], []
-    for m, (start, stop) in enumerate(intervals):
-        length = stop - start
-        for fraction in scale_fractions:
-            a = fraction * length / (2.0 * wavelet.half_width)
-            free = length - 2.0 * a * wavelet.half_width
-            count = shifts_per_scale if free > 1e-9 * length else 1
-            b = start + a * wavelet.half_width + np.linspace(0.0, max(free, 0.0), count)
-            scales.append(np.full(count, a))
-            shifts.append(b)
-            owner.append(np.full(count, m))
-    if not scales:
-        return np.zeros(0), np.zeros(0), np.zeros(0, dtype=int)
-    return np.concatenate(scales), np.concatenate(shifts), np.concatenate(owner)
-
-
+@register_method(
+    name="wavelet", letter="B", color="#d62728",
+    display_name="Method B (wavelet)",
+    description="wavelet transform on constant-direction intervals, derivatives moved onto "
+                "compact polynomial wavelets (the package's Method B)",
+    reference=REFERENCE,
+    presets={"wavelet-paper": Preset(
+        settings={"variant": "paper", "wavelet": "mexican_hat"},
+        display_name="Method B, paper's equations (Mexican hat)",
+        description="Method B with the paper's own equations: Mexican hat, W q_ddot and "
+                    "a W1 q_ddot from a Savitzky-Golay acceleration",
+        color="#ff7f0e")})
 class WaveletIdentifier(BaseIdentifier):
     """Identify Mt and Bt by the wavelet method of Zhang (2020) (Method B).
 
@@ -281,18 +152,20 @@ class WaveletIdentifier(BaseIdentifier):
         which keeps measurement noise out of the joint rates without moving their zeros.
     hysteresis : float
         A joint's direction counts as known only while its rate exceeds this many times the
-        rate's noise level (estimated from the data, :func:`rate_noise`); reversals inside the
+        rate's noise level (estimated from the data,
+        :func:`~stewartid.identification.noise.joint_rate_noise`); reversals inside the
         noise band are kept out of every interval (see
         :func:`~stewartid.identification.intervals.constant_direction_intervals`).
     odd_companion : bool
         With the polynomial wavelet, also use its odd companion g''' at every (a, b) (see
-        :class:`~stewartid.identification.wavelets.PolynomialWavelet`); use with
+        :class:`~stewartid.signals.wavelets.PolynomialWavelet`); use with
         ``wavelet_order`` >= 8.
     noise_correction : bool
         Errors-in-variables correction of the least squares (position variant, not with
         ``symmetric``): the pose noise covariance is estimated from the data
-        (:func:`position_noise_covariance`) and its contribution to the normal equations
-        removed (:func:`bias_compensated_least_squares`); standard errors from the
+        (:func:`~stewartid.identification.noise.position_noise_covariance`) and its
+        contribution to the normal equations removed
+        (:func:`~stewartid.identification.solvers.bias_compensated_least_squares`); standard errors from the
         corrected sandwich.
     symmetric : bool
         Impose Mt = Mt^T and Bt = Bt^T in the solve.
@@ -316,8 +189,6 @@ class WaveletIdentifier(BaseIdentifier):
     Zhang, C. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
     Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
     """
-
-    method = "wavelet"
 
     def __init__(self, wavelet: str = "polynomial", wavelet_order: int = 6,
                  truncation: float = 5.0, variant: str = "position",
@@ -466,7 +337,8 @@ class WaveletIdentifier(BaseIdentifier):
         return (np.vstack(rows), np.vstack(targets), owner, np.concatenate(products),
                 info)
 
-    def _fit(self, datasets: list[Dataset], platform: Platform) -> IdentificationResult:
+    def _fit(self, datasets: list[Dataset], platform: Platform
+             ) -> tuple[IdentificationResult, dict]:
         wavelet = make_wavelet(self.wavelet, **self._wavelet_options())
         experiments = prepare(datasets, platform, gravity=self.gravity)
         phi, target, cluster, infos, noise_xx, noise_xy = [], [], [], [], [], []
@@ -537,103 +409,7 @@ class WaveletIdentifier(BaseIdentifier):
             residual_rms=np.sqrt(np.mean(residual ** 2, axis=0)), method=self.method,
             settings={k: (list(v) if isinstance(v, tuple) else v)
                       for k, v in self.get_params().items()},
-            diagnostics=diagnostics)
-
-
-def bias_compensated_least_squares(phi: np.ndarray, target: np.ndarray, cluster: np.ndarray,
-                                   noise_xx: np.ndarray, noise_xy: np.ndarray
-                                   ) -> tuple[np.ndarray, np.ndarray]:
-    """Errors-in-variables least squares with cluster-robust standard errors.
-
-    With measured regressors X = X0 + E and targets Y = Y0 + E_y, ordinary least squares
-    is biased towards zero by E[E^T E] (attenuation) and shifted by E[E^T E_y]. With the
-    noise second moments known per row, the bias-compensated estimator (Stoica &
-    Soderstrom 1982, "Bias correction in least-squares identification")
-
-        theta_i = (X^T X - sum_k C_k)^-1 (X^T y_i - sum_k D_k[:, i])
-
-    is consistent. Its covariance is the sandwich A^-1 (sum_c s_c s_c^T) A^-1 with the
-    mean-zero estimating-equation scores of each cluster
-    s_c = X_c^T (y_c - X_c theta) + C_c theta - D_c, clusters being the intervals (their
-    equations share samples; intervals do not overlap, so clusters are independent).
-
-    Parameters
-    ----------
-    phi : ndarray, shape (K, p)
-    target : ndarray, shape (K, C)
-    cluster : ndarray of int, shape (K,)
-    noise_xx : ndarray, shape (K, p, p)
-        E[e_k e_k^T] of each row's regressor noise (C_k).
-    noise_xy : ndarray, shape (K, p, C)
-        E[e_k e_y,k^T] between regressor and target noise (D_k).
-
-    Returns
-    -------
-    theta : ndarray, shape (C, p)
-    std : ndarray, shape (C, p)
-        Cluster-robust standard errors with the small-sample factor G / (G - 1).
-    """
-    K, p = phi.shape
-    scale = np.linalg.norm(phi, axis=0)
-    scale = np.where(scale > 0, scale, 1.0)
-    xs = phi / scale
-    cxx = noise_xx / np.outer(scale, scale)
-    cxy = noise_xy / scale[None, :, None]
-    labels, index = np.unique(cluster, return_inverse=True)
-    groups = len(labels)
-    cluster_xx = np.zeros((groups, p, p))
-    cluster_xy = np.zeros((groups, p, target.shape[1]))
-    np.add.at(cluster_xx, index, cxx)
-    np.add.at(cluster_xy, index, cxy)
-    normal = xs.T @ xs - cluster_xx.sum(axis=0)
-    bread = np.linalg.inv(normal)
-    theta_s = (bread @ (xs.T @ target - cluster_xy.sum(axis=0))).T       # (C, p)
-    residual = target - xs @ theta_s.T
-    std = np.empty_like(theta_s)
-    factor = groups / max(groups - 1, 1) * (K - 1) / max(K - p, 1)
-    for c in range(target.shape[1]):
-        scores = np.zeros((groups, p))
-        np.add.at(scores, index, xs * residual[:, c:c + 1])
-        scores += cluster_xx @ theta_s[c] - cluster_xy[:, :, c]
-        cov = factor * bread @ (scores.T @ scores) @ bread.T
-        std[c] = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    return theta_s / scale, std / scale
-
-
-def cluster_robust_std(phi: np.ndarray, residual: np.ndarray, cluster: np.ndarray
-                       ) -> np.ndarray:
-    """Cluster-robust standard errors of per-channel ordinary least squares.
-
-    Parameters
-    ----------
-    phi : ndarray, shape (K, p)
-        Regressors.
-    residual : ndarray, shape (K, C)
-        Residuals of each channel.
-    cluster : ndarray of int, shape (K,)
-        Cluster (interval) of each row; residuals may correlate within a cluster.
-
-    Returns
-    -------
-    ndarray, shape (C, p)
-        Standard error of each coefficient, with the small-sample factor G / (G - 1).
-    """
-    K, p = phi.shape
-    scale = np.linalg.norm(phi, axis=0)
-    scale = np.where(scale > 0, scale, 1.0)
-    xs = phi / scale
-    bread = np.linalg.pinv(xs.T @ xs)
-    labels, index = np.unique(cluster, return_inverse=True)
-    groups = len(labels)
-    out = np.empty((residual.shape[1], p))
-    for c in range(residual.shape[1]):
-        scores = np.zeros((groups, p))
-        np.add.at(scores, index, xs * residual[:, c:c + 1])
-        meat = scores.T @ scores
-        factor = groups / max(groups - 1, 1) * (K - 1) / max(K - p, 1)
-        cov = factor * bread @ meat @ bread
-        out[c] = np.sqrt(np.clip(np.diag(cov), 0.0, None)) / scale
-    return out
+            diagnostics=diagnostics), {}
 
 
 def select_symmetric_pairs(matrix: np.ndarray, std: np.ndarray) -> list[dict]:
@@ -655,6 +431,4 @@ def select_symmetric_pairs(matrix: np.ndarray, std: np.ndarray) -> list[dict]:
 
 
 __all__ = ["EXACT_DEGREE", "MARGIN_PERIODS", "PAIR_SELECTIONS", "VARIANTS", "WaveletIdentifier",
-           "bias_compensated_least_squares", "cluster_robust_std",
-           "generalized_force_sensitivity", "joint_rate_noise", "position_noise_covariance",
-           "rate_noise", "select_symmetric_pairs", "wavelet_points"]
+           "select_symmetric_pairs"]

@@ -1,33 +1,37 @@
-"""Figures of a comparison run (matplotlib, Agg backend), each written as PNG and SVG.
+"""Figures of a comparison run, each written as PNG and SVG.
 
 Signal figures take :class:`ExperimentTrace` objects (one simulated experiment, with the
 model's force components already evaluated); comparison figures take a
-:class:`~stewartid.reporting.results.ComparisonResults`. Every function returns the written
-paths. matplotlib is imported inside the functions so that importing this module is cheap.
+:class:`~stewartid.reporting.comparison.ComparisonResults`. Every function returns the
+written paths. The figures are :class:`matplotlib.figure.Figure` objects drawn inside
+``matplotlib.rc_context(STYLE)``: no pyplot, no backend selection and no change to the
+caller's matplotlib settings. matplotlib is imported inside the functions so that importing
+this module is cheap.
 """
 
 from __future__ import annotations
 
+import functools
 import io
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from stewartid.published import PAPER_ENTRIES, entry_label
-from stewartid.reporting.files import write_bytes_atomic
-from stewartid.reporting.results import ComparisonResults, method_name
+from stewartid.io import write_bytes_atomic
+from stewartid.platform import COORDINATES
+from stewartid.reference.published import PAPER_ENTRIES, entry_label
+from stewartid.reporting.comparison import ComparisonResults, method_color, method_name
 
-#: Coordinate names and the display unit/scale of a displacement in each.
-COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
+#: Display unit and scale of a displacement in each coordinate.
 _DISPLAY = (("mm", 1e3),) * 3 + (("mrad", 1e3),) * 3
 _FORCE_UNITS = ("N",) * 3 + ("N·m",) * 3
 
-#: One colour per method, the same in every figure.
-METHOD_COLOURS = {"fourier": "#1f77b4", "wavelet": "#d62728", "wavelet_paper": "#ff7f0e",
-                  "least_squares": "#2ca02c"}
+#: matplotlib settings of every figure, applied with ``matplotlib.rc_context``.
+STYLE = {"font.size": 10, "axes.titlesize": 11, "axes.labelsize": 10, "legend.fontsize": 9,
+         "svg.fonttype": "none", "axes.grid": True, "grid.alpha": 0.3}
 
 #: Force components of a budget, in plotting order, with display names.
 FORCE_COMPONENTS = {
@@ -76,22 +80,28 @@ class ExperimentTrace:
     forces: dict[str, np.ndarray] = field(default_factory=dict)
 
 
-def _pyplot():
-    import matplotlib
+def _styled(plot: Callable[..., list[Path]]) -> Callable[..., list[Path]]:
+    """Draw and save inside ``rc_context(STYLE)``: the caller's settings are untouched."""
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    @functools.wraps(plot)
+    def wrapper(*args: Any, **kwargs: Any) -> list[Path]:
+        import matplotlib
 
-    plt.rcParams.update({"font.size": 10, "axes.titlesize": 11, "axes.labelsize": 10,
-                         "legend.fontsize": 9, "svg.fonttype": "none",
-                         "axes.grid": True, "grid.alpha": 0.3})
-    return plt
+        with matplotlib.rc_context(STYLE):
+            return plot(*args, **kwargs)
+
+    return wrapper
+
+
+def _figure(**options: Any) -> Any:
+    """A new :class:`matplotlib.figure.Figure` (not registered with pyplot)."""
+    from matplotlib.figure import Figure
+
+    return Figure(**options)
 
 
 def save_figure(figure: Any, directory: str | Path, stem: str, dpi: int = 120) -> list[Path]:
-    """Write ``figure`` as ``stem.png`` and ``stem.svg`` in ``directory`` (atomic) and close it."""
-    import matplotlib.pyplot as plt
-
+    """Write ``figure`` as ``stem.png`` and ``stem.svg`` in ``directory`` (atomic)."""
     directory = Path(directory)
     paths = []
     # metadata dates off: the same run gives byte-identical SVG files
@@ -101,7 +111,6 @@ def save_figure(figure: Any, directory: str | Path, stem: str, dpi: int = 120) -
         figure.savefig(buffer, format=kind, dpi=dpi, bbox_inches="tight",
                        metadata=metadata[kind])
         paths.append(write_bytes_atomic(directory / f"{stem}.{kind}", buffer.getvalue()))
-    plt.close(figure)
     return paths
 
 
@@ -119,16 +128,16 @@ def _shade_intervals(axis: Any, intervals: np.ndarray | None, label: bool) -> No
                      label="constant-direction interval" if (label and k == 0) else None)
 
 
+@_styled
 def plot_excitation(traces: Sequence[ExperimentTrace], directory: str | Path,
                     stem: str = "excitation") -> list[Path]:
     """Commanded and measured motion of the excited coordinate in each experiment, with the
     tracking error, one panel per experiment."""
-    plt = _pyplot()
     count = len(traces)
     columns = min(3, count)
     rows = int(np.ceil(count / columns))
-    figure, axes = plt.subplots(rows, columns, figsize=(4.6 * columns, 3.2 * rows),
-                                squeeze=False, constrained_layout=True)
+    figure = _figure(figsize=(4.6 * columns, 3.2 * rows), layout="constrained")
+    axes = figure.subplots(rows, columns, squeeze=False)
     for axis, trace in zip(axes.flat, traces, strict=False):
         k = trace.excited
         unit, scale = _DISPLAY[k]
@@ -160,19 +169,21 @@ def plot_excitation(traces: Sequence[ExperimentTrace], directory: str | Path,
     return save_figure(figure, directory, stem)
 
 
+@_styled
 def plot_joint_rates(trace: ExperimentTrace, directory: str | Path,
                      stem: str = "joint_velocities") -> list[Path]:
     """Rates of the 30 rotational joint axes and the 6 actuators of one experiment, with the
     constant-direction intervals shaded."""
     if trace.joint_rates is None:
         raise ValueError(f"trace {trace.name!r} has no joint rates to plot")
-    plt = _pyplot()
-    figure, (top, bottom) = plt.subplots(2, 1, figsize=(9, 6), sharex=True,
-                                         constrained_layout=True)
+    figure = _figure(figsize=(9, 6), layout="constrained")
+    top, bottom = figure.subplots(2, 1, sharex=True)
     step = _every(trace.t)
     t = trace.t[step]
     rotational = trace.joint_rates[step, :30]
-    axis_colours = plt.cm.viridis(np.linspace(0, 0.9, 5))
+    from matplotlib import colormaps
+
+    axis_colours = colormaps["viridis"](np.linspace(0, 0.9, 5))
     names = ("lower gimbal 1", "lower gimbal 2", "upper gimbal 1", "upper gimbal 2", "revolute")
     for axis_index in range(5):
         columns = rotational[:, axis_index::5] * 1e3
@@ -195,17 +206,17 @@ def plot_joint_rates(trace: ExperimentTrace, directory: str | Path,
     return save_figure(figure, directory, stem)
 
 
+@_styled
 def plot_force_budget(trace: ExperimentTrace, directory: str | Path,
                       channels: Sequence[int] | None = None,
                       stem: str = "force_budget") -> list[Path]:
     """Generalized force components of one experiment in the excited equation and its most
     coupled one: inertial, viscous, Coulomb, gravity variation and the actuators' total."""
-    plt = _pyplot()
     if channels is None:
         coupled = {0: 4, 1: 3, 2: 2, 3: 1, 4: 0, 5: 5}[trace.excited]
         channels = sorted({trace.excited, coupled})
-    figure, axes = plt.subplots(len(channels), 1, figsize=(9, 3.2 * len(channels)),
-                                sharex=True, squeeze=False, constrained_layout=True)
+    figure = _figure(figsize=(9, 3.2 * len(channels)), layout="constrained")
+    axes = figure.subplots(len(channels), 1, sharex=True, squeeze=False)
     styles = {"inertial": ("#1f77b4", 1.4), "viscous": ("#ff7f0e", 1.4),
               "coulomb": ("#d62728", 1.4), "gravity": ("#9467bd", 1.4),
               "actuators": ("#b0b0b0", 0.6)}
@@ -233,6 +244,7 @@ def plot_force_budget(trace: ExperimentTrace, directory: str | Path,
     return save_figure(figure, directory, stem)
 
 
+@_styled
 def plot_scalogram(t: np.ndarray, signal: np.ndarray, points: np.ndarray,
                    directory: str | Path, wavelet: Any = "mexican_hat",
                    signal_label: str = "signal", intervals: np.ndarray | None = None,
@@ -249,16 +261,15 @@ def plot_scalogram(t: np.ndarray, signal: np.ndarray, points: np.ndarray,
     points : ndarray, shape (K, 2)
         (a, b) pairs used (s, s).
     wavelet : str or MotherWavelet
-        The mother wavelet (see :func:`stewartid.identification.wavelets.make_wavelet`).
+        The mother wavelet (see :func:`stewartid.signals.wavelets.make_wavelet`).
     intervals : ndarray, shape (M, 2), optional
         Constant-direction intervals, drawn as bars under the map.
     max_rate_hz : float
         The signal is decimated to at most this rate for the map (the map is smooth at the
         scales shown); the (a, b) points are not affected.
     """
-    from stewartid.identification.wavelets import make_wavelet, wavelet_transform
+    from stewartid.signals.wavelets import make_wavelet, wavelet_transform
 
-    plt = _pyplot()
     t = np.asarray(t, dtype=float)
     signal = np.asarray(signal, dtype=float)
     points = np.asarray(points, dtype=float).reshape(-1, 2)
@@ -277,7 +288,8 @@ def plot_scalogram(t: np.ndarray, signal: np.ndarray, points: np.ndarray,
     inside = ((grid_b - mother.half_width * grid_a >= t[0])
               & (grid_b + mother.half_width * grid_a <= t[-1]))
     magnitude = np.where(inside, magnitude, np.nan)
-    figure, axis = plt.subplots(figsize=(9, 4.2), constrained_layout=True)
+    figure = _figure(figsize=(9, 4.2), layout="constrained")
+    axis = figure.subplots()
     mesh = axis.pcolormesh(shifts, scales, magnitude, shading="auto", cmap="magma",
                            rasterized=True)
     colourbar = figure.colorbar(mesh, ax=axis)
@@ -315,14 +327,14 @@ def _grouped_bars(axis: Any, labels: Sequence[str], series: Sequence[tuple[str, 
         axis.set_yscale("log")
 
 
+@_styled
 def plot_errors(results: ComparisonResults, directory: str | Path,
                 stem: str = "errors") -> list[Path]:
     """ε (%) per entry, every method against the others and against the paper's published ε,
     one panel per Coulomb level (log scale)."""
-    plt = _pyplot()
     levels = results.coulomb_levels
-    figure, axes = plt.subplots(len(levels), 1, figsize=(14, 3.6 * len(levels)),
-                                squeeze=False, constrained_layout=True)
+    figure = _figure(figsize=(14, 3.6 * len(levels)), layout="constrained")
+    axes = figure.subplots(len(levels), 1, squeeze=False)
     labels = [entry_label(k) for k in PAPER_ENTRIES]
     floor = 1e-3  # ε below this (%) is drawn at the floor so the log axis stays readable
     for axis, level in zip(axes[:, 0], levels, strict=True):
@@ -332,7 +344,7 @@ def plot_errors(results: ComparisonResults, directory: str | Path,
             if run is None:
                 continue
             eps = np.maximum([results.eps(run, k) for k in PAPER_ENTRIES], floor)
-            colour = METHOD_COLOURS.get(method, "grey")
+            colour = method_color(method)
             series.append((method_name(method), eps, {"color": colour}))
             if results.published_entry(method, level, PAPER_ENTRIES[0]) is not None:
                 paper = np.maximum([results.published_entry(method, level, k).eps
@@ -349,12 +361,13 @@ def plot_errors(results: ComparisonResults, directory: str | Path,
     return save_figure(figure, directory, stem)
 
 
+@_styled
 def plot_identified_vs_nominal(results: ComparisonResults, coulomb: float,
                                directory: str | Path, stem: str | None = None) -> list[Path]:
     """Identified value divided by nominal, per entry and method, at one Coulomb level; the
     nominal values are printed under the entry names (1 = exact)."""
-    plt = _pyplot()
-    figure, axes = plt.subplots(1, 2, figsize=(13, 4.6), constrained_layout=True)
+    figure = _figure(figsize=(13, 4.6), layout="constrained")
+    axes = figure.subplots(1, 2)
     for axis, matrix in zip(axes, ("M", "B"), strict=True):
         keys = [k for k in PAPER_ENTRIES if k[0] == matrix]
         labels = [f"{entry_label(k)}\n{results.nominal(k):,.0f}" for k in keys]
@@ -365,13 +378,13 @@ def plot_identified_vs_nominal(results: ComparisonResults, coulomb: float,
                 continue
             ratio = np.array([run.value(k) / results.nominal(k) for k in keys])
             series.append((method_name(method), ratio,
-                           {"color": METHOD_COLOURS.get(method, "grey")}))
+                           {"color": method_color(method)}))
             if results.published_entry(method, coulomb, keys[0]) is not None:
                 paper = np.array([results.published_entry(method, coulomb, k).value
                                   / results.nominal(k) for k in keys])
                 series.append((f"{method_name(method)}, paper", paper,
                                {"facecolor": "white", "hatch": "///", "lw": 0.8,
-                                "edgecolor": METHOD_COLOURS.get(method, "grey")}))
+                                "edgecolor": method_color(method)}))
         _grouped_bars(axis, labels, series, log=False, base=1.0)
         axis.axhline(1.0, color="k", lw=1.0, label="nominal")
         values = np.concatenate([s[1] for s in series]) if series else np.ones(1)
@@ -389,9 +402,8 @@ def plot_identified_vs_nominal(results: ComparisonResults, coulomb: float,
 
 
 __all__ = [
-    "COORDINATES",
     "FORCE_COMPONENTS",
-    "METHOD_COLOURS",
+    "STYLE",
     "ExperimentTrace",
     "plot_errors",
     "plot_excitation",

@@ -15,9 +15,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from stewartid.published import PAPER_ENTRIES, EntryKey, entry_label
-from stewartid.reporting.files import write_text_atomic
-from stewartid.reporting.results import ComparisonResults, MethodRun, method_name
+from stewartid.io import write_text_atomic
+from stewartid.reference.published import PAPER_ENTRIES, EntryKey, entry_label
+from stewartid.reporting.comparison import ComparisonResults, MethodRun, method_name
 from stewartid.reporting.tables import ResultTable, to_markdown
 
 #: The 1 % target of the wavelet method over the 20 entries.

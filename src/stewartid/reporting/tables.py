@@ -15,12 +15,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from stewartid.published import PAPER_ENTRIES, EntryKey, entry_label, entry_unit
-from stewartid.reporting.results import (
-    PAPER_LETTER,
-    ComparisonResults,
-    method_name,
-)
+from stewartid.reference.published import PAPER_ENTRIES, EntryKey, entry_label, entry_unit
+from stewartid.reporting.comparison import ComparisonResults, method_name, paper_methods
 
 Cell = float | str | None
 
@@ -110,11 +106,12 @@ def paper_table(results: ComparisonResults, number: int) -> ResultTable:
     computed from the platform description, and the paper's printed one).
     """
     published = results.published.table(number)
-    methods = [name for name, letter in PAPER_LETTER.items() if letter in published.methods]
+    letters = paper_methods()
+    methods = [name for name, letter in letters.items() if letter in published.methods]
     columns = ["Parameter", "Unit"]
     kinds = ["text", "text"]
     for method in methods:
-        letter = PAPER_LETTER[method]
+        letter = letters[method]
         columns += [f"{letter}: ours", f"{letter}: ε ours (%)",
                     f"{letter}: paper", f"{letter}: ε paper (%)"]
         kinds += ["value", "eps", "published", "published"]
@@ -127,17 +124,17 @@ def paper_table(results: ComparisonResults, number: int) -> ResultTable:
         row = _entry_cells(key)
         for method in methods:
             ours = results.run(method, published.coulomb)
-            entry = published.results[PAPER_LETTER[method]][key]
+            entry = published.results[letters[method]][key]
             row += [None, None] if ours is None else [ours.value(key), results.eps(ours, key)]
             row += [entry.value, entry.eps]
             if entry.note:
-                notes.append(f"{PAPER_LETTER[method]}, {entry.label}: {entry.note}.")
+                notes.append(f"{letters[method]}, {entry.label}: {entry.note}.")
         row += [results.nominal(key), results.published.nominal[key]]
         rows.append(tuple(row))
     missing = [method_name(m) for m in methods if results.run(m, published.coulomb) is None]
     if missing:
         notes.append(f"Not run here: {', '.join(missing)} (— in the table).")
-    label = " and ".join(f"Method {PAPER_LETTER[m]}" for m in methods)
+    label = " and ".join(f"Method {letters[m]}" for m in methods)
     title = (f"Table {number}: {label}, Coulomb friction {published.coulomb:g} N·m "
              f"({published.frequency_hz:g} Hz sine excitation)")
     return ResultTable(f"table{number}", title, tuple(columns), tuple(kinds), tuple(rows),
@@ -153,17 +150,18 @@ def comparison_table(results: ComparisonResults, coulomb: float) -> ResultTable:
     for run in runs:
         columns += [method_name(run.method), "ε (%)"]
         kinds += ["value", "eps"]
-    paper_methods = [run.method for run in runs
-                     if results.published_entry(run.method, coulomb, PAPER_ENTRIES[0])]
-    for method in paper_methods:
-        columns += [f"paper {PAPER_LETTER[method]}", "ε paper (%)"]
+    letters = paper_methods()
+    reported = [run.method for run in runs
+                if results.published_entry(run.method, coulomb, PAPER_ENTRIES[0])]
+    for method in reported:
+        columns += [f"paper {letters[method]}", "ε paper (%)"]
         kinds += ["published", "published"]
     rows = []
     for key in PAPER_ENTRIES:
         row = [*_entry_cells(key), results.nominal(key)]
         for run in runs:
             row += [run.value(key), results.eps(run, key)]
-        for method in paper_methods:
+        for method in reported:
             entry = results.published_entry(method, coulomb, key)
             row += [entry.value, entry.eps]
         rows.append(tuple(row))
@@ -204,7 +202,7 @@ def build_tables(results: ComparisonResults) -> list[ResultTable]:
 
 def write_tables(tables: Sequence[ResultTable], directory: str | Path) -> list[Path]:
     """Write each table as ``<name>.md`` and ``<name>.csv`` in ``directory``; return the paths."""
-    from stewartid.reporting.files import write_text_atomic
+    from stewartid.io import write_text_atomic
 
     directory = Path(directory)
     paths = []

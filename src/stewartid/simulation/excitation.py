@@ -18,10 +18,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from stewartid.errors import ConfigError
-from stewartid.platform import Platform
-
-#: Names of the pose coordinates, in order (the DOF index of a :class:`Sine`).
-DOF_NAMES = ("x", "y", "z", "rx", "ry", "rz")
+from stewartid.platform import COORDINATES, Platform
 
 #: Default sine amplitudes of the paper's experiments: 20 mm in translation, 10 mrad in
 #: rotation. Small enough that the motion is linear (M(q) changes by < 1 % over the
@@ -176,7 +173,7 @@ def sine_excitation(platform: Platform, dof: int, amplitude: float, frequency_hz
     """
     return Excitation((Sine(dof, amplitude, frequency_hz, phase, offset),),
                       tuple(platform.neutral_pose), fade_in,
-                      name or f"{DOF_NAMES[dof]}_sine")
+                      name or f"{COORDINATES[dof]}_sine")
 
 
 def multisine_excitation(platform: Platform, sines: Sequence[Sine],

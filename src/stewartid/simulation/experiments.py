@@ -9,7 +9,6 @@ writes them as ``exp1.csv ... exp6.csv`` + ``meta.json``.
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -20,6 +19,7 @@ import numpy as np
 from stewartid.dataset import Dataset, write_dataset
 from stewartid.dynamics import COULOMB_SMOOTHING
 from stewartid.errors import ConfigError, StewartidError
+from stewartid.io import check_output_folder, write_json_atomic
 from stewartid.platform import Platform
 from stewartid.simulation import plant
 from stewartid.simulation.controller import command_tables, controller_parameters
@@ -202,6 +202,16 @@ def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: 
     return dataset, record
 
 
+def noise_generator(seed: int, experiment: int, count: int = 6) -> np.random.Generator:
+    """Random generator of the sensor noise of experiment ``experiment`` of ``count``.
+
+    The ``experiment``-th child of ``SeedSequence(seed)``: independent streams per experiment,
+    and the same data whether the experiments are simulated together
+    (:func:`simulate_experiments`) or one per worker process.
+    """
+    return np.random.default_rng(np.random.SeedSequence(int(seed)).spawn(count)[experiment])
+
+
 def simulate_experiments(platform: Platform, coulomb: float | None = None,
                          viscous: float | None = None, frequency_hz: float = 0.5,
                          duration_s: float = 20.0,
@@ -259,11 +269,10 @@ def simulate_experiments(platform: Platform, coulomb: float | None = None,
     if not (isinstance(seed, int | np.integer) and seed >= 0):
         raise ConfigError(f"seed must be an integer >= 0; got {seed!r}.")
     excitations = paper_experiments(platform, frequency_hz, amplitudes, fade_in)
-    streams = np.random.SeedSequence(int(seed)).spawn(len(excitations))
     datasets, records = [], []
-    for k, (excitation, stream) in enumerate(zip(excitations, streams, strict=True)):
+    for k, excitation in enumerate(excitations):
         dataset, record = simulate_experiment(platform, excitation, duration_s, noise,
-                                              np.random.default_rng(stream), step)
+                                              noise_generator(seed, k, len(excitations)), step)
         datasets.append(dataset)
         records.append(record)
         if progress is not None:
@@ -296,25 +305,21 @@ def write_experiments(result: SimulationResult, out: str | Path, format: str = "
 
     Raises
     ------
+    OutputExistsError
+        If ``out`` already holds results (``meta.json`` or ``exp*`` files) and not ``force``.
     ConfigError
-        If ``out`` already holds results (``meta.json`` or ``exp*`` files) and not ``force``,
-        or if ``format`` is unknown.
+        If ``format`` is unknown.
     """
     if format not in ("csv", "parquet"):
         raise ConfigError(f"format must be 'csv' or 'parquet'; got {format!r}.")
     out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise ConfigError(f"output path {str(out)!r} exists and is not a folder.")
-    if out.is_dir() and not force:
-        existing = sorted(p.name for p in out.iterdir()
-                          if p.name == "meta.json" or p.name.startswith("exp"))
-        if existing:
-            raise ConfigError(
-                f"output folder {str(out)!r} already holds results ({existing[0]}); choose "
-                "another folder or pass --force to overwrite.")
+    check_output_folder(out, force, is_experiment_file)
     out.mkdir(parents=True, exist_ok=True)
     paths = [write_dataset(d, out / f"{d.name}.{format}", format=format)
              for d in result.datasets]
-    meta = out / "meta.json"
-    meta.write_text(json.dumps(result.meta, indent=1) + "\n", encoding="utf-8")
-    return [*paths, meta]
+    return [*paths, write_json_atomic(out / "meta.json", result.meta)]
+
+
+def is_experiment_file(path: Path) -> bool:
+    """True for the files :func:`write_experiments` writes (``exp*`` and ``meta.json``)."""
+    return path.name == "meta.json" or path.name.startswith("exp")

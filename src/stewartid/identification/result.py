@@ -1,57 +1,18 @@
-"""The result of an identification: matrices, standard errors, settings, diagnostics, and
-the comparison table in the layout of the paper (Zhang 2020, Tables 3-6)."""
+"""The result of an identification: matrices, standard errors, settings, diagnostics, its
+JSON file (``result.json``), and the comparison table in the layout of the paper (Zhang 2020,
+Tables 3-6)."""
 
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-#: The 20 entries of the paper's tables, (matrix, i, j) with 1-based indices: the diagonal,
-#: then the couplings Mt(1,5), Mt(2,4), Mt(4,2), Mt(5,1), and the same for Bt.
-PAPER_ENTRIES: tuple[tuple[str, int, int], ...] = tuple(
-    (matrix, i, j)
-    for matrix in ("M", "B")
-    for (i, j) in ((1, 1), (2, 2), (3, 3), (4, 4), (5, 5), (6, 6),
-                   (1, 5), (2, 4), (4, 2), (5, 1))
-)
-
-
-def _jsonable(value: Any) -> Any:
-    if isinstance(value, np.ndarray):
-        return _jsonable(value.tolist())
-    if isinstance(value, dict):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, np.generic):
-        return _jsonable(value.item())
-    if isinstance(value, float) and not np.isfinite(value):
-        return None if np.isnan(value) else ("inf" if value > 0 else "-inf")
-    if isinstance(value, Path):
-        return str(value)
-    return value
-
-
-def write_json_atomic(document: Any, path: str | Path) -> Path:
-    """Write ``document`` as JSON through a temporary file renamed over ``path``."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w") as handle:
-            json.dump(_jsonable(document), handle, indent=1)
-            handle.write("\n")
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+from stewartid.io import to_jsonable, write_json_atomic
+from stewartid.reference.published import PAPER_ENTRIES, entry_label, relative_error_percent
 
 
 @dataclass(frozen=True)
@@ -89,8 +50,9 @@ class IdentificationResult:
     diagnostics: dict[str, Any] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
-        """A JSON-ready dict; ``M`` and ``B`` at the top level."""
-        return _jsonable({
+        """A JSON-ready dict; ``M`` and ``B`` at the top level; non-finite numbers are None
+        (see :mod:`stewartid.io`)."""
+        return to_jsonable({
             "M": self.M, "B": self.B,
             "std_errors_M": self.std_errors_M, "std_errors_B": self.std_errors_B,
             "condition_number": float(self.condition_number),
@@ -100,7 +62,7 @@ class IdentificationResult:
 
     def to_json(self, path: str | Path) -> Path:
         """Write the result as JSON, atomically; returns the path."""
-        return write_json_atomic(self.to_dict(), path)
+        return write_json_atomic(path, self.to_dict())
 
     @classmethod
     def from_dict(cls, document: dict[str, Any]) -> IdentificationResult:
@@ -136,9 +98,11 @@ class IdentificationResult:
         Returns
         -------
         pandas.DataFrame
-            One row per entry of :data:`PAPER_ENTRIES`, columns ``entry`` ("Mt(1,1)"),
-            ``matrix``, ``i``, ``j`` (1-based), ``identified``, ``std_error``, ``nominal``,
-            ``error_percent`` (the paper's epsilon, |identified - nominal| / |nominal| in %).
+            One row per entry of :data:`~stewartid.reference.published.PAPER_ENTRIES`,
+            columns ``entry`` ("Mt(1,1)"), ``matrix``, ``i``, ``j`` (1-based, as printed),
+            ``identified``, ``std_error``, ``nominal``, ``error_percent`` (the paper's ε,
+            :func:`~stewartid.reference.published.relative_error_percent`; NaN where the
+            nominal value is zero).
         """
         return comparison_table(self.M, self.B, M_nominal, B_nominal,
                                 self.std_errors_M, self.std_errors_B)
@@ -147,7 +111,7 @@ class IdentificationResult:
 def comparison_table(M: np.ndarray, B: np.ndarray, M_nominal: np.ndarray,
                      B_nominal: np.ndarray, std_M: np.ndarray | None = None,
                      std_B: np.ndarray | None = None):
-    """Table of the 20 entries of :data:`PAPER_ENTRIES`; see
+    """Table of the paper's 20 entries; see
     :meth:`IdentificationResult.comparison_table`."""
     import pandas as pd
 
@@ -156,14 +120,14 @@ def comparison_table(M: np.ndarray, B: np.ndarray, M_nominal: np.ndarray,
     std = {"M": std_M if std_M is not None else np.full((6, 6), np.nan),
            "B": std_B if std_B is not None else np.full((6, 6), np.nan)}
     rows = []
-    for matrix, i, j in PAPER_ENTRIES:
-        value = float(identified[matrix][i - 1, j - 1])
-        ref = float(nominal[matrix][i - 1, j - 1])
+    for key in PAPER_ENTRIES:
+        matrix, row, col = key
+        value = float(identified[matrix][row, col])
+        ref = float(nominal[matrix][row, col])
         rows.append({
-            "entry": f"{matrix}t({i},{j})", "matrix": matrix, "i": i, "j": j,
-            "identified": value, "std_error": float(std[matrix][i - 1, j - 1]),
-            "nominal": ref,
-            "error_percent": abs(value - ref) / abs(ref) * 100.0 if ref != 0 else np.nan,
+            "entry": entry_label(key), "matrix": matrix, "i": row + 1, "j": col + 1,
+            "identified": value, "std_error": float(std[matrix][row, col]),
+            "nominal": ref, "error_percent": relative_error_percent(value, ref),
         })
     return pd.DataFrame(rows)
 
@@ -174,5 +138,4 @@ def max_error_percent(M: np.ndarray, B: np.ndarray, M_nominal: np.ndarray,
     return float(comparison_table(M, B, M_nominal, B_nominal)["error_percent"].max())
 
 
-__all__ = ["PAPER_ENTRIES", "IdentificationResult", "comparison_table", "max_error_percent",
-           "write_json_atomic"]
+__all__ = ["IdentificationResult", "comparison_table", "max_error_percent"]

@@ -60,16 +60,16 @@ def simulate(
     from rich.progress import Progress
 
     from stewartid.errors import ConfigError
+    from stewartid.io import check_output_folder
     from stewartid.platform import load_platform
     from stewartid.simulation import SensorNoise, simulate_experiments, write_experiments
+    from stewartid.simulation.experiments import is_experiment_file
 
     description = load_platform(platform)
     if format not in ("csv", "parquet"):
         raise ConfigError(f"--format must be 'csv' or 'parquet'; got {format!r}.")
-    if out.exists() and not force and out.is_dir() and any(
-            p.name == "meta.json" or p.name.startswith("exp") for p in out.iterdir()):
-        raise ConfigError(f"output folder {str(out)!r} already holds results; choose another "
-                          "folder or pass --force to overwrite.")
+    # before the simulation, which takes a while; write_experiments checks again
+    check_output_folder(out, force, is_experiment_file)
     for name, value in (("--coulomb", coulomb), ("--viscous", viscous),
                         ("--length-noise", length_noise), ("--force-noise", force_noise)):
         if value is not None and not value >= 0:

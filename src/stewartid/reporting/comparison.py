@@ -8,35 +8,61 @@ report says is computed from it, so the same object can be rebuilt from ``result
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from stewartid.published import (
+from stewartid.identification.registry import MethodSpec, registered_methods
+from stewartid.reference.published import (
     PAPER_ENTRIES,
-    PAPER_METHODS,
     EntryKey,
     PublishedEntry,
     PublishedResults,
     relative_error_percent,
 )
 
-#: Identification methods compared, in report order, with their display names.
-METHOD_NAMES = {
-    "fourier": "Method A (Fourier)",
-    "wavelet": "Method B (wavelet)",
-    "wavelet_paper": "Method B, paper's equations (Mexican hat)",
-    "least_squares": "Time-domain least squares",
-}
 
-#: The paper's letter for the methods it reports.
-PAPER_LETTER = {name: letter for letter, name in PAPER_METHODS.items()}
+def _spec(method: str) -> MethodSpec | None:
+    return next((spec for spec in registered_methods() if spec.name == method), None)
 
 
 def method_name(method: str) -> str:
-    """Display name of a method key (the key itself when unknown)."""
-    return METHOD_NAMES.get(method, method)
+    """Display name of a method (the registry's; the name itself when not registered)."""
+    spec = _spec(method)
+    return method if spec is None else spec.display_name
+
+
+def method_color(method: str) -> str:
+    """Colour of a method in every figure (the registry's; grey when not registered)."""
+    spec = _spec(method)
+    return "grey" if spec is None else spec.color
+
+
+def paper_letter(method: str) -> str | None:
+    """The paper's letter for a method ("A", "B"), None if the paper does not report it."""
+    spec = _spec(method)
+    return None if spec is None else spec.letter
+
+
+def paper_methods() -> dict[str, str]:
+    """Registered methods the paper reports, name -> letter, in the letters' order."""
+    found = {spec.name: spec.letter for spec in registered_methods() if spec.letter}
+    return dict(sorted(found.items(), key=lambda item: item[1]))
+
+
+def report_order(methods: Iterable[str]) -> tuple[str, ...]:
+    """``methods`` in report order: those the paper reports by their letter (A, B), then the
+    others in registry order, then unregistered names alphabetically."""
+    registry = [spec.name for spec in registered_methods()]
+
+    def key(method: str) -> tuple[int, str, int, str]:
+        letter = paper_letter(method)
+        rank = registry.index(method) if method in registry else len(registry)
+        return (0 if letter else 1, letter or "", rank, method)
+
+    return tuple(sorted(set(methods), key=key))
 
 
 @dataclass(frozen=True)
@@ -46,12 +72,12 @@ class MethodRun:
     Attributes
     ----------
     method : str
-        Method key (see :data:`METHOD_NAMES`).
+        Registered method name (:mod:`stewartid.identification.registry`).
     coulomb : float
         Coulomb friction of the simulated plant, N·m per joint axis.
     M, B : ndarray, shape (6, 6)
         Identified inertial and viscous matrices (paper frame, SI units).
-    M_std, B_std : ndarray, shape (6, 6), optional
+    std_errors_M, std_errors_B : ndarray, shape (6, 6), optional
         Standard errors of the entries, when the method provides them.
     seconds : float
         Wall time of the identification (s).
@@ -63,8 +89,8 @@ class MethodRun:
     coulomb: float
     M: np.ndarray
     B: np.ndarray
-    M_std: np.ndarray | None = None
-    B_std: np.ndarray | None = None
+    std_errors_M: np.ndarray | None = None
+    std_errors_B: np.ndarray | None = None
     seconds: float = 0.0
     diagnostics: dict[str, Any] = field(default_factory=dict)
 
@@ -101,9 +127,7 @@ class ComparisonResults:
     @property
     def methods(self) -> tuple[str, ...]:
         """Methods present, in report order."""
-        present = {run.method for run in self.runs}
-        ordered = [m for m in METHOD_NAMES if m in present]
-        return tuple(ordered + sorted(present - set(ordered)))
+        return report_order(run.method for run in self.runs)
 
     @property
     def coulomb_levels(self) -> tuple[float, ...]:
@@ -123,7 +147,7 @@ class ComparisonResults:
         return float((self.nominal_M if matrix == "M" else self.nominal_B)[row, col])
 
     def eps(self, run: MethodRun, key: EntryKey) -> float:
-        """ε (%) of one identified entry against our nominal value."""
+        """ε (%) of one identified entry against our nominal value (NaN at a zero nominal)."""
         return relative_error_percent(run.value(key), self.nominal(key))
 
     def eps_all(self, run: MethodRun, entries: tuple[EntryKey, ...] = PAPER_ENTRIES
@@ -141,7 +165,7 @@ class ComparisonResults:
     def published_entry(self, method: str, coulomb: float, key: EntryKey
                         ) -> PublishedEntry | None:
         """The paper's value for the same method, level and entry, if it reports one."""
-        letter = PAPER_LETTER.get(method)
+        letter = paper_letter(method)
         return None if letter is None else self.published.entry(letter, coulomb, key)
 
     def published_worst(self, method: str, coulomb: float, matrix: str | None = None
@@ -159,4 +183,5 @@ class ComparisonResults:
         return key, found[key]
 
 
-__all__ = ["METHOD_NAMES", "ComparisonResults", "MethodRun", "method_name"]
+__all__ = ["ComparisonResults", "MethodRun", "method_color", "method_name", "paper_letter",
+           "paper_methods", "report_order"]

@@ -26,7 +26,7 @@ def reproduce(
     """Regenerate the paper's Tables 3-6 on the simulated plant, beside the published values:
     every method at Coulomb friction 0, 5 and 30 N·m, with tables (Markdown, CSV),
     results.json, figures (PNG, SVG) and report.md/report.html."""
-    from stewartid.reproduce import run_reproduce
+    from stewartid.reproduction.run import run_reproduce
 
     output = run_reproduce(out=out, quick=quick, jobs=jobs, force=force, seed=seed,
                            progress=True)

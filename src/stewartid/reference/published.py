@@ -22,6 +22,9 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+from numpy.typing import ArrayLike
+
 from stewartid.errors import DataError
 
 #: One matrix entry: ("M" or "B", row, column), 0-based indices.
@@ -33,9 +36,6 @@ _PAIRS = ((0, 0), (1, 1), (2, 2), (3, 3), (4, 4), (5, 5), (0, 4), (1, 3), (3, 1)
 PAPER_ENTRIES: tuple[EntryKey, ...] = tuple(
     (matrix, row, col) for matrix in ("M", "B") for row, col in _PAIRS
 )
-
-#: The paper's method letters and the identifier each one corresponds to in this package.
-PAPER_METHODS = {"A": "fourier", "B": "wavelet"}
 
 _UNITS = {
     "M": ("kg", "kg", "kg", "kg·m²", "kg·m²", "kg·m²"),
@@ -58,9 +58,18 @@ def entry_unit(key: EntryKey) -> str:
     return "kg·m" if matrix == "M" else "N·s"
 
 
-def relative_error_percent(value: float, nominal: float) -> float:
-    """ε = |value − nominal| / |nominal| · 100 (%), the paper's relative absolute error."""
-    return abs(value - nominal) / abs(nominal) * 100.0
+def relative_error_percent(value: ArrayLike, nominal: ArrayLike) -> Any:
+    """ε = |value − nominal| / |nominal| · 100 (%), the paper's relative absolute error.
+
+    The one definition of ε in the package. Element-wise on arrays; a float for scalars.
+    Where the nominal value is zero ε is undefined and NaN is returned (no warning, no
+    exception): the paper tabulates only entries with a non-zero nominal value.
+    """
+    value = np.asarray(value, dtype=float)
+    nominal = np.asarray(nominal, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        eps = np.abs(value - nominal) / np.where(nominal == 0, np.nan, np.abs(nominal)) * 100.0
+    return float(eps) if eps.ndim == 0 else eps
 
 
 @dataclass(frozen=True)
@@ -272,7 +281,6 @@ def load_published(path: str | Path | None = None) -> PublishedResults:
 
 __all__ = [
     "PAPER_ENTRIES",
-    "PAPER_METHODS",
     "EntryKey",
     "PublishedEntry",
     "PublishedResults",

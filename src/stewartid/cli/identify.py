@@ -1,4 +1,4 @@
-"""``stewartid identify``: Mt and Bt from measured experiments by one of three methods."""
+"""``stewartid identify``: Mt and Bt from measured experiments by a registered method."""
 
 from __future__ import annotations
 
@@ -8,28 +8,7 @@ from typing import Annotated
 
 import typer
 
-METHODS = {
-    "wavelet": ("stewartid.identification.wavelet", "WaveletIdentifier"),
-    "fourier": ("stewartid.identification.fourier", "FourierIdentifier"),
-    "ls": ("stewartid.identification.least_squares", "LeastSquaresIdentifier"),
-}
-
-
-def make_identifier(method: str, **settings):
-    """The identifier class of ``method`` built with ``settings`` (imported lazily)."""
-    import importlib
-
-    from stewartid.errors import ConfigError
-
-    if method not in METHODS:
-        raise ConfigError(f"unknown method {method!r}; expected one of {', '.join(METHODS)}.")
-    module, name = METHODS[method]
-    try:
-        cls = getattr(importlib.import_module(module), name)
-    except (ModuleNotFoundError, AttributeError) as exc:
-        raise ConfigError(f"method {method!r} is not available in this installation ({exc}); "
-                          f"use one of {', '.join(m for m in METHODS if m != method)}.") from exc
-    return cls(**settings)
+from stewartid.errors import ConfigError
 
 
 def nominal_from_meta(files: list[Path]):
@@ -63,7 +42,8 @@ def identify(
     files: Annotated[list[Path], typer.Argument(
         help="Data files (CSV/Parquet, one experiment each) or folders of them.")],
     method: Annotated[str, typer.Option("--method",
-                                        help="wavelet (Zhang 2020), fourier (Tian) or ls.")]
+                                        help="wavelet (Zhang 2020), fourier (Tian), ls, or "
+                                             "another name that 'stewartid methods' lists.")]
     = "wavelet",
     platform: Annotated[str, typer.Option(
         "--platform", help="'paper' for the preset, or a platform TOML file.")] = "paper",
@@ -85,28 +65,28 @@ def identify(
     import numpy as np
 
     from stewartid.dataset import expand_paths, read_datasets
-    from stewartid.errors import ConfigError
+    from stewartid.identification.registry import create_identifier, method_spec
     from stewartid.linearization import nominal_matrices
     from stewartid.platform import load_platform
+    from stewartid.reporting.terminal import print_comparison
 
+    spec = method_spec(method)
+    accepted = spec.estimator_class._param_names()
+    options = {"--no-gravity": ("gravity", not no_gravity, no_gravity),
+               "--symmetric": ("symmetric", symmetric, symmetric),
+               "--frequency": ("frequency_hz", frequency or None, bool(frequency)),
+               "--stiffness": ("stiffness", stiffness, stiffness)}
+    settings = {}
+    for flag, (name, value, given) in options.items():
+        if name in accepted:
+            settings[name] = value
+        elif given:
+            raise ConfigError(f"{flag} does not apply to --method {method}; it has the "
+                              f"settings {', '.join(accepted)}.")
     description = load_platform(platform)
     paths = expand_paths(files)
     datasets = read_datasets(paths, description)
-    settings: dict = {}
-    if method in ("fourier", "ls", "wavelet"):
-        settings["gravity"] = not no_gravity
-        settings["symmetric"] = symmetric
-    if frequency or stiffness:
-        if method != "fourier":
-            raise ConfigError("--frequency and --stiffness apply to --method fourier only.")
-        if frequency:
-            settings["frequency_hz"] = frequency
-        settings["stiffness"] = stiffness
-    estimator = make_identifier(method, **settings)
-    try:
-        estimator.fit(datasets, description)
-    except TypeError as exc:  # a method without some setting
-        raise ConfigError(f"--method {method} does not accept these options: {exc}") from exc
+    estimator = create_identifier(method, **settings).fit(datasets, description)
     result = estimator.result_
 
     meta = nominal_from_meta(paths)
@@ -116,23 +96,9 @@ def identify(
         M_nom, B_nom = nominal_matrices(description)
         source = f"platform '{description.name}' at neutral"
     table = result.comparison_table(M_nom, B_nom)
-    _print_table(table, f"{method}: identified vs nominal ({source})")
+    print_comparison(table, f"{method}: identified vs nominal ({source})")
     typer.echo(f"condition number {result.condition_number:.3g}; largest error "
                f"{np.nanmax(table['error_percent']):.2f} % ({len(datasets)} experiments)")
     if out is not None:
         result.to_json(out)
         typer.echo(f"wrote {out}")
-
-
-def _print_table(table, title: str) -> None:
-    from rich.console import Console
-    from rich.table import Table
-
-    view = Table(title=title, title_justify="left")
-    for column, justify in (("entry", "left"), ("identified", "right"), ("± std", "right"),
-                            ("nominal", "right"), ("ε (%)", "right")):
-        view.add_column(column, justify=justify)
-    for row in table.itertuples():
-        view.add_row(row.entry, f"{row.identified:,.1f}", f"{row.std_error:,.2g}",
-                     f"{row.nominal:,.1f}", f"{row.error_percent:.2f}")
-    Console().print(view)

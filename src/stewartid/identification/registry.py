@@ -1,0 +1,211 @@
+"""The one list of identification methods.
+
+A method registers itself once, in its own module, with the class decorator
+:func:`register_method` (name, display name, the paper's letter, reference, description,
+colour, and named presets such as ``wavelet-paper``). The command line (``identify --method``,
+``stewartid methods``), ``reproduce``, the reports (labels, colours, the paper's columns) and
+the benchmarks read it from here.
+
+Adding a method is one new file: put a module in ``stewartid/identification/`` whose
+estimator class (a :class:`~stewartid.identification.base.BaseIdentifier`) carries
+``@register_method(...)``. Discovery imports every module of the ``stewartid.identification``
+package once (``pkgutil``), the built-in methods first in the order of
+:data:`BUILTIN_MODULES` (the paper's Method B, Method A, then least squares), the others
+alphabetically; the infrastructure modules register nothing. Presets come after every
+method.
+
+Example
+-------
+>>> from stewartid.identification.registry import create_identifier, method_spec
+>>> method_spec("ls").display_name
+'Time-domain least squares'
+>>> create_identifier("wavelet-paper").variant
+'paper'
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+import pkgutil
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from stewartid.errors import ConfigError
+
+#: Modules of the built-in methods, in registration order.
+BUILTIN_MODULES = ("wavelet", "fourier", "least_squares")
+
+
+@dataclass(frozen=True)
+class MethodSpec:
+    """A registered identification method (or a preset of one).
+
+    Attributes
+    ----------
+    name : str
+        Name on the command line and in result files, e.g. ``"ls"``.
+    display_name : str
+        Label in tables, figures and reports, e.g. ``"Method A (Fourier)"``.
+    letter : str or None
+        The paper's letter for the method (``"A"``, ``"B"``), None if the paper does not
+        report it; the published columns are matched by this letter.
+    reference : str
+        Citation (with DOI where there is one).
+    description : str
+        One line.
+    color : str
+        Matplotlib colour, the same in every figure.
+    estimator_class : type
+        The :class:`~stewartid.identification.base.BaseIdentifier` subclass.
+    defaults : mapping
+        Settings passed to ``estimator_class`` (a preset's; empty for a method).
+    preset_of : str or None
+        Name of the method this preset configures, None for a method.
+    """
+
+    name: str
+    display_name: str
+    letter: str | None
+    reference: str
+    description: str
+    color: str
+    estimator_class: type
+    defaults: Mapping[str, Any] = field(default_factory=dict)
+    preset_of: str | None = None
+
+    def create(self, **settings: Any) -> Any:
+        """A new estimator with this spec's defaults updated by ``settings``."""
+        return create_identifier(self.name, **settings)
+
+
+@dataclass(frozen=True)
+class Preset:
+    """A named configuration of a method, given to :func:`register_method`.
+
+    The reference is the method's; ``letter`` is the paper's letter if the paper reports
+    exactly this configuration.
+    """
+
+    settings: Mapping[str, Any]
+    display_name: str
+    description: str
+    color: str
+    letter: str | None = None
+
+
+_REGISTRY: dict[str, MethodSpec] = {}
+_discovered = False
+
+
+def register(spec: MethodSpec) -> MethodSpec:
+    """Add ``spec`` to the registry; returns it.
+
+    Raises
+    ------
+    ConfigError
+        If another class already registered the name.
+    """
+    known = _REGISTRY.get(spec.name)
+    if known is not None and _qualified(known.estimator_class) != _qualified(spec.estimator_class):
+        raise ConfigError(f"method name {spec.name!r} is already registered by "
+                          f"{_qualified(known.estimator_class)}; choose another name.")
+    if spec.preset_of is not None and spec.preset_of not in _REGISTRY:
+        raise ConfigError(f"preset {spec.name!r} configures {spec.preset_of!r}, which is not "
+                          "registered; register the method first.")
+    _REGISTRY[spec.name] = dataclasses.replace(spec, defaults=dict(spec.defaults))
+    return _REGISTRY[spec.name]
+
+
+def register_method(*, name: str, display_name: str, reference: str, description: str,
+                    color: str, letter: str | None = None,
+                    presets: Mapping[str, Preset] | None = None) -> Callable[[type], type]:
+    """Class decorator registering an estimator class as method ``name`` (and its presets).
+
+    Sets the class's ``method`` attribute (the name stored in its results) to ``name``.
+    """
+
+    def decorate(cls: type) -> type:
+        cls.method = name
+        register(MethodSpec(name, display_name, letter, reference, description, color, cls))
+        for preset_name, preset in (presets or {}).items():
+            register(MethodSpec(preset_name, preset.display_name, preset.letter, reference,
+                                preset.description, preset.color, cls,
+                                dict(preset.settings), preset_of=name))
+        return cls
+
+    return decorate
+
+
+def _qualified(cls: type) -> str:
+    return f"{cls.__module__}.{cls.__qualname__}"
+
+
+def _module_order() -> list[str]:
+    package = importlib.import_module("stewartid.identification")
+    found = sorted(info.name for info in pkgutil.iter_modules(package.__path__)
+                   if not info.name.startswith("_"))
+    return [m for m in BUILTIN_MODULES if m in found] + [m for m in found
+                                                        if m not in BUILTIN_MODULES]
+
+
+def _discover() -> None:
+    global _discovered
+    if _discovered:
+        return
+    for module in _module_order():
+        importlib.import_module(f"stewartid.identification.{module}")
+    _discovered = True
+
+
+def registered_methods() -> tuple[MethodSpec, ...]:
+    """Every registered method, built-ins first (wavelet, fourier, ls), then presets."""
+    _discover()
+    modules = {f"stewartid.identification.{m}": k for k, m in enumerate(_module_order())}
+    position = {name: k for k, name in enumerate(_REGISTRY)}
+
+    def order(spec: MethodSpec) -> tuple[bool, int, int]:
+        return (spec.preset_of is not None,
+                modules.get(spec.estimator_class.__module__, len(modules)), position[spec.name])
+
+    return tuple(sorted(_REGISTRY.values(), key=order))
+
+
+def method_spec(name: str) -> MethodSpec:
+    """The registered method or preset ``name``.
+
+    Raises
+    ------
+    ConfigError
+        For an unknown name; the message lists the registered ones.
+    """
+    _discover()
+    try:
+        return _REGISTRY[name]
+    except KeyError:
+        names = ", ".join(spec.name for spec in registered_methods())
+        raise ConfigError(f"unknown method {name!r}; expected one of {names}.") from None
+
+
+def create_identifier(name: str, **settings: Any) -> Any:
+    """A new estimator for method or preset ``name``: the preset's settings, updated by
+    ``settings``.
+
+    Raises
+    ------
+    ConfigError
+        For an unknown method or a setting the method does not have.
+    """
+    spec = method_spec(name)
+    cls = spec.estimator_class
+    valid = cls._param_names()
+    unknown = [key for key in settings if key not in valid]
+    if unknown:
+        raise ConfigError(f"method {name!r} has no setting {unknown[0]!r}; its settings are "
+                          f"{', '.join(valid)}.")
+    return cls(**{**spec.defaults, **settings})
+
+
+__all__ = ["BUILTIN_MODULES", "MethodSpec", "Preset", "create_identifier", "method_spec",
+           "register", "register_method", "registered_methods"]

@@ -1,0 +1,54 @@
+"""Readable terminal tables (rich): a 6x6 matrix, and identified versus nominal values."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from rich.console import Console
+from rich.table import Table
+
+from stewartid.platform import COORDINATES
+
+
+def matrix_table(matrix: np.ndarray, title: str, digits: int = 1) -> Table:
+    """A rich table of a 6x6 matrix with coordinate labels; entries below 1e-9 of the largest
+    are shown as 0 (rounding noise of symmetric terms)."""
+    table = Table(title=title, title_justify="left")
+    table.add_column("")
+    for name in COORDINATES:
+        table.add_column(name, justify="right")
+    scale = float(np.max(np.abs(matrix))) or 1.0
+    for name, row in zip(COORDINATES, matrix, strict=True):
+        cells = [f"{0.0 if abs(v) < 1e-9 * scale else v:,.{digits}f}" for v in row]
+        table.add_row(name, *cells)
+    return table
+
+
+def print_matrix(matrix: np.ndarray, title: str, digits: int = 1,
+                 console: Console | None = None) -> None:
+    """Print a 6x6 matrix as a labelled table."""
+    (console or Console()).print(matrix_table(matrix, title, digits))
+
+
+def print_comparison(table: Any, title: str, console: Console | None = None) -> None:
+    """Print identified versus nominal values of the paper's 20 entries.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        As :meth:`IdentificationResult.comparison_table
+        <stewartid.identification.result.IdentificationResult.comparison_table>` returns it.
+    title : str
+    """
+    view = Table(title=title, title_justify="left")
+    for column, justify in (("entry", "left"), ("identified", "right"), ("± std", "right"),
+                            ("nominal", "right"), ("ε (%)", "right")):
+        view.add_column(column, justify=justify)
+    for row in table.itertuples():
+        view.add_row(row.entry, f"{row.identified:,.1f}", f"{row.std_error:,.2g}",
+                     f"{row.nominal:,.1f}", f"{row.error_percent:.2f}")
+    (console or Console()).print(view)
+
+
+__all__ = ["matrix_table", "print_comparison", "print_matrix"]
