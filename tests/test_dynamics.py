@@ -18,7 +18,7 @@ from stewartid.dynamics import (
     potential_energy,
     velocity_product_forces,
 )
-from stewartid.kinematics import inverse_kinematics, rotation_matrix
+from stewartid.kinematics import inverse_kinematics, leg_lengths, rotation_matrix
 from stewartid.linearization import viscous_matrix
 
 BOX = np.array([0.2, 0.2, 0.2, 0.15, 0.15, 0.15])
@@ -93,7 +93,30 @@ def test_velocity_product_follows_lagrange(paper, rng):
                                    rtol=1e-5, atol=1e-5)
 
 
-def test_inverse_and_forward_dynamics_agree(paper, rng):
+def test_inverse_dynamics_balances_power(paper, rng):
+    """Independent truth: the actuators' power f · l_dot equals d(T + V)/dt plus the friction
+    power, with T from body velocities, V and l from inverse kinematics, all by central
+    differences along (q_dot, q_ddot); random accelerations probe every column of M."""
+    plant = paper.replace(friction__coulomb=30.0)
+    step = 1e-4
+    for q in poses(plant, rng, 6):
+        qd = rng.normal(size=6) * np.array([0.05, 0.05, 0.05, 0.03, 0.03, 0.03])
+        qdd = rng.normal(size=6) * 0.5
+        forces = inverse_dynamics(plant, q, qd, qdd)
+        leg_rates = (leg_lengths(plant, q + step * qd) - leg_lengths(plant, q - step * qd)) \
+            / (2 * step)
+        kinetic_rate = (independent_kinetic_energy(plant, q + step * qd, qd + step * qdd)
+                        - independent_kinetic_energy(plant, q - step * qd, qd - step * qdd)) \
+            / (2 * step)
+        potential_rate = (potential_energy(plant, q + step * qd)
+                          - potential_energy(plant, q - step * qd)) / (2 * step)
+        friction_power = friction_forces(plant, q, qd) @ qd
+        scale = np.abs(forces) @ np.abs(leg_rates)
+        assert forces @ leg_rates == pytest.approx(
+            kinetic_rate + potential_rate + friction_power, abs=1e-6 * scale)
+
+
+def test_forward_dynamics_inverts_inverse_dynamics(paper, rng):
     q = poses(paper, rng, 20)
     qd = rng.normal(size=(20, 6)) * 0.05
     qdd = rng.normal(size=(20, 6)) * 0.5

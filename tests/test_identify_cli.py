@@ -60,3 +60,41 @@ def test_unknown_method(files):
     result = CliRunner().invoke(app, ["identify", "--method", "magic", str(paths[0])])
     assert result.exit_code == 2
     assert "unknown method 'magic'" in result.output
+
+
+def test_methods_lists_every_registered_method_with_its_reference():
+    result = CliRunner().invoke(app, ["methods"])
+    assert result.exit_code == 0, result.output
+    lines = result.output.strip().splitlines()
+    names = [line.split(":")[0] for line in lines]
+    assert names[:3] == ["wavelet", "fourier", "ls"] and "wavelet-paper" in names
+    assert "doi:10.3390/math8020257" in lines[0] and "Khalil" in lines[2]
+
+
+def test_option_of_another_method_is_a_config_error(files):
+    paths, _, _ = files
+    result = CliRunner().invoke(app, ["identify", "--method", "ls", "--frequency", "1",
+                                      str(paths[0])])
+    assert result.exit_code == 2
+    assert "--frequency does not apply to --method ls" in result.output
+
+
+def test_a_bug_shows_its_traceback(monkeypatch, files):
+    """Only StewartidError and OSError become one line; anything else is a bug."""
+    import stewartid.identification.registry as registry
+
+    def broken(name, **settings):
+        raise ZeroDivisionError("a bug")
+
+    monkeypatch.setattr(registry, "create_identifier", broken)
+    paths, _, _ = files
+    result = CliRunner().invoke(app, ["identify", "--method", "ls", *map(str, paths)])
+    assert result.exit_code == 1
+    assert isinstance(result.exception, ZeroDivisionError)
+
+
+def test_debug_shows_the_traceback_of_expected_errors(files):
+    paths, _, _ = files
+    result = CliRunner().invoke(app, ["--debug", "identify", "--method", "magic", str(paths[0])])
+    assert result.exit_code == 1
+    assert "unknown method 'magic'" in str(result.exception)

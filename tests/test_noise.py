@@ -8,7 +8,10 @@ entries of the paper's tables and the seeds within [0.2, 5]); the noise-induced 
 difference from the same method's noise-free estimate (Method A's Coulomb bias is a bias,
 which no standard error predicts, so Method A is checked on that one only). Method B is
 checked with the 0.02 s interval margin; with the default margin (0.05 periods) its
-errors under noise are reported only (see docs/benchmarks.md).
+errors under noise are only compared with the short margin's (see docs/benchmarks.md).
+
+The fast test runs Methods A and least squares on one seed at a quarter of the sample rate:
+their noise-induced errors lie within three reported standard errors for most entries.
 """
 
 from __future__ import annotations
@@ -36,6 +39,17 @@ def _rms(values):
     return float(np.sqrt(np.mean(values ** 2)))
 
 
+def test_noise_induced_errors_within_three_standard_errors():
+    rows = study(methods=("fourier", "ls"), seeds=(0,), length_noise=20e-6, force_noise=0.005,
+                 stride=4)
+    for method in ("fourier", "ls"):
+        (noisy,) = [r for r in rows if r["method"] == method and r["noise"] == "noisy"]
+        within = np.mean(noisy["noise_ratios"] <= 3.0)
+        assert within >= 0.8, f"{method}: only {within:.0%} of the 20 entries within 3 SE"
+        # ... and the standard errors are not so pessimistic that the check is vacuous
+        assert _rms([noisy["noise_ratios"]]) >= 0.2, method
+
+
 def _noisy(rows, method):
     out = [r for r in rows if r["method"] == method and r["noise"] == "noisy"]
     assert len(out) == len(SEEDS)
@@ -57,13 +71,11 @@ def test_standard_errors_predict_the_error_against_truth(rows, method):
 
 
 @pytest.mark.slow
-def test_wavelet_noise_free_within_one_percent_and_noisy_error_reported(rows, capsys):
+def test_wavelet_noise_free_within_one_percent_and_short_margin_less_noise_sensitive(rows):
     clean = [r for r in rows if r["method"] == "wavelet" and r["noise"] == "none"]
     assert clean[0]["max_error_percent"] <= 1.0
-    for method in ("wavelet", "wavelet_m002"):
-        noisy = _noisy(rows, method)
-        largest = max(r["max_error_percent"] for r in noisy)
-        assert np.isfinite(largest)
-        with capsys.disabled():
-            print(f"\n{method} under 20 um / 0.5 % sensor noise: largest error {largest:.1f} %"
-                  f" over the paper's 20 entries and {len(noisy)} seeds")
+    largest = {method: max(r["max_error_percent"] for r in _noisy(rows, method))
+               for method in ("wavelet", "wavelet_m002")}
+    assert all(np.isfinite(value) for value in largest.values())
+    # the 0.02 s margin keeps longer intervals, so noise moves its estimate less
+    assert largest["wavelet_m002"] < largest["wavelet"], largest

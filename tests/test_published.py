@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -34,6 +35,16 @@ def test_tables_and_methods_as_in_the_paper(published):
     for method, coulomb in published.cases():
         assert all(published.entry(method, coulomb, key) for key in PAPER_ENTRIES)
     assert published.entry("B", 0.0, ("M", 0, 0)) is None
+
+
+def test_relative_error_percent_by_hand():
+    """ε against hand-computed values; NaN (not an exception) at a zero nominal value."""
+    assert relative_error_percent(101.0, 100.0) == pytest.approx(1.0)
+    assert relative_error_percent(-1178.0, -1096.0) == pytest.approx(7.481751824817518)
+    assert relative_error_percent(0.0, 50.0) == pytest.approx(100.0)
+    assert math.isnan(relative_error_percent(1.0, 0.0))
+    eps = relative_error_percent(np.array([[2.0, 1.0]]), np.array([[4.0, 0.0]]))
+    assert eps.shape == (1, 2) and eps[0, 0] == pytest.approx(50.0) and math.isnan(eps[0, 1])
 
 
 def test_printed_nominal_column_matches_our_model(published, paper):

@@ -1,10 +1,10 @@
 """Command-line interface: ``stewartid COMMAND ...``.
 
-:mod:`~stewartid.cli.app` holds the application and its error policy; one module per
+:mod:`~stewartid.cli.application` holds the application and its error policy; one module per
 command: :mod:`~stewartid.cli.nominal`, :mod:`~stewartid.cli.simulate`,
 :mod:`~stewartid.cli.identify`, :mod:`~stewartid.cli.reproduce`, :mod:`~stewartid.cli.methods`.
 """
 
-from stewartid.cli.app import app, main
+from stewartid.cli.application import app, main
 
 __all__ = ["app", "main"]

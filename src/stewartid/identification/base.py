@@ -13,6 +13,8 @@ import inspect
 from pathlib import Path
 from typing import Any, ClassVar
 
+import numpy as np
+
 from stewartid.dataset import Dataset
 from stewartid.errors import ConfigError, NotFittedError
 from stewartid.identification.preparation import resolve_datasets, resolve_platform
@@ -120,4 +122,13 @@ def check_parameter(owner: str, name: str, value: Any, ok: bool, expected: str) 
                           f"Got {value!r} instead.")
 
 
-__all__ = ["BaseIdentifier", "check_parameter"]
+def check_differentiation(owner: str, window: Any, order: Any) -> None:
+    """Check the Savitzky-Golay settings ``window`` (s, or None) and ``order`` of ``owner``."""
+    check_parameter(owner, "window", window,
+                    window is None or (np.isfinite(window) and window > 0),
+                    "a positive float (s) or None")
+    check_parameter(owner, "order", order,
+                    isinstance(order, int | np.integer) and order >= 3, "an int >= 3")
+
+
+__all__ = ["BaseIdentifier", "check_differentiation", "check_parameter"]

@@ -40,7 +40,11 @@ import numpy as np
 
 from stewartid.dataset import Dataset
 from stewartid.errors import DataError, IdentificationError
-from stewartid.identification.base import BaseIdentifier, check_parameter
+from stewartid.identification.base import (
+    BaseIdentifier,
+    check_differentiation,
+    check_parameter,
+)
 from stewartid.identification.preparation import prepare
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
@@ -151,12 +155,7 @@ class FourierIdentifier(BaseIdentifier):
                         freqs is None or (len(freqs) > 0 and all(
                             np.isfinite(f) and f > 0 for f in freqs)),
                         "a positive float, a sequence of them, or None")
-        check_parameter(owner, "window", self.window,
-                        self.window is None or (np.isfinite(self.window) and self.window > 0),
-                        "a positive float (s) or None")
-        check_parameter(owner, "order", self.order,
-                        isinstance(self.order, int | np.integer) and self.order >= 3,
-                        "an int >= 3")
+        check_differentiation(owner, self.window, self.order)
         check_parameter(owner, "periods_per_segment", self.periods_per_segment,
                         isinstance(self.periods_per_segment, int | np.integer)
                         and self.periods_per_segment >= 1, "an int >= 1")

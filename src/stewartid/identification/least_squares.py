@@ -34,7 +34,11 @@ from __future__ import annotations
 import numpy as np
 
 from stewartid.dataset import Dataset
-from stewartid.identification.base import BaseIdentifier, check_parameter
+from stewartid.identification.base import (
+    BaseIdentifier,
+    check_differentiation,
+    check_parameter,
+)
 from stewartid.identification.preparation import prepare
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
@@ -136,12 +140,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
 
     def _validate_params(self) -> None:
         owner = type(self).__name__
-        check_parameter(owner, "window", self.window,
-                        self.window is None or (np.isfinite(self.window) and self.window > 0),
-                        "a positive float (s) or None")
-        check_parameter(owner, "order", self.order,
-                        isinstance(self.order, int | np.integer) and self.order >= 3,
-                        "an int >= 3")
+        check_differentiation(owner, self.window, self.order)
         check_parameter(owner, "coulomb_smoothing", self.coulomb_smoothing,
                         np.isfinite(self.coulomb_smoothing) and self.coulomb_smoothing >= 0,
                         "a float in the range [0, inf)")

@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable
+from contextvars import ContextVar
 from typing import Annotated, Any
 
-import click
 import typer
 
 from stewartid.errors import StewartidError
@@ -27,17 +27,22 @@ app = typer.Typer(
 )
 
 
+#: ``--debug`` of the running invocation (set by the root callback on every run).
+_DEBUG: ContextVar[bool] = ContextVar("stewartid_debug", default=False)
+
+
 @app.callback()
 def _root(
     debug: Annotated[bool, typer.Option(
         "--debug", help="Show the full traceback of errors instead of one line.")] = False,
 ) -> None:
     """Dynamic parameter identification of Stewart platforms (Zhang 2020, wavelet method)."""
+    _DEBUG.set(debug)
+
 
 
 def _debugging() -> bool:
-    context = click.get_current_context(silent=True)
-    return bool(context is not None and context.find_root().params.get("debug"))
+    return _DEBUG.get()
 
 
 def fail(message: str) -> None:

@@ -1,0 +1,85 @@
+"""The scikit-learn estimator contract, checked the same way on every registered method and
+preset (modelled on scikit-learn's own estimator checks)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from sklearn.base import clone
+
+from linear_model_data import make_experiment, random_matrices
+from stewartid.errors import ConfigError, NotFittedError, StewartidError
+from stewartid.identification.base import BaseIdentifier
+from stewartid.identification.registry import registered_methods
+
+SPECS = registered_methods()
+
+
+@pytest.fixture(scope="module")
+def data(paper):
+    """Six short experiments of the linear model (one sine per DOF)."""
+    M, B = random_matrices(np.random.default_rng(5))
+    return [make_experiment(paper, M, B, k, frequency_hz=1.0, periods=4) for k in range(6)]
+
+
+@pytest.fixture(params=SPECS, ids=[spec.name for spec in SPECS])
+def spec(request):
+    return request.param
+
+
+def test_registry_lists_the_builtin_methods_first():
+    assert [spec.name for spec in SPECS][:3] == ["wavelet", "fourier", "ls"]
+    assert all(spec.preset_of is None for spec in SPECS[:3])
+    assert {spec.letter for spec in SPECS} >= {"A", "B"}
+
+
+def test_init_only_stores_settings(spec):
+    estimator = spec.create()
+    assert isinstance(estimator, BaseIdentifier)
+    params = estimator.get_params()
+    assert params == estimator.get_params(deep=False)
+    for name, value in spec.defaults.items():
+        assert params[name] == value
+    assert not [name for name in vars(estimator) if name.endswith("_")]
+
+
+def test_clone_round_trips(spec):
+    estimator = spec.create()
+    copy = clone(estimator)
+    assert type(copy) is type(estimator) and copy is not estimator
+    assert copy.get_params() == estimator.get_params()
+
+
+def test_set_params_changes_settings_and_refuses_unknown_ones(spec):
+    estimator = spec.create()
+    assert estimator.set_params(gravity=False) is estimator
+    assert estimator.get_params()["gravity"] is False
+    assert clone(estimator).get_params()["gravity"] is False
+    with pytest.raises(ConfigError, match="has no setting 'magic'"):
+        estimator.set_params(magic=1)
+
+
+def test_reading_a_result_before_fit_raises_not_fitted(spec):
+    estimator = spec.create()
+    with pytest.raises(NotFittedError, match="not fitted yet"):
+        _ = estimator.M_
+    assert not hasattr(estimator, "result_")
+    assert issubclass(NotFittedError, StewartidError | AttributeError | ValueError)
+
+
+def test_fit_requires_the_platform(spec, data):
+    with pytest.raises(TypeError, match="platform"):
+        spec.create().fit(data)
+
+
+def test_fit_returns_self_with_learned_attributes(spec, data, paper):
+    estimator = spec.create()
+    assert estimator.fit(data, paper) is estimator
+    learned = [name for name in vars(estimator) if not name.startswith("_")
+               and name not in estimator.get_params()]
+    assert learned and all(name.endswith("_") for name in learned)
+    assert estimator.M_.shape == estimator.B_.shape == (6, 6)
+    assert estimator.result_.method == spec.estimator_class.method
+    # a clone of a fitted estimator has its settings but nothing learned
+    copy = clone(estimator)
+    assert copy.get_params() == estimator.get_params() and not hasattr(copy, "M_")
