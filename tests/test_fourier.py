@@ -74,7 +74,7 @@ def test_stiffness_needs_two_frequencies(paper, truth):
     # at one frequency the same data give the biased Mt - K / w^2 (no stiffness term)
     single = FourierIdentifier(frequency_hz=1.0).fit([d for d in data], paper)
     assert not np.allclose(single.M_, M, rtol=1e-2)
-    with pytest.raises(IdentificationError, match="single excitation frequency"):
+    with pytest.raises(ConfigError, match="single excitation frequency"):
         FourierIdentifier(frequency_hz=1.0, stiffness=True).fit(data, paper)
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stewartid.errors import IdentificationError
+from stewartid.errors import ConfigError
 from stewartid.identification.intervals import (
     JOINT_RATE_NAMES,
     active_joints,
@@ -88,5 +88,5 @@ def test_check_intervals_says_what_to_change():
     assert good.ok and good.count >= 7
     bad = check_intervals(T, rates, min_duration=0.5)
     assert not bad.ok and "slower" in bad.message
-    with pytest.raises(IdentificationError, match="ignore_below must be a fraction"):
+    with pytest.raises(ConfigError, match="ignore_below must be a fraction"):
         constant_direction_intervals(T, rates, ignore_below=2.0)

@@ -39,7 +39,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from stewartid.dataset import Dataset
-from stewartid.errors import DataError, IdentificationError
+from stewartid.errors import ConfigError, DataError
 from stewartid.identification.base import (
     BaseIdentifier,
     check_differentiation,
@@ -160,7 +160,7 @@ class FourierIdentifier(BaseIdentifier):
                         isinstance(self.periods_per_segment, int | np.integer)
                         and self.periods_per_segment >= 1, "an int >= 1")
         if self.stiffness and freqs is not None and len(freqs) < 2:
-            raise IdentificationError(
+            raise ConfigError(
                 "a stiffness matrix cannot be separated from inertia at a single excitation "
                 f"frequency ({freqs[0]} Hz); give two or more frequencies in frequency_hz or "
                 "switch stiffness off.")

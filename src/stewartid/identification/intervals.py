@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from stewartid.errors import DataError, IdentificationError
+from stewartid.errors import ConfigError, DataError
 from stewartid.kinematics import JOINT_AXES
 from stewartid.platform import Platform
 
@@ -103,7 +103,7 @@ def active_joints(rates: np.ndarray, ignore_below: float = 0.0) -> np.ndarray:
     ndarray of bool, shape (J,)
     """
     if not 0.0 <= ignore_below < 1.0:
-        raise IdentificationError(
+        raise ConfigError(
             f"ignore_below must be a fraction in [0, 1); got {ignore_below!r}."
         )
     rms = np.sqrt(np.mean(np.square(rates), axis=0))
@@ -158,13 +158,13 @@ def constant_direction_intervals(t: np.ndarray, rates: np.ndarray, margin: float
         raise DataError(f"rates must have one row per sample: t has {t.shape}, rates "
                         f"{rates.shape}.")
     if margin < 0 or min_duration < 0:
-        raise IdentificationError(
+        raise ConfigError(
             f"margin and min_duration must be >= 0 s; got {margin!r} and {min_duration!r}."
         )
     mask = active_joints(rates, ignore_below)
     threshold = np.broadcast_to(np.asarray(hysteresis, dtype=float), (rates.shape[1],))
     if np.any(threshold < 0):
-        raise IdentificationError("hysteresis thresholds must be >= 0.")
+        raise ConfigError("hysteresis thresholds must be >= 0.")
     confirmed = np.abs(rates) > threshold
     mask &= confirmed.any(axis=0)
     used, confirmed, threshold = rates[:, mask], confirmed[:, mask], threshold[mask]

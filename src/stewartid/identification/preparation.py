@@ -26,7 +26,7 @@ import numpy as np
 
 from stewartid.dataset import Dataset, read_datasets
 from stewartid.dynamics import ModelTerms
-from stewartid.errors import ConfigError, IdentificationError
+from stewartid.errors import ConfigError, DataError
 from stewartid.platform import Platform, load_platform
 
 
@@ -89,7 +89,7 @@ def resolve_datasets(datasets: Any, platform: Platform) -> list[Dataset]:
         datasets = [datasets]
     datasets = list(datasets)
     if not datasets:
-        raise IdentificationError("no experiments given; pass one or more data sets.")
+        raise DataError("no experiments given; pass one or more data sets.")
     out: list[Dataset] = []
     for d in datasets:
         if isinstance(d, Dataset):
@@ -97,7 +97,7 @@ def resolve_datasets(datasets: Any, platform: Platform) -> list[Dataset]:
         elif isinstance(d, str | Path):
             out.extend(read_datasets([d], platform))
         else:
-            raise IdentificationError(f"expected Dataset objects or file paths; got "
+            raise ConfigError(f"expected Dataset objects or file paths; got "
                                       f"{type(d).__name__}.")
     return out
 
