@@ -57,6 +57,8 @@ Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from scipy import sparse
 
@@ -68,6 +70,7 @@ from stewartid.identification.intervals import (
     joint_rates,
     wavelet_points,
 )
+from stewartid.identification.least_squares import JOINT_TYPES
 from stewartid.identification.noise import (
     generalized_force_sensitivity,
     joint_rate_noise,
@@ -81,6 +84,7 @@ from stewartid.identification.solvers import (
     regressor_names,
     solve_least_squares,
 )
+from stewartid.identification.weak_form import interval_equations, solve_weak_form
 from stewartid.platform import COORDINATES, Platform
 from stewartid.signals.differentiation import default_window, differentiate, estimate_frequency
 from stewartid.signals.wavelets import (
@@ -100,6 +104,32 @@ EXACT_DEGREE = 5
 #: Default interval margin, in periods of the estimated excitation frequency.
 MARGIN_PERIODS = 0.05
 PAIR_SELECTIONS = ("std_error", "none")
+FRICTION_MODELS = ("shared", "free")
+
+
+class Detection(NamedTuple):
+    """Constant-direction intervals of one experiment and what their detection measured.
+
+    Attributes
+    ----------
+    intervals : ndarray, shape (M, 2)
+        Usable [start, stop] (s).
+    info : dict
+        Counts, lengths, the differentiation window and the pose-noise covariance.
+    joint_rates : ndarray, shape (N, 6, 5)
+        Smoothed joint-axis rates (rad/s).
+    rate_noise : ndarray, shape (6, 5)
+        Their noise levels (rad/s).
+    q_dot, q_ddot : ndarray, shape (N, 6)
+        Savitzky-Golay derivatives of the pose.
+    """
+
+    intervals: np.ndarray
+    info: dict
+    joint_rates: np.ndarray
+    rate_noise: np.ndarray
+    q_dot: np.ndarray
+    q_ddot: np.ndarray
 
 
 @register_method(
@@ -109,7 +139,7 @@ PAIR_SELECTIONS = ("std_error", "none")
                 "compact polynomial wavelets (the package's Method B)",
     reference=REFERENCE,
     presets={"wavelet-paper": Preset(
-        settings={"variant": "paper", "wavelet": "mexican_hat"},
+        settings={"variant": "paper", "wavelet": "mexican_hat", "test_functions": None},
         display_name="Method B, paper's equations (Mexican hat)",
         description="Method B with the paper's own equations: Mexican hat, W q_ddot and "
                     "a W1 q_ddot from a Savitzky-Golay acceleration",
@@ -127,6 +157,19 @@ class WaveletIdentifier(BaseIdentifier):
         Half-width (scales) at which the Mexican hat is cut.
     variant : {"position", "paper", "derivative"}
         How W q_ddot and W q_dot are obtained (see the module docstring).
+    test_functions : int or None
+        Number K of orthonormalised zero-mean test functions per interval, 1..12
+        (:mod:`~stewartid.identification.weak_form`; default 4). None: the wavelet transform
+        at (a, b) points set by ``scale_fractions`` and ``shifts_per_scale``, as in the paper.
+        Needs the polynomial wavelet and the position variant.
+    friction : {"shared", "free"}
+        With ``test_functions``: "free" (default) leaves every interval constant free (the
+        paper's invariance to any friction law: only the shape of q_dot inside an interval
+        informs Bt); "shared" models the interval constants as an offset per experiment plus
+        the Coulomb level of each joint type mapped through the joint Jacobians, with a
+        scatter estimated from the data, and estimates those levels (``coulomb_``): more
+        precise Bt under force noise, but biased where the plant's friction departs from
+        that structure (docs/benchmarks.md).
     scale_fractions : tuple of float
         Wavelet support as fractions of each interval's length, each in (0, 1].
     shifts_per_scale : int
@@ -193,7 +236,8 @@ class WaveletIdentifier(BaseIdentifier):
     def __init__(self, wavelet: str = "polynomial", wavelet_order: int = 6,
                  truncation: float = 5.0, variant: str = "position",
                  scale_fractions: tuple[float, ...] = (1.0, 0.8, 0.6),
-                 shifts_per_scale: int = 5, margin: float | None = None, ignore_below: float = 0.01,
+                 shifts_per_scale: int = 5, test_functions: int | None = 4,
+                 friction: str = "free", margin: float | None = None, ignore_below: float = 0.01,
                  min_interval: float | None = None, min_support_samples: int = 32,
                  differentiation_window: float | None = None, hysteresis: float = 4.0,
                  odd_companion: bool = False, noise_correction: bool = True,
@@ -205,6 +249,8 @@ class WaveletIdentifier(BaseIdentifier):
         self.variant = variant
         self.scale_fractions = scale_fractions
         self.shifts_per_scale = shifts_per_scale
+        self.test_functions = test_functions
+        self.friction = friction
         self.margin = margin
         self.ignore_below = ignore_below
         self.min_interval = min_interval
@@ -254,6 +300,23 @@ class WaveletIdentifier(BaseIdentifier):
         check_parameter(name, "hysteresis", self.hysteresis,
                         isinstance(self.hysteresis, int | float) and self.hysteresis >= 0,
                         "a float in [0, inf)")
+        check_parameter(name, "test_functions", self.test_functions,
+                        self.test_functions is None
+                        or (isinstance(self.test_functions, int | np.integer)
+                            and 1 <= self.test_functions <= 12), "None or an integer in [1, 12]")
+        check_parameter(name, "friction", self.friction, self.friction in FRICTION_MODELS,
+                        f"one of {FRICTION_MODELS}")
+        if self.test_functions is not None:
+            check_parameter(name, "wavelet", self.wavelet, self.wavelet == "polynomial",
+                            "'polynomial' when test_functions is set (use test_functions=None "
+                            "for the Mexican hat)")
+            check_parameter(name, "variant", self.variant, self.variant == "position",
+                            "'position' when test_functions is set (use test_functions=None "
+                            "for the paper's equations)")
+            check_parameter(name, "wavelet_order", self.wavelet_order,
+                            isinstance(self.wavelet_order, int | np.integer)
+                            and self.wavelet_order >= 3,
+                            "an integer >= 3 when test_functions is set")
         check_parameter(name, "pair_selection", self.pair_selection,
                         self.pair_selection in PAIR_SELECTIONS, f"one of {PAIR_SELECTIONS}")
         make_wavelet(self.wavelet, **self._wavelet_options())
@@ -264,9 +327,11 @@ class WaveletIdentifier(BaseIdentifier):
         return {"truncation": self.truncation}
 
     # ------------------------------------------------------------------ equations
-    def _experiment_equations(self, experiment: Experiment, wavelet: MotherWavelet,
-                              platform: Platform):
-        """Wavelet equations of one experiment: regressors (K, 12), targets (K, 6), info."""
+    def _intervals(self, experiment: Experiment, platform: Platform, smallest: float):
+        """Usable constant-direction intervals of one experiment.
+
+        ``smallest`` is the smallest wavelet support as a fraction of an interval.
+        """
         t, q, period = experiment.t, experiment.q, experiment.period
         rate = 1.0 / period
         window, margin = self.differentiation_window, self.margin
@@ -278,27 +343,37 @@ class WaveletIdentifier(BaseIdentifier):
         rates = joint_rates(platform, q, q_dot, experiment.joint_jacobians,
                             experiment.leg_jacobian)
         noise = position_noise_covariance(q, q_smooth)
-        thresholds = self.hysteresis * joint_rate_noise(
-            noise, rate, window, experiment.joint_jacobians, experiment.leg_jacobian)
+        rate_noise = joint_rate_noise(noise, rate, window, experiment.joint_jacobians,
+                                      experiment.leg_jacobian)
         found = constant_direction_intervals(t, rates, margin=margin,
                                              ignore_below=self.ignore_below,
-                                             hysteresis=thresholds)
+                                             hysteresis=self.hysteresis * rate_noise)
         lengths = found[:, 1] - found[:, 0]
         shortest = (self.min_interval if self.min_interval is not None
                     else 0.5 * float(np.median(lengths)) if len(lengths) else 0.0)
-        smallest = min(self.scale_fractions)
         # the smallest wavelet support must cover min_support_samples samples
         needed = self.min_support_samples * period / smallest
         intervals = found[lengths >= max(shortest, needed)]
         info = {"name": experiment.name, "intervals_found": int(len(found)),
                 "longest_interval": float(lengths.max()) if len(lengths) else 0.0,
                 "shortest_usable": float(max(shortest, needed)),
-                "intervals": intervals, "differentiation_window": float(window)}
+                "intervals": intervals, "differentiation_window": float(window),
+                "noise_covariance": noise}
+        return Detection(intervals=intervals, info=info,
+                         joint_rates=rates[:, :30].reshape(len(t), 6, 5),
+                         rate_noise=np.maximum(rate_noise[:30].reshape(6, 5), 1e-12),
+                         q_dot=q_dot, q_ddot=q_ddot)
+
+    def _experiment_equations(self, experiment: Experiment, wavelet: MotherWavelet,
+                              platform: Platform):
+        """Wavelet equations of one experiment: regressors (K, 12), targets (K, 6), info."""
+        t, q = experiment.t, experiment.q
+        found = self._intervals(experiment, platform, min(self.scale_fractions))
+        intervals, info, q_dot, q_ddot = found.intervals, found.info, found.q_dot, found.q_ddot
         scales, shifts, owner = wavelet_points(intervals, wavelet,
                                                tuple(self.scale_fractions),
                                                int(self.shifts_per_scale))
         info["scales"], info["shifts"] = scales, shifts
-        info["noise_covariance"] = noise
         if len(scales) == 0:
             return np.zeros((0, 12)), np.zeros((0, 6)), owner, np.zeros((0, 3, 3)), info
         wavelets = [wavelet]
@@ -337,10 +412,81 @@ class WaveletIdentifier(BaseIdentifier):
         return (np.vstack(rows), np.vstack(targets), owner, np.concatenate(products),
                 info)
 
+    def _fit_weak_form(self, experiments: list[Experiment], platform: Platform,
+                       wavelet: MotherWavelet) -> tuple[IdentificationResult, dict]:
+        """The default path: orthonormal test-function families per interval
+        (:mod:`~stewartid.identification.weak_form`)."""
+        detections = [self._intervals(e, platform, 1.0) for e in experiments]
+        equations = []
+        for k, (experiment, found) in enumerate(zip(experiments, detections, strict=True)):
+            for interval in found.intervals:
+                rows = interval_equations(
+                    experiment.t, experiment.q, experiment.generalized_force,
+                    experiment.joint_jacobians, found.joint_rates, found.rate_noise, interval,
+                    int(self.wavelet_order), int(self.test_functions), k)
+                if rows is not None:
+                    equations.append(rows)
+        if not equations:
+            self._raise_no_interval([d.info for d in detections])
+        solution = solve_weak_form(equations, len(experiments),
+                                   shared_friction=self.friction == "shared")
+        theta, std = solution.theta.copy(), solution.theta_std.copy()
+        M, B = theta[:, :6], theta[:, 6:12]
+        std_M, std_B = std[:, :6], std[:, 6:12]
+        chosen = self._combine_pairs(M, B, std_M, std_B)
+        levels = dict(zip(JOINT_TYPES, solution.coulomb.tolist(), strict=True))
+        levels_std = dict(zip(JOINT_TYPES, solution.coulomb_std.tolist(), strict=True))
+        diagnostics = {
+            "position_noise_std": [np.sqrt(np.diag(d.info["noise_covariance"])).tolist()
+                                   for d in detections],
+            "wavelet": wavelet.to_dict(), "test_functions": int(self.test_functions),
+            "n_equations": solution.n_equations, "n_intervals": len(equations),
+            "experiments": [{"name": d.info["name"], "intervals_found": d.info["intervals_found"],
+                             "intervals": d.info["intervals"].tolist()} for d in detections],
+            "pair_choice": chosen, "coordinates": list(COORDINATES),
+            "friction_model": self.friction, "coulomb": levels, "coulomb_std": levels_std,
+            "offsets": solution.offsets, "noise_std": solution.noise_std,
+            "constant_scatter": solution.constant_scatter}
+        result = IdentificationResult(
+            M=M, B=B, std_errors_M=std_M, std_errors_B=std_B,
+            condition_number=solution.condition_number, residual_rms=solution.noise_std,
+            method=self.method, settings=self._settings(), diagnostics=diagnostics)
+        return result, {"coulomb_": levels, "coulomb_std_": levels_std}
+
+    @staticmethod
+    def _raise_no_interval(infos: list[dict]) -> None:
+        longest = max(info["longest_interval"] for info in infos)
+        needed = min(info["shortest_usable"] for info in infos)
+        raise IdentificationError(
+            f"no constant-direction interval long enough for the smallest wavelet scale "
+            f"in any experiment (longest {longest:.3g} s, at least {needed:.3g} s needed); "
+            "excite with a slower single-frequency sine, lower 'margin' or "
+            "'min_support_samples', raise 'ignore_below' to leave idle joints out, or "
+            "record at a higher sample rate.")
+
+    def _combine_pairs(self, M: np.ndarray, B: np.ndarray, std_M: np.ndarray,
+                       std_B: np.ndarray) -> dict:
+        """Symmetric pairs, in place: the better-determined member (``pair_selection``), or
+        with ``symmetric`` the inverse-variance weighted mean of both."""
+        if self.symmetric:
+            for matrix, std in ((M, std_M), (B, std_B)):
+                w = 1.0 / np.maximum(std, 1e-300) ** 2
+                matrix[:] = (w * matrix + w.T * matrix.T) / (w + w.T)
+                std[:] = 1.0 / np.sqrt(w + w.T)
+            return {}
+        if self.pair_selection == "std_error":
+            return {"M": select_symmetric_pairs(M, std_M), "B": select_symmetric_pairs(B, std_B)}
+        return {}
+
+    def _settings(self) -> dict:
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.get_params().items()}
+
     def _fit(self, datasets: list[Dataset], platform: Platform
              ) -> tuple[IdentificationResult, dict]:
         wavelet = make_wavelet(self.wavelet, **self._wavelet_options())
         experiments = prepare(datasets, platform, gravity=self.gravity)
+        if self.test_functions is not None:
+            return self._fit_weak_form(experiments, platform, wavelet)
         phi, target, cluster, infos, noise_xx, noise_xy = [], [], [], [], [], []
         offset = 0
         for dataset, experiment in zip(datasets, experiments, strict=True):
@@ -366,14 +512,7 @@ class WaveletIdentifier(BaseIdentifier):
         phi, target, cluster = np.vstack(phi), np.vstack(target), np.concatenate(cluster)
         noise_xx, noise_xy = np.concatenate(noise_xx), np.concatenate(noise_xy)
         if len(phi) == 0:
-            longest = max(info["longest_interval"] for info in infos)
-            needed = min(info["shortest_usable"] for info in infos)
-            raise IdentificationError(
-                f"no constant-direction interval long enough for the smallest wavelet scale "
-                f"in any experiment (longest {longest:.3g} s, at least {needed:.3g} s needed); "
-                "excite with a slower single-frequency sine, lower 'margin' or "
-                "'min_support_samples', raise 'ignore_below' to leave idle joints out, or "
-                "record at a higher sample rate.")
+            self._raise_no_interval(infos)
         names = regressor_names("q_ddot", "q_dot")
         solution = solve_least_squares(phi, target, symmetric=bool(self.symmetric),
                                        regressor_names=names)
@@ -384,10 +523,7 @@ class WaveletIdentifier(BaseIdentifier):
                                                         noise_xy)
         M, B = theta[:, :6].copy(), theta[:, 6:12].copy()
         std_M, std_B = std[:, :6].copy(), std[:, 6:12].copy()
-        chosen = {}
-        if not self.symmetric and self.pair_selection == "std_error":
-            chosen["M"] = select_symmetric_pairs(M, std_M)
-            chosen["B"] = select_symmetric_pairs(B, std_B)
+        chosen = {} if self.symmetric else self._combine_pairs(M, B, std_M, std_B)
         residual = target - phi @ theta.T
         noise = [info["noise_covariance"] for info in infos]
         diagnostics = {
@@ -407,8 +543,7 @@ class WaveletIdentifier(BaseIdentifier):
             M=M, B=B, std_errors_M=std_M, std_errors_B=std_B,
             condition_number=solution.condition_number,
             residual_rms=np.sqrt(np.mean(residual ** 2, axis=0)), method=self.method,
-            settings={k: (list(v) if isinstance(v, tuple) else v)
-                      for k, v in self.get_params().items()},
+            settings=self._settings(),
             diagnostics=diagnostics), {}
 
 
