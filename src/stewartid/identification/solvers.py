@@ -334,10 +334,29 @@ def bias_compensated_least_squares(phi: np.ndarray, target: np.ndarray, cluster:
     return theta_s / scale, std / scale
 
 
+def select_symmetric_pairs(matrix: np.ndarray, std: np.ndarray) -> list[dict]:
+    """For every off-diagonal pair, copy the estimate with the smaller standard error.
+
+    Both ``matrix`` and ``std`` are modified in place (6, 6). Returns, per pair, which entry
+    was kept (1-based), as a list of {"pair": [[i, j], [j, i]], "kept": [i, j]}.
+    """
+    choice = []
+    n = matrix.shape[0]
+    for i in range(n):
+        for j in range(i + 1, n):
+            keep, drop = ((i, j), (j, i)) if std[i, j] <= std[j, i] else ((j, i), (i, j))
+            matrix[drop] = matrix[keep]
+            std[drop] = std[keep]
+            choice.append({"pair": [[i + 1, j + 1], [j + 1, i + 1]],
+                           "kept": [keep[0] + 1, keep[1] + 1]})
+    return choice
+
+
 __all__ = [
     "LeastSquaresSolution",
     "bias_compensated_least_squares",
     "integrated_autocorrelation",
     "regressor_names",
+    "select_symmetric_pairs",
     "solve_least_squares",
 ]

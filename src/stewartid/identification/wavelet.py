@@ -32,10 +32,10 @@ so its scales are limited to a tenth of the interval at the default truncation o
 on the independent example data set (docs/benchmarks.md), the polynomial wavelet with the
 position-only variant is the most accurate; it is the default.
 
-Scales and shifts are chosen per interval: for every fraction s of ``scale_fractions`` the
-scale is a = s T / (2 h) (T the interval length, h the wavelet's half-width in scales), and
-``shifts_per_scale`` shifts spread evenly over the positions that keep the support inside the
-interval.
+Default (``test_functions=4``): per interval a family of orthonormalised zero-mean test
+functions spanning the whole interval, the weak form of :mod:`.weak_form`, solved by
+reweighted least squares with the noise estimated from the data; ``test_functions=None``
+uses (a, b) points instead (:mod:`.point_equations`), as the paper does.
 
 Couplings (the paper's Mt(2,4) case): an off-diagonal entry and its transpose are estimated
 from different equations (Mt(5,1) from the pitch equation under surge, Mt(1,5) from the surge
@@ -57,79 +57,42 @@ Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
 
 from __future__ import annotations
 
-from typing import NamedTuple
-
 import numpy as np
-from scipy import sparse
 
 from stewartid.dataset import Dataset
 from stewartid.errors import IdentificationError
 from stewartid.identification.base import BaseIdentifier, check_parameter
-from stewartid.identification.intervals import (
-    constant_direction_intervals,
-    joint_rates,
-    wavelet_points,
-)
+from stewartid.identification.detection import Detection, detect_intervals
 from stewartid.identification.least_squares import JOINT_TYPES
 from stewartid.identification.noise import (
     generalized_force_sensitivity,
-    joint_rate_noise,
-    position_noise_covariance,
 )
+from stewartid.identification.point_equations import EXACT_DEGREE, point_equations
 from stewartid.identification.preparation import Experiment, prepare
 from stewartid.identification.registry import Preset, register_method
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.solvers import (
     bias_compensated_least_squares,
     regressor_names,
+    select_symmetric_pairs,
     solve_least_squares,
 )
 from stewartid.identification.weak_form import interval_equations, solve_weak_form
 from stewartid.platform import COORDINATES, Platform
-from stewartid.signals.differentiation import default_window, differentiate, estimate_frequency
 from stewartid.signals.wavelets import (
     MotherWavelet,
     PolynomialWavelet,
     make_wavelet,
-    transform_matrix,
 )
 
 #: Citation of the method.
 REFERENCE = ("Zhang, C. A Parameter Identification Method for Stewart Manipulator Based on "
              "Wavelet Transform. Mathematics 8(2), 257 (2020). doi:10.3390/math8020257")
 VARIANTS = ("position", "paper", "derivative")
-#: Polynomial degree up to which every transform row integrates exactly (moment-corrected
-#: quadrature, see :func:`~stewartid.signals.wavelets.transform_matrix`).
-EXACT_DEGREE = 5
 #: Default interval margin, in periods of the estimated excitation frequency.
 MARGIN_PERIODS = 0.05
 PAIR_SELECTIONS = ("std_error", "none")
 FRICTION_MODELS = ("shared", "free")
-
-
-class Detection(NamedTuple):
-    """Constant-direction intervals of one experiment and what their detection measured.
-
-    Attributes
-    ----------
-    intervals : ndarray, shape (M, 2)
-        Usable [start, stop] (s).
-    info : dict
-        Counts, lengths, the differentiation window and the pose-noise covariance.
-    joint_rates : ndarray, shape (N, 6, 5)
-        Smoothed joint-axis rates (rad/s).
-    rate_noise : ndarray, shape (6, 5)
-        Their noise levels (rad/s).
-    q_dot, q_ddot : ndarray, shape (N, 6)
-        Savitzky-Golay derivatives of the pose.
-    """
-
-    intervals: np.ndarray
-    info: dict
-    joint_rates: np.ndarray
-    rate_noise: np.ndarray
-    q_dot: np.ndarray
-    q_ddot: np.ndarray
 
 
 @register_method(
@@ -327,90 +290,24 @@ class WaveletIdentifier(BaseIdentifier):
         return {"truncation": self.truncation}
 
     # ------------------------------------------------------------------ equations
-    def _intervals(self, experiment: Experiment, platform: Platform, smallest: float):
-        """Usable constant-direction intervals of one experiment.
-
-        ``smallest`` is the smallest wavelet support as a fraction of an interval.
-        """
-        t, q, period = experiment.t, experiment.q, experiment.period
-        rate = 1.0 / period
-        window, margin = self.differentiation_window, self.margin
-        if window is None or margin is None:
-            frequency = estimate_frequency(q, rate)
-            window = default_window(frequency) if window is None else window
-            margin = MARGIN_PERIODS / frequency if margin is None else margin
-        q_smooth, q_dot, q_ddot = differentiate(q, rate, window)
-        rates = joint_rates(platform, q, q_dot, experiment.joint_jacobians,
-                            experiment.leg_jacobian)
-        noise = position_noise_covariance(q, q_smooth)
-        rate_noise = joint_rate_noise(noise, rate, window, experiment.joint_jacobians,
-                                      experiment.leg_jacobian)
-        found = constant_direction_intervals(t, rates, margin=margin,
-                                             ignore_below=self.ignore_below,
-                                             hysteresis=self.hysteresis * rate_noise)
-        lengths = found[:, 1] - found[:, 0]
-        shortest = (self.min_interval if self.min_interval is not None
-                    else 0.5 * float(np.median(lengths)) if len(lengths) else 0.0)
-        # the smallest wavelet support must cover min_support_samples samples
-        needed = self.min_support_samples * period / smallest
-        intervals = found[lengths >= max(shortest, needed)]
-        info = {"name": experiment.name, "intervals_found": int(len(found)),
-                "longest_interval": float(lengths.max()) if len(lengths) else 0.0,
-                "shortest_usable": float(max(shortest, needed)),
-                "intervals": intervals, "differentiation_window": float(window),
-                "noise_covariance": noise}
-        return Detection(intervals=intervals, info=info,
-                         joint_rates=rates[:, :30].reshape(len(t), 6, 5),
-                         rate_noise=np.maximum(rate_noise[:30].reshape(6, 5), 1e-12),
-                         q_dot=q_dot, q_ddot=q_ddot)
+    def _intervals(self, experiment: Experiment, platform: Platform, smallest: float
+                   ) -> Detection:
+        """Usable intervals of one experiment with this estimator's settings."""
+        return detect_intervals(
+            experiment, platform, window=self.differentiation_window, margin=self.margin,
+            margin_periods=MARGIN_PERIODS, hysteresis=self.hysteresis,
+            ignore_below=self.ignore_below, min_interval=self.min_interval,
+            min_support_samples=self.min_support_samples, smallest=smallest)
 
     def _experiment_equations(self, experiment: Experiment, wavelet: MotherWavelet,
                               platform: Platform):
-        """Wavelet equations of one experiment: regressors (K, 12), targets (K, 6), info."""
-        t, q = experiment.t, experiment.q
+        """Wavelet equations of one experiment at (a, b) points (``test_functions=None``)."""
         found = self._intervals(experiment, platform, min(self.scale_fractions))
-        intervals, info, q_dot, q_ddot = found.intervals, found.info, found.q_dot, found.q_ddot
-        scales, shifts, owner = wavelet_points(intervals, wavelet,
-                                               tuple(self.scale_fractions),
-                                               int(self.shifts_per_scale))
-        info["scales"], info["shifts"] = scales, shifts
-        if len(scales) == 0:
-            return np.zeros((0, 12)), np.zeros((0, 6)), owner, np.zeros((0, 3, 3)), info
         wavelets = [wavelet]
         if self.odd_companion and isinstance(wavelet, PolynomialWavelet):
             wavelets.append(PolynomialWavelet(wavelet.order, odd=True))
-        a = scales[:, None]
-        qc = q - q.mean(axis=0)
-        rows, targets, products = [], [], []
-        for psi in wavelets:
-            def matrix(derivative, psi=psi):
-                return transform_matrix(t, scales, shifts, psi, derivative,
-                                        exact_degree=EXACT_DEGREE)
-
-            w0 = matrix(0)
-            targets.append(w0 @ experiment.generalized_force)
-            if self.variant == "position":
-                # constants vanish analytically (and, with the moment correction, to
-                # rounding); removing the mean also keeps the Mexican hat's truncation error
-                # proportional to the motion, not the offset
-                w2 = sparse.diags(1.0 / scales ** 2) @ matrix(2)
-                w1 = sparse.diags(-1.0 / scales) @ matrix(1)
-                w_acc, w_vel = w2 @ qc, w1 @ qc
-                # inner products of the rows acting on q (acc, vel) and on y (target): the
-                # covariances of the transformed white pose noise
-                operators = (w2, w1, w0)
-                products.append(np.stack([
-                    np.stack([np.asarray(u.multiply(v).sum(axis=1)).ravel()
-                              for v in operators], axis=-1) for u in operators], axis=-2))
-            else:
-                w_acc = w0 @ q_ddot
-                w_vel = (-a * (matrix(-1) @ q_ddot) if self.variant == "paper"
-                         else w0 @ q_dot)
-                products.append(np.zeros((len(scales), 3, 3)))
-            rows.append(np.hstack([w_acc, w_vel]))
-        owner = np.tile(owner, len(wavelets))
-        return (np.vstack(rows), np.vstack(targets), owner, np.concatenate(products),
-                info)
+        return point_equations(experiment, found, wavelets, tuple(self.scale_fractions),
+                               int(self.shifts_per_scale), self.variant)
 
     def _fit_weak_form(self, experiments: list[Experiment], platform: Platform,
                        wavelet: MotherWavelet) -> tuple[IdentificationResult, dict]:
@@ -547,23 +444,5 @@ class WaveletIdentifier(BaseIdentifier):
             diagnostics=diagnostics), {}
 
 
-def select_symmetric_pairs(matrix: np.ndarray, std: np.ndarray) -> list[dict]:
-    """For every off-diagonal pair, copy the estimate with the smaller standard error.
-
-    Both ``matrix`` and ``std`` are modified in place (6, 6). Returns, per pair, which entry
-    was kept (1-based), as a list of {"pair": [[i, j], [j, i]], "kept": [i, j]}.
-    """
-    choice = []
-    n = matrix.shape[0]
-    for i in range(n):
-        for j in range(i + 1, n):
-            keep, drop = ((i, j), (j, i)) if std[i, j] <= std[j, i] else ((j, i), (i, j))
-            matrix[drop] = matrix[keep]
-            std[drop] = std[keep]
-            choice.append({"pair": [[i + 1, j + 1], [j + 1, i + 1]],
-                           "kept": [keep[0] + 1, keep[1] + 1]})
-    return choice
-
-
-__all__ = ["EXACT_DEGREE", "MARGIN_PERIODS", "PAIR_SELECTIONS", "VARIANTS", "WaveletIdentifier",
-           "select_symmetric_pairs"]
+__all__ = ["EXACT_DEGREE", "FRICTION_MODELS", "MARGIN_PERIODS", "PAIR_SELECTIONS", "VARIANTS",
+           "WaveletIdentifier", "select_symmetric_pairs"]

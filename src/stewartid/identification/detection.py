@@ -1,0 +1,111 @@
+"""Constant-direction intervals of one measured experiment, with the noise levels that
+decide them: the first step of Method B.
+
+The pose is smoothed and differentiated (Savitzky-Golay, window from the excitation
+frequency estimated from the data), mapped to the rates of the 30 joint axes and the 6
+actuators, and cut where any active joint reverses (:mod:`.intervals`). The noise of each
+rate is estimated from the data (:mod:`.noise`), so that a reversal inside the noise band
+stays outside every interval.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from stewartid.identification.intervals import constant_direction_intervals, joint_rates
+from stewartid.identification.noise import joint_rate_noise, position_noise_covariance
+from stewartid.identification.preparation import Experiment
+from stewartid.platform import Platform
+from stewartid.signals.differentiation import default_window, differentiate, estimate_frequency
+
+
+class Detection(NamedTuple):
+    """Constant-direction intervals of one experiment and what their detection measured.
+
+    Attributes
+    ----------
+    intervals : ndarray, shape (M, 2)
+        Usable [start, stop] (s).
+    info : dict
+        Counts, lengths, the differentiation window and the pose-noise covariance.
+    joint_rates : ndarray, shape (N, 6, 5)
+        Smoothed joint-axis rates (rad/s).
+    rate_noise : ndarray, shape (6, 5)
+        Their noise levels (rad/s).
+    q_dot, q_ddot : ndarray, shape (N, 6)
+        Savitzky-Golay derivatives of the pose.
+    """
+
+    intervals: np.ndarray
+    info: dict
+    joint_rates: np.ndarray
+    rate_noise: np.ndarray
+    q_dot: np.ndarray
+    q_ddot: np.ndarray
+
+
+def detect_intervals(experiment: Experiment, platform: Platform, *, window: float | None,
+                     margin: float | None, margin_periods: float, hysteresis: float,
+                     ignore_below: float, min_interval: float | None,
+                     min_support_samples: int, smallest: float) -> Detection:
+    """Usable constant-direction intervals of one experiment.
+
+    Parameters
+    ----------
+    experiment : Experiment
+    platform : Platform
+    window : float or None
+        Savitzky-Golay window (s); None: from the estimated excitation frequency.
+    margin : float or None
+        Time cut from both ends of every interval (s); None: ``margin_periods`` periods of
+        the estimated excitation frequency.
+    margin_periods : float
+    hysteresis : float
+        Multiple of each rate's noise level inside which its direction counts as unknown.
+    ignore_below : float
+        Joints whose rate RMS is below this fraction of the largest of their kind are left out.
+    min_interval : float or None
+        Shortest usable interval (s); None: half the median interval.
+    min_support_samples : int
+        Fewest samples the smallest test function's support may cover.
+    smallest : float
+        The smallest support as a fraction of an interval (1 for a whole interval).
+
+    Returns
+    -------
+    Detection
+    """
+    t, q, period = experiment.t, experiment.q, experiment.period
+    rate = 1.0 / period
+    if window is None or margin is None:
+        frequency = estimate_frequency(q, rate)
+        window = default_window(frequency) if window is None else window
+        margin = margin_periods / frequency if margin is None else margin
+    q_smooth, q_dot, q_ddot = differentiate(q, rate, window)
+    rates = joint_rates(platform, q, q_dot, experiment.joint_jacobians, experiment.leg_jacobian)
+    noise = position_noise_covariance(q, q_smooth)
+    rate_noise = joint_rate_noise(noise, rate, window, experiment.joint_jacobians,
+                                  experiment.leg_jacobian)
+    found = constant_direction_intervals(t, rates, margin=margin, ignore_below=ignore_below,
+                                         hysteresis=hysteresis * rate_noise)
+    lengths = found[:, 1] - found[:, 0]
+    shortest = (min_interval if min_interval is not None
+                else 0.5 * float(np.median(lengths)) if len(lengths) else 0.0)
+    # the smallest support must cover min_support_samples samples
+    needed = min_support_samples * period / smallest
+    intervals = found[lengths >= max(shortest, needed)]
+    info = {"name": experiment.name, "intervals_found": int(len(found)),
+            "longest_interval": float(lengths.max()) if len(lengths) else 0.0,
+            "shortest_usable": float(max(shortest, needed)),
+            "intervals": intervals, "differentiation_window": float(window),
+            "noise_covariance": noise}
+    # a floor keeps the direction weights of noise-free data finite
+    return Detection(intervals=intervals, info=info,
+                     joint_rates=rates[:, :30].reshape(len(t), 6, 5),
+                     rate_noise=np.maximum(rate_noise[:30].reshape(6, 5), 1e-12),
+                     q_dot=q_dot, q_ddot=q_ddot)
+
+
+__all__ = ["Detection", "detect_intervals"]
