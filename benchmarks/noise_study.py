@@ -30,12 +30,57 @@ from stewartid.platform import load_platform
 from stewartid.reference.published import PAPER_ENTRIES, relative_error_percent
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "tests" / "data" / "example_c10"
-#: Method B twice: default interval margin (0.05 excitation periods, needed at high Coulomb
-#: friction) and the short 0.02 s margin (longer intervals, far less noise-sensitive).
+#: Method B (default: every interval constant free), with the shared-friction interval
+#: constants, with the 0.02 s margin, and with the paper's equations; Method A; least squares;
+#: and the oracle (least squares given the true Coulomb force, which no user has).
 METHODS = {"fourier": functools.partial(create_identifier, "fourier"),
            "ls": functools.partial(create_identifier, "ls"),
            "wavelet": functools.partial(create_identifier, "wavelet"),
-           "wavelet_m002": functools.partial(create_identifier, "wavelet", margin=0.02)}
+           "wavelet_shared": functools.partial(create_identifier, "wavelet", friction="shared"),
+           "wavelet_m002": functools.partial(create_identifier, "wavelet", margin=0.02),
+           "wavelet-paper": functools.partial(create_identifier, "wavelet-paper")}
+
+
+class OracleIdentifier:
+    """Least squares given the Coulomb force of the noise-free motion (the efficiency bound a
+    friction-immune method is measured against): y - F_coulomb = Mt q_ddot + Bt q_dot + offset
+    per experiment, Savitzky-Golay derivatives of the measured pose, standard errors for
+    autocorrelated residuals."""
+
+    def __init__(self, clean):
+        self.clean = clean
+
+    def fit(self, datasets, platform):
+        from stewartid.dynamics import friction_forces
+        from stewartid.identification.preparation import prepare
+        from stewartid.identification.solvers import solve_least_squares
+        from stewartid.signals.differentiation import (
+            default_window,
+            differentiate,
+            estimate_frequency,
+            trim,
+        )
+
+        viscous_only = platform.replace(friction__coulomb=0.0)
+        phis, ys = [], []
+        for k, (experiment, clean) in enumerate(zip(prepare(datasets, platform), self.clean,
+                                                    strict=True)):
+            rate = experiment.sample_rate
+            window = default_window(estimate_frequency(clean.pose, rate))
+            _, qd_true, _ = differentiate(clean.pose, rate, window)
+            coulomb = (friction_forces(platform, clean.pose, qd_true)
+                       - friction_forces(viscous_only, clean.pose, qd_true))
+            _, qd, qdd = differentiate(experiment.q, rate, window)
+            cut = trim(window, rate)
+            offsets = np.zeros((len(qd), len(datasets)))
+            offsets[:, k] = 1.0
+            sl = slice(cut, len(qd) - cut)
+            phis.append(np.hstack([qdd, qd, offsets])[sl])
+            ys.append((experiment.generalized_force - coulomb)[sl])
+        solution = solve_least_squares(np.vstack(phis), np.vstack(ys), autocorrelated=True)
+        self.M_, self.B_ = solution.theta[:, :6], solution.theta[:, 6:12]
+        self.std_errors_ = {"M": solution.theta_std[:, :6], "B": solution.theta_std[:, 6:12]}
+        return self
 
 
 def load_example(folder: Path = EXAMPLE):
@@ -100,7 +145,9 @@ def study(methods=tuple(METHODS), seeds=(0, 1, 2, 3), length_noise=20e-6, force_
                                                         force_noise, seed)
             for method in methods:
                 start = time.perf_counter()
-                estimator = METHODS[method]().fit(data, platform)
+                factory = (functools.partial(OracleIdentifier, clean) if method == "oracle"
+                           else METHODS[method])
+                estimator = factory().fit(data, platform)
                 seconds = time.perf_counter() - start
                 if seed is None:
                     references[method] = estimator
@@ -122,7 +169,7 @@ def main() -> None:
     parser.add_argument("--length-noise", type=float, default=20e-6, help="m")
     parser.add_argument("--force-noise", type=float, default=0.005,
                         help="fraction of each leg's mean force")
-    parser.add_argument("--methods", default=",".join(METHODS))
+    parser.add_argument("--methods", default=",".join([*METHODS, "oracle"]))
     args = parser.parse_args()
     rows = study(tuple(args.methods.split(",")), tuple(range(args.seeds)), args.length_noise,
                  args.force_noise)
