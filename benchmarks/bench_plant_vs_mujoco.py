@@ -22,7 +22,7 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from stewartid import mjcf  # noqa: E402
+from stewartid import mjcf, mujoco_state  # noqa: E402
 from stewartid.platform import load_platform  # noqa: E402
 from stewartid.simulation import paper_experiments, simulate_experiment  # noqa: E402
 
@@ -71,18 +71,18 @@ def time_mujoco(paper, excitation, integrator: str, repeats: int,
 
     start = time.perf_counter()
     model = mjcf.load_model(paper, integrator=integrator, timestep=MUJOCO_STEP, coulomb=coulomb)
-    mjcf.add_leg_servo(paper, model)
+    mujoco_state.add_leg_servo(paper, model)
     data = mujoco.MjData(model)
     n = int(round(DURATION / MUJOCO_STEP))
     q_cmd, qd_cmd, _ = excitation.evaluate((np.arange(n) + 0.5) * MUJOCO_STEP)
-    ctrl = mjcf.servo_controls(paper, q_cmd, qd_cmd)
+    ctrl = mujoco_state.servo_controls(paper, q_cmd, qd_cmd)
     q0, qd0, _ = excitation.evaluate(np.zeros(1))
     setup = time.perf_counter() - start
     best, best_cpu, motion = np.inf, np.inf, 0.0
-    quat = mjcf.Indices(model).platform_qpos + 3
+    quat = mujoco_state.Indices(model).platform_qpos + 3
     for _ in range(repeats):
         mujoco.mj_resetData(model, data)
-        mjcf.set_state(paper, model, data, q0[0], qd0[0])
+        mujoco_state.set_state(paper, model, data, q0[0], qd0[0])
         step = mujoco.mj_step
         seen = []
         start, start_cpu = time.perf_counter(), time.process_time()

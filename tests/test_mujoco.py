@@ -2,7 +2,7 @@
 
 MuJoCo models the hexapod as 42 joint coordinates closed by 6 welds, with its own rigid-body
 algorithms (composite rigid body, RNE); we model it in the platform's 6 coordinates (Kane's
-method). Projecting MuJoCo's equations with the closure map (``mjcf.platform_space_terms``)
+method). Projecting MuJoCo's equations with the closure map (``mujoco_state.platform_space_terms``)
 must reproduce our mass matrix, gravity and leg Jacobian at any pose, and the same servo on
 both must give the same closed-loop motion. Tolerances are derived in each test.
 """
@@ -16,7 +16,7 @@ import pytest
 
 mujoco = pytest.importorskip("mujoco")
 
-from stewartid import mjcf  # noqa: E402
+from stewartid import mjcf, mujoco_state  # noqa: E402
 from stewartid.dynamics import gravity_forces, inverse_dynamics, mass_matrix  # noqa: E402
 from stewartid.kinematics import leg_jacobian  # noqa: E402
 from stewartid.linearization import viscous_matrix  # noqa: E402
@@ -64,7 +64,7 @@ def test_model_compiles_closed_at_neutral(engine):
     mujoco.mj_forward(model, data)
     assert data.nefc == 36  # 6 welds x 6 rows; no Coulomb rows for the paper's Fc = 0
     assert np.abs(data.efc_pos[:data.nefc]).max() < 1e-12
-    assert np.allclose(mjcf.leg_lengths(platform, model, data), platform.neutral_leg_length)
+    assert np.allclose(mujoco_state.leg_lengths(platform, model, data), platform.neutral_leg_length)
     # the end bodies' share of the platform is given back exactly
     total = sum(model.body_mass[model.body(n).id] for n in
                 ["platform", *(f"leg{k}_end" for k in range(1, 7))])
@@ -77,8 +77,8 @@ def test_state_round_trip_and_closure(engine):
     rng = np.random.default_rng(1)
     for q in random_poses(platform, 5):
         q_dot = rng.uniform(-1.0, 1.0, 6) * SPAN
-        mjcf.set_state(platform, model, data, q, q_dot)
-        q_back, q_dot_back = mjcf.platform_state(model, data)
+        mujoco_state.set_state(platform, model, data, q, q_dot)
+        q_back, q_dot_back = mujoco_state.platform_state(model, data)
         np.testing.assert_allclose(q_back, q, atol=1e-13)
         np.testing.assert_allclose(q_dot_back, q_dot, atol=1e-12)
         rows = data.efc_type[:data.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY
@@ -86,7 +86,7 @@ def test_state_round_trip_and_closure(engine):
         assert np.abs(data.efc_pos[:data.nefc][rows]).max() < 1e-12
         assert np.abs(data.efc_vel[:data.nefc][rows]).max() < 1e-12
         # slide rates are leg-length rates: MuJoCo's J_lq q_dot is ours
-        slide = data.qvel[mjcf.Indices(model).slide_dof]
+        slide = data.qvel[mujoco_state.Indices(model).slide_dof]
         np.testing.assert_allclose(slide, leg_jacobian(platform, q) @ q_dot, atol=1e-12)
 
 
@@ -100,7 +100,7 @@ def test_mass_matrix_gravity_and_leg_jacobian_match(engine):
     """
     platform, model, data = engine
     for q in [platform.neutral_pose, *random_poses(platform)]:
-        t = mjcf.platform_space_terms(platform, model, data, q)
+        t = mujoco_state.platform_space_terms(platform, model, data, q)
         assert t["constraint_violation"] < 1e-12
         assert scaled_error(t["mass_matrix"], mass_matrix(platform, q)) < 1e-10
         G = gravity_forces(platform, q)
@@ -113,7 +113,7 @@ def test_static_leg_forces_match(engine):
     platform, model, data = engine
     for q in [platform.neutral_pose, *random_poses(platform, seed=2)]:
         ours = inverse_dynamics(platform, q, np.zeros(6), np.zeros(6))
-        theirs = mjcf.static_leg_forces(platform, model, data, q)
+        theirs = mujoco_state.static_leg_forces(platform, model, data, q)
         # same derivation as above: 1e-10 of the largest leg force (about 30 kN: 3 uN)
         assert np.abs(theirs - ours).max() < 1e-10 * np.abs(ours).max()
 
@@ -128,12 +128,12 @@ def test_viscous_matrix_exact_at_neutral_first_order_elsewhere(engine):
     platforms (relative to Bt's largest entry). The bound 0.6 x angle checks that order.
     """
     platform, model, data = engine
-    t = mjcf.platform_space_terms(platform, model, data, platform.neutral_pose)
+    t = mujoco_state.platform_space_terms(platform, model, data, platform.neutral_pose)
     B0 = viscous_matrix(platform, platform.neutral_pose)
     assert np.abs(t["viscous"] - B0).max() < 1e-12 * np.abs(B0).max()
-    hinges = mjcf.Indices(model).joint_qpos
+    hinges = mujoco_state.Indices(model).joint_qpos
     for q in random_poses(platform, 6, seed=3):
-        t = mjcf.platform_space_terms(platform, model, data, q)
+        t = mujoco_state.platform_space_terms(platform, model, data, q)
         B = viscous_matrix(platform, q)
         angle = np.abs(data.qpos[hinges]).max()
         assert np.abs(t["viscous"] - B).max() < 0.6 * angle * np.abs(B).max()
@@ -156,19 +156,19 @@ def _closed_loop(platform, step=5e-4, duration=2.0):
 
     model = mjcf.load_model(plant, integrator="RK4", timestep=step)
     data = mujoco.MjData(model)
-    mjcf.add_leg_servo(plant, model)
+    mujoco_state.add_leg_servo(plant, model)
     n = int(round(duration / step))
     q_cmd, qd_cmd, _ = excitation.evaluate((np.arange(n) + 0.5) * step)
-    ctrl = mjcf.servo_controls(plant, q_cmd, qd_cmd)
+    ctrl = mujoco_state.servo_controls(plant, q_cmd, qd_cmd)
     q0, qd0, _ = excitation.evaluate(np.zeros(1))
-    mjcf.set_state(plant, model, data, q0[0], qd0[0])
+    mujoco_state.set_state(plant, model, data, q0[0], qd0[0])
     per_sample = int(round(1e-3 / step))
-    poses = [mjcf.platform_state(model, data)[0]]
+    poses = [mujoco_state.platform_state(model, data)[0]]
     for k in range(n):
         data.ctrl[:] = ctrl[k]
         mujoco.mj_step(model, data)
         if (k + 1) % per_sample == 0:
-            poses.append(mjcf.platform_state(model, data)[0])
+            poses.append(mujoco_state.platform_state(model, data)[0])
     return record.q, np.array(poses), excitation.evaluate(record.t)[0]
 
 
