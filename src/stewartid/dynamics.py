@@ -81,10 +81,15 @@ def friction_forces(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
     rotational axes, regularised as described in the module docstring.
     """
     t = ModelTerms(platform, q, q_dot)
+    return _out(_joint_friction(platform, t, q_dot, coulomb_smoothing), t.single)
+
+
+def _joint_friction(platform: Platform, terms: ModelTerms, q_dot: np.ndarray,
+                    coulomb_smoothing: float) -> np.ndarray:
+    """Generalized joint friction (N, 6) at the samples of ``terms``."""
     qd2, _ = _batch(q_dot, "q_dot")
-    F = _kernels.batch_friction(platform.parameters(), t.joint_jacobians, qd2,
-                                float(coulomb_smoothing))
-    return _out(F, t.single)
+    return _kernels.batch_friction(platform.parameters(), terms.joint_jacobians, qd2,
+                                   float(coulomb_smoothing))
 
 
 def inverse_dynamics(platform: Platform, q: np.ndarray, q_dot: np.ndarray, q_ddot: np.ndarray,
@@ -98,12 +103,10 @@ def inverse_dynamics(platform: Platform, q: np.ndarray, q_dot: np.ndarray, q_ddo
         Force along each leg, positive extending.
     """
     t = ModelTerms(platform, q, q_dot)
-    qd2, _ = _batch(q_dot, "q_dot")
     qdd2, _ = _batch(q_ddot, "q_ddot")
     rhs = np.einsum("nij,nj->ni", t.mass_matrix, qdd2) + t.velocity_product + t.gravity
     if friction:
-        rhs += _kernels.batch_friction(platform.parameters(), t.joint_jacobians, qd2,
-                                       float(coulomb_smoothing))
+        rhs += _joint_friction(platform, t, q_dot, coulomb_smoothing)
     f = np.linalg.solve(np.swapaxes(t.leg_jacobian, 1, 2), rhs[..., None])[..., 0]
     return _out(f, t.single)
 
@@ -118,12 +121,10 @@ def forward_dynamics(platform: Platform, q: np.ndarray, q_dot: np.ndarray, force
     ndarray, shape (6,) or (N, 6)
     """
     t = ModelTerms(platform, q, q_dot)
-    qd2, _ = _batch(q_dot, "q_dot")
     f2, _ = _batch(forces, "forces")
     rhs = np.einsum("nji,nj->ni", t.leg_jacobian, f2) - t.velocity_product - t.gravity
     if friction:
-        rhs -= _kernels.batch_friction(platform.parameters(), t.joint_jacobians, qd2,
-                                       float(coulomb_smoothing))
+        rhs -= _joint_friction(platform, t, q_dot, coulomb_smoothing)
     qdd = np.linalg.solve(t.mass_matrix, rhs[..., None])[..., 0]
     return _out(qdd, t.single)
 
