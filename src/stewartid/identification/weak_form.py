@@ -247,8 +247,13 @@ def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
     condition = _check_rank(x.T @ x, regressor_names("q_ddot", "q_dot"), max_condition)
     theta = np.linalg.solve(x.T @ x, x.T @ y).T
     dof = max(len(x) - 12, 1)
-    noise = np.sum((y - x @ theta.T) ** 2, axis=0) / dof
-    noise = np.maximum(noise, 1e-24 * np.maximum(np.mean(y ** 2, axis=0), 1e-300))
+    # floor: noise-free data must not give infinite weights
+    floor = 1e-24 * np.maximum(np.mean(y ** 2, axis=0), 1e-300)
+
+    def channel_noise(coefficients: np.ndarray) -> np.ndarray:
+        return np.maximum(np.sum((y - x @ coefficients.T) ** 2, axis=0) / dof, floor)
+
+    noise = channel_noise(theta)
     n_types = equations[0].coulomb.shape[0]
     n_theta = 72
     n_unknowns = n_theta + (6 * n_experiments + n_types if shared_friction else 0)
@@ -299,8 +304,7 @@ def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
         a_s = a / scale
         z = np.linalg.solve(a_s.T @ a_s, a_s.T @ b) / scale
         theta = z[:n_theta].reshape(6, 12)
-        noise = np.sum((y - x @ theta.T) ** 2, axis=0) / dof
-        noise = np.maximum(noise, 1e-24 * np.maximum(np.mean(y ** 2, axis=0), 1e-300))
+        noise = channel_noise(theta)
         if shared_friction:
             offsets = z[n_theta:n_theta + 6 * n_experiments].reshape(n_experiments, 6)
             levels = z[n_theta + 6 * n_experiments:]
