@@ -7,21 +7,6 @@ from typing import Annotated
 
 import typer
 
-#: Reference sensor noise of ``--noise``: leg-length standard deviation (m) and force
-#: standard deviation as a fraction of the static leg force at neutral.
-REFERENCE_LENGTH_NOISE_M = 20e-6
-REFERENCE_FORCE_NOISE = 0.005
-
-
-def static_leg_force(platform) -> float:
-    """Mean actuator force (N) holding the platform at rest at neutral."""
-    import numpy as np
-
-    from stewartid.dynamics import inverse_dynamics
-
-    zero = np.zeros(6)
-    return float(np.mean(np.abs(inverse_dynamics(platform, platform.neutral_pose, zero, zero))))
-
 
 def simulate(
     out: Annotated[Path, typer.Option("--out", help="Output folder for exp1..exp6 and "
@@ -64,6 +49,7 @@ def simulate(
     from stewartid.platform import load_platform
     from stewartid.simulation import SensorNoise, simulate_experiments, write_experiments
     from stewartid.simulation.experiments import is_experiment_file
+    from stewartid.simulation.sensors import reference_noise
 
     description = load_platform(platform)
     if format not in ("csv", "parquet"):
@@ -78,8 +64,7 @@ def simulate(
         raise ConfigError(f"--duration must be > 0 s; got {duration!r}.")
     noise = SensorNoise.from_sensors(description.sensors)
     if noise_on:
-        noise = dataclasses.replace(noise, length_noise=REFERENCE_LENGTH_NOISE_M,
-                                    force_noise=REFERENCE_FORCE_NOISE * static_leg_force(description))
+        noise = reference_noise(description)
     if length_noise is not None:
         noise = dataclasses.replace(noise, length_noise=length_noise)
     if force_noise is not None:

@@ -55,6 +55,41 @@ class SensorNoise:
         return all(getattr(self, f.name) == 0.0 for f in dataclasses.fields(self))
 
 
+#: The reference sensor noise (``stewartid simulate --noise``, ``noise_scale = 1`` in a
+#: study): leg-length standard deviation (m) and force standard deviation as a fraction of
+#: the static leg force at neutral (-).
+REFERENCE_LENGTH_NOISE_M = 20e-6
+REFERENCE_FORCE_NOISE = 0.005
+
+
+def static_leg_force(platform: Platform) -> float:
+    """Mean actuator force (N) holding the platform at rest at its neutral pose."""
+    from stewartid.dynamics import inverse_dynamics
+
+    zero = np.zeros(6)
+    return float(np.mean(np.abs(inverse_dynamics(platform, platform.neutral_pose, zero, zero))))
+
+
+def reference_noise(platform: Platform, scale: float = 1.0) -> SensorNoise:
+    """The platform's ``[sensors]`` errors with the noise set to ``scale`` times the reference.
+
+    The reference is 20 µm on the leg lengths and 0.5 % of the static leg force
+    (:func:`static_leg_force`) on the forces; biases and resolutions stay the platform's.
+
+    Parameters
+    ----------
+    platform : Platform
+    scale : float
+        Multiple of the reference noise (-), >= 0; 0 gives noise-free lengths and forces.
+    """
+    if not (np.isfinite(scale) and scale >= 0):
+        raise ConfigError(f"noise scale must be a finite number >= 0; got {scale!r}.")
+    return dataclasses.replace(
+        SensorNoise.from_sensors(platform.sensors),
+        length_noise=scale * REFERENCE_LENGTH_NOISE_M,
+        force_noise=scale * REFERENCE_FORCE_NOISE * static_leg_force(platform))
+
+
 def measure(true: np.ndarray, noise: float, bias: float, resolution: float,
             rng: np.random.Generator) -> np.ndarray:
     """quantise(true + bias + N(0, noise^2)) element-wise; same shape as ``true``."""
