@@ -20,8 +20,9 @@ from typing import Any
 
 import numpy as np
 
-from stewartid.config import section_from_mapping, section_to_mapping, spec
+from stewartid.config import read_toml_text, section_from_mapping, section_to_mapping, spec
 from stewartid.errors import ConfigError
+from stewartid.platform_ranges import check_physical_ranges
 
 #: Standard gravity used throughout the model (m/s^2), as in the paper's model.
 GRAVITY = 9.81
@@ -188,10 +189,40 @@ class Sensors:
                                    check="nonnegative", default=0.0)
 
 
+@dataclasses.dataclass(frozen=True)
+class Limits:
+    """Operating limits an excitation must respect (``stewartid design`` and its checks).
+
+    Keys left out are derived from the other sections by
+    :func:`stewartid.design.limits.resolve_limits`: the stroke ends from ``[hydraulics]
+    stroke`` centred on the neutral leg length, the leg velocity from the rated valve flow
+    through the piston area, the force from the smaller of the cylinder's stall forces.
+    """
+
+    stroke_min: float | None = spec("m", "shortest allowed leg length (default: neutral "
+                                    "length - stroke / 2)", default=None)
+    stroke_max: float | None = spec("m", "longest allowed leg length (default: neutral "
+                                    "length + stroke / 2)", default=None)
+    leg_velocity: float | None = spec("m/s", "largest leg-length rate (default: rated valve "
+                                      "flow / piston area)", default=None)
+    leg_acceleration: float = spec("m/s^2", "largest leg-length acceleration", default=5.0)
+    actuator_force: float | None = spec("N", "largest |actuator force| (default: the smaller "
+                                        "of the extending and retracting stall forces)",
+                                        default=None)
+    gimbal_angle: float = spec("rad", "largest deflection of a leg from its neutral "
+                               "direction, at either gimbal", default=0.35)
+
+    def __post_init__(self) -> None:
+        if (self.stroke_min is not None and self.stroke_max is not None
+                and not self.stroke_min < self.stroke_max):
+            raise ConfigError(f"[limits] stroke_min = {self.stroke_min} m must be below "
+                              f"stroke_max = {self.stroke_max} m.")
+
+
 #: TOML sections of a platform description, in file order, with their dataclass.
 SECTIONS: dict[str, type] = {"geometry": Geometry, "inertia": Inertia, "friction": Friction,
                              "hydraulics": Hydraulics, "controller": Controller,
-                             "sensors": Sensors}
+                             "sensors": Sensors, "limits": Limits}
 #: Sections that must be present in every file; the others take their documented defaults.
 REQUIRED_SECTIONS = ("geometry", "inertia", "friction")
 
@@ -206,6 +237,8 @@ class Platform:
         The required sections of the TOML description.
     hydraulics, controller, sensors : Hydraulics, Controller, Sensors
         Plant simulator settings; documented defaults when absent from the file.
+    limits : Limits
+        Operating limits of excitation design; derived defaults when absent.
     name : str
         Label used in reports ("paper" for the preset, the file stem otherwise).
     """
@@ -216,9 +249,11 @@ class Platform:
     hydraulics: Hydraulics = dataclasses.field(default_factory=Hydraulics)
     controller: Controller = dataclasses.field(default_factory=Controller)
     sensors: Sensors = dataclasses.field(default_factory=Sensors)
+    limits: Limits = dataclasses.field(default_factory=Limits)
     name: str = "platform"
 
     def __post_init__(self) -> None:
+        check_physical_ranges({name: getattr(self, name) for name in SECTIONS})
         _check_buildable(self)
 
     # -- derived geometry -------------------------------------------------------------------
@@ -315,7 +350,8 @@ class Platform:
         for name, table in self.to_dict().items():
             lines.append(f"\n[{name}]")
             for key, value in table.items():
-                lines.append(f"{key} = {_toml_value(value)}")
+                if value is not None:  # a derived default: TOML has no null
+                    lines.append(f"{key} = {_toml_value(value)}")
         return "\n".join(lines) + "\n"
 
 
@@ -411,7 +447,7 @@ def load_platform(source: str | Path) -> Platform:
         raise ConfigError(
             f"platform file {str(path)!r} not found; give a TOML file or 'paper' for the preset."
         )
-    return _parse(path.read_text(encoding="utf-8"), path.stem, str(path))
+    return _parse(read_toml_text(path), path.stem, str(path))
 
 
 def _parse(text: str, name: str, where: str) -> Platform:

@@ -1,0 +1,254 @@
+"""Excitation designs: records of one sine along a fixed pose direction, with level schedules.
+
+A designed record moves the platform along one direction of pose space (one DOF, or a
+combination such as surge with pitch) as
+
+    q(t) = q0 + d * a(t) * sin(2 pi f t),
+
+with d the direction (unit amplitude per DOF, m or rad), f the frequency and a(t) an
+amplitude envelope: a quintic fade-in to the first level, a hold, a one-period quintic ramp
+to the next level, ..., and a quintic fade-out to rest. Because every pose rate is the
+scalar a(t) sin' times d, every leg and every joint reverses at the same instants: the
+constant-direction intervals are the half-periods, whatever the direction. Two levels make
+two speeds in one record; their intervals share the joint-direction pattern but not the
+viscous force, which is what lets Method B with ``friction="shared"`` separate viscous from
+Coulomb friction.
+
+A :class:`Design` is a list of such records plus the platform's neutral pose; the paper's
+set (:func:`paper_design`) is six single-level records, record k on DOF k.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from stewartid.errors import ConfigError
+from stewartid.platform import COORDINATES, Platform
+from stewartid.simulation.excitation import DEFAULT_AMPLITUDES
+
+
+def _ramp(s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Quintic smoothstep on s in [0, 1] and its first two derivatives in s."""
+    s = np.clip(s, 0.0, 1.0)
+    return (s ** 3 * (10 - 15 * s + 6 * s ** 2), 30 * s ** 2 * (1 - s) ** 2,
+            60 * s * (1 - s) * (1 - 2 * s))
+
+
+@dataclasses.dataclass(frozen=True)
+class DesignedRecord:
+    """One record: a sine along a fixed pose direction under a level schedule.
+
+    Attributes
+    ----------
+    direction : tuple of 6 float
+        Motion per unit level along x, y, z, rx, ry, rz (m, m, m, rad, rad, rad).
+    frequency_hz : float
+        Hz.
+    levels : tuple of float
+        Amplitude levels (-, multiplying ``direction``), held one after the other.
+    hold_periods : int
+        Whole periods held at each level.
+    fade_periods : int
+        Periods of the fade-in, of the fade-out and of every ramp between levels.
+    name : str
+    """
+
+    direction: tuple[float, ...]
+    frequency_hz: float
+    levels: tuple[float, ...] = (1.0,)
+    hold_periods: int = 10
+    fade_periods: int = 1
+    name: str = "exp"
+
+    def __post_init__(self) -> None:
+        direction = tuple(float(v) for v in np.asarray(self.direction, dtype=float).ravel())
+        if len(direction) != 6 or not any(direction) or not all(map(math.isfinite, direction)):
+            raise ConfigError(f"record {self.name}: direction must be 6 finite values, not all "
+                              f"zero (m, rad); got {self.direction!r}.")
+        object.__setattr__(self, "direction", direction)
+        object.__setattr__(self, "levels", tuple(float(v) for v in self.levels))
+        if not (math.isfinite(self.frequency_hz) and self.frequency_hz > 0):
+            raise ConfigError(f"record {self.name}: frequency_hz must be > 0 Hz; got "
+                              f"{self.frequency_hz!r}.")
+        if not self.levels or not all(v > 0 and math.isfinite(v) for v in self.levels):
+            raise ConfigError(f"record {self.name}: levels must be one or more numbers > 0; "
+                              f"got {self.levels!r}.")
+        for key in ("hold_periods", "fade_periods"):
+            value = getattr(self, key)
+            if not (isinstance(value, int) and value >= 1):
+                raise ConfigError(f"record {self.name}: {key} must be an integer >= 1; got "
+                                  f"{value!r}.")
+
+    @property
+    def period(self) -> float:
+        """Sine period (s)."""
+        return 1.0 / self.frequency_hz
+
+    @property
+    def duration(self) -> float:
+        """Record length (s): fade-in, holds and ramps, fade-out."""
+        n = len(self.levels)
+        return self.period * (n * self.hold_periods + (n + 1) * self.fade_periods)
+
+    @property
+    def max_frequency(self) -> float:
+        """Highest frequency of the motion (Hz), for the sampling check of the plant."""
+        return self.frequency_hz
+
+    def envelope(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Amplitude envelope a(t) and its first two time derivatives; each shape (N,)."""
+        t = np.asarray(t, dtype=float)
+        a, da, dda = np.zeros_like(t), np.zeros_like(t), np.zeros_like(t)
+        fade, hold = self.fade_periods * self.period, self.hold_periods * self.period
+        start, previous = 0.0, 0.0
+        for level in (*self.levels, 0.0):
+            w, dw, ddw = _ramp((t - start) / fade)
+            a += (level - previous) * w
+            da += (level - previous) * dw / fade
+            dda += (level - previous) * ddw / fade ** 2
+            start += fade + hold
+            previous = level
+        return a, da, dda
+
+    def evaluate_offsets(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Motion about the base pose: dq, dq_dot, dq_ddot, each shape (N, 6) (m, rad, /s, /s^2)."""
+        t = np.asarray(t, dtype=float)
+        a, da, dda = self.envelope(t)
+        omega = 2 * math.pi * self.frequency_hz
+        s, c = np.sin(omega * t), np.cos(omega * t)
+        d = np.asarray(self.direction)
+        scalar = (a * s, da * s + a * omega * c,
+                  dda * s + 2 * da * omega * c - a * omega ** 2 * s)
+        return tuple(np.outer(x, d) for x in scalar)
+
+    def to_dict(self) -> dict:
+        """Plain data (JSON ready); :func:`record_from_dict` reads it back."""
+        return {**dataclasses.asdict(self), "direction": list(self.direction),
+                "levels": list(self.levels), "duration_s": self.duration}
+
+
+def record_from_dict(data: dict) -> DesignedRecord:
+    """Inverse of :meth:`DesignedRecord.to_dict`."""
+    fields = {f.name for f in dataclasses.fields(DesignedRecord)}
+    return DesignedRecord(**{k: (tuple(v) if isinstance(v, list) else v)
+                             for k, v in data.items() if k in fields})
+
+
+@dataclasses.dataclass(frozen=True)
+class PlayableRecord:
+    """A designed record about a base pose: what the plant plays (``evaluate``, ``name``,
+    ``max_frequency``, as :class:`~stewartid.simulation.excitation.Excitation`)."""
+
+    record: DesignedRecord
+    base_pose: tuple[float, ...]
+
+    @property
+    def name(self) -> str:
+        """Record label."""
+        return self.record.name
+
+    @property
+    def max_frequency(self) -> float:
+        """Hz."""
+        return self.record.max_frequency
+
+    def evaluate(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Pose, velocity and acceleration at times ``t`` (s); each shape (N, 6)."""
+        dq, dqd, dqdd = self.record.evaluate_offsets(t)
+        return dq + np.asarray(self.base_pose), dqd, dqdd
+
+
+@dataclasses.dataclass(frozen=True)
+class Design:
+    """A set of records to run one after the other (each from rest at the neutral pose).
+
+    Attributes
+    ----------
+    records : tuple of DesignedRecord
+    label : str
+        Short description for reports.
+    """
+
+    records: tuple[DesignedRecord, ...]
+    label: str = "design"
+
+    @property
+    def duration(self) -> float:
+        """Total motion time (s)."""
+        return float(sum(r.duration for r in self.records))
+
+    def playable(self, platform: Platform) -> list[PlayableRecord]:
+        """The records about the platform's neutral pose."""
+        base = tuple(platform.neutral_pose)
+        return [PlayableRecord(r, base) for r in self.records]
+
+    def to_dict(self) -> dict:
+        """Plain data (JSON ready)."""
+        return {"label": self.label, "duration_s": self.duration,
+                "records": [r.to_dict() for r in self.records]}
+
+
+def design_from_dict(data: dict) -> Design:
+    """Inverse of :meth:`Design.to_dict`."""
+    return Design(tuple(record_from_dict(r) for r in data["records"]), data.get("label", ""))
+
+
+def unit_direction(dof: int, amplitude: float) -> tuple[float, ...]:
+    """Direction moving DOF ``dof`` (0..5) alone by ``amplitude`` (m or rad)."""
+    d = [0.0] * 6
+    d[dof] = float(amplitude)
+    return tuple(d)
+
+
+def paper_design(frequency_hz: float = 0.5, duration_s: float = 20.0,
+                 amplitudes: Sequence[float] = DEFAULT_AMPLITUDES) -> Design:
+    """The paper's set: six records, record k a single-level sine on DOF k.
+
+    The record length is ``duration_s`` rounded to whole periods (fade-in and fade-out of
+    one period each included).
+    """
+    periods = max(1, round(duration_s * frequency_hz) - 2)
+    return Design(tuple(
+        DesignedRecord(unit_direction(k, amplitudes[k]), frequency_hz, (1.0,), periods, 1,
+                       f"exp{k + 1}") for k in range(6)),
+        f"paper: 6 single-DOF sines, {frequency_hz:g} Hz, {duration_s:g} s each")
+
+
+def scheduled_design(amplitudes: Sequence[float], frequency_hz: float,
+                     durations_s: Sequence[float], levels: Sequence[float] = (1.0, 0.5),
+                     label: str | None = None) -> Design:
+    """Six single-DOF records with a level schedule, each of (about) its own duration.
+
+    Parameters
+    ----------
+    amplitudes : sequence of 6 float
+        Largest amplitude per DOF (m, m, m, rad, rad, rad); ``levels`` scale it.
+    frequency_hz : float
+        Hz, the same for every record (all half-periods are equally long).
+    durations_s : sequence of 6 float
+        Record lengths (s), rounded down to whole hold periods per level.
+    levels : sequence of float
+        Level schedule relative to the amplitude, largest first (e.g. (1, 0.5)).
+    label : str, optional
+    """
+    peak = max(levels)
+    period = 1.0 / frequency_hz
+    records = []
+    for k in range(6):
+        hold = int((durations_s[k] / period - (len(levels) + 1)) // len(levels))
+        if hold < 1:
+            raise ConfigError(f"record {k + 1}: {durations_s[k]:.3g} s is too short for "
+                              f"{len(levels)} levels at {frequency_hz:g} Hz.")
+        records.append(DesignedRecord(unit_direction(k, amplitudes[k] * peak), frequency_hz,
+                                      tuple(v / peak for v in levels), hold, 1, f"exp{k + 1}"))
+    text = label or (f"6 single-DOF records, {frequency_hz:g} Hz, levels "
+                     + "/".join(f"{v:g}" for v in levels))
+    return Design(tuple(records), text)
+
+
+__all__ = ["COORDINATES", "Design", "DesignedRecord", "PlayableRecord", "design_from_dict",
+           "paper_design", "record_from_dict", "scheduled_design", "unit_direction"]

@@ -1,0 +1,190 @@
+"""Operating limits of a hexapod and how much of them a motion uses.
+
+The ``[limits]`` section of a platform description (:class:`stewartid.platform.Limits`) may
+leave keys out; :func:`resolve_limits` fills them from the model: the stroke ends from
+``[hydraulics] stroke`` centred on the neutral leg length, the leg velocity from the rated
+valve flow through the piston area, the force from the smaller stall force of the cylinder.
+
+:func:`limit_use` turns a motion (pose, leg lengths, rates, accelerations, forces) into the
+fraction of every limit used at every sample: 1 is the limit itself. It serves both the
+design (on commanded trajectories and model forces) and the check of a simulation (on the
+plant's true states).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from stewartid.errors import ConfigError
+from stewartid.kinematics import inverse_kinematics, rotation_matrix
+from stewartid.platform import Platform
+from stewartid.simulation.hydraulics import force_limits
+
+#: The limits, in the order of the columns of :attr:`LimitUse.use`.
+LIMIT_NAMES = ("stroke", "leg_velocity", "leg_acceleration", "actuator_force", "gimbal_angle")
+
+
+@dataclasses.dataclass(frozen=True)
+class OperatingLimits:
+    """All limits with numbers: the ``[limits]`` section with its derived defaults filled in.
+
+    Attributes
+    ----------
+    stroke_min, stroke_max : float
+        Leg-length range (m).
+    leg_velocity : float
+        Largest |leg-length rate| (m/s).
+    leg_acceleration : float
+        Largest |leg-length acceleration| (m/s^2).
+    actuator_force : float
+        Largest |actuator force| (N).
+    gimbal_angle : float
+        Largest deflection of a leg from its neutral direction at either gimbal (rad).
+    neutral_length : float
+        Leg length at the neutral pose (m), the reference of the stroke use.
+    """
+
+    stroke_min: float
+    stroke_max: float
+    leg_velocity: float
+    leg_acceleration: float
+    actuator_force: float
+    gimbal_angle: float
+    neutral_length: float
+
+    def to_dict(self) -> dict[str, float]:
+        """Plain values (JSON ready)."""
+        return dataclasses.asdict(self)
+
+
+def resolve_limits(platform: Platform) -> OperatingLimits:
+    """The platform's limits with every default derived from its other sections.
+
+    Raises
+    ------
+    ConfigError
+        If the neutral leg length lies outside [stroke_min, stroke_max].
+    """
+    given, hydraulics = platform.limits, platform.hydraulics
+    neutral = platform.neutral_leg_length
+    f_min, f_max = force_limits(hydraulics)
+    limits = OperatingLimits(
+        stroke_min=(neutral - hydraulics.stroke / 2 if given.stroke_min is None
+                    else given.stroke_min),
+        stroke_max=(neutral + hydraulics.stroke / 2 if given.stroke_max is None
+                    else given.stroke_max),
+        leg_velocity=(hydraulics.valve_rated_flow / hydraulics.piston_area
+                      if given.leg_velocity is None else given.leg_velocity),
+        leg_acceleration=given.leg_acceleration,
+        actuator_force=(min(abs(f_min), abs(f_max)) if given.actuator_force is None
+                        else given.actuator_force),
+        gimbal_angle=given.gimbal_angle, neutral_length=neutral)
+    if not limits.stroke_min < neutral < limits.stroke_max:
+        raise ConfigError(
+            f"[limits] the neutral leg length {neutral:.4f} m must lie inside [stroke_min, "
+            f"stroke_max] = [{limits.stroke_min:.4f}, {limits.stroke_max:.4f}] m.")
+    return limits
+
+
+@dataclasses.dataclass(frozen=True)
+class LimitUse:
+    """Fraction of every limit used along a motion.
+
+    Attributes
+    ----------
+    t : ndarray, shape (N,)
+        s.
+    use : ndarray, shape (N, 5)
+        Per sample, the largest over the legs of |value| / limit for each of
+        :data:`LIMIT_NAMES` (-); the stroke use is measured from the neutral leg length
+        towards the end the leg moves to.
+    """
+
+    t: np.ndarray
+    use: np.ndarray
+
+    @property
+    def peak(self) -> dict[str, float]:
+        """Largest use of every limit over the motion (-)."""
+        return {name: float(self.use[:, k].max()) for k, name in enumerate(LIMIT_NAMES)}
+
+    @property
+    def exceeded(self) -> list[str]:
+        """Names of the limits used beyond 1."""
+        return [name for name, value in self.peak.items() if value > 1.0]
+
+
+def gimbal_angles(platform: Platform, q: np.ndarray) -> np.ndarray:
+    """Deflection of every leg from its neutral direction at both gimbals.
+
+    Parameters
+    ----------
+    platform : Platform
+    q : ndarray, shape (N, 6)
+        Poses (m, rad).
+
+    Returns
+    -------
+    ndarray, shape (N, 6, 2)
+        rad; [..., 0] at the lower gimbal (leg direction in the base frame), [..., 1] at the
+        upper gimbal (leg direction in the platform frame).
+    """
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    u = inverse_kinematics(platform, q).directions
+    u0 = inverse_kinematics(platform, platform.neutral_pose).directions[0]
+    body = np.einsum("nji,nkj->nki", rotation_matrix(q[:, 3:]), u)
+    lower = np.arccos(np.clip(np.einsum("nki,ki->nk", u, u0), -1.0, 1.0))
+    upper = np.arccos(np.clip(np.einsum("nki,ki->nk", body, u0), -1.0, 1.0))
+    return np.stack([lower, upper], axis=-1)
+
+
+def limit_use(platform: Platform, limits: OperatingLimits, t: np.ndarray, q: np.ndarray,
+              lengths: np.ndarray, length_rates: np.ndarray,
+              length_accelerations: np.ndarray, forces: np.ndarray) -> LimitUse:
+    """Fraction of every limit used at every sample of a motion.
+
+    Parameters
+    ----------
+    platform : Platform
+    limits : OperatingLimits
+    t : ndarray, shape (N,)
+        s.
+    q : ndarray, shape (N, 6)
+        Poses (m, rad).
+    lengths, length_rates, length_accelerations : ndarray, shape (N, 6)
+        Leg lengths (m), rates (m/s) and accelerations (m/s^2).
+    forces : ndarray, shape (N, 6)
+        Actuator forces (N).
+
+    Returns
+    -------
+    LimitUse
+    """
+    stretch = lengths - limits.neutral_length
+    stroke = np.where(stretch >= 0, stretch / (limits.stroke_max - limits.neutral_length),
+                      -stretch / (limits.neutral_length - limits.stroke_min))
+    use = np.column_stack([
+        stroke.max(axis=1),
+        np.abs(length_rates).max(axis=1) / limits.leg_velocity,
+        np.abs(length_accelerations).max(axis=1) / limits.leg_acceleration,
+        np.abs(forces).max(axis=1) / limits.actuator_force,
+        gimbal_angles(platform, q).max(axis=(1, 2)) / limits.gimbal_angle,
+    ])
+    return LimitUse(t=np.asarray(t, dtype=float), use=use)
+
+
+def record_limit_use(platform: Platform, record) -> LimitUse:
+    """Limit use of a simulated experiment, from the plant's true states.
+
+    Parameters
+    ----------
+    platform : Platform
+    record : stewartid.simulation.ExperimentRecord
+        True signals; the leg accelerations are the central differences of the true leg
+        rates.
+    """
+    accelerations = np.gradient(record.length_rates, record.t, axis=0)
+    return limit_use(platform, resolve_limits(platform), record.t, record.q, record.lengths,
+                     record.length_rates, accelerations, record.forces)
