@@ -12,6 +12,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Mapping
+from pathlib import Path
 from typing import Any, TypeVar
 
 from stewartid.errors import ConfigError
@@ -131,6 +132,23 @@ def section_from_mapping(cls: type[T], table: Any, where: str) -> T:
                 f"{field.metadata['unit']})."
             )
     return cls(**values)
+
+
+def read_toml_text(path: str | Path) -> str:
+    """The text of a TOML file, which must be UTF-8 (a byte-order mark is allowed).
+
+    Raises
+    ------
+    ConfigError
+        Naming the file and the line of the first byte that is not UTF-8, with the fix.
+    """
+    data = Path(path).read_bytes()
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data[:exc.start].count(b"\n") + 1
+        raise ConfigError(f"{path}: not UTF-8 (byte 0x{data[exc.start]:02x} on line {line}); "
+                          "TOML files are UTF-8: re-save it as UTF-8.") from None
 
 
 def section_to_mapping(section: Any) -> dict[str, Any]:
