@@ -77,6 +77,9 @@ def _register() -> None:
     for command in (nominal.nominal, simulate.simulate, identify.identify,
                     reproduce.reproduce, methods.methods):
         app.command()(clean_errors(command))
+    from stewartid.cli import study
+
+    app.command()(clean_errors(study.study))
 
 
 _register()

@@ -1,0 +1,69 @@
+"""Expansion of a study into tasks: one per (grid point, seed).
+
+A task simulates the six experiments once and identifies them with every method of the study,
+so the methods are compared on the same data. Its key is a hash of every parameter value and
+the seed: the same point gives the same key in every run, which is what lets a resumed run
+skip the finished tasks and lets the results be deduplicated.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import itertools
+import json
+
+from stewartid.studies.spec import PARAMETERS, StudySpec
+
+
+@dataclasses.dataclass(frozen=True)
+class StudyTask:
+    """One simulation of a study and its identifications.
+
+    Attributes
+    ----------
+    parameters : dict
+        ``{parameter: value}`` for every name of :data:`~stewartid.studies.spec.PARAMETERS`
+        (units there).
+    seed : int
+        Seed of the sensor noise.
+    """
+
+    parameters: dict[str, float]
+    seed: int
+
+    @property
+    def key(self) -> str:
+        """Stable identifier: 16 hex digits of a SHA-1 of the parameters and the seed."""
+        canonical = json.dumps({**{name: float(self.parameters[name]) for name in PARAMETERS},
+                                "seed": int(self.seed)}, sort_keys=True)
+        return hashlib.sha1(canonical.encode("ascii")).hexdigest()[:16]
+
+    @property
+    def label(self) -> str:
+        """Short human-readable description, e.g. ``"coulomb=5 noise_scale=1 seed=3"``."""
+        values = " ".join(f"{name}={value:g}" for name, value in self.parameters.items())
+        return f"{values} seed={self.seed}"
+
+
+def expand_grid(spec: StudySpec) -> list[StudyTask]:
+    """Every task of ``spec``: the Cartesian product of the grid, times the seeds.
+
+    The seed is the outer loop, so a run stopped half-way has covered the whole grid with its
+    first seeds rather than half of the grid with all of them.
+
+    Returns
+    -------
+    list of StudyTask
+        ``spec.size`` tasks with distinct keys.
+    """
+    names = list(spec.grid)
+    tasks = []
+    for seed in spec.seeds:
+        for values in itertools.product(*(spec.grid[name] for name in names)):
+            point = {**spec.fixed, **dict(zip(names, values, strict=True))}
+            tasks.append(StudyTask({name: point[name] for name in PARAMETERS}, seed))
+    return tasks
+
+
+__all__ = ["StudyTask", "expand_grid"]

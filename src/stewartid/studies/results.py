@@ -1,0 +1,147 @@
+"""The results of a study: one row per (grid point, seed, method), stored as a partitioned
+Parquet data set.
+
+``DIR/results.parquet/`` is a folder holding one file ``part-<task key>.parquet`` per
+finished task (one row per method), each written atomically (a temporary file renamed into
+place; readers and pyarrow ignore the temporary files, whose names start with a dot). A task
+that finishes twice (a worker lost after the result came back, a rerun) replaces its own file,
+so no row is ever duplicated, and a run killed at any moment leaves only whole files.
+``pandas.read_parquet(DIR / "results.parquet")`` reads the data set; :func:`read_results`
+does so and also drops duplicate (task, method) rows, should files have been copied in.
+
+Columns
+-------
+task : str
+    Task key (:attr:`~stewartid.studies.grid.StudyTask.key`).
+coulomb, viscous, noise_scale, frequency, duration : float
+    The point's parameters (N m, N m s/rad, -, Hz, s).
+seed : int
+    Seed of the sensor noise.
+method : str
+    Registered method name.
+max_error_percent : float
+    Largest relative error ε over the paper's 20 entries (%), NaN if the method failed.
+max_error_entry : str
+    The entry with that error, e.g. ``"Bt(1,1)"``.
+max_error_M_percent, max_error_B_percent : float
+    Largest ε over the paper's 10 entries of Mt, of Bt (%).
+error_Mt(1,1) ... error_Bt(5,1) : float
+    ε of each of the 20 entries (%), in :data:`~stewartid.reference.published.PAPER_ENTRIES`
+    order.
+run_time_s : float
+    Wall time of the identification (s).
+simulation_time_s : float
+    Wall time of the task's simulation, shared by its methods (s).
+failure : str
+    Why the simulation or the identification failed (a StewartidError), null otherwise.
+worker : str
+    Address of the worker that ran the task, null outside dask.
+"""
+
+from __future__ import annotations
+
+import io
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from stewartid.io import write_bytes_atomic
+from stewartid.reference.published import PAPER_ENTRIES, entry_label
+from stewartid.studies.spec import PARAMETERS
+
+#: Folder of the data set inside the output folder.
+RESULTS_NAME = "results.parquet"
+
+#: Column of each of the paper's 20 entries, in PAPER_ENTRIES order.
+ENTRY_COLUMNS = tuple(f"error_{entry_label(key)}" for key in PAPER_ENTRIES)
+
+_PREFIX, _SUFFIX = "part-", ".parquet"
+
+
+def _schema() -> Any:
+    import pyarrow as pa
+
+    text, number = pa.string(), pa.float64()
+    return pa.schema(
+        [("task", text), *((name, number) for name in PARAMETERS), ("seed", pa.int64()),
+         ("method", text), ("max_error_percent", number), ("max_error_entry", text),
+         ("max_error_M_percent", number), ("max_error_B_percent", number),
+         *((name, number) for name in ENTRY_COLUMNS), ("run_time_s", number),
+         ("simulation_time_s", number), ("failure", text), ("worker", text)])
+
+
+def columns() -> tuple[str, ...]:
+    """Every column of the data set, in order."""
+    return tuple(_schema().names)
+
+
+def part_path(directory: str | Path, task_key: str) -> Path:
+    """The file of task ``task_key`` in the data set of output folder ``directory``."""
+    return Path(directory) / RESULTS_NAME / f"{_PREFIX}{task_key}{_SUFFIX}"
+
+
+def write_part(directory: str | Path, task_key: str, rows: Sequence[Mapping[str, Any]]
+               ) -> Path:
+    """Write the rows of one task as its own Parquet file, atomically; returns the path.
+
+    Raises
+    ------
+    ValueError
+        If a row misses a column or belongs to another task (a bug in the caller).
+    """
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    schema = _schema()
+    for row in rows:
+        missing = [name for name in schema.names if name not in row]
+        if missing or row["task"] != task_key:
+            raise ValueError(f"row of task {row.get('task')!r} for {task_key!r} misses "
+                             f"columns {missing}")
+    table = pa.Table.from_pylist([dict(row) for row in rows], schema=schema)
+    buffer = io.BytesIO()
+    pq.write_table(table, buffer)
+    return write_bytes_atomic(part_path(directory, task_key), buffer.getvalue())
+
+
+def finished_tasks(directory: str | Path) -> set[str]:
+    """Keys of the tasks whose rows are in the data set of output folder ``directory``."""
+    folder = Path(directory) / RESULTS_NAME
+    if not folder.is_dir():
+        return set()
+    return {path.name[len(_PREFIX):-len(_SUFFIX)]
+            for path in folder.glob(f"{_PREFIX}*{_SUFFIX}")}
+
+
+def read_results(directory: str | Path, tasks: Iterable[str] | None = None) -> Any:
+    """Every row of the data set of output folder ``directory`` as a pandas DataFrame.
+
+    Parameters
+    ----------
+    directory : str or Path
+    tasks : iterable of str, optional
+        Keep only these task keys.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The columns of :func:`columns`, one row per (task, method), sorted by the parameters,
+        the seed and the method; empty (with the columns) if no task has finished.
+    """
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    folder = Path(directory) / RESULTS_NAME
+    paths = sorted(folder.glob(f"{_PREFIX}*{_SUFFIX}")) if folder.is_dir() else []
+    schema = _schema()
+    tables = [pq.read_table(path, schema=schema) for path in paths]
+    frame = pa.concat_tables(tables or [schema.empty_table()]).to_pandas()
+    if tasks is not None:
+        frame = frame[frame["task"].isin(set(tasks))]
+    frame = frame.drop_duplicates(["task", "method"], keep="last")
+    order = [*PARAMETERS, "seed", "method"]
+    return frame.sort_values(order, kind="stable").reset_index(drop=True)
+
+
+__all__ = ["ENTRY_COLUMNS", "RESULTS_NAME", "columns", "finished_tasks", "part_path",
+           "read_results", "write_part"]

@@ -1,0 +1,296 @@
+"""The study file: a TOML description of a Monte Carlo study or a parameter sweep.
+
+A study runs the paper's six virtual experiments at every point of a grid of plant and
+excitation parameters, ``seeds`` times with independent sensor noise, and identifies Mt and
+Bt with every listed method. Example::
+
+    [study]
+    platform = "paper"              # or a platform TOML path (relative to the study file)
+    methods = ["wavelet", "fourier", "ls"]
+    duration = 20.0                 # s per experiment
+    seeds = 8                       # noise seeds per grid point
+    [grid]
+    coulomb = [0.0, 5.0, 30.0]      # N m per joint axis
+    noise_scale = [0.0, 1.0, 2.0]   # multiples of the reference sensor noise
+    frequency = [0.5]               # Hz
+
+Every point parameter (:data:`PARAMETERS`) may be fixed in ``[study]`` or swept in
+``[grid]``, not both; those given in neither take their default. Optional ``[settings.NAME]``
+tables pass settings to method ``NAME`` (``[settings.wavelet] friction = "shared"``). Unknown
+keys and tables are errors. The format is documented in ``docs/studies.md``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from stewartid.errors import ConfigError
+from stewartid.platform import Platform, load_platform
+
+
+@dataclasses.dataclass(frozen=True)
+class Parameter:
+    """A parameter of a study point: a column of the results.
+
+    Attributes
+    ----------
+    unit : str
+    doc : str
+    minimum : float
+        Smallest allowed value.
+    strict : bool
+        True if the minimum itself is excluded.
+    """
+
+    unit: str
+    doc: str
+    minimum: float = 0.0
+    strict: bool = False
+
+    def check(self, name: str, value: Any, where: str) -> float:
+        """``value`` as a float, or ConfigError naming ``where`` and ``name``."""
+        bound = f"> {self.minimum:g}" if self.strict else f">= {self.minimum:g}"
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise ConfigError(f"{where}: {name} must be a number {bound} ({self.unit}); got "
+                              f"{value!r}.")
+        value = float(value)
+        if not math.isfinite(value) or value < self.minimum or (self.strict
+                                                                and value == self.minimum):
+            raise ConfigError(f"{where}: {name} must be {bound} ({self.unit}); got {value!r}.")
+        return value
+
+
+#: Parameters of a study point, in column order. ``coulomb`` and ``viscous`` default to the
+#: platform's friction; ``noise_scale`` multiplies the reference sensor noise
+#: (:func:`stewartid.simulation.sensors.reference_noise`).
+PARAMETERS: dict[str, Parameter] = {
+    "coulomb": Parameter("N m", "Coulomb friction per joint axis"),
+    "viscous": Parameter("N m s/rad", "viscous friction per gimbal axis"),
+    "noise_scale": Parameter("-", "multiple of the reference sensor noise"),
+    "frequency": Parameter("Hz", "excitation sine frequency", strict=True),
+    "duration": Parameter("s", "record length of each experiment", strict=True),
+}
+
+#: Defaults of the parameters that do not come from the platform.
+DEFAULTS = {"noise_scale": 0.0, "frequency": 0.5, "duration": 20.0}
+
+#: Keys of ``[study]`` other than the point parameters.
+STUDY_KEYS = ("platform", "methods", "seeds", "first_seed", "actuator", "title")
+
+
+@dataclasses.dataclass(frozen=True)
+class StudySpec:
+    """A validated study file.
+
+    Attributes
+    ----------
+    platform : str
+        ``"paper"`` or the absolute path of the platform TOML file.
+    methods : tuple of str
+        Registered method or preset names, in the file's order.
+    seeds : tuple of int
+        Noise seeds run at every grid point.
+    fixed : dict
+        ``{parameter: value}`` of the parameters not swept (defaults resolved).
+    grid : dict
+        ``{parameter: tuple of values}`` of the swept parameters, in the file's order.
+    actuator : str or None
+        ``"hydraulic"`` or ``"ideal"`` to override ``[hydraulics] mode``.
+    method_settings : dict
+        ``{method: {setting: value}}`` from the ``[settings.*]`` tables.
+    title : str
+    """
+
+    platform: str
+    methods: tuple[str, ...]
+    seeds: tuple[int, ...]
+    fixed: dict[str, float]
+    grid: dict[str, tuple[float, ...]]
+    actuator: str | None = None
+    method_settings: dict[str, dict[str, Any]] = dataclasses.field(default_factory=dict)
+    title: str = "Identification study"
+
+    @property
+    def size(self) -> int:
+        """Number of tasks (grid points times seeds); each gives one row per method."""
+        return math.prod(len(values) for values in self.grid.values()) * len(self.seeds)
+
+    def load_platform(self) -> Platform:
+        """The platform description the study runs on."""
+        return load_platform(self.platform)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready form (``study.json`` of the output folder)."""
+        document = dataclasses.asdict(self)
+        document["grid"] = {name: list(values) for name, values in self.grid.items()}
+        document["seeds"] = list(self.seeds)
+        document["methods"] = list(self.methods)
+        return document
+
+    def mismatch(self, other: Mapping[str, Any]) -> str | None:
+        """The first setting in which ``other`` (a :meth:`to_dict` document) differs from this
+        study where a resumed run must agree (everything but the grid and the seeds), or None."""
+        mine = self.to_dict()
+        for key in ("platform", "methods", "fixed", "actuator", "method_settings"):
+            if mine[key] != other.get(key):
+                return key
+        if set(mine["grid"]) != set(other.get("grid", {})):
+            return "grid parameters"
+        return None
+
+
+def _table(document: Mapping[str, Any], name: str, where: str) -> Mapping[str, Any]:
+    table = document.get(name, {})
+    if not isinstance(table, Mapping):
+        raise ConfigError(f"{where}: [{name}] must be a TOML table; got {table!r}.")
+    return table
+
+
+def _methods(value: Any, where: str) -> tuple[str, ...]:
+    from stewartid.identification.registry import method_spec
+
+    if (not isinstance(value, list) or not value
+            or not all(isinstance(name, str) for name in value)):
+        raise ConfigError(f"{where}: [study] methods must be a non-empty list of method names, "
+                          f"e.g. [\"wavelet\", \"fourier\"]; got {value!r}.")
+    if len(set(value)) != len(value):
+        raise ConfigError(f"{where}: [study] methods lists a method twice: {value!r}.")
+    for name in value:
+        method_spec(name)
+    return tuple(value)
+
+
+def _integer(value: Any, name: str, minimum: int, where: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+        raise ConfigError(f"{where}: [study] {name} must be an integer >= {minimum}; got "
+                          f"{value!r}.")
+    return value
+
+
+def _grid(table: Mapping[str, Any], where: str) -> dict[str, tuple[float, ...]]:
+    grid = {}
+    for name, values in table.items():
+        if name not in PARAMETERS:
+            raise ConfigError(f"{where}: [grid] has unknown key {name!r}; valid keys are: "
+                              f"{', '.join(PARAMETERS)}.")
+        if not isinstance(values, list) or not values:
+            raise ConfigError(f"{where}: [grid] {name} must be a non-empty list of values in "
+                              f"{PARAMETERS[name].unit}, e.g. {name} = [0.0, 1.0]; got "
+                              f"{values!r}.")
+        checked = tuple(PARAMETERS[name].check(f"{name}[{k}]", v, f"{where}: [grid]")
+                        for k, v in enumerate(values))
+        if len(set(checked)) != len(checked):
+            raise ConfigError(f"{where}: [grid] {name} lists a value twice: {values!r}.")
+        grid[name] = checked
+    return grid
+
+
+def _method_settings(table: Mapping[str, Any], methods: tuple[str, ...], where: str
+                     ) -> dict[str, dict[str, Any]]:
+    from stewartid.identification.registry import create_identifier
+
+    settings = {}
+    for name, values in table.items():
+        if name not in methods:
+            raise ConfigError(f"{where}: [settings.{name}] names a method the study does not "
+                              f"run; [study] methods are {', '.join(methods)}.")
+        if not isinstance(values, Mapping):
+            raise ConfigError(f"{where}: [settings.{name}] must be a table of settings.")
+        create_identifier(name, **values)
+        settings[name] = dict(values)
+    return settings
+
+
+def parse_study(document: Mapping[str, Any], where: str = "study file",
+                base: str | Path = ".") -> StudySpec:
+    """Validate a decoded study file.
+
+    Parameters
+    ----------
+    document : mapping
+        The decoded TOML.
+    where : str
+        Name of the file in error messages.
+    base : str or Path
+        Folder that a relative platform path is relative to.
+
+    Raises
+    ------
+    ConfigError
+        On an unknown table or key, a missing or mistyped value, a value out of range, a
+        parameter both fixed and swept, an unknown method or method setting, or a platform
+        that cannot be loaded.
+    """
+    unknown = sorted(set(document) - {"study", "grid", "settings"})
+    if unknown:
+        raise ConfigError(f"{where}: unknown table [{unknown[0]}]; valid tables are [study], "
+                          "[grid] and [settings.METHOD].")
+    study = _table(document, "study", where)
+    valid = (*STUDY_KEYS, *PARAMETERS)
+    for key in study:
+        if key not in valid:
+            raise ConfigError(f"{where}: [study] has unknown key {key!r}; valid keys are: "
+                              f"{', '.join(valid)}.")
+    if "methods" not in study:
+        raise ConfigError(f"{where}: [study] is missing required key 'methods' (the methods "
+                          "to run, e.g. methods = [\"wavelet\", \"fourier\", \"ls\"]).")
+    methods = _methods(study["methods"], where)
+    platform = study.get("platform", "paper")
+    if not isinstance(platform, str):
+        raise ConfigError(f"{where}: [study] platform must be \"paper\" or a TOML path; got "
+                          f"{platform!r}.")
+    if platform != "paper":
+        platform = str((Path(base) / platform).resolve())
+    description = load_platform(platform)
+    grid = _grid(_table(document, "grid", where), where)
+    both = [name for name in grid if name in study]
+    if both:
+        raise ConfigError(f"{where}: {both[0]!r} is both fixed in [study] and swept in [grid]; "
+                          "keep one.")
+    defaults = {**DEFAULTS, "coulomb": description.friction.coulomb,
+                "viscous": description.friction.gimbal_viscous}
+    fixed = {name: PARAMETERS[name].check(name, study[name], f"{where}: [study]")
+             if name in study else float(defaults[name])
+             for name in PARAMETERS if name not in grid}
+    actuator = study.get("actuator")
+    if actuator not in (None, "hydraulic", "ideal"):
+        raise ConfigError(f"{where}: [study] actuator must be \"hydraulic\" or \"ideal\"; got "
+                          f"{actuator!r}.")
+    title = study.get("title", "Identification study")
+    if not isinstance(title, str):
+        raise ConfigError(f"{where}: [study] title must be a string; got {title!r}.")
+    seeds = _integer(study.get("seeds", 1), "seeds", 1, where)
+    first_seed = _integer(study.get("first_seed", 0), "first_seed", 0, where)
+    return StudySpec(platform=platform, methods=methods,
+                     seeds=tuple(range(first_seed, first_seed + seeds)), fixed=fixed,
+                     grid=grid, actuator=actuator,
+                     method_settings=_method_settings(_table(document, "settings", where),
+                                                      methods, where),
+                     title=title)
+
+
+def load_study(path: str | Path) -> StudySpec:
+    """Read and validate a study file (TOML).
+
+    Raises
+    ------
+    ConfigError
+        If the file is missing, is not valid TOML, or fails :func:`parse_study`.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"study file {str(path)!r} not found; give the path of a TOML study "
+                          "file (see docs/studies.md).")
+    try:
+        document = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path}: not valid TOML ({exc}).") from None
+    return parse_study(document, str(path), path.parent)
+
+
+__all__ = ["DEFAULTS", "PARAMETERS", "Parameter", "StudySpec", "load_study", "parse_study"]

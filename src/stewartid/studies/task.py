@@ -1,0 +1,133 @@
+"""What one study task computes, on whichever worker runs it: one simulation of the six
+experiments and its identification by every method, as result rows.
+
+The function is module-level and takes only picklable values, so dask (or any executor) can
+ship it to another process or machine; it writes nothing, the client stores the rows.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from stewartid.errors import StewartidError
+from stewartid.platform import Platform
+from stewartid.reference.published import PAPER_ENTRIES, entry_label, relative_error_percent
+from stewartid.studies.grid import StudyTask
+from stewartid.studies.results import ENTRY_COLUMNS
+
+
+def _worker_address() -> str | None:
+    try:
+        from distributed import get_worker
+
+        return str(get_worker().address)
+    except (ImportError, ValueError):
+        return None
+
+
+def error_columns(M: np.ndarray, B: np.ndarray, nominal_M: np.ndarray, nominal_B: np.ndarray
+                  ) -> dict[str, Any]:
+    """The error columns of a row: ε (%) of the 20 paper entries and their maxima.
+
+    Parameters
+    ----------
+    M, B : ndarray, shape (6, 6)
+        Identified Mt (kg, kg·m, kg·m²) and Bt (N·s/m, N·s, N·m·s/rad).
+    nominal_M, nominal_B : ndarray, shape (6, 6)
+        The true matrices, same units.
+    """
+    matrices = {"M": (M, nominal_M), "B": (B, nominal_B)}
+    errors = {key: relative_error_percent(matrices[key[0]][0][key[1], key[2]],
+                                          matrices[key[0]][1][key[1], key[2]])
+              for key in PAPER_ENTRIES}
+    finite = {key: value for key, value in errors.items() if math.isfinite(value)}
+    worst = max(finite, key=finite.__getitem__) if finite else None
+    row: dict[str, Any] = {
+        "max_error_percent": math.nan if worst is None else finite[worst],
+        "max_error_entry": None if worst is None else entry_label(worst),
+    }
+    for matrix in ("M", "B"):
+        values = [value for key, value in finite.items() if key[0] == matrix]
+        row[f"max_error_{matrix}_percent"] = max(values) if values else math.nan
+    row.update(zip(ENTRY_COLUMNS, errors.values(), strict=True))
+    return row
+
+
+def _failed(message: str) -> dict[str, Any]:
+    return {"max_error_percent": math.nan, "max_error_entry": None,
+            "max_error_M_percent": math.nan, "max_error_B_percent": math.nan,
+            **dict.fromkeys(ENTRY_COLUMNS, math.nan), "run_time_s": math.nan,
+            "failure": message}
+
+
+def run_task(task: StudyTask, platform: Platform, methods: Sequence[str],
+             method_settings: Mapping[str, Mapping[str, Any]] | None = None,
+             actuator: str | None = None) -> list[dict[str, Any]]:
+    """Simulate the six experiments at ``task``'s point and identify them with each method.
+
+    A :class:`~stewartid.errors.StewartidError` of the simulation (a leg leaving its stroke,
+    a frequency above Nyquist) or of one identification (too few equations) is a result of
+    the study: it gives rows with NaN errors and the message in ``failure``. Any other
+    exception is a bug and propagates (the task then counts as failed).
+
+    Parameters
+    ----------
+    task : StudyTask
+    platform : Platform
+        The study's platform; the task's friction is applied to it.
+    methods : sequence of str
+        Registered method names.
+    method_settings : mapping, optional
+        ``{method: {setting: value}}`` passed to :func:`create_identifier`.
+    actuator : {"hydraulic", "ideal"}, optional
+        Override ``[hydraulics] mode``.
+
+    Returns
+    -------
+    list of dict
+        One row per method, with the columns of :func:`stewartid.studies.results.columns`.
+    """
+    from stewartid.identification.registry import create_identifier
+    from stewartid.simulation import simulate_experiments
+    from stewartid.simulation.sensors import reference_noise
+
+    point = task.parameters
+    common = {"task": task.key, **point, "seed": int(task.seed), "worker": _worker_address()}
+    start = time.perf_counter()
+    try:
+        run = simulate_experiments(
+            platform, coulomb=point["coulomb"], viscous=point["viscous"],
+            frequency_hz=point["frequency"], duration_s=point["duration"],
+            noise=reference_noise(platform, point["noise_scale"]), seed=int(task.seed),
+            actuator=actuator)
+    except StewartidError as exc:
+        elapsed = time.perf_counter() - start
+        return [{**common, "method": method, **_failed(f"simulation: {exc}"),
+                 "simulation_time_s": elapsed} for method in methods]
+    simulation_time = time.perf_counter() - start
+    nominal_M = np.asarray(run.meta["nominal"]["M"], dtype=float)
+    nominal_B = np.asarray(run.meta["nominal"]["B"], dtype=float)
+    plant = platform.replace(friction__coulomb=point["coulomb"],
+                             friction__gimbal_viscous=point["viscous"])
+    rows = []
+    for method in methods:
+        settings = dict((method_settings or {}).get(method, {}))
+        start = time.perf_counter()
+        try:
+            estimator = create_identifier(method, **settings).fit(run.datasets, plant)
+        except StewartidError as exc:
+            row = _failed(f"{method}: {exc}")
+        else:
+            row = {**error_columns(np.asarray(estimator.M_), np.asarray(estimator.B_),
+                                   nominal_M, nominal_B), "failure": None}
+        row["run_time_s"] = time.perf_counter() - start
+        rows.append({**common, "method": method, **row, "simulation_time_s": simulation_time})
+    return rows
+
+
+__all__ = ["error_columns", "run_task"]
