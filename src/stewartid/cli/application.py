@@ -3,22 +3,54 @@ commands (one module per command in :mod:`stewartid.cli`; heavy imports happen i
 
 Error policy: a :class:`~stewartid.errors.StewartidError` (bad input, failed numerics) or an
 OSError (a user's file cannot be read or written) becomes one line ``error: ...`` on stderr
-and exit code 2. Anything else is a bug and propagates with its traceback. ``--debug`` shows
-the traceback of the expected errors too.
+and exit code 2, and so does a usage error (a mistyped option or option value). Anything else
+is a bug and propagates with its traceback. ``--debug`` shows the traceback of the expected
+errors too. Warnings are printed as one line ``warning: ...`` each, without source lines.
 """
 
 from __future__ import annotations
 
 import functools
+import sys
+import warnings
 from collections.abc import Callable
 from contextvars import ContextVar
 from typing import Annotated, Any
 
+import click
 import typer
+from typer.core import TyperGroup
 
 from stewartid.errors import StewartidError
 
+
+class OneLineUsageErrors(TyperGroup):
+    """The command group, with usage errors (an unknown option, a value that does not parse)
+    as one line ``error: ...`` and exit code 2 instead of a usage box."""
+
+    def main(self, *args: Any, standalone_mode: bool = True, **kwargs: Any) -> Any:
+        if not standalone_mode:
+            return super().main(*args, standalone_mode=False, **kwargs)
+        try:
+            code = super().main(*args, standalone_mode=False, **kwargs)
+        except click.exceptions.NoArgsIsHelpError as exc:
+            exc.show()
+            sys.exit(exc.exit_code)
+        except click.UsageError as exc:
+            path = exc.ctx.command_path if exc.ctx is not None else "stewartid"
+            click.echo(f"error: {exc.format_message()} See '{path} --help'.", err=True)
+            sys.exit(2)
+        except click.ClickException as exc:
+            click.echo(f"error: {exc.format_message()}", err=True)
+            sys.exit(exc.exit_code)
+        except click.exceptions.Abort:
+            click.echo("Aborted.", err=True)
+            sys.exit(1)
+        sys.exit(code if isinstance(code, int) else 0)
+
+
 app = typer.Typer(
+    cls=OneLineUsageErrors,
     name="stewartid",
     help="Dynamic parameter identification of Stewart platforms (Zhang 2020, wavelet method).",
     no_args_is_help=True,
@@ -51,6 +83,11 @@ def fail(message: str) -> None:
     raise typer.Exit(code=2)
 
 
+def _show_warning(message: Warning | str, category: type[Warning], *args: Any,
+                  **kwargs: Any) -> None:
+    typer.echo(f"warning: {message}", err=True)
+
+
 def clean_errors(command: Callable[..., Any]) -> Callable[..., Any]:
     """Decorator: StewartidError and OSError become one error line and exit code 2 (unless
     ``--debug``); every other exception propagates."""
@@ -58,7 +95,10 @@ def clean_errors(command: Callable[..., Any]) -> Callable[..., Any]:
     @functools.wraps(command)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
-            return command(*args, **kwargs)
+            with warnings.catch_warnings():
+                warnings.simplefilter("default")
+                warnings.showwarning = _show_warning
+                return command(*args, **kwargs)
         except StewartidError as exc:
             if _debugging():
                 raise

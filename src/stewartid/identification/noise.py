@@ -13,7 +13,11 @@ from __future__ import annotations
 import numpy as np
 
 from stewartid.platform import Platform
-from stewartid.signals.differentiation import DEFAULT_ORDER, window_samples
+from stewartid.signals.differentiation import (
+    DEFAULT_ORDER,
+    savgol_coefficients,
+    window_samples,
+)
 
 
 def position_noise_covariance(q: np.ndarray, smooth: np.ndarray | None = None) -> np.ndarray:
@@ -68,10 +72,8 @@ def joint_rate_noise(covariance: np.ndarray, sample_rate: float, window: float,
     ndarray, shape (36,)
         Columns as :data:`~stewartid.identification.intervals.JOINT_RATE_NAMES`.
     """
-    from scipy.signal import savgol_coeffs
-
     n = window_samples(window, sample_rate, DEFAULT_ORDER)
-    gain = np.linalg.norm(savgol_coeffs(n, DEFAULT_ORDER, deriv=1, delta=1.0 / sample_rate))
+    gain = np.linalg.norm(savgol_coefficients(n, DEFAULT_ORDER, 1, 1.0 / sample_rate))
     jac = np.concatenate([joint_jacobians.mean(axis=0).reshape(30, 6),
                           leg_jacobian.mean(axis=0)], axis=0)
     variance = np.einsum("ij,jk,ik->i", jac, covariance, jac)

@@ -19,8 +19,10 @@ are noisier, so identifiers drop them (:func:`trim`).
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable, Sequence
+
 import numpy as np
-from scipy.signal import savgol_filter
 
 from stewartid.errors import ConfigError, DataError
 
@@ -79,23 +81,113 @@ def differentiate(x: np.ndarray, sample_rate: float, window: float,
         raise DataError(f"record of {len(x)} samples is shorter than the differentiation "
                         f"window ({n} samples = {window:.3g} s); record longer or shorten "
                         "the window.")
-    from scipy.signal import oaconvolve, savgol_coeffs
-
     delta = 1.0 / sample_rate
     half = n // 2
+    taps = [savgol_coefficients(n, order, deriv, delta) for deriv in (0, 1, 2)]
+    # the interior by FFT convolution (one transform of x for the three filters), the two
+    # edge half-windows by the end polynomials (scipy's savgol_filter(mode="interp"))
+    # the mean is filtered apart (a constant's response is its value times the taps' sum):
+    # the FFT's round-off then scales with the motion, not with the absolute position
+    offset = x.mean(axis=0)
+    interior = convolve_valid(x - offset, taps)
     out = []
-    for deriv in (0, 1, 2):
-        # interior by FFT convolution (long windows), the two edge half-windows by the end
-        # polynomials of scipy's savgol_filter(mode="interp")
-        taps = savgol_coeffs(n, order, deriv=deriv, delta=delta, use="conv")
-        taps = taps.reshape((n,) + (1,) * (x.ndim - 1))
-        y = oaconvolve(x, taps, mode="same", axes=0)
-        head = savgol_filter(x[:n], n, order, deriv=deriv, delta=delta, axis=0, mode="interp")
-        tail = savgol_filter(x[-n:], n, order, deriv=deriv, delta=delta, axis=0, mode="interp")
-        y[:half] = head[:half]
-        y[len(x) - half:] = tail[n - half:]
+    for deriv, y_interior in enumerate(interior):
+        y = np.empty_like(x)
+        y[half:len(x) - half] = y_interior + offset * np.sum(taps[deriv])
+        y[:half] = _end_polynomial(x[:n], order, deriv, delta, np.arange(half))
+        y[len(x) - half:] = _end_polynomial(x[-n:], order, deriv, delta,
+                                            np.arange(n - half, n))
         out.append(y)
     return out[0], out[1], out[2]
+
+
+def savgol_coefficients(n: int, order: int, deriv: int = 0, delta: float = 1.0) -> np.ndarray:
+    """Convolution taps of the Savitzky-Golay estimate of the ``deriv``-th derivative.
+
+    The least-squares polynomial of degree ``order`` through ``n`` (odd) samples, its
+    ``deriv``-th derivative at the centre sample: equal to ``scipy.signal.savgol_coeffs(n,
+    order, deriv, delta, use="conv")``, without importing scipy.signal (about a second).
+
+    Parameters
+    ----------
+    n : int
+        Window length (samples, odd).
+    order : int
+        Polynomial order (< n).
+    deriv : int
+        Derivative order.
+    delta : float
+        Sample period (s); the taps are in 1/s^deriv.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Taps for ``np.convolve`` (reversed in time: ``taps[::-1]`` are the dot-product
+        weights of the samples from oldest to newest).
+    """
+    offsets = np.arange(n // 2, n // 2 - n, -1, dtype=float)
+    vandermonde = offsets ** np.arange(order + 1).reshape(-1, 1)
+    target = np.zeros(order + 1)
+    target[deriv] = math.factorial(deriv) / delta ** deriv
+    return np.linalg.lstsq(vandermonde, target, rcond=None)[0]
+
+
+def _end_polynomial(segment: np.ndarray, order: int, deriv: int, delta: float,
+                    positions: np.ndarray) -> np.ndarray:
+    """The ``deriv``-th derivative of the polynomial fitted to ``segment`` (n, ...) by least
+    squares, at the sample ``positions`` (k,) of the segment; shape (k, ...)."""
+    flat = segment.reshape(len(segment), -1)
+    coefficients = np.polyfit(np.arange(len(segment)), flat, order)
+    for k in range(deriv):
+        coefficients = coefficients[:-1] * np.arange(order - k, 0, -1)[:, None]
+    values = np.polyval(coefficients, positions.reshape(-1, 1)) / delta ** deriv
+    return values.reshape((len(positions),) + segment.shape[1:])
+
+
+def convolve_valid(x: np.ndarray, kernels: Sequence[np.ndarray],
+                   block_bytes: int = 1 << 26) -> list[np.ndarray]:
+    """Convolve the columns of ``x`` with each kernel along axis 0, "valid" part only.
+
+    Overlap-save FFT convolution: one forward transform of ``x`` serves every kernel, and
+    ``x`` is processed in blocks of about ``block_bytes`` so that the scratch memory stays
+    bounded for records of any length.
+
+    Parameters
+    ----------
+    x : ndarray, shape (N, ...)
+        Time on axis 0.
+    kernels : sequence of ndarray, each of shape (L,)
+        Same odd or even length L <= N.
+    block_bytes : int
+        Approximate size of the blocks of ``x`` transformed at once.
+
+    Returns
+    -------
+    list of ndarray, each of shape (N - L + 1, ...)
+        ``y[j] = sum_k kernel[k] x[j + L - 1 - k]``, as ``np.convolve(..., mode="valid")``.
+    """
+    x = np.asarray(x, dtype=float)
+    length = len(kernels[0])
+    tail = x.shape[1:]
+    flat = x.reshape(len(x), -1)
+    n_out = len(x) - length + 1
+    nfft = max(1024, 1 << int(math.ceil(math.log2(8 * length))))
+    step = nfft - length + 1
+    spectra = [np.fft.rfft(k, nfft)[:, None] for k in kernels]
+    outputs = [np.empty((n_out, flat.shape[1])) for _ in kernels]
+    per_group = max(1, block_bytes // (8 * nfft * max(flat.shape[1], 1)))
+    for start in range(0, n_out, per_group * step):
+        stop = min(n_out, start + per_group * step)
+        blocks = -(-(stop - start) // step)
+        segment = flat[start:stop + length - 1]
+        padded = np.zeros(((blocks - 1) * step + nfft, flat.shape[1]))
+        padded[:len(segment)] = segment
+        windows = np.lib.stride_tricks.sliding_window_view(padded, nfft, axis=0)[::step]
+        transformed = np.fft.rfft(windows, axis=-1)  # (blocks, columns, nfft // 2 + 1)
+        for spectrum, out in zip(spectra, outputs, strict=True):
+            y = np.fft.irfft(transformed * spectrum.T[None], nfft, axis=-1)[..., length - 1:]
+            out[start:stop] = y.transpose(0, 2, 1).reshape(-1, flat.shape[1])[:stop - start]
+    return [out.reshape((n_out,) + tail) for out in outputs]
 
 
 def savgol_gain(frequency_hz: float, sample_rate: float, window: float,
@@ -106,10 +198,8 @@ def savgol_gain(frequency_hz: float, sample_rate: float, window: float,
     gain * d^k/dt^k sin(w t) (no phase error); dividing harmonic coefficients by this gain
     removes the filter's amplitude bias at that frequency.
     """
-    from scipy.signal import savgol_coeffs
-
     n = window_samples(window, sample_rate, order)
-    coefficients = savgol_coeffs(n, order, deriv=deriv, delta=1.0 / sample_rate, use="dot")
+    coefficients = savgol_coefficients(n, order, deriv, 1.0 / sample_rate)[::-1]
     w = 2 * np.pi * frequency_hz
     offsets = (np.arange(n) - n // 2) / sample_rate
     response = np.sum(coefficients * np.exp(1j * w * offsets))
@@ -151,8 +241,6 @@ def kernel_filter(x: np.ndarray, sample_rate: float, window: float, derivatives:
         [x * h, (x * h'), (x * h'')], aligned with the samples L//2 ... N - 1 - L//2 of x
         (L = kernel samples, odd).
     """
-    from scipy.signal import oaconvolve
-
     x = np.asarray(x, dtype=float)
     n = window_samples(window, sample_rate, 2 * exponent)
     if n > len(x):
@@ -168,9 +256,11 @@ def kernel_filter(x: np.ndarray, sample_rate: float, window: float, derivatives:
                (p * (p - 1) * base ** (p - 2) * (2 * u / half) ** 2
                 + p * base ** (p - 1) * (-2 / half ** 2))]
     norm = np.sum(kernels[0]) / sample_rate
-    shape = (n,) + (1,) * (x.ndim - 1)
-    return [oaconvolve(x, (k / norm / sample_rate).reshape(shape), mode="valid", axes=0)
-            for k in kernels[:derivatives + 1]]
+    # the mean filtered apart, as in differentiate
+    offset = x.mean(axis=0)
+    taps = [k / norm / sample_rate for k in kernels[:derivatives + 1]]
+    return [y + offset * np.sum(k)
+            for y, k in zip(convolve_valid(x - offset, taps), taps, strict=True)]
 
 
 def trim(window: float, sample_rate: float, order: int = DEFAULT_ORDER) -> int:
@@ -218,8 +308,6 @@ def estimate_frequency(x: np.ndarray, sample_rate: float) -> float:
 
 
 def _refine_frequency(x: np.ndarray, sample_rate: float, frequency: float) -> float:
-    from scipy.optimize import minimize_scalar
-
     t = np.arange(len(x)) / sample_rate
     design_constant = np.ones_like(t)
 
@@ -230,11 +318,89 @@ def _refine_frequency(x: np.ndarray, sample_rate: float, frequency: float) -> fl
         return float(np.sum((x - A @ coef) ** 2))
 
     bin_width = sample_rate / len(x)
-    result = minimize_scalar(cost, bounds=(max(frequency - bin_width, 1e-6 * frequency),
-                                           frequency + bin_width),
-                             method="bounded", options={"xatol": 1e-9 * frequency})
-    return float(result.x)
+    return minimize_bounded(cost, max(frequency - bin_width, 1e-6 * frequency),
+                            frequency + bin_width, 1e-9 * frequency)
 
 
-__all__ = ["DEFAULT_ORDER", "DEFAULT_WINDOW_PERIODS", "default_window", "differentiate",
-           "estimate_frequency", "kernel_filter", "savgol_gain", "trim", "window_samples"]
+def minimize_bounded(cost: Callable[[float], float], lower: float, upper: float,
+                     tolerance: float, max_evaluations: int = 500) -> float:
+    """Minimiser of a scalar function on [lower, upper] by Brent's bounded method.
+
+    Golden-section steps safeguarded by parabolic interpolation (Forsythe, Malcolm & Moler,
+    *Computer Methods for Mathematical Computations*, 1977, procedure ``fmin``), step for
+    step as ``scipy.optimize.minimize_scalar(method="bounded")``, whose import would cost
+    more than the search itself.
+
+    Parameters
+    ----------
+    cost : callable
+        f(x) -> float.
+    lower, upper : float
+        Bounds, lower <= upper.
+    tolerance : float
+        Absolute tolerance on x.
+    max_evaluations : int
+        Largest number of evaluations of ``cost``.
+
+    Returns
+    -------
+    float
+        The best x found.
+    """
+    sqrt_eps = math.sqrt(2.2e-16)
+    golden = 0.5 * (3.0 - math.sqrt(5.0))
+    a, b = lower, upper
+    v = w = x = a + golden * (b - a)  # v, w: the previous two best points; x: the best
+    fv = fw = fx = cost(x)
+    d = e = 0.0  # the last step and the one before it
+    evaluations = 1
+    middle = 0.5 * (a + b)
+    tol1 = sqrt_eps * abs(x) + tolerance / 3.0
+    while abs(x - middle) > 2.0 * tol1 - 0.5 * (b - a):
+        parabolic = False
+        if abs(e) > tol1:
+            r = (x - w) * (fx - fv)
+            q = (x - v) * (fx - fw)
+            p = (x - v) * q - (x - w) * r
+            q = 2.0 * (q - r)
+            if q > 0.0:
+                p = -p
+            q = abs(q)
+            r, e = e, d
+            if abs(p) < abs(0.5 * q * r) and q * (a - x) < p < q * (b - x):
+                parabolic = True
+                d = p / q
+                u = x + d
+                if u - a < 2.0 * tol1 or b - u < 2.0 * tol1:
+                    d = tol1 * (1.0 if middle >= x else -1.0)
+        if not parabolic:
+            e = (a - x) if x >= middle else (b - x)
+            d = golden * e
+        u = x + (1.0 if d >= 0 else -1.0) * max(abs(d), tol1)
+        fu = cost(u)
+        evaluations += 1
+        if fu <= fx:
+            if u >= x:
+                a = x
+            else:
+                b = x
+            v, fv, w, fw, x, fx = w, fw, x, fx, u, fu
+        else:
+            if u < x:
+                a = u
+            else:
+                b = u
+            if fu <= fw or w == x:
+                v, fv, w, fw = w, fw, u, fu
+            elif fu <= fv or v == x or v == w:
+                v, fv = u, fu
+        middle = 0.5 * (a + b)
+        tol1 = sqrt_eps * abs(x) + tolerance / 3.0
+        if evaluations >= max_evaluations:
+            break
+    return float(x)
+
+
+__all__ = ["DEFAULT_ORDER", "DEFAULT_WINDOW_PERIODS", "convolve_valid", "default_window",
+           "differentiate", "estimate_frequency", "kernel_filter", "minimize_bounded",
+           "savgol_coefficients", "savgol_gain", "trim", "window_samples"]
