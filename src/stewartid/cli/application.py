@@ -17,11 +17,15 @@ from collections.abc import Callable
 from contextvars import ContextVar
 from typing import Annotated, Any
 
-import click
 import typer
 from typer.core import TyperGroup
 
 from stewartid.errors import StewartidError
+
+try:  # typer >= 0.20 carries its own copy of click
+    from typer._click import exceptions as _usage
+except ImportError:  # pragma: no cover - older typer on click
+    from click import exceptions as _usage
 
 
 class OneLineUsageErrors(TyperGroup):
@@ -33,18 +37,18 @@ class OneLineUsageErrors(TyperGroup):
             return super().main(*args, standalone_mode=False, **kwargs)
         try:
             code = super().main(*args, standalone_mode=False, **kwargs)
-        except click.exceptions.NoArgsIsHelpError as exc:
-            exc.show()
-            sys.exit(exc.exit_code)
-        except click.UsageError as exc:
+        except _usage.UsageError as exc:
+            if isinstance(exc, getattr(_usage, "NoArgsIsHelpError", ())):
+                exc.show()
+                sys.exit(0)
             path = exc.ctx.command_path if exc.ctx is not None else "stewartid"
-            click.echo(f"error: {exc.format_message()} See '{path} --help'.", err=True)
+            typer.echo(f"error: {exc.format_message()} See '{path} --help'.", err=True)
             sys.exit(2)
-        except click.ClickException as exc:
-            click.echo(f"error: {exc.format_message()}", err=True)
+        except _usage.ClickException as exc:
+            typer.echo(f"error: {exc.format_message()}", err=True)
             sys.exit(exc.exit_code)
-        except click.exceptions.Abort:
-            click.echo("Aborted.", err=True)
+        except typer.Abort:
+            typer.echo("Aborted.", err=True)
             sys.exit(1)
         sys.exit(code if isinstance(code, int) else 0)
 

@@ -37,6 +37,12 @@ class IdentificationResult:
         Every setting of the identifier.
     diagnostics : dict
         Method-specific: intervals, (a, b) points, frequencies, Coulomb levels, ...
+    validation : dict, optional
+        Held-out prediction scores, ``{"vaf_percent": [6], "nrmse": [6], "folds": N}``
+        (:mod:`stewartid.reporting.validation`); None when not validated.
+
+    ``to_dict`` also writes ``consistency``, the symmetry and definiteness of M and B
+    (:func:`~stewartid.identification.consistency.consistency_metrics`).
     """
 
     M: np.ndarray
@@ -48,17 +54,24 @@ class IdentificationResult:
     method: str
     settings: dict[str, Any] = field(default_factory=dict)
     diagnostics: dict[str, Any] = field(default_factory=dict)
+    validation: dict[str, Any] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict; ``M`` and ``B`` at the top level; non-finite numbers are None
         (see :mod:`stewartid.io`)."""
-        return to_jsonable({
+        from stewartid.identification.consistency import consistency_metrics
+
+        document = {
             "M": self.M, "B": self.B,
             "std_errors_M": self.std_errors_M, "std_errors_B": self.std_errors_B,
             "condition_number": float(self.condition_number),
             "residual_rms": self.residual_rms,
             "method": self.method, "settings": self.settings, "diagnostics": self.diagnostics,
-        })
+            "consistency": consistency_metrics(self.M, self.B),
+        }
+        if self.validation is not None:
+            document["validation"] = self.validation
+        return to_jsonable(document)
 
     def to_json(self, path: str | Path) -> Path:
         """Write the result as JSON, atomically; returns the path."""
@@ -81,7 +94,8 @@ class IdentificationResult:
                    residual_rms=array("residual_rms", (6,)),
                    method=str(document.get("method", "unknown")),
                    settings=dict(document.get("settings", {})),
-                   diagnostics=dict(document.get("diagnostics", {})))
+                   diagnostics=dict(document.get("diagnostics", {})),
+                   validation=document.get("validation"))
 
     @classmethod
     def from_json(cls, path: str | Path) -> IdentificationResult:

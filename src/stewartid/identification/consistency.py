@@ -1,0 +1,212 @@
+"""Physical consistency of identified Mt and Bt, and the nearest consistent pair.
+
+Physics: Mt is the inertia matrix of the linearised platform, symmetric positive definite
+(kinetic energy q_dot^T Mt q_dot / 2 > 0 for every motion); Bt comes from viscous joint
+friction, symmetric positive semidefinite (dissipated power q_dot^T Bt q_dot >= 0). An
+unconstrained least-squares estimate need not be either: noise, friction the method does not
+model, or weakly excited directions leave asymmetric parts and, at worst, negative
+eigenvalues that make a model-based controller or simulator unstable.
+
+:func:`consistency_metrics` measures both (the ``consistency`` object of ``result.json``);
+:func:`project_consistent` solves the constrained problem
+
+    minimise   sum_ij ((M_ij - M^_ij) / s^M_ij)^2 + sum_ij ((B_ij - B^_ij) / s^B_ij)^2
+    subject to M = M^T,  M - delta I positive semidefinite,  B = B^T positive semidefinite,
+
+with M^, B^ the unconstrained estimate and s its standard errors: the projection of the
+estimate onto the consistent set in the metric of its own uncertainty (the Mahalanobis
+distance with the estimate's covariance taken diagonal). Compared with imposing the
+constraints inside each method's regression, it works the same way for every method, needs
+only the result (matrices and standard errors), keeps the method's own treatment of friction
+and noise, and moves well-determined entries little and poorly determined ones more. The
+diagonal weighting is what the result files carry; the cross-covariances between entries of
+one equation are not kept by every method. For a symmetric pair the solution without active
+eigenvalue constraints is the inverse-variance weighted mean of the two entries, i.e. what a
+symmetric fit of the same data would give. ``delta`` (a millionth of the mean diagonal of
+|M^|) makes the inequality on Mt strict without affecting any estimate that is already
+positive definite.
+
+The problem is a small semidefinite program (two 6x6 matrix variables) solved with cvxpy
+(Clarabel, else SCS), an optional dependency: ``pip install "stewartid[convex]"``.
+
+References
+----------
+Traversaro, S., Brossette, S., Escande, A., Nori, F. "Identification of fully physical
+consistent inertial parameters using optimization on manifolds." IROS 2016, 5446-5451;
+arXiv:1610.08703 (why estimates must be projected onto the physically consistent set).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from stewartid.errors import ConfigError, IdentificationError
+
+#: Floor of the smallest eigenvalue of Mt, relative to the mean of |diag(M^)|.
+STRICT_FRACTION = 1e-6
+
+
+def asymmetry(matrix: np.ndarray) -> float:
+    """Relative Frobenius norm of the antisymmetric part, ||(A - A^T) / 2|| / ||A|| (0 for a
+    symmetric matrix, 1 for an antisymmetric one; NaN for a zero matrix)."""
+    matrix = np.asarray(matrix, dtype=float)
+    norm = np.linalg.norm(matrix)
+    return float(np.linalg.norm(matrix - matrix.T) / 2 / norm) if norm > 0 else float("nan")
+
+
+def min_eigenvalue(matrix: np.ndarray) -> float:
+    """Smallest eigenvalue of the symmetric part (A + A^T) / 2 (the one the quadratic forms
+    q_dot^T A q_dot see), in the matrix's units; NaN if an entry is not finite."""
+    matrix = np.asarray(matrix, dtype=float)
+    if not np.all(np.isfinite(matrix)):
+        return float("nan")
+    return float(np.linalg.eigvalsh((matrix + matrix.T) / 2)[0])
+
+
+def consistency_metrics(M: np.ndarray, B: np.ndarray) -> dict[str, float]:
+    """The ``consistency`` object of ``result.json``.
+
+    Parameters
+    ----------
+    M, B : ndarray, shape (6, 6)
+        Inertial (kg, kg m, kg m^2) and viscous (N s/m, N s, N m s) matrices.
+
+    Returns
+    -------
+    dict
+        ``M_min_eigenvalue``, ``B_min_eigenvalue`` (of the symmetric parts) and
+        ``M_asymmetry``, ``B_asymmetry`` (:func:`asymmetry`).
+    """
+    return {"M_min_eigenvalue": min_eigenvalue(M), "B_min_eigenvalue": min_eigenvalue(B),
+            "M_asymmetry": asymmetry(M), "B_asymmetry": asymmetry(B)}
+
+
+def is_consistent(M: np.ndarray, B: np.ndarray, tolerance: float = 1e-9) -> bool:
+    """True if M is symmetric positive definite and B symmetric positive semidefinite, up to
+    ``tolerance`` relative to each matrix's largest entry."""
+    metrics = consistency_metrics(M, B)
+    scale_M, scale_B = np.abs(M).max(), max(np.abs(B).max(), 1e-300)
+    return bool(metrics["M_asymmetry"] <= tolerance and metrics["B_asymmetry"] <= tolerance
+                and metrics["M_min_eigenvalue"] > 0
+                and metrics["B_min_eigenvalue"] >= -tolerance * scale_B
+                and scale_M > 0)
+
+
+@dataclass(frozen=True)
+class ConsistentEstimate:
+    """The nearest physically consistent pair to an estimate.
+
+    Attributes
+    ----------
+    M, B : ndarray, shape (6, 6)
+        Symmetric, M positive definite, B positive semidefinite.
+    change_M, change_B : ndarray, shape (6, 6)
+        |consistent - unconstrained| in standard errors of the unconstrained estimate.
+    solver : str
+    objective : float
+        The weighted squared distance minimised (sum of squared changes in standard errors).
+    """
+
+    M: np.ndarray
+    B: np.ndarray
+    change_M: np.ndarray
+    change_B: np.ndarray
+    solver: str
+    objective: float
+
+    @property
+    def max_change(self) -> float:
+        """Largest change of any entry, in standard errors."""
+        return float(max(self.change_M.max(), self.change_B.max()))
+
+    def to_dict(self) -> dict[str, Any]:
+        """Summary for ``result.json`` (diagnostics)."""
+        return {"solver": self.solver, "objective": self.objective,
+                "max_change_std_errors": self.max_change,
+                "change_M_std_errors": self.change_M, "change_B_std_errors": self.change_B}
+
+
+def _weights(std: np.ndarray, estimate: np.ndarray) -> np.ndarray:
+    """1 / standard error, with unusable errors (0, NaN) replaced by the matrix's median
+    error (or a tiny fraction of its scale) so that no entry is free or infinitely stiff."""
+    std = np.asarray(std, dtype=float)
+    usable = np.isfinite(std) & (std > 0)
+    scale = float(np.abs(estimate).max()) or 1.0
+    fallback = float(np.median(std[usable])) if usable.any() else 1e-6 * scale
+    return 1.0 / np.where(usable, np.maximum(std, 1e-9 * scale), fallback)
+
+
+def project_consistent(M: np.ndarray, B: np.ndarray, std_M: np.ndarray, std_B: np.ndarray,
+                       solver: str | None = None) -> ConsistentEstimate:
+    """The consistent (M, B) nearest to an estimate, in standard errors (module docstring).
+
+    Parameters
+    ----------
+    M, B : ndarray, shape (6, 6)
+        Unconstrained estimate.
+    std_M, std_B : ndarray, shape (6, 6)
+        Its standard errors (same units).
+    solver : str, optional
+        A cvxpy solver name; Clarabel when installed, else SCS.
+
+    Returns
+    -------
+    ConsistentEstimate
+
+    Raises
+    ------
+    ConfigError
+        If cvxpy is not installed (the message names the extra to install).
+    IdentificationError
+        If the solver fails.
+    """
+    try:
+        import cvxpy as cp
+    except ImportError:
+        raise ConfigError('the consistent fit needs cvxpy; install the extra with pip install '
+                          '"stewartid[convex]".') from None
+    M_hat, B_hat = np.asarray(M, dtype=float), np.asarray(B, dtype=float)
+    W_M, W_B = _weights(std_M, M_hat), _weights(std_B, B_hat)
+    floor = STRICT_FRACTION * float(np.mean(np.abs(np.diag(M_hat))))
+    M_var = cp.Variable((6, 6), symmetric=True)
+    B_var = cp.Variable((6, 6), symmetric=True)
+    # in standard errors the problem is unit-free, which keeps the solver's tolerances meaningful
+    objective = cp.Minimize(cp.sum_squares(cp.multiply(W_M, M_var - M_hat))
+                            + cp.sum_squares(cp.multiply(W_B, B_var - B_hat)))
+    constraints = [M_var - floor * np.eye(6) >> 0, B_var >> 0]
+    problem = cp.Problem(objective, constraints)
+    if solver is None:
+        solver = "CLARABEL" if "CLARABEL" in cp.installed_solvers() else "SCS"
+    try:
+        problem.solve(solver=solver)
+    except cp.error.SolverError as exc:
+        raise IdentificationError(f"the consistent fit failed in solver {solver}: {exc}; "
+                                  "try another solver.") from None
+    if problem.status not in ("optimal", "optimal_inaccurate") or M_var.value is None:
+        raise IdentificationError(f"the consistent fit did not converge (solver {solver}, "
+                                  f"status {problem.status}); check the standard errors.")
+    # exact symmetry and definiteness after the solver's tolerances
+    M_new, B_new = _symmetric(M_var.value), _clip_psd(_symmetric(B_var.value), 0.0)
+    M_new = _clip_psd(M_new, floor)
+    return ConsistentEstimate(M=M_new, B=B_new, change_M=np.abs(M_new - M_hat) * W_M,
+                              change_B=np.abs(B_new - B_hat) * W_B, solver=solver,
+                              objective=float(problem.value))
+
+
+def _symmetric(matrix: np.ndarray) -> np.ndarray:
+    return (matrix + matrix.T) / 2
+
+
+def _clip_psd(matrix: np.ndarray, floor: float) -> np.ndarray:
+    """Raise eigenvalues below ``floor`` to it (removes the solver's last tolerance)."""
+    values, vectors = np.linalg.eigh(matrix)
+    if values[0] >= floor:
+        return matrix
+    return _symmetric((vectors * np.maximum(values, floor)) @ vectors.T)
+
+
+__all__ = ["STRICT_FRACTION", "ConsistentEstimate", "asymmetry", "consistency_metrics",
+           "is_consistent", "min_eigenvalue", "project_consistent"]
