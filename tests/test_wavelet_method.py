@@ -117,6 +117,15 @@ def test_symmetric_solve_and_pair_selection(paper, linear_data):
     std = np.array([[0.1, 0.5], [0.2, 0.1]])
     choice = select_symmetric_pairs(matrix, std)
     assert matrix[0, 1] == matrix[1, 0] == 3.0 and choice[0]["kept"] == [2, 1]
+    # a significant disagreement: the translational row wins whatever the standard errors,
+    # and the kept standard error covers the difference
+    matrix = np.zeros((6, 6))
+    std = np.full((6, 6), 1.0)
+    matrix[0, 4], matrix[4, 0], std[0, 4], std[4, 0] = 100.0, 70.0, 2.0, 1.0
+    choice = select_symmetric_pairs(matrix, std)
+    pair = next(c for c in choice if c["pair"] == [[1, 5], [5, 1]])
+    assert pair["kept"] == [1, 5] and matrix[4, 0] == 100.0
+    assert std[0, 4] == std[4, 0] == pytest.approx(30.0 / 3.0)
 
 
 @pytest.mark.slow

@@ -42,7 +42,11 @@ class OneLineUsageErrors(TyperGroup):
                 exc.show()
                 sys.exit(0)
             path = exc.ctx.command_path if exc.ctx is not None else "stewartid"
-            typer.echo(f"error: {exc.format_message()} See '{path} --help'.", err=True)
+            message = exc.format_message().rstrip(".") + "."
+            parameter = getattr(exc, "param", None)
+            if getattr(parameter, "help", None) and getattr(parameter, "opts", None):
+                message += f" {parameter.opts[0]}: {parameter.help.rstrip('.')}."
+            typer.echo(f"error: {message} See '{path} --help'.", err=True)
             sys.exit(2)
         except _usage.ClickException as exc:
             typer.echo(f"error: {exc.format_message()}", err=True)
