@@ -85,12 +85,22 @@ def test_time_not_increasing(tmp_path, dataset):
         read_dataset(_write(tmp_path, frame))
 
 
-def test_non_uniform_time_is_resampled_with_a_warning(tmp_path, dataset):
+def test_jittery_time_stamps_are_timing_noise_on_a_uniform_clock(tmp_path, dataset):
     frame = dataset.to_frame()
     frame["t"] = frame["t"] + 0.002 * np.sin(np.arange(len(frame)))
+    with pytest.warns(DataWarning, match="jitter by up to 2.01 ms around a uniform 200 Hz clock"):
+        back = read_dataset(_write(tmp_path, frame))
+    assert back.t == pytest.approx(dataset.t, abs=1e-4)
+    assert np.array_equal(back.pose, dataset.pose) and np.array_equal(back.forces,
+                                                                      dataset.forces)
+
+
+def test_skipped_samples_are_resampled_with_a_warning(tmp_path, dataset):
+    frame = dataset.to_frame().drop(index=range(100, 103))
     with pytest.warns(DataWarning, match="not uniform .* resampled"):
         back = read_dataset(_write(tmp_path, frame))
-    assert np.allclose(np.diff(back.t), np.diff(back.t)[0])
+    assert np.allclose(np.diff(back.t), 0.005)
+    assert back.pose[101, 0] == pytest.approx(dataset.pose[101, 0], abs=1e-4)
 
 
 def test_too_few_samples(tmp_path, dataset):

@@ -10,10 +10,16 @@ the leg lengths may be missing: forward or inverse kinematics fill them in from 
 description. Several files are several experiments.
 
 Validation happens here, at the boundary, so that identification code can trust its input:
-required columns, finite values, strictly increasing time, a uniform sample period, and at
-least :data:`MIN_SAMPLES` samples. A non-uniform time base is resampled onto a uniform grid
-(linear interpolation at the median sample period) with a :class:`DataWarning`, because
-every identification method here assumes a fixed sample period.
+required columns, finite values, strictly increasing time, a uniform sample period, at least
+:data:`MIN_SAMPLES` samples, and a sample rate in :data:`SAMPLE_RATE_RANGE_HZ` (a time column
+in ms or µs read as seconds falls outside). Every identification method here assumes a fixed
+sample period: time stamps that jitter around a uniform sample clock (every sample within
+half a period of its slot, none skipped) are timing noise of the logger and are replaced by
+the least-squares uniform clock; any other non-uniform time base is resampled onto a uniform
+grid (linear interpolation at the median sample period). Both with a :class:`DataWarning`.
+With a platform description, the data are checked against it (:mod:`stewartid.checks`).
+Logs in other layouts or units are read through a :class:`~stewartid.logformat.LogFormat`
+(``docs/logs.md``).
 """
 
 from __future__ import annotations
@@ -29,6 +35,7 @@ import pandas as pd
 
 from stewartid.errors import DataError, KinematicsError
 from stewartid.io import write_bytes_atomic, write_text_atomic
+from stewartid.logformat import LogFormat, read_table
 from stewartid.platform import COORDINATES, Platform
 
 #: All columns of the interchange format, in order.
@@ -44,6 +51,9 @@ MIN_SAMPLES = 64
 #: Largest relative deviation of a sample period from the median before the time base counts
 #: as non-uniform (tolerates the rounding of t in text files written with enough digits).
 UNIFORM_TOLERANCE = 1e-3
+
+#: Plausible sample rates of a hexapod log (Hz); outside, the time column is in another unit.
+SAMPLE_RATE_RANGE_HZ = (10.0, 1e6)
 
 SUFFIXES = {".csv": "csv", ".parquet": "parquet", ".pq": "parquet"}
 
@@ -133,7 +143,32 @@ def _check_time(t: np.ndarray, where: str) -> bool:
                         f"t = {t[bad]!r} after t = {t[bad - 1]!r} (sort the rows and drop "
                         "duplicate time stamps).")
     period = float(np.median(dt))
+    low, high = SAMPLE_RATE_RANGE_HZ
+    if not low <= 1.0 / period <= high:
+        units = [unit for unit, factor in (("ms", 1e-3), ("us", 1e-6))
+                 if low <= 1.0 / (period * factor) <= high]
+        fix = f"map it with --columns t=:{units[0]}" if units else "give it in seconds"
+        raise DataError(f"{where}: column 't' has a sample period of {period:.6g} s "
+                        f"({1.0 / period:.3g} Hz), implausible for a hexapod log; is it in "
+                        f"another unit? {fix}.")
     return bool(np.max(np.abs(dt - period)) <= UNIFORM_TOLERANCE * period)
+
+
+def _uniform_clock(t: np.ndarray, where: str) -> np.ndarray | None:
+    """The least-squares uniform clock t0 + T i of jittery time stamps, or None when the time
+    base is not a uniform clock with timing noise (a sample off its slot by half a period or
+    more, or a skipped slot)."""
+    index = np.arange(len(t), dtype=float)
+    index -= index.mean()
+    period = float(index @ (t - t.mean()) / (index @ index))
+    clock = t.mean() + period * index
+    deviation = np.abs(t - clock)
+    if np.max(deviation) >= 0.5 * period or np.max(np.diff(t)) >= 1.9 * period:
+        return None
+    warnings.warn(f"{where}: time stamps jitter by up to {np.max(deviation) * 1e3:.3g} ms "
+                  f"around a uniform {1.0 / period:.6g} Hz clock; read as timing noise and "
+                  "replaced by that clock.", DataWarning, stacklevel=4)
+    return clock
 
 
 def _resample(t: np.ndarray, columns: dict[str, np.ndarray], where: str
@@ -144,7 +179,7 @@ def _resample(t: np.ndarray, columns: dict[str, np.ndarray], where: str
     warnings.warn(f"{where}: time base is not uniform (sample periods from "
                   f"{np.min(np.diff(t)):.6g} s to {np.max(np.diff(t)):.6g} s); resampled "
                   f"linearly onto {n} samples at the median period {period:.6g} s.",
-                  DataWarning, stacklevel=3)
+                  DataWarning, stacklevel=4)
     return grid, {k: np.interp(grid, t, v) for k, v in columns.items()}
 
 
@@ -174,7 +209,8 @@ def dataset_from_frame(frame: pd.DataFrame, platform: Platform | None = None,
     missing = [c for c in ("t", *FORCE_COLUMNS) if c not in present]
     if missing:
         raise DataError(f"{where}: missing required column(s) {', '.join(missing)}; expected "
-                        f"columns {', '.join(COLUMNS)}.")
+                        f"columns {', '.join(COLUMNS)} (other names or units: --columns, "
+                        "docs/logs.md).")
     has_pose = all(c in present for c in POSE_COLUMNS)
     has_lengths = all(c in present for c in LENGTH_COLUMNS)
     if not (has_pose or has_lengths):
@@ -195,10 +231,21 @@ def dataset_from_frame(frame: pd.DataFrame, platform: Platform | None = None,
         columns[c] = values
     t = columns.pop("t")
     if not _check_time(t, where):
-        t, columns = _resample(t, columns, where)
+        clock = _uniform_clock(t, where)
+        if clock is None:
+            t, columns = _resample(t, columns, where)
+        else:
+            t = clock
     forces = np.column_stack([columns[c] for c in FORCE_COLUMNS])
     pose = np.column_stack([columns[c] for c in POSE_COLUMNS]) if has_pose else None
     lengths = np.column_stack([columns[c] for c in LENGTH_COLUMNS]) if has_lengths else None
+    if platform is not None:
+        from stewartid import checks
+
+        if pose is not None:
+            checks.check_pose(pose, platform, where)
+        if lengths is not None:
+            checks.check_leg_lengths(lengths, platform, where)
     if pose is None or lengths is None:
         if platform is None:
             group = "pose (x..rz)" if pose is None else "leg lengths (l1..l6)"
@@ -213,6 +260,9 @@ def dataset_from_frame(frame: pd.DataFrame, platform: Platform | None = None,
                 raise DataError(f"{where}: cannot compute the pose from l1..l6: {exc}") from exc
         else:
             lengths = leg_lengths(platform, pose)
+    if platform is not None:
+        checks.check_dataset(pose, lengths, forces, platform, where,
+                             both_logged=has_pose and has_lengths)
     return Dataset(t=t, pose=pose, lengths=lengths, forces=forces, name=name)
 
 
@@ -231,17 +281,22 @@ def _forward_kinematics_tracked(platform: Platform, lengths: np.ndarray, solve) 
 
 
 def read_dataset(path: str | Path, platform: Platform | None = None,
-                 format: str | None = None) -> Dataset:
+                 format: str | None = None, log_format: LogFormat | None = None) -> Dataset:
     """Read and validate one experiment from a CSV or Parquet file.
 
     Parameters
     ----------
     path : str or Path
-        ``.csv`` or ``.parquet`` file in the interchange format.
+        ``.csv`` or ``.parquet`` file in the interchange format, or in the layout and units
+        that ``log_format`` describes. The CSV delimiter (``,`` ``;`` tab) and decimal mark
+        are detected.
     platform : Platform, optional
-        Platform description, used when the pose or the leg lengths are missing.
+        Platform description, used when the pose or the leg lengths are missing, and to
+        check the data against it (:mod:`stewartid.checks`).
     format : {'csv', 'parquet'}, optional
         Overrides the file suffix.
+    log_format : LogFormat, optional
+        Column mapping with units (:mod:`stewartid.logformat`).
 
     Returns
     -------
@@ -257,12 +312,7 @@ def read_dataset(path: str | Path, platform: Platform | None = None,
     kind = _format_of(path, format)
     if not path.is_file():
         raise DataError(f"{path}: no such data file.")
-    try:
-        frame = pd.read_csv(path, skipinitialspace=True) if kind == "csv" else \
-            pd.read_parquet(path)
-    except (ValueError, OSError, pd.errors.ParserError) as exc:
-        raise DataError(f"{path}: cannot be read as {kind}: {exc}") from exc
-    frame.columns = [str(c).strip() for c in frame.columns]
+    frame = read_table(path, kind, log_format)
     return dataset_from_frame(frame, platform, name=path.stem, where=str(path))
 
 
@@ -281,8 +331,10 @@ def expand_paths(paths: Iterable[str | Path]) -> list[Path]:
 
 
 def read_datasets(paths: str | Path | Sequence[str | Path],
-                  platform: Platform | None = None) -> list[Dataset]:
-    """Read several experiments (one file each; a directory means all data files in it).
+                  platform: Platform | None = None,
+                  log_format: LogFormat | None = None) -> list[Dataset]:
+    """Read several experiments (one file each; a directory means all data files in it),
+    with the ``platform`` and ``log_format`` of :func:`read_dataset`.
 
     Returns
     -------
@@ -294,7 +346,7 @@ def read_datasets(paths: str | Path | Sequence[str | Path],
     files = expand_paths(paths)
     if not files:
         raise DataError("no data files given; pass one or more .csv/.parquet files.")
-    return [read_dataset(f, platform) for f in files]
+    return [read_dataset(f, platform, log_format=log_format) for f in files]
 
 
 def write_dataset(dataset: Dataset, path: str | Path, format: str | None = None) -> Path:

@@ -23,8 +23,8 @@ PHYSICAL_RANGES: dict[str, dict[str, tuple[float, float]]] = {
         "upper_radius": (0.01, 50.0),
         "lower_radius": (0.01, 50.0),
         "neutral_height": (0.01, 50.0),
-        "upper_half_angle": (0.0, math.pi / 6),
-        "lower_half_angle": (0.0, math.pi / 6),
+        "upper_half_angle": (0.0, math.pi / 2),
+        "lower_half_angle": (0.0, math.pi / 2),
         "reference_height": (0.0, 50.0),
     },
     "inertia": {
