@@ -187,9 +187,10 @@ def trend_sentences(statistics: Any, parameter: str, others: Sequence[str],
             where = f"at {_panel_title(others, values)}: " if values else ""
             parts.append(f"{where}{path} % ({_trend(medians)})")
         if parts:
-            lines.append(f"**{method_name(method)}**, {label} against {parameter} "
-                         f"({', '.join(f'{v:g}' for v in sorted(statistics[parameter].unique()))}"
-                         f" {PARAMETERS[parameter].unit}), median over the seeds: "
+            grid = ", ".join(f"{v:g}" for v in sorted(statistics[parameter].unique()))
+            unit = PARAMETERS[parameter].unit
+            lines.append(f"**{method_name(method)}**, {label} against {parameter} ({grid}"
+                         f"{'' if unit == '-' else ' ' + unit}), median over the seeds: "
                          + "; ".join(parts) + ".")
     return lines
 
