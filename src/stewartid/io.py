@@ -18,7 +18,7 @@ import json
 import math
 import os
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
@@ -117,5 +117,49 @@ def check_output_folder(directory: str | Path, force: bool,
                                 "choose another folder or pass --force to overwrite.")
 
 
-__all__ = ["check_output_folder", "to_jsonable", "write_bytes_atomic", "write_json_atomic",
-           "write_text_atomic"]
+def check_output_file(path: str | Path, force: bool, inputs: Iterable[str | Path] = (),
+                      is_result: Callable[[Path], bool] | None = None,
+                      option: str = "--out") -> None:
+    """Check, before any computation, that ``path`` can take an output file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The output file (its folder is created when written if missing).
+    force : bool
+        Overwrite an existing file that is not an earlier result. Inputs are never
+        overwritten, whatever ``force``.
+    inputs : iterable of str or Path
+        Files the command reads.
+    is_result : callable, optional
+        Which existing files are earlier results of the same command, overwritten without
+        ``force``; by default none is.
+    option : str
+        Option named in the messages.
+
+    Raises
+    ------
+    OutputExistsError
+        ``path`` is a folder, one of ``inputs``, an existing file that is not an earlier
+        result (without ``force``), or lies under a file or a folder that cannot be written.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise OutputExistsError(f"{option} {str(path)!r} is a folder; give a file name, e.g. "
+                                f"{str(path / 'result.json')!r}.")
+    target = path.resolve()
+    for source in inputs:
+        if Path(source).resolve() == target:
+            raise OutputExistsError(f"{option} {str(path)!r} is one of the input files; give "
+                                    "another file name.")
+    if path.exists() and not force and not (is_result is not None and is_result(path)):
+        raise OutputExistsError(f"{option} {str(path)!r} exists and is not an earlier result; "
+                                "give another file name or pass --force to overwrite it.")
+    folder = next(p for p in target.parents if p.exists())
+    if not folder.is_dir() or not os.access(folder, os.W_OK):
+        raise OutputExistsError(f"{option} {str(path)!r}: {str(folder)!r} is not a writable "
+                                "folder; give another file name.")
+
+
+__all__ = ["check_output_file", "check_output_folder", "to_jsonable", "write_bytes_atomic",
+           "write_json_atomic", "write_text_atomic"]

@@ -3,12 +3,65 @@
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
 from stewartid.errors import ConfigError
+
+#: Suffixes of data and description files, which a JSON result must not be named like.
+INPUT_SUFFIXES = (".csv", ".parquet", ".pq", ".toml")
+
+
+def platform_from_meta(files: list[Path]):
+    """The platform description that a ``meta.json`` beside the data names, if any.
+
+    ``stewartid simulate`` writes the whole description under ``"platform"``; a hand-written
+    ``meta.json`` may name a preset or a TOML file instead (``{"platform": "paper"}`` or
+    ``{"platform": "hexapod.toml"}``, relative to the ``meta.json``).
+
+    Returns
+    -------
+    (Platform, Path) or None
+        The description and the ``meta.json`` that names it.
+
+    Raises
+    ------
+    ConfigError
+        The data folders name different platforms, or a named description is invalid.
+    """
+    from stewartid.platform import load_platform, platform_from_mapping
+
+    found = []
+    for folder in dict.fromkeys(f.parent for f in files):
+        path = folder / "meta.json"
+        try:
+            document = json.loads(path.read_text()) if path.is_file() else {}
+        except (OSError, ValueError):
+            continue
+        named = document.get("platform") if isinstance(document, dict) else None
+        if isinstance(named, dict):
+            sections = {section: {k: v for k, v in table.items() if v is not None}
+                        for section, table in named.items() if isinstance(table, dict)}
+            name = str(document.get("platform_name", "meta"))
+            found.append((platform_from_mapping(sections, name), path))
+        elif isinstance(named, str):
+            found.append((load_platform(named if named == "paper" else folder / named), path))
+    if len({json.dumps(p.to_dict(), sort_keys=True) for p, _ in found}) > 1:
+        raise ConfigError(f"{found[0][1]} and {found[-1][1]} name different platforms; identify "
+                          "one platform's data at a time, or pass --platform.")
+    return found[0] if found else None
+
+
+def _is_result(path: Path) -> bool:
+    """True for a JSON file that ``identify --out`` wrote (overwritten without --force)."""
+    try:
+        document = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return False
+    return isinstance(document, dict) and {"M", "B", "method"} <= set(document)
 
 
 def nominal_from_meta(files: list[Path]):
@@ -45,10 +98,17 @@ def identify(
                                         help="wavelet (Zhang 2020), fourier (Tian), ls, or "
                                              "another name that 'stewartid methods' lists.")]
     = "wavelet",
-    platform: Annotated[str, typer.Option(
-        "--platform", help="'paper' for the preset, or a platform TOML file.")] = "paper",
+    platform: Annotated[str | None, typer.Option(
+        "--platform", help="'paper' for the preset, or a platform TOML file; required unless "
+                           "a meta.json beside the data names the platform.")] = None,
     out: Annotated[Path | None, typer.Option("--out", help="Write the result as JSON.")]
     = None,
+    force: Annotated[bool, typer.Option(
+        "--force", help="Overwrite an existing --out file that is not an earlier result.")]
+    = False,
+    columns: Annotated[str | None, typer.Option(
+        "--columns", help="Column mapping of the logs with units: a TOML file or entries "
+                          "such as 't=Time:ms,l1..l6=Leg{k}:mm' (docs/logs.md).")] = None,
     no_gravity: Annotated[bool, typer.Option(
         "--no-gravity", help="Do not subtract the model's gravity term G(q).")] = False,
     symmetric: Annotated[bool, typer.Option(
@@ -64,9 +124,12 @@ def identify(
     known (platform description, or meta.json/truth.json beside the data) and write JSON."""
     import numpy as np
 
+    from stewartid.checks import check_identified
     from stewartid.dataset import expand_paths, read_datasets
     from stewartid.identification.registry import create_identifier, method_spec
+    from stewartid.io import check_output_file
     from stewartid.linearization import nominal_matrices
+    from stewartid.logformat import load_log_format
     from stewartid.platform import load_platform
     from stewartid.reporting.terminal import print_comparison
 
@@ -83,11 +146,26 @@ def identify(
         elif given:
             raise ConfigError(f"{flag} does not apply to --method {method}; it has the "
                               f"settings {', '.join(accepted)}.")
-    description = load_platform(platform)
     paths = expand_paths(files)
-    datasets = read_datasets(paths, description)
+    named = platform_from_meta(paths)
+    if platform is None and named is None:
+        raise ConfigError("--platform is required (a platform TOML file, or 'paper' for the "
+                          "preset): masses and geometry decide the result and its checks.")
+    description = load_platform(platform) if platform is not None else named[0]
+    if platform is not None and named is not None and named[0].to_dict() != \
+            description.to_dict():
+        warnings.warn(f"{named[1]} describes platform '{named[0].name}', which differs from "
+                      f"--platform {platform}; using --platform.", stacklevel=1)
+    if out is not None:
+        inputs = [*paths, *(p for p in (platform, columns) if p and Path(p).is_file())]
+        check_output_file(out, force, inputs, is_result=_is_result)
+        if out.suffix.lower() in INPUT_SUFFIXES:
+            raise ConfigError(f"--out {str(out)!r}: the result is JSON; give a .json file name.")
+    log_format = load_log_format(columns) if columns is not None else None
+    datasets = read_datasets(paths, description, log_format)
     estimator = create_identifier(method, **settings).fit(datasets, description)
     result = estimator.result_
+    check_identified(result.M, result.B, description)
 
     meta = nominal_from_meta(paths)
     if meta is not None:
