@@ -1,0 +1,79 @@
+"""``stewartid design``: an excitation within the machine's limits, its predicted accuracy
+and the command files to play it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+
+def design(
+    out: Annotated[Path, typer.Option("--out", help="Output folder: design.json, commands/, "
+                                      "figures/, report.md, report.html.")],
+    budget: Annotated[float, typer.Option("--budget", help="Total motion time (s).")] = 120.0,
+    platform: Annotated[str, typer.Option("--platform", help="'paper' for the preset, or a "
+                                          "platform TOML file (with its [limits]).")] = "paper",
+    method: Annotated[str, typer.Option("--method", help="Identification method the design "
+                                        "is for.")] = "wavelet",
+    coulomb: Annotated[float | None, typer.Option(
+        "--coulomb", help="Coulomb friction per joint axis the machine is expected to have "
+        "(N m); default: the platform's.")] = None,
+    length_noise: Annotated[float | None, typer.Option(
+        "--length-noise", help="Leg-length noise, standard deviation (m); default: [sensors] "
+        "length_noise, or the reference 20 um when that is 0.")] = None,
+    force_noise: Annotated[float | None, typer.Option(
+        "--force-noise", help="Force noise, standard deviation (N); default: [sensors] "
+        "force_noise, or the reference 0.5 % of the static leg force when that is 0.")] = None,
+    rate: Annotated[float, typer.Option("--rate", help="Controller rate of the command files "
+                                        "(Hz).")] = 500.0,
+    max_use: Annotated[float, typer.Option("--max-use", help="Largest fraction of every limit "
+                                           "the design may use.")] = 0.7,
+    seeds: Annotated[int, typer.Option("--seeds", help="Noise realisations of the predicted "
+                                       "accuracy.")] = 20,
+    quick: Annotated[bool, typer.Option("--quick", help="One candidate and few realisations "
+                                        "(a smoke test).")] = False,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite a design already in "
+                                        "--out.")] = False,
+) -> None:
+    """Design an excitation for identification: records within the platform's [limits],
+    chosen to minimise the predicted worst relative standard error of Mt and Bt, written as
+    command files (pose and leg lengths) with a report against the paper's set."""
+    import dataclasses
+
+    from stewartid.design.run import run_design
+    from stewartid.errors import ConfigError
+    from stewartid.identification.registry import registered_methods
+    from stewartid.platform import load_platform
+    from stewartid.simulation.sensors import SensorNoise, reference_noise
+
+    description = load_platform(platform)
+    names = [m.name for m in registered_methods()]
+    if method not in names:
+        raise ConfigError(f"--method must be one of {', '.join(names)}; got {method!r}.")
+    for name, value in (("--budget", budget), ("--rate", rate), ("--seeds", seeds)):
+        if not value > 0:
+            raise ConfigError(f"{name} must be > 0; got {value!r}.")
+    for name, value in (("--coulomb", coulomb), ("--length-noise", length_noise),
+                        ("--force-noise", force_noise)):
+        if value is not None and not value >= 0:
+            raise ConfigError(f"{name} must be >= 0; got {value!r}.")
+    if coulomb is not None:
+        description = description.replace(friction__coulomb=coulomb)
+    noise, reference = SensorNoise.from_sensors(description.sensors), reference_noise(description)
+    noise = dataclasses.replace(
+        noise,
+        length_noise=(length_noise if length_noise is not None
+                      else noise.length_noise or reference.length_noise),
+        force_noise=(force_noise if force_noise is not None
+                     else noise.force_noise or reference.force_noise))
+    output = run_design(description, budget, noise, out, method=method, rate_hz=rate,
+                        max_use=max_use, seeds=seeds if not quick else min(seeds, 4),
+                        quick=quick, force=force, progress=typer.echo)
+    p, b = output.prediction, output.baseline
+    typer.echo(f"design: {output.design.label}")
+    typer.echo(f"predicted worst relative standard error {p.worst_relative_std:.2f} % "
+               f"(paper's set {b.worst_relative_std:.2f} %, ratio "
+               f"{p.worst_relative_std / b.worst_relative_std:.2f})")
+    typer.echo(f"wrote {len(output.files)} files to {out}; report: {out / 'report.md'}")

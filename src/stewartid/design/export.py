@@ -1,0 +1,199 @@
+"""Command files of a design, and playing any excitation file on the plant.
+
+A command file is a CSV table of one record at the motion controller's rate: ``t`` (s), the
+pose ``x, y, z, rx, ry, rz`` (m, rad; absolute, paper frame, as in data files) and the leg
+lengths ``l1..l6`` (m, inverse kinematics of the pose). The record fades in from rest at the
+neutral pose and fades out to it (every designed record does). :func:`read_excitation`
+reads such a file, or one a user wrote with the pose or the leg lengths alone, into a
+:class:`TabulatedExcitation` that the plant plays like an analytic excitation: a cubic spline
+of the pose (of the forward kinematics of the lengths when the pose is missing) gives q, q_dot
+and q_ddot between the samples.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stewartid.design.candidates import Design
+from stewartid.errors import ConfigError, DataError
+from stewartid.io import write_text_atomic
+from stewartid.kinematics import forward_kinematics, inverse_kinematics
+from stewartid.platform import COORDINATES, Platform
+from stewartid.simulation.sensors import SensorNoise
+
+LENGTH_COLUMNS = tuple(f"l{k}" for k in range(1, 7))
+
+
+def command_table(platform: Platform, design: Design, rate_hz: float
+                  ) -> list[tuple[str, np.ndarray]]:
+    """Pose and leg-length commands of every record at ``rate_hz``.
+
+    Returns
+    -------
+    list of (name, table)
+        ``table`` has shape (N, 13): t (s), pose (m, rad), leg lengths (m).
+    """
+    if not (math.isfinite(rate_hz) and rate_hz > 0):
+        raise ConfigError(f"controller rate must be > 0 Hz; got {rate_hz!r}.")
+    out = []
+    for playable in design.playable(platform):
+        nyquist = rate_hz / 2
+        if not playable.max_frequency < nyquist / 10:
+            raise ConfigError(f"controller rate {rate_hz:g} Hz is too low for "
+                              f"{playable.max_frequency:g} Hz; use at least "
+                              f"{20 * playable.max_frequency:g} Hz.")
+        t = np.arange(int(math.floor(playable.record.duration * rate_hz + 1e-9)) + 1) / rate_hz
+        q, _, _ = playable.evaluate(t)
+        out.append((playable.name, np.column_stack(
+            [t, q, inverse_kinematics(platform, q).lengths])))
+    return out
+
+
+def write_commands(platform: Platform, design: Design, directory: str | Path,
+                   rate_hz: float = 500.0) -> list[Path]:
+    """Write one command file ``<record>.csv`` per record into ``directory``.
+
+    Returns
+    -------
+    list of Path
+    """
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    header = ",".join(("t", *COORDINATES, *LENGTH_COLUMNS))
+    paths = []
+    for name, table in command_table(platform, design, rate_hz):
+        lines = [header] + [",".join(f"{v:.10g}" for v in row) for row in table]
+        paths.append(write_text_atomic(directory / f"{name}.csv", "\n".join(lines) + "\n"))
+    return paths
+
+
+@dataclasses.dataclass(frozen=True)
+class TabulatedExcitation:
+    """A pose trajectory given by samples, played through a cubic spline.
+
+    Attributes
+    ----------
+    t : ndarray, shape (N,)
+        s, strictly increasing, from 0.
+    pose : ndarray, shape (N, 6)
+        m, rad.
+    name : str
+    max_frequency : float
+        Dominant frequency of the motion (Hz), for the plant's sampling check.
+    """
+
+    t: np.ndarray
+    pose: np.ndarray
+    name: str
+    max_frequency: float
+
+    @property
+    def duration(self) -> float:
+        """s."""
+        return float(self.t[-1] - self.t[0])
+
+    def evaluate(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Pose, velocity and acceleration at ``t`` (s), each (N, 6); held at the last
+        sample after the end of the table."""
+        from scipy.interpolate import CubicSpline
+
+        spline = CubicSpline(self.t, self.pose, axis=0, bc_type="clamped")
+        inside = np.clip(np.asarray(t, dtype=float), self.t[0], self.t[-1])
+        return spline(inside), spline(inside, 1), spline(inside, 2)
+
+
+def read_excitation(path: str | Path, platform: Platform) -> TabulatedExcitation:
+    """Read an excitation file: ``t`` and the pose columns, or ``t`` and ``l1..l6``.
+
+    Raises
+    ------
+    DataError
+        If the file cannot be read, lacks ``t`` or both column groups, has non-finite values,
+        or its time is not strictly increasing.
+    """
+    import pandas as pd
+
+    from stewartid.signals.differentiation import estimate_frequency
+
+    path = Path(path)
+    if not path.is_file():
+        raise DataError(f"{path}: no such excitation file.")
+    try:
+        frame = pd.read_csv(path)
+    except (ValueError, pd.errors.ParserError) as exc:
+        raise DataError(f"{path}: not a readable CSV table ({exc}).") from None
+    columns = set(frame.columns)
+    if "t" not in columns:
+        raise DataError(f"{path}: missing column 't' (s).")
+    has_pose = set(COORDINATES) <= columns
+    if not has_pose and not set(LENGTH_COLUMNS) <= columns:
+        raise DataError(f"{path}: give the pose columns {', '.join(COORDINATES)} (m, rad) or "
+                        f"the leg lengths {', '.join(LENGTH_COLUMNS)} (m).")
+    used = ["t", *(COORDINATES if has_pose else LENGTH_COLUMNS)]
+    values = frame[used].to_numpy(dtype=float)
+    if not np.all(np.isfinite(values)):
+        raise DataError(f"{path}: non-finite values in columns {', '.join(used)}.")
+    t = values[:, 0] - values[0, 0]
+    if len(t) < 4 or not np.all(np.diff(t) > 0):
+        raise DataError(f"{path}: t must be strictly increasing over at least 4 samples.")
+    pose = values[:, 1:] if has_pose else forward_kinematics(platform, values[:, 1:])
+    rate = (len(t) - 1) / t[-1]
+    return TabulatedExcitation(t=t, pose=pose, name=path.stem,
+                               max_frequency=estimate_frequency(pose, rate))
+
+
+def simulate_excitations(platform: Platform, excitations: Sequence[Any],
+                         noise: SensorNoise | None = None, seed: int = 0,
+                         progress: Callable[[int, int, str], Any] | None = None):
+    """Play excitations on the plant, one experiment each, named ``exp1..expN``.
+
+    Parameters
+    ----------
+    platform : Platform
+    excitations : sequence
+        :class:`TabulatedExcitation` or designed records
+        (:meth:`~stewartid.design.candidates.Design.playable`); each runs for its duration.
+    noise : SensorNoise, optional
+        The platform's ``[sensors]`` errors by default.
+    seed : int
+        Noise seed (one independent stream per experiment, as ``simulate``).
+    progress : callable, optional
+        ``progress(done, total, name)``.
+
+    Returns
+    -------
+    stewartid.simulation.SimulationResult
+    """
+    import stewartid
+    from stewartid.linearization import nominal_matrices
+    from stewartid.simulation.experiments import (
+        SimulationResult,
+        noise_generator,
+        simulate_experiment,
+    )
+
+    noise = SensorNoise.from_sensors(platform.sensors) if noise is None else noise
+    datasets, records, sources = [], [], []
+    for k, excitation in enumerate(excitations):
+        duration = (excitation.duration if hasattr(excitation, "duration")
+                    else excitation.record.duration)
+        dataset, record = simulate_experiment(platform, excitation, duration, noise,
+                                              noise_generator(seed, k, len(excitations)))
+        datasets.append(dataclasses.replace(dataset, name=f"exp{k + 1}"))
+        records.append(record)
+        sources.append(excitation.name)
+        if progress is not None:
+            progress(k + 1, len(excitations), excitation.name)
+    M, B = nominal_matrices(platform)
+    meta = {"platform": platform.to_dict(), "platform_name": platform.name,
+            "excitation": {"sources": sources}, "noise": dataclasses.asdict(noise),
+            "seed": int(seed),
+            "tracking_error_rms": [r.tracking_error().tolist() for r in records],
+            "nominal": {"M": M.tolist(), "B": B.tolist()}, "version": stewartid.__version__}
+    return SimulationResult(datasets, meta, records)

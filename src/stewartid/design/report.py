@@ -1,0 +1,120 @@
+"""The design report: limit use over time, interval lengths, predicted accuracy vs the paper's set.
+
+Figures are matplotlib PNG + SVG (:func:`stewartid.reporting.figures.save_figure`), the text is
+Markdown, rendered to a self-contained HTML page by :func:`stewartid.reporting.report.render_html`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from stewartid.design.candidates import Design
+from stewartid.design.limits import LIMIT_NAMES, LimitUse
+from stewartid.design.prediction import Prediction
+from stewartid.io import write_text_atomic
+from stewartid.reference.published import PAPER_ENTRIES, entry_label
+
+
+def plot_limit_use(uses: Sequence[LimitUse], names: Sequence[str], directory: str | Path
+                   ) -> list[Path]:
+    """Use of every limit (fraction, 1 = the limit) over time, one panel per record."""
+    import matplotlib
+    from matplotlib.figure import Figure
+
+    from stewartid.reporting.figures import STYLE, save_figure
+
+    with matplotlib.rc_context(STYLE):
+        figure = Figure(figsize=(9, 1.6 * len(uses) + 0.6))
+        axes = figure.subplots(len(uses), 1, sharex=False, squeeze=False)[:, 0]
+        for axis, use, name in zip(axes, uses, names, strict=True):
+            every = slice(None, None, max(1, len(use.t) // 3000))
+            for k, limit in enumerate(LIMIT_NAMES):
+                axis.plot(use.t[every], use.use[every, k], lw=0.8, label=limit)
+            axis.axhline(1.0, color="k", lw=0.8, ls="--")
+            axis.set_ylim(0, 1.1)
+            axis.set_ylabel(f"{name}\nuse (-)")
+        axes[-1].set_xlabel("t (s)")
+        axes[0].legend(ncol=5, fontsize="small", loc="lower center", bbox_to_anchor=(0.5, 1.0))
+        return save_figure(figure, directory, "limit_use")
+
+
+def plot_accuracy(design: Prediction, baseline: Prediction, directory: str | Path
+                  ) -> list[Path]:
+    """Predicted relative standard error of the 20 entries, design beside the paper's set."""
+    import matplotlib
+    from matplotlib.figure import Figure
+
+    from stewartid.reporting.figures import STYLE, save_figure
+
+    labels = [entry_label(k) for k in PAPER_ENTRIES]
+    x = np.arange(len(labels))
+    with matplotlib.rc_context(STYLE):
+        figure = Figure(figsize=(10, 3.6))
+        axis = figure.subplots()
+        axis.bar(x - 0.2, baseline.relative_std, 0.4, label="paper's set", color="#7f7f7f")
+        axis.bar(x + 0.2, design.relative_std, 0.4, label="design", color="#d62728")
+        axis.set_yscale("log")
+        axis.set_xticks(x, labels, rotation=60, fontsize="small")
+        axis.set_ylabel("predicted standard error (%)")
+        axis.legend()
+        return save_figure(figure, directory, "predicted_accuracy")
+
+
+def render_markdown(design: Design, prediction: Prediction, baseline: Prediction,
+                    peaks: Sequence[dict[str, float]], intervals: Sequence[float],
+                    settings: dict) -> str:
+    """The report text.
+
+    Parameters
+    ----------
+    design : Design
+    prediction, baseline : Prediction
+        Of the design and of the paper's set at the same budget.
+    peaks : sequence of dict
+        Peak use of every limit, per record.
+    intervals : sequence of float
+        Constant-direction interval length of each record (s): its half period.
+    settings : dict
+        Budget, noise, method, grid (shown as given).
+    """
+    lines = ["# Excitation design", "", f"{design.label}; {design.duration:.1f} s of motion.",
+             "", "## Settings", ""]
+    lines += [f"- {key}: {value}" for key, value in settings.items()]
+    lines += ["", "## Records", "",
+              "| record | direction (m, rad) | frequency (Hz) | levels | duration (s) | "
+              "interval (s) | " + " | ".join(LIMIT_NAMES) + " |",
+              "|---" * (6 + len(LIMIT_NAMES)) + "|"]
+    for record, peak, interval in zip(design.records, peaks, intervals, strict=True):
+        direction = ", ".join(f"{v:.4g}" for v in record.direction if v)
+        lines.append(f"| {record.name} | {direction} | {record.frequency_hz:g} | "
+                     + "/".join(f"{v:g}" for v in record.levels)
+                     + f" | {record.duration:.1f} | {interval:.2f} | "
+                     + " | ".join(f"{peak[n]:.0%}" for n in LIMIT_NAMES) + " |")
+    lines += ["", "Limit use is the largest over the legs and the record, 100 % = the limit "
+              "(commanded motion, rigid-body model forces).", "",
+              "![limit use](figures/limit_use.png)", "", "## Predicted accuracy", "",
+              f"Method: {prediction.method}; {prediction.seeds} noise realisations "
+              f"(paper's set: {baseline.seeds}). Worst relative standard error: "
+              f"**{prediction.worst_relative_std:.2f} %** (paper's set "
+              f"{baseline.worst_relative_std:.2f} %, ratio "
+              f"{prediction.worst_relative_std / baseline.worst_relative_std:.2f}).", "",
+              "| entry | design SE (%) | design bias (%) | paper's set SE (%) |",
+              "|---|---|---|---|"]
+    for key, s, b, s0 in zip(PAPER_ENTRIES, prediction.relative_std, prediction.relative_bias,
+                             baseline.relative_std, strict=True):
+        lines.append(f"| {entry_label(key)} | {s:.3f} | {b:.3f} | {s0:.3f} |")
+    lines += ["", "![predicted accuracy](figures/predicted_accuracy.png)", ""]
+    return "\n".join(lines)
+
+
+def write_design_report(directory: str | Path, markdown_text: str) -> list[Path]:
+    """Write ``report.md`` and the self-contained ``report.html`` into ``directory``."""
+    from stewartid.reporting.report import render_html
+
+    directory = Path(directory)
+    return [write_text_atomic(directory / "report.md", markdown_text),
+            write_text_atomic(directory / "report.html",
+                              render_html(markdown_text, directory, "stewartid design"))]

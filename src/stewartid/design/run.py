@@ -1,0 +1,129 @@
+"""``stewartid design`` end to end: optimise, predict the baseline, export, report.
+
+Output folder layout::
+
+    design.json           the design, its prediction, the baseline's, the limits
+    commands/exp*.csv     pose and leg-length commands at the controller rate
+    figures/*.png, *.svg  limit use over time, predicted accuracy vs the paper's set
+    report.md, report.html
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from pathlib import Path
+
+from stewartid.design.candidates import Design, paper_design
+from stewartid.design.export import write_commands
+from stewartid.design.limits import resolve_limits
+from stewartid.design.optimise import (
+    DEFAULT_FREQUENCIES,
+    DEFAULT_SCHEDULES,
+    commanded_use,
+    optimise_design,
+)
+from stewartid.design.prediction import Prediction, predict_accuracy
+from stewartid.design.report import (
+    plot_accuracy,
+    plot_limit_use,
+    render_markdown,
+    write_design_report,
+)
+from stewartid.io import check_output_folder, write_json_atomic
+from stewartid.platform import Platform
+from stewartid.simulation.sensors import SensorNoise
+
+
+@dataclasses.dataclass(frozen=True)
+class DesignOutput:
+    """What :func:`run_design` produced.
+
+    Attributes
+    ----------
+    design : Design
+    prediction, baseline : Prediction
+        Of the design and of the paper's set of the same total length.
+    files : list of Path
+    """
+
+    design: Design
+    prediction: Prediction
+    baseline: Prediction
+    files: list[Path]
+
+
+def is_design_file(path: Path) -> bool:
+    """True for what :func:`run_design` writes."""
+    return path.name in ("design.json", "report.md", "report.html", "commands", "figures")
+
+
+def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str | Path,
+               method: str = "wavelet", rate_hz: float = 500.0, max_use: float = 0.7,
+               seeds: int = 20, quick: bool = False, force: bool = False,
+               progress: Callable[[str], None] | None = None) -> DesignOutput:
+    """Design an excitation for ``platform`` and write it with its report to ``out``.
+
+    Parameters
+    ----------
+    platform : Platform
+    budget_s : float
+        Total motion time (s).
+    noise : SensorNoise
+        Sensor noise the prediction assumes.
+    out : str or Path
+        Output folder.
+    method : str
+        Identification method the design is for.
+    rate_hz : float
+        Controller rate of the command files (Hz).
+    max_use : float
+        Fraction of every limit the design may use.
+    seeds : int
+        Noise realisations of the final predictions.
+    quick : bool
+        One frequency and schedule, few seeds (for tests).
+    force : bool
+        Overwrite an earlier design in ``out``.
+    progress : callable, optional
+        Receives one line of text per step.
+
+    Returns
+    -------
+    DesignOutput
+    """
+    out = Path(out)
+    check_output_folder(out, force, is_design_file)
+    limits = resolve_limits(platform)
+    grid = {"frequencies": (1.0,), "schedules": ((1.0, 0.5),), "screening_seeds": 3} if quick \
+        else {"frequencies": DEFAULT_FREQUENCIES, "schedules": DEFAULT_SCHEDULES}
+    best, screened = optimise_design(platform, budget_s, noise, method, max_use=max_use,
+                                     seeds=seeds, progress=progress, **grid)
+    baseline_design = paper_design(duration_s=budget_s / 6)
+    baseline = predict_accuracy(platform, baseline_design, noise, method, seeds)
+    if progress:
+        progress(f"paper's set: predicted worst error {baseline.worst_relative_error:.2f} %")
+    design, prediction = best.design, best.prediction
+    out.mkdir(parents=True, exist_ok=True)
+    uses = [commanded_use(platform, record) for record in design.records]
+    files = write_commands(platform, design, out / "commands", rate_hz)
+    files += plot_limit_use(uses, [r.name for r in design.records], out / "figures")
+    files += plot_accuracy(prediction, baseline, out / "figures")
+    settings = {"platform": platform.name, "budget (s)": budget_s, "method": prediction.method,
+                "Coulomb friction (N m)": platform.friction.coulomb,
+                "length noise (m)": noise.length_noise, "force noise (N)": noise.force_noise,
+                "largest limit use": max_use, "controller rate (Hz)": rate_hz,
+                "frequencies tried (Hz)": list(grid["frequencies"]),
+                "schedules tried": [list(s) for s in grid["schedules"]]}
+    intervals = [0.5 / r.frequency_hz for r in design.records]
+    text = render_markdown(design, prediction, baseline, [u.peak for u in uses], intervals,
+                           settings)
+    files += write_design_report(out, text)
+    document = {"design": design.to_dict(), "prediction": prediction.to_dict(),
+                "baseline": {"design": baseline_design.to_dict(), **baseline.to_dict()},
+                "limits": limits.to_dict(), "limit_use": [u.peak for u in uses],
+                "screened": [{"label": c.design.label, "score_percent": c.score}
+                             for c in screened],
+                "settings": settings}
+    files.append(write_json_atomic(out / "design.json", document))
+    return DesignOutput(design, prediction, baseline, files)
