@@ -128,6 +128,9 @@ def _register() -> None:
     from stewartid.cli import study
 
     app.command()(clean_errors(study.study))
+    from stewartid.cli import design
+
+    app.command()(clean_errors(design.design))
 
 
 _register()

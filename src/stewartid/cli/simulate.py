@@ -38,6 +38,10 @@ def simulate(
     format: Annotated[str, typer.Option("--format", help="'csv' or 'parquet'.")] = "csv",
     force: Annotated[bool, typer.Option("--force", help="Overwrite results already in "
                                         "--out.")] = False,
+    excitation: Annotated[list[Path] | None, typer.Option(
+        "--excitation", help="Play this excitation file instead of the paper's sines: CSV "
+        "with t and the pose x..rz (m, rad) or t and l1..l6 (m), e.g. a command file of "
+        "`stewartid design`; repeat for more experiments (exp1, exp2, ...).")] = None,
 ) -> None:
     """Simulate the six experiments (experiment k excites DOF k) on the hydraulic plant."""
     import dataclasses
@@ -70,14 +74,25 @@ def simulate(
     if force_noise is not None:
         noise = dataclasses.replace(noise, force_noise=force_noise)
     with Progress(transient=True) as bar:
-        task = bar.add_task("simulating", total=6)
+        task = bar.add_task("simulating", total=len(excitation) if excitation else 6)
 
         def progress(done: int, total: int, name: str) -> None:
             bar.update(task, completed=done, description=f"simulated {name}")
 
-        result = simulate_experiments(description, coulomb=coulomb, viscous=viscous,
-                                      frequency_hz=frequency, duration_s=duration,
-                                      noise=noise, seed=seed, actuator=actuator,
-                                      progress=progress)
+        if excitation:
+            from stewartid.design.export import read_excitation, simulate_excitations
+
+            overrides = {key: value for key, value in (
+                ("friction__coulomb", coulomb), ("friction__gimbal_viscous", viscous),
+                ("hydraulics__mode", actuator)) if value is not None}
+            description = description.replace(**overrides) if overrides else description
+            result = simulate_excitations(
+                description, [read_excitation(path, description) for path in excitation],
+                noise, seed, progress)
+        else:
+            result = simulate_experiments(description, coulomb=coulomb, viscous=viscous,
+                                          frequency_hz=frequency, duration_s=duration,
+                                          noise=noise, seed=seed, actuator=actuator,
+                                          progress=progress)
     paths = write_experiments(result, out, format=format, force=force)
     typer.echo(f"wrote {len(paths) - 1} experiments and meta.json to {out}")
