@@ -280,42 +280,61 @@ def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
         mean_residual = base - design @ nuisance
         excess = np.sum(mean_residual ** 2, axis=0) - noise * len(ym)
         scatter = np.sqrt(np.maximum(excess, 0.0) / np.sum(weight ** 2))
-    for _ in range(max(1, iterations)):
-        blocks, rhs, clusters = [], [], []
+    xtx = x.T @ x
+    n_clusters = len(equations)
+    if shared_friction:
+        # the mean rows as an explicit (small) design: channel-major, (6 m, n_unknowns)
+        n_mean = len(xm)
+        mean_design = np.zeros((6, n_mean, n_unknowns))
         for i in range(6):
-            w = 1.0 / np.sqrt(noise[i])
-            a = np.zeros((len(x), n_unknowns))
-            a[:, 12 * i:12 * i + 12] = x * w
-            blocks.append(a)
-            rhs.append(y[:, i] * w)
-            clusters.append(cluster)
-            if shared_friction:
-                wmean = 1.0 / np.sqrt(noise[i] + scatter[i] ** 2 * weight ** 2)
-                a = np.zeros((len(xm), n_unknowns))
-                a[:, 12 * i:12 * i + 12] = xm * wmean[:, None]
-                a[np.arange(len(xm)), n_theta + 6 * owner + i] = weight * wmean
-                a[:, n_theta + 6 * n_experiments:] = wm[:, :, i] * wmean[:, None]
-                blocks.append(a)
-                rhs.append(ym[:, i] * wmean)
-                clusters.append(mean_cluster)
-        a, b, groups = np.vstack(blocks), np.concatenate(rhs), np.concatenate(clusters)
-        scale = np.linalg.norm(a, axis=0)
+            mean_design[i, :, 12 * i:12 * i + 12] = xm
+            mean_design[i, np.arange(n_mean), n_theta + 6 * owner + i] = weight
+            mean_design[i, :, n_theta + 6 * n_experiments:] = wm[:, :, i]
+        mean_design = mean_design.reshape(6 * n_mean, n_unknowns)
+        mean_rhs = ym.T.ravel()
+        mean_groups = np.tile(mean_cluster, 6)
+    for _ in range(max(1, iterations)):
+        # normal equations of the weighted rows: the invariant rows of channel i share the
+        # design x, so they contribute x^T x / noise_i to their own 12 x 12 block
+        normal = np.zeros((n_unknowns, n_unknowns))
+        rhs = np.zeros(n_unknowns)
+        xty = x.T @ y
+        for i in range(6):
+            block = slice(12 * i, 12 * i + 12)
+            normal[block, block] = xtx / noise[i]
+            rhs[block] = xty[:, i] / noise[i]
+        if shared_friction:
+            row_weight = 1.0 / (np.repeat(noise, n_mean)
+                                + np.repeat(scatter ** 2, n_mean) * np.tile(weight ** 2, 6))
+            weighted = mean_design * row_weight[:, None]
+            normal += mean_design.T @ weighted
+            rhs += weighted.T @ mean_rhs
+        scale = np.sqrt(np.diag(normal))
         scale = np.where(scale > 0, scale, 1.0)
-        a_s = a / scale
-        z = np.linalg.solve(a_s.T @ a_s, a_s.T @ b) / scale
+        z = np.linalg.solve(normal / np.outer(scale, scale), rhs / scale) / scale
         theta = z[:n_theta].reshape(6, 12)
+        noise_used = noise
         noise = channel_noise(theta)
         if shared_friction:
             offsets = z[n_theta:n_theta + 6 * n_experiments].reshape(n_experiments, 6)
             levels = z[n_theta + 6 * n_experiments:]
-    residual = b - a @ z
-    bread = np.linalg.pinv(a_s.T @ a_s)
-    n_rows = len(b)
-    model_cov = bread * (residual @ residual / max(n_rows - n_unknowns, 1))
-    labels, index = np.unique(groups, return_inverse=True)
-    scores = np.zeros((len(labels), n_unknowns))
-    np.add.at(scores, index, a_s * residual[:, None])
-    g = len(labels)
+    # covariances of the last solve (weights noise_used), in scaled coordinates
+    residual = (y - x @ theta.T) / np.sqrt(noise_used)                 # weighted, (n, 6)
+    scores = np.zeros((n_clusters, n_unknowns))
+    for i in range(6):
+        np.add.at(scores[:, 12 * i:12 * i + 12], cluster,
+                  x * (residual[:, i] / np.sqrt(noise_used[i]))[:, None])
+    squares = float(np.sum(residual ** 2))
+    n_rows = residual.size
+    if shared_friction:
+        mean_residual = (mean_rhs - mean_design @ z) * np.sqrt(row_weight)
+        np.add.at(scores, mean_groups, mean_design * (mean_residual * np.sqrt(row_weight))[:, None])
+        squares += float(mean_residual @ mean_residual)
+        n_rows += len(mean_residual)
+    scores /= scale
+    bread = np.linalg.pinv(normal / np.outer(scale, scale))
+    model_cov = bread * (squares / max(n_rows - n_unknowns, 1))
+    g = n_clusters
     robust_cov = (g / max(g - 1, 1) * (n_rows - 1) / max(n_rows - n_unknowns, 1)
                   * bread @ (scores.T @ scores) @ bread)
     std = np.sqrt(np.maximum(np.diag(model_cov), np.diag(robust_cov))) / scale
