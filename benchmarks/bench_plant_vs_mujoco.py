@@ -1,7 +1,7 @@
 """Real-time factor of our hydraulic closed-loop plant beside MuJoCo on the same mechanism.
 
 In one run, on the same machine: our plant (``stewartid.simulation``, hydraulic legs, PID
-and inner force loop, RK4 at its default 0.25 ms) on the paper's 20 s roll experiment with
+and inner force loop, RK4 at its default 0.5 ms) on the paper's 20 s roll experiment with
 Coulomb 5 N m, and MuJoCo on the mechanism of ``stewartid.mjcf`` (42 joints closed by six
 welds, ideal force actuators, the same servo's PD part in the motors' bias, gimbal damping
 and Coulomb ``frictionloss``) along the same command: a bare ``mj_step`` loop that only
@@ -111,7 +111,7 @@ def main() -> None:
     print(f"load: paper platform, Coulomb 5 N m, '{excitation.name}' ({DURATION:g} s)")
     rows = []
     wall, cpu = time_plant(paper, excitation, args.repeats)
-    rows.append(("stewartid plant, hydraulic, RK4 0.25 ms (whole experiment)", wall, cpu))
+    rows.append(("stewartid plant, hydraulic, RK4 0.5 ms (whole experiment)", wall, cpu))
     for coulomb in (True, False):
         for integrator in ("RK4", "implicitfast"):
             wall, cpu, setup, motion = time_mujoco(paper, excitation, integrator, args.repeats,

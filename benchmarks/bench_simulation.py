@@ -1,7 +1,7 @@
 """Speed of the plant simulator: simulated seconds per wall-clock second.
 
 Full hydraulic closed loop (valves, chambers, PID, friction), 1 kHz output, RK4 at the
-default 0.25 ms step, on one core. Run: ``python benchmarks/bench_simulation.py``.
+default 0.5 ms step, on one core. Run: ``python benchmarks/bench_simulation.py``.
 """
 
 from __future__ import annotations

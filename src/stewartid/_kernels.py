@@ -165,29 +165,8 @@ def model_terms(params, upper, base, q, qd, M, h, G, J_leg, J_joint, lengths):
     Gn[2] = -m * g
 
     for i in range(6):
-        # leg geometry: r = R upper_i, leg vector A - B, unit u
-        s = 0.0
-        for k in range(3):
-            r[k] = R[k, 0] * upper[i, 0] + R[k, 1] * upper[i, 1] + R[k, 2] * upper[i, 2]
-            ui[k] = q[k] + r[k] - base[i, k]
-            s += ui[k] * ui[k]
-        l = math.sqrt(s)
-        for k in range(3):
-            ui[k] /= l
+        l = _leg_geometry(R, upper, base, q, i, r, ui, JA)
         lengths[i] = l
-        # J_A = [I, -[r]x]: velocity of the upper joint point from the twist
-        for k in range(3):
-            for c in range(6):
-                JA[k, c] = 0.0
-        JA[0, 0] = 1.0
-        JA[1, 1] = 1.0
-        JA[2, 2] = 1.0
-        JA[0, 4] = r[2]
-        JA[0, 5] = -r[1]
-        JA[1, 3] = -r[2]
-        JA[1, 5] = r[0]
-        JA[2, 3] = r[1]
-        JA[2, 4] = -r[0]
         vA[0] = qd[0] + (omega[1] * r[2] - omega[2] * r[1])
         vA[1] = qd[1] + (omega[2] * r[0] - omega[0] * r[2])
         vA[2] = qd[2] + (omega[0] * r[1] - omega[1] * r[0])
@@ -235,23 +214,7 @@ def model_terms(params, upper, base, q, qd, M, h, G, J_leg, J_joint, lengths):
                 s += m_l * Jcl[k, a] * acl[k] + m_u * Jcu[k, a] * acu[k] + I_leg * Jw[k, a] * wd[k]
             hn[a] += s
             Gn[a] -= g * (m_l * Jcl[2, a] + m_u * Jcu[2, a])
-        # leg frame for the joint axes: e1 = unit(z x u), e2 = u x e1
-        nx, ny = -ui[1], ui[0]
-        nn = math.sqrt(nx * nx + ny * ny)
-        e10, e11 = nx / nn, ny / nn
-        e20 = -ui[2] * e11
-        e21 = ui[2] * e10
-        e22 = ui[0] * e11 - ui[1] * e10
-        for c in range(6):
-            for k in range(3):
-                w_rel[k] = -Jw[k, c]
-            if c >= 3:
-                w_rel[c - 3] += 1.0
-            J_joint[i, 0, c] = e10 * Jw[0, c] + e11 * Jw[1, c]
-            J_joint[i, 1, c] = e20 * Jw[0, c] + e21 * Jw[1, c] + e22 * Jw[2, c]
-            J_joint[i, 2, c] = e10 * w_rel[0] + e11 * w_rel[1]
-            J_joint[i, 3, c] = e20 * w_rel[0] + e21 * w_rel[1] + e22 * w_rel[2]
-            J_joint[i, 4, c] = ui[0] * w_rel[0] + ui[1] * w_rel[1] + ui[2] * w_rel[2]
+        _joint_axes(ui, Jw, w_rel, J_joint[i])
 
     # map the twist equations to q coordinates: nu = T qd, nu_dot = T qdd + [0, Edot rates],
     # T = blockdiag(I, E); M = T^T Mn T, h = T^T (hn + Mn bias), G = T^T Gn, J = J T
@@ -273,17 +236,131 @@ def model_terms(params, upper, base, q, qd, M, h, G, J_leg, J_joint, lengths):
         h[3 + a] = E[0, a] * hn[3] + E[1, a] * hn[4] + E[2, a] * hn[5]
         G[3 + a] = E[0, a] * Gn[3] + E[1, a] * Gn[4] + E[2, a] * Gn[5]
     for i in range(6):
-        x0 = J_leg[i, 3]
-        x1 = J_leg[i, 4]
-        x2 = J_leg[i, 5]
-        for b in range(3):
-            J_leg[i, 3 + b] = x0 * E[0, b] + x1 * E[1, b] + x2 * E[2, b]
+        _rotation_columns(J_leg[i], E)
         for j in range(N_JOINTS):
-            x0 = J_joint[i, j, 3]
-            x1 = J_joint[i, j, 4]
-            x2 = J_joint[i, j, 5]
-            for b in range(3):
-                J_joint[i, j, 3 + b] = x0 * E[0, b] + x1 * E[1, b] + x2 * E[2, b]
+            _rotation_columns(J_joint[i, j], E)
+
+
+@njit(cache=True)
+def _leg_geometry(R, upper, base, q, i, r, u, JA):
+    """Leg i: r = R upper_i, unit leg vector u (into ``r``, ``u``, (3,)), J_A = [I, -[r]x]
+    (velocity of the upper joint point from the twist, into ``JA`` (3, 6)); returns the leg
+    length (m)."""
+    s = 0.0
+    for k in range(3):
+        r[k] = R[k, 0] * upper[i, 0] + R[k, 1] * upper[i, 1] + R[k, 2] * upper[i, 2]
+        u[k] = q[k] + r[k] - base[i, k]
+        s += u[k] * u[k]
+    length = math.sqrt(s)
+    for k in range(3):
+        u[k] /= length
+    for k in range(3):
+        for c in range(6):
+            JA[k, c] = 0.0
+    JA[0, 0] = 1.0
+    JA[1, 1] = 1.0
+    JA[2, 2] = 1.0
+    JA[0, 4] = r[2]
+    JA[0, 5] = -r[1]
+    JA[1, 3] = -r[2]
+    JA[1, 5] = r[0]
+    JA[2, 3] = r[1]
+    JA[2, 4] = -r[0]
+    return length
+
+
+@njit(cache=True)
+def _joint_axes(u, Jw, w_rel, J_joint_leg):
+    """Rates of a leg's five joint axes per twist component (into ``J_joint_leg`` (5, 6)),
+    from its unit vector ``u`` and angular-velocity Jacobian ``Jw`` (3, 6); ``w_rel`` (3,) is
+    scratch. Leg frame e1 = unit(z x u), e2 = u x e1."""
+    nx, ny = -u[1], u[0]
+    nn = math.sqrt(nx * nx + ny * ny)
+    e10, e11 = nx / nn, ny / nn
+    e20 = -u[2] * e11
+    e21 = u[2] * e10
+    e22 = u[0] * e11 - u[1] * e10
+    for c in range(6):
+        for k in range(3):
+            w_rel[k] = -Jw[k, c]
+        if c >= 3:
+            w_rel[c - 3] += 1.0
+        J_joint_leg[0, c] = e10 * Jw[0, c] + e11 * Jw[1, c]
+        J_joint_leg[1, c] = e20 * Jw[0, c] + e21 * Jw[1, c] + e22 * Jw[2, c]
+        J_joint_leg[2, c] = e10 * w_rel[0] + e11 * w_rel[1]
+        J_joint_leg[3, c] = e20 * w_rel[0] + e21 * w_rel[1] + e22 * w_rel[2]
+        J_joint_leg[4, c] = u[0] * w_rel[0] + u[1] * w_rel[1] + u[2] * w_rel[2]
+
+
+@njit(cache=True)
+def _rotation_columns(row, E):
+    """Map the angular part of a twist row (6,) to Euler-angle rates in place: row[3:] E."""
+    x0 = row[3]
+    x1 = row[4]
+    x2 = row[5]
+    for b in range(3):
+        row[3 + b] = x0 * E[0, b] + x1 * E[1, b] + x2 * E[2, b]
+
+
+@njit(cache=True)
+def leg_terms(params, upper, base, q, G, J_leg, lengths, J_joint, joints):
+    """The pose-only terms of :func:`model_terms` at one sample, without M and h.
+
+    Outputs as in :func:`model_terms`: ``G`` (6,), ``J_leg`` (6, 6), ``lengths`` (6,) and,
+    when ``joints``, ``J_joint`` (6, 5, 6) (else untouched). A fraction of the cost of
+    :func:`model_terms`, for the callers that need no inertia: command tables, forward
+    kinematics, and the measured generalized forces of the identification.
+    """
+    m_u, m_l = params[P_M_UPPER], params[P_M_LOWER]
+    d_u, d_l = params[P_D_UPPER], params[P_D_LOWER]
+    g = params[P_GRAVITY]
+    R = rotation(q[3], q[4], q[5])
+    E = euler_rate_map(q[4], q[5])
+    r = np.empty(3)
+    ui = np.empty(3)
+    JA = np.empty((3, 6))
+    Jw = np.empty((3, 6))
+    w_rel = np.empty(3)
+    Gn = np.zeros(6)
+    Gn[2] = -params[P_MASS] * g
+    for i in range(6):
+        l = _leg_geometry(R, upper, base, q, i, r, ui, JA)
+        lengths[i] = l
+        for c in range(6):
+            uJ = ui[0] * JA[0, c] + ui[1] * JA[1, c] + ui[2] * JA[2, c]
+            J_leg[i, c] = uJ
+            # vertical velocity of the two centres of mass (gravity is along z)
+            Judot2 = (JA[2, c] - ui[2] * uJ) / l
+            Gn[c] -= g * (m_l * (d_l * Judot2) + m_u * (JA[2, c] - d_u * Judot2))
+            if joints:
+                Jw[0, c] = (ui[1] * JA[2, c] - ui[2] * JA[1, c]) / l
+                Jw[1, c] = (ui[2] * JA[0, c] - ui[0] * JA[2, c]) / l
+                Jw[2, c] = (ui[0] * JA[1, c] - ui[1] * JA[0, c]) / l
+        if joints:
+            _joint_axes(ui, Jw, w_rel, J_joint[i])
+        _rotation_columns(J_leg[i], E)
+        if joints:
+            for j in range(N_JOINTS):
+                _rotation_columns(J_joint[i, j], E)
+    for a in range(3):
+        G[a] = Gn[a]
+        G[3 + a] = E[0, a] * Gn[3] + E[1, a] * Gn[4] + E[2, a] * Gn[5]
+
+
+@njit(cache=True)
+def batch_leg_terms(params, upper, base, q, joints):
+    """:func:`leg_terms` over samples: q of shape (N, 6); J_joint is (N, 6, 5, 6) when
+    ``joints``, else (0, 6, 5, 6)."""
+    n = q.shape[0]
+    G = np.empty((n, 6))
+    Jl = np.empty((n, 6, 6))
+    lengths = np.empty((n, 6))
+    Jj = np.empty((n if joints else 0, 6, N_JOINTS, 6))
+    scratch = np.empty((6, N_JOINTS, 6))
+    for k in range(n):
+        leg_terms(params, upper, base, q[k], G[k], Jl[k], lengths[k],
+                  Jj[k] if joints else scratch, joints)
+    return G, Jl, lengths, Jj
 
 
 @njit(cache=True)

@@ -111,6 +111,13 @@ def _terms(platform: Platform, q: np.ndarray, qd: np.ndarray | None = None):
                                 platform.base_joints, q2, qd2), single
 
 
+def _leg_terms(platform: Platform, q: np.ndarray, joints: bool = False):
+    """(G, J_leg, lengths, J_joint) at poses q (N, 6), without the inertia terms; J_joint is
+    empty unless ``joints``."""
+    return _kernels.batch_leg_terms(platform.parameters(), platform.upper_joints,
+                                    platform.base_joints, q, joints)
+
+
 def leg_jacobian(platform: Platform, q: np.ndarray) -> np.ndarray:
     """Leg Jacobian J_lq: leg-length rates = J_lq q_dot.
 
@@ -125,7 +132,8 @@ def leg_jacobian(platform: Platform, q: np.ndarray) -> np.ndarray:
         Row k: d l_k / d q (m/m, m/rad). J_lq^T f maps actuator forces (N) to generalized
         forces (N, N m).
     """
-    (_, _, _, J_leg, _, _), single = _terms(platform, q)
+    q2, single = _batch(q)
+    J_leg = _leg_terms(platform, q2)[1]
     return J_leg[0] if single else J_leg
 
 
@@ -141,7 +149,8 @@ def joint_rate_jacobians(platform: Platform, q: np.ndarray) -> np.ndarray:
     -------
     ndarray, shape (6, 5, 6) or (N, 6, 5, 6)
     """
-    (_, _, _, _, J_joint, _), single = _terms(platform, q)
+    q2, single = _batch(q)
+    J_joint = _leg_terms(platform, q2, joints=True)[3]
     return J_joint[0] if single else J_joint
 
 
@@ -177,21 +186,27 @@ def forward_kinematics(platform: Platform, lengths: np.ndarray, initial: np.ndar
     q = np.tile(platform.neutral_pose, (len(l2), 1)) if initial is None else \
         np.array(np.broadcast_to(_batch(initial, "initial")[0], l2.shape))
     residual = np.inf
+    active = np.arange(len(q))  # samples not yet converged: only they are iterated
     for _ in range(max_iterations):
-        (_, _, _, J, _, current), _ = _terms(platform, q)
-        error = current - l2
-        residual = np.max(np.abs(error), axis=1)
-        if np.all(residual < tolerance):
+        _, J, current, _ = _leg_terms(platform, q[active])
+        error = current - l2[active]
+        residual_active = np.max(np.abs(error), axis=1)
+        keep = residual_active >= tolerance
+        active, J, error = active[keep], J[keep], error[keep]
+        if len(active) == 0:
             return q[0] if single else q
         cond = np.linalg.cond(J)
-        if np.any(~np.isfinite(cond) | (cond > 1e12)):
-            bad = int(np.argmax(~np.isfinite(cond) | (cond > 1e12)))
+        singular = ~np.isfinite(cond) | (cond > 1e12)
+        if np.any(singular):
+            worst = int(np.argmax(singular))
             raise KinematicsError(
-                f"forward kinematics met a singular leg Jacobian at sample {bad} "
-                f"(condition number {cond[bad]:.3g}); check the leg lengths and the platform "
-                "description, or give a better initial pose."
+                f"forward kinematics met a singular leg Jacobian at sample {active[worst]} "
+                f"(condition number {cond[worst]:.3g}); check the leg lengths and the "
+                "platform description, or give a better initial pose."
             )
-        q = q - np.linalg.solve(J, error[..., None])[..., 0]
+        q[active] -= np.linalg.solve(J, error[..., None])[..., 0]
+        residual = np.zeros(len(q))
+        residual[active] = residual_active[keep]
     bad = int(np.argmax(residual))
     raise KinematicsError(
         f"forward kinematics did not converge in {max_iterations} iterations at sample {bad} "

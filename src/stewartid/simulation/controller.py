@@ -103,15 +103,12 @@ def command_tables(params, upper, base, q_cmd, qd_cmd, feedforward):
     lengths = np.empty((n, 6))
     rates = np.empty((n, 6))
     forces = np.zeros((n, 6))
-    M = np.empty((6, 6))
-    h = np.empty(6)
     G = np.empty(6)
     J = np.empty((6, 6))
-    Jj = np.empty((6, 5, 6))
+    Jj = np.empty((6, 5, 6))  # not computed: joints=False
     A = np.empty((6, 7))
     for k in range(n):
-        _kernels.model_terms(params, upper, base, q_cmd[k], qd_cmd[k], M, h, G, J, Jj,
-                             lengths[k])
+        _kernels.leg_terms(params, upper, base, q_cmd[k], G, J, lengths[k], Jj, False)
         for i in range(6):
             s = 0.0
             for c in range(6):

@@ -8,14 +8,16 @@ controller's demands.
 Integration: classical fixed-step Runge-Kutta (RK4) inside one numba loop; the commanded
 leg lengths, their rates and the gravity feed-forward are tabulated beforehand on the
 half-step grid that RK4 samples. Step choice: the fastest dynamics of the hydraulic loop are
-the spool (80 Hz, w_v = 503 rad/s, damping 0.7: eigenvalues |lambda| = 503 rad/s), the
-inner force loop and the hydraulic resonance of the legs (15-25 Hz); RK4 is stable for
-|lambda h| < 2.78 and accurate to O((lambda h)^4). The default step of 0.25 ms
-(|lambda h| = 0.13 for the spool) is 20x inside the stability limit; the step-halving test
-(``tests/test_simulation.py``) shows the recorded signals change by far less than the sensor
-resolution when it is halved. The regularised Coulomb friction adds a damping Fc / s per
-joint axis near zero rate (s = 1e-4 rad/s: 5e4 N m s/rad at Fc = 5 N m, about ten times the
-viscous gimbal friction, |lambda| < 100 rad/s), which the same step resolves.
+the spool (80 Hz, w_v = 503 rad/s, damping 0.7), the inner force loop and the hydraulic
+resonance of the legs (15-25 Hz); the closed loop's fastest pole on the paper's platform is
+at |lambda| = 406 rad/s (:func:`stewartid.simulation.stability.closed_loop_poles`, Coulomb
+0-30 N m). RK4 is stable for |lambda h| < 2.78 and accurate to O((lambda h)^4). The default
+step of 0.5 ms (|lambda h| = 0.2) is 14x inside the stability limit; halving it (the
+step-halving test, ``tests/test_simulation.py``) changes the recorded pose by 2e-10 m and the
+leg forces by 0.02 N (Coulomb 0-30 N m), far below any sensor resolution. The regularised
+Coulomb friction adds a damping Fc / s per joint axis near zero rate (s = 1e-4 rad/s: 5e4
+N m s/rad at Fc = 5 N m, about ten times the viscous gimbal friction), which the poles above
+include (they are taken at rest, where that damping is largest).
 
 Friction: viscous on the four gimbal axes of each leg, Coulomb on all five rotational axes,
 regularised as Fc w / sqrt(w^2 + s^2) (:func:`stewartid._kernels.joint_friction`). Within
@@ -67,6 +69,15 @@ def _solve_spd(M: np.ndarray, b: np.ndarray, L: np.ndarray, out: np.ndarray) -> 
         for k in range(i + 1, n):
             s -= L[k, i] * out[k]
         out[i] = s / L[i, i]
+
+
+@njit(cache=True)
+def _scratch():
+    """Scratch arrays of :func:`rhs` after ``dy``: M, h, G, J, Jj, lengths, rates, force,
+    demand, work, chol, qdd."""
+    return (np.empty((6, 6)), np.empty(6), np.empty(6), np.empty((6, 6)), np.empty((6, 5, 6)),
+            np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.zeros((6, 6)),
+            np.empty(6))
 
 
 @njit(cache=True)
@@ -180,18 +191,7 @@ def integrate(y0, step, substeps, n_out, cmd_length, cmd_rate, cmd_force, params
     rec_rate = np.zeros((n_out, 6))
     rec_force = np.zeros((n_out, 6))
     rec_demand = np.zeros((n_out, 6))
-    M = np.empty((6, 6))
-    h = np.empty(6)
-    G = np.empty(6)
-    J = np.empty((6, 6))
-    Jj = np.empty((6, 5, 6))
-    lengths = np.empty(6)
-    rates = np.empty(6)
-    force = np.empty(6)
-    demand = np.empty(6)
-    work = np.empty(6)
-    chol = np.zeros((6, 6))
-    qdd = np.empty(6)
+    M, h, G, J, Jj, lengths, rates, force, demand, work, chol, qdd = _scratch()
     y = y0.copy()
     yt = np.empty(n)
     k1 = np.empty(n)
@@ -254,18 +254,7 @@ def linearize(y0, scales, cmd_length, cmd_rate, cmd_force, params, upper, base, 
     O(scale^2).
     """
     n = N_STATES
-    M = np.empty((6, 6))
-    h = np.empty(6)
-    G = np.empty(6)
-    J = np.empty((6, 6))
-    Jj = np.empty((6, 5, 6))
-    lengths = np.empty(6)
-    rates = np.empty(6)
-    force = np.empty(6)
-    demand = np.empty(6)
-    work = np.empty(6)
-    chol = np.zeros((6, 6))
-    qdd = np.empty(6)
+    M, h, G, J, Jj, lengths, rates, force, demand, work, chol, qdd = _scratch()
     plus = np.empty(n)
     minus = np.empty(n)
     y = y0.copy()
