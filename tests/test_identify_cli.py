@@ -42,7 +42,8 @@ def test_bad_input_is_one_line(tmp_path, files):
     paths, _, _ = files
     bad = tmp_path / "bad.csv"
     bad.write_text("t,x\n0,1\n")
-    result = CliRunner().invoke(app, ["identify", "--method", "fourier", str(bad)])
+    result = CliRunner().invoke(app, ["identify", "--method", "fourier", "--platform", "paper",
+                                      str(bad)])
     assert result.exit_code == 2
     lines = result.output.strip().splitlines()
     assert len(lines) == 1 and "missing required column" in lines[0]
@@ -50,7 +51,8 @@ def test_bad_input_is_one_line(tmp_path, files):
 
 def test_rank_deficiency_is_one_line(files):
     paths, _, _ = files
-    result = CliRunner().invoke(app, ["identify", "--method", "ls", *map(str, paths[:5])])
+    result = CliRunner().invoke(app, ["identify", "--method", "ls", "--platform", "paper",
+                                      *map(str, paths[:5])])
     assert result.exit_code == 2
     assert "DOF rz was never excited" in result.output
 
@@ -88,7 +90,8 @@ def test_a_bug_shows_its_traceback(monkeypatch, files):
 
     monkeypatch.setattr(registry, "create_identifier", broken)
     paths, _, _ = files
-    result = CliRunner().invoke(app, ["identify", "--method", "ls", *map(str, paths)])
+    result = CliRunner().invoke(app, ["identify", "--method", "ls", "--platform", "paper",
+                                      *map(str, paths)])
     assert result.exit_code == 1
     assert isinstance(result.exception, ZeroDivisionError)
 

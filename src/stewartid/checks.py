@@ -135,7 +135,7 @@ def check_pose(pose: np.ndarray, platform: Platform, where: str) -> None:
         cause = "x, y, z look like millimetres: map them with --columns x..z=:mm"
     else:
         cause = "check the position unit (m), the frame and --platform"
-    raise DataError(f"{where}: the position is {offset:.4g} from the neutral pose of platform "
+    raise DataError(f"{where}: the position is {offset:.4g} m from the neutral pose of platform "
                     f"'{platform.name}' (z = {neutral[2]:.6g} m); {cause}.")
 
 
@@ -217,8 +217,11 @@ def _leg_order(pose: np.ndarray, lengths: np.ndarray, platform: Platform, fits) 
     computed = computed - computed.mean(axis=0)
     logged = lengths - lengths.mean(axis=0)
     cost = np.sqrt(np.mean((logged[:, :, None] - computed[:, None, :]) ** 2, axis=0))
-    best = min(itertools.permutations(range(6)), key=lambda p: sum(cost[j, p[j]]
-                                                                      for j in range(6)))
+    totals = {p: sum(cost[j, p[j]] for j in range(6)) for p in itertools.permutations(range(6))}
+    lowest = min(totals.values())
+    # legs that move alike in one experiment tie; the renumbering that moves fewest wins
+    best = min((p for p, total in totals.items() if total <= lowest + IK_TOLERANCE_M),
+               key=lambda p: sum(j != p[j] for j in range(6)))
     if best == tuple(range(6)) or not fits(pose, lengths[:, np.argsort(best)]):
         return None
     mapping = ",".join(f"l{best[j] + 1}=l{j + 1}" for j in range(6) if best[j] != j)
@@ -259,32 +262,28 @@ def check_static_balance(pose: np.ndarray, forces: np.ndarray, platform: Platfor
     terms = ModelTerms(platform, pose)
     generalized = np.einsum("nij,ni->nj", terms.leg_jacobian, forces)
     weight = -float(np.mean(terms.gravity[:, 2]))
-    ratio = -float(np.mean(generalized[:, 2])) / weight
+    ratio = round(-float(np.mean(generalized[:, 2])) / weight, 6) + 0.0  # no "-0"
     what = (f"{where}: the forces f1..f6 carry {ratio:.3g} times the weight of platform "
             f"'{platform.name}' ({weight:.4g} N)")
-    if abs(ratio - 1.0) <= BALANCE_WARNING:
-        static = np.linalg.solve(np.transpose(terms.leg_jacobian, (0, 2, 1)),
-                                 terms.gravity[..., None])[..., 0]
-        shares = forces.mean(axis=0) / static.mean(axis=0)
-        leg = int(np.argmax(np.abs(shares - 1.0)))
-        if abs(shares[leg] - 1.0) > LEG_BALANCE_ERROR:
-            raise DataError(f"{where}: column f{leg + 1} carries {shares[leg]:.3g} times its "
-                            "static load while the legs together carry the weight; check that "
-                            "channel (unplugged, unit, sign).")
-        return
+    if abs(ratio * 1000.0 - 1.0) <= BALANCE_ERROR:
+        raise DataError(f"{what}; forces in kN? map them with --columns f1..f6=:kN.")
     if abs(ratio) < 0.02:
-        cause = "force channels unplugged or not logged?"
-    elif abs(ratio * 1000.0 - 1.0) <= BALANCE_ERROR:
-        cause = "forces in kN? map them with --columns f1..f6=:kN"
-    elif abs(ratio + 1.0) <= BALANCE_ERROR:
-        cause = ("positive must extend the leg: map f1..f6 with scale = -1 "
-                 "(docs/logs.md)")
-    elif abs(ratio - 1.0) <= BALANCE_ERROR:
+        raise DataError(f"{what}; force channels unplugged or not logged?")
+    if abs(ratio + 1.0) <= BALANCE_ERROR:
+        raise DataError(f"{what}; positive must extend the leg: map f1..f6 with scale = -1 "
+                        "(docs/logs.md).")
+    if abs(ratio - 1.0) > BALANCE_ERROR:
+        raise DataError(f"{what}; wrong platform file (--platform) or force unit (N)?")
+    static = np.linalg.solve(np.transpose(terms.leg_jacobian, (0, 2, 1)),
+                             terms.gravity[..., None])[..., 0]
+    shares = forces.mean(axis=0) / static.mean(axis=0)
+    leg = int(np.argmax(np.abs(shares - 1.0)))
+    if abs(shares[leg] - 1.0) > LEG_BALANCE_ERROR:
+        raise DataError(f"{where}: column f{leg + 1} carries {shares[leg]:.3g} times its static "
+                        "load, the other legs about their share; check that channel "
+                        "(unplugged, unit, sign).")
+    if abs(ratio - 1.0) > BALANCE_WARNING:
         _warn(f"{what}: a payload missing from [inertia] platform_mass?")
-        return
-    else:
-        cause = "wrong platform file (--platform) or force unit (N)?"
-    raise DataError(f"{what}; {cause}")
 
 
 def check_dataset(pose: np.ndarray, lengths: np.ndarray, forces: np.ndarray,
