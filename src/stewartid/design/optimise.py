@@ -177,8 +177,9 @@ def optimise_design(platform: Platform, budget_s: float, noise: SensorNoise,
     for frequency in frequencies:
         amplitudes = largest_amplitudes(platform, frequency, max_use, cap)
         for levels in schedules:
-            short = min(screening_s, budget_s)
-            design = scheduled_design(amplitudes, frequency, [short / 6] * 6, levels)
+            # at least two held periods per level, whatever the screening length
+            short = max(min(screening_s, budget_s) / 6, (3 * len(levels) + 1) / frequency)
+            design = scheduled_design(amplitudes, frequency, [short] * 6, levels)
             prediction = predict_accuracy(platform, design, noise, method, screening_seeds)
             candidate = Candidate(design, prediction.scaled(budget_s / design.duration))
             screened.append(candidate)

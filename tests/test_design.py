@@ -1,0 +1,162 @@
+"""Excitation design: [limits], limit use, designed records, command files, predicted accuracy."""
+
+from __future__ import annotations
+
+import math
+import tomllib
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from stewartid.cli.application import app
+from stewartid.design.candidates import (
+    Design,
+    DesignedRecord,
+    paper_design,
+    scheduled_design,
+    unit_direction,
+)
+from stewartid.design.export import read_excitation, simulate_excitations, write_commands
+from stewartid.design.limits import limit_use, record_limit_use, resolve_limits
+from stewartid.design.prediction import model_datasets, predict_accuracy
+from stewartid.errors import ConfigError
+from stewartid.kinematics import inverse_kinematics
+from stewartid.platform import load_platform, platform_from_mapping
+from stewartid.simulation import SensorNoise
+
+
+@pytest.fixture(scope="module")
+def paper():
+    return load_platform("paper")
+
+
+def small_design() -> Design:
+    """Two short records (surge with two levels, yaw) at 1 Hz."""
+    return Design((DesignedRecord(unit_direction(0, 0.05), 1.0, (1.0, 0.5), 2, 1, "exp1"),
+                   DesignedRecord(unit_direction(5, 0.02), 1.0, (1.0,), 3, 1, "exp2")))
+
+
+def test_limits_defaults_from_the_model(paper):
+    limits = resolve_limits(paper)
+    # paper Table 1: legs of 3.41 m; 1 m stroke centred on them
+    assert limits.stroke_min == pytest.approx(3.41 - 0.5, abs=2e-3)
+    assert limits.stroke_max == pytest.approx(3.41 + 0.5, abs=2e-3)
+    # 200 L/min through a 100 mm bore
+    assert limits.leg_velocity == pytest.approx(200 / 60000 / (math.pi * 0.05 ** 2))
+    # retracting stall force p_s A_B - p_r A_A, the smaller of the two
+    area_b = math.pi * (0.1 ** 2 - 0.07 ** 2) / 4
+    assert limits.actuator_force == pytest.approx(21e6 * area_b - 0.5e6 * math.pi * 0.05 ** 2)
+
+
+def test_limits_section_read_checked_and_written(paper):
+    document = tomllib.loads(paper.to_toml())
+    document["limits"] = {"stroke_min": 3.2, "leg_velocity": 0.3}
+    custom = platform_from_mapping(document)
+    assert resolve_limits(custom).stroke_min == 3.2
+    assert resolve_limits(custom).leg_velocity == 0.3
+    assert platform_from_mapping(tomllib.loads(custom.to_toml())).limits == custom.limits
+    document["limits"] = {"stroke_min": 3.6, "stroke_max": 3.5}
+    with pytest.raises(ConfigError, match=r"stroke_min = 3.6 m must be below"):
+        platform_from_mapping(document)
+    document["limits"] = {"leg_speed": 1.0}
+    with pytest.raises(ConfigError, match=r"\[limits\] has unknown key 'leg_speed'"):
+        platform_from_mapping(document)
+    document["limits"] = {"stroke_min": 3.5}
+    with pytest.raises(ConfigError, match=r"neutral leg length .* must lie inside"):
+        resolve_limits(platform_from_mapping(document))
+
+
+def test_record_starts_and_ends_at_rest_and_derivatives_match(paper):
+    record = small_design().records[0]
+    t = np.linspace(0.0, record.duration, 20001)
+    q, qd, qdd = record.evaluate_offsets(t)
+    assert record.duration == pytest.approx(2 * 2 + 3 * 1)
+    for k in (0, -1):
+        assert np.abs(q[k]).max() < 1e-12 and np.abs(qd[k]).max() < 1e-12
+    h = t[1] - t[0]
+    assert np.allclose(np.gradient(q, h, axis=0)[1:-1], qd[1:-1], atol=2e-5)
+    assert np.allclose(np.gradient(qd, h, axis=0)[1:-1], qdd[1:-1], atol=2e-4)
+    # both levels are held: peak speed of the second hold is half the first's
+    first = (t > 1.0) & (t < 3.0)
+    second = (t > 4.0) & (t < 6.0)
+    assert np.abs(qd[second, 0]).max() == pytest.approx(0.5 * np.abs(qd[first, 0]).max(),
+                                                        rel=1e-3)
+
+
+def test_limit_use_against_finite_differences(paper):
+    design = small_design()
+    data = model_datasets(paper, design)[0]
+    limits = resolve_limits(paper)
+    rates = np.gradient(data.lengths, data.t, axis=0)
+    accelerations = np.gradient(rates, data.t, axis=0)
+    use = limit_use(paper, limits, data.t, data.pose, data.lengths, rates, accelerations,
+                    data.forces)
+    assert use.peak["leg_velocity"] == pytest.approx(np.abs(rates).max() / limits.leg_velocity)
+    assert use.peak["actuator_force"] == pytest.approx(
+        np.abs(data.forces).max() / limits.actuator_force)
+    # at the neutral pose (t = 0) no leg has turned and none has moved
+    assert use.use[0, [0, 4]] == pytest.approx([0.0, 0.0], abs=1e-6)
+    assert use.exceeded == []
+
+
+def test_command_files_play_back_the_design(paper, tmp_path):
+    design = small_design()
+    paths = write_commands(paper, design, tmp_path, rate_hz=500.0)
+    assert [p.name for p in paths] == ["exp1.csv", "exp2.csv"]
+    table = np.loadtxt(paths[0], delimiter=",", skiprows=1)
+    assert np.allclose(table[:, 7:], inverse_kinematics(paper, table[:, 1:7]).lengths)
+    played = read_excitation(paths[0], paper)
+    t = np.linspace(0.0, design.records[0].duration, 3001)
+    q, qd, _ = played.evaluate(t)
+    q_true, qd_true, _ = design.playable(paper)[0].evaluate(t)
+    assert np.abs(q - q_true).max() < 1e-8
+    assert np.abs(qd - qd_true).max() < 1e-6
+    assert played.max_frequency == pytest.approx(1.0, rel=1e-2)
+    # a user file with the leg lengths alone gives the same pose (forward kinematics)
+    lengths_only = tmp_path / "legs.csv"
+    columns = ["t"] + [f"l{k}" for k in range(1, 7)]
+    np.savetxt(lengths_only, table[:, [0, 7, 8, 9, 10, 11, 12]], delimiter=",",
+               header=",".join(columns), comments="")
+    assert np.abs(read_excitation(lengths_only, paper).pose - table[:, 1:7]).max() < 1e-8
+
+
+def test_excitation_file_errors(paper, tmp_path):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("t,x\n0,0\n1,0\n")
+    with pytest.raises(ConfigError.__mro__[1], match=r"give the pose columns"):
+        read_excitation(bad, paper)
+    runner = CliRunner()
+    result = runner.invoke(app, ["simulate", "--out", str(tmp_path / "o"), "--excitation",
+                                 str(tmp_path / "missing.csv")])
+    assert result.exit_code == 2
+    assert "no such excitation file" in result.output
+
+
+def test_design_cli_refuses_bad_budget(tmp_path):
+    result = CliRunner().invoke(app, ["design", "--budget", "-5", "--out", str(tmp_path)])
+    assert result.exit_code == 2
+    assert "--budget must be > 0" in result.output
+
+
+def test_predicted_errors_scale_with_the_noise(paper):
+    design = scheduled_design((0.05, 0.05, 0.05, 0.02, 0.02, 0.03), 1.0, [5.0] * 6)
+    noise = SensorNoise(length_noise=20e-6, force_noise=150.0)
+    one = predict_accuracy(paper, design, noise, seeds=3)
+    assert predict_accuracy(paper, design, SensorNoise(), seeds=2).worst_relative_std == 0.0
+    two = predict_accuracy(paper, design, SensorNoise(length_noise=40e-6, force_noise=300.0),
+                           seeds=3)
+    # twice the noise: at least twice the spread (the interval detection also loses data)
+    assert two.worst_relative_std > 1.9 * one.worst_relative_std
+    # noise-free model data of a near-linear motion: the estimate is close to nominal
+    assert one.relative_bias.max() < 1.0
+    assert one.scaled(4.0).worst_relative_std == pytest.approx(one.worst_relative_std / 2)
+
+
+@pytest.mark.slow
+def test_designed_records_on_the_plant_stay_within_limits(paper):
+    design = paper_design(frequency_hz=1.0, duration_s=5.0,
+                          amplitudes=(0.06, 0.06, 0.06, 0.02, 0.02, 0.03))
+    run = simulate_excitations(paper, design.playable(paper)[:2])
+    for record in run.states:
+        assert record_limit_use(paper, record).exceeded == []
