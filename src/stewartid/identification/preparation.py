@@ -18,15 +18,16 @@ Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from stewartid.dataset import Dataset, read_datasets
-from stewartid.dynamics import ModelTerms
 from stewartid.errors import ConfigError, DataError
+from stewartid.kinematics import _leg_terms, joint_rate_jacobians
 from stewartid.platform import Platform, load_platform
 
 
@@ -46,13 +47,16 @@ class Experiment:
         is off.
     leg_jacobian : ndarray, shape (N, 6, 6)
         J_lq at every measured pose.
-    joint_jacobians : ndarray, shape (N, 6, 5, 6)
-        Joint-axis rate Jacobians at every measured pose (rad/s per unit q_dot), axes
-        lower 1, lower 2, upper 1, upper 2, revolute.
     gravity : ndarray, shape (N, 6)
         G(q) of the platform description (N, N m), whether or not it was subtracted.
     sample_rate : float
         Hz.
+    platform : Platform
+        The description the terms were computed from.
+    joint_jacobians : ndarray, shape (N, 6, 5, 6)
+        Joint-axis rate Jacobians at every measured pose (rad/s per unit q_dot), axes
+        lower 1, lower 2, upper 1, upper 2, revolute; computed on first use (1.4 kB a
+        sample, and not every method needs them).
     """
 
     name: str
@@ -60,9 +64,14 @@ class Experiment:
     q: np.ndarray
     generalized_force: np.ndarray
     leg_jacobian: np.ndarray
-    joint_jacobians: np.ndarray
     gravity: np.ndarray
     sample_rate: float
+    platform: Platform = field(repr=False)
+
+    @cached_property
+    def joint_jacobians(self) -> np.ndarray:
+        """Joint-axis rate Jacobians, shape (N, 6, 5, 6); see the class docstring."""
+        return joint_rate_jacobians(self.platform, self.q)
 
     @property
     def period(self) -> float:
@@ -122,14 +131,13 @@ def prepare(datasets: Sequence[Dataset], platform: Platform, gravity: bool = Tru
     """
     out = []
     for d in datasets:
-        terms = ModelTerms(platform, d.pose)
-        y = np.einsum("nji,nj->ni", terms.leg_jacobian, d.forces)
+        G, J, _, _ = _leg_terms(platform, np.ascontiguousarray(d.pose))
+        y = np.einsum("nji,nj->ni", J, d.forces)
         if gravity:
-            y = y - terms.gravity
+            y = y - G
         out.append(Experiment(name=d.name, t=d.t, q=d.pose, generalized_force=y,
-                              leg_jacobian=terms.leg_jacobian,
-                              joint_jacobians=terms.joint_jacobians, gravity=terms.gravity,
-                              sample_rate=d.sample_rate))
+                              leg_jacobian=J, gravity=G, sample_rate=d.sample_rate,
+                              platform=platform))
     return out
 
 
