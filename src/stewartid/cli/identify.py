@@ -119,6 +119,16 @@ def identify(
     stiffness: Annotated[bool, typer.Option(
         "--stiffness", help="fourier: identify a stiffness matrix too (needs >= 2 "
                             "frequencies).")] = False,
+    report: Annotated[Path | None, typer.Option(
+        "--report", help="Write a report into this folder: data, intervals, matrices with "
+                         "standard errors, residuals, validation on held-out data, "
+                         "consistency, friction, CSV and MATLAB exports, result.json.")] = None,
+    consistent: Annotated[bool, typer.Option(
+        "--consistent", help="Replace Mt, Bt by the nearest symmetric pair with Mt positive "
+                             "definite and Bt positive semidefinite (needs the 'convex' "
+                             "extra).")] = False,
+    folds: Annotated[int, typer.Option(
+        "--folds", help="--report: time segments per experiment for the validation.")] = 3,
 ) -> None:
     """Identify Mt and Bt from experiments; print the paper-style table when nominal values are
     known (platform description, or meta.json/truth.json beside the data) and write JSON."""
@@ -132,9 +142,11 @@ def identify(
     from stewartid.logformat import load_log_format
     from stewartid.platform import load_platform
     from stewartid.reporting.terminal import print_comparison
+    from stewartid.reporting.user_report import methods_for
 
-    spec = method_spec(method)
-    accepted = spec.estimator_class._param_names()
+    names = methods_for(method)
+    accepted = {name for each in names
+                for name in method_spec(each).estimator_class._param_names()}
     options = {"--no-gravity": ("gravity", not no_gravity, no_gravity),
                "--symmetric": ("symmetric", symmetric, symmetric),
                "--frequency": ("frequency_hz", frequency or None, bool(frequency)),
@@ -161,10 +173,26 @@ def identify(
         check_output_file(out, force, inputs, is_result=_is_result)
         if out.suffix.lower() in INPUT_SUFFIXES:
             raise ConfigError(f"--out {str(out)!r}: the result is JSON; give a .json file name.")
+    if report is not None:
+        from stewartid.io import check_output_folder
+
+        check_output_folder(report, force)
+    elif len(names) > 1:
+        raise ConfigError(f"--method {method} compares the methods in a report; add "
+                          "--report DIR.")
     log_format = load_log_format(columns) if columns is not None else None
     datasets = read_datasets(paths, description, log_format)
-    estimator = create_identifier(method, **settings).fit(datasets, description)
-    result = estimator.result_
+    if report is not None or consistent or len(names) > 1:
+        from stewartid.reporting.user_report import identify_for_command
+
+        result, written = identify_for_command(
+            datasets, description, method, settings, report, consistent, folds,
+            nominal_from_meta(paths), [str(p) for p in paths],
+            check=lambda found: check_identified(found.M, found.B, description))
+        if written is not None:
+            typer.echo(f"wrote the report to {report}/report.html; trusted: {written.trusted}")
+    else:
+        result = create_identifier(method, **settings).fit(datasets, description).result_
     check_identified(result.M, result.B, description)
 
     meta = nominal_from_meta(paths)

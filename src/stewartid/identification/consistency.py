@@ -139,6 +139,22 @@ def _weights(std: np.ndarray, estimate: np.ndarray) -> np.ndarray:
     return 1.0 / np.where(usable, np.maximum(std, 1e-9 * scale), fallback)
 
 
+def require_cvxpy() -> Any:
+    """The cvxpy module.
+
+    Raises
+    ------
+    ConfigError
+        If it is not installed; the message names the extra to install.
+    """
+    try:
+        import cvxpy
+    except ImportError:
+        raise ConfigError('the consistent fit needs cvxpy; install the extra with pip install '
+                          '"stewartid[convex]".') from None
+    return cvxpy
+
+
 def project_consistent(M: np.ndarray, B: np.ndarray, std_M: np.ndarray, std_B: np.ndarray,
                        solver: str | None = None) -> ConsistentEstimate:
     """The consistent (M, B) nearest to an estimate, in standard errors (module docstring).
@@ -163,11 +179,7 @@ def project_consistent(M: np.ndarray, B: np.ndarray, std_M: np.ndarray, std_B: n
     IdentificationError
         If the solver fails.
     """
-    try:
-        import cvxpy as cp
-    except ImportError:
-        raise ConfigError('the consistent fit needs cvxpy; install the extra with pip install '
-                          '"stewartid[convex]".') from None
+    cp = require_cvxpy()
     M_hat, B_hat = np.asarray(M, dtype=float), np.asarray(B, dtype=float)
     W_M, W_B = _weights(std_M, M_hat), _weights(std_B, B_hat)
     floor = STRICT_FRACTION * float(np.mean(np.abs(np.diag(M_hat))))
@@ -209,4 +221,4 @@ def _clip_psd(matrix: np.ndarray, floor: float) -> np.ndarray:
 
 
 __all__ = ["STRICT_FRACTION", "ConsistentEstimate", "asymmetry", "consistency_metrics",
-           "is_consistent", "min_eigenvalue", "project_consistent"]
+           "is_consistent", "min_eigenvalue", "project_consistent", "require_cvxpy"]

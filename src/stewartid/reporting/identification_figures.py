@@ -3,7 +3,8 @@
 Drawn like every figure of the package (:mod:`stewartid.reporting.figures`): a
 :class:`matplotlib.figure.Figure` inside ``rc_context(STYLE)``, no pyplot, lines thinned to a
 few thousand points, saved by :func:`~stewartid.reporting.figures.save_figure`. Every
-function returns the written paths.
+function returns the written paths. The layouts are regular grids with fixed margins rather
+than matplotlib's constrained layout, which would triple the drawing time of a report.
 """
 
 from __future__ import annotations
@@ -23,12 +24,23 @@ DISPLACEMENT_UNITS = (("mm", 1e3),) * 3 + (("mrad", 1e3),) * 3
 FORCE_UNITS = ("N",) * 3 + ("N·m",) * 3
 
 
-def _grid(figure, count: int, columns: int = 3, **options):
+def _grid(figure, count: int, columns: int = 3, top: float = 0.9, **options):
+    """A grid of ``count`` axes with fixed margins (hidden axes fill the last row)."""
     rows = int(np.ceil(count / columns))
-    axes = figure.subplots(rows, columns, squeeze=False, **options)
+    margins = {"left": 0.07, "right": 0.98, "bottom": 0.08, "top": top, "hspace": 0.45,
+               "wspace": 0.3, **options}
+    axes = figure.subplots(rows, columns, squeeze=False, gridspec_kw=margins)
     for axis in list(axes.flat)[count:]:
         axis.set_visible(False)
     return axes
+
+
+def _log_floor(axis, values: np.ndarray, decades: float = 5.0) -> None:
+    """Show ``decades`` decades below the largest value: fewer ticks to draw, and the
+    numerical floor of a noise-free record is not the interesting part."""
+    top = float(np.nanmax(values)) if np.size(values) else 1.0
+    if top > 0:
+        axis.set_ylim(top * 10 ** -decades, top * 3)
 
 
 @_styled
@@ -47,7 +59,7 @@ def plot_spectra(names: Sequence[str], poses: Sequence[np.ndarray], sample_rates
     frequencies_hz : sequence of float
         Dominant excitation frequency of each experiment (Hz), marked and used for the range.
     """
-    figure = _figure(figsize=(13, 3.3 * int(np.ceil(len(names) / 3))), layout="constrained")
+    figure = _figure(figsize=(13, 3.3 * int(np.ceil(len(names) / 3)) + 0.6))
     axes = _grid(figure, len(names))
     colours = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b"]
     for axis, name, q, rate, f0 in zip(axes.flat, names, poses, sample_rates, frequencies_hz,
@@ -57,17 +69,18 @@ def plot_spectra(names: Sequence[str], poses: Sequence[np.ndarray], sample_rates
         spectrum = 2 * np.abs(np.fft.rfft((q - q.mean(axis=0)) * window, axis=0)) / window.sum()
         frequency = np.fft.rfftfreq(n, 1.0 / rate)
         keep = (frequency > 0) & (frequency <= min(20 * f0, rate / 2))
+        shown = spectrum[keep] * np.array([scale for _, scale in DISPLACEMENT_UNITS])
         for k in range(6):
-            unit, scale = DISPLACEMENT_UNITS[k]
-            axis.semilogy(frequency[keep], np.maximum(spectrum[keep, k] * scale, 1e-12),
-                          color=colours[k], lw=0.9, label=f"{COORDINATES[k]} ({unit})")
+            axis.semilogy(frequency[keep], shown[:, k], color=colours[k], lw=0.9,
+                          label=f"{COORDINATES[k]} ({DISPLACEMENT_UNITS[k][0]})")
+        _log_floor(axis, shown)
         axis.axvline(f0, color="k", lw=0.6, ls="--")
         axis.set_title(f"{name}: dominant {f0:.4g} Hz")
         axis.set_xlabel("frequency (Hz)")
         axis.set_ylabel("amplitude (mm, mrad)")
     axes[0, 0].legend(loc="upper right", ncol=2, framealpha=0.9)
     figure.suptitle("Spectrum of the measured motion (Hann window)")
-    return save_figure(figure, directory, stem)
+    return save_figure(figure, directory, stem, tight=False)
 
 
 @_styled
@@ -88,8 +101,10 @@ def plot_intervals(names: Sequence[str], spans: Sequence[tuple[float, float]],
     points : sequence of ndarray, shape (K_k, 2), or None
         (a, b) pairs (s, s).
     """
-    figure = _figure(figsize=(11, 0.55 * len(names) + 1.6), layout="constrained")
-    axis = figure.subplots()
+    height = 0.55 * len(names) + 1.6
+    figure = _figure(figsize=(11, height))
+    axis = figure.subplots(gridspec_kw={"left": 0.1, "right": 0.98, "bottom": 0.9 / height,
+                                        "top": 1 - 0.7 / height})
     for row, (span, found, used) in enumerate(zip(spans, intervals, points, strict=True)):
         axis.plot(span, [row, row], color="#cccccc", lw=6, solid_capstyle="butt")
         for k, (start, stop) in enumerate(np.asarray(found).reshape(-1, 2)):
@@ -105,8 +120,9 @@ def plot_intervals(names: Sequence[str], spans: Sequence[tuple[float, float]],
     axis.set_xlabel("time (s)")
     axis.set_title("Intervals in which no active joint reverses (grey: the record)")
     if axis.get_legend_handles_labels()[0]:
-        axis.legend(loc="upper right", bbox_to_anchor=(1.0, 1.25), ncol=2, framealpha=0.9)
-    return save_figure(figure, directory, stem)
+        axis.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), ncol=2, framealpha=0.9,
+                    fontsize=8)
+    return save_figure(figure, directory, stem, tight=False)
 
 
 def _significant(nominal: np.ndarray) -> list[tuple[int, int]]:
@@ -129,8 +145,9 @@ def plot_matrices(estimates: Mapping[str, tuple[np.ndarray, np.ndarray, np.ndarr
     colours : mapping of label to colour
     M_nominal, B_nominal : ndarray, shape (6, 6)
     """
-    figure = _figure(figsize=(13, 7.5), layout="constrained")
-    axes = figure.subplots(2, 1)
+    figure = _figure(figsize=(13, 7.5))
+    axes = figure.subplots(2, 1, gridspec_kw={"left": 0.07, "right": 0.98, "bottom": 0.1,
+                                              "top": 0.95, "hspace": 0.45})
     width = 0.8 / max(len(estimates), 1)
     for axis, index, nominal, name in ((axes[0], 0, M_nominal, "Mt"),
                                        (axes[1], 1, B_nominal, "Bt")):
@@ -149,7 +166,7 @@ def plot_matrices(estimates: Mapping[str, tuple[np.ndarray, np.ndarray, np.ndarr
         axis.set_title(f"{name}: identified over nominal (nominal under each entry), "
                        "bars ±2 standard errors")
     axes[0].legend(loc="best", framealpha=0.9)
-    return save_figure(figure, directory, stem)
+    return save_figure(figure, directory, stem, tight=False)
 
 
 def _concatenated(validation: ValidationResult, values: Sequence[np.ndarray]):
@@ -168,21 +185,25 @@ def plot_residuals(validation: ValidationResult, frequencies_hz: Sequence[float]
     spectrum, with the excitation frequencies and their harmonics marked."""
     residual = [m - p for m, p in zip(validation.measured, validation.predicted, strict=True)]
     t, values = _concatenated(validation, residual)
-    figure = _figure(figsize=(13, 12), layout="constrained")
-    axes = figure.subplots(6, 2, gridspec_kw={"width_ratios": [2.2, 1]})
+    figure = _figure(figsize=(13, 12))
+    axes = _grid(figure, 12, columns=2, top=0.95, bottom=0.05, hspace=0.35, wspace=0.2,
+                 width_ratios=[2.2, 1])
     step = _every(t, 6000)
     rate = 1.0 / (validation.segments[0].t[1] - validation.segments[0].t[0])
     top = 10 * max(frequencies_hz)
     for c in range(6):
         axes[c, 0].plot(t[step], values[step, c], color="#444444", lw=0.6)
         axes[c, 0].set_ylabel(f"{COORDINATES[c]} ({FORCE_UNITS[c]})")
+        peaks = []
         for piece in (r[:, c] for r in residual):
             window = np.hanning(len(piece))
             amplitude = 2 * np.abs(np.fft.rfft((piece - piece.mean()) * window)) / window.sum()
             frequency = np.fft.rfftfreq(len(piece), 1.0 / rate)
             keep = frequency <= top
-            axes[c, 1].semilogy(frequency[keep], np.maximum(amplitude[keep], 1e-12), lw=0.5,
-                                color="#444444", alpha=0.5)
+            axes[c, 1].semilogy(frequency[keep], amplitude[keep], lw=0.5, color="#444444",
+                                alpha=0.5)
+            peaks.append(amplitude[keep])
+        _log_floor(axes[c, 1], np.concatenate(peaks), decades=4.0)
         for f in sorted(set(np.round(frequencies_hz, 6))):
             for harmonic in range(1, int(top / f) + 1):
                 axes[c, 1].axvline(harmonic * f, color="#d62728", lw=0.5, ls=":")
@@ -190,7 +211,7 @@ def plot_residuals(validation: ValidationResult, frequencies_hz: Sequence[float]
     axes[0, 1].set_title("Residual spectrum per segment; dotted: excitation harmonics")
     axes[-1, 0].set_xlabel("time across the experiments (s)")
     axes[-1, 1].set_xlabel("frequency (Hz)")
-    return save_figure(figure, directory, stem)
+    return save_figure(figure, directory, stem, tight=False)
 
 
 @_styled
@@ -206,8 +227,8 @@ def plot_validation(validations: Mapping[str, ValidationResult], colours: Mappin
     colours : mapping of label to colour
     """
     first = next(iter(validations.values()))
-    figure = _figure(figsize=(13, 9), layout="constrained")
-    axes = _grid(figure, 6)
+    figure = _figure(figsize=(13, 9))
+    axes = _grid(figure, 6, top=0.91)
     styles = ["-", "--", "-.", ":"]
     for c, axis in enumerate(axes.flat[:6]):
         energy: dict[int, float] = {}
@@ -232,15 +253,16 @@ def plot_validation(validations: Mapping[str, ValidationResult], colours: Mappin
         axis.legend(loc="upper right", fontsize=7, framealpha=0.9)
     figure.suptitle("Held-out data: measured generalized force and the identified model's "
                     "prediction (each segment predicted by the fit without it)")
-    return save_figure(figure, directory, stem)
+    return save_figure(figure, directory, stem, tight=False)
 
 
 @_styled
 def plot_unexplained(vaf: Mapping[str, np.ndarray], colours: Mapping[str, str],
                      directory: str | Path, stem: str = "methods") -> list[Path]:
     """Held-out unexplained force, 100 − VAF (%), per DOF and method (log scale)."""
-    figure = _figure(figsize=(9, 4), layout="constrained")
-    axis = figure.subplots()
+    figure = _figure(figsize=(9, 4))
+    axis = figure.subplots(gridspec_kw={"left": 0.1, "right": 0.98, "bottom": 0.1,
+                                        "top": 0.9})
     width = 0.8 / max(len(vaf), 1)
     x = np.arange(6)
     for k, (label, values) in enumerate(vaf.items()):
@@ -253,7 +275,7 @@ def plot_unexplained(vaf: Mapping[str, np.ndarray], colours: Mapping[str, str],
     axis.set_title("Force the model does not explain on data it was not fitted on "
                    "(lower is better)")
     axis.legend(loc="best", framealpha=0.9)
-    return save_figure(figure, directory, stem)
+    return save_figure(figure, directory, stem, tight=False)
 
 
 @_styled
@@ -268,8 +290,9 @@ def plot_friction(levels: Mapping[str, tuple[np.ndarray, np.ndarray]],
     nominal : float or None
         The platform description's Coulomb level (N m per joint axis), drawn as a line.
     """
-    figure = _figure(figsize=(7, 3.6), layout="constrained")
-    axis = figure.subplots()
+    figure = _figure(figsize=(7, 3.6))
+    axis = figure.subplots(gridspec_kw={"left": 0.12, "right": 0.98, "bottom": 0.12,
+                                        "top": 0.9})
     width = 0.8 / max(len(levels), 1)
     x = np.arange(len(FRICTION_TYPES))
     for k, (label, (value, std)) in enumerate(levels.items()):
@@ -281,7 +304,7 @@ def plot_friction(levels: Mapping[str, tuple[np.ndarray, np.ndarray]],
     axis.set_ylabel("Coulomb level (N·m per joint axis)")
     axis.set_title("Coulomb friction per joint type, ±2 standard errors")
     axis.legend(loc="best", framealpha=0.9)
-    return save_figure(figure, directory, stem)
+    return save_figure(figure, directory, stem, tight=False)
 
 
 __all__ = ["plot_friction", "plot_intervals", "plot_matrices", "plot_residuals",

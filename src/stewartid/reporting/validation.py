@@ -241,9 +241,22 @@ def excitation_window(dataset: Dataset) -> float:
     return default_window(estimate_frequency(dataset.pose, dataset.sample_rate))
 
 
+def held_out_segments(datasets: Sequence[Dataset], platform: Platform,
+                      folds: int = DEFAULT_FOLDS, gravity: bool = True) -> list[Segment]:
+    """Every fold segment of every experiment, filtered (:func:`prepare_segment`); the same
+    for every method with the same ``gravity`` setting."""
+    segments = []
+    for e, dataset in enumerate(datasets):
+        edges, window = fold_bounds(len(dataset), folds), excitation_window(dataset)
+        for k in range(folds):
+            segments.append(prepare_segment(_piece(dataset, edges[k], edges[k + 1]), platform,
+                                            window, gravity=gravity, experiment=e, fold=k))
+    return segments
+
+
 def cross_validate(create: Callable[[], Any], datasets: Sequence[Dataset], platform: Platform,
                    folds: int = DEFAULT_FOLDS, gravity: bool = True,
-                   coulomb_smoothing: float = 1e-4) -> CrossValidation:
+                   segments: list[Segment] | None = None) -> CrossValidation:
     """Refit a method without each time segment and prepare the held-out segments.
 
     Parameters
@@ -257,8 +270,9 @@ def cross_validate(create: Callable[[], Any], datasets: Sequence[Dataset], platf
         Segments per experiment, >= 2.
     gravity : bool
         Whether the method subtracts G(q) (its ``gravity`` setting).
-    coulomb_smoothing : float
-        See :func:`prepare_segment`.
+    segments : list of Segment, optional
+        The held-out segments if already prepared (:func:`held_out_segments` with the same
+        ``folds`` and ``gravity``).
 
     Returns
     -------
@@ -273,7 +287,6 @@ def cross_validate(create: Callable[[], Any], datasets: Sequence[Dataset], platf
     if not (isinstance(folds, int | np.integer) and folds >= 2):
         raise DataError(f"validation needs at least 2 folds; got {folds!r}.")
     bounds = [fold_bounds(len(d), folds) for d in datasets]
-    windows = [excitation_window(d) for d in datasets]
     fold_results = []
     for k in range(folds):
         training = []
@@ -287,13 +300,33 @@ def cross_validate(create: Callable[[], Any], datasets: Sequence[Dataset], platf
             raise DataError(f"validation fold {k + 1} of {folds} (segment {k + 1} of every "
                             f"experiment held out) cannot be fitted: {exc} Record longer "
                             "experiments or use fewer folds.") from exc
-    segments = []
-    for e, (dataset, edges, window) in enumerate(zip(datasets, bounds, windows, strict=True)):
-        for k in range(folds):
-            segments.append(prepare_segment(_piece(dataset, edges[k], edges[k + 1]), platform,
-                                            window, gravity=gravity, experiment=e, fold=k,
-                                            coulomb_smoothing=coulomb_smoothing))
+    if segments is None:
+        segments = held_out_segments(datasets, platform, folds, gravity)
     return CrossValidation(folds=int(folds), fold_results=fold_results, segments=segments)
+
+
+def friction_signature(validation: ValidationResult) -> float:
+    """Share of the held-out residual that has the shape of Coulomb joint friction.
+
+    The residuals of all six equations (each divided by the RMS of its measured force) are
+    fitted by least squares with the three Coulomb regressors (one level per joint type,
+    shared by the equations, centred per segment like the forces). 0: nothing of the
+    residual looks like friction; near 1: the residual is mostly friction the model lacks.
+    """
+    measured = np.concatenate(validation.measured)
+    scale = np.sqrt(np.mean(measured ** 2, axis=0))
+    scale = np.where(scale > 0, scale, 1.0)
+    residual = (measured - np.concatenate(validation.predicted)) / scale
+    regressors = np.concatenate([s.coulomb - s.coulomb.mean(axis=0)
+                                 for s in validation.segments]) / scale
+    design = np.transpose(regressors, (0, 2, 1)).reshape(-1, regressors.shape[1])
+    target = residual.reshape(-1)
+    energy = float(target @ target)
+    if energy == 0:
+        return 0.0
+    coefficients, *_ = np.linalg.lstsq(design, target, rcond=None)
+    left = target - design @ coefficients
+    return float(1.0 - left @ left / energy)
 
 
 def in_sample(segments: Sequence[Segment], result: IdentificationResult) -> ValidationResult:
@@ -304,4 +337,5 @@ def in_sample(segments: Sequence[Segment], result: IdentificationResult) -> Vali
 
 __all__ = ["DEFAULT_FOLDS", "FRICTION_TYPES", "CrossValidation", "Segment", "ValidationResult",
            "coulomb_levels", "cross_validate", "excitation_window", "fold_bounds",
-           "in_sample", "predict", "prepare_segment", "score"]
+           "friction_signature", "held_out_segments", "in_sample", "predict", "prepare_segment",
+           "score"]
