@@ -39,6 +39,19 @@ def test_round_trip(tmp_path, dataset, suffix):
     assert not list(tmp_path.glob(".*.tmp"))
 
 
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_round_trip_is_bit_exact_over_magnitudes(tmp_path, dataset, suffix):
+    """Doubles from 1e-300 to 1e300, negative zero and every last bit read back identical."""
+    rng = np.random.default_rng(1)
+    n = len(dataset)
+    forces = rng.standard_normal((n, 6)) * 10.0 ** rng.integers(-300, 300, (n, 6))
+    forces[0, 0], forces[1, 1] = -0.0, np.nextafter(1.0, 2.0)
+    odd = Dataset(t=dataset.t, pose=dataset.pose, lengths=dataset.lengths, forces=forces,
+                  name="odd")
+    back = read_dataset(write_dataset(odd, tmp_path / f"odd{suffix}"))
+    assert np.array_equal(back.forces.view(np.int64), forces.view(np.int64))
+
+
 def _write(tmp_path, frame, name="bad.csv"):
     path = tmp_path / name
     frame.to_csv(path, index=False)
