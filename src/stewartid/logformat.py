@@ -183,7 +183,7 @@ def _column_source(target: str, value: Any, source: str, index: int | None) -> C
     if isinstance(value, str):
         name, unit = value, ""
         head, colon, tail = value.rpartition(":")
-        if colon and tail.lower() in UNITS[_QUANTITY[target]]:
+        if colon and any(tail.lower() in units for units in UNITS.values()):
             name, unit = head, tail
         value = {"name": name, "unit": unit}
     if not isinstance(value, Mapping):

@@ -103,11 +103,11 @@ def check_physical_ranges(sections: Mapping[str, Any]) -> None:
             value = getattr(section, field.name)
             values = value if isinstance(value, tuple) else (value,)
             low, high = ranges[field.name]
-            for v in values:
+            for index, v in enumerate(values):
                 if v is None or isinstance(v, bool | str) or low <= v <= high:
                     continue
                 unit = field.metadata.get("unit", "")
-                label = field.name if len(values) == 1 else f"{field.name} entry {v:g}"
+                label = field.name if len(values) == 1 else f"{field.name}[{index}]"
                 raise ConfigError(f"[{name}] {label} = {v:g} {unit} is outside the physical "
                                   f"range {low:g} to {high:g} {unit}; check its unit (SI).")
 
