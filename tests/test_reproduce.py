@@ -19,9 +19,10 @@ from stewartid.reproduction.settings import default_methods, make_settings
 
 LEVELS = (0, 5, 30)
 TABLES = ["summary", "table3", "table4", "table5", "table6"] + [
-    f"comparison_coulomb{level}" for level in LEVELS]
+    f"comparison_coulomb{level}" for level in LEVELS] + ["comparison_coulomb30_noisy"]
 FIGURES = ["excitation", "joint_velocities", "force_budget", "scalogram", "errors"] + [
-    f"identified_vs_nominal_coulomb{level}" for level in LEVELS]
+    f"identified_vs_nominal_coulomb{level}" for level in LEVELS] + [
+    "identified_vs_nominal_noisy"]
 
 
 @pytest.fixture(scope="module")
@@ -82,6 +83,32 @@ def test_results_json_holds_finite_values_in_range(quick_run, paper):
     # the paper's own Table 5 value travels with the run it belongs to
     fourier5 = next(r for r in document["runs"] if (r["method"], r["coulomb"]) == ("fourier", 5))
     assert fourier5["published"]["Bt(3,3)"] == {"value": 3478.0, "eps": 70.6}
+
+
+@pytest.mark.slow
+def test_noisy_case_is_reported(quick_run, paper):
+    out, output = quick_run
+    document = json.loads((out / "results.json").read_text())
+    case = document["noise_case"]
+    assert case["coulomb"] == 30.0 and case["noise_scale"] == 1.0
+    assert {r["method"] for r in case["runs"]} == set(default_methods())
+    M0, B0 = nominal_matrices(paper)
+    clean = {r["method"]: r for r in document["runs"] if r["coulomb"] == 30.0}
+    for run in case["runs"]:
+        M, B = np.asarray(run["M"]), np.asarray(run["B"])
+        # the records really are other ones: noise moves every method's estimate
+        assert not np.allclose(M, clean[run["method"]]["M"], rtol=1e-9, atol=0)
+        # the count of entries within three standard errors, recomputed here
+        within = 0
+        for label, (matrix, truth, std) in {"M": (M, M0, run["std_errors_M"]),
+                                            "B": (B, B0, run["std_errors_B"])}.items():
+            for i, j in ((0, 0), (1, 1), (2, 2), (3, 3), (4, 4), (5, 5), (0, 4), (1, 3),
+                         (3, 1), (4, 0)):
+                within += abs(matrix[i, j] - truth[i, j]) <= 3 * np.asarray(std)[i, j]
+                eps = abs(matrix[i, j] / truth[i, j] - 1) * 100
+                assert run["eps"][f"{label}t({i + 1},{j + 1})"] == pytest.approx(eps)
+        assert run["within_3_std"] == within
+    assert "reference sensor noise" in output and case["summary"] in document["summary"]
 
 
 @pytest.mark.slow

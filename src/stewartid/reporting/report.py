@@ -139,7 +139,9 @@ def others_summary(results: ComparisonResults) -> list[str]:
 
 def summary_lines(results: ComparisonResults) -> list[str]:
     """The automatic summary, one Markdown sentence group per bullet."""
-    return wavelet_summary(results) + fourier_summary(results) + others_summary(results)
+    noisy = results.settings.get("noise_case_summary")
+    return (wavelet_summary(results) + fourier_summary(results) + others_summary(results)
+            + ([str(noisy)] if noisy else []))
 
 
 def _settings_lines(results: ComparisonResults) -> list[str]:

@@ -37,6 +37,14 @@ from stewartid.platform import Platform, load_platform
 from stewartid.reference.published import load_published
 from stewartid.reporting.comparison import ComparisonResults, MethodRun
 from stewartid.reproduction.document import results_document
+from stewartid.reproduction.noisy import (
+    NOISE_SCALE,
+    STEM,
+    noisy_document,
+    noisy_results,
+    noisy_summary,
+    noisy_table,
+)
 from stewartid.reproduction.plots import (
     FigureQueue,
     submit_comparison_figures,
@@ -53,7 +61,8 @@ from stewartid.reproduction.settings import (
 # Module-level functions: they run in worker processes and must be picklable.
 
 def simulate_one(platform: Platform, experiment: int, frequency_hz: float, duration_s: float,
-                 seed: int, keep_record: bool = False) -> tuple[Any, Any, list[float]]:
+                 seed: int, keep_record: bool = False, noise_scale: float = 0.0
+                 ) -> tuple[Any, Any, list[float]]:
     """Simulate experiment ``experiment`` (0-5) of the paper's six on ``platform``.
 
     The noise generator is :func:`~stewartid.simulation.experiments.noise_generator`'s, as in
@@ -68,13 +77,20 @@ def simulate_one(platform: Platform, experiment: int, frequency_hz: float, durat
         True signals, only when ``keep_record`` (they are large).
     tracking_error : list of float
         RMS leg-length tracking error per leg (m).
+
+    ``noise_scale`` > 0 measures with that multiple of the reference sensor noise
+    (:func:`~stewartid.simulation.sensors.reference_noise`) instead of the platform's
+    ``[sensors]`` errors.
     """
     from stewartid.simulation import SensorNoise, paper_experiments, simulate_experiment
     from stewartid.simulation.experiments import noise_generator
+    from stewartid.simulation.sensors import reference_noise
 
     excitations = paper_experiments(platform, frequency_hz)
+    sensors = reference_noise(platform, noise_scale) if noise_scale > 0 else \
+        SensorNoise.from_sensors(platform.sensors)
     dataset, record = simulate_experiment(platform, excitations[experiment], duration_s,
-                                          SensorNoise.from_sensors(platform.sensors),
+                                          sensors,
                                           noise_generator(seed, experiment, len(excitations)))
     return dataset, record if keep_record else None, record.tracking_error().tolist()
 
@@ -227,6 +243,7 @@ def run_reproduce(out: str | Path = "results/reproduce", quick: bool = False,
     """
     from stewartid import __version__
     from stewartid.linearization import nominal_matrices
+    from stewartid.reporting.figures import plot_identified_vs_nominal
     from stewartid.reporting.report import write_report
     from stewartid.reporting.tables import build_tables, write_tables
 
@@ -247,34 +264,54 @@ def run_reproduce(out: str | Path = "results/reproduce", quick: bool = False,
                                settings.duration_s, settings.seed,
                                keep_record=(level == trace_level and k == TRACE_EXPERIMENT))
                    for level, k in keys]
+        # the noisy case: the highest level once more, with the reference sensor noise
+        noisy_futures = [pool.submit(simulate_one, plants[trace_level], k,
+                                     settings.frequency_hz, settings.duration_s,
+                                     settings.seed, noise_scale=NOISE_SCALE)
+                         for k in range(6)] if settings.noise_case else []
+        bar.update(task, total=len(futures) + len(noisy_futures))
         outputs = dict(zip(keys, _collect(futures, bar, task), strict=True))
         datasets = {level: [outputs[(level, k)][0] for k in range(6)] for level in levels}
+        noisy_datasets = [output[0] for output in _collect(noisy_futures, bar, task)]
 
         jobs_list = [(method, level) for level in levels for method in settings.methods]
         identify_task = bar.add_task("identifying Mt, Bt", total=len(jobs_list))
         identifications = [pool.submit(identify, method, level, datasets[level], plants[level])
                            for method, level in jobs_list]
+        noisy_identifications = [pool.submit(identify, method, trace_level, noisy_datasets,
+                                             plants[trace_level])
+                                 for method in settings.methods] if noisy_datasets else []
+        bar.update(identify_task, total=len(identifications) + len(noisy_identifications))
         figure_task = bar.add_task("drawing figures", total=6 + len(levels))
         figures = FigureQueue(pool, directory / "figures", bar, figure_task)
         traces = submit_signal_figures(figures, plants[trace_level], datasets[trace_level],
                                  outputs[(trace_level, TRACE_EXPERIMENT)][1], trace_level,
                                  settings.frequency_hz)
         runs = tuple(_collect(identifications, bar, identify_task))
+        noisy_runs = _collect(noisy_identifications, bar, identify_task)
         recorded = settings.to_dict()
         recorded["version"] = __version__
         recorded["tracking_error_rms_m"] = {
             f"{level:g}": [outputs[(level, k)][2] for k in range(6)] for level in levels}
         results = ComparisonResults(runs, nominal_M, nominal_B, load_published(), recorded)
+        noisy = noisy_results(noisy_runs, results) if noisy_runs else None
+        if noisy is not None:
+            recorded["noise_case_summary"] = noisy_summary(noisy)
+            figures.submit(plot_identified_vs_nominal, f"identified_vs_nominal_{STEM}",
+                           f"Identified / nominal per entry at Coulomb {trace_level:g} N·m "
+                           "with the reference sensor noise.", noisy, trace_level)
         submit_comparison_figures(figures, results, trace_level, traces)
         bar.update(figure_task, total=len(figures.submitted))
         entries, files = figures.finish()
-    tables = build_tables(results)
+    tables = build_tables(results) + ([noisy_table(noisy)] if noisy is not None else [])
     files += write_tables(tables, directory / "tables")
     recorded["runtime_s"] = time.perf_counter() - start
     files += list(write_report(results, tables, entries, directory))
     names = [str(p.relative_to(directory)) for p in files] + ["results.json"]
-    files.append(write_json_atomic(directory / "results.json",
-                                   results_document(results, recorded["runtime_s"], names)))
+    document = results_document(results, recorded["runtime_s"], names)
+    if noisy is not None:
+        document["noise_case"] = to_jsonable(noisy_document(noisy))
+    files.append(write_json_atomic(directory / "results.json", document))
     return ReproduceOutput(results=results, directory=directory, files=files,
                            runtime_s=time.perf_counter() - start)
 

@@ -73,6 +73,9 @@ class ReproduceSettings:
         Worker processes (1: everything in this process).
     platform : str
         ``"paper"`` or a platform TOML file.
+    noise_case : bool
+        Also run every method at the highest level with the reference sensor noise
+        (:mod:`~stewartid.reproduction.noisy`).
     """
 
     quick: bool = False
@@ -83,6 +86,7 @@ class ReproduceSettings:
     seed: int = 0
     jobs: int = 1
     platform: str = "paper"
+    noise_case: bool = True
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready settings."""
@@ -90,14 +94,15 @@ class ReproduceSettings:
                 "frequency_hz": self.frequency_hz,
                 "coulomb_levels": list(self.coulomb_levels), "methods": list(self.methods),
                 "seed": self.seed, "jobs": self.jobs, "platform": self.platform,
-                "experiments": 6}
+                "experiments": 6, "noise_case": self.noise_case}
 
 
 def make_settings(quick: bool = False, jobs: int | None = None, seed: int = 0,
                   duration_s: float | None = None,
                   coulomb_levels: Sequence[float] = COULOMB_LEVELS,
                   methods: Sequence[str] | None = None, platform: str = "paper",
-                  frequency_hz: float = FREQUENCY_HZ) -> ReproduceSettings:
+                  frequency_hz: float = FREQUENCY_HZ, noise_case: bool = True
+                  ) -> ReproduceSettings:
     """Validated :class:`ReproduceSettings`; ``jobs=None`` uses every core."""
     jobs = (os.cpu_count() or 1) if jobs is None else jobs
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
@@ -120,7 +125,7 @@ def make_settings(quick: bool = False, jobs: int | None = None, seed: int = 0,
     return ReproduceSettings(quick=bool(quick), duration_s=duration,
                              frequency_hz=float(frequency_hz), coulomb_levels=levels,
                              methods=methods, seed=int(seed), jobs=int(jobs),
-                             platform=str(platform))
+                             platform=str(platform), noise_case=bool(noise_case))
 
 
 @dataclass(frozen=True)
