@@ -159,7 +159,12 @@ def identify(
             raise ConfigError(f"{flag} does not apply to --method {method}; it has the "
                               f"settings {', '.join(accepted)}.")
     paths = expand_paths(files)
-    named = platform_from_meta(paths)
+    try:
+        named = platform_from_meta(paths)
+    except ConfigError:
+        if platform is None:
+            raise
+        named = None  # --platform decides; a broken meta.json does not matter then
     if platform is None and named is None:
         raise ConfigError("--platform is required (a platform TOML file, or 'paper' for the "
                           "preset): masses and geometry decide the result and its checks.")
