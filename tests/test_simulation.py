@@ -216,3 +216,14 @@ def test_cli_noise_flag_switches_on_reference_noise(tmp_path):
     assert noise["length_noise"] == 20e-6
     # the paper platform's static leg load is ~30.5 kN (MODEL.md)
     assert noise["force_noise"] == pytest.approx(0.005 * 30_495, rel=1e-3)
+
+
+def test_worker_processes_give_the_same_data(paper):
+    """Experiments on two worker processes: the same data, bit for bit, as in one process."""
+    serial = simulate_experiments(paper, coulomb=5.0, duration_s=0.3, fade_in=0.2)
+    parallel = simulate_experiments(paper, coulomb=5.0, duration_s=0.3, fade_in=0.2, jobs=2)
+    for a, b in zip(serial.datasets, parallel.datasets, strict=True):
+        assert a.name == b.name
+        assert np.array_equal(a.pose, b.pose) and np.array_equal(a.forces, b.forces)
+    with pytest.raises(ConfigError, match="jobs must be a positive integer"):
+        simulate_experiments(paper, duration_s=0.3, jobs=0)

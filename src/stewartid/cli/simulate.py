@@ -42,9 +42,13 @@ def simulate(
         "--excitation", help="Play this excitation file instead of the paper's sines: CSV "
         "with t and the pose x..rz (m, rad) or t and l1..l6 (m), e.g. a command file of "
         "`stewartid design`; repeat for more experiments (exp1, exp2, ...).")] = None,
+    jobs: Annotated[int | None, typer.Option(
+        "--jobs", help="Worker processes for the paper's experiments (default: every core); "
+        "the data do not depend on it.")] = None,
 ) -> None:
     """Simulate the six experiments (experiment k excites DOF k) on the hydraulic plant."""
     import dataclasses
+    import os
 
     from rich.progress import Progress
 
@@ -93,6 +97,7 @@ def simulate(
             result = simulate_experiments(description, coulomb=coulomb, viscous=viscous,
                                           frequency_hz=frequency, duration_s=duration,
                                           noise=noise, seed=seed, actuator=actuator,
-                                          progress=progress)
+                                          progress=progress,
+                                          jobs=(os.cpu_count() or 1) if jobs is None else jobs)
     paths = write_experiments(result, out, format=format, force=force)
     typer.echo(f"wrote {len(paths) - 1} experiments and meta.json to {out}")

@@ -10,7 +10,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import multiprocessing
+import os
 from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 from typing import Any
 
@@ -222,6 +225,7 @@ def simulate_experiments(platform: Platform, coulomb: float | None = None,
                          actuator: str | None = None, fade_in: float = DEFAULT_FADE_IN,
                          step: float = DEFAULT_STEP,
                          progress: Callable[[int, int, str], Any] | None = None,
+                         jobs: int = 1,
                          ) -> SimulationResult:
     """The paper's six virtual experiments (experiment k excites DOF k with a sine).
 
@@ -249,6 +253,9 @@ def simulate_experiments(platform: Platform, coulomb: float | None = None,
         Largest integration step (s).
     progress : callable, optional
         Called as ``progress(done, total, name)`` after each experiment.
+    jobs : int
+        Worker processes; the experiments are independent (each has its own noise stream),
+        so the data are the same for any number.
 
     Returns
     -------
@@ -270,15 +277,13 @@ def simulate_experiments(platform: Platform, coulomb: float | None = None,
     _check_timing(duration_s, platform.sensors.sample_rate, frequency_hz)
     if not (isinstance(seed, int | np.integer) and seed >= 0):
         raise ConfigError(f"seed must be an integer >= 0; got {seed!r}.")
+    if isinstance(jobs, bool) or not isinstance(jobs, int | np.integer) or jobs < 1:
+        raise ConfigError(f"jobs must be a positive integer (worker processes); got {jobs!r}.")
     excitations = paper_experiments(platform, frequency_hz, amplitudes, fade_in)
-    datasets, records = [], []
-    for k, excitation in enumerate(excitations):
-        dataset, record = simulate_experiment(platform, excitation, duration_s, noise,
-                                              noise_generator(seed, k, len(excitations)), step)
-        datasets.append(dataset)
-        records.append(record)
-        if progress is not None:
-            progress(k + 1, len(excitations), excitation.name)
+    runs = [(platform, excitation, duration_s, noise, seed, k, len(excitations), step)
+            for k, excitation in enumerate(excitations)]
+    datasets, records = zip(*run_experiments(runs, jobs, progress), strict=True)
+    datasets, records = list(datasets), list(records)
     M, B = nominal_matrices(platform)
     meta = {
         "platform": platform.to_dict(),
@@ -299,6 +304,57 @@ def simulate_experiments(platform: Platform, coulomb: float | None = None,
         "version": stewartid.__version__,
     }
     return SimulationResult(datasets, meta, records)
+
+
+def _simulate_run(run: tuple) -> tuple[Dataset, ExperimentRecord]:
+    platform, excitation, duration_s, noise, seed, k, count, step = run
+    return simulate_experiment(platform, excitation, duration_s, noise,
+                               noise_generator(seed, k, count), step)
+
+
+def run_experiments(runs: Sequence[tuple], jobs: int = 1,
+                    progress: Callable[[int, int, str], Any] | None = None,
+                    ) -> list[tuple[Dataset, ExperimentRecord]]:
+    """Simulate ``runs`` in order, on up to ``jobs`` worker processes.
+
+    Parameters
+    ----------
+    runs : sequence of tuple
+        ``(platform, excitation, duration_s, noise, seed, k, count, step)``: experiment ``k``
+        of ``count``, with the noise stream :func:`noise_generator` ``(seed, k, count)``.
+    jobs : int
+        Worker processes (forked where the system can, so that they start with the
+        compiled kernels of this process already loaded); 1 runs here.
+    progress : callable, optional
+        ``progress(done, total, name)`` as experiments finish.
+
+    Returns
+    -------
+    list of (Dataset, ExperimentRecord)
+        In the order of ``runs``.
+    """
+    jobs = min(jobs, len(runs), os.cpu_count() or 1)
+    results: list[Any] = [None] * len(runs)
+    if jobs <= 1:
+        for k, run in enumerate(runs):
+            results[k] = _simulate_run(run)
+            if progress is not None:
+                progress(k + 1, len(runs), run[1].name)
+        return results
+    methods = multiprocessing.get_all_start_methods()
+    context = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
+    if context.get_start_method() == "fork":
+        # load the compiled kernels here, once: forked workers inherit them
+        platform, excitation, *_ = runs[0]
+        simulate_experiment(platform, excitation, 2.0 / platform.sensors.sample_rate)
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=context) as pool:
+        futures = {pool.submit(_simulate_run, run): k for k, run in enumerate(runs)}
+        for done, future in enumerate(as_completed(futures), 1):
+            k = futures[future]
+            results[k] = future.result()
+            if progress is not None:
+                progress(done, len(runs), runs[k][1].name)
+    return results
 
 
 def write_experiments(result: SimulationResult, out: str | Path, format: str = "csv",
