@@ -35,12 +35,17 @@ def _grid(figure, count: int, columns: int = 3, top: float = 0.9, **options):
     return axes
 
 
-def _log_floor(axis, values: np.ndarray, decades: float = 5.0) -> None:
-    """Show ``decades`` decades below the largest value: fewer ticks to draw, and the
-    numerical floor of a noise-free record is not the interesting part."""
+def _log_floor(axis, values: np.ndarray, decades: float | None = 5.0) -> None:
+    """Show ``decades`` decades below the largest value (None: all; the numerical floor of a
+    noise-free record is not the interesting part) with plain tick labels (``0.001``: mathtext powers of
+    ten take most of a log axis's drawing time)."""
+    from matplotlib.ticker import FuncFormatter, NullLocator
+
     top = float(np.nanmax(values)) if np.size(values) else 1.0
-    if top > 0:
+    if top > 0 and decades is not None:
         axis.set_ylim(top * 10 ** -decades, top * 3)
+    axis.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+    axis.yaxis.set_minor_locator(NullLocator())
 
 
 @_styled
@@ -270,6 +275,7 @@ def plot_unexplained(vaf: Mapping[str, np.ndarray], colours: Mapping[str, str],
                  np.maximum(100.0 - np.asarray(values), 1e-5), width, color=colours[label],
                  label=label)
     axis.set_yscale("log")
+    _log_floor(axis, np.zeros(0), decades=None)
     axis.set_xticks(x, COORDINATES)
     axis.set_ylabel("100 − VAF (%), held out")
     axis.set_title("Force the model does not explain on data it was not fitted on "
