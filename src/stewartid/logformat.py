@@ -30,10 +30,11 @@ import pandas as pd
 
 from stewartid.config import read_toml_text
 from stewartid.errors import ConfigError, DataError
+from stewartid.platform import COORDINATES
 
 #: Interchange columns a log format may map, in order, with the chamber pressures.
 PRESSURE_COLUMNS = tuple(f"pa{k}" for k in range(1, 7)) + tuple(f"pb{k}" for k in range(1, 7))
-_TIME, _POSITIONS, _ANGLES = ("t",), ("x", "y", "z"), ("rx", "ry", "rz")
+_TIME, _POSITIONS, _ANGLES = ("t",), COORDINATES[:3], COORDINATES[3:]
 _LENGTHS = tuple(f"l{k}" for k in range(1, 7))
 _FORCES = tuple(f"f{k}" for k in range(1, 7))
 MAPPABLE = (*_TIME, *_POSITIONS, *_ANGLES, *_LENGTHS, *_FORCES, *PRESSURE_COLUMNS)
