@@ -169,10 +169,14 @@ def identify(
         raise ConfigError("--platform is required (a platform TOML file, or 'paper' for the "
                           "preset): masses and geometry decide the result and its checks.")
     description = load_platform(platform) if platform is not None else named[0]
-    if platform is not None and named is not None and named[0].to_dict() != \
-            description.to_dict():
-        warnings.warn(f"{named[1]} describes platform '{named[0].name}', which differs from "
-                      f"--platform {platform}; using --platform.", stacklevel=1)
+    if platform is not None and named is not None:
+        # friction is what the data measure; geometry and inertia must be the platform's
+        differing = [f"[{section}]" for section in ("geometry", "inertia")
+                     if named[0].to_dict()[section] != description.to_dict()[section]]
+        if differing:
+            warnings.warn(f"{named[1]} describes platform '{named[0].name}' with another "
+                          f"{' and '.join(differing)} than --platform {platform}; using "
+                          "--platform.", stacklevel=1)
     if out is not None:
         inputs = [*paths, *(p for p in (platform, columns) if p and Path(p).is_file())]
         check_output_file(out, force, inputs, is_result=_is_result)
