@@ -119,6 +119,13 @@ def test_meta_json_beside_the_data_may_name_the_platform(tmp_path, folder, paper
                                                     "platform_name": "paper"}))
     result = _identify(tmp_path, "--out", tmp_path / "result.json")
     assert result.exit_code == 0, result.output
+    other = tmp_path / "other.toml"
+    inertia = [1.2 * value for value in paper.inertia.platform_inertia]
+    other.write_text(paper.replace(inertia__platform_inertia=inertia).to_toml())
+    result = _identify("--platform", other, tmp_path)
+    assert result.exit_code == 0, result.output
+    assert "meta.json describes platform 'paper' with another [inertia] than --platform" \
+        in result.stderr
     (tmp_path / "meta.json").write_text(json.dumps({"platform": "missing.toml"}))
     result = _identify(tmp_path)
     assert "platform file" in result.stderr and "missing.toml' not found" in result.stderr
