@@ -302,7 +302,7 @@ def load_log_format(spec: str | Path) -> LogFormat:
         The file is missing, not UTF-8, not valid TOML, or any entry is invalid.
     """
     text = str(spec)
-    if isinstance(spec, Path) or text.lower().endswith(".toml"):
+    if isinstance(spec, Path) or text.lower().endswith(".toml") or Path(text).is_file():
         path = Path(spec)
         if not path.is_file():
             raise ConfigError(f"column mapping file {text!r} not found; give a TOML file "
