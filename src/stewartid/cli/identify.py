@@ -185,6 +185,10 @@ def identify(
     if report is not None:
         from stewartid.io import check_output_folder
 
+        inside = [p for p in paths if report.resolve() in p.resolve().parents]
+        if inside:
+            raise ConfigError(f"--report {str(report)!r} holds the input {str(inside[0])!r}; "
+                              "choose another folder for the report.")
         check_output_folder(report, force)
     elif len(names) > 1:
         raise ConfigError(f"--method {method} compares the methods in a report; add "

@@ -228,16 +228,16 @@ def _figures(runs: Sequence[MethodReport], datasets: Sequence[Dataset], platform
         "dominant excitation frequency.",
         plots.plot_spectra([d.name for d in datasets], [d.pose for d in datasets],
                            [d.sample_rate for d in datasets], frequencies, folder))
-    intervals, points = used_intervals(best.result, datasets)
+    owner, intervals, points = used_intervals(runs, trusted, datasets)
     first = prepare([datasets[0]], platform)[0]
     _, q_dot, _ = differentiate(first.q, first.sample_rate, 0.2 / frequencies[0])
     rates = joint_rates(platform, first.q, q_dot, first.joint_jacobians, first.leg_jacobian)
     trace = dataclasses.replace(traces[0], joint_rates=rates,
                                 intervals=intervals[0] if intervals else None)
     add("joint_rates", f"Joint rates of {datasets[0].name}; shaded: the constant-direction "
-        f"intervals {best.display_name} used." if intervals else
-        f"Joint rates of {datasets[0].name} ({best.display_name} does not use "
-        "constant-direction intervals).", plot_joint_rates(trace, folder, "joint_rates"))
+        f"intervals {owner} used." if intervals else
+        f"Joint rates of {datasets[0].name} (no method here uses constant-direction "
+        "intervals).", plot_joint_rates(trace, folder, "joint_rates"))
     if intervals:
         add("intervals", "Constant-direction intervals used in every experiment"
             + (", with the (a, b) points (bar: scale a)." if any(p is not None for p in points)
@@ -327,6 +327,8 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
     from stewartid.reporting.user_report_text import choose_trusted, data_rows, render_report
 
     started = time.perf_counter()
+    if not (isinstance(folds, int | np.integer) and folds >= 2):
+        raise ConfigError(f"the validation needs at least 2 folds; got {folds!r}.")
     directory = Path(directory)
     datasets = list(datasets)
     if nominal is None:

@@ -55,18 +55,34 @@ def data_rows(datasets: Sequence[Dataset], platform: Platform) -> list[dict[str,
     return rows
 
 
-def used_intervals(result: IdentificationResult, datasets: Sequence[Dataset]
-                   ) -> tuple[list[np.ndarray], list[np.ndarray | None]]:
+def used_intervals(runs: Sequence[MethodReport], trusted: str, datasets: Sequence[Dataset]
+                   ) -> tuple[str, list[np.ndarray], list[np.ndarray | None]]:
     """Constant-direction intervals (M_k, 2) and (a, b) points (K_k, 2) per experiment, as
-    the result's diagnostics record them; two empty lists for a method without intervals."""
-    experiments = result.diagnostics.get("experiments") or []
-    if len(experiments) != len(datasets) or not all("intervals" in e for e in experiments):
-        return [], []
+    the diagnostics record them, of the trusted method or else the first that uses them.
+
+    Returns
+    -------
+    display_name : str
+        Of the method they come from ("" if no method uses intervals).
+    intervals, points : list
+        Empty if no method uses intervals.
+    """
+    def recorded(run: MethodReport) -> list[dict]:
+        experiments = [] if run.result is None else run.result.diagnostics.get("experiments")
+        experiments = experiments or []
+        ok = len(experiments) == len(datasets) and all("intervals" in e for e in experiments)
+        return experiments if ok else []
+
+    ordered = sorted(runs, key=lambda run: run.name != trusted)
+    chosen = next((run for run in ordered if recorded(run)), None)
+    if chosen is None:
+        return "", [], []
+    experiments = recorded(chosen)
     intervals = [np.asarray(e["intervals"], dtype=float).reshape(-1, 2) for e in experiments]
     points = [np.column_stack([np.asarray(e["scales"], dtype=float),
                                np.asarray(e["shifts"], dtype=float)])
               if "scales" in e and "shifts" in e else None for e in experiments]
-    return intervals, points
+    return chosen.display_name, intervals, points
 
 
 def _worst(run: MethodReport) -> tuple[float, str]:
@@ -147,7 +163,8 @@ def method_lines(run: MethodReport) -> list[str]:
     else:
         share = friction_signature(run.validation)
         lines.append(f"It does not estimate friction; {100 * share:.0f} % of its held-out "
-                     "residual has the shape of Coulomb joint friction.")
+                     "residual has the shape of Coulomb joint friction (`--method all` "
+                     "compares it with a method that estimates friction).")
     return lines
 
 
@@ -283,11 +300,11 @@ def render_report(report: IdentificationReport, datasets: Sequence[Dataset],
     lines += ["## Data", ""] + _data_section(rows)
     lines += _figure(figures, "excitation") + _figure(figures, "spectrum")
     lines += ["## Joint rates and constant-direction intervals", ""]
-    intervals, points = used_intervals(best.result, datasets)
+    owner, intervals, points = used_intervals(report.runs, report.trusted, datasets)
     if intervals:
         counts = ", ".join(f"{d.name} {len(i)}" for d, i in zip(datasets, intervals,
                                                                 strict=True))
-        lines += [f"{best.display_name} used {sum(len(i) for i in intervals)} intervals in "
+        lines += [f"{owner} used {sum(len(i) for i in intervals)} intervals in "
                   f"which no active joint reverses ({counts}); "
                   + ("the (a, b) points are marked." if any(p is not None for p in points)
                      else "its test functions span each whole interval, so there are no "
