@@ -10,7 +10,8 @@ honest).
 
 Usage::
 
-    python benchmarks/noise_study.py [--seeds 4] [--length-noise 20e-6] [--force-noise 0.005]
+    python benchmarks/noise_study.py [--seeds 4] [--scales 0.5,1,2] [--length-noise 20e-6]
+        [--force-noise 0.005] [--methods wavelet,fourier,...]
 """
 
 from __future__ import annotations
@@ -122,12 +123,13 @@ def entry_ratios(estimator, M, B, reference=None) -> tuple[np.ndarray, np.ndarra
 
 
 def study(methods=tuple(METHODS), seeds=(0, 1, 2, 3), length_noise=20e-6, force_noise=0.005,
-          stride=1, datasets=None):
-    """Rows (method, noise, seed, largest error %, median and RMS of |err| / SE, seconds).
+          stride=1, datasets=None, scales=(1.0,)):
+    """Rows (method, noise scale, seed, largest error %, err/SE ratios, seconds).
 
-    Two ratios per row: against the truth (``ratios``) and against the same method's
-    noise-free estimate (``noise_ratios``, the noise-induced error the standard errors are
-    meant to predict).
+    Every method runs on the noise-free records once and on ``seeds`` noisy copies at every
+    nonzero multiple in ``scales`` of (``length_noise``, ``force_noise``). Two ratios per row:
+    against the truth (``ratios``) and against the same method's noise-free estimate
+    (``noise_ratios``, the noise-induced error the standard errors are meant to predict).
 
     ``stride`` keeps every stride-th sample of the records (shorter runs for tests).
     """
@@ -137,12 +139,12 @@ def study(methods=tuple(METHODS), seeds=(0, 1, 2, 3), length_noise=20e-6, force_
                          forces=d.forces[::stride], name=d.name) for d in clean]
     rows = []
     references = {}
-    cases = [("none", [None])] + ([("noisy", list(seeds))] if length_noise or force_noise
-                                  else [])
-    for label, case_seeds in cases:
+    cases = [(0.0, [None])] + [(float(scale), list(seeds)) for scale in scales
+                               if scale > 0 and (length_noise or force_noise)]
+    for scale, case_seeds in cases:
         for seed in case_seeds:
-            data = clean if seed is None else add_noise(platform, clean, length_noise,
-                                                        force_noise, seed)
+            data = clean if seed is None else add_noise(
+                platform, clean, scale * length_noise, scale * force_noise, seed)
             for method in methods:
                 start = time.perf_counter()
                 factory = (functools.partial(OracleIdentifier, clean) if method == "oracle"
@@ -153,7 +155,8 @@ def study(methods=tuple(METHODS), seeds=(0, 1, 2, 3), length_noise=20e-6, force_
                     references[method] = estimator
                 errors, ratios = entry_ratios(estimator, M, B)
                 _, noise_ratios = entry_ratios(estimator, M, B, references.get(method))
-                rows.append({"method": method, "noise": label, "seed": seed,
+                rows.append({"method": method, "scale": scale,
+                             "noise": "none" if seed is None else "noisy", "seed": seed,
                              "max_error_percent": float(errors.max()),
                              "median_ratio": float(np.median(ratios)),
                              "rms_ratio": float(np.sqrt(np.mean(ratios ** 2))),
@@ -163,36 +166,40 @@ def study(methods=tuple(METHODS), seeds=(0, 1, 2, 3), length_noise=20e-6, force_
     return rows
 
 
+def summary(rows) -> list[str]:
+    """Markdown table: per method and noise scale, the median and worst largest error over
+    seeds, the share of (entry, seed) pairs within 3 standard errors, the mean fit time."""
+    lines = ["| method | noise (x reference) | median largest error (%) | worst largest "
+             "error (%) | within 3 SE (%) | time (s) |", "|---|---|---|---|---|---|"]
+    for method in dict.fromkeys(r["method"] for r in rows):
+        for scale in dict.fromkeys(r["scale"] for r in rows):
+            group = [r for r in rows if r["method"] == method and r["scale"] == scale]
+            if not group:
+                continue
+            largest = np.array([r["max_error_percent"] for r in group])
+            ratios = np.concatenate([r["ratios"] for r in group])
+            lines.append(f"| {method} | {scale:g} | {np.median(largest):.3g} | "
+                         f"{largest.max():.3g} | {100 * np.mean(ratios <= 3):.0f} | "
+                         f"{np.mean([r['seconds'] for r in group]):.1f} |")
+    return lines
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=4)
     parser.add_argument("--length-noise", type=float, default=20e-6, help="m")
     parser.add_argument("--force-noise", type=float, default=0.005,
                         help="fraction of each leg's mean force")
+    parser.add_argument("--scales", default="0.5,1,2",
+                        help="comma-separated multiples of the noise levels (0 is always run)")
     parser.add_argument("--methods", default=",".join([*METHODS, "oracle"]))
     args = parser.parse_args()
+    scales = tuple(float(v) for v in args.scales.split(","))
     rows = study(tuple(args.methods.split(",")), tuple(range(args.seeds)), args.length_noise,
-                 args.force_noise)
-    print(f"length noise {args.length_noise * 1e6:g} um, force noise "
-          f"{100 * args.force_noise:g} % of the mean leg force")
-    print("| method | noise | seed | largest error (%) | median err/SE | RMS err/SE | "
-          "RMS noise-induced err/SE | time (s) |")
-    print("|---|---|---|---|---|---|---|---|")
-    for r in rows:
-        seed = "-" if r["seed"] is None else r["seed"]
-        noise_ratio = "-" if r["seed"] is None else f"{r['rms_noise_ratio']:.2f}"
-        print(f"| {r['method']} | {r['noise']} | {seed} | {r['max_error_percent']:.2f} | "
-              f"{r['median_ratio']:.2f} | {r['rms_ratio']:.2f} | {noise_ratio} | "
-              f"{r['seconds']:.1f} |")
-    for method in dict.fromkeys(r["method"] for r in rows):
-        noisy = [r for r in rows if r["method"] == method and r["noise"] == "noisy"]
-        if noisy:
-            ratios = np.concatenate([r["ratios"] for r in noisy])
-            induced = np.concatenate([r["noise_ratios"] for r in noisy])
-            print(f"{method}: over {len(noisy)} seeds, RMS err/SE "
-                  f"{np.sqrt(np.mean(ratios ** 2)):.2f} (median {np.median(ratios):.2f}), "
-                  f"RMS noise-induced err/SE {np.sqrt(np.mean(induced ** 2)):.2f}, "
-                  f"largest error {max(r['max_error_percent'] for r in noisy):.2f} %")
+                 args.force_noise, scales=scales)
+    print(f"reference: length noise {args.length_noise * 1e6:g} um, force noise "
+          f"{100 * args.force_noise:g} % of the mean leg force; {args.seeds} seeds")
+    print("\n".join(summary(rows)))
 
 
 if __name__ == "__main__":
