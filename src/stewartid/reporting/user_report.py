@@ -197,82 +197,6 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
                         seconds=time.perf_counter() - start)
 
 
-def _figures(runs: Sequence[MethodReport], datasets: Sequence[Dataset], platform: Platform,
-             nominal: tuple[np.ndarray, np.ndarray], trusted: str,
-             rows: Sequence[dict[str, Any]], folder: Path
-             ) -> tuple[dict[str, tuple[str, str]], list[Path]]:
-    """Draw every figure; returns {key: (relative PNG path, caption)} and the files."""
-    from stewartid.identification.intervals import joint_rates
-    from stewartid.identification.preparation import prepare
-    from stewartid.reporting import identification_figures as plots
-    from stewartid.reporting.figures import ExperimentTrace, plot_excitation, plot_joint_rates
-    from stewartid.reporting.user_report_text import used_intervals
-    from stewartid.signals.differentiation import differentiate
-
-    figures: dict[str, tuple[str, str]] = {}
-    files: list[Path] = []
-
-    def add(key: str, caption: str, paths: list[Path]) -> None:
-        figures[key] = (f"figures/{key}.png", caption)
-        files.extend(paths)
-
-    ok = [run for run in runs if run.result is not None]
-    best = next(run for run in ok if run.name == trusted)
-    neutral = np.asarray(platform.neutral_pose, dtype=float)
-    traces = [ExperimentTrace(name=d.name, excited=row["excited"], t=d.t, pose=d.pose,
-                              neutral=neutral) for d, row in zip(datasets, rows, strict=True)]
-    add("excitation", "Measured motion of the most excited coordinate of each experiment "
-        "(displacement from the neutral pose).", plot_excitation(traces, folder, "excitation"))
-    frequencies = [row["frequency_hz"] for row in rows]
-    add("spectrum", "Amplitude spectrum of the motion of every coordinate; dashed: the "
-        "dominant excitation frequency.",
-        plots.plot_spectra([d.name for d in datasets], [d.pose for d in datasets],
-                           [d.sample_rate for d in datasets], frequencies, folder))
-    owner, intervals, points = used_intervals(runs, trusted, datasets)
-    first = prepare([datasets[0]], platform)[0]
-    _, q_dot, _ = differentiate(first.q, first.sample_rate, 0.2 / frequencies[0])
-    rates = joint_rates(platform, first.q, q_dot, first.joint_jacobians, first.leg_jacobian)
-    trace = dataclasses.replace(traces[0], joint_rates=rates,
-                                intervals=intervals[0] if intervals else None)
-    add("joint_rates", f"Joint rates of {datasets[0].name}; shaded: the constant-direction "
-        f"intervals {owner} used." if intervals else
-        f"Joint rates of {datasets[0].name} (no method here uses constant-direction "
-        "intervals).", plot_joint_rates(trace, folder, "joint_rates"))
-    if intervals:
-        add("intervals", "Constant-direction intervals used in every experiment"
-            + (", with the (a, b) points (bar: scale a)." if any(p is not None for p in points)
-               else "; the test functions span each whole interval."),
-            plots.plot_intervals([d.name for d in datasets],
-                                 [(float(d.t[0]), float(d.t[-1])) for d in datasets],
-                                 intervals, points, folder))
-    colours = {run.display_name: run.color for run in ok}
-    estimates = {run.display_name: (run.result.M, run.result.B, run.result.std_errors_M,
-                                    run.result.std_errors_B) for run in ok}
-    add("matrices", "Identified over nominal for every entry with a non-zero nominal value, "
-        "±2 standard errors.", plots.plot_matrices(estimates, colours, *nominal, folder))
-    add("residuals", f"Residuals of {best.display_name} fitted on all data, over time and "
-        "their spectrum.", plots.plot_residuals(best.in_sample, frequencies, folder))
-    shown = {run.display_name: run.validation for run in ok}
-    if best.validation_unconstrained is not None:
-        shown = {f"{best.display_name}, consistent": best.validation,
-                 f"{best.display_name}, unconstrained": best.validation_unconstrained}
-        colours = {**colours, f"{best.display_name}, consistent": best.color,
-                   f"{best.display_name}, unconstrained": "#555555"}
-    add("validation", "Held-out measured and predicted generalized force.",
-        plots.plot_validation(shown, colours, folder))
-    if len(ok) > 1:
-        add("methods", "Held-out unexplained force per DOF and method.",
-            plots.plot_unexplained({run.display_name: run.validation.vaf_percent
-                                    for run in ok}, colours, folder))
-    friction = {run.display_name: run.coulomb for run in ok
-                if np.all(np.isfinite(run.coulomb[0]))}
-    if friction:
-        add("friction", "Coulomb levels per joint type, ±2 standard errors; dashed: the "
-            "platform description's level.",
-            plots.plot_friction(friction, colours, float(platform.friction.coulomb), folder))
-    return figures, files
-
-
 def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
                                 directory: str | Path, methods: Sequence[str] = ("wavelet",),
                                 settings: Mapping[str, Any] | None = None,
@@ -280,8 +204,8 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
                                 nominal: tuple[np.ndarray, np.ndarray] | None = None,
                                 nominal_source: str | None = None,
                                 sources: Sequence[str] = (),
-                                check: Callable[[IdentificationResult], None] | None = None
-                                ) -> IdentificationReport:
+                                check: Callable[[IdentificationResult], None] | None = None,
+                                jobs: int = 2) -> IdentificationReport:
     """Identify, validate and report on measured experiments.
 
     Parameters
@@ -311,6 +235,9 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
         The data files, listed in the report.
     check : callable, optional
         See :func:`run_method`.
+    jobs : int
+        Worker processes drawing the figures while the methods are fitted; 1 draws them in
+        this process (less CPU in total, more time).
 
     Returns
     -------
@@ -324,6 +251,11 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
     from stewartid.io import write_text_atomic
     from stewartid.linearization import nominal_matrices
     from stewartid.reporting.report import render_html
+    from stewartid.reporting.user_report_figures import (
+        FigureDrawer,
+        data_figures,
+        result_figures,
+    )
     from stewartid.reporting.user_report_text import choose_trusted, data_rows, render_report
 
     started = time.perf_counter()
@@ -335,22 +267,28 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
         nominal = nominal_matrices(platform)
         nominal_source = nominal_source or (f"platform description '{platform.name}' at the "
                                             "neutral pose")
-    segments: dict[bool, list[Segment]] = {}
-    runs = [run_method(name, settings or {}, datasets, platform, folds, consistent, segments,
-                       check) for name in dict.fromkeys(methods)]
-    usable = [run for run in runs if run.result is not None]
-    if not usable:
-        raise runs[0].exception
-    trusted, verdict = choose_trusted(runs, nominal)
     rows = data_rows(datasets, platform)
-    figures, files = _figures(runs, datasets, platform, nominal, trusted, rows,
-                              directory / "figures")
-    models = [ExportedModel(run.name, run.result, *run.coulomb) for run in usable]
-    files += write_exports(models, directory, trusted)
-    report = IdentificationReport(runs, trusted, verdict, directory)
-    files.append(report.result.to_json(directory / "result.json"))
+    drawer = FigureDrawer(directory / "figures", jobs)
+    try:
+        data_figures(drawer, datasets, platform, rows)
+        segments: dict[bool, list[Segment]] = {}
+        runs = [run_method(name, settings or {}, datasets, platform, folds, consistent,
+                           segments, check) for name in dict.fromkeys(methods)]
+        usable = [run for run in runs if run.result is not None]
+        if not usable:
+            raise runs[0].exception
+        trusted, verdict = choose_trusted(runs, nominal)
+        result_figures(drawer, runs, datasets, platform, nominal, trusted, rows)
+        models = [ExportedModel(run.name, run.result, *run.coulomb) for run in usable]
+        files = write_exports(models, directory, trusted)
+        report = IdentificationReport(runs, trusted, verdict, directory)
+        files.append(report.result.to_json(directory / "result.json"))
+    except BaseException:
+        drawer.close()
+        raise
+    files += drawer.finish()
     text = render_report(report, datasets, platform, nominal, nominal_source or "", rows,
-                         figures, sources, folds, time.perf_counter() - started)
+                         drawer.entries, sources, folds, time.perf_counter() - started)
     files.append(write_text_atomic(directory / "report.md", text))
     files.append(write_text_atomic(directory / "report.html", render_html(
         text, directory, title=f"stewartid identification report: {platform.name}")))
