@@ -29,12 +29,15 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.polynomial import Polynomial
-from scipy import sparse
 
 from stewartid.errors import ConfigError
+
+if TYPE_CHECKING:  # scipy.sparse is imported where a matrix is built
+    from scipy.sparse import csr_matrix
 
 #: Derivative orders a wavelet can be evaluated at: -2 and -1 are its second and first
 #: integrals (psi2, psi1), 0 the wavelet, 1 and 2 its derivatives.
@@ -255,7 +258,7 @@ def _quadrature_weights(t: np.ndarray) -> np.ndarray:
 
 def transform_matrix(t: np.ndarray, scales: np.ndarray, shifts: np.ndarray,
                      wavelet: MotherWavelet, derivative: int = 0,
-                     exact_degree: int | None = None) -> sparse.csr_matrix:
+                     exact_degree: int | None = None) -> csr_matrix:
     """Sparse matrix W with (W @ f)[k] = W_psi f (scales[k], shifts[k]) for samples f of t.
 
     Row k holds (1 / a_k) psi^(derivative)((t - b_k) / a_k) times trapezoid weights, on the
@@ -313,7 +316,9 @@ def transform_matrix(t: np.ndarray, scales: np.ndarray, shifts: np.ndarray,
     if exact_degree is not None and exact_degree >= 0 and len(values):
         values = _correct_moments(values, x, rows, counts, indptr,
                                   wavelet.moments(derivative, int(exact_degree)))
-    return sparse.csr_matrix((values, cols, indptr), shape=(len(a), len(t)))
+    from scipy.sparse import csr_matrix
+
+    return csr_matrix((values, cols, indptr), shape=(len(a), len(t)))
 
 
 def _correct_moments(values: np.ndarray, x: np.ndarray, rows: np.ndarray, counts: np.ndarray,
