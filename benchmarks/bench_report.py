@@ -44,7 +44,7 @@ def main() -> None:
                                              consistent=options.consistent)
         wall, cpu = time.perf_counter() - start, time.process_time() - cpu
     print(f"report ({options.method}{', consistent' if options.consistent else ''}): "
-          f"{wall:.1f} s wall, {cpu:.1f} s CPU of this process; trusted {report.trusted}")
+          f"{wall:.1f} s wall, {cpu:.1f} s CPU; trusted {report.trusted}")
     for method in report.runs:
         print(f"  {method.name:8s} fit + validation {method.seconds:5.1f} s")
 

@@ -52,8 +52,7 @@ def linear_report(tmp_path_factory, linear_data, paper):
     folder = tmp_path_factory.mktemp("report")
     report = write_identification_report(data, paper, folder, methods=("ls",),
                                          settings={"coulomb": False}, folds=3,
-                                         nominal=(M, B), nominal_source="the generating model",
-                                         jobs=1)
+                                         nominal=(M, B), nominal_source="the generating model")
     return report, folder
 
 

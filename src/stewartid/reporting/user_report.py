@@ -204,8 +204,8 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
                                 nominal: tuple[np.ndarray, np.ndarray] | None = None,
                                 nominal_source: str | None = None,
                                 sources: Sequence[str] = (),
-                                check: Callable[[IdentificationResult], None] | None = None,
-                                jobs: int = 2) -> IdentificationReport:
+                                check: Callable[[IdentificationResult], None] | None = None
+                                ) -> IdentificationReport:
     """Identify, validate and report on measured experiments.
 
     Parameters
@@ -235,9 +235,6 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
         The data files, listed in the report.
     check : callable, optional
         See :func:`run_method`.
-    jobs : int
-        Worker processes drawing the figures while the methods are fitted; 1 draws them in
-        this process (less CPU in total, more time).
 
     Returns
     -------
@@ -268,25 +265,20 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
         nominal_source = nominal_source or (f"platform description '{platform.name}' at the "
                                             "neutral pose")
     rows = data_rows(datasets, platform)
-    drawer = FigureDrawer(directory / "figures", jobs)
-    try:
-        data_figures(drawer, datasets, platform, rows)
-        segments: dict[bool, list[Segment]] = {}
-        runs = [run_method(name, settings or {}, datasets, platform, folds, consistent,
-                           segments, check) for name in dict.fromkeys(methods)]
-        usable = [run for run in runs if run.result is not None]
-        if not usable:
-            raise runs[0].exception
-        trusted, verdict = choose_trusted(runs, nominal)
-        result_figures(drawer, runs, datasets, platform, nominal, trusted, rows)
-        models = [ExportedModel(run.name, run.result, *run.coulomb) for run in usable]
-        files = write_exports(models, directory, trusted)
-        report = IdentificationReport(runs, trusted, verdict, directory)
-        files.append(report.result.to_json(directory / "result.json"))
-    except BaseException:
-        drawer.close()
-        raise
-    files += drawer.finish()
+    segments: dict[bool, list[Segment]] = {}
+    runs = [run_method(name, settings or {}, datasets, platform, folds, consistent, segments,
+                       check) for name in dict.fromkeys(methods)]
+    usable = [run for run in runs if run.result is not None]
+    if not usable:
+        raise runs[0].exception
+    trusted, verdict = choose_trusted(runs, nominal)
+    drawer = FigureDrawer(directory / "figures")
+    data_figures(drawer, datasets, platform, rows)
+    result_figures(drawer, runs, datasets, platform, nominal, trusted, rows)
+    models = [ExportedModel(run.name, run.result, *run.coulomb) for run in usable]
+    files = drawer.files + write_exports(models, directory, trusted)
+    report = IdentificationReport(runs, trusted, verdict, directory)
+    files.append(report.result.to_json(directory / "result.json"))
     text = render_report(report, datasets, platform, nominal, nominal_source or "", rows,
                          drawer.entries, sources, folds, time.perf_counter() - started)
     files.append(write_text_atomic(directory / "report.md", text))

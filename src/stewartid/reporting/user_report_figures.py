@@ -1,5 +1,4 @@
-"""The figures of the identification report (:mod:`.user_report`), in report order, drawn in
-worker processes while the methods are fitted or in the calling process.
+"""The figures of the identification report (:mod:`.user_report`), in report order.
 
 The drawing itself is :mod:`.identification_figures` and :mod:`.figures`; this module decides
 what is drawn, with which data and caption.
@@ -7,7 +6,6 @@ what is drawn, with which data and caption.
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -16,60 +14,29 @@ import numpy as np
 
 from stewartid.dataset import Dataset
 from stewartid.platform import Platform
-from stewartid.reporting.validation import ValidationResult
 
 if TYPE_CHECKING:
     from stewartid.reporting.user_report import MethodReport
 
 
 class FigureDrawer:
-    """Draws the figures in worker processes (``jobs`` > 1, so drawing overlaps the fits) or
-    in this process, and keeps their captions in report order."""
+    """Draws the figures into one folder and keeps their captions in report order.
 
-    def __init__(self, folder: Path, jobs: int):
+    Drawing in worker processes while the methods are fitted was measured on the 2-core
+    machine (docs/benchmarks.md): each worker pays its own imports, and under load the extra
+    process slows the fits more than it saves, so the figures are drawn here.
+    """
+
+    def __init__(self, folder: Path):
         self.folder = folder
         self.entries: dict[str, tuple[str, str]] = {}
-        self.pending: list[Any] = []
-        self.pool = None
-        if jobs > 1:
-            import multiprocessing
-            from concurrent.futures import ProcessPoolExecutor
-
-            # spawn: a clean interpreter, whatever threads this process runs
-            self.pool = ProcessPoolExecutor(max_workers=jobs,
-                                            mp_context=multiprocessing.get_context("spawn"))
+        self.files: list[Path] = []
 
     def add(self, key: str, caption: str, function: Callable[..., list[Path]],
             *args: Any) -> None:
+        """Draw ``function(*args)`` as ``figures/<key>.png`` and ``.svg`` with ``caption``."""
         self.entries[key] = (f"figures/{key}.png", caption)
-        if self.pool is None:
-            self.pending.append(function(*args, directory=self.folder, stem=key))
-        else:
-            self.pending.append(self.pool.submit(function, *args, directory=self.folder,
-                                                 stem=key))
-
-    def finish(self) -> list[Path]:
-        """Wait for every figure; the written files."""
-        try:
-            return [path for item in self.pending
-                    for path in (item if isinstance(item, list) else item.result())]
-        finally:
-            self.close()
-
-    def close(self) -> None:
-        """Stop the workers (figures not started are dropped)."""
-        if self.pool is not None:
-            self.pool.shutdown(cancel_futures=True)
-            self.pool = None
-
-
-def _lean(validation: ValidationResult) -> ValidationResult:
-    """``validation`` with only what the figures read of its segments (times, names): less to
-    send to a worker process."""
-    empty = np.zeros((0, 6))
-    segments = [dataclasses.replace(s, force=empty, q_dot=empty, q_ddot=empty,
-                                    coulomb=np.zeros((0, 3, 6))) for s in validation.segments]
-    return dataclasses.replace(validation, segments=segments)
+        self.files += function(*args, directory=self.folder, stem=key)
 
 
 def data_figures(drawer: FigureDrawer, datasets: Sequence[Dataset], platform: Platform,
@@ -131,11 +98,11 @@ def result_figures(drawer: FigureDrawer, runs: Sequence[MethodReport],
     drawer.add("matrices", "Identified over nominal for every entry with a non-zero nominal "
                "value, ±2 standard errors.", plots.plot_matrices, estimates, colours, *nominal)
     drawer.add("residuals", f"Residuals of {best.display_name} fitted on all data, over time "
-               "and their spectrum.", plots.plot_residuals, _lean(best.in_sample), frequencies)
-    shown = {run.display_name: _lean(run.validation) for run in ok}
+               "and their spectrum.", plots.plot_residuals, best.in_sample, frequencies)
+    shown = {run.display_name: run.validation for run in ok}
     if best.validation_unconstrained is not None:
-        shown = {f"{best.display_name}, consistent": _lean(best.validation),
-                 f"{best.display_name}, unconstrained": _lean(best.validation_unconstrained)}
+        shown = {f"{best.display_name}, consistent": best.validation,
+                 f"{best.display_name}, unconstrained": best.validation_unconstrained}
         colours = {**colours, f"{best.display_name}, consistent": best.color,
                    f"{best.display_name}, unconstrained": "#555555"}
     drawer.add("validation", "Held-out measured and predicted generalized force.",
