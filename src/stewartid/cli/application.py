@@ -137,8 +137,16 @@ _register()
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Console-script entry point."""
-    app(args=argv, prog_name="stewartid")
+    """Console-script entry point.
+
+    BLAS runs on one thread: the commands' linear algebra is on small matrices, where extra
+    BLAS threads only synchronise, and on a busy machine their spinning costs 20-40 % of the
+    identification time (worker processes get the same limit).
+    """
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):
+        app(args=argv, prog_name="stewartid")
 
 
 __all__ = ["app", "clean_errors", "fail", "main"]
