@@ -188,9 +188,11 @@ def test_a_worker_killed_mid_run_loses_and_duplicates_nothing(cluster, tmp_path)
     killed = []
 
     def kill_a_busy_worker(done, failed, remaining):
-        if killed or remaining == 0:
+        if killed or done == 0 or remaining == 0:
             return
         busy = [address for address, keys in client.processing().items() if keys]
+        if not busy:
+            return
         pids = client.run(os.getpid, workers=busy[:1])
         for address, pid in pids.items():
             os.kill(pid, signal.SIGKILL)

@@ -202,7 +202,7 @@ def _settings_lines(spec: StudySpec, rows: Any, total_tasks: int, failed_tasks: 
     lines = [f"- platform: {spec.platform}",
              "- methods: " + ", ".join(method_name(m) for m in spec.methods),
              f"- seeds per grid point: {len(spec.seeds)} ({spec.seeds[0]}…{spec.seeds[-1]})"]
-    lines += [f"- swept: {name} = {', '.join(f'{v:g}' for v in values)} "
+    lines += [f"- grid: {name} = {', '.join(f'{v:g}' for v in values)} "
               f"({PARAMETERS[name].unit})" for name, values in spec.grid.items()]
     lines += [f"- fixed: {_parameter_text(name, value)}" for name, value in spec.fixed.items()]
     if spec.actuator is not None:

@@ -99,7 +99,7 @@ class StudyRun:
     runtime_s: float
 
 
-def _prepare_folder(spec: StudySpec, directory: Path, resume: bool) -> None:
+def _check_folder(spec: StudySpec, directory: Path, resume: bool) -> None:
     """Refuse a folder holding another study, or any study without ``resume``."""
     if directory.exists() and not directory.is_dir():
         raise OutputExistsError(f"output path {str(directory)!r} exists and is not a folder; "
@@ -123,7 +123,6 @@ def _prepare_folder(spec: StudySpec, directory: Path, resume: bool) -> None:
     elif holds_study:
         raise ConfigError(f"{directory}: has results but no {SPEC_NAME}; cannot check that "
                           "they belong to this study. Use another folder.")
-    write_json_atomic(recorded, spec.to_dict())
 
 
 def _worker_environment() -> dict[str, str]:
@@ -243,7 +242,7 @@ def run_study(spec: StudySpec, out: str | Path, *, scheduler: str | None = None,
     """
     start = time.perf_counter()
     directory = Path(out)
-    _prepare_folder(spec, directory, resume)
+    _check_folder(spec, directory, resume)
     tasks = expand_grid(spec)
     stored = finished_tasks(directory)
     todo = [task for task in tasks if task.key not in stored]
@@ -253,6 +252,8 @@ def run_study(spec: StudySpec, out: str | Path, *, scheduler: str | None = None,
     if todo:
         with (connect(scheduler, workers) if client is None else _given(client)) as active, \
                 _progress_display(progress is True, len(tasks)) as display:
+            # written once a cluster is reached: a run that cannot start leaves no study
+            write_json_atomic(directory / SPEC_NAME, spec.to_dict())
             notify = display or (progress if callable(progress) else None)
             if notify is not None:
                 notify(skipped, 0, len(todo))
@@ -266,15 +267,15 @@ def run_study(spec: StudySpec, out: str | Path, *, scheduler: str | None = None,
                         write_part(directory, task.key, future.result())
                         computed += 1
                     else:
-                        error = future.exception()
-                        failures.append(TaskFailure(task.key, task.label,
-                                                    f"{type(error).__name__}: {error}"))
+                        failures.append(TaskFailure(task.key, task.label, _describe(future)))
                     future.release()
                     if notify is not None:
                         notify(skipped + computed, len(failures), len(futures))
             finally:
                 if futures:
                     active.cancel(list(futures))
+    else:
+        write_json_atomic(directory / SPEC_NAME, spec.to_dict())
     failed_path = directory / FAILED_NAME
     if failures:
         write_json_atomic(failed_path, [dataclasses.asdict(f) for f in failures])
@@ -289,6 +290,14 @@ def run_study(spec: StudySpec, out: str | Path, *, scheduler: str | None = None,
                                    failed_tasks=len(failures))
     return StudyRun(directory, spec, rows, computed, skipped, tuple(failures), files,
                     time.perf_counter() - start)
+
+
+def _describe(future: Any) -> str:
+    """``Type: message`` of a future's exception (a cancelled one has none to give)."""
+    if future.status == "cancelled":
+        return "CancelledError: the task was cancelled on the cluster"
+    error = future.exception()
+    return f"{type(error).__name__}: {error}"
 
 
 @contextmanager
