@@ -6,4 +6,12 @@ labels and colours from the registry), :mod:`~stewartid.reporting.tables` (Markd
 tables beside the paper's published values), :mod:`~stewartid.reporting.figures`
 (matplotlib figures, PNG and SVG), :mod:`~stewartid.reporting.report` (``report.md`` and a
 self-contained ``report.html``) and :mod:`~stewartid.reporting.terminal` (rich tables).
+
+The report on a user's own measured experiments (``identify --report``):
+:mod:`~stewartid.reporting.user_report` (fits, validation, consistency, files),
+:mod:`~stewartid.reporting.validation` (held-out prediction, VAF and NRMSE),
+:mod:`~stewartid.reporting.user_report_text` (which method to trust, ``report.md``),
+:mod:`~stewartid.reporting.user_report_figures` and
+:mod:`~stewartid.reporting.identification_figures` (its figures) and
+:mod:`~stewartid.reporting.exports` (CSV and MATLAB files).
 """

@@ -9,7 +9,8 @@ pair (:mod:`stewartid.identification.consistency`), and writes into ``DIR``:
 - ``report.md`` and a self-contained ``report.html`` (:mod:`.user_report_text`): the data,
   the constant-direction intervals, Mt and Bt with standard errors beside the nominal values,
   residuals, validation, consistency, friction and, for several methods, which one to trust;
-- ``figures/``: every figure as PNG and SVG (:mod:`.identification_figures`);
+- ``figures/``: every figure as PNG and SVG (:mod:`.user_report_figures` chooses them,
+  :mod:`.identification_figures` draws them);
 - ``result.json``: the trusted method's result with its ``validation`` and ``consistency``
   objects, and the CSV and MATLAB exports of every method (:mod:`.exports`).
 """

@@ -40,7 +40,7 @@ class FigureDrawer:
 
 
 def data_figures(drawer: FigureDrawer, datasets: Sequence[Dataset], platform: Platform,
-                  rows: Sequence[dict[str, Any]]) -> None:
+                 rows: Sequence[dict[str, Any]]) -> None:
     """The figures of the data alone: excitation and spectrum."""
     from stewartid.reporting import identification_figures as plots
     from stewartid.reporting.figures import ExperimentTrace, plot_excitation
@@ -57,9 +57,9 @@ def data_figures(drawer: FigureDrawer, datasets: Sequence[Dataset], platform: Pl
 
 
 def result_figures(drawer: FigureDrawer, runs: Sequence[MethodReport],
-                    datasets: Sequence[Dataset], platform: Platform,
-                    nominal: tuple[np.ndarray, np.ndarray], trusted: str,
-                    rows: Sequence[dict[str, Any]]) -> None:
+                   datasets: Sequence[Dataset], platform: Platform,
+                   nominal: tuple[np.ndarray, np.ndarray], trusted: str,
+                   rows: Sequence[dict[str, Any]]) -> None:
     """The figures of the identification: intervals, matrices, residuals, validation, the
     comparison of methods and friction."""
     from stewartid.identification.intervals import joint_rates
