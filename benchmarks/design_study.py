@@ -3,19 +3,21 @@
 Steps (paper platform, Coulomb friction ``--coulomb``, the reference sensor noise):
 
 1. the design: read from ``--design DIR/design.json`` (``stewartid design``) or optimised here;
-2. its predicted accuracy and the paper's set's (Monte Carlo over the estimator on model data);
-3. on the plant: the design played once (the plant is deterministic; the sensor noise is
-   drawn afterwards, as ``simulate`` does), the limits checked from the true states, then
-   ``--seeds`` noise realisations identified with Method B (shared friction): per seed the
-   largest error of the Mt diagonal, the Bt diagonal and the couplings; the spread of the
-   estimates against the predicted standard errors;
+2. on the plant: the design played once (the plant is deterministic; the sensor noise is
+   drawn afterwards, as ``simulate`` does), the limits checked from the true states;
+3. its predicted accuracy (Monte Carlo over the estimator on the noise-free plant records,
+   ``--prediction-seeds`` noise streams apart from ``simulate``'s) and the paper's set's;
+   then ``--seeds`` noise realisations as ``simulate --seed 0, 1, ...`` draws them,
+   identified with Method B (shared friction): per seed the largest error of the Mt
+   diagonal, the Bt diagonal and the couplings; their spread against the predicted
+   standard errors;
 4. playback: the exported command files played through ``simulate --excitation``'s code path
    give the same estimate as the design played directly (noise-free).
 
 Usage::
 
-    python benchmarks/design_study.py [--design results/design/design.json] [--seeds 24]
-        [--coulomb 30] [--out results/design_study]
+    python benchmarks/design_study.py [--design results/design/design.json] [--seeds 20]
+        [--prediction-seeds 20] [--baseline-seeds 8] [--coulomb 30] [--out results/design_study]
 """
 
 from __future__ import annotations
@@ -28,19 +30,22 @@ from pathlib import Path
 
 import numpy as np
 
-from stewartid.dataset import Dataset
 from stewartid.design.candidates import design_from_dict, paper_design
 from stewartid.design.export import read_excitation, simulate_excitations, write_commands
 from stewartid.design.limits import record_limit_use
 from stewartid.design.optimise import optimise_design
-from stewartid.design.prediction import default_estimator, predict_accuracy
+from stewartid.design.prediction import (
+    default_estimator,
+    measured_plant_datasets,
+    predict_accuracy,
+)
 from stewartid.io import write_json_atomic
 from stewartid.linearization import nominal_matrices
 from stewartid.platform import load_platform
 from stewartid.reference.published import PAPER_ENTRIES, entry_label, relative_error_percent
 from stewartid.simulation import SensorNoise
 from stewartid.simulation.experiments import noise_generator
-from stewartid.simulation.sensors import measure_legs, measured_pose, reference_noise
+from stewartid.simulation.sensors import reference_noise
 
 #: Acceptance thresholds (%): Mt diagonal, Bt diagonal, couplings of both.
 THRESHOLDS = {"Mt diagonal": 0.5, "Bt diagonal": 2.0, "couplings": 8.0}
@@ -62,13 +67,9 @@ def estimates(estimator) -> np.ndarray:
 
 def noisy_datasets(platform, records, noise, seed):
     """The measured data of a played design for one noise seed (as ``simulate`` draws it)."""
-    out = []
-    for k, record in enumerate(records):
-        lengths, forces = measure_legs(record.lengths, record.forces, noise,
-                                       noise_generator(seed, k, len(records)))
-        out.append(Dataset(t=record.t, pose=measured_pose(platform, lengths, record.q),
-                           lengths=lengths, forces=forces, name=f"exp{k + 1}"))
-    return out
+    return measured_plant_datasets(platform, records, noise,
+                                   [noise_generator(seed, k, len(records))
+                                    for k in range(len(records))])
 
 
 def main() -> None:
@@ -76,8 +77,9 @@ def main() -> None:
     parser.add_argument("--design", type=Path, default=None)
     parser.add_argument("--budget", type=float, default=120.0)
     parser.add_argument("--coulomb", type=float, default=30.0)
-    parser.add_argument("--seeds", type=int, default=24)
-    parser.add_argument("--prediction-seeds", type=int, default=40)
+    parser.add_argument("--seeds", type=int, default=20)
+    parser.add_argument("--prediction-seeds", type=int, default=20)
+    parser.add_argument("--baseline-seeds", type=int, default=8)
     parser.add_argument("--out", type=Path, default=Path("results/design_study"))
     args = parser.parse_args()
     start = time.perf_counter()
@@ -88,18 +90,18 @@ def main() -> None:
     else:
         design = optimise_design(platform, args.budget, noise, progress=print)[0].design
     print(f"design: {design.label}, {design.duration:.1f} s")
-    predicted = predict_accuracy(platform, design, noise, seeds=args.prediction_seeds)
-    baseline = predict_accuracy(platform, paper_design(duration_s=args.budget / 6), noise,
-                                seeds=args.prediction_seeds)
-    ratio = predicted.worst_relative_std / baseline.worst_relative_std
-    print(f"predicted worst relative SE: design {predicted.worst_relative_std:.3f} %, paper's "
-          f"set {baseline.worst_relative_std:.3f} %, ratio {ratio:.3f}")
-
     played = simulate_excitations(platform, design.playable(platform), SensorNoise())
     peaks = [record_limit_use(platform, r).peak for r in played.states]
     worst_use = {name: max(p[name] for p in peaks) for name in peaks[0]}
     print("limit use on the plant (true states): "
           + ", ".join(f"{k} {v:.0%}" for k, v in worst_use.items()))
+    predicted = predict_accuracy(platform, design, noise, seeds=args.prediction_seeds,
+                                 records=played.states)
+    baseline = predict_accuracy(platform, paper_design(duration_s=args.budget / 6), noise,
+                                seeds=args.baseline_seeds)
+    ratio = predicted.worst_relative_std / baseline.worst_relative_std
+    print(f"predicted worst relative SE (plant data): design {predicted.worst_relative_std:.3f}"
+          f" %, paper's set {baseline.worst_relative_std:.3f} %, ratio {ratio:.3f}")
     clean_fit = estimates(default_estimator().fit(played.datasets, platform))
 
     M0, B0 = nominal_matrices(platform)
@@ -140,6 +142,7 @@ def main() -> None:
     args.out.mkdir(parents=True, exist_ok=True)
     write_json_atomic(args.out / "design_study.json", {
         "design": design.to_dict(), "coulomb": args.coulomb, "seeds": args.seeds,
+        "prediction_seeds": args.prediction_seeds, "baseline_seeds": args.baseline_seeds,
         "predicted_worst_std_percent": predicted.worst_relative_std,
         "baseline_worst_std_percent": baseline.worst_relative_std, "ratio": ratio,
         "limit_use": worst_use, "passed_of_8": passed,

@@ -19,11 +19,16 @@ from stewartid.design.candidates import (
 )
 from stewartid.design.export import read_excitation, simulate_excitations, write_commands
 from stewartid.design.limits import limit_use, record_limit_use, resolve_limits
-from stewartid.design.prediction import model_datasets, predict_accuracy
+from stewartid.design.prediction import (
+    measured_plant_datasets,
+    model_datasets,
+    predict_accuracy,
+)
 from stewartid.errors import ConfigError
 from stewartid.kinematics import inverse_kinematics
 from stewartid.platform import load_platform, platform_from_mapping
 from stewartid.simulation import SensorNoise
+from stewartid.simulation.experiments import noise_generator
 
 
 @pytest.fixture(scope="module")
@@ -84,6 +89,19 @@ def test_record_starts_and_ends_at_rest_and_derivatives_match(paper):
                                                         rel=1e-3)
 
 
+def test_scheduled_design_with_one_schedule_per_record():
+    amplitudes = (0.08, 0.08, 0.08, 0.03, 0.03, 0.04)
+    plans = [(1.0,)] * 3 + [(1.0, 0.5)] * 3
+    design = scheduled_design(amplitudes, 0.75, [20.0] * 6, plans)
+    assert [r.levels for r in design.records] == plans
+    assert design.label.endswith("levels translations 1, rotations 1/0.5")
+    # whole periods: 13 held of a single level, 6 of each of two levels, within 20 s
+    assert [r.hold_periods for r in design.records] == [13] * 3 + [6] * 3
+    assert design.duration == pytest.approx(120.0)
+    with pytest.raises(ConfigError, match=r"levels must be one schedule or six .* got 5"):
+        scheduled_design(amplitudes, 0.75, [20.0] * 6, plans[:5])
+
+
 def test_limit_use_against_finite_differences(paper):
     design = small_design()
     data = model_datasets(paper, design)[0]
@@ -142,15 +160,33 @@ def test_design_cli_refuses_bad_budget(tmp_path):
 def test_predicted_errors_scale_with_the_noise(paper):
     design = scheduled_design((0.05, 0.05, 0.05, 0.02, 0.02, 0.03), 1.0, [5.0] * 6)
     noise = SensorNoise(length_noise=20e-6, force_noise=150.0)
-    one = predict_accuracy(paper, design, noise, seeds=3)
-    assert predict_accuracy(paper, design, SensorNoise(), seeds=2).worst_relative_std == 0.0
+    one = predict_accuracy(paper, design, noise, seeds=3, source="model")
+    assert predict_accuracy(paper, design, SensorNoise(), seeds=2,
+                            source="model").worst_relative_std == 0.0
     two = predict_accuracy(paper, design, SensorNoise(length_noise=40e-6, force_noise=300.0),
-                           seeds=3)
+                           seeds=3, source="model")
     # twice the noise: at least twice the spread (the interval detection also loses data)
     assert two.worst_relative_std > 1.9 * one.worst_relative_std
     # noise-free model data of a near-linear motion: the estimate is close to nominal
     assert one.relative_bias.max() < 1.0
     assert one.scaled(4.0).worst_relative_std == pytest.approx(one.worst_relative_std / 2)
+
+
+def test_plant_prediction_draws_the_noise_as_simulate_does(paper):
+    design = scheduled_design((0.05, 0.05, 0.05, 0.02, 0.02, 0.03), 1.0, [4.0] * 6, (1.0,))
+    noise = SensorNoise(length_noise=20e-6, force_noise=150.0)
+    played = simulate_excitations(paper, design.playable(paper), noise, seed=3)
+    measured = measured_plant_datasets(paper, list(played.states), noise,
+                                       [noise_generator(3, k, 6) for k in range(6)])
+    for ours, theirs in zip(measured, played.datasets, strict=True):
+        assert np.array_equal(ours.lengths, theirs.lengths)
+        assert np.array_equal(ours.forces, theirs.forces)
+        assert np.abs(ours.pose - theirs.pose).max() < 1e-9
+    plant = predict_accuracy(paper, design, noise, seeds=2, records=list(played.states))
+    assert plant.method.endswith("plant data")
+    assert 0 < plant.worst_relative_std < 100
+    with pytest.raises(ConfigError, match=r"source must be one of plant, model; got 'hardware'"):
+        predict_accuracy(paper, design, noise, seeds=2, source="hardware")
 
 
 @pytest.mark.slow

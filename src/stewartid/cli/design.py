@@ -32,6 +32,9 @@ def design(
                                            "the design may use.")] = 0.7,
     seeds: Annotated[int, typer.Option("--seeds", help="Noise realisations of the predicted "
                                        "accuracy.")] = 20,
+    model_data: Annotated[bool, typer.Option(
+        "--model-data", help="Predict on rigid-body model data with perfect tracking (fast, "
+        "optimistic) instead of the design played on the plant.")] = False,
     quick: Annotated[bool, typer.Option("--quick", help="One candidate and few realisations "
                                         "(a smoke test).")] = False,
     force: Annotated[bool, typer.Option("--force", help="Overwrite a design already in "
@@ -70,6 +73,7 @@ def design(
                      else noise.force_noise or reference.force_noise))
     output = run_design(description, budget, noise, out, method=method, rate_hz=rate,
                         max_use=max_use, seeds=seeds if not quick else min(seeds, 4),
+                        source="model" if model_data else "plant",
                         quick=quick, force=force, progress=typer.echo)
     p, b = output.prediction, output.baseline
     typer.echo(f"design: {output.design.label}")

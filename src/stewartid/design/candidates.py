@@ -219,7 +219,8 @@ def paper_design(frequency_hz: float = 0.5, duration_s: float = 20.0,
 
 
 def scheduled_design(amplitudes: Sequence[float], frequency_hz: float,
-                     durations_s: Sequence[float], levels: Sequence[float] = (1.0, 0.5),
+                     durations_s: Sequence[float],
+                     levels: Sequence[float] | Sequence[Sequence[float]] = (1.0, 0.5),
                      label: str | None = None) -> Design:
     """Six single-DOF records with a level schedule, each of (about) its own duration.
 
@@ -231,24 +232,42 @@ def scheduled_design(amplitudes: Sequence[float], frequency_hz: float,
         Hz, the same for every record (all half-periods are equally long).
     durations_s : sequence of 6 float
         Record lengths (s), rounded down to whole hold periods per level.
-    levels : sequence of float
-        Level schedule relative to the amplitude, largest first (e.g. (1, 0.5)).
+    levels : sequence of float, or 6 sequences of float
+        Level schedule relative to the amplitude, largest first (e.g. (1, 0.5)): one for
+        every record, or one per record.
     label : str, optional
     """
-    peak = max(levels)
+    schedules = ([tuple(v) for v in levels] if isinstance(levels[0], Sequence)
+                 else [tuple(levels)] * 6)
+    if len(schedules) != 6:
+        raise ConfigError(f"levels must be one schedule or six (one per record); got "
+                          f"{len(schedules)}.")
     period = 1.0 / frequency_hz
     records = []
-    for k in range(6):
-        hold = int((durations_s[k] / period - (len(levels) + 1)) // len(levels))
+    for k, schedule in enumerate(schedules):
+        peak = max(schedule)
+        hold = int((durations_s[k] / period - (len(schedule) + 1)) // len(schedule))
         if hold < 1:
             raise ConfigError(f"record {k + 1}: {durations_s[k]:.3g} s is too short for "
-                              f"{len(levels)} levels at {frequency_hz:g} Hz.")
+                              f"{len(schedule)} levels at {frequency_hz:g} Hz.")
         records.append(DesignedRecord(unit_direction(k, amplitudes[k] * peak), frequency_hz,
-                                      tuple(v / peak for v in levels), hold, 1, f"exp{k + 1}"))
+                                      tuple(v / peak for v in schedule), hold, 1, f"exp{k + 1}"))
     text = label or (f"6 single-DOF records, {frequency_hz:g} Hz, levels "
-                     + "/".join(f"{v:g}" for v in levels))
+                     + schedule_label(schedules))
     return Design(tuple(records), text)
 
 
+def schedule_label(schedules: Sequence[Sequence[float]]) -> str:
+    """'1/0.5' for one schedule shared by all records, 'translations 1, rotations 1/0.5' for
+    one per group of three, else the six schedules."""
+    names = ["/".join(f"{v:g}" for v in s) for s in schedules]
+    if len(set(names)) == 1:
+        return names[0]
+    if len(set(names[:3])) == 1 and len(set(names[3:])) == 1:
+        return f"translations {names[0]}, rotations {names[3]}"
+    return ", ".join(names)
+
+
 __all__ = ["COORDINATES", "Design", "DesignedRecord", "PlayableRecord", "design_from_dict",
-           "paper_design", "record_from_dict", "scheduled_design", "unit_direction"]
+           "paper_design", "record_from_dict", "schedule_label", "scheduled_design",
+           "unit_direction"]

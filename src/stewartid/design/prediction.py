@@ -1,20 +1,28 @@
 """Predicted accuracy of a design: the standard error of every Mt and Bt entry, before any test.
 
-How: the design's records are turned into noise-free model data (the commanded motion, taken
-as tracked exactly, and the actuator forces of the full nonlinear rigid-body model with the
-platform's friction, :func:`stewartid.dynamics.inverse_dynamics`); the chosen estimator is fitted
-to it once without noise (its deviation from the nominal matrices is the design's bias: the
-non-linearity of the larger motion, friction the estimator does not model) and then to
-``seeds`` copies with the sensor noise added, and the spread of those estimates about the
-noise-free one is the predicted standard error.
+How: the design's records are turned into noise-free data, the chosen estimator is fitted to
+it once without noise (its deviation from the nominal matrices is the design's bias: the
+non-linearity of the larger motion, friction the estimator does not model, tracking) and then
+to ``seeds`` copies with the sensor noise added, and the spread of those estimates about the
+noise-free one is the predicted standard error. The noise-free data come from
+
+* ``source="plant"`` (the default): the records played once on the closed-loop hydraulic
+  plant without sensor noise (:func:`stewartid.design.export.simulate_excitations`); the
+  noise is then drawn exactly as ``simulate`` draws it (:func:`measure_legs`, the pose by
+  forward kinematics from the measured lengths). The plant's motion is not the commanded one
+  (tracking error, servo and valve dynamics, friction the controller fights), and the
+  estimator's spread on it is 2-10 times the spread on model data for some entries;
+* ``source="model"``: the commanded motion taken as tracked exactly, with the actuator forces
+  of the nonlinear rigid-body model (:func:`stewartid.dynamics.inverse_dynamics`) and the
+  pose noise to first order. Fast, for screening and tests, but optimistic.
 
 Why a Monte Carlo over the estimator rather than a covariance formula: Method B's default
 (reweighted weak form, interval detection with noise-dependent hysteresis, shared friction
 constants whose scatter is estimated from the data, the choice of the better member of every
 symmetric pair) is not one linear map of the noise; running the estimator itself predicts
-what it will do, whatever its settings. The pose noise is propagated to first order
-(dq = J_lq^-1 dl, what forward kinematics does to 20 um of leg noise to within 1e-9 m), which
-replaces one forward kinematics per sample by one linear solve. A standard error estimated
+what it will do, whatever its settings. On model data the pose noise is propagated to
+first order (dq = J_lq^-1 dl, what forward kinematics does to 20 um of leg noise to within
+1e-9 m), which replaces one forward kinematics per sample by one linear solve. A standard error estimated
 from K seeds has a relative uncertainty of about 1 / sqrt(2 K) (16 % at 20 seeds).
 """
 
@@ -28,12 +36,13 @@ import numpy as np
 from stewartid.dataset import Dataset
 from stewartid.design.candidates import Design
 from stewartid.dynamics import inverse_dynamics
+from stewartid.errors import ConfigError
 from stewartid.identification.registry import create_identifier
 from stewartid.kinematics import inverse_kinematics, leg_jacobian
 from stewartid.linearization import nominal_matrices
 from stewartid.platform import Platform
 from stewartid.reference.published import PAPER_ENTRIES, entry_label
-from stewartid.simulation.sensors import SensorNoise
+from stewartid.simulation.sensors import SensorNoise, measure_legs, measured_pose
 
 
 def model_datasets(platform: Platform, design: Design) -> list[Dataset]:
@@ -164,8 +173,51 @@ def default_estimator(method: str = "wavelet"):
     return create_identifier(method)
 
 
+#: Entropy that keeps the prediction's noise streams apart from ``simulate``'s seeds.
+PREDICTION_STREAM = 0x5D1
+
+#: Where the noise-free data of a prediction come from.
+SOURCES = ("plant", "model")
+
+
+def measured_plant_datasets(platform: Platform, records: list, noise: SensorNoise,
+                            generators: list[np.random.Generator]) -> list[Dataset]:
+    """Measured data of noise-free plant records, the noise drawn as ``simulate`` draws it.
+
+    Parameters
+    ----------
+    platform : Platform
+    records : list of stewartid.simulation.experiments.ExperimentRecord
+        True signals of the played records.
+    noise : SensorNoise
+        Noise, bias and resolution of the lengths (m) and forces (N).
+    generators : list of numpy.random.Generator
+        One per record.
+
+    Returns
+    -------
+    list of Dataset
+        Named ``exp1..expN``; pose by forward kinematics from the measured lengths.
+    """
+    out = []
+    for k, (record, rng) in enumerate(zip(records, generators, strict=True)):
+        lengths, forces = measure_legs(record.lengths, record.forces, noise, rng)
+        out.append(Dataset(t=record.t, pose=measured_pose(platform, lengths, record.q),
+                           lengths=lengths, forces=forces, name=f"exp{k + 1}"))
+    return out
+
+
+def plant_records(platform: Platform, design: Design) -> list:
+    """The design played once on the plant without sensor noise: the true signals of every
+    record (:class:`~stewartid.simulation.experiments.ExperimentRecord`)."""
+    from stewartid.design.export import simulate_excitations
+
+    return list(simulate_excitations(platform, design.playable(platform), SensorNoise()).states)
+
+
 def predict_accuracy(platform: Platform, design: Design, noise: SensorNoise,
-                     method: str = "wavelet", seeds: int = 20, seed: int = 0) -> Prediction:
+                     method: str = "wavelet", seeds: int = 20, seed: int = 0,
+                     source: str = "plant", records: list | None = None) -> Prediction:
     """Predicted bias and standard errors of Mt and Bt for a design (see the module docstring).
 
     Parameters
@@ -180,24 +232,44 @@ def predict_accuracy(platform: Platform, design: Design, noise: SensorNoise,
     seeds : int
         Noise realisations, >= 2.
     seed : int
-        Seed of the first realisation.
+        Seed of the first realisation; the streams differ from those of ``simulate --seed``.
+    source : {"plant", "model"}
+        Noise-free data from the plant (honest, slower) or from the rigid-body model with
+        perfect tracking (fast, optimistic).
+    records : list of ExperimentRecord, optional
+        The design already played on the plant (:func:`plant_records`), ``source="plant"``.
 
     Returns
     -------
     Prediction
     """
-    clean = model_datasets(platform, design)
-    jacobians = [leg_jacobian(platform, d.pose) for d in clean]
+    if source not in SOURCES:
+        raise ConfigError(f"source must be one of {', '.join(SOURCES)}; got {source!r}.")
     M0, B0 = nominal_matrices(platform)
     estimator = default_estimator(method)
+    if source == "plant":
+        records = plant_records(platform, design) if records is None else records
+        clean = measured_plant_datasets(platform, records, SensorNoise(),
+                                        [np.random.default_rng(0)] * len(records))
+
+        def noisy(k: int) -> list[Dataset]:
+            streams = np.random.SeedSequence([PREDICTION_STREAM, int(seed), k]).spawn(
+                len(records))
+            return measured_plant_datasets(platform, records, noise,
+                                           [np.random.default_rng(s) for s in streams])
+    else:
+        clean = model_datasets(platform, design)
+        jacobians = [leg_jacobian(platform, d.pose) for d in clean]
+
+        def noisy(k: int) -> list[Dataset]:
+            rng = np.random.default_rng(np.random.SeedSequence([int(seed), k]))
+            return [add_noise(platform, d, noise, rng, j)
+                    for d, j in zip(clean, jacobians, strict=True)]
     estimator.fit(clean, platform)
     M_clean, B_clean = estimator.M_.copy(), estimator.B_.copy()
     deviations_M, deviations_B = [], []
     for k in range(int(seeds)):
-        rng = np.random.default_rng(np.random.SeedSequence([int(seed), k]))
-        noisy = [add_noise(platform, d, noise, rng, j) for d, j in zip(clean, jacobians,
-                                                                       strict=True)]
-        estimator.fit(noisy, platform)
+        estimator.fit(noisy(k), platform)
         deviations_M.append(estimator.M_ - M_clean)
         deviations_B.append(estimator.B_ - B_clean)
     settings = estimator.get_params()
@@ -206,4 +278,4 @@ def predict_accuracy(platform: Platform, design: Design, noise: SensorNoise,
         nominal_M=M0, nominal_B=B0, bias_M=M_clean - M0, bias_B=B_clean - B0,
         std_M=np.sqrt(np.mean(np.square(deviations_M), axis=0)),
         std_B=np.sqrt(np.mean(np.square(deviations_B), axis=0)), seeds=int(seeds),
-        method=label)
+        method=f"{label}, {source} data")

@@ -14,7 +14,7 @@ import dataclasses
 from collections.abc import Callable
 from pathlib import Path
 
-from stewartid.design.candidates import Design, paper_design
+from stewartid.design.candidates import Design, paper_design, schedule_label
 from stewartid.design.export import write_commands
 from stewartid.design.limits import resolve_limits
 from stewartid.design.optimise import (
@@ -60,7 +60,8 @@ def is_design_file(path: Path) -> bool:
 
 def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str | Path,
                method: str = "wavelet", rate_hz: float = 500.0, max_use: float = 0.7,
-               seeds: int = 20, quick: bool = False, force: bool = False,
+               seeds: int = 20, source: str = "plant", quick: bool = False,
+               force: bool = False,
                progress: Callable[[str], None] | None = None) -> DesignOutput:
     """Design an excitation for ``platform`` and write it with its report to ``out``.
 
@@ -81,6 +82,9 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
         Fraction of every limit the design may use.
     seeds : int
         Noise realisations of the final predictions.
+    source : {"plant", "model"}
+        Noise-free data of the predictions: the design played on the plant, or the
+        rigid-body model with perfect tracking (faster, optimistic).
     quick : bool
         One frequency and schedule, few seeds (for tests).
     force : bool
@@ -98,9 +102,9 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
     grid = {"frequencies": (1.0,), "schedules": ((1.0, 0.5),), "screening_seeds": 3} if quick \
         else {"frequencies": DEFAULT_FREQUENCIES, "schedules": DEFAULT_SCHEDULES}
     best, screened = optimise_design(platform, budget_s, noise, method, max_use=max_use,
-                                     seeds=seeds, progress=progress, **grid)
+                                     seeds=seeds, source=source, progress=progress, **grid)
     baseline_design = paper_design(duration_s=budget_s / 6)
-    baseline = predict_accuracy(platform, baseline_design, noise, method, seeds)
+    baseline = predict_accuracy(platform, baseline_design, noise, method, seeds, source=source)
     if progress:
         progress(f"paper's set: predicted worst error {baseline.worst_relative_error:.2f} %")
     design, prediction = best.design, best.prediction
@@ -113,8 +117,10 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
                 "Coulomb friction (N m)": platform.friction.coulomb,
                 "length noise (m)": noise.length_noise, "force noise (N)": noise.force_noise,
                 "largest limit use": max_use, "controller rate (Hz)": rate_hz,
+                "prediction data": source,
                 "frequencies tried (Hz)": list(grid["frequencies"]),
-                "schedules tried": [list(s) for s in grid["schedules"]]}
+                "schedules tried": [schedule_label(s if isinstance(s[0], tuple) else [s])
+                                    for s in grid["schedules"]]}
     intervals = [0.5 / r.frequency_hz for r in design.records]
     text = render_markdown(design, prediction, baseline, [u.peak for u in uses], intervals,
                            settings)
