@@ -155,3 +155,21 @@ def test_energy_is_conserved_without_friction(paper):
     drift = np.max(np.abs(energy - energy[0])) / kinetic_energy(plant, q0, qd0)
     assert drift < 1e-6
     assert np.ptp(kinetic_energy(plant, q, qd)) > 0.01 * kinetic_energy(plant, q0, qd0)
+
+
+def test_lean_leg_terms_equal_the_full_model_terms(paper, rng):
+    """The kernel without inertia terms (command tables, forward kinematics, identification)
+    gives the gravity, leg Jacobian, lengths and joint Jacobians of the full one, which the
+    tests above check against energy, Lagrange's equations and finite differences."""
+    from stewartid import _kernels
+
+    q = poses(paper, rng, 50)
+    full = ModelTerms(paper, q)
+    G, J, lengths, J_joint = _kernels.batch_leg_terms(
+        paper.parameters(), paper.upper_joints, paper.base_joints, q, True)
+    assert np.array_equal(G, full.gravity)
+    assert np.array_equal(J, full.leg_jacobian)
+    assert np.array_equal(lengths, full.leg_lengths)
+    assert np.array_equal(J_joint, full.joint_jacobians)
+    assert _kernels.batch_leg_terms(paper.parameters(), paper.upper_joints,
+                                    paper.base_joints, q, False)[3].shape == (0, 6, 5, 6)
