@@ -27,6 +27,7 @@ Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
 
 from __future__ import annotations
 
+import functools
 import math
 from abc import ABC, abstractmethod
 from typing import TYPE_CHECKING
@@ -42,6 +43,13 @@ if TYPE_CHECKING:  # scipy.sparse is imported where a matrix is built
 #: Derivative orders a wavelet can be evaluated at: -2 and -1 are its second and first
 #: integrals (psi2, psi1), 0 the wavelet, 1 and 2 its derivatives.
 DERIVATIVE_ORDERS = (-2, -1, 0, 1, 2)
+
+
+@functools.cache
+def _gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights on [-1, 1], shape (n,) each; computed once per
+    process (an n x n eigenproblem)."""
+    return np.polynomial.legendre.leggauss(n)
 
 
 class MotherWavelet(ABC):
@@ -110,7 +118,7 @@ class MotherWavelet(ABC):
         cache = self.__dict__.setdefault("_moment_cache", {})
         if key not in cache:
             span = self.half_width if self.compact else max(12.0, self.half_width)
-            nodes, weights = np.polynomial.legendre.leggauss(256)
+            nodes, weights = _gauss_legendre(256)
             x = span * nodes
             values = self._evaluate(x, derivative) * weights * span
             cache[key] = np.array([np.sum(values * x ** j) for j in range(degree + 1)])
