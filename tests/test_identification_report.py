@@ -262,6 +262,9 @@ def test_cli_report_and_its_errors(tmp_path, files):
                                   *map(str, files)])
     assert compare.exit_code == 2
     assert "add --report DIR" in compare.output
+    folds = runner.invoke(app, ["identify", "--platform", "paper", "--folds", "4",
+                                *map(str, files)])
+    assert folds.exit_code == 2 and "--folds" in folds.output and "--report" in folds.output
 
 
 @pytest.mark.slow

@@ -127,8 +127,9 @@ def identify(
         "--consistent", help="Replace Mt, Bt by the nearest symmetric pair with Mt positive "
                              "definite and Bt positive semidefinite (needs the 'convex' "
                              "extra).")] = False,
-    folds: Annotated[int, typer.Option(
-        "--folds", help="--report: time segments per experiment for the validation.")] = 3,
+    folds: Annotated[int | None, typer.Option(
+        "--folds", help="--report: time segments per experiment for the validation "
+                        "(default 3).")] = None,
 ) -> None:
     """Identify Mt and Bt from experiments; print the paper-style table when nominal values are
     known (platform description, or meta.json/truth.json beside the data) and write JSON."""
@@ -193,6 +194,9 @@ def identify(
     elif len(names) > 1:
         raise ConfigError(f"--method {method} compares the methods in a report; add "
                           "--report DIR.")
+    elif folds is not None:
+        raise ConfigError("--folds sets the report's validation; add --report DIR.")
+    folds = 3 if folds is None else folds
     log_format = load_log_format(columns) if columns is not None else None
     datasets = read_datasets(paths, description, log_format)
     if report is not None or consistent or len(names) > 1:
