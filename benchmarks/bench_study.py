@@ -4,7 +4,9 @@ Coulomb friction 0, 5 and 30 N m times noise scale 0, 1 and 2 times 8 seeds is 7
 (one simulation of the six experiments each) and 216 rows over Methods B, A and least
 squares. Each worker count runs the whole study into a fresh folder on a fresh LocalCluster
 (start-up included in the wall time); the last run's report is kept in ``--out``. Prints a
-Markdown table with the machine and its load average before and after each run.
+Markdown table with the machine, its load average before and after each run, the tasks' wall
+and CPU times summed, and the cores the study obtained (CPU seconds per wall second): on a
+machine shared with other jobs, that is what limits the speed-up.
 
 Usage::
 
@@ -60,8 +62,9 @@ def main() -> None:
           f"{platform.python_version()}")
     print(f"study: {spec.size} tasks, {spec.size * len(spec.methods)} rows, "
           f"{args.duration:g} s records")
-    lines = ["| workers | wall time (s) | rows | compute summed over tasks (s) | load before | "
-             "load after | speed-up |", "|---:|---:|---:|---:|---:|---:|---:|"]
+    lines = ["| workers | wall time (s) | rows | task wall time, sum (s) | task CPU time, sum (s) "
+             "| cores obtained | load before | load after | speed-up |",
+             "|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     first = None
     for k, count in enumerate(counts):
         last = k == len(counts) - 1
@@ -72,11 +75,14 @@ def main() -> None:
         wall = time.perf_counter() - start
         load_after = os.getloadavg()[0]
         rows = run.rows
-        compute = (rows.groupby("task")["simulation_time_s"].first().sum()
-                   + rows["run_time_s"].sum())
+        tasks = rows.groupby("task")
+        task_wall = tasks["simulation_time_s"].first().sum() + rows["run_time_s"].sum()
+        task_cpu = tasks["task_cpu_time_s"].first().sum()
         first = first or wall
-        lines.append(f"| {count} | {wall:.0f} | {len(rows)} | {compute:.0f} | "
-                     f"{load_before:.2f} | {load_after:.2f} | {first / wall:.2f}× |")
+        # CPU seconds per wall second: the cores the study actually got on a shared machine
+        lines.append(f"| {count} | {wall:.0f} | {len(rows)} | {task_wall:.0f} | {task_cpu:.0f} "
+                     f"| {task_cpu / wall:.2f} | {load_before:.2f} | {load_after:.2f} | "
+                     f"{first / wall:.2f}× |")
         print(lines[-1], flush=True)
         if last:
             shutil.rmtree(args.out, ignore_errors=True)

@@ -207,6 +207,7 @@ def test_a_worker_killed_mid_run_loses_and_duplicates_nothing(cluster, tmp_path)
     assert _present_once(rows, spec)
     assert len(finished_tasks(tmp_path)) == spec.size
     assert rows["failure"].isna().all() and np.isfinite(rows["max_error_percent"]).all()
+    assert (rows["task_cpu_time_s"] > 0).all() and rows["worker"].str.startswith("tcp://").all()
 
 
 def test_an_interrupted_run_resumes_without_recomputing(cluster, tmp_path):

@@ -214,9 +214,8 @@ def _settings_lines(spec: StudySpec, rows: Any, total_tasks: int, failed_tasks: 
               f"experiments each), {len(rows)} rows; {failed_tasks} tasks crashed in the last "
               f"run, {failed_rows} rows record a failed simulation or identification"]
     if len(rows):
-        seconds = rows.groupby("task")["simulation_time_s"].first().sum() + rows[
-            "run_time_s"].fillna(0).sum()
-        lines.append(f"- compute time summed over the tasks: {seconds / 60:.1f} min")
+        seconds = rows.groupby("task")["task_cpu_time_s"].first().sum()
+        lines.append(f"- CPU time summed over the tasks: {seconds / 60:.1f} min")
     return lines
 
 

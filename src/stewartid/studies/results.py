@@ -32,6 +32,9 @@ run_time_s : float
     Wall time of the identification (s).
 simulation_time_s : float
     Wall time of the task's simulation, shared by its methods (s).
+task_cpu_time_s : float
+    CPU time of the whole task, simulation and every identification (s); unlike the wall
+    times it does not grow when other processes compete for the cores.
 failure : str
     Why the simulation or the identification failed (a StewartidError), null otherwise.
 worker : str
@@ -67,7 +70,8 @@ def _schema() -> Any:
          ("method", text), ("max_error_percent", number), ("max_error_entry", text),
          ("max_error_M_percent", number), ("max_error_B_percent", number),
          *((name, number) for name in ENTRY_COLUMNS), ("run_time_s", number),
-         ("simulation_time_s", number), ("failure", text), ("worker", text)])
+         ("simulation_time_s", number), ("task_cpu_time_s", number), ("failure", text),
+         ("worker", text)])
 
 
 def columns() -> tuple[str, ...]:
