@@ -129,7 +129,7 @@ def main() -> None:
     for key, p, o, b in zip(PAPER_ENTRIES, prediction, observed, predicted.relative_bias,
                             strict=True):
         print(f"  {entry_label(key):8s} predicted {p:.3f} %  observed {o:.3f} %  "
-              f"ratio {p / o:.2f}  model bias {b:.3f} %")
+              f"ratio {p / o:.2f}  predicted bias {b:.3f} %")
 
     with tempfile.TemporaryDirectory() as folder:
         paths = write_commands(platform, design, folder, 500.0)

@@ -168,7 +168,7 @@ def test_predicted_errors_scale_with_the_noise(paper):
     # twice the noise: at least twice the spread (the interval detection also loses data)
     assert two.worst_relative_std > 1.9 * one.worst_relative_std
     # noise-free model data of a near-linear motion: the estimate is close to nominal
-    assert one.relative_bias.max() < 1.0
+    assert one.relative_noise_free_bias.max() < 1.0
     assert one.scaled(4.0).worst_relative_std == pytest.approx(one.worst_relative_std / 2)
 
 
