@@ -337,7 +337,13 @@ def _correct_moments(values: np.ndarray, x: np.ndarray, rows: np.ndarray, counts
     all rows at once with segment sums.
     """
     m = len(target)
-    powers = x[:, None] ** np.arange(2 * m - 1)            # x^0 .. x^(2m-2)
+    # x^0 .. x^(2m-2) by repeated products: float powers through pow() cost several times
+    # the rest of the correction
+    rows_of_powers = np.empty((2 * m - 1, len(x)))
+    rows_of_powers[0] = 1.0
+    for j in range(1, 2 * m - 1):
+        np.multiply(rows_of_powers[j - 1], x, out=rows_of_powers[j])
+    powers = rows_of_powers.T
     nonempty = counts > 0
     starts = indptr[:-1][nonempty]
     gram_sums = np.zeros((len(counts), 2 * m - 1))
