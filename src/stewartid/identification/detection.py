@@ -17,6 +17,7 @@ import numpy as np
 from stewartid.identification.intervals import constant_direction_intervals, joint_rates
 from stewartid.identification.noise import joint_rate_noise, position_noise_covariance
 from stewartid.identification.preparation import Experiment
+from stewartid.kinematics import joint_rate_jacobians
 from stewartid.platform import Platform
 from stewartid.signals.differentiation import default_window, differentiate, estimate_frequency
 
@@ -44,6 +45,33 @@ class Detection(NamedTuple):
     rate_noise: np.ndarray
     q_dot: np.ndarray
     q_ddot: np.ndarray
+
+
+#: Samples per block when joint Jacobians are formed on the fly (1.4 kB a sample).
+BLOCK_SAMPLES = 65536
+
+
+def _joint_rates_in_blocks(experiment: Experiment, platform: Platform, q_dot: np.ndarray
+                           ) -> tuple[np.ndarray, np.ndarray]:
+    """Joint rates (N, 36) and the mean joint-axis Jacobian (1, 6, 5, 6) of an experiment.
+
+    The joint Jacobians (N, 6, 5, 6) of a long record would take 1.4 kB a sample; unless the
+    experiment already holds them they are formed block by block and dropped.
+    """
+    if "joint_jacobians" in vars(experiment):
+        jacobians = experiment.joint_jacobians
+        return (joint_rates(platform, experiment.q, q_dot, jacobians, experiment.leg_jacobian),
+                jacobians.mean(axis=0, keepdims=True))
+    n = len(experiment.q)
+    rates = np.empty((n, 36))
+    total = np.zeros((6, 5, 6))
+    for start in range(0, n, BLOCK_SAMPLES):
+        block = slice(start, min(start + BLOCK_SAMPLES, n))
+        jacobians = joint_rate_jacobians(platform, experiment.q[block])
+        rates[block] = joint_rates(platform, experiment.q[block], q_dot[block], jacobians,
+                                   experiment.leg_jacobian[block])
+        total += jacobians.sum(axis=0)
+    return rates, (total / max(n, 1))[None]
 
 
 def detect_intervals(experiment: Experiment, platform: Platform, *, window: float | None,
@@ -84,9 +112,9 @@ def detect_intervals(experiment: Experiment, platform: Platform, *, window: floa
         window = default_window(frequency) if window is None else window
         margin = margin_periods / frequency if margin is None else margin
     q_smooth, q_dot, q_ddot = differentiate(q, rate, window)
-    rates = joint_rates(platform, q, q_dot, experiment.joint_jacobians, experiment.leg_jacobian)
+    rates, mean_jacobian = _joint_rates_in_blocks(experiment, platform, q_dot)
     noise = position_noise_covariance(q, q_smooth)
-    rate_noise = joint_rate_noise(noise, rate, window, experiment.joint_jacobians,
+    rate_noise = joint_rate_noise(noise, rate, window, mean_jacobian,
                                   experiment.leg_jacobian)
     found = constant_direction_intervals(t, rates, margin=margin, ignore_below=ignore_below,
                                          hysteresis=hysteresis * rate_noise)

@@ -37,17 +37,15 @@ functions spanning the whole interval, the weak form of :mod:`.weak_form`, solve
 reweighted least squares with the noise estimated from the data; ``test_functions=None``
 uses (a, b) points instead (:mod:`.point_equations`), as the paper does.
 
-Couplings (the paper's Mt(2,4) case): an off-diagonal entry and its transpose are estimated
-from different equations (Mt(5,1) from the pitch equation under surge, Mt(1,5) from the surge
-equation under pitch). The rotational equations under translational excitation are the
-sensitive ones, because joints that barely move (and so are left out of the interval
-detection) switch friction at odd times. With ``pair_selection="std_error"`` (default) both
-entries of every symmetric pair take the estimate with the smaller standard error, computed
-from the data alone; ``symmetric=True`` imposes symmetry in the least-squares solve instead.
+Couplings (the paper's Mt(2,4) case): an entry and its transpose come from different
+equations (Mt(5,1) from pitch under surge, Mt(1,5) from surge under pitch); the rotational
+equations under translational excitation are the sensitive ones. With
+``pair_selection="std_error"`` (default) both entries of a pair take the better-determined
+estimate (:func:`~stewartid.identification.solvers.select_symmetric_pairs`);
+``symmetric=True`` imposes symmetry in the solve instead.
 
-Standard errors are cluster-robust over intervals: the equations of one interval share
-samples (overlapping wavelets) and the same friction state, so their residuals are
-correlated; treating them as independent would understate the uncertainty.
+Standard errors are cluster-robust over intervals (the equations of one interval share
+samples and friction state).
 
 References
 ----------
@@ -78,6 +76,7 @@ from stewartid.identification.solvers import (
     solve_least_squares,
 )
 from stewartid.identification.weak_form import interval_equations, solve_weak_form
+from stewartid.kinematics import joint_rate_jacobians
 from stewartid.platform import COORDINATES, Platform
 from stewartid.signals.wavelets import (
     MotherWavelet,
@@ -163,21 +162,17 @@ class WaveletIdentifier(BaseIdentifier):
         noise band are kept out of every interval (see
         :func:`~stewartid.identification.intervals.constant_direction_intervals`).
     odd_companion : bool
-        With the polynomial wavelet, also use its odd companion g''' at every (a, b) (see
-        :class:`~stewartid.signals.wavelets.PolynomialWavelet`); use with
-        ``wavelet_order`` >= 8.
+        ``test_functions=None``: also use the polynomial wavelet's odd companion g'''
+        (:class:`~stewartid.signals.wavelets.PolynomialWavelet`; ``wavelet_order`` >= 8).
     noise_correction : bool
-        Errors-in-variables correction of the least squares (position variant, not with
-        ``symmetric``): the pose noise covariance is estimated from the data
-        (:func:`~stewartid.identification.noise.position_noise_covariance`) and its
-        contribution to the normal equations removed
-        (:func:`~stewartid.identification.solvers.bias_compensated_least_squares`); standard errors from the
-        corrected sandwich.
+        ``test_functions=None``, position variant: remove the pose noise's contribution to
+        the normal equations (errors in variables, noise estimated from the data;
+        :func:`~stewartid.identification.solvers.bias_compensated_least_squares`).
     symmetric : bool
         Impose Mt = Mt^T and Bt = Bt^T in the solve.
     pair_selection : {"std_error", "none"}
-        For each symmetric pair of off-diagonal entries, use the estimate with the smaller
-        standard error for both (ignored with ``symmetric``).
+        For each symmetric pair, use the better-determined estimate for both (ignored with
+        ``symmetric``).
     gravity : bool
         Subtract the model's pose-dependent gravity G(q) before identification.
 
@@ -192,8 +187,7 @@ class WaveletIdentifier(BaseIdentifier):
 
     References
     ----------
-    Zhang, C. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
-    Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
+    Zhang (2020), see the module docstring.
     """
 
     def __init__(self, wavelet: str = "polynomial", wavelet_order: int = 6,
@@ -309,23 +303,31 @@ class WaveletIdentifier(BaseIdentifier):
         return point_equations(experiment, found, wavelets, tuple(self.scale_fractions),
                                int(self.shifts_per_scale), self.variant)
 
-    def _fit_weak_form(self, experiments: list[Experiment], platform: Platform,
+    def _fit_weak_form(self, datasets: list[Dataset], platform: Platform,
                        wavelet: MotherWavelet) -> tuple[IdentificationResult, dict]:
         """The default path: orthonormal test-function families per interval
-        (:mod:`~stewartid.identification.weak_form`)."""
-        detections = [self._intervals(e, platform, 1.0) for e in experiments]
-        equations = []
-        for k, (experiment, found) in enumerate(zip(experiments, detections, strict=True)):
+        (:mod:`~stewartid.identification.weak_form`). One experiment at a time, its arrays
+        dropped once its equations are formed, so that long logs fit in memory."""
+        infos, equations = [], []
+        for k, dataset in enumerate(datasets):
+            (experiment,) = prepare([dataset], platform, gravity=self.gravity)
+            found = self._intervals(experiment, platform, 1.0)
+
+            def jacobians(indices: np.ndarray, q: np.ndarray = experiment.q) -> np.ndarray:
+                return joint_rate_jacobians(platform, q[indices])
+
             for interval in found.intervals:
                 rows = interval_equations(
-                    experiment.t, experiment.q, experiment.generalized_force,
-                    experiment.joint_jacobians, found.joint_rates, found.rate_noise, interval,
+                    experiment.t, experiment.q, experiment.generalized_force, jacobians,
+                    found.joint_rates, found.rate_noise, interval,
                     int(self.wavelet_order), int(self.test_functions), k)
                 if rows is not None:
                     equations.append(rows)
+            infos.append(found.info)
+            del experiment, found
         if not equations:
-            self._raise_no_interval([d.info for d in detections])
-        solution = solve_weak_form(equations, len(experiments),
+            self._raise_no_interval(infos)
+        solution = solve_weak_form(equations, len(datasets),
                                    shared_friction=self.friction == "shared")
         theta, std = solution.theta.copy(), solution.theta_std.copy()
         M, B = theta[:, :6], theta[:, 6:12]
@@ -334,12 +336,12 @@ class WaveletIdentifier(BaseIdentifier):
         levels = dict(zip(JOINT_TYPES, solution.coulomb.tolist(), strict=True))
         levels_std = dict(zip(JOINT_TYPES, solution.coulomb_std.tolist(), strict=True))
         diagnostics = {
-            "position_noise_std": [np.sqrt(np.diag(d.info["noise_covariance"])).tolist()
-                                   for d in detections],
+            "position_noise_std": [np.sqrt(np.diag(i["noise_covariance"])).tolist()
+                                   for i in infos],
             "wavelet": wavelet.to_dict(), "test_functions": int(self.test_functions),
             "n_equations": solution.n_equations, "n_intervals": len(equations),
-            "experiments": [{"name": d.info["name"], "intervals_found": d.info["intervals_found"],
-                             "intervals": d.info["intervals"].tolist()} for d in detections],
+            "experiments": [{"name": i["name"], "intervals_found": i["intervals_found"],
+                             "intervals": i["intervals"].tolist()} for i in infos],
             "pair_choice": chosen, "coordinates": list(COORDINATES),
             "friction_model": self.friction, "coulomb": levels, "coulomb_std": levels_std,
             "offsets": solution.offsets, "noise_std": solution.noise_std,
@@ -381,9 +383,9 @@ class WaveletIdentifier(BaseIdentifier):
     def _fit(self, datasets: list[Dataset], platform: Platform
              ) -> tuple[IdentificationResult, dict]:
         wavelet = make_wavelet(self.wavelet, **self._wavelet_options())
-        experiments = prepare(datasets, platform, gravity=self.gravity)
         if self.test_functions is not None:
-            return self._fit_weak_form(experiments, platform, wavelet)
+            return self._fit_weak_form(datasets, platform, wavelet)
+        experiments = prepare(datasets, platform, gravity=self.gravity)
         phi, target, cluster, infos, noise_xx, noise_xy = [], [], [], [], [], []
         offset = 0
         for dataset, experiment in zip(datasets, experiments, strict=True):

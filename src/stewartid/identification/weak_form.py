@@ -50,7 +50,7 @@ Shinbrot, M. "On the analysis of linear and nonlinear systems." Trans. ASME 79, 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -115,7 +115,8 @@ class IntervalEquations:
 
 
 def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
-                       joint_jacobians: np.ndarray, joint_rates: np.ndarray,
+                       joint_jacobians: np.ndarray | Callable[[np.ndarray], np.ndarray],
+                       joint_rates: np.ndarray,
                        rate_noise: np.ndarray, interval: Sequence[float], order: int, size: int,
                        experiment: int = 0) -> IntervalEquations | None:
     """Weak-form equations of one interval (see the module docstring).
@@ -128,8 +129,9 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
         Measured pose (m, rad).
     y : ndarray, shape (N, 6)
         Generalized force J^T f - G(q) (N, N m).
-    joint_jacobians : ndarray, shape (N, 6, 5, 6)
-        Joint-axis rate Jacobians (rad/s per unit q_dot).
+    joint_jacobians : ndarray, shape (N, 6, 5, 6), or callable
+        Joint-axis rate Jacobians (rad/s per unit q_dot), or a function returning them
+        (n, 6, 5, 6) at the sample indices it is given (long records need not hold them).
     joint_rates : ndarray, shape (N, 6, 5)
         Smoothed joint-axis rates (rad/s); only their mean over the interval is used, for the
         joint directions.
@@ -177,7 +179,8 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
     ys = y[sel]
     mean_rate = joint_rates[sel].mean(axis=0)
     direction = mean_rate / np.sqrt(mean_rate ** 2 + rate_noise ** 2)
-    pattern = np.einsum("la,nlac->nac", direction, joint_jacobians[sel])        # (n, 5, 6)
+    jacobians = joint_jacobians(sel) if callable(joint_jacobians) else joint_jacobians[sel]
+    pattern = np.einsum("la,nlac->nac", direction, jacobians)                  # (n, 5, 6)
     coulomb = np.array([bump0 @ pattern[:, list(axes)].sum(axis=1)
                         for axes in JOINT_TYPES.values()])
     return IntervalEquations(
