@@ -256,12 +256,13 @@ def check_static_balance(pose: np.ndarray, forces: np.ndarray, platform: Platfor
     DataWarning
         A weight off by more than :data:`BALANCE_WARNING` (a payload not in the file?).
     """
-    from stewartid.dynamics import ModelTerms
+    from stewartid.kinematics import _leg_terms
 
     pose, forces = _subsample(pose, forces)
-    terms = ModelTerms(platform, pose)
-    generalized = np.einsum("nij,ni->nj", terms.leg_jacobian, forces)
-    weight = -float(np.mean(terms.gravity[:, 2]))
+    # the lean kernel that preparation uses too: no mass matrix, one compiled kernel loaded
+    gravity, leg_jacobian, _, _ = _leg_terms(platform, np.ascontiguousarray(pose))
+    generalized = np.einsum("nij,ni->nj", leg_jacobian, forces)
+    weight = -float(np.mean(gravity[:, 2]))
     ratio = round(-float(np.mean(generalized[:, 2])) / weight, 6) + 0.0  # no "-0"
     what = (f"{where}: the forces f1..f6 carry {ratio:.3g} times the weight of platform "
             f"'{platform.name}' ({weight:.4g} N)")
@@ -274,8 +275,7 @@ def check_static_balance(pose: np.ndarray, forces: np.ndarray, platform: Platfor
                         "(docs/logs.md).")
     if abs(ratio - 1.0) > BALANCE_ERROR:
         raise DataError(f"{what}; wrong platform file (--platform) or force unit (N)?")
-    static = np.linalg.solve(np.transpose(terms.leg_jacobian, (0, 2, 1)),
-                             terms.gravity[..., None])[..., 0]
+    static = np.linalg.solve(np.transpose(leg_jacobian, (0, 2, 1)), gravity[..., None])[..., 0]
     shares = forces.mean(axis=0) / static.mean(axis=0)
     leg = int(np.argmax(np.abs(shares - 1.0)))
     if abs(shares[leg] - 1.0) > LEG_BALANCE_ERROR:

@@ -13,7 +13,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from scipy import sparse
 
 from stewartid.identification.detection import Detection
 from stewartid.identification.intervals import wavelet_points
@@ -74,6 +73,8 @@ def point_equations(experiment: Experiment, found: Detection,
             # constants vanish analytically (and, with the moment correction, to
             # rounding); removing the mean also keeps the Mexican hat's truncation error
             # proportional to the motion, not the offset
+            from scipy import sparse  # only this path builds sparse matrices
+
             w2 = sparse.diags(1.0 / scales ** 2) @ matrix(2)
             w1 = sparse.diags(-1.0 / scales) @ matrix(1)
             w_acc, w_vel = w2 @ qc, w1 @ qc
