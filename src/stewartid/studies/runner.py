@@ -163,8 +163,10 @@ def connect(scheduler: str | None = None, workers: int | None = None) -> Iterato
     count = (os.cpu_count() or 1) if workers is None else workers
     if count < 1:
         raise ConfigError(f"--workers must be >= 1; got {workers!r}.")
+    # quiet workers: at shutdown their heartbeats to the closing scheduler log errors, and a
+    # task's own failure reaches the client through its future anyway
     with LocalCluster(n_workers=count, threads_per_worker=1, processes=True,
-                      dashboard_address=None, silence_logs=logging.ERROR,
+                      dashboard_address=None, silence_logs=logging.CRITICAL,
                       env=_worker_environment()) as cluster, Client(cluster) as client:
         yield client
 
