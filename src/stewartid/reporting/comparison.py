@@ -103,6 +103,12 @@ class MethodRun:
         matrix, row, col = key
         return float(self.matrix(matrix)[row, col])
 
+    def std_error(self, key: EntryKey) -> float:
+        """Standard error of one entry; NaN when the method gives none."""
+        matrix, row, col = key
+        std = self.std_errors_M if matrix == "M" else self.std_errors_B
+        return float("nan") if std is None else float(np.asarray(std)[row, col])
+
 
 @dataclass(frozen=True)
 class ComparisonResults:

@@ -29,34 +29,38 @@ from stewartid.reporting.comparison import ComparisonResults, MethodRun
 LEGACY_METHOD_NAMES = {"least_squares": "ls", "wavelet_paper": "wavelet-paper"}
 
 
+def run_record(results: ComparisonResults, run: MethodRun) -> dict[str, Any]:
+    """One identification of a run as a JSON-ready dict: matrices, standard errors, ε per
+    entry, the largest, the paper's values where published, time and diagnostics."""
+    eps = results.eps_all(run)
+    worst = max(eps, key=eps.__getitem__)
+    published = {}
+    for key in PAPER_ENTRIES:
+        entry = results.published_entry(run.method, run.coulomb, key)
+        if entry is not None:
+            published[entry_label(key)] = {"value": entry.value, "eps": entry.eps}
+    return {
+        "method": run.method, "coulomb": run.coulomb,
+        "M": run.M.tolist(), "B": run.B.tolist(),
+        "std_errors_M": run.std_errors_M, "std_errors_B": run.std_errors_B,
+        "eps": {entry_label(k): v for k, v in eps.items()},
+        "max_eps": eps[worst], "max_eps_entry": entry_label(worst),
+        "eps_all_entries": {
+            "M": relative_error_percent(run.M, results.nominal_M),
+            "B": relative_error_percent(run.B, results.nominal_B)},
+        "published": published or None,
+        "seconds": run.seconds,
+        "diagnostics": run.diagnostics,
+    }
+
+
 def results_document(results: ComparisonResults, runtime_s: float,
                      files: Sequence[str] = ()) -> dict[str, Any]:
     """Everything of a run as a JSON-ready dict (see the module docstring)."""
     from stewartid import __version__
     from stewartid.reporting.report import summary_lines
 
-    runs = []
-    for run in results.runs:
-        eps = results.eps_all(run)
-        worst = max(eps, key=eps.__getitem__)
-        published = {}
-        for key in PAPER_ENTRIES:
-            entry = results.published_entry(run.method, run.coulomb, key)
-            if entry is not None:
-                published[entry_label(key)] = {"value": entry.value, "eps": entry.eps}
-        runs.append({
-            "method": run.method, "coulomb": run.coulomb,
-            "M": run.M.tolist(), "B": run.B.tolist(),
-            "std_errors_M": run.std_errors_M, "std_errors_B": run.std_errors_B,
-            "eps": {entry_label(k): v for k, v in eps.items()},
-            "max_eps": eps[worst], "max_eps_entry": entry_label(worst),
-            "eps_all_entries": {
-                "M": relative_error_percent(run.M, results.nominal_M),
-                "B": relative_error_percent(run.B, results.nominal_B)},
-            "published": published or None,
-            "seconds": run.seconds,
-            "diagnostics": run.diagnostics,
-        })
+    runs = [run_record(results, run) for run in results.runs]
     return to_jsonable({
         "package": "stewartid", "version": __version__,
         "created": datetime.now(UTC).isoformat(timespec="seconds"),
@@ -97,4 +101,4 @@ def load_results(path: str | Path) -> ComparisonResults:
                              dict(document.get("settings", {})))
 
 
-__all__ = ["LEGACY_METHOD_NAMES", "load_results", "results_document"]
+__all__ = ["LEGACY_METHOD_NAMES", "load_results", "results_document", "run_record"]

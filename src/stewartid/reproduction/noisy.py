@@ -15,11 +15,10 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Sequence
 
-import numpy as np
-
 from stewartid.reference.published import PAPER_ENTRIES, entry_label
 from stewartid.reporting.comparison import ComparisonResults, MethodRun, method_name
 from stewartid.reporting.tables import ResultTable, comparison_table
+from stewartid.reproduction.document import run_record
 
 #: Multiple of the reference sensor noise in the noisy case.
 NOISE_SCALE = 1.0
@@ -27,18 +26,12 @@ NOISE_SCALE = 1.0
 STEM = "noisy"
 
 
-def _std_error(run: MethodRun, key: tuple) -> float:
-    matrix, i, j = key
-    std = run.std_errors_M if matrix == "M" else run.std_errors_B
-    return float("nan") if std is None else float(np.asarray(std)[i, j])
-
-
 def within_three_std(results: ComparisonResults, run: MethodRun) -> int:
     """Number of the 20 paper entries whose error is at most 3 reported standard errors."""
     count = 0
     for key in PAPER_ENTRIES:
         error = abs(run.value(key) - results.nominal(key))
-        count += bool(error <= 3.0 * _std_error(run, key))
+        count += bool(error <= 3.0 * run.std_error(key))
     return count
 
 
@@ -76,19 +69,12 @@ def noisy_results(runs: Sequence[MethodRun], clean: ComparisonResults) -> Compar
 
 
 def noisy_document(results: ComparisonResults) -> dict:
-    """JSON-ready record of the noisy case (``results.json`` key ``noise_case``)."""
+    """JSON-ready record of the noisy case (``results.json`` key ``noise_case``): the runs as
+    in the rest of ``results.json`` (:func:`~stewartid.reproduction.document.run_record`),
+    each with ``within_3_std``."""
     level = max(results.coulomb_levels)
-    runs = []
-    for run in (results.run(m, level) for m in results.methods):
-        if run is None:
-            continue
-        key, eps = results.worst(run)
-        runs.append({"method": run.method, "coulomb": run.coulomb, "M": run.M, "B": run.B,
-                     "std_errors_M": run.std_errors_M, "std_errors_B": run.std_errors_B,
-                     "eps": {entry_label(k): results.eps(run, k) for k in PAPER_ENTRIES},
-                     "max_eps": eps, "max_eps_entry": entry_label(key),
-                     "within_3_std": within_three_std(results, run),
-                     "seconds": run.seconds})
+    runs = [{**run_record(results, run), "within_3_std": within_three_std(results, run)}
+            for run in (results.run(m, level) for m in results.methods) if run is not None]
     return {"coulomb": level, "noise_scale": NOISE_SCALE,
             "noise": "reference: 20 um leg lengths (pose by forward kinematics), 0.5 % of "
                      "the static leg force",
