@@ -158,18 +158,32 @@ def test_energy_is_conserved_without_friction(paper):
 
 
 def test_lean_leg_terms_equal_the_full_model_terms(paper, rng):
-    """The kernel without inertia terms (command tables, forward kinematics, identification)
-    gives the gravity, leg Jacobian, lengths and joint Jacobians of the full one, which the
-    tests above check against energy, Lagrange's equations and finite differences."""
-    from stewartid import _kernels
+    """The numpy leg terms (command tables, forward kinematics, identification) are the
+    compiled kernel's gravity, leg Jacobian, lengths and joint Jacobians to the last bit; the
+    tests above check those against energy, Lagrange's equations and finite differences."""
+    from stewartid.leg_terms import BLOCK, leg_terms
 
-    q = poses(paper, rng, 50)
+    q = poses(paper, rng, BLOCK + 50)  # more than one block
     full = ModelTerms(paper, q)
-    G, J, lengths, J_joint = _kernels.batch_leg_terms(
+    G, J, lengths, J_joint = leg_terms(
         paper.parameters(), paper.upper_joints, paper.base_joints, q, True)
     assert np.array_equal(G, full.gravity)
     assert np.array_equal(J, full.leg_jacobian)
     assert np.array_equal(lengths, full.leg_lengths)
     assert np.array_equal(J_joint, full.joint_jacobians)
-    assert _kernels.batch_leg_terms(paper.parameters(), paper.upper_joints,
-                                    paper.base_joints, q, False)[3].shape == (0, 6, 5, 6)
+    assert leg_terms(paper.parameters(), paper.upper_joints, paper.base_joints, q,
+                     False).joint_jacobians.shape == (0, 6, 5, 6)
+
+
+def test_interpreted_kernel_equals_the_compiled_one(paper, rng):
+    """nominal_matrices runs the mass-matrix kernel interpreted for its one pose."""
+    from stewartid import _kernels
+
+    q, qd = poses(paper, rng, 1)[0], rng.normal(scale=0.1, size=6)
+    shapes = ((6, 6), 6, 6, (6, 6), (6, 5, 6), 6)
+    compiled, interpreted = ([np.empty(s) for s in shapes] for _ in range(2))
+    args = (paper.parameters(), paper.upper_joints, paper.base_joints, q, qd)
+    _kernels.model_terms(*args, *compiled)
+    _kernels.interpreted("model_terms")(*args, *interpreted)
+    for a, b in zip(compiled, interpreted, strict=True):
+        np.testing.assert_allclose(b, a, rtol=1e-12, atol=1e-9)

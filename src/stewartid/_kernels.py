@@ -1,9 +1,11 @@
 """Compiled per-sample kernels of the platform model (numba).
 
 One kernel, :func:`model_terms`, evaluates every pose-dependent term of the model at one
-sample, so the simulator pays for the leg geometry once per right-hand-side call. The public,
-batched functions in :mod:`stewartid.kinematics` and :mod:`stewartid.dynamics` loop over
-samples in compiled code around it.
+sample, so the simulator pays for the leg geometry once per right-hand-side call. The batched
+functions of :mod:`stewartid.dynamics` loop over samples in compiled code around it; the
+pose-only terms (leg lengths, J_lq, G, joint Jacobians) that kinematics, command tables and
+identification need are computed by :mod:`stewartid.leg_terms` in numpy, equal to these to
+the last bit.
 
 Coordinates: q = [x, y, z, rx, ry, rz] (m, rad; R = Rz(rz) Ry(ry) Rx(rx)), q_dot its time
 derivative (Euler-angle rates). Internally the body equations are written in the twist
@@ -23,9 +25,12 @@ relative to the leg (upper) on e1 and e2, the revolute rate is the relative rate
 from __future__ import annotations
 
 import math
+from functools import cache
+from types import FunctionType
 
 import numpy as np
 from numba import njit
+from numba.core.dispatcher import Dispatcher
 
 #: Indices into the packed parameter vector built by Platform.parameters().
 P_MASS, P_IXX, P_IYY, P_IZZ = 0, 1, 2, 3
@@ -303,67 +308,6 @@ def _rotation_columns(row, E):
 
 
 @njit(cache=True)
-def leg_terms(params, upper, base, q, G, J_leg, lengths, J_joint, joints):
-    """The pose-only terms of :func:`model_terms` at one sample, without M and h.
-
-    Outputs as in :func:`model_terms`: ``G`` (6,), ``J_leg`` (6, 6), ``lengths`` (6,) and,
-    when ``joints``, ``J_joint`` (6, 5, 6) (else untouched). A fraction of the cost of
-    :func:`model_terms`, for the callers that need no inertia: command tables, forward
-    kinematics, and the measured generalized forces of the identification.
-    """
-    m_u, m_l = params[P_M_UPPER], params[P_M_LOWER]
-    d_u, d_l = params[P_D_UPPER], params[P_D_LOWER]
-    g = params[P_GRAVITY]
-    R = rotation(q[3], q[4], q[5])
-    E = euler_rate_map(q[4], q[5])
-    r = np.empty(3)
-    ui = np.empty(3)
-    JA = np.empty((3, 6))
-    Jw = np.empty((3, 6))
-    w_rel = np.empty(3)
-    Gn = np.zeros(6)
-    Gn[2] = -params[P_MASS] * g
-    for i in range(6):
-        l = _leg_geometry(R, upper, base, q, i, r, ui, JA)
-        lengths[i] = l
-        for c in range(6):
-            uJ = ui[0] * JA[0, c] + ui[1] * JA[1, c] + ui[2] * JA[2, c]
-            J_leg[i, c] = uJ
-            # vertical velocity of the two centres of mass (gravity is along z)
-            Judot2 = (JA[2, c] - ui[2] * uJ) / l
-            Gn[c] -= g * (m_l * (d_l * Judot2) + m_u * (JA[2, c] - d_u * Judot2))
-            if joints:
-                Jw[0, c] = (ui[1] * JA[2, c] - ui[2] * JA[1, c]) / l
-                Jw[1, c] = (ui[2] * JA[0, c] - ui[0] * JA[2, c]) / l
-                Jw[2, c] = (ui[0] * JA[1, c] - ui[1] * JA[0, c]) / l
-        if joints:
-            _joint_axes(ui, Jw, w_rel, J_joint[i])
-        _rotation_columns(J_leg[i], E)
-        if joints:
-            for j in range(N_JOINTS):
-                _rotation_columns(J_joint[i, j], E)
-    for a in range(3):
-        G[a] = Gn[a]
-        G[3 + a] = E[0, a] * Gn[3] + E[1, a] * Gn[4] + E[2, a] * Gn[5]
-
-
-@njit(cache=True)
-def batch_leg_terms(params, upper, base, q, joints):
-    """:func:`leg_terms` over samples: q of shape (N, 6); J_joint is (N, 6, 5, 6) when
-    ``joints``, else (0, 6, 5, 6)."""
-    n = q.shape[0]
-    G = np.empty((n, 6))
-    Jl = np.empty((n, 6, 6))
-    lengths = np.empty((n, 6))
-    Jj = np.empty((n if joints else 0, 6, N_JOINTS, 6))
-    scratch = np.empty((6, N_JOINTS, 6))
-    for k in range(n):
-        leg_terms(params, upper, base, q[k], G[k], Jl[k], lengths[k],
-                  Jj[k] if joints else scratch, joints)
-    return G, Jl, lengths, Jj
-
-
-@njit(cache=True)
 def joint_friction(params, J_joint, qd, smoothing):
     """Generalized joint friction forces (N, N m) at one sample, regularised Coulomb.
 
@@ -421,3 +365,19 @@ def batch_friction(params, J_joint, qd, smoothing):
     for k in range(n):
         F[k] = joint_friction(params, J_joint[k], qd[k], smoothing)
     return F
+
+
+@cache
+def interpreted(name: str) -> FunctionType:
+    """The kernel ``name`` run by the Python interpreter, with the kernels it calls.
+
+    The same code as the compiled kernel, for a handful of samples in a process that has not
+    compiled or loaded any: the first compiled call starts numba's code generator and loads
+    the cached machine code (about 0.4 s), interpreting one sample of :func:`model_terms`
+    takes milliseconds.
+    """
+    namespace = dict(globals())
+    for key, value in globals().items():
+        if isinstance(value, Dispatcher):
+            namespace[key] = FunctionType(value.py_func.__code__, namespace, key)
+    return namespace[name]

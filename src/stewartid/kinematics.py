@@ -14,8 +14,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from stewartid import _kernels
 from stewartid.errors import KinematicsError
+from stewartid.leg_terms import LegTerms, leg_terms
 from stewartid.platform import Platform
 
 #: Names of the five rotational joint axes of a leg, in the order of joint_rate_jacobians.
@@ -103,6 +103,8 @@ def leg_lengths(platform: Platform, q: np.ndarray) -> np.ndarray:
 
 
 def _terms(platform: Platform, q: np.ndarray, qd: np.ndarray | None = None):
+    from stewartid import _kernels  # numba: only the full model terms need it
+
     q2, single = _batch(q)
     qd2 = np.zeros_like(q2) if qd is None else _batch(qd, "q_dot")[0]
     if qd2.shape != q2.shape:
@@ -111,11 +113,11 @@ def _terms(platform: Platform, q: np.ndarray, qd: np.ndarray | None = None):
                                 platform.base_joints, q2, qd2), single
 
 
-def _leg_terms(platform: Platform, q: np.ndarray, joints: bool = False):
+def _leg_terms(platform: Platform, q: np.ndarray, joints: bool = False) -> LegTerms:
     """(G, J_leg, lengths, J_joint) at poses q (N, 6), without the inertia terms; J_joint is
     empty unless ``joints``."""
-    return _kernels.batch_leg_terms(platform.parameters(), platform.upper_joints,
-                                    platform.base_joints, q, joints)
+    return leg_terms(platform.parameters(), platform.upper_joints, platform.base_joints, q,
+                     joints)
 
 
 def leg_jacobian(platform: Platform, q: np.ndarray) -> np.ndarray:

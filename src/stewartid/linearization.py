@@ -14,17 +14,21 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewartid._kernels import GIMBAL_AXES
+from stewartid._kernels import GIMBAL_AXES, interpreted
 from stewartid.dynamics import ModelTerms
+from stewartid.kinematics import joint_rate_jacobians
 from stewartid.platform import Platform
 
 
 def viscous_matrix(platform: Platform, q: np.ndarray) -> np.ndarray:
     """Bt(q) = c * sum_{legs, gimbal axes} J_j^T J_j; shape (6, 6) or (N, 6, 6)."""
-    t = ModelTerms(platform, q)
-    J = t.joint_jacobians[:, :, list(GIMBAL_AXES), :]
-    B = platform.friction.gimbal_viscous * np.einsum("nlai,nlaj->nij", J, J)
-    return B[0] if t.single else B
+    return _viscous(platform, joint_rate_jacobians(platform, q))
+
+
+def _viscous(platform: Platform, joint_jacobians: np.ndarray) -> np.ndarray:
+    """Bt from joint-axis Jacobians of shape (..., 6, 5, 6); shape (..., 6, 6)."""
+    J = joint_jacobians[..., list(GIMBAL_AXES), :]
+    return platform.friction.gimbal_viscous * np.einsum("...lai,...laj->...ij", J, J)
 
 
 def nominal_matrices(platform: Platform, pose: np.ndarray | None = None
@@ -45,8 +49,13 @@ def nominal_matrices(platform: Platform, pose: np.ndarray | None = None
         N s/m, N s/rad, N m s/rad blocks.
     """
     q0 = platform.neutral_pose if pose is None else np.asarray(pose, dtype=float)
-    t = ModelTerms(platform, q0)
-    return t.mass_matrix[0], viscous_matrix(platform, q0)
+    M, h, G, J_leg, J_joint, lengths = (np.empty(shape) for shape in
+                                        ((6, 6), 6, 6, (6, 6), (6, 5, 6), 6))
+    # one pose: interpreted, which spares the command line numba's start (see the kernel)
+    interpreted("model_terms")(platform.parameters(), platform.upper_joints,
+                               platform.base_joints, q0, np.zeros(6), M, h, G, J_leg, J_joint,
+                               lengths)
+    return M, _viscous(platform, J_joint)
 
 
 def gravity_stiffness(platform: Platform, pose: np.ndarray | None = None,

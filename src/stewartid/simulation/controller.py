@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from stewartid import _kernels
+from stewartid.leg_terms import leg_terms
 from stewartid.platform import Platform
 from stewartid.simulation.hydraulics import force_limits
 
@@ -84,7 +84,6 @@ def valve_command(cp: np.ndarray, demand: float, force: float) -> float:
     return u
 
 
-@njit(cache=True)
 def command_tables(params, upper, base, q_cmd, qd_cmd, feedforward):
     """Leg-length commands, their rates and the gravity feed-forward along a trajectory.
 
@@ -99,24 +98,27 @@ def command_tables(params, upper, base, q_cmd, qd_cmd, feedforward):
     -------
     lengths, rates, forces : (N, 6) each; m, m/s, N.
     """
-    n = q_cmd.shape[0]
-    lengths = np.empty((n, 6))
+    G, J, lengths, _ = leg_terms(params, upper, base, np.ascontiguousarray(q_cmd))
+    rates, forces = _rates_and_feedforward(J, G, np.ascontiguousarray(qd_cmd), feedforward)
+    return lengths, rates, forces
+
+
+@njit(cache=True)
+def _rates_and_feedforward(J, G, qd_cmd, feedforward):
+    """Leg-length rates J qd and, when ``feedforward``, forces J^-T G at every sample."""
+    n = qd_cmd.shape[0]
     rates = np.empty((n, 6))
     forces = np.zeros((n, 6))
-    G = np.empty(6)
-    J = np.empty((6, 6))
-    Jj = np.empty((6, 5, 6))  # not computed: joints=False
     A = np.empty((6, 7))
     for k in range(n):
-        _kernels.leg_terms(params, upper, base, q_cmd[k], G, J, lengths[k], Jj, False)
         for i in range(6):
             s = 0.0
             for c in range(6):
-                s += J[i, c] * qd_cmd[k, c]
+                s += J[k, i, c] * qd_cmd[k, c]
             rates[k, i] = s
         if feedforward:
-            _solve_transposed(J, G, A, forces[k])
-    return lengths, rates, forces
+            _solve_transposed(J[k], G[k], A, forces[k])
+    return rates, forces
 
 
 @njit(cache=True)
