@@ -259,7 +259,7 @@ def check_static_balance(pose: np.ndarray, forces: np.ndarray, platform: Platfor
     from stewartid.kinematics import _leg_terms
 
     pose, forces = _subsample(pose, forces)
-    # the lean kernel that preparation uses too: no mass matrix, one compiled kernel loaded
+    # the pose-only leg terms that preparation uses too: no mass matrix, no compiled kernel
     gravity, leg_jacobian, _, _ = _leg_terms(platform, np.ascontiguousarray(pose))
     generalized = np.einsum("nij,ni->nj", leg_jacobian, forces)
     weight = -float(np.mean(gravity[:, 2]))
