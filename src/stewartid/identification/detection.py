@@ -10,15 +10,19 @@ stays outside every interval.
 
 from __future__ import annotations
 
+import warnings
+from collections.abc import Sequence
 from typing import NamedTuple
 
 import numpy as np
 
+from stewartid.dataset import DataWarning
+from stewartid.errors import IdentificationError
 from stewartid.identification.intervals import constant_direction_intervals, joint_rates
 from stewartid.identification.noise import joint_rate_noise, position_noise_covariance
 from stewartid.identification.preparation import Experiment
 from stewartid.kinematics import joint_rate_jacobians
-from stewartid.platform import Platform
+from stewartid.platform import COORDINATES, Platform
 from stewartid.signals.differentiation import default_window, differentiate, estimate_frequency
 
 
@@ -49,6 +53,57 @@ class Detection(NamedTuple):
 
 #: Samples per block when joint Jacobians are formed on the fly (1.4 kB a sample).
 BLOCK_SAMPLES = 65536
+
+
+#: Joints whose rate RMS is below this multiple of its noise level count as idle.
+IDLE_NOISE_RATIO = 2.0
+#: A DOF moved by the experiments that gave intervals less than this fraction of its largest
+#: motion in any experiment has lost its excitation.
+COVERAGE_FRACTION = 0.1
+
+
+def raise_no_interval(infos: Sequence[dict]) -> None:
+    """Raise the error for data without a single usable interval (``infos`` of
+    :func:`detect_intervals`), naming the longest found and what was needed."""
+    longest = max(info["longest_interval"] for info in infos)
+    needed = min(info["shortest_usable"] for info in infos)
+    raise IdentificationError(
+        f"no constant-direction interval long enough for the smallest wavelet scale "
+        f"in any experiment (longest {longest:.3g} s, at least {needed:.3g} s needed); "
+        "excite with a slower single-frequency sine, lower 'margin' or "
+        "'min_support_samples', raise 'ignore_below' to leave idle joints out, or "
+        "record at a higher sample rate.")
+
+
+def check_coverage(names: Sequence[str], motion: np.ndarray, counts: Sequence[int]) -> None:
+    """Warn for every experiment without a usable interval; raise when those left out were
+    the only ones to move a DOF (its entries would rest on noise, with small standard errors).
+
+    Parameters
+    ----------
+    names : sequence of str
+        Experiment names.
+    motion : ndarray, shape (n_experiments, 6)
+        RMS of each pose coordinate about its mean (m, rad).
+    counts : sequence of int
+        Usable intervals per experiment.
+    """
+    counts = np.asarray(counts)
+    for name, count in zip(names, counts, strict=True):
+        if count == 0:
+            warnings.warn(f"{name}: no usable constant-direction interval (joint rates within "
+                          f"their noise, or reversals too close together); it adds nothing "
+                          f"to Method B", DataWarning, stacklevel=3)
+    largest = motion.max(axis=0)
+    kept = motion[counts > 0].max(axis=0) if np.any(counts > 0) else np.zeros(6)
+    lost = [c for c, k, top in zip(COORDINATES, kept, largest, strict=True)
+            if top > 0 and k < COVERAGE_FRACTION * top]
+    if lost:
+        raise IdentificationError(
+            f"DOF {', '.join(lost)} lost its excitation: the experiments that move it most "
+            f"({', '.join(n for n, c in zip(names, counts, strict=True) if c == 0)}) gave no "
+            f"usable constant-direction interval; check their joint-rate noise in the "
+            f"diagnostics, or lower hysteresis / margin")
 
 
 def _joint_rates_in_blocks(experiment: Experiment, platform: Platform, q_dot: np.ndarray
@@ -116,6 +171,11 @@ def detect_intervals(experiment: Experiment, platform: Platform, *, window: floa
     noise = position_noise_covariance(q, q_smooth)
     rate_noise = joint_rate_noise(noise, rate, window, mean_jacobian,
                                   experiment.leg_jacobian)
+    # a joint whose rate is no larger than its noise has no direction to keep, whatever its
+    # share of the largest rate (pure heave with 20 um pose noise leaves three axes per leg at
+    # 1.0x their noise and 1 % of the largest rate; on some seeds they broke every interval)
+    idle = np.sqrt(np.mean(np.square(rates), axis=0)) < IDLE_NOISE_RATIO * rate_noise
+    rates[:, idle] = 0.0
     found = constant_direction_intervals(t, rates, margin=margin, ignore_below=ignore_below,
                                          hysteresis=hysteresis * rate_noise)
     lengths = found[:, 1] - found[:, 0]

@@ -58,13 +58,15 @@ from __future__ import annotations
 import numpy as np
 
 from stewartid.dataset import Dataset
-from stewartid.errors import IdentificationError
 from stewartid.identification.base import BaseIdentifier, check_parameter
-from stewartid.identification.detection import Detection, detect_intervals
-from stewartid.identification.least_squares import JOINT_TYPES
-from stewartid.identification.noise import (
-    generalized_force_sensitivity,
+from stewartid.identification.detection import (
+    Detection,
+    check_coverage,
+    detect_intervals,
+    raise_no_interval,
 )
+from stewartid.identification.least_squares import JOINT_TYPES
+from stewartid.identification.noise import generalized_force_sensitivity
 from stewartid.identification.point_equations import EXACT_DEGREE, point_equations
 from stewartid.identification.preparation import Experiment, prepare
 from stewartid.identification.registry import Preset, register_method
@@ -75,14 +77,11 @@ from stewartid.identification.solvers import (
     select_symmetric_pairs,
     solve_least_squares,
 )
-from stewartid.identification.weak_form import interval_equations, solve_weak_form
+from stewartid.identification.weak_form import interval_equations
+from stewartid.identification.weak_form_solver import solve_weak_form
 from stewartid.kinematics import joint_rate_jacobians
 from stewartid.platform import COORDINATES, Platform
-from stewartid.signals.wavelets import (
-    MotherWavelet,
-    PolynomialWavelet,
-    make_wavelet,
-)
+from stewartid.signals.wavelets import MotherWavelet, PolynomialWavelet, make_wavelet
 
 #: Citation of the method.
 REFERENCE = ("Zhang, C. A Parameter Identification Method for Stewart Manipulator Based on "
@@ -165,8 +164,8 @@ class WaveletIdentifier(BaseIdentifier):
         ``test_functions=None``: also use the polynomial wavelet's odd companion g'''
         (:class:`~stewartid.signals.wavelets.PolynomialWavelet`; ``wavelet_order`` >= 8).
     noise_correction : bool
-        ``test_functions=None``, position variant: remove the pose noise's contribution to
-        the normal equations (errors in variables, noise estimated from the data;
+        Position variant: weight by and remove the pose noise's contribution to the normal
+        equations (errors in variables, noise estimated from the data; :mod:`.weak_form_solver`,
         :func:`~stewartid.identification.solvers.bias_compensated_least_squares`).
     symmetric : bool
         Impose Mt = Mt^T and Bt = Bt^T in the solve.
@@ -308,9 +307,11 @@ class WaveletIdentifier(BaseIdentifier):
         """The default path: orthonormal test-function families per interval
         (:mod:`~stewartid.identification.weak_form`). One experiment at a time, its arrays
         dropped once its equations are formed, so that long logs fit in memory."""
-        infos, equations = [], []
+        infos, equations, sensitivities, motion = [], [], [], []
         for k, dataset in enumerate(datasets):
             (experiment,) = prepare([dataset], platform, gravity=self.gravity)
+            sensitivities.append(generalized_force_sensitivity(
+                platform, dataset.pose, dataset.forces, self.gravity))
             found = self._intervals(experiment, platform, 1.0)
 
             def jacobians(indices: np.ndarray, q: np.ndarray = experiment.q) -> np.ndarray:
@@ -324,11 +325,17 @@ class WaveletIdentifier(BaseIdentifier):
                 if rows is not None:
                     equations.append(rows)
             infos.append(found.info)
+            motion.append(np.std(experiment.q, axis=0))
             del experiment, found
         if not equations:
-            self._raise_no_interval(infos)
+            raise_no_interval(infos)
+        check_coverage([i["name"] for i in infos], np.array(motion),
+                       [sum(e.experiment == k for e in equations) for k in range(len(infos))])
         solution = solve_weak_form(equations, len(datasets),
-                                   shared_friction=self.friction == "shared")
+                                   shared_friction=self.friction == "shared",
+                                   **({"pose_covariance": [i["noise_covariance"] for i in infos],
+                                       "force_sensitivity": sensitivities}
+                                      if self.noise_correction else {}))
         theta, std = solution.theta.copy(), solution.theta_std.copy()
         M, B = theta[:, :6], theta[:, 6:12]
         std_M, std_B = std[:, :6], std[:, 6:12]
@@ -345,23 +352,13 @@ class WaveletIdentifier(BaseIdentifier):
             "pair_choice": chosen, "coordinates": list(COORDINATES),
             "friction_model": self.friction, "coulomb": levels, "coulomb_std": levels_std,
             "offsets": solution.offsets, "noise_std": solution.noise_std,
-            "constant_scatter": solution.constant_scatter}
+            "constant_scatter": solution.constant_scatter,
+            "pose_noise_share": solution.pose_noise_share}
         result = IdentificationResult(
             M=M, B=B, std_errors_M=std_M, std_errors_B=std_B,
             condition_number=solution.condition_number, residual_rms=solution.noise_std,
             method=self.method, settings=self._settings(), diagnostics=diagnostics)
         return result, {"coulomb_": levels, "coulomb_std_": levels_std}
-
-    @staticmethod
-    def _raise_no_interval(infos: list[dict]) -> None:
-        longest = max(info["longest_interval"] for info in infos)
-        needed = min(info["shortest_usable"] for info in infos)
-        raise IdentificationError(
-            f"no constant-direction interval long enough for the smallest wavelet scale "
-            f"in any experiment (longest {longest:.3g} s, at least {needed:.3g} s needed); "
-            "excite with a slower single-frequency sine, lower 'margin' or "
-            "'min_support_samples', raise 'ignore_below' to leave idle joints out, or "
-            "record at a higher sample rate.")
 
     def _combine_pairs(self, M: np.ndarray, B: np.ndarray, std_M: np.ndarray,
                        std_B: np.ndarray) -> dict:
@@ -411,7 +408,7 @@ class WaveletIdentifier(BaseIdentifier):
         phi, target, cluster = np.vstack(phi), np.vstack(target), np.concatenate(cluster)
         noise_xx, noise_xy = np.concatenate(noise_xx), np.concatenate(noise_xy)
         if len(phi) == 0:
-            self._raise_no_interval(infos)
+            raise_no_interval(infos)
         names = regressor_names("q_ddot", "q_dot")
         solution = solve_least_squares(phi, target, symmetric=bool(self.symmetric),
                                        regressor_names=names)

@@ -30,11 +30,10 @@ friction structure across intervals and experiments gives that information back,
 decides how much it is trusted: a plant whose friction does not fit the structure gets a
 large tau^2 and the estimate falls back on the invariant rows alone.
 
-The solve is iteratively reweighted least squares over all channels at once (the Coulomb
-levels are shared by the channels), with the noise variance of each channel estimated from
-the invariant rows' residuals. Standard errors are the larger of the model-based ones and a
-cluster-robust sandwich over intervals (model errors such as a friction reversal inside an
-interval show in the spread between intervals, not in the noise level).
+The solve (:mod:`~stewartid.identification.weak_form_solver`) is generalized least squares
+over all channels at once (the Coulomb levels are shared by the channels), each interval's
+rows weighted by their covariance: the force noise, and the pose noise the test functions'
+derivatives carry into the regressors, whose bias it also compensates.
 
 References
 ----------
@@ -58,7 +57,6 @@ import numpy as np
 from numpy.polynomial import polynomial
 
 from stewartid.identification.least_squares import JOINT_TYPES
-from stewartid.identification.solvers import _check_rank, regressor_names
 
 
 @lru_cache(maxsize=32)
@@ -103,6 +101,10 @@ class IntervalEquations:
         interval's joint directions.
     experiment : int
         Index of the experiment the interval belongs to.
+    noise_gram : ndarray, shape (3, 3, K + 1, K + 1)
+        Gram matrices <phi^(a), phi^(b)> of the rows' test functions and their first and
+        second derivatives (a, b = 0, 1, 2), invariant rows then the mean row: what white
+        pose noise puts into the rows (:mod:`~stewartid.identification.weak_form_solver`).
     """
 
     regressors: np.ndarray
@@ -112,6 +114,7 @@ class IntervalEquations:
     weight: float
     coulomb: np.ndarray
     experiment: int
+    noise_gram: np.ndarray
 
 
 def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
@@ -183,173 +186,14 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
     pattern = np.einsum("la,nlac->nac", direction, jacobians)                  # (n, 5, 6)
     coulomb = np.array([bump0 @ pattern[:, list(axes)].sum(axis=1)
                         for axes in JOINT_TYPES.values()])
+    family = np.stack([np.vstack([phi0, bump0]), np.vstack([phi1, bump1]),
+                       np.vstack([phi2, bump2])])                            # (3, K + 1, n)
+    gram = np.einsum("arn,bsn->abrs", family, family)
     return IntervalEquations(
         regressors=np.hstack([phi2 @ qc, -(phi1 @ qc)]), targets=phi0 @ ys,
         mean_regressors=np.r_[bump2 @ qc, -(bump1 @ qc)], mean_target=bump0 @ ys,
-        weight=float(bump0.sum()), coulomb=coulomb, experiment=int(experiment))
+        weight=float(bump0.sum()), coulomb=coulomb, experiment=int(experiment),
+        noise_gram=gram)
 
 
-@dataclass(frozen=True)
-class WeakFormSolution:
-    """Solution of :func:`solve_weak_form`.
-
-    Attributes
-    ----------
-    theta, theta_std : ndarray, shape (6, 12)
-        [Mt Bt] and standard errors.
-    coulomb, coulomb_std : ndarray, shape (n_types,)
-        Coulomb level per joint type (N m), NaN without shared friction.
-    offsets : ndarray, shape (n_experiments, 6)
-        Constant per experiment (N, N m), NaN without shared friction.
-    noise_std : ndarray, shape (6,)
-        Residual standard deviation of the invariant rows per channel.
-    constant_scatter : ndarray, shape (6,)
-        tau: spread of the interval constants around the friction structure (N, N m).
-    condition_number : float
-        Of the column-equilibrated invariant regression.
-    n_equations : int
-        Rows per channel.
-    """
-
-    theta: np.ndarray
-    theta_std: np.ndarray
-    coulomb: np.ndarray
-    coulomb_std: np.ndarray
-    offsets: np.ndarray
-    noise_std: np.ndarray
-    constant_scatter: np.ndarray
-    condition_number: float
-    n_equations: int
-
-
-def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
-                    shared_friction: bool = True, iterations: int = 5,
-                    max_condition: float = 1e8) -> WeakFormSolution:
-    """Iteratively reweighted least squares for [Mt Bt] (and the friction structure).
-
-    Parameters
-    ----------
-    equations : sequence of IntervalEquations
-    n_experiments : int
-    shared_friction : bool
-        Use the mean rows with the friction structure of the module docstring; False: the
-        invariant rows alone (every interval constant free).
-    iterations : int
-        Reweighting passes.
-    max_condition : float
-        Rank check of the invariant regression (names the DOF never excited).
-
-    Returns
-    -------
-    WeakFormSolution
-    """
-    x = np.concatenate([e.regressors for e in equations])
-    y = np.concatenate([e.targets for e in equations])
-    rows_per = np.array([len(e.regressors) for e in equations])
-    cluster = np.repeat(np.arange(len(equations)), rows_per)
-    condition = _check_rank(x.T @ x, regressor_names("q_ddot", "q_dot"), max_condition)
-    theta = np.linalg.solve(x.T @ x, x.T @ y).T
-    dof = max(len(x) - 12, 1)
-    # floor: noise-free data must not give infinite weights
-    floor = 1e-24 * np.maximum(np.mean(y ** 2, axis=0), 1e-300)
-
-    def channel_noise(coefficients: np.ndarray) -> np.ndarray:
-        return np.maximum(np.sum((y - x @ coefficients.T) ** 2, axis=0) / dof, floor)
-
-    noise = channel_noise(theta)
-    n_types = equations[0].coulomb.shape[0]
-    n_theta = 72
-    n_unknowns = n_theta + (6 * n_experiments + n_types if shared_friction else 0)
-    if shared_friction:
-        xm = np.array([e.mean_regressors for e in equations])
-        ym = np.array([e.mean_target for e in equations])
-        weight = np.array([e.weight for e in equations])
-        wm = np.array([e.coulomb for e in equations])                     # (m, types, 6)
-        owner = np.array([e.experiment for e in equations])
-        mean_cluster = np.arange(len(equations))
-    scatter = np.zeros(6)
-    if shared_friction:
-        # the scatter of the interval constants around the friction structure, measured with
-        # the invariant estimate: a joint fit would bend Bt to hide a structure that does
-        # not hold, and so report a scatter too small to notice it
-        base = ym - xm @ theta.T
-        design = np.zeros((len(ym), 6, 6 * n_experiments + n_types))
-        for i in range(6):
-            design[np.arange(len(ym)), i, 6 * owner + i] = weight
-            design[:, i, 6 * n_experiments:] = wm[:, :, i]
-        flat = design.reshape(-1, design.shape[-1]) / np.sqrt(np.tile(noise, len(ym)))[:, None]
-        nuisance = np.linalg.lstsq(flat, base.ravel() / np.sqrt(np.tile(noise, len(ym))),
-                                   rcond=None)[0]
-        mean_residual = base - design @ nuisance
-        excess = np.sum(mean_residual ** 2, axis=0) - noise * len(ym)
-        scatter = np.sqrt(np.maximum(excess, 0.0) / np.sum(weight ** 2))
-    xtx = x.T @ x
-    n_clusters = len(equations)
-    if shared_friction:
-        # the mean rows as an explicit (small) design: channel-major, (6 m, n_unknowns)
-        n_mean = len(xm)
-        mean_design = np.zeros((6, n_mean, n_unknowns))
-        for i in range(6):
-            mean_design[i, :, 12 * i:12 * i + 12] = xm
-            mean_design[i, np.arange(n_mean), n_theta + 6 * owner + i] = weight
-            mean_design[i, :, n_theta + 6 * n_experiments:] = wm[:, :, i]
-        mean_design = mean_design.reshape(6 * n_mean, n_unknowns)
-        mean_rhs = ym.T.ravel()
-        mean_groups = np.tile(mean_cluster, 6)
-    for _ in range(max(1, iterations)):
-        # normal equations of the weighted rows: the invariant rows of channel i share the
-        # design x, so they contribute x^T x / noise_i to their own 12 x 12 block
-        normal = np.zeros((n_unknowns, n_unknowns))
-        rhs = np.zeros(n_unknowns)
-        xty = x.T @ y
-        for i in range(6):
-            block = slice(12 * i, 12 * i + 12)
-            normal[block, block] = xtx / noise[i]
-            rhs[block] = xty[:, i] / noise[i]
-        if shared_friction:
-            row_weight = 1.0 / (np.repeat(noise, n_mean)
-                                + np.repeat(scatter ** 2, n_mean) * np.tile(weight ** 2, 6))
-            weighted = mean_design * row_weight[:, None]
-            normal += mean_design.T @ weighted
-            rhs += weighted.T @ mean_rhs
-        scale = np.sqrt(np.diag(normal))
-        scale = np.where(scale > 0, scale, 1.0)
-        z = np.linalg.solve(normal / np.outer(scale, scale), rhs / scale) / scale
-        theta = z[:n_theta].reshape(6, 12)
-        noise_used = noise
-        noise = channel_noise(theta)
-        if shared_friction:
-            offsets = z[n_theta:n_theta + 6 * n_experiments].reshape(n_experiments, 6)
-            levels = z[n_theta + 6 * n_experiments:]
-    # covariances of the last solve (weights noise_used), in scaled coordinates
-    residual = (y - x @ theta.T) / np.sqrt(noise_used)                 # weighted, (n, 6)
-    scores = np.zeros((n_clusters, n_unknowns))
-    for i in range(6):
-        np.add.at(scores[:, 12 * i:12 * i + 12], cluster,
-                  x * (residual[:, i] / np.sqrt(noise_used[i]))[:, None])
-    squares = float(np.sum(residual ** 2))
-    n_rows = residual.size
-    if shared_friction:
-        mean_residual = (mean_rhs - mean_design @ z) * np.sqrt(row_weight)
-        np.add.at(scores, mean_groups, mean_design * (mean_residual * np.sqrt(row_weight))[:, None])
-        squares += float(mean_residual @ mean_residual)
-        n_rows += len(mean_residual)
-    scores /= scale
-    bread = np.linalg.pinv(normal / np.outer(scale, scale))
-    model_cov = bread * (squares / max(n_rows - n_unknowns, 1))
-    g = n_clusters
-    robust_cov = (g / max(g - 1, 1) * (n_rows - 1) / max(n_rows - n_unknowns, 1)
-                  * bread @ (scores.T @ scores) @ bread)
-    std = np.sqrt(np.maximum(np.diag(model_cov), np.diag(robust_cov))) / scale
-    if shared_friction:
-        coulomb, coulomb_std = levels, std[n_theta + 6 * n_experiments:]
-    else:
-        offsets = np.full((n_experiments, 6), np.nan)
-        coulomb = coulomb_std = np.full(n_types, np.nan)
-    return WeakFormSolution(
-        theta=theta, theta_std=std[:n_theta].reshape(6, 12), coulomb=coulomb,
-        coulomb_std=coulomb_std, offsets=offsets, noise_std=np.sqrt(noise),
-        constant_scatter=scatter, condition_number=condition, n_equations=int(len(x)))
-
-
-__all__ = ["IntervalEquations", "WeakFormSolution", "interval_equations", "solve_weak_form"]
+__all__ = ["IntervalEquations", "interval_equations"]
