@@ -319,7 +319,8 @@ class WaveletIdentifier(BaseIdentifier):
 
             for interval in found.intervals:
                 rows = interval_equations(
-                    experiment.t, experiment.q, experiment.generalized_force, jacobians,
+                    experiment.t, experiment.q, experiment.generalized_force,
+                    jacobians if self.friction == "shared" else None,
                     found.joint_rates, found.rate_noise, interval,
                     int(self.wavelet_order), int(self.test_functions), k)
                 if rows is not None:

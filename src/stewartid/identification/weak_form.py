@@ -118,7 +118,7 @@ class IntervalEquations:
 
 
 def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
-                       joint_jacobians: np.ndarray | Callable[[np.ndarray], np.ndarray],
+                       joint_jacobians: np.ndarray | Callable[[np.ndarray], np.ndarray] | None,
                        joint_rates: np.ndarray,
                        rate_noise: np.ndarray, interval: Sequence[float], order: int, size: int,
                        experiment: int = 0) -> IntervalEquations | None:
@@ -135,6 +135,7 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
     joint_jacobians : ndarray, shape (N, 6, 5, 6), or callable
         Joint-axis rate Jacobians (rad/s per unit q_dot), or a function returning them
         (n, 6, 5, 6) at the sample indices it is given (long records need not hold them).
+        None: no friction structure (``coulomb`` zero; the mean row is then unused).
     joint_rates : ndarray, shape (N, 6, 5)
         Smoothed joint-axis rates (rad/s); only their mean over the interval is used, for the
         joint directions.
@@ -182,10 +183,14 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
     ys = y[sel]
     mean_rate = joint_rates[sel].mean(axis=0)
     direction = mean_rate / np.sqrt(mean_rate ** 2 + rate_noise ** 2)
-    jacobians = joint_jacobians(sel) if callable(joint_jacobians) else joint_jacobians[sel]
-    pattern = np.einsum("la,nlac->nac", direction, jacobians)                  # (n, 5, 6)
-    coulomb = np.array([bump0 @ pattern[:, list(axes)].sum(axis=1)
-                        for axes in JOINT_TYPES.values()])
+    if joint_jacobians is None:
+        coulomb = np.zeros((len(JOINT_TYPES), 6))
+    else:
+        jacobians = (joint_jacobians(sel) if callable(joint_jacobians)
+                     else joint_jacobians[sel])
+        pattern = np.einsum("la,nlac->nac", direction, jacobians)              # (n, 5, 6)
+        coulomb = np.array([bump0 @ pattern[:, list(axes)].sum(axis=1)
+                            for axes in JOINT_TYPES.values()])
     family = np.stack([np.vstack([phi0, bump0]), np.vstack([phi1, bump1]),
                        np.vstack([phi2, bump2])])                            # (3, K + 1, n)
     gram = np.einsum("arn,bsn->abrs", family, family)
