@@ -177,13 +177,13 @@ def test_lean_leg_terms_equal_the_full_model_terms(paper, rng):
 
 def test_interpreted_kernel_equals_the_compiled_one(paper, rng):
     """nominal_matrices runs the mass-matrix kernel interpreted for its one pose."""
-    from stewartid import _kernels
+    from stewartid import _kernel_code, _kernels
 
     q, qd = poses(paper, rng, 1)[0], rng.normal(scale=0.1, size=6)
     shapes = ((6, 6), 6, 6, (6, 6), (6, 5, 6), 6)
     compiled, interpreted = ([np.empty(s) for s in shapes] for _ in range(2))
     args = (paper.parameters(), paper.upper_joints, paper.base_joints, q, qd)
     _kernels.model_terms(*args, *compiled)
-    _kernels.interpreted("model_terms")(*args, *interpreted)
+    _kernel_code.model_terms(*args, *interpreted)
     for a, b in zip(compiled, interpreted, strict=True):
         np.testing.assert_allclose(b, a, rtol=1e-12, atol=1e-9)

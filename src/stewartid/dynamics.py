@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewartid import _kernels
 from stewartid.kinematics import _batch, _terms
 from stewartid.platform import Platform
 
@@ -87,6 +86,8 @@ def friction_forces(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
 def _joint_friction(platform: Platform, terms: ModelTerms, q_dot: np.ndarray,
                     coulomb_smoothing: float) -> np.ndarray:
     """Generalized joint friction (N, 6) at the samples of ``terms``."""
+    from stewartid import _kernels  # numba, started only when a model term is computed
+
     qd2, _ = _batch(q_dot, "q_dot")
     return _kernels.batch_friction(platform.parameters(), terms.joint_jacobians, qd2,
                                    float(coulomb_smoothing))

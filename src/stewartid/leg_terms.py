@@ -2,7 +2,7 @@
 
 The leg lengths, the leg Jacobian J_lq, the gravity forces G(q) and the joint-axis Jacobians
 at every sample: what the command tables, forward kinematics and the identifiers need, without
-the mass matrix and velocity products of :func:`stewartid._kernels.model_terms` (the
+the mass matrix and velocity products of :func:`stewartid._kernel_code.model_terms` (the
 simulator's compiled kernel, which evaluates the same leg geometry at one state).
 
 Numpy, not numba: in a fresh process, starting numba and loading its cached kernels costs
@@ -11,7 +11,7 @@ leg's twist Jacobian J_A = [I, -[r]x] is written out by column so that its struc
 are never multiplied; the other products and sums are in the kernel's order, and the results
 equal the kernel's to the last bit (``tests/test_dynamics.py``).
 
-Coordinates and joint axes as in :mod:`stewartid._kernels`: q = [x, y, z, rx, ry, rz] (m, rad),
+Coordinates and joint axes as in :mod:`stewartid._kernel_code`: q = [x, y, z, rx, ry, rz] (m, rad),
 R = Rz Ry Rx, twist nu = [v, omega] mapped to q rates by E(q); leg frame e1 = unit(z x u),
 e2 = u x e1; joint axes [lower 1, lower 2, upper 1, upper 2, revolute].
 """

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewartid._kernels import GIMBAL_AXES, interpreted
+from stewartid._kernel_code import GIMBAL_AXES, model_terms
 from stewartid.dynamics import ModelTerms
 from stewartid.kinematics import joint_rate_jacobians
 from stewartid.platform import Platform
@@ -51,10 +51,9 @@ def nominal_matrices(platform: Platform, pose: np.ndarray | None = None
     q0 = platform.neutral_pose if pose is None else np.asarray(pose, dtype=float)
     M, h, G, J_leg, J_joint, lengths = (np.empty(shape) for shape in
                                         ((6, 6), 6, 6, (6, 6), (6, 5, 6), 6))
-    # one pose: interpreted, which spares the command line numba's start (see the kernel)
-    interpreted("model_terms")(platform.parameters(), platform.upper_joints,
-                               platform.base_joints, q0, np.zeros(6), M, h, G, J_leg, J_joint,
-                               lengths)
+    # one pose: the kernel interpreted, which spares the command line numba's start
+    model_terms(platform.parameters(), platform.upper_joints, platform.base_joints, q0,
+                np.zeros(6), M, h, G, J_leg, J_joint, lengths)
     return M, _viscous(platform, J_joint)
 
 

@@ -89,14 +89,15 @@ def generalized_force_sensitivity(platform: Platform, q: np.ndarray, forces: np.
     errors-in-variables correction can account for noise shared by regressors and targets.
     Central differences of ``step`` (m, rad).
     """
-    from stewartid.dynamics import ModelTerms
+    from stewartid.kinematics import _leg_terms
 
     q0, f0 = q.mean(axis=0), forces.mean(axis=0)
     poses = np.repeat(q0[None], 12, axis=0)
     for j in range(6):
         poses[2 * j, j] += step
         poses[2 * j + 1, j] -= step
-    terms = ModelTerms(platform, poses)
+    # the numpy pose-only terms: equal to the compiled model terms, without numba's start
+    terms = _leg_terms(platform, poses)
     y = np.einsum("nji,j->ni", terms.leg_jacobian, f0)
     if gravity:
         y = y - terms.gravity
