@@ -174,10 +174,11 @@ def detect_intervals(experiment: Experiment, platform: Platform, *, window: floa
     # a joint whose rate is no larger than its noise has no direction to keep, whatever its
     # share of the largest rate (pure heave with 20 um pose noise leaves three axes per leg at
     # 1.0x their noise and 1 % of the largest rate; on some seeds they broke every interval)
+    # (an infinite threshold leaves them out; their rates still give the friction pattern)
     idle = np.sqrt(np.mean(np.square(rates), axis=0)) < IDLE_NOISE_RATIO * rate_noise
-    rates[:, idle] = 0.0
     found = constant_direction_intervals(t, rates, margin=margin, ignore_below=ignore_below,
-                                         hysteresis=hysteresis * rate_noise)
+                                         hysteresis=np.where(idle, np.inf,
+                                                             hysteresis * rate_noise))
     lengths = found[:, 1] - found[:, 0]
     shortest = (min_interval if min_interval is not None
                 else 0.5 * float(np.median(lengths)) if len(lengths) else 0.0)

@@ -226,19 +226,19 @@ def solve_weak_form(equations: Sequence, n_experiments: int, shared_friction: bo
             normal, rhs = compensated(*_weighted_normal(x, w, y[:, :, i]), w, gram_inv, i)
             theta[i] = np.linalg.solve(normal, rhs)
 
-    def channel_weights(i: int, theta_i: np.ndarray) -> np.ndarray:
+    def channel_covariance(i: int, theta_i: np.ndarray) -> np.ndarray:
         v = noise[i] * np.eye(rows) + _pose_covariance(gram, sigma,
                                                        _coefficients(sensitivity[:, i], theta_i))
         if shared_friction:
             v[:, -1, -1] += (scatter[i] * weight) ** 2
-        return np.linalg.inv(v)
+        return v
 
     scatter = np.zeros(6)
     if shared_friction:
         # the scatter of the interval constants around the friction structure, measured with
         # the invariant estimate: a joint fit would bend Bt to hide a structure that does
         # not hold, and so report a scatter too small to notice it
-        variance = np.stack([1.0 / channel_weights(i, theta[i])[:, -1, -1]
+        variance = np.stack([channel_covariance(i, theta[i])[:, -1, -1]
                              for i in range(6)], axis=1)                  # (n, 6), tau = 0
         base = ym - xm @ theta.T
         nuisance_design = np.stack([d[:, -1, N_THETA:] for d in designs], axis=1)  # (n,6,u)
@@ -257,7 +257,7 @@ def solve_weak_form(equations: Sequence, n_experiments: int, shared_friction: bo
         weights = []
         for i in range(6):
             block = slice(12 * i, 12 * i + 12)
-            w = channel_weights(i, z[block])
+            w = np.linalg.inv(channel_covariance(i, z[block]))
             weights.append(w)
             part, part_rhs = _weighted_normal(designs[i], w, targets[i])
             normal += part
