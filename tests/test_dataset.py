@@ -145,3 +145,39 @@ def test_frame_with_extra_columns_is_accepted(tmp_path, dataset):
     frame = dataset.to_frame()
     frame["comment"] = "x"
     assert len(read_dataset(_write(tmp_path, pd.DataFrame(frame)))) == len(dataset)
+
+
+@pytest.mark.parametrize("layout", ["written", "spaces, CRLF, quoted names, integers, BOM"])
+def test_plain_csv_reads_as_the_pandas_reader_does(tmp_path, dataset, layout):
+    """The pandas-free reader of plain files gives the pandas reader's columns, bit for bit."""
+    from stewartid.plain_csv import read_plain_csv
+
+    path = write_dataset(dataset, tmp_path / "run.csv")
+    if layout != "written":
+        frame = dataset.to_frame()
+        frame["rz"] = np.arange(len(frame)) % 3  # an integer column
+        header, body = frame.to_csv(index=False, float_format="%.17g",
+                                    lineterminator="\r\n").split("\r\n", 1)
+        header = ",".join(f'"{name}"' for name in header.split(","))
+        path.write_bytes(b"\xef\xbb\xbf" + (header + "\r\n" + body.replace(",", ", ")).encode())
+    columns = read_plain_csv(path.read_text(encoding="utf-8-sig").encode())
+    frame = pd.read_csv(path, skipinitialspace=True, encoding="utf-8-sig")
+    assert list(columns) == list(COLUMNS)
+    for name in COLUMNS:
+        expected = frame[name].to_numpy(dtype=float)
+        assert np.array_equal(columns[name].view(np.int64), expected.view(np.int64)), name
+    assert np.array_equal(read_dataset(path).forces, frame[["f1", "f2", "f3", "f4", "f5",
+                                                            "f6"]].to_numpy())
+
+
+def test_plain_csv_leaves_other_files_to_the_pandas_reader(tmp_path, dataset):
+    from stewartid.plain_csv import read_plain_csv
+
+    frame = dataset.to_frame()
+    cases = {"missing value": frame.assign(f2=frame["f2"].where(frame.index != 5)),
+             "text": frame.assign(comment="x"), "infinity": frame.assign(f1=np.inf)}
+    for case, table in cases.items():
+        assert read_plain_csv(table.to_csv(index=False).encode()) is None, case
+    assert read_plain_csv(b"t,t\n1,2\n") is None
+    assert read_plain_csv(b't, "x"\n1,2\n') is None  # pandas strips the space, then the quotes
+    assert read_plain_csv(b"t,x\n1,2\n3\n") is None

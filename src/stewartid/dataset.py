@@ -25,17 +25,20 @@ Logs in other layouts or units are read through a :class:`~stewartid.logformat.L
 from __future__ import annotations
 
 import warnings
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from stewartid.errors import DataError, KinematicsError
 from stewartid.io import write_bytes_atomic
 from stewartid.logformat import LogFormat, read_table
 from stewartid.platform import COORDINATES, Platform
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 #: All columns of the interchange format, in order.
 COLUMNS = ("t", *COORDINATES, "l1", "l2", "l3", "l4", "l5", "l6",
@@ -113,6 +116,8 @@ class Dataset:
 
     def to_frame(self) -> pd.DataFrame:
         """The experiment as a table with the interchange columns."""
+        import pandas as pd
+
         data = np.column_stack([self.t, self.pose, self.lengths, self.forces])
         return pd.DataFrame(data, columns=list(COLUMNS))
 
@@ -182,13 +187,14 @@ def _resample(t: np.ndarray, columns: dict[str, np.ndarray], where: str
     return grid, {k: np.interp(grid, t, v) for k, v in columns.items()}
 
 
-def dataset_from_frame(frame: pd.DataFrame, platform: Platform | None = None,
-                       name: str = "exp", where: str | None = None) -> Dataset:
+def dataset_from_frame(frame: pd.DataFrame | Mapping[str, np.ndarray],
+                       platform: Platform | None = None, name: str = "exp",
+                       where: str | None = None) -> Dataset:
     """Validate a table in the interchange format and build a :class:`Dataset`.
 
     Parameters
     ----------
-    frame : DataFrame
+    frame : DataFrame, or mapping of str to ndarray of shape (N,)
         Columns ``t``, ``f1..f6`` and at least one of the groups ``x..rz`` or ``l1..l6``.
         Unknown extra columns are ignored.
     platform : Platform, optional
@@ -204,7 +210,7 @@ def dataset_from_frame(frame: pd.DataFrame, platform: Platform | None = None,
         Missing columns, non-finite or non-numeric values, non-increasing time, too few samples.
     """
     where = where or name
-    present = set(frame.columns)
+    present = set(frame.keys())
     missing = [c for c in ("t", *FORCE_COLUMNS) if c not in present]
     if missing:
         raise DataError(f"{where}: missing required column(s) {', '.join(missing)}; expected "
@@ -220,13 +226,19 @@ def dataset_from_frame(frame: pd.DataFrame, platform: Platform | None = None,
               *FORCE_COLUMNS]
     columns: dict[str, np.ndarray] = {}
     for c in wanted:
-        values = pd.to_numeric(frame[c], errors="coerce").to_numpy(dtype=float)
+        column = frame[c]
+        if isinstance(column, np.ndarray):
+            values = column.astype(float)
+        else:
+            import pandas as pd
+
+            values = pd.to_numeric(column, errors="coerce").to_numpy(dtype=float)
         finite = np.isfinite(values)
         if not np.all(finite):
             row = int(np.argmin(finite))
+            value = column[row] if isinstance(column, np.ndarray) else column.iloc[row]
             raise DataError(f"{where}: column {c!r} has a missing, non-numeric or non-finite "
-                            f"value at row {row} ({frame[c].iloc[row]!r}); clean or drop that "
-                            "row.")
+                            f"value at row {row} ({value!r}); clean or drop that row.")
         columns[c] = values
     t = columns.pop("t")
     if not _check_time(t, where):

@@ -23,14 +23,17 @@ import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from stewartid.config import read_toml_text
 from stewartid.errors import ConfigError, DataError
+from stewartid.plain_csv import read_plain_csv
 from stewartid.platform import COORDINATES
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 #: Interchange columns a log format may map, in order, with the chamber pressures.
 PRESSURE_COLUMNS = tuple(f"pa{k}" for k in range(1, 7)) + tuple(f"pb{k}" for k in range(1, 7))
@@ -130,6 +133,8 @@ class LogFormat:
         DataError
             A mapped column is missing or not numeric, or pressures come without areas.
         """
+        import pandas as pd
+
         out = frame.copy()
         for target, source in self.columns.items():
             name = source.name or target
@@ -366,7 +371,8 @@ def detect_delimiter(lines: list[str]) -> str:
 _DECIMAL_COMMA = re.compile(r"^\s*[+-]?\d+,\d+([eE][+-]?\d+)?\s*$")
 
 
-def read_table(path: Path, kind: str, log_format: LogFormat | None = None) -> pd.DataFrame:
+def read_table(path: Path, kind: str, log_format: LogFormat | None = None
+               ) -> pd.DataFrame | dict[str, np.ndarray]:
     """Read a log (CSV or Parquet) and map it to the interchange columns in SI units.
 
     Parameters
@@ -376,6 +382,12 @@ def read_table(path: Path, kind: str, log_format: LogFormat | None = None) -> pd
     log_format : LogFormat, optional
         Column mapping, units, delimiter, encoding; detection and identity mapping otherwise.
 
+    Returns
+    -------
+    DataFrame, or dict of str to ndarray
+        The table; a plain CSV file in the interchange format without a log format comes as
+        its float columns (:mod:`stewartid.plain_csv`).
+
     Raises
     ------
     DataError
@@ -383,18 +395,30 @@ def read_table(path: Path, kind: str, log_format: LogFormat | None = None) -> pd
     """
     log_format = log_format or LogFormat()
     where = str(path)
+    if kind == "csv":
+        try:
+            text = decode_text(path.read_bytes(), where, log_format.encoding)
+        except OSError as exc:
+            raise DataError(f"{path}: cannot be read as {kind}: {exc}") from exc
+        lines = _head_lines(text, log_format.skip_rows + 6)[log_format.skip_rows:]
+        delimiter = log_format.delimiter or detect_delimiter(lines)
+        decimal = log_format.decimal
+        if decimal is None:
+            fields = lines[1].split(delimiter) if len(lines) > 1 else []
+            decimal = "," if delimiter != "," and any(
+                _DECIMAL_COMMA.match(f) for f in fields) else "."
+        if (delimiter, decimal) == (",", ".") and not log_format.columns and (
+                log_format.skip_rows == 0):
+            columns = read_plain_csv(text.encode("utf-8"))
+            # forces from pressures, and every message about a bad file, come from below
+            if columns is not None and all(f in columns for f in _FORCES):
+                return columns
+    import pandas as pd
+
     try:
         if kind == "parquet":
             frame = pd.read_parquet(path)
         else:
-            text = decode_text(path.read_bytes(), where, log_format.encoding)
-            lines = text.splitlines()[log_format.skip_rows:log_format.skip_rows + 6]
-            delimiter = log_format.delimiter or detect_delimiter(lines)
-            decimal = log_format.decimal
-            if decimal is None:
-                fields = lines[1].split(delimiter) if len(lines) > 1 else []
-                decimal = "," if delimiter != "," and any(
-                    _DECIMAL_COMMA.match(f) for f in fields) else "."
             frame = pd.read_csv(io.StringIO(text), sep=delimiter, decimal=decimal,
                                 skiprows=log_format.skip_rows, skipinitialspace=True)
     except (ValueError, OSError, pd.errors.ParserError) as exc:
@@ -403,6 +427,18 @@ def read_table(path: Path, kind: str, log_format: LogFormat | None = None) -> pd
         raise DataError(f"{path}: cannot be read as {kind}: {exc}") from exc
     frame.columns = [str(c).strip() for c in frame.columns]
     return log_format.to_interchange(frame, where)
+
+
+def _head_lines(text: str, count: int) -> list[str]:
+    """``text.splitlines()[:count]`` without splitting the whole text."""
+    size = 4096
+    while True:
+        lines = text[:size].splitlines()
+        if size >= len(text):
+            return lines[:count]
+        if len(lines) > count:  # the last line of the prefix may be cut short
+            return lines[:count]
+        size *= 4
 
 
 __all__ = ["MAPPABLE", "PRESSURE_COLUMNS", "UNITS", "ColumnSource", "LogFormat",

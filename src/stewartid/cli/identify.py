@@ -138,6 +138,7 @@ def identify(
     from stewartid.checks import check_identified
     from stewartid.dataset import expand_paths, read_datasets
     from stewartid.identification.registry import create_identifier, method_spec
+    from stewartid.identification.result import comparison_rows
     from stewartid.io import check_output_file
     from stewartid.linearization import nominal_matrices
     from stewartid.logformat import load_log_format
@@ -218,10 +219,12 @@ def identify(
     else:
         M_nom, B_nom = nominal_matrices(description)
         source = f"platform '{description.name}' at neutral"
-    table = result.comparison_table(M_nom, B_nom)
-    print_comparison(table, f"{method}: identified vs nominal ({source})")
+    rows = comparison_rows(result.M, result.B, M_nom, B_nom, result.std_errors_M,
+                           result.std_errors_B)
+    print_comparison(rows, f"{method}: identified vs nominal ({source})")
+    largest = np.nanmax([row["error_percent"] for row in rows])
     typer.echo(f"condition number {result.condition_number:.3g}; largest error "
-               f"{np.nanmax(table['error_percent']):.2f} % ({len(datasets)} experiments)")
+               f"{largest:.2f} % ({len(datasets)} experiments)")
     if out is not None:
         result.to_json(out)
         typer.echo(f"wrote {out}")

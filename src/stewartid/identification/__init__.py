@@ -29,6 +29,7 @@ _EXPORTS = {
     "prepare": "preparation",
     "solve_least_squares": "solvers",
     "IdentificationResult": "result",
+    "comparison_rows": "result",
     "comparison_table": "result",
     "MethodSpec": "registry",
     "create_identifier": "registry",

@@ -122,13 +122,11 @@ class IdentificationResult:
                                 self.std_errors_M, self.std_errors_B)
 
 
-def comparison_table(M: np.ndarray, B: np.ndarray, M_nominal: np.ndarray,
-                     B_nominal: np.ndarray, std_M: np.ndarray | None = None,
-                     std_B: np.ndarray | None = None):
-    """Table of the paper's 20 entries; see
-    :meth:`IdentificationResult.comparison_table`."""
-    import pandas as pd
-
+def comparison_rows(M: np.ndarray, B: np.ndarray, M_nominal: np.ndarray,
+                    B_nominal: np.ndarray, std_M: np.ndarray | None = None,
+                    std_B: np.ndarray | None = None) -> list[dict[str, Any]]:
+    """The rows of :func:`comparison_table` as dicts, without pandas (the command line prints
+    them)."""
     identified = {"M": np.asarray(M), "B": np.asarray(B)}
     nominal = {"M": np.asarray(M_nominal, dtype=float), "B": np.asarray(B_nominal, dtype=float)}
     std = {"M": std_M if std_M is not None else np.full((6, 6), np.nan),
@@ -143,7 +141,17 @@ def comparison_table(M: np.ndarray, B: np.ndarray, M_nominal: np.ndarray,
             "identified": value, "std_error": float(std[matrix][row, col]),
             "nominal": ref, "error_percent": relative_error_percent(value, ref),
         })
-    return pd.DataFrame(rows)
+    return rows
+
+
+def comparison_table(M: np.ndarray, B: np.ndarray, M_nominal: np.ndarray,
+                     B_nominal: np.ndarray, std_M: np.ndarray | None = None,
+                     std_B: np.ndarray | None = None):
+    """Table of the paper's 20 entries; see
+    :meth:`IdentificationResult.comparison_table`."""
+    import pandas as pd
+
+    return pd.DataFrame(comparison_rows(M, B, M_nominal, B_nominal, std_M, std_B))
 
 
 def max_error_percent(M: np.ndarray, B: np.ndarray, M_nominal: np.ndarray,
@@ -152,4 +160,4 @@ def max_error_percent(M: np.ndarray, B: np.ndarray, M_nominal: np.ndarray,
     return float(comparison_table(M, B, M_nominal, B_nominal)["error_percent"].max())
 
 
-__all__ = ["IdentificationResult", "comparison_table", "max_error_percent"]
+__all__ = ["IdentificationResult", "comparison_rows", "comparison_table", "max_error_percent"]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 import numpy as np
@@ -31,23 +32,24 @@ def print_matrix(matrix: np.ndarray, title: str, digits: int = 1,
     (console or Console()).print(matrix_table(matrix, title, digits))
 
 
-def print_comparison(table: Any, title: str, console: Console | None = None) -> None:
+def print_comparison(rows: Iterable[Mapping[str, Any]], title: str,
+                     console: Console | None = None) -> None:
     """Print identified versus nominal values of the paper's 20 entries.
 
     Parameters
     ----------
-    table : pandas.DataFrame
-        As :meth:`IdentificationResult.comparison_table
-        <stewartid.identification.result.IdentificationResult.comparison_table>` returns it.
+    rows : iterable of mapping
+        As :func:`~stewartid.identification.result.comparison_rows` returns them (the rows
+        of a comparison table: ``table.to_dict("records")``).
     title : str
     """
     view = Table(title=title, title_justify="left")
     for column, justify in (("entry", "left"), ("identified", "right"), ("± std", "right"),
                             ("nominal", "right"), ("ε (%)", "right")):
         view.add_column(column, justify=justify)
-    for row in table.itertuples():
-        view.add_row(row.entry, f"{row.identified:,.1f}", f"{row.std_error:,.2g}",
-                     f"{row.nominal:,.1f}", f"{row.error_percent:.2f}")
+    for row in rows:
+        view.add_row(row["entry"], f"{row['identified']:,.1f}", f"{row['std_error']:,.2g}",
+                     f"{row['nominal']:,.1f}", f"{row['error_percent']:.2f}")
     (console or Console()).print(view)
 
 
