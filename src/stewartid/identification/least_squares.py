@@ -152,7 +152,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
 
     def _fit(self, datasets: list[Dataset], platform: Platform
              ) -> tuple[IdentificationResult, dict]:
-        experiments = prepare(datasets, platform, gravity=self.gravity)
+        experiments = prepare(datasets, platform, gravity=self.gravity, joints=self.coulomb)
         n_exp = len(experiments)
         phis, ys, shared, used = [], [], [], []
         for e, exp in enumerate(experiments):

@@ -56,7 +56,7 @@ class Experiment:
     joint_jacobians : ndarray, shape (N, 6, 5, 6)
         Joint-axis rate Jacobians at every measured pose (rad/s per unit q_dot), axes
         lower 1, lower 2, upper 1, upper 2, revolute; computed on first use (1.4 kB a
-        sample, and not every method needs them).
+        sample, and not every method needs them) unless :func:`prepare` was asked for them.
     """
 
     name: str
@@ -111,8 +111,8 @@ def resolve_datasets(datasets: Any, platform: Platform) -> list[Dataset]:
     return out
 
 
-def prepare(datasets: Sequence[Dataset], platform: Platform, gravity: bool = True
-            ) -> list[Experiment]:
+def prepare(datasets: Sequence[Dataset], platform: Platform, gravity: bool = True,
+            joints: bool = False) -> list[Experiment]:
     """Jacobians, gravity and generalized forces at every measured pose.
 
     Parameters
@@ -124,6 +124,9 @@ def prepare(datasets: Sequence[Dataset], platform: Platform, gravity: bool = Tru
         Subtract the model's pose-dependent gravity term G(q) from J_lq^T f_a. Without it the
         legs' gravity stiffness biases Mt by about -K_G / omega^2 (about -3 % on Mt(4,4) of
         the paper's platform at 0.5 Hz).
+    joints : bool
+        Compute the joint-axis Jacobians now, with the other leg terms, rather than on first
+        use: a method that needs them then evaluates the leg geometry once, not twice.
 
     Returns
     -------
@@ -131,13 +134,16 @@ def prepare(datasets: Sequence[Dataset], platform: Platform, gravity: bool = Tru
     """
     out = []
     for d in datasets:
-        G, J, _, _ = _leg_terms(platform, np.ascontiguousarray(d.pose))
+        G, J, _, joint_jacobians = _leg_terms(platform, np.ascontiguousarray(d.pose), joints)
         y = np.einsum("nji,nj->ni", J, d.forces)
         if gravity:
             y = y - G
-        out.append(Experiment(name=d.name, t=d.t, q=d.pose, generalized_force=y,
-                              leg_jacobian=J, gravity=G, sample_rate=d.sample_rate,
-                              platform=platform))
+        experiment = Experiment(name=d.name, t=d.t, q=d.pose, generalized_force=y,
+                                leg_jacobian=J, gravity=G, sample_rate=d.sample_rate,
+                                platform=platform)
+        if joints:  # the cached property's slot, as its first use would fill it
+            experiment.__dict__["joint_jacobians"] = joint_jacobians
+        out.append(experiment)
     return out
 
 
