@@ -32,10 +32,11 @@ so its scales are limited to a tenth of the interval at the default truncation o
 on the independent example data set (docs/benchmarks.md), the polynomial wavelet with the
 position-only variant is the most accurate; it is the default.
 
-Default (``test_functions=4``): per interval a family of orthonormalised zero-mean test
+Default (``test_functions=8``): per interval a family of orthonormalised zero-mean test
 functions spanning the whole interval, the weak form of :mod:`.weak_form`, solved by
-reweighted least squares with the noise estimated from the data; ``test_functions=None``
-uses (a, b) points instead (:mod:`.point_equations`), as the paper does.
+generalized least squares with the force and pose noise estimated from the data and the pose
+noise's bias removed (:mod:`.weak_form_solver`); ``test_functions=None`` uses (a, b) points
+(:mod:`.point_equations`), as the paper does.
 
 Couplings (the paper's Mt(2,4) case): an entry and its transpose come from different
 equations (Mt(5,1) from pitch under surge, Mt(1,5) from surge under pitch); the rotational
@@ -120,7 +121,7 @@ class WaveletIdentifier(BaseIdentifier):
         How W q_ddot and W q_dot are obtained (see the module docstring).
     test_functions : int or None
         Number K of orthonormalised zero-mean test functions per interval, 1..12
-        (:mod:`~stewartid.identification.weak_form`; default 4). None: the wavelet transform
+        (:mod:`~stewartid.identification.weak_form`; default 8). None: the wavelet transform
         at (a, b) points set by ``scale_fractions`` and ``shifts_per_scale``, as in the paper.
         Needs the polynomial wavelet and the position variant.
     friction : {"shared", "free"}
@@ -192,7 +193,7 @@ class WaveletIdentifier(BaseIdentifier):
     def __init__(self, wavelet: str = "polynomial", wavelet_order: int = 6,
                  truncation: float = 5.0, variant: str = "position",
                  scale_fractions: tuple[float, ...] = (1.0, 0.8, 0.6),
-                 shifts_per_scale: int = 5, test_functions: int | None = 4,
+                 shifts_per_scale: int = 5, test_functions: int | None = 8,
                  friction: str = "free", margin: float | None = None, ignore_below: float = 0.01,
                  min_interval: float | None = None, min_support_samples: int = 32,
                  differentiation_window: float | None = None, hysteresis: float = 4.0,
