@@ -336,8 +336,9 @@ def bias_compensated_least_squares(phi: np.ndarray, target: np.ndarray, cluster:
 
 def select_symmetric_pairs(matrix: np.ndarray, std: np.ndarray,
                            preferred_rows: tuple[int, ...] = (0, 1, 2),
-                           disagreement: float = 3.0) -> list[dict]:
-    """For every off-diagonal pair, copy the better estimate onto both entries.
+                           disagreement: float = 3.0, pool: bool = False) -> list[dict]:
+    """For every off-diagonal pair, copy the better estimate (or, with ``pool``, the
+    inverse-variance mean of two that agree) onto both entries.
 
     Normally the estimate with the smaller standard error is kept. When the two estimates
     differ by more than ``disagreement`` combined standard errors, at least one carries a
@@ -356,11 +357,16 @@ def select_symmetric_pairs(matrix: np.ndarray, std: np.ndarray,
         0-based rows whose equations are trusted first on a significant disagreement.
     disagreement : float
         Threshold of |a - b| / sqrt(s_a^2 + s_b^2).
+    pool : bool
+        Two members within ``disagreement`` are both estimates of the one entry of a
+        symmetric matrix: take their inverse-variance mean, standard error
+        (s_a^-2 + s_b^-2)^(-1/2), recorded as ``"pooled": True``.
 
     Returns
     -------
     list of dict
-        Per pair {"pair": [[i, j], [j, i]], "kept": [i, j], "disagreement": z} (1-based).
+        Per pair {"pair": [[i, j], [j, i]], "kept": [i, j], "disagreement": z, "pooled": bool}
+        (1-based; "kept" is the better-determined member when pooled).
     """
     choice = []
     n = matrix.shape[0]
@@ -371,12 +377,18 @@ def select_symmetric_pairs(matrix: np.ndarray, std: np.ndarray,
             z = difference / max(float(np.hypot(std[i, j], std[j, i])), 1e-300)
             if z > disagreement and (i in preferred_rows) != (j in preferred_rows):
                 keep, drop = ((i, j), (j, i)) if i in preferred_rows else ((j, i), (i, j))
+            pooled = pool and z <= disagreement
+            if pooled:
+                w_keep, w_drop = std[keep] ** -2.0, std[drop] ** -2.0
+                matrix[keep] = (w_keep * matrix[keep] + w_drop * matrix[drop]) / (w_keep + w_drop)
+                std[keep] = (w_keep + w_drop) ** -0.5
             matrix[drop] = matrix[keep]
             if z > disagreement:
                 std[keep] = max(std[keep], difference / disagreement)
             std[drop] = std[keep]
             choice.append({"pair": [[i + 1, j + 1], [j + 1, i + 1]],
-                           "kept": [keep[0] + 1, keep[1] + 1], "disagreement": float(z)})
+                           "kept": [keep[0] + 1, keep[1] + 1], "disagreement": float(z),
+                           "pooled": bool(pooled)})
     return choice
 
 

@@ -39,11 +39,10 @@ noise's bias removed (:mod:`.weak_form_solver`); ``test_functions=None`` uses (a
 (:mod:`.point_equations`), as the paper does.
 
 Couplings (the paper's Mt(2,4) case): an entry and its transpose come from different
-equations (Mt(5,1) from pitch under surge, Mt(1,5) from surge under pitch); the rotational
-equations under translational excitation are the sensitive ones. With
-``pair_selection="std_error"`` (default) both entries of a pair take the better-determined
-estimate (:func:`~stewartid.identification.solvers.select_symmetric_pairs`);
-``symmetric=True`` imposes symmetry in the solve instead.
+equations (Mt(5,1) from pitch under surge, Mt(1,5) from surge under pitch), the rotational
+ones the sensitive; ``pair_selection`` combines them
+(:func:`~stewartid.identification.solvers.select_symmetric_pairs`), ``symmetric=True``
+imposes symmetry in the solve instead.
 
 Standard errors are cluster-robust over intervals (the equations of one interval share
 samples and friction state).
@@ -90,7 +89,7 @@ REFERENCE = ("Zhang, C. A Parameter Identification Method for Stewart Manipulato
 VARIANTS = ("position", "paper", "derivative")
 #: Default interval margin, in periods of the estimated excitation frequency.
 MARGIN_PERIODS = 0.05
-PAIR_SELECTIONS = ("std_error", "none")
+PAIR_SELECTIONS = ("pooled", "std_error", "none")
 FRICTION_MODELS = ("shared", "free")
 
 
@@ -170,9 +169,10 @@ class WaveletIdentifier(BaseIdentifier):
         :func:`~stewartid.identification.solvers.bias_compensated_least_squares`).
     symmetric : bool
         Impose Mt = Mt^T and Bt = Bt^T in the solve.
-    pair_selection : {"std_error", "none"}
-        For each symmetric pair, use the better-determined estimate for both (ignored with
-        ``symmetric``).
+    pair_selection : {"pooled", "std_error", "none"}
+        Symmetric pairs (not with ``symmetric``): "pooled" (default) the inverse-variance mean
+        of members within 3 standard errors, else the translational one; "std_error" the
+        better-determined member.
     gravity : bool
         Subtract the model's pose-dependent gravity G(q) before identification.
 
@@ -199,7 +199,7 @@ class WaveletIdentifier(BaseIdentifier):
                  differentiation_window: float | None = None, hysteresis: float = 4.0,
                  odd_companion: bool = False, noise_correction: bool = True,
                  symmetric: bool = False,
-                 pair_selection: str = "std_error", gravity: bool = True):
+                 pair_selection: str = "pooled", gravity: bool = True):
         self.wavelet = wavelet
         self.wavelet_order = wavelet_order
         self.truncation = truncation
@@ -338,9 +338,8 @@ class WaveletIdentifier(BaseIdentifier):
                                    **({"pose_covariance": [i["noise_covariance"] for i in infos],
                                        "force_sensitivity": sensitivities}
                                       if self.noise_correction else {}))
-        theta, std = solution.theta.copy(), solution.theta_std.copy()
-        M, B = theta[:, :6], theta[:, 6:12]
-        std_M, std_B = std[:, :6], std[:, 6:12]
+        M, B = solution.theta[:, :6].copy(), solution.theta[:, 6:12].copy()
+        std_M, std_B = solution.theta_std[:, :6].copy(), solution.theta_std[:, 6:12].copy()
         chosen = self._combine_pairs(M, B, std_M, std_B)
         levels = dict(zip(JOINT_TYPES, solution.coulomb.tolist(), strict=True))
         levels_std = dict(zip(JOINT_TYPES, solution.coulomb_std.tolist(), strict=True))
@@ -372,8 +371,10 @@ class WaveletIdentifier(BaseIdentifier):
                 matrix[:] = (w * matrix + w.T * matrix.T) / (w + w.T)
                 std[:] = 1.0 / np.sqrt(w + w.T)
             return {}
-        if self.pair_selection == "std_error":
-            return {"M": select_symmetric_pairs(M, std_M), "B": select_symmetric_pairs(B, std_B)}
+        if self.pair_selection in ("std_error", "pooled"):
+            pool = self.pair_selection == "pooled"
+            return {"M": select_symmetric_pairs(M, std_M, pool=pool),
+                    "B": select_symmetric_pairs(B, std_B, pool=pool)}
         return {}
 
     def _settings(self) -> dict:
