@@ -84,12 +84,15 @@ def test_wavelet_noise_free_within_one_percent_and_short_margin_less_noise_sensi
 def test_method_b_under_reference_noise_is_accurate_and_calibrated():
     """Default Method B on the independent example with the reference sensor noise (20 um on
     the leg lengths, pose by forward kinematics, 0.5 % force noise): the inertia diagonal
-    within 1.5 %, and |error| within three reported standard errors for at least 18 of the 20
-    entries of the paper's tables (measured over 8 seeds at 1 kHz: Mt diagonal <= 1.0 %,
-    every entry within 3 SE)."""
+    within 0.75 %, the inertia couplings within 15 %, and |error| within three reported
+    standard errors for at least 19 of the 20 entries of the paper's tables (this seed at
+    500 Hz: 0.26 %, 5.5 %, 20/20; over 8 seeds at 1 kHz: Mt diagonal <= 0.76 %, couplings
+    <= 11.5 %, 98.8 % of the entries within 3 SE). Before the pose noise was weighted and its
+    bias removed the Mt diagonal reached 1.0 %, the couplings 19 %."""
     (row,) = [r for r in study(methods=("wavelet",), seeds=(1,), length_noise=20e-6,
                                force_noise=0.005, stride=2) if r["noise"] == "noisy"]
-    assert np.max(row["errors"][:6]) <= 1.5, row["errors"][:6]
-    assert np.sum(row["ratios"] <= 3.0) >= 18, row["ratios"]
+    assert np.max(row["errors"][:6]) <= 0.75, row["errors"][:6]
+    assert np.max(row["errors"][6:10]) <= 15.0, row["errors"][6:10]
+    assert np.sum(row["ratios"] <= 3.0) >= 19, row["ratios"]
     # the standard errors are not so wide that the check says nothing
     assert np.median(row["ratios"]) >= 0.1
