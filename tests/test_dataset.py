@@ -181,3 +181,15 @@ def test_plain_csv_leaves_other_files_to_the_pandas_reader(tmp_path, dataset):
     assert read_plain_csv(b"t,t\n1,2\n") is None
     assert read_plain_csv(b't, "x"\n1,2\n') is None  # pandas strips the space, then the quotes
     assert read_plain_csv(b"t,x\n1,2\n3\n") is None
+
+
+def test_median_equals_numpys_to_the_last_bit():
+    from stewartid._arrays import median
+
+    rng = np.random.default_rng(2)
+    for n in (1, 2, 3, 10, 11, 4000, 4001):
+        values = rng.standard_normal(n) * 1e3
+        values[: n // 3] = values[0]  # ties
+        assert median(values) == np.median(values)
+        assert median(values.reshape(n, 1)) == np.median(values)
+    assert np.isnan(median(np.array([1.0, np.nan, 2.0])))

@@ -22,6 +22,7 @@ import warnings
 
 import numpy as np
 
+from stewartid._arrays import median
 from stewartid.errors import DataError
 from stewartid.platform import Platform
 
@@ -82,7 +83,7 @@ def check_leg_lengths(lengths: np.ndarray, platform: Platform, where: str) -> No
         Lengths in mm or cm, strokes instead of gimbal-to-gimbal lengths, wrong platform.
     """
     neutral = platform.neutral_leg_length
-    ratio = float(np.median(lengths)) / neutral
+    ratio = median(lengths) / neutral
     if abs(ratio - 1.0) <= MAX_LENGTH_DEVIATION:
         return
     if abs(ratio / 1000.0 - 1.0) <= MAX_LENGTH_DEVIATION:
@@ -94,7 +95,7 @@ def check_leg_lengths(lengths: np.ndarray, platform: Platform, where: str) -> No
                  "stroke as an offset (docs/logs.md), or check --platform")
     else:
         cause = "check the length unit (m) and --platform"
-    raise DataError(f"{where}: leg lengths l1..l6 have median {np.median(lengths):.4g}, but "
+    raise DataError(f"{where}: leg lengths l1..l6 have median {median(lengths):.4g}, but "
                     f"platform '{platform.name}' has {neutral:.4g} m legs at neutral; {cause}.")
 
 
@@ -124,7 +125,7 @@ def check_pose(pose: np.ndarray, platform: Platform, where: str) -> None:
     offset = np.max(np.abs(pose[:, :3] - neutral[:3]))
     if offset <= MAX_POSITION_OFFSET * height:
         return
-    z = float(np.median(pose[:, 2]))
+    z = median(pose[:, 2])
     if abs(z) < MAX_POSITION_OFFSET * height:
         cause = (f"the pose looks relative to neutral; add offset = {neutral[2]:.6g} to z "
                  "(docs/logs.md)")

@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from stewartid._arrays import median
 from stewartid.errors import DataError, KinematicsError
 from stewartid.io import write_bytes_atomic
 from stewartid.logformat import LogFormat, read_table
@@ -146,7 +147,7 @@ def _check_time(t: np.ndarray, where: str) -> bool:
         raise DataError(f"{where}: column 't' must be strictly increasing; row {bad} has "
                         f"t = {t[bad]!r} after t = {t[bad - 1]!r} (sort the rows and drop "
                         "duplicate time stamps).")
-    period = float(np.median(dt))
+    period = median(dt)
     low, high = SAMPLE_RATE_RANGE_HZ
     if not low <= 1.0 / period <= high:
         units = [unit for unit, factor in (("ms", 1e-3), ("us", 1e-6))
@@ -177,7 +178,7 @@ def _uniform_clock(t: np.ndarray, where: str) -> np.ndarray | None:
 
 def _resample(t: np.ndarray, columns: dict[str, np.ndarray], where: str
               ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    period = float(np.median(np.diff(t)))
+    period = median(np.diff(t))
     n = int(np.floor((t[-1] - t[0]) / period + 1e-9)) + 1
     grid = t[0] + period * np.arange(n)
     warnings.warn(f"{where}: time base is not uniform (sample periods from "
