@@ -88,7 +88,7 @@ REFERENCE = ("Zhang, C. A Parameter Identification Method for Stewart Manipulato
              "Wavelet Transform. Mathematics 8(2), 257 (2020). doi:10.3390/math8020257")
 VARIANTS = ("position", "paper", "derivative")
 #: Default interval margin, in periods of the estimated excitation frequency.
-MARGIN_PERIODS = 0.05
+MARGIN_PERIODS = 0.015
 PAIR_SELECTIONS = ("pooled", "std_error", "none")
 FRICTION_MODELS = ("shared", "free")
 
@@ -137,10 +137,10 @@ class WaveletIdentifier(BaseIdentifier):
         Shifts per scale and interval.
     margin : float or None
         Time (s) cut from both ends of every constant-direction interval. None (default):
-        :data:`MARGIN_PERIODS` periods of the estimated excitation frequency (0.1 s at
-        0.5 Hz): with large Coulomb friction the friction of joints that barely move
-        reverses somewhat after the measured zero crossings (measured on the paper's
-        platform at 30 N m: Mt(1,5) off by 1.5 % with 0.02 s, 0.5 % with 0.1 s).
+        :data:`MARGIN_PERIODS` periods of the estimated excitation frequency (0.03 s at
+        0.5 Hz): idle joints' friction reverses late, but longer intervals inform more
+        (paper platform, 30 N m: noise-free 0.23 / 0.37 % at 0.1 / 0.03 s; reference
+        noise, Bt diagonal 19 / 11 % worst of 8 seeds).
     ignore_below : float
         Joints whose rate RMS is below this fraction of the largest of their kind are left
         out of the interval detection (they barely move, and their sign flips at odd times).
