@@ -33,7 +33,7 @@ import numpy as np
 from stewartid.design.candidates import design_from_dict, paper_design
 from stewartid.design.export import read_excitation, simulate_excitations, write_commands
 from stewartid.design.limits import record_limit_use
-from stewartid.design.optimise import optimise_design
+from stewartid.design.optimise import REQUIRED_ACCURACY, entry_group, optimise_design
 from stewartid.design.prediction import (
     default_estimator,
     measured_plant_datasets,
@@ -46,17 +46,6 @@ from stewartid.reference.published import PAPER_ENTRIES, entry_label, relative_e
 from stewartid.simulation import SensorNoise
 from stewartid.simulation.experiments import noise_generator
 from stewartid.simulation.sensors import reference_noise
-
-#: Acceptance thresholds (%): Mt diagonal, Bt diagonal, couplings of both.
-THRESHOLDS = {"Mt diagonal": 0.5, "Bt diagonal": 2.0, "couplings": 8.0}
-
-
-def group(key) -> str:
-    """Acceptance group of a paper entry."""
-    matrix, row, column = key
-    if row != column:
-        return "couplings"
-    return "Mt diagonal" if matrix == "M" else "Bt diagonal"
 
 
 def estimates(estimator) -> np.ndarray:
@@ -107,15 +96,15 @@ def main() -> None:
     M0, B0 = nominal_matrices(platform)
     nominal = np.array([(M0 if m == "M" else B0)[i, j] for m, i, j in PAPER_ENTRIES])
     values, passed = [], 0
-    groups = [group(k) for k in PAPER_ENTRIES]
+    groups = [entry_group(k) for k in PAPER_ENTRIES]
     for seed in range(args.seeds):
         fit = estimates(default_estimator().fit(
             noisy_datasets(platform, played.states, noise, seed), platform))
         values.append(fit)
         error = relative_error_percent(fit, nominal)
         worst = {g: float(max(e for e, h in zip(error, groups, strict=True) if h == g))
-                 for g in THRESHOLDS}
-        ok = all(worst[g] <= THRESHOLDS[g] for g in THRESHOLDS) if seed < 8 else None
+                 for g in REQUIRED_ACCURACY}
+        ok = all(worst[g] <= REQUIRED_ACCURACY[g] for g in REQUIRED_ACCURACY) if seed < 8 else None
         passed += bool(ok)
         print(f"seed {seed}: " + ", ".join(f"{g} {v:.2f} %" for g, v in worst.items())
               + ("" if ok is None else f" {'pass' if ok else 'FAIL'}"))

@@ -19,7 +19,14 @@ from stewartid.design.candidates import (
 )
 from stewartid.design.export import read_excitation, simulate_excitations, write_commands
 from stewartid.design.limits import limit_use, record_limit_use, resolve_limits
+from stewartid.design.optimise import (
+    REQUIRED_ACCURACY,
+    entry_group,
+    required_score,
+    within_plant_limits,
+)
 from stewartid.design.prediction import (
+    Prediction,
     measured_plant_datasets,
     model_datasets,
     predict_accuracy,
@@ -27,6 +34,7 @@ from stewartid.design.prediction import (
 from stewartid.errors import ConfigError
 from stewartid.kinematics import inverse_kinematics
 from stewartid.platform import load_platform, platform_from_mapping
+from stewartid.reference.published import PAPER_ENTRIES
 from stewartid.simulation import SensorNoise
 from stewartid.simulation.experiments import noise_generator
 
@@ -100,6 +108,48 @@ def test_scheduled_design_with_one_schedule_per_record():
     assert design.duration == pytest.approx(120.0)
     with pytest.raises(ConfigError, match=r"levels must be one schedule or six .* got 5"):
         scheduled_design(amplitudes, 0.75, [20.0] * 6, plans[:5])
+
+
+def test_scheduled_design_with_a_frequency_per_group():
+    amplitudes = (0.12, 0.12, 0.12, 0.03, 0.03, 0.04)
+    design = scheduled_design(amplitudes, (0.5,) * 3 + (0.75,) * 3, [20.0] * 6, (1.0, 0.3))
+    assert design.label == ("6 single-DOF records, translations 0.5 Hz, rotations 0.75 Hz, "
+                            "levels 1/0.3")
+    # 20 s: 3 held periods of 2 s per level at 0.5 Hz (18 s), 6 of 4/3 s at 0.75 Hz (20 s)
+    assert [r.hold_periods for r in design.records] == [3] * 3 + [6] * 3
+    assert design.duration == pytest.approx(3 * 18.0 + 3 * 20.0)
+
+
+def test_criterion_against_the_required_accuracy():
+    zeros = np.zeros((6, 6))
+    nominal = np.ones((6, 6))
+    std_B = zeros.copy()
+    std_B[2, 2] = 0.005  # 0.5 % on Bt(3,3)
+    bias_M = zeros.copy()
+    bias_M[1, 3] = 0.04  # 4 % on the coupling Mt(2,4)
+    prediction = Prediction(nominal, nominal, bias_M, zeros, zeros, zeros, zeros, std_B, 2,
+                            "wavelet")
+    assert {entry_group(k) for k in PAPER_ENTRIES} == set(REQUIRED_ACCURACY)
+    # Bt(3,3): 2 x 0.5 % of the 2 % required; Mt(2,4): 4 % of the 8 % required
+    assert required_score(prediction) == pytest.approx(0.5)
+    assert required_score(prediction, {**REQUIRED_ACCURACY, "Bt diagonal": 0.5}) == \
+        pytest.approx(2.0)
+
+
+@pytest.mark.slow
+def test_records_scaled_down_to_the_limits_on_the_plant(paper):
+    design = Design((DesignedRecord(unit_direction(2, 0.06), 1.0, (1.0,), 2, 1, "exp1"),
+                     DesignedRecord(unit_direction(5, 0.005), 1.0, (1.0,), 2, 1, "exp2")))
+    before = [max(record_limit_use(paper, r).peak.values())
+              for r in simulate_excitations(paper, design.playable(paper)).states]
+    assert before[0] > 0.55 > before[1]
+    scaled, records, uses = within_plant_limits(paper, design, 0.55)
+    assert len(records) == 2
+    assert max(uses[0].peak.values()) == pytest.approx(0.55, abs=0.01)
+    assert max(scaled.records[0].direction) < 0.06
+    # the record within the limit is left as it was
+    assert scaled.records[1] == design.records[1]
+    assert uses[1].peak == record_limit_use(paper, records[1]).peak
 
 
 def test_limit_use_against_finite_differences(paper):

@@ -218,7 +218,7 @@ def paper_design(frequency_hz: float = 0.5, duration_s: float = 20.0,
         f"paper: 6 single-DOF sines, {frequency_hz:g} Hz, {duration_s:g} s each")
 
 
-def scheduled_design(amplitudes: Sequence[float], frequency_hz: float,
+def scheduled_design(amplitudes: Sequence[float], frequency_hz: float | Sequence[float],
                      durations_s: Sequence[float],
                      levels: Sequence[float] | Sequence[Sequence[float]] = (1.0, 0.5),
                      label: str | None = None) -> Design:
@@ -228,8 +228,9 @@ def scheduled_design(amplitudes: Sequence[float], frequency_hz: float,
     ----------
     amplitudes : sequence of 6 float
         Largest amplitude per DOF (m, m, m, rad, rad, rad); ``levels`` scale it.
-    frequency_hz : float
-        Hz, the same for every record (all half-periods are equally long).
+    frequency_hz : float or sequence of 6 float
+        Hz, one for every record or one per record (a record's half-periods are its
+        constant-direction intervals).
     durations_s : sequence of 6 float
         Record lengths (s), rounded down to whole hold periods per level.
     levels : sequence of float, or 6 sequences of float
@@ -242,30 +243,38 @@ def scheduled_design(amplitudes: Sequence[float], frequency_hz: float,
     if len(schedules) != 6:
         raise ConfigError(f"levels must be one schedule or six (one per record); got "
                           f"{len(schedules)}.")
-    period = 1.0 / frequency_hz
+    frequencies = [float(v) for v in np.broadcast_to(np.asarray(frequency_hz, dtype=float), 6)]
     records = []
-    for k, schedule in enumerate(schedules):
+    for k, (schedule, frequency) in enumerate(zip(schedules, frequencies, strict=True)):
         peak = max(schedule)
-        hold = int((durations_s[k] / period - (len(schedule) + 1)) // len(schedule))
+        hold = int((durations_s[k] * frequency - (len(schedule) + 1)) // len(schedule))
         if hold < 1:
             raise ConfigError(f"record {k + 1}: {durations_s[k]:.3g} s is too short for "
-                              f"{len(schedule)} levels at {frequency_hz:g} Hz.")
-        records.append(DesignedRecord(unit_direction(k, amplitudes[k] * peak), frequency_hz,
+                              f"{len(schedule)} levels at {frequency:g} Hz.")
+        records.append(DesignedRecord(unit_direction(k, amplitudes[k] * peak), frequency,
                                       tuple(v / peak for v in schedule), hold, 1, f"exp{k + 1}"))
-    text = label or (f"6 single-DOF records, {frequency_hz:g} Hz, levels "
+    text = label or (f"6 single-DOF records, {schedule_label(frequencies, 'Hz')}, levels "
                      + schedule_label(schedules))
     return Design(tuple(records), text)
 
 
-def schedule_label(schedules: Sequence[Sequence[float]]) -> str:
-    """'1/0.5' for one schedule shared by all records, 'translations 1, rotations 1/0.5' for
-    one per group of three, else the six schedules."""
-    names = ["/".join(f"{v:g}" for v in s) for s in schedules]
+def schedule_label(schedules: Sequence, unit: str = "") -> str:
+    """A short text for one schedule (or value) per record: '1/0.5' when all six are equal,
+    else runs of equal ones, 'x and y 0.75 Hz, z 0.5 Hz, rotations 0.75 Hz'; ``unit`` follows
+    every value."""
+    tail = f" {unit}" if unit else ""
+    names = ["/".join(f"{v:g}" for v in np.atleast_1d(s)) + tail for s in schedules]
     if len(set(names)) == 1:
         return names[0]
-    if len(set(names[:3])) == 1 and len(set(names[3:])) == 1:
-        return f"translations {names[0]}, rotations {names[3]}"
-    return ", ".join(names)
+    runs: list[list] = []
+    for k, name in enumerate(names):
+        if runs and runs[-1][2] == name:
+            runs[-1][1] = k
+        else:
+            runs.append([k, k, name])
+    groups = {(0, 2): "translations", (3, 5): "rotations"}
+    return ", ".join(f"{groups.get((a, b), ' and '.join(COORDINATES[a:b + 1]))} {name}"
+                     for a, b, name in runs)
 
 
 __all__ = ["COORDINATES", "Design", "DesignedRecord", "PlayableRecord", "design_from_dict",

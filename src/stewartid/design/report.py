@@ -65,7 +65,7 @@ def plot_accuracy(design: Prediction, baseline: Prediction, directory: str | Pat
 
 def render_markdown(design: Design, prediction: Prediction, baseline: Prediction,
                     peaks: Sequence[dict[str, float]], intervals: Sequence[float],
-                    settings: dict) -> str:
+                    settings: dict, use_source: str = "the plant's true states") -> str:
     """The report text.
 
     Parameters
@@ -79,6 +79,8 @@ def render_markdown(design: Design, prediction: Prediction, baseline: Prediction
         Constant-direction interval length of each record (s): its half period.
     settings : dict
         Budget, noise, method, grid (shown as given).
+    use_source : str
+        What the limit use was measured on.
     """
     lines = ["# Excitation design", "", f"{design.label}; {design.duration:.1f} s of motion.",
              "", "## Settings", ""]
@@ -94,7 +96,7 @@ def render_markdown(design: Design, prediction: Prediction, baseline: Prediction
                      + f" | {record.duration:.1f} | {interval:.2f} | "
                      + " | ".join(f"{peak[n]:.0%}" for n in LIMIT_NAMES) + " |")
     lines += ["", "Limit use is the largest over the legs and the record, 100 % = the limit "
-              "(commanded motion, rigid-body model forces).", "",
+              f"({use_source}).", "",
               "![limit use](figures/limit_use.png)", "", "## Predicted accuracy", "",
               f"Method: {prediction.method}; {prediction.seeds} noise realisations "
               f"(paper's set: {baseline.seeds}). Worst relative standard error: "

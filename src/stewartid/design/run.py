@@ -20,7 +20,6 @@ from stewartid.design.limits import resolve_limits
 from stewartid.design.optimise import (
     DEFAULT_FREQUENCIES,
     DEFAULT_SCHEDULES,
-    commanded_use,
     optimise_design,
 )
 from stewartid.design.prediction import Prediction, predict_accuracy
@@ -79,14 +78,14 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
     rate_hz : float
         Controller rate of the command files (Hz).
     max_use : float
-        Fraction of every limit the design may use.
+        Fraction of every limit the design may use (on the plant's true states).
     seeds : int
         Noise realisations of the final predictions.
     source : {"plant", "model"}
         Noise-free data of the predictions: the design played on the plant, or the
         rigid-body model with perfect tracking (faster, optimistic).
     quick : bool
-        One frequency and schedule, few seeds (for tests).
+        One candidate (1 Hz, levels 1/0.5) and no screening (for tests).
     force : bool
         Overwrite an earlier design in ``out``.
     progress : callable, optional
@@ -99,17 +98,19 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
     out = Path(out)
     check_output_folder(out, force, is_design_file)
     limits = resolve_limits(platform)
-    grid = {"frequencies": (1.0,), "schedules": ((1.0, 0.5),), "screening_seeds": 3} if quick \
+    grid = {"frequencies": ((1.0,),) * 3, "schedules": ((1.0, 0.5),)} if quick \
         else {"frequencies": DEFAULT_FREQUENCIES, "schedules": DEFAULT_SCHEDULES}
     best, screened = optimise_design(platform, budget_s, noise, method, max_use=max_use,
                                      seeds=seeds, source=source, progress=progress, **grid)
     baseline_design = paper_design(duration_s=budget_s / 6)
     baseline = predict_accuracy(platform, baseline_design, noise, method, seeds, source=source)
     if progress:
-        progress(f"paper's set: predicted worst error {baseline.worst_relative_error:.2f} %")
+        progress(f"paper's set: predicted worst relative SE {baseline.worst_relative_std:.2f} %")
     design, prediction = best.design, best.prediction
     out.mkdir(parents=True, exist_ok=True)
-    uses = [commanded_use(platform, record) for record in design.records]
+    uses = list(best.plant_use)
+    use_source = ("the plant's true states" if source == "plant"
+                  else "commanded motion, rigid-body model forces")
     files = write_commands(platform, design, out / "commands", rate_hz)
     files += plot_limit_use(uses, [r.name for r in design.records], out / "figures")
     files += plot_accuracy(prediction, baseline, out / "figures")
@@ -118,18 +119,23 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
                 "length noise (m)": noise.length_noise, "force noise (N)": noise.force_noise,
                 "largest limit use": max_use, "controller rate (Hz)": rate_hz,
                 "prediction data": source,
-                "frequencies tried (Hz)": list(grid["frequencies"]),
+                "frequencies tried (Hz)": dict(zip(("x and y", "z", "rotations"),
+                                                   map(list, grid["frequencies"]), strict=True)),
                 "schedules tried": [schedule_label(s if isinstance(s[0], tuple) else [s])
-                                    for s in grid["schedules"]]}
+                                    for s in grid["schedules"]],
+                "required accuracy (%)": dict(best.required),
+                "criterion (worst (|bias| + 2 SE) / required)": round(best.score, 3)}
     intervals = [0.5 / r.frequency_hz for r in design.records]
     text = render_markdown(design, prediction, baseline, [u.peak for u in uses], intervals,
-                           settings)
+                           settings, use_source)
     files += write_design_report(out, text)
     document = {"design": design.to_dict(), "prediction": prediction.to_dict(),
                 "baseline": {"design": baseline_design.to_dict(), **baseline.to_dict()},
                 "limits": limits.to_dict(), "limit_use": [u.peak for u in uses],
-                "screened": [{"label": c.design.label, "score_percent": c.score}
-                             for c in screened],
+                "limit_use_from": use_source,
+                "screened": [{"label": c.design.label, "criterion": c.score,
+                              "worst_relative_std_percent": c.prediction.worst_relative_std,
+                              "seeds": c.prediction.seeds} for c in screened],
                 "settings": settings}
     files.append(write_json_atomic(out / "design.json", document))
     return DesignOutput(design, prediction, baseline, files)
