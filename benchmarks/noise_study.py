@@ -32,13 +32,13 @@ from stewartid.reference.published import PAPER_ENTRIES, relative_error_percent
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "tests" / "data" / "example_c10"
 #: Method B (default: every interval constant free), with the shared-friction interval
-#: constants, with the 0.02 s margin, and with the paper's equations; Method A; least squares;
+#: constants, with a 0.1 s margin, and with the paper's equations; Method A; least squares;
 #: and the oracle (least squares given the true Coulomb force, which no user has).
 METHODS = {"fourier": functools.partial(create_identifier, "fourier"),
            "ls": functools.partial(create_identifier, "ls"),
            "wavelet": functools.partial(create_identifier, "wavelet"),
            "wavelet_shared": functools.partial(create_identifier, "wavelet", friction="shared"),
-           "wavelet_m002": functools.partial(create_identifier, "wavelet", margin=0.02),
+           "wavelet_m01": functools.partial(create_identifier, "wavelet", margin=0.1),
            "wavelet-paper": functools.partial(create_identifier, "wavelet-paper")}
 
 
