@@ -279,8 +279,6 @@ def solve_weak_form(equations: Sequence, n_experiments: int, shared_friction: bo
         scores += (weighted[:, None, :] @ designs[i])[:, 0, :]
         squares += float(np.sum(residual * weighted))
         n_rows += residual.size
-    scale = np.sqrt(np.abs(np.diag(normal)))
-    scale = np.where(scale > 0, scale, 1.0)
     # the equilibrated normal matrix is well conditioned (checked above): an inverse, not
     # pinv's SVD of the 111 x 111 shared-friction system
     bread = np.linalg.inv(normal / np.outer(scale, scale)) / np.outer(scale, scale)
