@@ -201,3 +201,19 @@ def test_pose_noise_attenuation_is_compensated(paper):
     biased, corrected = np.mean(errors[False]), np.mean(errors[True])
     assert biased < -0.002, biased
     assert abs(corrected) < 0.25 * abs(biased), (corrected, biased)
+
+
+def test_an_experiment_without_intervals_is_never_silent():
+    """An experiment that gives no usable interval warns; when it was the only one to move a
+    DOF (its entries would rest on noise, with small standard errors) the fit is refused."""
+    from stewartid.dataset import DataWarning
+    from stewartid.identification.detection import check_coverage
+
+    motion = np.eye(6) * 0.01 + 1e-6                       # experiment k moves DOF k
+    with pytest.warns(DataWarning, match="exp2: no usable constant-direction interval"):
+        with pytest.raises(IdentificationError, match=r"DOF y lost its excitation.*exp2"):
+            check_coverage([f"exp{k + 1}" for k in range(6)], motion, [5, 0, 5, 5, 5, 5])
+    # another experiment moving y as much keeps the fit going, with the warning
+    motion[0, 1] = 0.01
+    with pytest.warns(DataWarning):
+        check_coverage([f"exp{k + 1}" for k in range(6)], motion, [5, 0, 5, 5, 5, 5])

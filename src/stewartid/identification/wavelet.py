@@ -27,10 +27,9 @@ Variants (``variant``):
 
 Wavelets (``wavelet``): ``"polynomial"`` (default), psi = g'' with g = (1 - x^2)^p on [-1, 1],
 compactly supported, so the largest scale spans a whole interval (the modulating-function
-idea); ``"mexican_hat"``, the paper's Gaussian wavelet, truncated at +-``truncation`` scales,
-so its scales are limited to a tenth of the interval at the default truncation of 5. Measured
-on the independent example data set (docs/benchmarks.md), the polynomial wavelet with the
-position-only variant is the most accurate; it is the default.
+idea); ``"mexican_hat"``, the paper's Gaussian wavelet, truncated at +-``truncation`` scales
+(a tenth of the interval at the default 5). The polynomial wavelet with the position-only
+variant is the most accurate (docs/benchmarks.md).
 
 Default (``test_functions=8``): per interval a family of orthonormalised zero-mean test
 functions spanning the whole interval, the weak form of :mod:`.weak_form`, solved by
@@ -412,11 +411,12 @@ class WaveletIdentifier(BaseIdentifier):
         noise_xx, noise_xy = np.concatenate(noise_xx), np.concatenate(noise_xy)
         if len(phi) == 0:
             raise_no_interval(infos)
+        check_coverage([i["name"] for i in infos], np.array([np.std(e.q, axis=0) for e in
+                       experiments]), [len(i["intervals"]) for i in infos])
         names = regressor_names("q_ddot", "q_dot")
         solution = solve_least_squares(phi, target, symmetric=bool(self.symmetric),
                                        regressor_names=names)
-        theta = solution.theta
-        std = solution.theta_std
+        theta, std = solution.theta, solution.theta_std
         if not self.symmetric:
             theta, std = bias_compensated_least_squares(phi, target, cluster, noise_xx,
                                                         noise_xy)
