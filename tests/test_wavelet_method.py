@@ -95,6 +95,10 @@ def test_shared_friction_recovers_the_coulomb_levels(example_dir, example_truth)
     for joint in ("lower_gimbal", "upper_gimbal"):
         assert est.coulomb_[joint] == pytest.approx(example_truth["coulomb"], rel=0.05)
         assert 0 < est.coulomb_std_[joint] < 0.1 * example_truth["coulomb"]
+    # one level for every axis (the example's friction model): the revolute joints too
+    uniform = WaveletIdentifier(friction="uniform").fit(paths, example_dir / "platform.toml")
+    assert len(set(uniform.coulomb_.values())) == 1
+    assert uniform.coulomb_["revolute"] == pytest.approx(example_truth["coulomb"], rel=0.02)
 
 
 @pytest.mark.parametrize("settings", [

@@ -179,11 +179,13 @@ class Prediction:
 
 
 def default_estimator(method: str = "wavelet"):
-    """The estimator a design is made for: Method B with shared friction constants, whose
-    interval constants of different speeds separate viscous from Coulomb friction; any
-    other registered method with its defaults."""
+    """The estimator a design is made for: Method B with the interval constants tied to one
+    Coulomb level for every joint axis (``friction="uniform"``), so that intervals of
+    different speeds separate viscous from Coulomb friction (three levels, one per joint
+    type, drift apart on some noise seeds: 95, 28 and -21 N m for 30 N m, and Bt with
+    them); any other registered method with its defaults."""
     if method == "wavelet":
-        return create_identifier("wavelet", friction="shared")
+        return create_identifier("wavelet", friction="uniform")
     return create_identifier(method)
 
 

@@ -28,8 +28,7 @@ Variants (``variant``):
 Wavelets (``wavelet``): ``"polynomial"`` (default), psi = g'' with g = (1 - x^2)^p on [-1, 1],
 compactly supported, so the largest scale spans a whole interval (the modulating-function
 idea); ``"mexican_hat"``, the paper's Gaussian wavelet, truncated at +-``truncation`` scales
-(a tenth of the interval at the default 5). The polynomial wavelet with the position-only
-variant is the most accurate (docs/benchmarks.md).
+(a tenth of the interval at the default 5); the polynomial one is the more accurate.
 
 Default (``test_functions=8``): per interval a family of orthonormalised zero-mean test
 functions spanning the whole interval, the weak form of :mod:`.weak_form`, solved by
@@ -89,7 +88,7 @@ VARIANTS = ("position", "paper", "derivative")
 #: Default interval margin, in periods of the estimated excitation frequency.
 MARGIN_PERIODS = 0.015
 PAIR_SELECTIONS = ("pooled", "std_error", "none")
-FRICTION_MODELS = ("shared", "free")
+FRICTION_MODELS = ("free", "shared", "uniform")
 
 
 @register_method(
@@ -122,14 +121,14 @@ class WaveletIdentifier(BaseIdentifier):
         (:mod:`~stewartid.identification.weak_form`; default 8). None: the wavelet transform
         at (a, b) points set by ``scale_fractions`` and ``shifts_per_scale``, as in the paper.
         Needs the polynomial wavelet and the position variant.
-    friction : {"shared", "free"}
+    friction : {"free", "shared", "uniform"}
         With ``test_functions``: "free" (default) leaves every interval constant free (the
-        paper's invariance to any friction law: only the shape of q_dot inside an interval
-        informs Bt); "shared" models the interval constants as an offset per experiment plus
-        the Coulomb level of each joint type mapped through the joint Jacobians, with a
-        scatter estimated from the data, and estimates those levels (``coulomb_``): more
-        precise Bt under force noise, but biased where the plant's friction departs from
-        that structure (docs/benchmarks.md).
+        paper's invariance to any friction law: only q_dot's shape inside an interval informs
+        Bt); "shared" models the constants as an offset per experiment plus the Coulomb
+        level of each joint type through the joint Jacobians, with a scatter estimated from
+        the data, and estimates the levels (``coulomb_``): more precise Bt under noise, biased
+        where the plant's friction departs from that structure (docs/benchmarks.md);
+        "uniform" one level for every axis, as the platform file's ``coulomb``.
     scale_fractions : tuple of float
         Wavelet support as fractions of each interval's length, each in (0, 1].
     shifts_per_scale : int
@@ -320,9 +319,10 @@ class WaveletIdentifier(BaseIdentifier):
             for interval in found.intervals:
                 rows = interval_equations(
                     experiment.t, experiment.q, experiment.generalized_force,
-                    jacobians if self.friction == "shared" else None,
+                    jacobians if self.friction != "free" else None,
                     found.joint_rates, found.rate_noise, interval,
-                    int(self.wavelet_order), int(self.test_functions), k)
+                    int(self.wavelet_order), int(self.test_functions), k,
+                    uniform=self.friction == "uniform")
                 if rows is not None:
                     equations.append(rows)
             infos.append(found.info)
@@ -333,15 +333,15 @@ class WaveletIdentifier(BaseIdentifier):
         check_coverage([i["name"] for i in infos], np.array(motion),
                        [sum(e.experiment == k for e in equations) for k in range(len(infos))])
         solution = solve_weak_form(equations, len(datasets),
-                                   shared_friction=self.friction == "shared",
+                                   shared_friction=self.friction != "free",
                                    **({"pose_covariance": [i["noise_covariance"] for i in infos],
                                        "force_sensitivity": sensitivities}
                                       if self.noise_correction else {}))
         M, B = solution.theta[:, :6].copy(), solution.theta[:, 6:12].copy()
         std_M, std_B = solution.theta_std[:, :6].copy(), solution.theta_std[:, 6:12].copy()
         chosen = self._combine_pairs(M, B, std_M, std_B)
-        levels = dict(zip(JOINT_TYPES, solution.coulomb.tolist(), strict=True))
-        levels_std = dict(zip(JOINT_TYPES, solution.coulomb_std.tolist(), strict=True))
+        levels, levels_std = (dict(zip(JOINT_TYPES, np.resize(v, 3).tolist(), strict=True))
+                              for v in (solution.coulomb, solution.coulomb_std))  # uniform: 1
         diagnostics = {
             "position_noise_std": [np.sqrt(np.diag(i["noise_covariance"])).tolist()
                                    for i in infos],

@@ -96,7 +96,7 @@ class IntervalEquations:
         <g, y>.
     weight : float
         <g, 1> (s^(1/2)): the mean row's coefficient of the interval constant.
-    coulomb : ndarray, shape (n_types, 6)
+    coulomb : ndarray, shape (n_types, 6), or (1, 6) with one level for every axis
         <g, W_type>: generalized Coulomb force per unit level of each joint type, with the
         interval's joint directions.
     experiment : int
@@ -121,7 +121,7 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
                        joint_jacobians: np.ndarray | Callable[[np.ndarray], np.ndarray] | None,
                        joint_rates: np.ndarray,
                        rate_noise: np.ndarray, interval: Sequence[float], order: int, size: int,
-                       experiment: int = 0) -> IntervalEquations | None:
+                       experiment: int = 0, uniform: bool = False) -> IntervalEquations | None:
     """Weak-form equations of one interval (see the module docstring).
 
     Parameters
@@ -150,6 +150,8 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
         Number of invariant test functions K.
     experiment : int
         Stored in the result.
+    uniform : bool
+        One Coulomb level for every joint axis: ``coulomb`` summed over the joint types.
 
     Returns
     -------
@@ -191,6 +193,8 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
         pattern = np.einsum("la,nlac->nac", direction, jacobians)              # (n, 5, 6)
         coulomb = np.array([bump0 @ pattern[:, list(axes)].sum(axis=1)
                             for axes in JOINT_TYPES.values()])
+        if uniform:
+            coulomb = coulomb.sum(axis=0, keepdims=True)
     family = np.stack([np.vstack([phi0, bump0]), np.vstack([phi1, bump1]),
                        np.vstack([phi2, bump2])])                            # (3, K + 1, n)
     gram = np.einsum("arn,bsn->abrs", family, family)
