@@ -113,11 +113,12 @@ def _terms(platform: Platform, q: np.ndarray, qd: np.ndarray | None = None):
                                 platform.base_joints, q2, qd2), single
 
 
-def _leg_terms(platform: Platform, q: np.ndarray, joints: bool = False) -> LegTerms:
+def _leg_terms(platform: Platform, q: np.ndarray, joints: bool = False,
+               pose_terms: bool = True) -> LegTerms:
     """(G, J_leg, lengths, J_joint) at poses q (N, 6), without the inertia terms; J_joint is
-    empty unless ``joints``."""
+    empty unless ``joints``, G and J_leg unless ``pose_terms``."""
     return leg_terms(platform.parameters(), platform.upper_joints, platform.base_joints, q,
-                     joints)
+                     joints, pose_terms)
 
 
 def leg_jacobian(platform: Platform, q: np.ndarray) -> np.ndarray:
@@ -152,7 +153,7 @@ def joint_rate_jacobians(platform: Platform, q: np.ndarray) -> np.ndarray:
     ndarray, shape (6, 5, 6) or (N, 6, 5, 6)
     """
     q2, single = _batch(q)
-    J_joint = _leg_terms(platform, q2, joints=True)[3]
+    J_joint = _leg_terms(platform, q2, joints=True, pose_terms=False)[3]
     return J_joint[0] if single else J_joint
 
 

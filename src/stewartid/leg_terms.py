@@ -72,7 +72,7 @@ def _euler_columns(x0, x1, x2, E):
 
 
 def leg_terms(params: np.ndarray, upper: np.ndarray, base: np.ndarray, q: np.ndarray,
-              joints: bool = False) -> LegTerms:
+              joints: bool = False, pose_terms: bool = True) -> LegTerms:
     """Leg lengths, J_lq, G(q) and optionally the joint-axis Jacobians at poses ``q``.
 
     Parameters
@@ -87,6 +87,9 @@ def leg_terms(params: np.ndarray, upper: np.ndarray, base: np.ndarray, q: np.nda
         Poses (m, rad).
     joints : bool
         Also compute the joint-axis Jacobians.
+    pose_terms : bool
+        False: the joint-axis Jacobians and lengths only (``gravity`` and ``leg_jacobian``
+        left empty, shape (0, ...)), for the callers that need no more.
 
     Returns
     -------
@@ -94,18 +97,20 @@ def leg_terms(params: np.ndarray, upper: np.ndarray, base: np.ndarray, q: np.nda
     """
     q = np.asarray(q, dtype=float)
     n = len(q)
-    out = LegTerms(np.empty((n, 6)), np.empty((n, 6, 6)), np.empty((n, 6)),
+    m = n if pose_terms else 0
+    out = LegTerms(np.empty((m, 6)), np.empty((m, 6, 6)), np.empty((n, 6)),
                    np.empty((n if joints else 0, 6, 5, 6)))
     for start in range(0, n, BLOCK):
         block = slice(start, start + BLOCK)
         _leg_terms_block(params, upper, base, q[block],
-                         *(part[block] for part in out[:3]),
-                         out.joint_jacobians[block] if joints else None)
+                         *(part[block] if pose_terms else None for part in out[:2]),
+                         out.lengths[block], out.joint_jacobians[block] if joints else None)
     return out
 
 
 def _leg_terms_block(params, upper, base, q, G, J_leg, lengths, J_joint):
-    """:func:`leg_terms` for one block of samples, into the outputs (J_joint if not None)."""
+    """:func:`leg_terms` for one block of samples, into the outputs (G and J_leg, J_joint
+    if not None)."""
     sx, cx = np.sin(q[:, 3:4]), np.cos(q[:, 3:4])  # (n, 1): broadcast over the legs
     sy, cy = np.sin(q[:, 4:5]), np.cos(q[:, 4:5])
     sz, cz = np.sin(q[:, 5:6]), np.cos(q[:, 5:6])
@@ -125,6 +130,9 @@ def _leg_terms_block(params, upper, base, q, G, J_leg, lengths, J_joint):
     # columns of J_A = [I, -[r]x] (None: structural zero) and u . J_A[:, c]
     JA = [(1.0, None, None), (None, 1.0, None), (None, None, 1.0),
           (None, -r2, r1), (r2, None, -r0), (-r1, r0, None)]
+    if G is None:  # joint Jacobians only
+        _joint_jacobians(u, JA, length, E, J_joint)
+        return
     uJ = [_dot(*zip(u, column, strict=True)) for column in JA]
 
     m_u, m_l = params[_M_UPPER], params[_M_LOWER]
