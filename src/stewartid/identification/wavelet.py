@@ -309,8 +309,9 @@ class WaveletIdentifier(BaseIdentifier):
         infos, equations, sensitivities, motion = [], [], [], []
         for k, dataset in enumerate(datasets):
             (experiment,) = prepare([dataset], platform, gravity=self.gravity)
-            sensitivities.append(generalized_force_sensitivity(
-                platform, dataset.pose, dataset.forces, self.gravity))
+            if self.noise_correction:
+                sensitivities.append(generalized_force_sensitivity(
+                    platform, dataset.pose, dataset.forces, self.gravity))
             found = self._intervals(experiment, platform, 1.0)
 
             def jacobians(indices: np.ndarray, q: np.ndarray = experiment.q) -> np.ndarray:
@@ -332,11 +333,9 @@ class WaveletIdentifier(BaseIdentifier):
             raise_no_interval(infos)
         check_coverage([i["name"] for i in infos], np.array(motion),
                        [sum(e.experiment == k for e in equations) for k in range(len(infos))])
-        solution = solve_weak_form(equations, len(datasets),
-                                   shared_friction=self.friction != "free",
-                                   **({"pose_covariance": [i["noise_covariance"] for i in infos],
-                                       "force_sensitivity": sensitivities}
-                                      if self.noise_correction else {}))
+        pose = [i["noise_covariance"] for i in infos] if self.noise_correction else None
+        solution = solve_weak_form(equations, len(datasets), shared_friction=self.friction != "free",
+                                   pose_covariance=pose, force_sensitivity=sensitivities or None)
         M, B = solution.theta[:, :6].copy(), solution.theta[:, 6:12].copy()
         std_M, std_B = solution.theta_std[:, :6].copy(), solution.theta_std[:, 6:12].copy()
         chosen = self._combine_pairs(M, B, std_M, std_B)
