@@ -19,7 +19,7 @@ import numpy as np
 from stewartid.dataset import DataWarning
 from stewartid.errors import IdentificationError
 from stewartid.identification.intervals import constant_direction_intervals, joint_rates
-from stewartid.identification.noise import joint_rate_noise, position_noise_covariance
+from stewartid.identification.noise import joint_rate_noise, white_noise_covariance
 from stewartid.identification.preparation import Experiment
 from stewartid.kinematics import joint_rate_jacobians
 from stewartid.platform import COORDINATES, Platform
@@ -34,7 +34,8 @@ class Detection(NamedTuple):
     intervals : ndarray, shape (M, 2)
         Usable [start, stop] (s).
     info : dict
-        Counts, lengths, the differentiation window and the pose-noise covariance.
+        Counts, lengths, the differentiation window, the pose-noise covariance and the
+        white-noise variance of the generalized force.
     joint_rates : ndarray, shape (N, 6, 5)
         Smoothed joint-axis rates (rad/s).
     rate_noise : ndarray, shape (6, 5)
@@ -168,7 +169,9 @@ def detect_intervals(experiment: Experiment, platform: Platform, *, window: floa
         margin = margin_periods / frequency if margin is None else margin
     q_smooth, q_dot, q_ddot = differentiate(q, rate, window)
     rates, mean_jacobian = _joint_rates_in_blocks(experiment, platform, q_dot)
-    noise = position_noise_covariance(q, q_smooth)
+    noise = white_noise_covariance(q, q_smooth)
+    y = experiment.generalized_force
+    force_noise = np.diag(white_noise_covariance(y, differentiate(y, rate, window)[0]))
     rate_noise = joint_rate_noise(noise, rate, window, mean_jacobian,
                                   experiment.leg_jacobian)
     # a joint whose rate is no larger than its noise has no direction to keep, whatever its
@@ -189,7 +192,7 @@ def detect_intervals(experiment: Experiment, platform: Platform, *, window: floa
             "longest_interval": float(lengths.max()) if len(lengths) else 0.0,
             "shortest_usable": float(max(shortest, needed)),
             "intervals": intervals, "differentiation_window": float(window),
-            "noise_covariance": noise}
+            "noise_covariance": noise, "force_noise_variance": force_noise}
     # a floor keeps the direction weights of noise-free data finite
     return Detection(intervals=intervals, info=info,
                      joint_rates=rates[:, :30].reshape(len(t), 6, 5),

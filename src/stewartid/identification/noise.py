@@ -1,7 +1,7 @@
 """Measurement noise estimated from the data, and how it propagates into the wavelet
 equations of Method B.
 
-- :func:`position_noise_covariance`: covariance of white pose noise per sample;
+- :func:`white_noise_covariance`: covariance of white noise per sample (pose, forces);
 - :func:`joint_rate_noise`: the noise it causes on the Savitzky-Golay joint rates (for the
   hysteresis thresholds of the interval detection);
 - :func:`generalized_force_sensitivity`: how pose noise enters the generalized force (for
@@ -20,10 +20,10 @@ from stewartid.signals.differentiation import (
 )
 
 
-def position_noise_covariance(q: np.ndarray, smooth: np.ndarray | None = None) -> np.ndarray:
-    """Covariance of white measurement noise on the pose, from second differences.
+def white_noise_covariance(q: np.ndarray, smooth: np.ndarray | None = None) -> np.ndarray:
+    """Covariance of white measurement noise on a smooth signal, from second differences.
 
-    For a smooth motion, q[n+1] - 2 q[n] + q[n-1] is the noise e[n+1] - 2 e[n] + e[n-1]
+    For a smooth signal, q[n+1] - 2 q[n] + q[n-1] is the noise e[n+1] - 2 e[n] + e[n-1]
     (covariance 6 Sigma for white noise) plus q_ddot dt^2. The latter is removed by taking
     the differences of q minus a smoothed copy (a low-pass smoother leaves the noise's second
     differences almost untouched), so noise-free data give a covariance near zero. The pose
@@ -32,16 +32,16 @@ def position_noise_covariance(q: np.ndarray, smooth: np.ndarray | None = None) -
 
     Parameters
     ----------
-    q : ndarray, shape (N, 6)
-        Measured poses (m, rad).
-    smooth : ndarray, shape (N, 6), optional
+    q : ndarray, shape (N, m)
+        Measured signals, e.g. poses (m, rad) or generalized forces (N, N m).
+    smooth : ndarray, shape (N, m), optional
         A low-pass smoothed copy of ``q`` (e.g. the Savitzky-Golay output); None: raw
         second differences.
 
     Returns
     -------
-    ndarray, shape (6, 6)
-        Sigma (m^2, m rad, rad^2) per sample.
+    ndarray, shape (m, m)
+        Sigma per sample (units of q squared).
     """
     r = q if smooth is None else q - smooth
     d2 = r[2:] - 2.0 * r[1:-1] + r[:-2]
@@ -61,7 +61,7 @@ def joint_rate_noise(covariance: np.ndarray, sample_rate: float, window: float,
     Parameters
     ----------
     covariance : ndarray, shape (6, 6)
-        Pose noise per sample (:func:`position_noise_covariance`).
+        Pose noise per sample (:func:`white_noise_covariance`).
     sample_rate, window : float
         Hz and the differentiation window (s).
     joint_jacobians : ndarray, shape (N, 6, 5, 6)
@@ -104,4 +104,4 @@ def generalized_force_sensitivity(platform: Platform, q: np.ndarray, forces: np.
     return ((y[0::2] - y[1::2]) / (2 * step)).T
 
 
-__all__ = ["generalized_force_sensitivity", "joint_rate_noise", "position_noise_covariance"]
+__all__ = ["generalized_force_sensitivity", "joint_rate_noise", "white_noise_covariance"]

@@ -333,9 +333,10 @@ class WaveletIdentifier(BaseIdentifier):
             raise_no_interval(infos)
         check_coverage([i["name"] for i in infos], np.array(motion),
                        [sum(e.experiment == k for e in equations) for k in range(len(infos))])
-        pose = [i["noise_covariance"] for i in infos] if self.noise_correction else None
-        solution = solve_weak_form(equations, len(datasets), shared_friction=self.friction != "free",
-                                   pose_covariance=pose, force_sensitivity=sensitivities or None)
+        pose, white = ([[i[key] for i in infos] for key in ("noise_covariance",
+                        "force_noise_variance")] if self.noise_correction else (None, None))
+        solution = solve_weak_form(equations, len(datasets), self.friction != "free", pose_covariance=pose,
+                                   force_sensitivity=sensitivities or None, force_variance=white)
         M, B = solution.theta[:, :6].copy(), solution.theta[:, 6:12].copy()
         std_M, std_B = solution.theta_std[:, :6].copy(), solution.theta_std[:, 6:12].copy()
         chosen = self._combine_pairs(M, B, std_M, std_B)

@@ -24,8 +24,16 @@ depends on the estimate), and the expected noise parts of the weighted normal eq
 sum_rs W_rs <phi_r^(a), phi_s^(b)> Sigma per block (and the targets' share through K), are
 subtracted (the bias-compensated, errors-in-variables normal equations).
 
-Sigma comes from the data (:func:`~stewartid.identification.noise.position_noise_covariance`
-per experiment); s_i from the residuals by moments (their power less the pose part).
+Sigma comes from the data (:func:`~stewartid.identification.noise.white_noise_covariance`
+per experiment), and so does the white force noise of each experiment (the same estimator on
+the generalized force); s_i is that white part plus, when the weighted residuals hold more
+than noise explains (model error), the excess that brings their chi-square to its degrees of
+freedom. The white part must be measured, not
+left to the moments: with 20 µm pose noise the pose part is 99.9 % of the residual power on
+the narrow test functions, the moments' difference of two large numbers came out negative on
+most channels, and the widest functions, where the force noise is the larger part, were then
+weighted as if noise-free (weighted residuals 8-34 times their expected size, standard errors
+up to 45 times the spread over seeds).
 
 References
 ----------
@@ -119,6 +127,26 @@ def _coefficients(sensitivity: np.ndarray, theta_i: np.ndarray) -> np.ndarray:
                      np.broadcast_to(-theta_i[:6], (n, 6))], axis=1)
 
 
+def _excess_variance(covariance: np.ndarray, residual: np.ndarray, dof: int) -> float:
+    """e >= 0 with sum_n r_n^T (V_n + e I)^-1 r_n = dof: the white variance per row the
+    residuals (n, R) hold beyond their expected covariance V (n, R, R), model error.
+
+    Weighted, because the pose part of V is orders of magnitude larger on the narrow test
+    functions than on the wide ones: the plain moment (sum |r|^2 - tr V) / (n R) is then the
+    difference of two numbers whose randomness alone exceeds the force noise."""
+    lam, vectors = np.linalg.eigh(covariance)
+    proj = np.einsum("nrk,nr->nk", vectors, residual) ** 2
+    lam = np.maximum(lam, 0.0)
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):  # noise-free rows
+        if np.sum(np.where(proj > 0, proj / lam, 0.0)) <= dof:
+            return 0.0
+    low, high = 0.0, float(np.sum(proj)) / max(dof, 1)   # chi2(high) <= dof
+    for _ in range(60):  # bisection on the monotone chi2(e), to 1e-18 of the bracket
+        mid = 0.5 * (low + high)
+        low, high = (mid, high) if np.sum(proj / (lam + mid)) > dof else (low, mid)
+    return high
+
+
 def _weighted_normal(design: np.ndarray, weights: np.ndarray, target: np.ndarray
                      ) -> tuple[np.ndarray, np.ndarray]:
     """sum_n D_n^T W_n D_n and sum_n D_n^T W_n t_n for designs (n, R, u), weights (n, R, R)
@@ -132,7 +160,8 @@ def _weighted_normal(design: np.ndarray, weights: np.ndarray, target: np.ndarray
 def solve_weak_form(equations: Sequence, n_experiments: int, shared_friction: bool = True,
                     iterations: int = 5, max_condition: float = 1e8,
                     pose_covariance: np.ndarray | None = None,
-                    force_sensitivity: np.ndarray | None = None) -> WeakFormSolution:
+                    force_sensitivity: np.ndarray | None = None,
+                    force_variance: np.ndarray | None = None) -> WeakFormSolution:
     """Generalized least squares for [Mt Bt] (and the friction structure), pose noise
     propagated and its bias compensated (module docstring).
 
@@ -156,6 +185,10 @@ def solve_weak_form(equations: Sequence, n_experiments: int, shared_friction: bo
         K = d(J^T f - G) / dq of each experiment
         (:func:`~stewartid.identification.noise.generalized_force_sensitivity`): the pose
         noise the targets share with the regressors. None: zero.
+    force_variance : ndarray, shape (n_experiments, 6), optional
+        White noise variance per sample of each experiment's generalized force (N^2,
+        N^2 m^2), e.g. :func:`~stewartid.identification.noise.white_noise_covariance`
+        of it; None: zero (the force noise then comes from the residuals alone).
 
     Returns
     -------
@@ -170,6 +203,8 @@ def solve_weak_form(equations: Sequence, n_experiments: int, shared_friction: bo
              else np.asarray(pose_covariance, dtype=float)[owner])
     sensitivity = (np.zeros((n, 6, 6)) if force_sensitivity is None
                    else np.asarray(force_sensitivity, dtype=float)[owner])      # (n, 6, 6)
+    white = (np.zeros((n, 6)) if force_variance is None
+             else np.asarray(force_variance, dtype=float)[owner])             # (n, 6)
     flat = x.reshape(-1, 12)
     condition = _check_rank(flat.T @ flat, regressor_names("q_ddot", "q_dot"), max_condition)
     n_types = equations[0].coulomb.shape[0]
@@ -202,7 +237,7 @@ def solve_weak_form(equations: Sequence, n_experiments: int, shared_friction: bo
     theta = np.linalg.lstsq(flat, y.reshape(-1, 6), rcond=None)[0].T
     # floor: noise-free data must not give infinite weights
     floor = 1e-24 * np.maximum(np.mean(y.reshape(-1, 6) ** 2, axis=0), 1e-300)
-    noise = np.zeros(6)
+    noise = np.zeros((n, 6))  # s per interval and channel
     pose_share = np.zeros(6)
 
     def compensated(normal: np.ndarray, rhs: np.ndarray, w: np.ndarray, g: np.ndarray,
@@ -220,14 +255,16 @@ def solve_weak_form(equations: Sequence, n_experiments: int, shared_friction: bo
             q_inv = _pose_covariance(gram_inv, sigma, _coefficients(sensitivity[:, i], theta[i]))
             residual = y[:, :, i] - x @ theta[i]
             power, pose = float(np.sum(residual ** 2)), float(np.trace(q_inv, 0, 1, 2).sum())
-            noise[i] = max((power - pose) / residual.size, floor[i])
+            excess = _excess_variance(white[:, i, None, None] * np.eye(k_rows) + q_inv,
+                                      residual, residual.size - 12)
+            noise[:, i] = np.maximum(white[:, i] + excess, floor[i])
             pose_share[i] = min(pose / max(power, 1e-300), 1.0)
-            w = np.linalg.inv(noise[i] * np.eye(k_rows) + q_inv)
+            w = np.linalg.inv(noise[:, i, None, None] * np.eye(k_rows) + q_inv)
             normal, rhs = compensated(*_weighted_normal(x, w, y[:, :, i]), w, gram_inv, i)
             theta[i] = np.linalg.solve(normal, rhs)
 
     def channel_covariance(i: int, theta_i: np.ndarray) -> np.ndarray:
-        v = noise[i] * np.eye(rows) + _pose_covariance(gram, sigma,
+        v = noise[:, i, None, None] * np.eye(rows) + _pose_covariance(gram, sigma,
                                                        _coefficients(sensitivity[:, i], theta_i))
         if shared_friction:
             v[:, -1, -1] += (scatter[i] * weight) ** 2
@@ -296,7 +333,7 @@ def solve_weak_form(equations: Sequence, n_experiments: int, shared_friction: bo
         coulomb = coulomb_std = np.full(n_types, np.nan)
     return WeakFormSolution(
         theta=theta, theta_std=std[:N_THETA].reshape(6, 12), coulomb=coulomb,
-        coulomb_std=coulomb_std, offsets=offsets, noise_std=np.sqrt(noise),
+        coulomb_std=coulomb_std, offsets=offsets, noise_std=np.sqrt(noise.mean(axis=0)),
         pose_noise_share=pose_share, constant_scatter=scatter, condition_number=condition,
         n_equations=int(n * k_rows))
 

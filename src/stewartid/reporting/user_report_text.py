@@ -33,7 +33,7 @@ def data_rows(datasets: Sequence[Dataset], platform: Platform) -> list[dict[str,
     """Per experiment: samples, duration (s), sample rate (Hz), dominant frequency (Hz), the
     most excited coordinate (rotations weighted by the upper joint radius), its amplitude
     (mm or mrad) and the noise estimated from the data: pose (um, urad) and leg forces (N)."""
-    from stewartid.identification.noise import position_noise_covariance
+    from stewartid.identification.noise import white_noise_covariance
     from stewartid.signals.differentiation import differentiate, estimate_frequency
 
     rows = []
@@ -49,8 +49,8 @@ def data_rows(datasets: Sequence[Dataset], platform: Platform) -> list[dict[str,
             "name": d.name, "samples": len(d), "duration_s": d.duration,
             "sample_rate_hz": d.sample_rate, "frequency_hz": frequency, "excited": excited,
             "amplitude": 0.5 * float(np.ptp(d.pose[:, excited])) * 1e3,
-            "pose_noise": np.sqrt(np.diag(position_noise_covariance(d.pose, smooth_pose))),
-            "force_noise": np.sqrt(np.diag(position_noise_covariance(d.forces,
+            "pose_noise": np.sqrt(np.diag(white_noise_covariance(d.pose, smooth_pose))),
+            "force_noise": np.sqrt(np.diag(white_noise_covariance(d.forces,
                                                                      smooth_force)))})
     return rows
 
