@@ -1,0 +1,149 @@
+"""Cramér-Rao bounds on Mt and Bt: the best any unbiased estimator can do with a motion.
+
+For the linearised model y = Mt q_ddot + Bt q_dot + c + J_lq^T e, with the motion known
+exactly and white leg-force noise e (standard deviation sigma per leg), the Fisher
+information of vec([Mt Bt]) is
+
+    I = sum_t C_t^-1 (x) x_t x_t^T,      C_t = J_lq(q_t)^T diag(sigma^2) J_lq(q_t),
+    x_t = [q_ddot_t, q_dot_t],
+
+less what the nuisance constants c take (the Schur complement over them). Two nuisance
+structures:
+
+* ``friction="known"``: the Coulomb force is known (subtracted exactly), one constant per
+  record remains (what the gravity model leaves): the bound of the oracle;
+* ``friction="immune"``: a free constant per constant-direction interval (every joint
+  keeps its direction), which is all a Coulomb-invariant estimator (Method B with free
+  interval constants) may assume: inside an interval the mean viscous force cannot be
+  told from the constant, and only the within-interval variation of q_dot informs Bt.
+
+Pose noise, which the real estimators also face, only adds to these bounds, so they are
+lower bounds for noisy logs: an accuracy target below them cannot be met by any unbiased
+estimator on that motion, whatever its cleverness; only a different excitation helps.
+
+References
+----------
+Kay, S. M. "Fundamentals of Statistical Signal Processing: Estimation Theory", ch. 3 and
+the Schur-complement form of the bound with nuisance parameters (Prentice Hall, 1993).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from stewartid.errors import ConfigError
+from stewartid.identification.intervals import constant_direction_intervals, joint_rates
+from stewartid.kinematics import leg_jacobian
+from stewartid.platform import Platform
+from stewartid.reference.published import PAPER_ENTRIES
+
+#: Nuisance structures of :func:`information_bound`.
+FRICTION_KNOWLEDGE = ("known", "immune")
+
+
+@dataclass(frozen=True)
+class InformationBound:
+    """Cramér-Rao lower bound on the covariance of [Mt Bt].
+
+    Attributes
+    ----------
+    covariance : ndarray, shape (72, 72)
+        Of the row-major [Mt Bt] (6, 12): index 12 i + j is Mt(i, j) for j < 6 and
+        Bt(i, j - 6) for j >= 6 (kg, kg m, kg m^2 and N s/m ... squared).
+    friction : str
+        ``"known"`` or ``"immune"``.
+    n_constants : int
+        Nuisance constants per channel (records, or intervals).
+    """
+
+    covariance: np.ndarray
+    friction: str
+    n_constants: int
+
+    @property
+    def std(self) -> np.ndarray:
+        """Lower bound on the standard error of [Mt Bt]; shape (6, 12)."""
+        return np.sqrt(np.diag(self.covariance)).reshape(6, 12)
+
+    def paper_covariance(self) -> np.ndarray:
+        """Covariance of the paper's 20 entries (:data:`PAPER_ENTRIES` order); (20, 20)."""
+        index = [12 * i + (j if m == "M" else 6 + j) for m, i, j in PAPER_ENTRIES]
+        return self.covariance[np.ix_(index, index)]
+
+
+def _profiled_information(q_dot: np.ndarray, q_ddot: np.ndarray, precision: np.ndarray,
+                          labels: np.ndarray) -> tuple[np.ndarray, int]:
+    """Fisher information of the 72 [Mt Bt] unknowns with one free 6-vector constant per
+    label >= 0 profiled out; samples labelled -1 are not used. Returns (72, 72) and the
+    number of constants."""
+    keep = labels >= 0
+    x = np.hstack([q_ddot, q_dot])[keep]                                # (n, 12)
+    p, lab = precision[keep], labels[keep]
+    # theta block: I[a i, b j] = sum_t P_ab x_i x_j
+    full = np.einsum("nab,ni,nj->aibj", p, x, x, optimize=True).reshape(72, 72)
+    groups = np.unique(lab)
+    for g in groups:
+        sel = lab == g
+        a = p[sel].sum(axis=0)                                          # (6, 6)
+        cross = np.einsum("nab,ni->abi", p[sel], x[sel]).reshape(6, 72)  # d c_a, theta_bi
+        full -= cross.T @ np.linalg.solve(a, cross)
+    return full, len(groups)
+
+
+def information_bound(platform: Platform, motions: Sequence[tuple[np.ndarray, ...]],
+                      force_noise: float | np.ndarray, friction: str = "immune",
+                      margin: float = 0.0, ignore_below: float = 0.01) -> InformationBound:
+    """Cramér-Rao bound on [Mt Bt] for true motions and white leg-force noise.
+
+    Parameters
+    ----------
+    platform : Platform
+        Geometry (for J_lq and the joint-axis rates).
+    motions : sequence of (t, q, q_dot, q_ddot)
+        True motion of every record: times (N,) in s, pose, rate and acceleration (N, 6) in
+        m, rad and their derivatives.
+    force_noise : float or ndarray, shape (6,)
+        Standard deviation of each leg's force sensor (N), > 0.
+    friction : {"immune", "known"}
+        Nuisance structure (module docstring).
+    margin : float
+        Time cut from both ends of every interval (s), ``friction="immune"``.
+    ignore_below : float
+        Joints whose rate RMS is below this fraction of the largest of their kind do not
+        split intervals (as in Method B's detection).
+
+    Returns
+    -------
+    InformationBound
+    """
+    if friction not in FRICTION_KNOWLEDGE:
+        raise ConfigError(f"friction must be one of {', '.join(FRICTION_KNOWLEDGE)}; "
+                          f"got {friction!r}.")
+    sigma = np.broadcast_to(np.asarray(force_noise, dtype=float), (6,))
+    if not np.all(np.isfinite(sigma) & (sigma > 0)):
+        raise ConfigError(f"force_noise must be finite and > 0 (N); got {force_noise!r}.")
+    information = np.zeros((72, 72))
+    n_constants = 0
+    for t, q, q_dot, q_ddot in motions:
+        jacobian = leg_jacobian(platform, q)                           # (N, 6 legs, 6)
+        # C_t^-1 = (J^T S J)^-1 = J^-1 S^-1 J^-T
+        inverse = np.linalg.inv(jacobian)
+        precision = np.einsum("nal,l,nbl->nab", inverse, sigma ** -2.0, inverse)
+        labels = np.zeros(len(t), dtype=int)
+        if friction == "immune":
+            found = constant_direction_intervals(t, joint_rates(platform, q, q_dot),
+                                                 margin=margin, ignore_below=ignore_below)
+            labels[:] = -1
+            for k, (start, stop) in enumerate(found):
+                labels[(t > start) & (t < stop)] = k
+        part, count = _profiled_information(q_dot, q_ddot, precision, labels)
+        information += part
+        n_constants += count
+    return InformationBound(covariance=np.linalg.inv(information), friction=friction,
+                            n_constants=n_constants)
+
+
+__all__ = ["FRICTION_KNOWLEDGE", "InformationBound", "information_bound"]
