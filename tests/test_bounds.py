@@ -67,9 +67,9 @@ def gls_spread(platform, data, labels, sigma, seeds=400):
 @pytest.mark.parametrize("friction", ["known", "immune"])
 def test_bound_is_the_spread_of_the_efficient_estimator(paper, friction):
     """For the linear model with white leg-force noise, generalized least squares is
-    efficient: its spread over 400 seeds equals the bound (within the Monte Carlo's 3.5 %
-    sampling error, 3 sigma, at 400 seeds) for every entry of Mt and Bt, with one constant for the record
-    (friction known) or one per constant-direction interval (friction-immune)."""
+    efficient: its spread over 400 seeds equals the bound for every entry of Mt and Bt
+    (the Monte Carlo's sampling error is 3.5 %; 144 entries reach 3 sigma), with one
+    constant per record (friction known) or per constant-direction interval (immune)."""
     sigma = 150.0
     data = motions(paper)
     bound = information_bound(paper, data, sigma, friction)
