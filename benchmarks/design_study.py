@@ -16,8 +16,8 @@ Steps (paper platform, Coulomb friction ``--coulomb``, the reference sensor nois
 
 Usage::
 
-    python benchmarks/design_study.py [--design results/design/design.json] [--seeds 20]
-        [--prediction-seeds 20] [--baseline-seeds 8] [--coulomb 30] [--out results/design_study]
+    python benchmarks/design_study.py [--design results/design/design.json] [--seeds 40]
+        [--prediction-seeds 60] [--baseline-seeds 8] [--coulomb 30] [--out results/design_study]
 """
 
 from __future__ import annotations
@@ -66,8 +66,8 @@ def main() -> None:
     parser.add_argument("--design", type=Path, default=None)
     parser.add_argument("--budget", type=float, default=120.0)
     parser.add_argument("--coulomb", type=float, default=30.0)
-    parser.add_argument("--seeds", type=int, default=20)
-    parser.add_argument("--prediction-seeds", type=int, default=20)
+    parser.add_argument("--seeds", type=int, default=40)
+    parser.add_argument("--prediction-seeds", type=int, default=60)
     parser.add_argument("--baseline-seeds", type=int, default=8)
     parser.add_argument("--out", type=Path, default=Path("results/design_study"))
     args = parser.parse_args()

@@ -200,7 +200,7 @@ def optimise_design(platform: Platform, budget_s: float, noise: SensorNoise,
                     frequencies: Sequence[Sequence[float]] = DEFAULT_FREQUENCIES,
                     schedules: Sequence[Sequence] = DEFAULT_SCHEDULES,
                     max_use: float = 0.7, cap: float | Sequence[float] = DEFAULT_AMPLITUDE_CAP,
-                    screening_seeds: int = 8, seeds: int = 20, source: str = "plant",
+                    screening_seeds: int = 8, seeds: int = 60, source: str = "plant",
                     required: Mapping[str, float] = REQUIRED_ACCURACY,
                     progress: Callable[[str], None] | None = None,
                     ) -> tuple[Candidate, list[Candidate]]:

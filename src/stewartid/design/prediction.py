@@ -25,7 +25,9 @@ symmetric pair) is not one linear map of the noise; running the estimator itself
 what it will do, whatever its settings. On model data the pose noise is propagated to
 first order (dq = J_lq^-1 dl, what forward kinematics does to 20 um of leg noise to within
 1e-9 m), which replaces one forward kinematics per sample by one linear solve. A standard error estimated
-from K seeds has a relative uncertainty of about 1 / sqrt(2 K) (16 % at 20 seeds).
+from K seeds has a relative uncertainty of about 1 / sqrt(2 K): 16 % at 20 seeds, 9 % at
+the default 60 (compared with an observed spread over 20 seeds, itself 16 % uncertain, a
+prediction from 20 seeds lands within 30 % of it for only about 3 entries in 4).
 """
 
 from __future__ import annotations
@@ -232,7 +234,7 @@ def plant_records(platform: Platform, design: Design) -> list:
 
 
 def predict_accuracy(platform: Platform, design: Design, noise: SensorNoise,
-                     method: str = "wavelet", seeds: int = 20, seed: int = 0,
+                     method: str = "wavelet", seeds: int = 60, seed: int = 0,
                      source: str = "plant", records: list | None = None) -> Prediction:
     """Predicted bias and standard errors of Mt and Bt for a design (see the module docstring).
 

@@ -59,7 +59,7 @@ def is_design_file(path: Path) -> bool:
 
 def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str | Path,
                method: str = "wavelet", rate_hz: float = 500.0, max_use: float = 0.7,
-               seeds: int = 20, source: str = "plant", quick: bool = False,
+               seeds: int = 60, source: str = "plant", quick: bool = False,
                force: bool = False,
                progress: Callable[[str], None] | None = None) -> DesignOutput:
     """Design an excitation for ``platform`` and write it with its report to ``out``.
