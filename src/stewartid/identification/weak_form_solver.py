@@ -28,12 +28,12 @@ Sigma comes from the data (:func:`~stewartid.identification.noise.white_noise_co
 per experiment), and so does the white force noise of each experiment (the same estimator on
 the generalized force); s_i is that white part plus, when the weighted residuals hold more
 than noise explains (model error), the excess that brings their chi-square to its degrees of
-freedom. The white part must be measured, not
-left to the moments: with 20 µm pose noise the pose part is 99.9 % of the residual power on
-the narrow test functions, the moments' difference of two large numbers came out negative on
-most channels, and the widest functions, where the force noise is the larger part, were then
-weighted as if noise-free (weighted residuals 8-34 times their expected size, standard errors
-up to 45 times the spread over seeds).
+freedom. The white part must be measured, not left to the moments: with 20 µm pose noise the
+pose part is 99.9 % of the residual power on the narrow test functions, the moments'
+difference of two large numbers came out negative on most channels, and the widest
+functions, where the force noise is the larger part, were then weighted as if noise-free
+(weighted residuals 8-34 times their expected size, standard errors up to 45 times the
+spread over seeds).
 
 References
 ----------
