@@ -37,7 +37,6 @@ from stewartid.signals.differentiation import default_window, differentiate, est
 from stewartid.simulation import SensorNoise, simulate_experiments
 from stewartid.simulation.sensors import reference_noise
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "tests" / "data" / "example_c10"
 #: Targets (%) of the noisy acceptance: Mt diagonal, Bt diagonal, couplings.
 TARGETS = {"Mt diagonal": 0.5, "Bt diagonal": 3.0, "couplings": 10.0}
 GROUPS = {"Mt diagonal": slice(0, 6), "Bt diagonal": slice(10, 16)}
@@ -53,11 +52,9 @@ def own_case(coulomb: float):
 
 def example_case():
     """Platform, motions, leg-force noise and truth of the example data set."""
-    from stewartid.dataset import read_datasets
+    from noise_study import load_example
 
-    platform = load_platform(EXAMPLE / "platform.toml")
-    truth = json.loads((EXAMPLE / "truth.json").read_text())
-    datasets = read_datasets(sorted(EXAMPLE.glob("exp*.csv")), platform)
+    platform, datasets, M, B = load_example()
     motions, levels = [], []
     for d in datasets:
         rate = 1.0 / float(d.t[1] - d.t[0])
@@ -66,8 +63,7 @@ def example_case():
         motions.append((d.t, q, q_dot, q_ddot))
         levels.append(0.005 * np.abs(d.forces).mean(axis=0))
     # one noise level per leg for the whole set (the records' levels differ by a few %)
-    return platform, motions, np.mean(levels, axis=0), (np.array(truth["Mt"]),
-                                                         np.array(truth["Bt"]))
+    return platform, motions, np.mean(levels, axis=0), (M, B)
 
 
 def design_case(path: Path, coulomb: float):
