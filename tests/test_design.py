@@ -248,3 +248,54 @@ def test_designed_records_on_the_plant_stay_within_limits(paper):
     run = simulate_excitations(paper, design.playable(paper)[:2])
     for record in run.states:
         assert record_limit_use(paper, record).exceeded == []
+
+
+def test_first_order_pose_and_workers_leave_the_prediction_unchanged(paper):
+    """The realisations' pose (first Newton step of forward kinematics from the true pose) is
+    the converged forward kinematics of the measured lengths to 1e-8 m, and spreading the
+    realisations over two processes gives the same estimates as one."""
+    from stewartid.design.prediction import NoiseRuns, inverse_leg_jacobians
+
+    design = scheduled_design((0.05, 0.05, 0.05, 0.02, 0.02, 0.03), 1.0, [3.0] * 6, (1.0,))
+    noise = SensorNoise(length_noise=20e-6, force_noise=150.0, length_resolution=1e-6)
+    records = list(simulate_excitations(paper, design.playable(paper)).states)
+    runs = NoiseRuns(paper, noise, "wavelet", 0, records=records,
+                     inverse_jacobians=inverse_leg_jacobians(paper, records))
+    exact = NoiseRuns(paper, noise, "wavelet", 0, records=records)
+    for first, converged in zip(runs.noisy(1), exact.noisy(1), strict=True):
+        assert np.array_equal(first.lengths, converged.lengths)
+        assert np.abs(first.pose - converged.pose).max() < 1e-8
+    assert np.array_equal(runs.estimates(range(3), workers=2), runs.estimates(range(3), 1))
+    with pytest.raises(ConfigError, match="workers must be >= 1"):
+        predict_accuracy(paper, design, noise, seeds=2, records=records, workers=0)
+
+
+@pytest.mark.slow
+def test_design_cli_names_the_commands_that_play_and_identify_it(tmp_path):
+    """``design --quick`` writes the design with the simulate and identify commands of its
+    estimator; both run as written and identify the played design."""
+    import json
+    import shlex
+
+    out = tmp_path / "design"
+    result = CliRunner().invoke(app, ["design", "--quick", "--budget", "36", "--seeds", "3",
+                                      "--workers", "1", "--coulomb", "10", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    document = json.loads((out / "design.json").read_text())
+    commands = document["identify"]
+    assert commands["settings"] == {"friction": "uniform"}
+    report = (out / "report.md").read_text()
+    assert commands["command"] in report and commands["play"] in report
+    assert "--friction uniform" in commands["command"]
+    assert commands["command"] in result.output
+
+    def run(command: str) -> str:
+        words = shlex.split(command.replace("PLATFORM", "paper").replace("DIR", str(out))
+                            .replace("RUN", str(tmp_path / "run")))
+        assert words[0] == "stewartid"
+        done = CliRunner().invoke(app, words[1:])
+        assert done.exit_code == 0, (command, done.output)
+        return done.output
+
+    run(commands["play"])
+    assert "largest error" in run(commands["command"])

@@ -101,3 +101,27 @@ def test_debug_shows_the_traceback_of_expected_errors(files):
     result = CliRunner().invoke(app, ["--debug", "identify", "--method", "magic", str(paths[0])])
     assert result.exit_code == 1
     assert "unknown method 'magic'" in str(result.exception)
+
+
+def test_friction_option_reaches_method_b(tmp_path, example_dir, example_truth):
+    """``--friction uniform`` (what ``stewartid design`` predicts for) ties the interval
+    constants to one Coulomb level: on the independent example it is the simulator's 10 N m."""
+    out = tmp_path / "uniform.json"
+    files = sorted(map(str, example_dir.glob("exp*.csv")))
+    result = CliRunner().invoke(app, ["identify", "--method", "wavelet", "--friction",
+                                      "uniform", "--platform",
+                                      str(example_dir / "platform.toml"), "--out", str(out),
+                                      *files])
+    assert result.exit_code == 0, result.output
+    document = json.loads(out.read_text())
+    assert document["settings"]["friction"] == "uniform"
+    levels = set(document["diagnostics"]["coulomb"].values())
+    assert len(levels) == 1
+    assert levels.pop() == pytest.approx(example_truth["coulomb"], rel=0.02)
+    bad = CliRunner().invoke(app, ["identify", "--method", "wavelet", "--friction", "viscous",
+                                   "--platform", str(example_dir / "platform.toml"), *files])
+    assert bad.exit_code == 2 and len(bad.output.strip().splitlines()) == 1
+    assert "'friction'" in bad.output and "'uniform'" in bad.output
+    other = CliRunner().invoke(app, ["identify", "--method", "ls", "--friction", "uniform",
+                                     *files])
+    assert other.exit_code == 2 and "--friction does not apply to --method ls" in other.output

@@ -32,8 +32,12 @@ def design(
                                            "the design may use on the plant's simulated "
                                            "states.")] = 0.7,
     seeds: Annotated[int, typer.Option("--seeds", help="Noise realisations of the predicted "
-                                       "accuracy (a predicted standard error is uncertain "
-                                       "by about 1/sqrt(2 seeds): 9 % at 60).")] = 60,
+                                       "accuracy, >= 2 (a predicted standard error is "
+                                       "uncertain by about 1/sqrt(2 seeds): 6.5 % at "
+                                       "120).")] = 120,
+    workers: Annotated[int | None, typer.Option(
+        "--workers", help="Processes the predictions are spread over (default: every "
+        "available core).")] = None,
     model_data: Annotated[bool, typer.Option(
         "--model-data", help="Predict on rigid-body model data with perfect tracking (fast, "
         "optimistic) instead of the design played on the plant.")] = False,
@@ -49,6 +53,7 @@ def design(
     the paper's set."""
     import dataclasses
 
+    from stewartid.design.report import identify_command
     from stewartid.design.run import run_design
     from stewartid.errors import ConfigError
     from stewartid.identification.registry import registered_methods
@@ -59,9 +64,13 @@ def design(
     names = [m.name for m in registered_methods()]
     if method not in names:
         raise ConfigError(f"--method must be one of {', '.join(names)}; got {method!r}.")
-    for name, value in (("--budget", budget), ("--rate", rate), ("--seeds", seeds)):
+    for name, value in (("--budget", budget), ("--rate", rate)):
         if not value > 0:
             raise ConfigError(f"{name} must be > 0; got {value!r}.")
+    if seeds < 2:
+        raise ConfigError(f"--seeds must be >= 2 (a spread needs two realisations); got {seeds}.")
+    if workers is not None and workers < 1:
+        raise ConfigError(f"--workers must be >= 1; got {workers}.")
     for name, value in (("--coulomb", coulomb), ("--length-noise", length_noise),
                         ("--force-noise", force_noise)):
         if value is not None and not value >= 0:
@@ -78,10 +87,11 @@ def design(
     output = run_design(description, budget, noise, out, method=method, rate_hz=rate,
                         max_use=max_use, seeds=seeds if not quick else min(seeds, 4),
                         source="model" if model_data else "plant",
-                        quick=quick, force=force, progress=typer.echo)
+                        quick=quick, force=force, progress=typer.echo, workers=workers)
     p, b = output.prediction, output.baseline
     typer.echo(f"design: {output.design.label}")
     typer.echo(f"predicted worst relative standard error {p.worst_relative_std:.2f} % "
                f"(paper's set {b.worst_relative_std:.2f} %, ratio "
                f"{p.worst_relative_std / b.worst_relative_std:.2f})")
+    typer.echo(f"identify its logs with: {identify_command(method)}")
     typer.echo(f"wrote {len(output.files)} files to {out}; report: {out / 'report.md'}")

@@ -119,6 +119,11 @@ def identify(
     stiffness: Annotated[bool, typer.Option(
         "--stiffness", help="fourier: identify a stiffness matrix too (needs >= 2 "
                             "frequencies).")] = False,
+    friction: Annotated[str | None, typer.Option(
+        "--friction", help="wavelet: the interval constants: 'free' (default; immune to the "
+                           "friction law), 'shared' (Coulomb level per joint type), 'uniform' "
+                           "(one level for every joint axis; what 'stewartid design' "
+                           "predicts for).")] = None,
     report: Annotated[Path | None, typer.Option(
         "--report", help="Write a report into this folder: data, intervals, matrices with "
                          "standard errors, residuals, validation on held-out data, "
@@ -152,10 +157,11 @@ def identify(
     options = {"--no-gravity": ("gravity", not no_gravity, no_gravity),
                "--symmetric": ("symmetric", symmetric, symmetric),
                "--frequency": ("frequency_hz", frequency or None, bool(frequency)),
-               "--stiffness": ("stiffness", stiffness, stiffness)}
+               "--stiffness": ("stiffness", stiffness, stiffness),
+               "--friction": ("friction", friction, friction is not None)}
     settings = {}
     for flag, (name, value, given) in options.items():
-        if name in accepted:
+        if name in accepted and (given or name != "friction"):
             settings[name] = value
         elif given:
             raise ConfigError(f"{flag} does not apply to --method {method}; it has the "

@@ -200,10 +200,10 @@ def optimise_design(platform: Platform, budget_s: float, noise: SensorNoise,
                     frequencies: Sequence[Sequence[float]] = DEFAULT_FREQUENCIES,
                     schedules: Sequence[Sequence] = DEFAULT_SCHEDULES,
                     max_use: float = 0.7, cap: float | Sequence[float] = DEFAULT_AMPLITUDE_CAP,
-                    screening_seeds: int = 8, seeds: int = 60, source: str = "plant",
+                    screening_seeds: int = 8, seeds: int = 120, source: str = "plant",
                     required: Mapping[str, float] = REQUIRED_ACCURACY,
                     progress: Callable[[str], None] | None = None,
-                    ) -> tuple[Candidate, list[Candidate]]:
+                    workers: int | None = None) -> tuple[Candidate, list[Candidate]]:
     """Choose the design of the family with the smallest :func:`required_score`.
 
     Parameters
@@ -231,6 +231,9 @@ def optimise_design(platform: Platform, budget_s: float, noise: SensorNoise,
         Accuracy (%) required of the groups of :data:`REQUIRED_ACCURACY`.
     progress : callable, optional
         Called with one line of text per step.
+    workers : int, optional
+        Processes the realisations are spread over
+        (:func:`~stewartid.design.prediction.predict_accuracy`).
 
     Returns
     -------
@@ -268,7 +271,7 @@ def optimise_design(platform: Platform, budget_s: float, noise: SensorNoise,
     screened = []
     for design, records, uses in candidates if len(candidates) > 1 else ():
         prediction = predict_accuracy(platform, design, noise, method, screening_seeds,
-                                      source=source, records=records)
+                                      source=source, records=records, workers=workers)
         screened.append(Candidate(design, prediction, uses, dict(required)))
         say(f"{design.label}: criterion {screened[-1].score:.2f} (worst |bias| + 2 SE over "
             f"the required accuracy, {screening_seeds} seeds)")
@@ -276,7 +279,7 @@ def optimise_design(platform: Platform, budget_s: float, noise: SensorNoise,
             else candidates[0])
     design, records, uses = best
     prediction = predict_accuracy(platform, design, noise, method, seeds, source=source,
-                                  records=records)
+                                  records=records, workers=workers)
     final = Candidate(design, prediction, uses, dict(required))
     say(f"{design.label}: criterion {final.score:.2f}, predicted worst relative SE "
         f"{prediction.worst_relative_std:.2f} % ({seeds} seeds)")

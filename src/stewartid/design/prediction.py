@@ -10,10 +10,13 @@ it is comparable to the standard error on the Mt diagonal). The noise-free data 
 
 * ``source="plant"`` (the default): the records played once on the closed-loop hydraulic
   plant without sensor noise (:func:`stewartid.design.export.simulate_excitations`); the
-  noise is then drawn exactly as ``simulate`` draws it (:func:`measure_legs`, the pose by
-  forward kinematics from the measured lengths). The plant's motion is not the commanded one
-  (tracking error, servo and valve dynamics, friction the controller fights), and the
-  estimator's spread on it is 2-10 times the spread on model data for some entries;
+  noise is then drawn exactly as ``simulate`` draws it (:func:`measure_legs`), and the pose
+  is the first Newton step of forward kinematics from the true pose (J_lq^-1 at the true
+  poses computed once; within 2e-9 m of ``simulate``'s converged forward kinematics for
+  20 um of length noise, at a tenth of the cost per realisation). The plant's motion is not
+  the commanded one (tracking error, servo and valve dynamics, friction the controller
+  fights), and the estimator's spread on it is 2-10 times the spread on model data for some
+  entries;
 * ``source="model"``: the commanded motion taken as tracked exactly, with the actuator forces
   of the nonlinear rigid-body model (:func:`stewartid.dynamics.inverse_dynamics`) and the
   pose noise to first order. Fast, for screening and tests, but optimistic.
@@ -22,18 +25,23 @@ Why a Monte Carlo over the estimator rather than a covariance formula: Method B'
 (reweighted weak form, interval detection with noise-dependent hysteresis, shared friction
 constants whose scatter is estimated from the data, the choice of the better member of every
 symmetric pair) is not one linear map of the noise; running the estimator itself predicts
-what it will do, whatever its settings. On model data the pose noise is propagated to
-first order (dq = J_lq^-1 dl, what forward kinematics does to 20 um of leg noise to within
-1e-9 m), which replaces one forward kinematics per sample by one linear solve. A standard error estimated
-from K seeds has a relative uncertainty of about 1 / sqrt(2 K): 16 % at 20 seeds, 9 % at
-the default 60 (compared with an observed spread over 20 seeds, itself 16 % uncertain, a
-prediction from 20 seeds lands within 30 % of it for only about 3 entries in 4).
-"""
+what it will do, whatever its settings. A standard error estimated from K seeds has a
+relative uncertainty of about 1 / sqrt(2 K): 16 % at 20 seeds, 6.5 % at the design's 120.
+Compared with an observed spread over 20 seeds (itself 16 % uncertain), a prediction from
+120 seeds lands within 30 % of it for about 9 entries in 10 when the estimates are close to
+Gaussian, as Method B's are since its interval-constant scatter is matched in weighted
+chi-square (:mod:`~stewartid.identification.weak_form_solver`). The realisations are spread
+over processes (``workers``); each draws from its own stream, so the count does not change
+the result."""
 
 from __future__ import annotations
 
 import dataclasses
 import math
+import multiprocessing
+import os
+from collections.abc import Sequence
+from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
@@ -70,7 +78,8 @@ def model_datasets(platform: Platform, design: Design) -> list[Dataset]:
 
 
 def add_noise(platform: Platform, dataset: Dataset, noise: SensorNoise,
-              rng: np.random.Generator, jacobians: np.ndarray | None = None) -> Dataset:
+              rng: np.random.Generator, jacobians: np.ndarray | None = None,
+              inverse_jacobian: np.ndarray | None = None) -> Dataset:
     """A noisy copy of noise-free data: white noise on lengths and forces, pose to first order.
 
     Parameters
@@ -82,7 +91,9 @@ def add_noise(platform: Platform, dataset: Dataset, noise: SensorNoise,
         Standard deviations (m, N); biases and resolutions are not modelled here.
     rng : numpy.random.Generator
     jacobians : ndarray, shape (N, 6, 6), optional
-        J_lq at the noise-free poses (computed when not given).
+        J_lq at the noise-free poses (computed when neither it nor its inverse is given).
+    inverse_jacobian : ndarray, shape (N, 6, 6), optional
+        J_lq^-1 at the noise-free poses (faster when many copies are drawn).
 
     Returns
     -------
@@ -92,8 +103,11 @@ def add_noise(platform: Platform, dataset: Dataset, noise: SensorNoise,
     n = len(dataset.t)
     d_lengths = rng.normal(0.0, noise.length_noise, size=(n, 6))
     d_forces = rng.normal(0.0, noise.force_noise, size=(n, 6))
-    jacobians = leg_jacobian(platform, dataset.pose) if jacobians is None else jacobians
-    d_pose = np.linalg.solve(jacobians, d_lengths[..., None])[..., 0]
+    if inverse_jacobian is not None:
+        d_pose = np.einsum("nij,nj->ni", inverse_jacobian, d_lengths)
+    else:
+        jacobians = leg_jacobian(platform, dataset.pose) if jacobians is None else jacobians
+        d_pose = np.linalg.solve(jacobians, d_lengths[..., None])[..., 0]
     return Dataset(t=dataset.t, pose=dataset.pose + d_pose, lengths=dataset.lengths + d_lengths,
                    forces=dataset.forces + d_forces, name=dataset.name)
 
@@ -180,15 +194,26 @@ class Prediction:
                 "noise_free_bias_B": self.noise_free_bias_B.tolist()}
 
 
+#: Settings of the estimator a design is made for, per method (the rest: its defaults).
+#: Method B with the interval constants tied to one Coulomb level for every joint axis, so
+#: that intervals of different speeds separate viscous from Coulomb friction (three levels,
+#: one per joint type, drift apart on some noise seeds: 95, 28 and -21 N m for 30 N m, and
+#: Bt with them; with every constant free, the default, the Bt diagonal of the 120 s design
+#: scatters 4-10 times more).
+DESIGN_SETTINGS = {"wavelet": {"friction": "uniform"}}
+
+
 def default_estimator(method: str = "wavelet"):
-    """The estimator a design is made for: Method B with the interval constants tied to one
-    Coulomb level for every joint axis (``friction="uniform"``), so that intervals of
-    different speeds separate viscous from Coulomb friction (three levels, one per joint
-    type, drift apart on some noise seeds: 95, 28 and -21 N m for 30 N m, and Bt with
-    them); any other registered method with its defaults."""
-    if method == "wavelet":
-        return create_identifier("wavelet", friction="uniform")
-    return create_identifier(method)
+    """The estimator a design is made for: ``method`` with :data:`DESIGN_SETTINGS`."""
+    return create_identifier(method, **DESIGN_SETTINGS.get(method, {}))
+
+
+def identify_options(method: str = "wavelet") -> list[str]:
+    """The ``stewartid identify`` options that fit :func:`default_estimator`."""
+    options = ["--method", method]
+    for name, value in DESIGN_SETTINGS.get(method, {}).items():
+        options += [f"--{name}", str(value)]
+    return options
 
 
 #: Entropy that keeps the prediction's noise streams apart from ``simulate``'s seeds.
@@ -199,7 +224,8 @@ SOURCES = ("plant", "model")
 
 
 def measured_plant_datasets(platform: Platform, records: list, noise: SensorNoise,
-                            generators: list[np.random.Generator]) -> list[Dataset]:
+                            generators: list[np.random.Generator],
+                            inverse_jacobians: list[np.ndarray] | None = None) -> list[Dataset]:
     """Measured data of noise-free plant records, the noise drawn as ``simulate`` draws it.
 
     Parameters
@@ -211,18 +237,33 @@ def measured_plant_datasets(platform: Platform, records: list, noise: SensorNois
         Noise, bias and resolution of the lengths (m) and forces (N).
     generators : list of numpy.random.Generator
         One per record.
+    inverse_jacobians : list of ndarray, shape (N, 6, 6), optional
+        J_lq^-1 at each record's true poses (:func:`inverse_leg_jacobians`): the pose is
+        then the true pose plus J_lq^-1 (measured - true lengths), the first Newton step of
+        forward kinematics from the true pose (within 1e-9 m of it for 20 um of length
+        noise, at a fiftieth of the cost). None: forward kinematics, as ``simulate``.
 
     Returns
     -------
     list of Dataset
-        Named ``exp1..expN``; pose by forward kinematics from the measured lengths.
+        Named ``exp1..expN``.
     """
     out = []
     for k, (record, rng) in enumerate(zip(records, generators, strict=True)):
         lengths, forces = measure_legs(record.lengths, record.forces, noise, rng)
-        out.append(Dataset(t=record.t, pose=measured_pose(platform, lengths, record.q),
-                           lengths=lengths, forces=forces, name=f"exp{k + 1}"))
+        if inverse_jacobians is None:
+            pose = measured_pose(platform, lengths, record.q)
+        else:
+            pose = record.q + np.einsum("nij,nj->ni", inverse_jacobians[k],
+                                        lengths - record.lengths)
+        out.append(Dataset(t=record.t, pose=pose, lengths=lengths, forces=forces,
+                           name=f"exp{k + 1}"))
     return out
+
+
+def inverse_leg_jacobians(platform: Platform, records: list) -> list[np.ndarray]:
+    """J_lq^-1 (N, 6, 6) at the true poses of each record (m and rad per m of leg length)."""
+    return [np.linalg.inv(leg_jacobian(platform, r.q)) for r in records]
 
 
 def plant_records(platform: Platform, design: Design) -> list:
@@ -234,8 +275,9 @@ def plant_records(platform: Platform, design: Design) -> list:
 
 
 def predict_accuracy(platform: Platform, design: Design, noise: SensorNoise,
-                     method: str = "wavelet", seeds: int = 60, seed: int = 0,
-                     source: str = "plant", records: list | None = None) -> Prediction:
+                     method: str = "wavelet", seeds: int = 120, seed: int = 0,
+                     source: str = "plant", records: list | None = None,
+                     workers: int | None = None) -> Prediction:
     """Predicted bias and standard errors of Mt and Bt for a design (see the module docstring).
 
     Parameters
@@ -256,6 +298,10 @@ def predict_accuracy(platform: Platform, design: Design, noise: SensorNoise,
         perfect tracking (fast, optimistic).
     records : list of ExperimentRecord, optional
         The design already played on the plant (:func:`plant_records`), ``source="plant"``.
+    workers : int, optional
+        Processes the realisations are spread over; None: every available core when there
+        are at least :data:`PARALLEL_SEEDS` realisations, else 1. Each realisation draws
+        from its own stream, so the result does not depend on the count.
 
     Returns
     -------
@@ -263,40 +309,106 @@ def predict_accuracy(platform: Platform, design: Design, noise: SensorNoise,
     """
     if source not in SOURCES:
         raise ConfigError(f"source must be one of {', '.join(SOURCES)}; got {source!r}.")
+    if workers is not None and int(workers) < 1:
+        raise ConfigError(f"workers must be >= 1; got {workers!r}.")
     M0, B0 = nominal_matrices(platform)
-    estimator = default_estimator(method)
     if source == "plant":
-        records = plant_records(platform, design) if records is None else records
-        clean = measured_plant_datasets(platform, records, SensorNoise(),
-                                        [np.random.default_rng(0)] * len(records))
-
-        def noisy(k: int) -> list[Dataset]:
-            streams = np.random.SeedSequence([PREDICTION_STREAM, int(seed), k]).spawn(
-                len(records))
-            return measured_plant_datasets(platform, records, noise,
-                                           [np.random.default_rng(s) for s in streams])
+        records = plant_records(platform, design) if records is None else list(records)
+        runs = NoiseRuns(platform, noise, method, int(seed), records=records,
+                         inverse_jacobians=inverse_leg_jacobians(platform, records))
     else:
         clean = model_datasets(platform, design)
-        jacobians = [leg_jacobian(platform, d.pose) for d in clean]
-
-        def noisy(k: int) -> list[Dataset]:
-            rng = np.random.default_rng(np.random.SeedSequence([int(seed), k]))
-            return [add_noise(platform, d, noise, rng, j)
-                    for d, j in zip(clean, jacobians, strict=True)]
-    estimator.fit(clean, platform)
+        runs = NoiseRuns(platform, noise, method, int(seed), datasets=clean,
+                         inverse_jacobians=[np.linalg.inv(leg_jacobian(platform, d.pose))
+                                            for d in clean])
+    estimator = default_estimator(method).fit(runs.clean(), platform)
     M_clean, B_clean = estimator.M_.copy(), estimator.B_.copy()
-    fits_M, fits_B = [], []
-    for k in range(int(seeds)):
-        estimator.fit(noisy(k), platform)
-        fits_M.append(estimator.M_.copy())
-        fits_B.append(estimator.B_.copy())
+    fits = runs.estimates(range(int(seeds)), workers)                   # (seeds, 2, 6, 6)
     settings = estimator.get_params()
     label = method + ("" if method != "wavelet" else f" (friction={settings['friction']})")
     # the noise also shifts the mean (pose noise in the regressors): that shift belongs to
     # the bias, the spread about the mean is the standard error
+    mean, std = fits.mean(axis=0), fits.std(axis=0, ddof=1)
     return Prediction(
-        nominal_M=M0, nominal_B=B0, bias_M=np.mean(fits_M, axis=0) - M0,
-        bias_B=np.mean(fits_B, axis=0) - B0, noise_free_bias_M=M_clean - M0,
-        noise_free_bias_B=B_clean - B0, std_M=np.std(fits_M, axis=0, ddof=1),
-        std_B=np.std(fits_B, axis=0, ddof=1), seeds=int(seeds),
-        method=f"{label}, {source} data")
+        nominal_M=M0, nominal_B=B0, bias_M=mean[0] - M0, bias_B=mean[1] - B0,
+        noise_free_bias_M=M_clean - M0, noise_free_bias_B=B_clean - B0, std_M=std[0],
+        std_B=std[1], seeds=int(seeds), method=f"{label}, {source} data")
+
+
+#: Realisations from which a prediction is spread over processes (fewer: not worth starting
+#: them, about 2 s each).
+PARALLEL_SEEDS = 16
+
+
+def available_cores() -> int:
+    """CPU cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+@dataclasses.dataclass(frozen=True)
+class NoiseRuns:
+    """The noisy copies of a design's noise-free data and the estimator fitted to each.
+
+    Either ``records`` (true plant signals; the noise drawn as ``simulate`` draws it) or
+    ``datasets`` (noise-free model data; white noise on lengths and forces), with J_lq^-1 at
+    their poses for the first-order forward kinematics.
+    """
+
+    platform: Platform
+    noise: SensorNoise
+    method: str
+    seed: int
+    records: list | None = None
+    datasets: list[Dataset] | None = None
+    inverse_jacobians: list[np.ndarray] | None = None
+
+    def clean(self) -> list[Dataset]:
+        """The noise-free data."""
+        if self.records is None:
+            return list(self.datasets)
+        return measured_plant_datasets(self.platform, self.records, SensorNoise(),
+                                       [np.random.default_rng(0)] * len(self.records),
+                                       self.inverse_jacobians)
+
+    def noisy(self, k: int) -> list[Dataset]:
+        """Realisation ``k``: one stream per record, apart from ``simulate --seed``'s."""
+        if self.records is None:
+            rng = np.random.default_rng(np.random.SeedSequence([self.seed, k]))
+            return [add_noise(self.platform, d, self.noise, rng, inverse_jacobian=j)
+                    for d, j in zip(self.datasets, self.inverse_jacobians, strict=True)]
+        streams = np.random.SeedSequence([PREDICTION_STREAM, self.seed, k]).spawn(
+            len(self.records))
+        return measured_plant_datasets(self.platform, self.records, self.noise,
+                                       [np.random.default_rng(s) for s in streams],
+                                       self.inverse_jacobians)
+
+    def fit(self, ks: Sequence[int]) -> np.ndarray:
+        """[M_, B_] of the estimator on realisations ``ks``; shape (len(ks), 2, 6, 6)."""
+        estimator = default_estimator(self.method)
+        out = []
+        for k in ks:
+            estimator.fit(self.noisy(int(k)), self.platform)
+            out.append((estimator.M_.copy(), estimator.B_.copy()))
+        return np.array(out).reshape(len(out), 2, 6, 6)
+
+    def estimates(self, ks: Sequence[int], workers: int | None = None) -> np.ndarray:
+        """:meth:`fit` over ``workers`` processes (module docstring of ``predict_accuracy``),
+        in the order of ``ks``."""
+        ks = list(ks)
+        if workers is None:
+            workers = available_cores() if len(ks) >= PARALLEL_SEEDS else 1
+        workers = max(1, min(int(workers), len(ks)))
+        if workers == 1:
+            return self.fit(ks)
+        chunks = [ks[i::workers] for i in range(workers)]
+        # spawn, not fork: the parent may hold BLAS and numba threads
+        context = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(workers, mp_context=context) as pool:
+            parts = list(pool.map(self.fit, chunks))
+        out = np.empty((len(ks), 2, 6, 6))
+        for i, part in enumerate(parts):
+            out[i::workers] = part
+        return out

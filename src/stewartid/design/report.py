@@ -6,6 +6,7 @@ Markdown, rendered to a self-contained HTML page by :func:`stewartid.reporting.r
 
 from __future__ import annotations
 
+import shlex
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -13,7 +14,7 @@ import numpy as np
 
 from stewartid.design.candidates import Design
 from stewartid.design.limits import LIMIT_NAMES, LimitUse
-from stewartid.design.prediction import Prediction
+from stewartid.design.prediction import Prediction, identify_options
 from stewartid.io import write_text_atomic
 from stewartid.reference.published import PAPER_ENTRIES, entry_label
 
@@ -65,7 +66,9 @@ def plot_accuracy(design: Prediction, baseline: Prediction, directory: str | Pat
 
 def render_markdown(design: Design, prediction: Prediction, baseline: Prediction,
                     peaks: Sequence[dict[str, float]], intervals: Sequence[float],
-                    settings: dict, use_source: str = "the plant's true states") -> str:
+                    settings: dict, use_source: str = "the plant's true states",
+                    method: str = "wavelet", coulomb: float = 0.0, folder: str = "DIR"
+                    ) -> str:
     """The report text.
 
     Parameters
@@ -81,6 +84,12 @@ def render_markdown(design: Design, prediction: Prediction, baseline: Prediction
         Budget, noise, method, grid (shown as given).
     use_source : str
         What the limit use was measured on.
+    method : str
+        Identification method the design is for.
+    coulomb : float
+        Coulomb friction the design assumed (N m).
+    folder : str
+        Where the design is written (its command files are under ``commands/``).
     """
     lines = ["# Excitation design", "", f"{design.label}; {design.duration:.1f} s of motion.",
              "", "## Settings", ""]
@@ -108,8 +117,28 @@ def render_markdown(design: Design, prediction: Prediction, baseline: Prediction
     for key, s, b, s0 in zip(PAPER_ENTRIES, prediction.relative_std, prediction.relative_bias,
                              baseline.relative_std, strict=True):
         lines.append(f"| {entry_label(key)} | {s:.3f} | {b:.3f} | {s0:.3f} |")
-    lines += ["", "![predicted accuracy](figures/predicted_accuracy.png)", ""]
+    lines += ["", "![predicted accuracy](figures/predicted_accuracy.png)", "",
+              "## Playing and identifying it", "",
+              "The prediction holds for the estimator it was made with. On the plant first "
+              "(with the sensor noise; `--seed` for another realisation), then on the "
+              "machine's logs (PLATFORM: the platform file of the design):", "", "```bash",
+              play_command(design, coulomb, folder), identify_command(method), "```", ""]
     return "\n".join(lines)
+
+
+def play_command(design: Design, coulomb: float, folder: str = "DIR", run: str = "RUN"
+                 ) -> str:
+    """The ``stewartid simulate`` command that plays the exported records on the plant with
+    the Coulomb friction (N m) the design assumed."""
+    files = " ".join(f"--excitation {shlex.quote(f'{folder}/commands/{r.name}.csv')}"
+                     for r in design.records)
+    return (f"stewartid simulate --platform PLATFORM --coulomb {coulomb:g} {files} --noise "
+            f"--out {run}")
+
+
+def identify_command(method: str, run: str = "RUN") -> str:
+    """The ``stewartid identify`` command of the estimator a design is made for."""
+    return f"stewartid identify {run} --platform PLATFORM {' '.join(identify_options(method))}"
 
 
 def write_design_report(directory: str | Path, markdown_text: str) -> list[Path]:

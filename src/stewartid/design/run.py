@@ -22,8 +22,10 @@ from stewartid.design.optimise import (
     DEFAULT_SCHEDULES,
     optimise_design,
 )
-from stewartid.design.prediction import Prediction, predict_accuracy
+from stewartid.design.prediction import DESIGN_SETTINGS, Prediction, predict_accuracy
 from stewartid.design.report import (
+    identify_command,
+    play_command,
     plot_accuracy,
     plot_limit_use,
     render_markdown,
@@ -59,8 +61,8 @@ def is_design_file(path: Path) -> bool:
 
 def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str | Path,
                method: str = "wavelet", rate_hz: float = 500.0, max_use: float = 0.7,
-               seeds: int = 60, source: str = "plant", quick: bool = False,
-               force: bool = False,
+               seeds: int = 120, source: str = "plant", quick: bool = False,
+               force: bool = False, workers: int | None = None,
                progress: Callable[[str], None] | None = None) -> DesignOutput:
     """Design an excitation for ``platform`` and write it with its report to ``out``.
 
@@ -88,6 +90,8 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
         One candidate (1 Hz, levels 1/0.5) and no screening (for tests).
     force : bool
         Overwrite an earlier design in ``out``.
+    workers : int, optional
+        Processes the predictions are spread over (default: every available core).
     progress : callable, optional
         Receives one line of text per step.
 
@@ -101,9 +105,11 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
     grid = {"frequencies": ((1.0,),) * 3, "schedules": ((1.0, 0.5),)} if quick \
         else {"frequencies": DEFAULT_FREQUENCIES, "schedules": DEFAULT_SCHEDULES}
     best, screened = optimise_design(platform, budget_s, noise, method, max_use=max_use,
-                                     seeds=seeds, source=source, progress=progress, **grid)
+                                     seeds=seeds, source=source, progress=progress,
+                                     workers=workers, **grid)
     baseline_design = paper_design(duration_s=budget_s / 6)
-    baseline = predict_accuracy(platform, baseline_design, noise, method, seeds, source=source)
+    baseline = predict_accuracy(platform, baseline_design, noise, method, seeds, source=source,
+                                workers=workers)
     if progress:
         progress(f"paper's set: predicted worst relative SE {baseline.worst_relative_std:.2f} %")
     design, prediction = best.design, best.prediction
@@ -127,7 +133,7 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
                 "criterion (worst (|bias| + 2 SE) / required)": round(best.score, 3)}
     intervals = [0.5 / r.frequency_hz for r in design.records]
     text = render_markdown(design, prediction, baseline, [u.peak for u in uses], intervals,
-                           settings, use_source)
+                           settings, use_source, method, platform.friction.coulomb, str(out))
     files += write_design_report(out, text)
     document = {"design": design.to_dict(), "prediction": prediction.to_dict(),
                 "baseline": {"design": baseline_design.to_dict(), **baseline.to_dict()},
@@ -136,6 +142,9 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
                 "screened": [{"label": c.design.label, "criterion": c.score,
                               "worst_relative_std_percent": c.prediction.worst_relative_std,
                               "seeds": c.prediction.seeds} for c in screened],
-                "settings": settings}
+                "settings": settings,
+                "identify": {"method": method, "settings": DESIGN_SETTINGS.get(method, {}),
+                             "command": identify_command(method),
+                             "play": play_command(design, platform.friction.coulomb, str(out))}}
     files.append(write_json_atomic(out / "design.json", document))
     return DesignOutput(design, prediction, baseline, files)
