@@ -47,12 +47,15 @@ Söderström, T. "Errors-in-variables methods in system identification." Automat
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
+from stewartid.dataset import DataWarning
 from stewartid.identification.solvers import _check_rank, regressor_names
+from stewartid.platform import COORDINATES
 
 #: Unknowns of [Mt Bt].
 N_THETA = 72
@@ -247,13 +250,17 @@ def solve_weak_form(equations: Sequence, n_experiments: int, shared_friction: bo
     noise = np.zeros((n, 6))  # s per interval and channel
     pose_share = np.zeros(6)
 
+    uncorrected = np.zeros(6, dtype=bool)  # channels of the last pass left uncorrected
+
     def compensated(normal: np.ndarray, rhs: np.ndarray, w: np.ndarray, g: np.ndarray,
                     i: int) -> tuple[np.ndarray, np.ndarray]:
         bias, bias_rhs = _noise_bias(w, g, sigma, sensitivity[:, i])
         try:  # noise so large that the correction leaves no information: no correction
             np.linalg.cholesky(normal - bias)
         except np.linalg.LinAlgError:
+            uncorrected[i] = True
             return normal, rhs
+        uncorrected[i] = False
         return normal - bias, rhs - bias_rhs
 
     # invariant rows alone (the estimate the scatter is measured with)
@@ -318,6 +325,14 @@ def solve_weak_form(equations: Sequence, n_experiments: int, shared_friction: bo
         scale = np.sqrt(np.abs(np.diag(normal)))
         scale = np.where(scale > 0, scale, 1.0)
         z = np.linalg.solve(normal / np.outer(scale, scale), rhs / scale) / scale
+
+    if uncorrected.any():
+        names = ", ".join(c for c, u in zip(COORDINATES, uncorrected, strict=True) if u)
+        warnings.warn(f"pose noise too large for the errors-in-variables correction of the "
+                      f"{names} equations: their rows of Mt and Bt keep the attenuation the "
+                      f"noise causes (biased towards zero by its share of the regressors' "
+                      f"power); longer intervals or less pose noise remove it", DataWarning,
+                      stacklevel=3)
 
     # standard errors: the model's (GLS with the compensated normal matrix) and a
     # cluster-robust sandwich over intervals (model errors such as a friction reversal
