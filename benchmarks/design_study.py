@@ -1,6 +1,7 @@
 """Excitation design study: a designed 120 s excitation against the paper's 6 x 20 s set.
 
-Steps (paper platform, Coulomb friction ``--coulomb``, the reference sensor noise):
+Steps (``--platform``, the paper's by default, Coulomb friction ``--coulomb``, the reference
+sensor noise):
 
 1. the design: read from ``--design DIR/design.json`` (``stewartid design``) or optimised here;
 2. on the plant: the design played once (the plant is deterministic; the sensor noise is
@@ -8,16 +9,17 @@ Steps (paper platform, Coulomb friction ``--coulomb``, the reference sensor nois
 3. its predicted accuracy (Monte Carlo over the estimator on the noise-free plant records,
    ``--prediction-seeds`` noise streams apart from ``simulate``'s) and the paper's set's;
    then ``--seeds`` noise realisations as ``simulate --seed 0, 1, ...`` draws them,
-   identified with Method B (shared friction): per seed the largest error of the Mt
-   diagonal, the Bt diagonal and the couplings; their spread against the predicted
-   standard errors;
+   identified with Method B (``friction="uniform"``, the design's estimator): per seed the
+   largest error of the Mt diagonal, the Bt diagonal and the couplings; their spread
+   against the predicted standard errors (over all seeds and blocks of 20);
 4. playback: the exported command files played through ``simulate --excitation``'s code path
    give the same estimate as the design played directly (noise-free).
 
 Usage::
 
-    python benchmarks/design_study.py [--design results/design/design.json] [--seeds 40]
-        [--prediction-seeds 120] [--baseline-seeds 8] [--coulomb 30] [--out results/design_study]
+    python benchmarks/design_study.py [--design results/design/design.json] [--seeds 60]
+        [--prediction-seeds 120] [--baseline-seeds 8] [--coulomb 30] [--platform paper]
+        [--out results/design_study]
 """
 
 from __future__ import annotations
@@ -66,13 +68,15 @@ def main() -> None:
     parser.add_argument("--design", type=Path, default=None)
     parser.add_argument("--budget", type=float, default=120.0)
     parser.add_argument("--coulomb", type=float, default=30.0)
-    parser.add_argument("--seeds", type=int, default=40)
+    parser.add_argument("--platform", default="paper",
+                        help="'paper' or a platform TOML file (its friction set to --coulomb)")
+    parser.add_argument("--seeds", type=int, default=60)
     parser.add_argument("--prediction-seeds", type=int, default=120)
     parser.add_argument("--baseline-seeds", type=int, default=8)
     parser.add_argument("--out", type=Path, default=Path("results/design_study"))
     args = parser.parse_args()
     start = time.perf_counter()
-    platform = load_platform("paper").replace(friction__coulomb=args.coulomb)
+    platform = load_platform(args.platform).replace(friction__coulomb=args.coulomb)
     noise = reference_noise(platform)
     if args.design is not None:
         design = design_from_dict(json.loads(args.design.read_text())["design"])
@@ -136,7 +140,8 @@ def main() -> None:
 
     args.out.mkdir(parents=True, exist_ok=True)
     write_json_atomic(args.out / "design_study.json", {
-        "design": design.to_dict(), "coulomb": args.coulomb, "seeds": args.seeds,
+        "design": design.to_dict(), "platform": platform.name, "coulomb": args.coulomb,
+        "seeds": args.seeds,
         "prediction_seeds": args.prediction_seeds, "baseline_seeds": args.baseline_seeds,
         "predicted_worst_std_percent": predicted.worst_relative_std,
         "baseline_worst_std_percent": baseline.worst_relative_std, "ratio": ratio,
