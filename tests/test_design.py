@@ -253,7 +253,8 @@ def test_designed_records_on_the_plant_stay_within_limits(paper):
 def test_first_order_pose_and_workers_leave_the_prediction_unchanged(paper):
     """The realisations' pose (first Newton step of forward kinematics from the true pose) is
     the converged forward kinematics of the measured lengths to 1e-8 m, and spreading the
-    realisations over two processes gives the same estimates as one."""
+    realisations over two processes gives the same estimates as one, with a progress call
+    per realisation."""
     from stewartid.design.prediction import NoiseRuns, inverse_leg_jacobians
 
     design = scheduled_design((0.05, 0.05, 0.05, 0.02, 0.02, 0.03), 1.0, [3.0] * 6, (1.0,))
@@ -265,7 +266,10 @@ def test_first_order_pose_and_workers_leave_the_prediction_unchanged(paper):
     for first, converged in zip(runs.noisy(1), exact.noisy(1), strict=True):
         assert np.array_equal(first.lengths, converged.lengths)
         assert np.abs(first.pose - converged.pose).max() < 1e-8
-    assert np.array_equal(runs.estimates(range(3), workers=2), runs.estimates(range(3), 1))
+    seen = []
+    parallel = runs.estimates(range(3), workers=2, progress=lambda *done: seen.append(done))
+    assert np.array_equal(parallel, runs.estimates(range(3), 1))
+    assert seen == [(1, 3), (2, 3), (3, 3)]
     with pytest.raises(ConfigError, match="workers must be >= 1"):
         predict_accuracy(paper, design, noise, seeds=2, records=records, workers=0)
 

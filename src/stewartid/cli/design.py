@@ -53,6 +53,8 @@ def design(
     the paper's set."""
     import dataclasses
 
+    from rich.progress import Progress
+
     from stewartid.design.report import identify_command
     from stewartid.design.run import run_design
     from stewartid.errors import ConfigError
@@ -84,10 +86,19 @@ def design(
                       else noise.length_noise or reference.length_noise),
         force_noise=(force_noise if force_noise is not None
                      else noise.force_noise or reference.force_noise))
-    output = run_design(description, budget, noise, out, method=method, rate_hz=rate,
-                        max_use=max_use, seeds=seeds if not quick else min(seeds, 4),
-                        source="model" if model_data else "plant",
-                        quick=quick, force=force, progress=typer.echo, workers=workers)
+    with Progress(transient=True) as bar:
+        task = bar.add_task("noise realisations", total=None)
+
+        def realisations(done: int, total: int) -> None:
+            bar.update(task, completed=done, total=total,
+                       description=f"noise realisations {done}/{total}")
+
+        output = run_design(description, budget, noise, out, method=method, rate_hz=rate,
+                            max_use=max_use, seeds=seeds if not quick else min(seeds, 4),
+                            source="model" if model_data else "plant", quick=quick,
+                            force=force, workers=workers, realisations=realisations,
+                            progress=lambda text: bar.console.print(text, markup=False, soft_wrap=True,
+                                                                    highlight=False))
     p, b = output.prediction, output.baseline
     typer.echo(f"design: {output.design.label}")
     typer.echo(f"predicted worst relative standard error {p.worst_relative_std:.2f} % "

@@ -203,7 +203,9 @@ def optimise_design(platform: Platform, budget_s: float, noise: SensorNoise,
                     screening_seeds: int = 8, seeds: int = 120, source: str = "plant",
                     required: Mapping[str, float] = REQUIRED_ACCURACY,
                     progress: Callable[[str], None] | None = None,
-                    workers: int | None = None) -> tuple[Candidate, list[Candidate]]:
+                    workers: int | None = None,
+                    realisations: Callable[[int, int], None] | None = None,
+                    ) -> tuple[Candidate, list[Candidate]]:
     """Choose the design of the family with the smallest :func:`required_score`.
 
     Parameters
@@ -234,6 +236,8 @@ def optimise_design(platform: Platform, budget_s: float, noise: SensorNoise,
     workers : int, optional
         Processes the realisations are spread over
         (:func:`~stewartid.design.prediction.predict_accuracy`).
+    realisations : callable, optional
+        Called with (done, total) after each noise realisation of a prediction.
 
     Returns
     -------
@@ -271,7 +275,8 @@ def optimise_design(platform: Platform, budget_s: float, noise: SensorNoise,
     screened = []
     for design, records, uses in candidates if len(candidates) > 1 else ():
         prediction = predict_accuracy(platform, design, noise, method, screening_seeds,
-                                      source=source, records=records, workers=workers)
+                                      source=source, records=records, workers=workers,
+                                      progress=realisations)
         screened.append(Candidate(design, prediction, uses, dict(required)))
         say(f"{design.label}: criterion {screened[-1].score:.2f} (worst |bias| + 2 SE over "
             f"the required accuracy, {screening_seeds} seeds)")
@@ -279,7 +284,7 @@ def optimise_design(platform: Platform, budget_s: float, noise: SensorNoise,
             else candidates[0])
     design, records, uses = best
     prediction = predict_accuracy(platform, design, noise, method, seeds, source=source,
-                                  records=records, workers=workers)
+                                  records=records, workers=workers, progress=realisations)
     final = Candidate(design, prediction, uses, dict(required))
     say(f"{design.label}: criterion {final.score:.2f}, predicted worst relative SE "
         f"{prediction.worst_relative_std:.2f} % ({seeds} seeds)")

@@ -40,8 +40,8 @@ import dataclasses
 import math
 import multiprocessing
 import os
-from collections.abc import Sequence
-from concurrent.futures import ProcessPoolExecutor
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
 
@@ -277,7 +277,8 @@ def plant_records(platform: Platform, design: Design) -> list:
 def predict_accuracy(platform: Platform, design: Design, noise: SensorNoise,
                      method: str = "wavelet", seeds: int = 120, seed: int = 0,
                      source: str = "plant", records: list | None = None,
-                     workers: int | None = None) -> Prediction:
+                     workers: int | None = None,
+                     progress: Callable[[int, int], None] | None = None) -> Prediction:
     """Predicted bias and standard errors of Mt and Bt for a design (see the module docstring).
 
     Parameters
@@ -302,6 +303,8 @@ def predict_accuracy(platform: Platform, design: Design, noise: SensorNoise,
         Processes the realisations are spread over; None: every available core when there
         are at least :data:`PARALLEL_SEEDS` realisations, else 1. Each realisation draws
         from its own stream, so the result does not depend on the count.
+    progress : callable, optional
+        Called with (done, total) after each realisation.
 
     Returns
     -------
@@ -323,7 +326,7 @@ def predict_accuracy(platform: Platform, design: Design, noise: SensorNoise,
                                             for d in clean])
     estimator = default_estimator(method).fit(runs.clean(), platform)
     M_clean, B_clean = estimator.M_.copy(), estimator.B_.copy()
-    fits = runs.estimates(range(int(seeds)), workers)                   # (seeds, 2, 6, 6)
+    fits = runs.estimates(range(int(seeds)), workers, progress)         # (seeds, 2, 6, 6)
     settings = estimator.get_params()
     label = method + ("" if method != "wavelet" else f" (friction={settings['friction']})")
     # the noise also shifts the mean (pose noise in the regressors): that shift belongs to
@@ -385,30 +388,49 @@ class NoiseRuns:
                                        [np.random.default_rng(s) for s in streams],
                                        self.inverse_jacobians)
 
-    def fit(self, ks: Sequence[int]) -> np.ndarray:
-        """[M_, B_] of the estimator on realisations ``ks``; shape (len(ks), 2, 6, 6)."""
+    def fit(self, ks: Sequence[int], progress: Callable[[int, int], None] | None = None
+            ) -> np.ndarray:
+        """[M_, B_] of the estimator on realisations ``ks``; shape (len(ks), 2, 6, 6).
+        ``progress(done, total)`` after each."""
         estimator = default_estimator(self.method)
-        out = []
-        for k in ks:
+        out = np.empty((len(ks), 2, 6, 6))
+        for i, k in enumerate(ks):
             estimator.fit(self.noisy(int(k)), self.platform)
-            out.append((estimator.M_.copy(), estimator.B_.copy()))
-        return np.array(out).reshape(len(out), 2, 6, 6)
+            out[i] = estimator.M_, estimator.B_
+            if progress:
+                progress(i + 1, len(ks))
+        return out
 
-    def estimates(self, ks: Sequence[int], workers: int | None = None) -> np.ndarray:
-        """:meth:`fit` over ``workers`` processes (module docstring of ``predict_accuracy``),
-        in the order of ``ks``."""
+    def estimates(self, ks: Sequence[int], workers: int | None = None,
+                  progress: Callable[[int, int], None] | None = None) -> np.ndarray:
+        """:meth:`fit` over ``workers`` processes, in the order of ``ks``."""
         ks = list(ks)
         if workers is None:
             workers = available_cores() if len(ks) >= PARALLEL_SEEDS else 1
         workers = max(1, min(int(workers), len(ks)))
         if workers == 1:
-            return self.fit(ks)
-        chunks = [ks[i::workers] for i in range(workers)]
-        # spawn, not fork: the parent may hold BLAS and numba threads
-        context = multiprocessing.get_context("spawn")
-        with ProcessPoolExecutor(workers, mp_context=context) as pool:
-            parts = list(pool.map(self.fit, chunks))
+            return self.fit(ks, progress)
         out = np.empty((len(ks), 2, 6, 6))
-        for i, part in enumerate(parts):
-            out[i::workers] = part
+        # spawn, not fork: the parent may hold BLAS and numba threads; the records go to
+        # each worker once, the tasks carry only their realisation's number
+        context = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(workers, mp_context=context, initializer=_hold,
+                                 initargs=(self,)) as pool:
+            tasks = {pool.submit(_fit_held, k): i for i, k in enumerate(ks)}
+            for done, task in enumerate(as_completed(tasks), start=1):
+                out[tasks[task]] = task.result()
+                if progress:
+                    progress(done, len(ks))
         return out
+
+
+#: The NoiseRuns a worker process fits (set once per process by :func:`_hold`).
+_HELD: list[NoiseRuns] = []
+
+
+def _hold(runs: NoiseRuns) -> None:
+    _HELD[:] = [runs]
+
+
+def _fit_held(k: int) -> np.ndarray:
+    return _HELD[0].fit([k])[0]

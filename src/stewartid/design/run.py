@@ -63,7 +63,8 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
                method: str = "wavelet", rate_hz: float = 500.0, max_use: float = 0.7,
                seeds: int = 120, source: str = "plant", quick: bool = False,
                force: bool = False, workers: int | None = None,
-               progress: Callable[[str], None] | None = None) -> DesignOutput:
+               progress: Callable[[str], None] | None = None,
+               realisations: Callable[[int, int], None] | None = None) -> DesignOutput:
     """Design an excitation for ``platform`` and write it with its report to ``out``.
 
     Parameters
@@ -94,6 +95,8 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
         Processes the predictions are spread over (default: every available core).
     progress : callable, optional
         Receives one line of text per step.
+    realisations : callable, optional
+        Called with (done, total) after each noise realisation of a prediction.
 
     Returns
     -------
@@ -106,10 +109,12 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
         else {"frequencies": DEFAULT_FREQUENCIES, "schedules": DEFAULT_SCHEDULES}
     best, screened = optimise_design(platform, budget_s, noise, method, max_use=max_use,
                                      seeds=seeds, source=source, progress=progress,
-                                     workers=workers, **grid)
+                                     workers=workers, realisations=realisations, **grid)
     baseline_design = paper_design(duration_s=budget_s / 6)
+    if progress:
+        progress("predicting the paper's set of the same length")
     baseline = predict_accuracy(platform, baseline_design, noise, method, seeds, source=source,
-                                workers=workers)
+                                workers=workers, progress=realisations)
     if progress:
         progress(f"paper's set: predicted worst relative SE {baseline.worst_relative_std:.2f} %")
     design, prediction = best.design, best.prediction
