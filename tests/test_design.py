@@ -261,7 +261,7 @@ def test_first_order_pose_and_workers_leave_the_prediction_unchanged(paper):
     noise = SensorNoise(length_noise=20e-6, force_noise=150.0, length_resolution=1e-6)
     records = list(simulate_excitations(paper, design.playable(paper)).states)
     runs = NoiseRuns(paper, noise, "wavelet", 0, records=records,
-                     inverse_jacobians=inverse_leg_jacobians(paper, records))
+                     inverse_jacobians=inverse_leg_jacobians(paper, [r.q for r in records]))
     exact = NoiseRuns(paper, noise, "wavelet", 0, records=records)
     for first, converged in zip(runs.noisy(1), exact.noisy(1), strict=True):
         assert np.array_equal(first.lengths, converged.lengths)

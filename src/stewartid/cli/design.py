@@ -93,12 +93,14 @@ def design(
             bar.update(task, completed=done, total=total,
                        description=f"noise realisations {done}/{total}")
 
+        def say(text: str) -> None:  # above the bar, as plain text
+            bar.console.print(text, markup=False, highlight=False, soft_wrap=True)
+
         output = run_design(description, budget, noise, out, method=method, rate_hz=rate,
                             max_use=max_use, seeds=seeds if not quick else min(seeds, 4),
                             source="model" if model_data else "plant", quick=quick,
-                            force=force, workers=workers, realisations=realisations,
-                            progress=lambda text: bar.console.print(text, markup=False, soft_wrap=True,
-                                                                    highlight=False))
+                            force=force, workers=workers, progress=say,
+                            realisations=realisations)
     p, b = output.prediction, output.baseline
     typer.echo(f"design: {output.design.label}")
     typer.echo(f"predicted worst relative standard error {p.worst_relative_std:.2f} % "

@@ -78,8 +78,7 @@ def model_datasets(platform: Platform, design: Design) -> list[Dataset]:
 
 
 def add_noise(platform: Platform, dataset: Dataset, noise: SensorNoise,
-              rng: np.random.Generator, jacobians: np.ndarray | None = None,
-              inverse_jacobian: np.ndarray | None = None) -> Dataset:
+              rng: np.random.Generator, inverse_jacobian: np.ndarray | None = None) -> Dataset:
     """A noisy copy of noise-free data: white noise on lengths and forces, pose to first order.
 
     Parameters
@@ -90,10 +89,9 @@ def add_noise(platform: Platform, dataset: Dataset, noise: SensorNoise,
     noise : SensorNoise
         Standard deviations (m, N); biases and resolutions are not modelled here.
     rng : numpy.random.Generator
-    jacobians : ndarray, shape (N, 6, 6), optional
-        J_lq at the noise-free poses (computed when neither it nor its inverse is given).
     inverse_jacobian : ndarray, shape (N, 6, 6), optional
-        J_lq^-1 at the noise-free poses (faster when many copies are drawn).
+        J_lq^-1 at the noise-free poses (:func:`inverse_leg_jacobians`; computed when not
+        given, worth keeping when many copies are drawn).
 
     Returns
     -------
@@ -103,13 +101,16 @@ def add_noise(platform: Platform, dataset: Dataset, noise: SensorNoise,
     n = len(dataset.t)
     d_lengths = rng.normal(0.0, noise.length_noise, size=(n, 6))
     d_forces = rng.normal(0.0, noise.force_noise, size=(n, 6))
-    if inverse_jacobian is not None:
-        d_pose = np.einsum("nij,nj->ni", inverse_jacobian, d_lengths)
-    else:
-        jacobians = leg_jacobian(platform, dataset.pose) if jacobians is None else jacobians
-        d_pose = np.linalg.solve(jacobians, d_lengths[..., None])[..., 0]
+    if inverse_jacobian is None:
+        (inverse_jacobian,) = inverse_leg_jacobians(platform, [dataset.pose])
+    d_pose = np.einsum("nij,nj->ni", inverse_jacobian, d_lengths)
     return Dataset(t=dataset.t, pose=dataset.pose + d_pose, lengths=dataset.lengths + d_lengths,
                    forces=dataset.forces + d_forces, name=dataset.name)
+
+
+def inverse_leg_jacobians(platform: Platform, poses: list[np.ndarray]) -> list[np.ndarray]:
+    """J_lq^-1 (N, 6, 6) at each array of poses (N, 6) (m and rad per m of leg length)."""
+    return [np.linalg.inv(leg_jacobian(platform, q)) for q in poses]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -261,11 +262,6 @@ def measured_plant_datasets(platform: Platform, records: list, noise: SensorNois
     return out
 
 
-def inverse_leg_jacobians(platform: Platform, records: list) -> list[np.ndarray]:
-    """J_lq^-1 (N, 6, 6) at the true poses of each record (m and rad per m of leg length)."""
-    return [np.linalg.inv(leg_jacobian(platform, r.q)) for r in records]
-
-
 def plant_records(platform: Platform, design: Design) -> list:
     """The design played once on the plant without sensor noise: the true signals of every
     record (:class:`~stewartid.simulation.experiments.ExperimentRecord`)."""
@@ -318,12 +314,13 @@ def predict_accuracy(platform: Platform, design: Design, noise: SensorNoise,
     if source == "plant":
         records = plant_records(platform, design) if records is None else list(records)
         runs = NoiseRuns(platform, noise, method, int(seed), records=records,
-                         inverse_jacobians=inverse_leg_jacobians(platform, records))
+                         inverse_jacobians=inverse_leg_jacobians(platform,
+                                                                 [r.q for r in records]))
     else:
         clean = model_datasets(platform, design)
         runs = NoiseRuns(platform, noise, method, int(seed), datasets=clean,
-                         inverse_jacobians=[np.linalg.inv(leg_jacobian(platform, d.pose))
-                                            for d in clean])
+                         inverse_jacobians=inverse_leg_jacobians(platform,
+                                                                 [d.pose for d in clean]))
     estimator = default_estimator(method).fit(runs.clean(), platform)
     M_clean, B_clean = estimator.M_.copy(), estimator.B_.copy()
     fits = runs.estimates(range(int(seeds)), workers, progress)         # (seeds, 2, 6, 6)
