@@ -205,6 +205,10 @@ def test_design_cli_refuses_bad_budget(tmp_path):
     result = CliRunner().invoke(app, ["design", "--budget", "-5", "--out", str(tmp_path)])
     assert result.exit_code == 2
     assert "--budget must be > 0" in result.output
+    for flag, value, message in (("--seeds", "1", "--seeds must be >= 2"),
+                                 ("--workers", "0", "--workers must be >= 1")):
+        result = CliRunner().invoke(app, ["design", flag, value, "--out", str(tmp_path)])
+        assert result.exit_code == 2 and message in result.output
 
 
 def test_predicted_errors_scale_with_the_noise(paper):
