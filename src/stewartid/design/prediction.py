@@ -200,7 +200,7 @@ class Prediction:
 #: that intervals of different speeds separate viscous from Coulomb friction (three levels,
 #: one per joint type, drift apart on some noise seeds: 95, 28 and -21 N m for 30 N m, and
 #: Bt with them; with every constant free, the default, the Bt diagonal of the 120 s design
-#: scatters 4-10 times more).
+#: scatters 2.7-11 times more).
 DESIGN_SETTINGS = {"wavelet": {"friction": "uniform"}}
 
 
