@@ -175,6 +175,9 @@ def test_bad_settings_are_refused(paper, linear_data):
         WaveletIdentifier(scale_fractions=(1.5,)).fit(linear_data, paper)
     with pytest.raises(ConfigError, match="'friction' parameter of WaveletIdentifier"):
         WaveletIdentifier(friction="coulomb").fit(linear_data, paper)
+    # the point equations (the paper's) have no interval constants to share: not ignored
+    with pytest.raises(ConfigError, match="'free' when test_functions is None"):
+        WaveletIdentifier(test_functions=None, friction="uniform").fit(linear_data, paper)
     with pytest.raises(ConfigError, match="'wavelet' parameter .* test_functions=None"):
         WaveletIdentifier(wavelet="mexican_hat").fit(linear_data, paper)
 

@@ -259,8 +259,9 @@ class WaveletIdentifier(BaseIdentifier):
                         self.test_functions is None
                         or (isinstance(self.test_functions, int | np.integer)
                             and 1 <= self.test_functions <= 12), "None or an integer in [1, 12]")
-        check_parameter(name, "friction", self.friction, self.friction in FRICTION_MODELS,
-                        f"one of {FRICTION_MODELS}")
+        check_parameter(name, "friction", self.friction, self.friction in FRICTION_MODELS
+                        and (self.friction == "free" or self.test_functions is not None),
+                        f"one of {FRICTION_MODELS}, 'free' when test_functions is None")
         if self.test_functions is not None:
             check_parameter(name, "wavelet", self.wavelet, self.wavelet == "polynomial",
                             "'polynomial' when test_functions is set (use test_functions=None "
@@ -435,9 +436,7 @@ class WaveletIdentifier(BaseIdentifier):
                  "intervals": info["intervals"].tolist(),
                  "scales": info["scales"].tolist(), "shifts": info["shifts"].tolist()}
                 for info in infos],
-            "pair_choice": chosen,
-            "coordinates": list(COORDINATES),
-        }
+            "pair_choice": chosen, "coordinates": list(COORDINATES)}
         return IdentificationResult(
             M=M, B=B, std_errors_M=std_M, std_errors_B=std_B,
             condition_number=solution.condition_number,
