@@ -341,14 +341,6 @@ def predict_accuracy(platform: Platform, design: Design, noise: SensorNoise,
 PARALLEL_SEEDS = 16
 
 
-def available_cores() -> int:
-    """CPU cores this process may run on."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        return os.cpu_count() or 1
-
-
 @dataclasses.dataclass(frozen=True)
 class NoiseRuns:
     """The noisy copies of a design's noise-free data and the estimator fitted to each.
@@ -404,7 +396,7 @@ class NoiseRuns:
         """:meth:`fit` over ``workers`` processes, in the order of ``ks``."""
         ks = list(ks)
         if workers is None:
-            workers = available_cores() if len(ks) >= PARALLEL_SEEDS else 1
+            workers = (os.cpu_count() or 1) if len(ks) >= PARALLEL_SEEDS else 1
         workers = max(1, min(int(workers), len(ks)))
         if workers == 1:
             return self.fit(ks, progress)
