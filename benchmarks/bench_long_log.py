@@ -49,7 +49,7 @@ def simulate_base(path: Path) -> None:
 
 def long_datasets(base: Path, seconds_each: float) -> list:
     """Six experiments of ``seconds_each`` s: the base records' last whole periods, repeated."""
-    from stewartid.dataset import Dataset
+    from stewartid.datasets.dataset import Dataset
 
     arrays = np.load(base)
     n = int(round(seconds_each * SAMPLE_RATE)) + 1
@@ -73,7 +73,7 @@ def resident_mib() -> float:
 
 def measure(base: Path, minutes: float) -> dict:
     """Time and memory of one Method B fit on ``minutes`` of log (this process)."""
-    from stewartid.identification.wavelet import WaveletIdentifier
+    from stewartid.identification.wavelet.estimator import WaveletIdentifier
     from stewartid.platform import load_platform
 
     paper = load_platform("paper")
@@ -99,7 +99,8 @@ def stages(base: Path, minutes: float) -> list[tuple[str, float, float]]:
     """
     import threading
 
-    from stewartid.identification import preparation, wavelet
+    from stewartid.identification import preparation
+    from stewartid.identification.wavelet import estimator as wavelet
     from stewartid.platform import load_platform
 
     rows: dict[str, list[float]] = {}

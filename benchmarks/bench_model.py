@@ -12,9 +12,9 @@ import time
 import numpy as np
 from numba import njit
 
-from stewartid import _kernels
-from stewartid.dynamics import inverse_dynamics
-from stewartid.kinematics import inverse_kinematics, joint_rate_jacobians, leg_jacobian
+from stewartid.model import compiled
+from stewartid.model.dynamics import inverse_dynamics
+from stewartid.model.kinematics import inverse_kinematics, joint_rate_jacobians, leg_jacobian
 from stewartid.platform import load_platform
 
 
@@ -22,7 +22,7 @@ from stewartid.platform import load_platform
 def _repeat_forward_dynamics(params, upper, base, q, qd, forces, n):
     acc = 0.0
     for _ in range(n):
-        acc += _kernels.forward_dynamics_sample(params, upper, base, q, qd, forces, 1e-4, True)[0]
+        acc += compiled.forward_dynamics_sample(params, upper, base, q, qd, forces, 1e-4, True)[0]
     return acc
 
 
@@ -42,11 +42,11 @@ def main() -> None:
     q = paper.neutral_pose + rng.uniform(-0.05, 0.05, 6)
     qd = rng.normal(size=6) * 0.05
     forces = inverse_dynamics(paper, q, qd, np.zeros(6))
-    _kernels.forward_dynamics_sample(*args, q, qd, forces, 1e-4, True)
+    compiled.forward_dynamics_sample(*args, q, qd, forces, 1e-4, True)
     _repeat_forward_dynamics(*args, q, qd, forces, 10)
 
     n = 20_000
-    python_call = best_of(lambda: [_kernels.forward_dynamics_sample(*args, q, qd, forces, 1e-4, True)
+    python_call = best_of(lambda: [compiled.forward_dynamics_sample(*args, q, qd, forces, 1e-4, True)
                                    for _ in range(n)]) / n
     compiled_loop = best_of(lambda: _repeat_forward_dynamics(*args, q, qd, forces, n)) / n
 

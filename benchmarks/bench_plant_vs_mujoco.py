@@ -2,7 +2,7 @@
 
 In one run, on the same machine: our plant (``stewartid.simulation``, hydraulic legs, PID
 and inner force loop, RK4 at its default 0.5 ms) on the paper's 20 s roll experiment with
-Coulomb 5 N m, and MuJoCo on the mechanism of ``stewartid.mjcf`` (42 joints closed by six
+Coulomb 5 N m, and MuJoCo on the mechanism of ``stewartid.mujoco.model`` (42 joints closed by six
 welds, ideal force actuators, the same servo's PD part in the motors' bias, gimbal damping
 and Coulomb ``frictionloss``) along the same command: a bare ``mj_step`` loop that only
 copies the precomputed command into ``ctrl``, with RK4 and implicitfast at 0.5 ms.
@@ -22,7 +22,8 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from stewartid import mjcf, mujoco_state  # noqa: E402
+from stewartid.mujoco import model as mjcf  # noqa: E402
+from stewartid.mujoco import state as mujoco_state
 from stewartid.platform import load_platform  # noqa: E402
 from stewartid.simulation import paper_experiments, simulate_experiment  # noqa: E402
 

@@ -17,7 +17,7 @@ import time
 from pathlib import Path
 
 from stewartid.platform import load_platform
-from stewartid.reporting.user_report import methods_for, write_identification_report
+from stewartid.reports.identification.report import methods_for, write_identification_report
 from stewartid.simulation import simulate_experiments
 from stewartid.simulation.sensors import reference_noise
 

@@ -41,8 +41,8 @@ from stewartid.design.prediction import (
     measured_plant_datasets,
     predict_accuracy,
 )
-from stewartid.io import write_json_atomic
-from stewartid.linearization import nominal_matrices
+from stewartid.files import write_json_atomic
+from stewartid.model.linearization import nominal_matrices
 from stewartid.platform import load_platform
 from stewartid.reference.published import PAPER_ENTRIES, entry_label, relative_error_percent
 from stewartid.simulation import SensorNoise

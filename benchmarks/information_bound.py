@@ -30,7 +30,7 @@ import numpy as np
 from scipy.stats import binom
 
 from stewartid.identification.bounds import information_bound
-from stewartid.linearization import nominal_matrices
+from stewartid.model.linearization import nominal_matrices
 from stewartid.platform import load_platform
 from stewartid.reference.published import PAPER_ENTRIES, entry_label
 from stewartid.signals.differentiation import default_window, differentiate, estimate_frequency

@@ -24,9 +24,9 @@ from pathlib import Path
 
 import numpy as np
 
-from stewartid.dataset import Dataset, read_datasets
+from stewartid.datasets.dataset import Dataset, read_datasets
 from stewartid.identification.registry import create_identifier
-from stewartid.kinematics import forward_kinematics
+from stewartid.model.kinematics import forward_kinematics
 from stewartid.platform import load_platform
 from stewartid.reference.published import PAPER_ENTRIES, relative_error_percent
 
@@ -52,9 +52,9 @@ class OracleIdentifier:
         self.clean = clean
 
     def fit(self, datasets, platform):
-        from stewartid.dynamics import friction_forces
         from stewartid.identification.preparation import prepare
         from stewartid.identification.solvers import solve_least_squares
+        from stewartid.model.dynamics import friction_forces
         from stewartid.signals.differentiation import (
             default_window,
             differentiate,

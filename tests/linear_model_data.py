@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewartid.dataset import Dataset
-from stewartid.dynamics import ModelTerms
-from stewartid.kinematics import leg_lengths
+from stewartid.datasets.dataset import Dataset
+from stewartid.model.dynamics import ModelTerms
+from stewartid.model.kinematics import leg_lengths
 
 AMPLITUDES = np.array([0.01, 0.01, 0.01, 0.005, 0.005, 0.005])
 

@@ -5,9 +5,9 @@ import pytest
 
 from stewartid.errors import ConfigError
 from stewartid.identification.bounds import information_bound
-from stewartid.identification.intervals import constant_direction_intervals, joint_rates
-from stewartid.kinematics import leg_jacobian
-from stewartid.linearization import nominal_matrices
+from stewartid.identification.wavelet.intervals import constant_direction_intervals, joint_rates
+from stewartid.model.kinematics import leg_jacobian
+from stewartid.model.linearization import nominal_matrices
 
 AMPLITUDE = np.array([0.03, 0.03, 0.02, 0.03, 0.03, 0.03])
 

@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from stewartid.dataset import (
+from stewartid.datasets.dataset import (
     COLUMNS,
     Dataset,
     DataWarning,
@@ -15,7 +15,7 @@ from stewartid.dataset import (
     write_dataset,
 )
 from stewartid.errors import DataError
-from stewartid.kinematics import leg_lengths
+from stewartid.model.kinematics import leg_lengths
 
 
 @pytest.fixture()
@@ -150,7 +150,7 @@ def test_frame_with_extra_columns_is_accepted(tmp_path, dataset):
 @pytest.mark.parametrize("layout", ["written", "spaces, CRLF, quoted names, integers, BOM"])
 def test_plain_csv_reads_as_the_pandas_reader_does(tmp_path, dataset, layout):
     """The pandas-free reader of plain files gives the pandas reader's columns, bit for bit."""
-    from stewartid.plain_csv import read_plain_csv
+    from stewartid.datasets.plain_csv import read_plain_csv
 
     path = write_dataset(dataset, tmp_path / "run.csv")
     if layout != "written":
@@ -171,7 +171,7 @@ def test_plain_csv_reads_as_the_pandas_reader_does(tmp_path, dataset, layout):
 
 
 def test_plain_csv_leaves_other_files_to_the_pandas_reader(tmp_path, dataset):
-    from stewartid.plain_csv import read_plain_csv
+    from stewartid.datasets.plain_csv import read_plain_csv
 
     frame = dataset.to_frame()
     cases = {"missing value": frame.assign(f2=frame["f2"].where(frame.index != 5)),
@@ -184,7 +184,7 @@ def test_plain_csv_leaves_other_files_to_the_pandas_reader(tmp_path, dataset):
 
 
 def test_median_equals_numpys_to_the_last_bit():
-    from stewartid._arrays import median
+    from stewartid.datasets.arrays import median
 
     rng = np.random.default_rng(2)
     for n in (1, 2, 3, 10, 11, 4000, 4001):

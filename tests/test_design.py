@@ -32,7 +32,7 @@ from stewartid.design.prediction import (
     predict_accuracy,
 )
 from stewartid.errors import ConfigError
-from stewartid.kinematics import inverse_kinematics
+from stewartid.model.kinematics import inverse_kinematics
 from stewartid.platform import load_platform, platform_from_mapping
 from stewartid.reference.published import PAPER_ENTRIES
 from stewartid.simulation import SensorNoise

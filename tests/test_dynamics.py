@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from stewartid.dynamics import (
+from stewartid.model.dynamics import (
     ModelTerms,
     forward_dynamics,
     friction_forces,
@@ -18,8 +18,8 @@ from stewartid.dynamics import (
     potential_energy,
     velocity_product_forces,
 )
-from stewartid.kinematics import inverse_kinematics, leg_lengths, rotation_matrix
-from stewartid.linearization import viscous_matrix
+from stewartid.model.kinematics import inverse_kinematics, leg_lengths, rotation_matrix
+from stewartid.model.linearization import viscous_matrix
 
 BOX = np.array([0.2, 0.2, 0.2, 0.15, 0.15, 0.15])
 
@@ -161,7 +161,7 @@ def test_lean_leg_terms_equal_the_full_model_terms(paper, rng):
     """The numpy leg terms (command tables, forward kinematics, identification) are the
     compiled kernel's gravity, leg Jacobian, lengths and joint Jacobians to the last bit; the
     tests above check those against energy, Lagrange's equations and finite differences."""
-    from stewartid.leg_terms import BLOCK, leg_terms
+    from stewartid.model.leg_terms import BLOCK, leg_terms
 
     q = poses(paper, rng, BLOCK + 50)  # more than one block
     full = ModelTerms(paper, q)
@@ -177,7 +177,8 @@ def test_lean_leg_terms_equal_the_full_model_terms(paper, rng):
 
 def test_interpreted_kernel_equals_the_compiled_one(paper, rng):
     """nominal_matrices runs the mass-matrix kernel interpreted for its one pose."""
-    from stewartid import _kernel_code, _kernels
+    from stewartid.model import compiled as _kernels
+    from stewartid.model import kernels as _kernel_code
 
     q, qd = poses(paper, rng, 1)[0], rng.normal(scale=0.1, size=6)
     shapes = ((6, 6), 6, 6, (6, 6), (6, 5, 6), 6)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from stewartid.errors import ConfigError
-from stewartid.identification.intervals import check_intervals, joint_rates
+from stewartid.identification.wavelet.intervals import check_intervals, joint_rates
 from stewartid.simulation import Sine, multisine_excitation, paper_experiments
 
 

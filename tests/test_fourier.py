@@ -60,7 +60,7 @@ def test_stiffness_needs_two_frequencies(paper, truth):
         extra = [(k, AMPLITUDES[k] / 2, 2 * np.pi * 3.0, 0.3)]
         exp = make_experiment(paper, M, B, k, extra=extra, periods=6)
         # add the stiffness force K (q - q0) through the forces
-        from stewartid.dynamics import ModelTerms
+        from stewartid.model.dynamics import ModelTerms
         terms = ModelTerms(paper, exp.pose)
         y = np.einsum("nji,nj->ni", terms.leg_jacobian, exp.forces) - terms.gravity
         y = y + (exp.pose - paper.neutral_pose) @ K.T

@@ -16,7 +16,7 @@ from typer.testing import CliRunner
 
 from linear_model_data import AMPLITUDES, make_experiment, random_matrices
 from stewartid.cli import app
-from stewartid.dataset import write_dataset
+from stewartid.datasets.dataset import write_dataset
 from stewartid.errors import ConfigError
 from stewartid.identification.consistency import (
     asymmetry,
@@ -24,7 +24,7 @@ from stewartid.identification.consistency import (
     project_consistent,
 )
 from stewartid.reporting.exports import read_matrix_csv
-from stewartid.reporting.user_report import write_identification_report
+from stewartid.reports.identification.report import write_identification_report
 
 SAMPLE_RATE = 200.0
 #: Force disturbance the model cannot explain: a sine at a frequency the motion lacks (N, N m).
@@ -66,7 +66,7 @@ def kernel(window: float, rate: float) -> np.ndarray:
 def independent_validation(paper, data, folds=3, window=0.2):
     """k-fold VAF and NRMSE by plain numpy: analytic rates filtered like the force, one
     least-squares fit of [q_ddot q_dot, offset per piece] per fold, held-out centring."""
-    from stewartid.dynamics import ModelTerms
+    from stewartid.model.dynamics import ModelTerms
 
     h = kernel(window, SAMPLE_RATE)
     w = 2 * np.pi
@@ -134,7 +134,7 @@ def test_validation_of_the_exact_model_is_perfect(linear_report, linear_data):
     # VAF of the true matrices on the same segments: what the disturbance alone leaves
     report, _ = linear_report
     _, M, B = linear_data
-    from stewartid.reporting.validation import predict, score
+    from stewartid.assessment.validation import predict, score
 
     run = report.runs[0]
     truth = report.result.__class__(M=M, B=B, std_errors_M=M * 0, std_errors_B=B * 0,
@@ -269,7 +269,7 @@ def test_cli_report_and_its_errors(tmp_path, files):
 
 @pytest.mark.slow
 def test_report_on_the_independent_example(tmp_path, example_dir, example_platform):
-    from stewartid.dataset import expand_paths, read_datasets
+    from stewartid.datasets.dataset import expand_paths, read_datasets
 
     data = read_datasets(expand_paths([example_dir]), example_platform)
     report = write_identification_report(data, example_platform, tmp_path / "one",

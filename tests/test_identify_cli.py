@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 from linear_model_data import make_experiment, random_matrices
 from stewartid.cli import app
-from stewartid.dataset import write_dataset
+from stewartid.datasets.dataset import write_dataset
 
 
 @pytest.fixture(scope="module")

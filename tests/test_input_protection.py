@@ -15,10 +15,11 @@ from typer.testing import CliRunner
 
 from linear_model_data import make_experiment, random_matrices
 from stewartid.cli import app
-from stewartid.dataset import DataWarning, dataset_from_frame, read_datasets, write_dataset
+from stewartid.datasets.dataset import DataWarning, dataset_from_frame, read_datasets, write_dataset
 from stewartid.errors import ConfigError
-from stewartid.platform import SECTIONS, load_platform
-from stewartid.platform_ranges import PHYSICAL_RANGES
+from stewartid.platform import load_platform
+from stewartid.platform.description import SECTIONS
+from stewartid.platform.ranges import PHYSICAL_RANGES
 
 # -- the platform description ----------------------------------------------------------------
 
@@ -197,7 +198,7 @@ def test_jittery_time_stamps_cost_below_0p2_percent(example_dir, example_platfor
                                                     example_truth):
     """+-0.3 ms of timing noise on the example's 1 kHz clock, identified by the default
     method: every entry of Mt and Bt within 0.2 % of the clean identification."""
-    from stewartid.identification.wavelet import WaveletIdentifier
+    from stewartid.identification.wavelet.estimator import WaveletIdentifier
 
     clean = read_datasets(example_dir, example_platform)
     jittery = []

@@ -6,14 +6,14 @@ import numpy as np
 import pytest
 
 from stewartid.errors import ConfigError
-from stewartid.identification.intervals import (
+from stewartid.identification.wavelet.intervals import (
     JOINT_RATE_NAMES,
     active_joints,
     check_intervals,
     constant_direction_intervals,
     joint_rates,
 )
-from stewartid.kinematics import leg_lengths
+from stewartid.model.kinematics import leg_lengths
 
 DT = 1e-3
 T = np.arange(0.0, 4.0, DT) + DT / 3  # no sample exactly on a zero crossing

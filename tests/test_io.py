@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from stewartid.errors import ConfigError, OutputExistsError
+from stewartid.files import check_output_folder, to_jsonable, write_json_atomic
 from stewartid.identification.result import IdentificationResult
-from stewartid.io import check_output_folder, to_jsonable, write_json_atomic
 
 
 def test_non_finite_numbers_are_written_as_null_and_read_back_as_nan(tmp_path):

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from stewartid.errors import KinematicsError
-from stewartid.kinematics import (
+from stewartid.model.kinematics import (
     forward_kinematics,
     inverse_kinematics,
     joint_rate_jacobians,

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from stewartid.cli import app
-from stewartid.dynamics import inverse_dynamics
-from stewartid.kinematics import leg_jacobian
-from stewartid.linearization import gravity_stiffness, nominal_matrices
+from stewartid.model.dynamics import inverse_dynamics
+from stewartid.model.kinematics import leg_jacobian
+from stewartid.model.linearization import gravity_stiffness, nominal_matrices
 
 # Nominal Value columns of Zhang (2020), Tables 3-6, as listed in MODEL.md (1-based indices).
 PAPER_NOMINAL = [

@@ -16,10 +16,11 @@ import pytest
 
 mujoco = pytest.importorskip("mujoco")
 
-from stewartid import mjcf, mujoco_state  # noqa: E402
-from stewartid.dynamics import gravity_forces, inverse_dynamics, mass_matrix  # noqa: E402
-from stewartid.kinematics import leg_jacobian  # noqa: E402
-from stewartid.linearization import viscous_matrix  # noqa: E402
+from stewartid.model.dynamics import gravity_forces, inverse_dynamics, mass_matrix  # noqa: E402
+from stewartid.model.kinematics import leg_jacobian  # noqa: E402
+from stewartid.model.linearization import viscous_matrix  # noqa: E402
+from stewartid.mujoco import model as mjcf  # noqa: E402
+from stewartid.mujoco import state as mujoco_state  # noqa: E402
 from stewartid.platform import load_platform  # noqa: E402
 from stewartid.simulation import Sine, multisine_excitation, simulate_experiment  # noqa: E402
 

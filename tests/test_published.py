@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from stewartid.errors import DataError
-from stewartid.linearization import nominal_matrices
+from stewartid.model.linearization import nominal_matrices
 from stewartid.reference.published import (
     PAPER_ENTRIES,
     entry_label,

@@ -12,9 +12,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from stewartid.dataset import DataWarning, dataset_from_frame, read_dataset
+from stewartid.datasets.dataset import DataWarning, dataset_from_frame, read_dataset
+from stewartid.datasets.log_format import load_log_format, log_format_from_mapping
 from stewartid.errors import ConfigError, DataError
-from stewartid.logformat import load_log_format, log_format_from_mapping
 
 DOCS = Path(__file__).parents[1] / "docs" / "logs.md"
 
@@ -204,8 +204,8 @@ def test_a_payload_missing_from_the_platform_is_a_warning(tmp_path, frame, examp
 
 
 def test_identified_matrices_far_from_nominal(example_platform):
-    from stewartid.checks import check_identified
-    from stewartid.linearization import nominal_matrices
+    from stewartid.datasets.plausibility import check_identified
+    from stewartid.model.linearization import nominal_matrices
 
     M, B = nominal_matrices(example_platform)
     check_identified(1.5 * M, 0.6 * B, example_platform)  # within the factor 2: silent

@@ -10,22 +10,22 @@ import os
 import numpy as np
 import pytest
 
-from stewartid.io import write_text_atomic
-from stewartid.linearization import nominal_matrices
+from stewartid.files import write_text_atomic
+from stewartid.model.linearization import nominal_matrices
 from stewartid.reference.published import load_published
 from stewartid.reporting.comparison import ComparisonResults, MethodRun
-from stewartid.reporting.figures import (
-    ExperimentTrace,
-    plot_errors,
-    plot_force_budget,
-    plot_joint_rates,
-)
-from stewartid.reporting.report import (
+from stewartid.reporting.document import (
     FigureEntry,
     fourier_summary,
     render_html,
     render_markdown,
     wavelet_summary,
+)
+from stewartid.reporting.figures import (
+    ExperimentTrace,
+    plot_errors,
+    plot_force_budget,
+    plot_joint_rates,
 )
 from stewartid.reporting.tables import build_tables, paper_table, to_csv, to_markdown
 

@@ -9,11 +9,11 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicSpline
 
-from stewartid.dataset import read_dataset
-from stewartid.dynamics import ModelTerms, forward_dynamics, friction_forces
+from stewartid.datasets.dataset import read_dataset
 from stewartid.errors import ConfigError
-from stewartid.kinematics import leg_lengths
-from stewartid.linearization import nominal_matrices
+from stewartid.model.dynamics import ModelTerms, forward_dynamics, friction_forces
+from stewartid.model.kinematics import leg_lengths
+from stewartid.model.linearization import nominal_matrices
 from stewartid.simulation import (
     SensorNoise,
     paper_experiments,

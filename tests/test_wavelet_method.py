@@ -6,13 +6,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stewartid.dataset import Dataset
-from stewartid.dynamics import ModelTerms
+from stewartid.datasets.dataset import Dataset
 from stewartid.errors import ConfigError, IdentificationError
 from stewartid.identification.result import max_error_percent
-from stewartid.identification.wavelet import WaveletIdentifier, select_symmetric_pairs
-from stewartid.kinematics import leg_lengths
-from stewartid.linearization import nominal_matrices
+from stewartid.identification.wavelet.estimator import WaveletIdentifier, select_symmetric_pairs
+from stewartid.model.dynamics import ModelTerms
+from stewartid.model.kinematics import leg_lengths
+from stewartid.model.linearization import nominal_matrices
 
 AMPLITUDES = np.array([0.01, 0.01, 0.01, 0.005, 0.005, 0.005])
 
@@ -213,8 +213,8 @@ def test_pose_noise_attenuation_is_compensated(paper):
 def test_an_experiment_without_intervals_is_never_silent():
     """An experiment that gives no usable interval warns; when it was the only one to move a
     DOF (its entries would rest on noise, with small standard errors) the fit is refused."""
-    from stewartid.dataset import DataWarning
-    from stewartid.identification.detection import check_coverage
+    from stewartid.datasets.dataset import DataWarning
+    from stewartid.identification.wavelet.detection import check_coverage
 
     motion = np.eye(6) * 0.01 + 1e-6                       # experiment k moves DOF k
     with pytest.warns(DataWarning, match="exp2: no usable constant-direction interval"):
@@ -260,7 +260,7 @@ def test_pose_noise_beyond_the_correction_is_not_silent(paper):
     """With 0.2 mm of pose noise on 10 mm motions the compensated normal matrix is no longer
     positive definite, the attenuation stays (Mt diagonal measured 85-99 % low) and the fit
     says so."""
-    from stewartid.dataset import DataWarning
+    from stewartid.datasets.dataset import DataWarning
 
     M, B = nominal_matrices(paper)
     clean = linear_model_datasets(paper, M, B, np.zeros(6), np.full(6, 300.0), frequency=1.0,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewartid.identification.weak_form_solver import _chi2_excess
+from stewartid.identification.wavelet.gls import _chi2_excess
 
 
 def test_interval_constant_scatter_is_estimated_in_weighted_chi_square():

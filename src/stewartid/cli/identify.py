@@ -140,16 +140,16 @@ def identify(
     known (platform description, or meta.json/truth.json beside the data) and write JSON."""
     import numpy as np
 
-    from stewartid.checks import check_identified
-    from stewartid.dataset import expand_paths, read_datasets
+    from stewartid.datasets.dataset import expand_paths, read_datasets
+    from stewartid.datasets.log_format import load_log_format
+    from stewartid.datasets.plausibility import check_identified
+    from stewartid.files import check_output_file
     from stewartid.identification.registry import create_identifier, method_spec
     from stewartid.identification.result import comparison_rows
-    from stewartid.io import check_output_file
-    from stewartid.linearization import nominal_matrices
-    from stewartid.logformat import load_log_format
+    from stewartid.model.linearization import nominal_matrices
     from stewartid.platform import load_platform
     from stewartid.reporting.terminal import print_comparison
-    from stewartid.reporting.user_report import methods_for
+    from stewartid.reports.identification.report import methods_for
 
     names = methods_for(method)
     accepted = {name for each in names
@@ -191,7 +191,7 @@ def identify(
         if out.suffix.lower() in INPUT_SUFFIXES:
             raise ConfigError(f"--out {str(out)!r}: the result is JSON; give a .json file name.")
     if report is not None:
-        from stewartid.io import check_output_folder
+        from stewartid.files import check_output_folder
 
         inside = [p for p in paths if report.resolve() in p.resolve().parents]
         if inside:
@@ -207,7 +207,7 @@ def identify(
     log_format = load_log_format(columns) if columns is not None else None
     datasets = read_datasets(paths, description, log_format)
     if report is not None or consistent or len(names) > 1:
-        from stewartid.reporting.user_report import identify_for_command
+        from stewartid.reports.identification.report import identify_for_command
 
         result, written = identify_for_command(
             datasets, description, method, settings, report, consistent, folds,

@@ -17,7 +17,7 @@ def nominal(
                                           help="Also print K_G = dG/dq.")] = False,
 ) -> None:
     """Nominal Mt and Bt of the linearised model at the neutral pose (paper frame)."""
-    from stewartid.linearization import gravity_stiffness, nominal_matrices
+    from stewartid.model.linearization import gravity_stiffness, nominal_matrices
     from stewartid.platform import load_platform
 
     description = load_platform(platform)

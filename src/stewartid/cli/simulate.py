@@ -53,7 +53,7 @@ def simulate(
     from rich.progress import Progress
 
     from stewartid.errors import ConfigError
-    from stewartid.io import check_output_folder
+    from stewartid.files import check_output_folder
     from stewartid.platform import load_platform
     from stewartid.simulation import SensorNoise, simulate_experiments, write_experiments
     from stewartid.simulation.experiments import is_experiment_file

@@ -22,8 +22,8 @@ import numpy as np
 
 from stewartid.design.candidates import Design
 from stewartid.errors import ConfigError, DataError
-from stewartid.io import write_text_atomic
-from stewartid.kinematics import forward_kinematics, inverse_kinematics
+from stewartid.files import write_text_atomic
+from stewartid.model.kinematics import forward_kinematics, inverse_kinematics
 from stewartid.platform import COORDINATES, Platform
 from stewartid.simulation.sensors import SensorNoise
 
@@ -171,7 +171,7 @@ def simulate_excitations(platform: Platform, excitations: Sequence[Any],
     stewartid.simulation.SimulationResult
     """
     import stewartid
-    from stewartid.linearization import nominal_matrices
+    from stewartid.model.linearization import nominal_matrices
     from stewartid.simulation.experiments import (
         SimulationResult,
         noise_generator,

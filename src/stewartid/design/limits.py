@@ -18,7 +18,7 @@ import dataclasses
 import numpy as np
 
 from stewartid.errors import ConfigError
-from stewartid.kinematics import inverse_kinematics, rotation_matrix
+from stewartid.model.kinematics import inverse_kinematics, rotation_matrix
 from stewartid.platform import Platform
 from stewartid.simulation.hydraulics import force_limits
 

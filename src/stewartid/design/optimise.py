@@ -34,9 +34,9 @@ import numpy as np
 from stewartid.design.candidates import Design, DesignedRecord, scheduled_design, unit_direction
 from stewartid.design.limits import LimitUse, limit_use, record_limit_use, resolve_limits
 from stewartid.design.prediction import Prediction, plant_records, predict_accuracy
-from stewartid.dynamics import inverse_dynamics
 from stewartid.errors import ConfigError
-from stewartid.kinematics import inverse_kinematics, leg_jacobian
+from stewartid.model.dynamics import inverse_dynamics
+from stewartid.model.kinematics import inverse_kinematics, leg_jacobian
 from stewartid.platform import Platform
 from stewartid.reference.published import PAPER_ENTRIES
 from stewartid.simulation.excitation import DEFAULT_AMPLITUDES

@@ -18,7 +18,7 @@ it is comparable to the standard error on the Mt diagonal). The noise-free data 
   controller fights), and the estimator's spread on it is 2-10 times the spread on model
   data for some entries;
 * ``source="model"``: the commanded motion taken as tracked exactly, with the actuator forces
-  of the nonlinear rigid-body model (:func:`stewartid.dynamics.inverse_dynamics`) and the
+  of the nonlinear rigid-body model (:func:`stewartid.model.dynamics.inverse_dynamics`) and the
   pose noise to first order. Fast, for screening and tests, but optimistic.
 
 Why a Monte Carlo over the estimator rather than a covariance formula: Method B's default
@@ -30,7 +30,7 @@ relative uncertainty of about 1 / sqrt(2 K): 16 % at 20 seeds, 6.5 % at the desi
 Compared with an observed spread over 20 seeds (itself 16 % uncertain), a prediction from
 120 seeds lands within 30 % of it for about 9 entries in 10 when the estimates are close to
 Gaussian, as Method B's are since its interval-constant scatter is matched in weighted
-chi-square (:mod:`~stewartid.identification.weak_form_solver`). The realisations are spread
+chi-square (:mod:`~stewartid.identification.wavelet.gls`). The realisations are spread
 over processes (``workers``); each draws from its own stream, so the count does not change
 the result."""
 
@@ -45,13 +45,13 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
 
-from stewartid.dataset import Dataset
+from stewartid.datasets.dataset import Dataset
 from stewartid.design.candidates import Design
-from stewartid.dynamics import inverse_dynamics
 from stewartid.errors import ConfigError
 from stewartid.identification.registry import create_identifier
-from stewartid.kinematics import inverse_kinematics, leg_jacobian
-from stewartid.linearization import nominal_matrices
+from stewartid.model.dynamics import inverse_dynamics
+from stewartid.model.kinematics import inverse_kinematics, leg_jacobian
+from stewartid.model.linearization import nominal_matrices
 from stewartid.platform import Platform
 from stewartid.reference.published import PAPER_ENTRIES, entry_label
 from stewartid.simulation.sensors import SensorNoise, measure_legs, measured_pose

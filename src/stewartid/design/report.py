@@ -1,7 +1,7 @@
 """The design report: limit use over time, interval lengths, predicted accuracy vs the paper's set.
 
 Figures are matplotlib PNG + SVG (:func:`stewartid.reporting.figures.save_figure`), the text is
-Markdown, rendered to a self-contained HTML page by :func:`stewartid.reporting.report.render_html`.
+Markdown, rendered to a self-contained HTML page by :func:`stewartid.reporting.document.render_html`.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ import numpy as np
 from stewartid.design.candidates import Design
 from stewartid.design.limits import LIMIT_NAMES, LimitUse
 from stewartid.design.prediction import Prediction, identify_options
-from stewartid.io import write_text_atomic
+from stewartid.files import write_text_atomic
 from stewartid.reference.published import PAPER_ENTRIES, entry_label
 
 
@@ -143,7 +143,7 @@ def identify_command(method: str, run: str = "RUN") -> str:
 
 def write_design_report(directory: str | Path, markdown_text: str) -> list[Path]:
     """Write ``report.md`` and the self-contained ``report.html`` into ``directory``."""
-    from stewartid.reporting.report import render_html
+    from stewartid.reporting.document import render_html
 
     directory = Path(directory)
     return [write_text_atomic(directory / "report.md", markdown_text),

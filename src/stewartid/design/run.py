@@ -31,7 +31,7 @@ from stewartid.design.report import (
     render_markdown,
     write_design_report,
 )
-from stewartid.io import check_output_folder, write_json_atomic
+from stewartid.files import check_output_folder, write_json_atomic
 from stewartid.platform import Platform
 from stewartid.simulation.sensors import SensorNoise
 

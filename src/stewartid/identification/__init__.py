@@ -8,10 +8,10 @@ One module per method over a small shared base; each method registers itself in
 - :mod:`~stewartid.identification.preparation`: measured experiments with Jacobians and
   gravity at every measured pose;
 - :mod:`~stewartid.identification.solvers`: weighted and errors-in-variables least squares;
-- :mod:`~stewartid.identification.intervals`: constant-direction intervals, (a, b) points;
-- :mod:`~stewartid.identification.noise`: measurement noise estimated from the data;
+- :mod:`~stewartid.identification.wavelet.intervals`: constant-direction intervals, (a, b) points;
+- :mod:`~stewartid.identification.wavelet.noise`: measurement noise estimated from the data;
 - :mod:`~stewartid.identification.result`: the result object and its JSON file;
-- :mod:`~stewartid.identification.wavelet`: Method B (Zhang 2020);
+- :mod:`~stewartid.identification.wavelet.estimator`: Method B (Zhang 2020);
 - :mod:`~stewartid.identification.fourier`: Method A (Tian et al.), first-harmonic Fourier;
 - :mod:`~stewartid.identification.least_squares`: time-domain least squares with Coulomb terms.
 

@@ -15,7 +15,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from stewartid.dataset import Dataset
+from stewartid.datasets.dataset import Dataset
 from stewartid.errors import ConfigError, NotFittedError
 from stewartid.identification.preparation import resolve_datasets, resolve_platform
 from stewartid.identification.result import IdentificationResult

@@ -35,8 +35,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from stewartid.errors import ConfigError
-from stewartid.identification.intervals import constant_direction_intervals, joint_rates
-from stewartid.kinematics import leg_jacobian
+from stewartid.identification.wavelet.intervals import constant_direction_intervals, joint_rates
+from stewartid.model.kinematics import leg_jacobian
 from stewartid.platform import Platform
 from stewartid.reference.published import PAPER_ENTRIES
 

@@ -38,7 +38,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from stewartid.dataset import Dataset
+from stewartid.datasets.dataset import Dataset
 from stewartid.errors import ConfigError, DataError
 from stewartid.identification.base import (
     BaseIdentifier,

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewartid.dataset import Dataset
+from stewartid.datasets.dataset import Dataset
 from stewartid.identification.base import (
     BaseIdentifier,
     check_differentiation,

@@ -25,9 +25,9 @@ from typing import Any
 
 import numpy as np
 
-from stewartid.dataset import Dataset, read_datasets
+from stewartid.datasets.dataset import Dataset, read_datasets
 from stewartid.errors import ConfigError, DataError
-from stewartid.kinematics import _leg_terms, joint_rate_jacobians
+from stewartid.model.kinematics import _leg_terms, joint_rate_jacobians
 from stewartid.platform import Platform, load_platform
 
 

@@ -165,9 +165,13 @@ def registered_methods() -> tuple[MethodSpec, ...]:
     modules = {f"stewartid.identification.{m}": k for k, m in enumerate(_module_order())}
     position = {name: k for k, name in enumerate(_REGISTRY)}
 
+    def module_rank(cls: type) -> int:
+        # a method is a module or a subpackage of stewartid.identification
+        parts = cls.__module__.split(".")
+        return modules.get(".".join(parts[:3]), len(modules))
+
     def order(spec: MethodSpec) -> tuple[bool, int, int]:
-        return (spec.preset_of is not None,
-                modules.get(spec.estimator_class.__module__, len(modules)), position[spec.name])
+        return (spec.preset_of is not None, module_rank(spec.estimator_class), position[spec.name])
 
     return tuple(sorted(_REGISTRY.values(), key=order))
 

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from stewartid.io import to_jsonable, write_json_atomic
+from stewartid.files import to_jsonable, write_json_atomic
 from stewartid.reference.published import PAPER_ENTRIES, entry_label, relative_error_percent
 
 
@@ -39,7 +39,7 @@ class IdentificationResult:
         Method-specific: intervals, (a, b) points, frequencies, Coulomb levels, ...
     validation : dict, optional
         Held-out prediction scores, ``{"vaf_percent": [6], "nrmse": [6], "folds": N}``
-        (:mod:`stewartid.reporting.validation`); None when not validated.
+        (:mod:`stewartid.assessment.validation`); None when not validated.
 
     ``to_dict`` also writes ``consistency``, the symmetry and definiteness of M and B
     (:func:`~stewartid.identification.consistency.consistency_metrics`).
@@ -58,7 +58,7 @@ class IdentificationResult:
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict; ``M`` and ``B`` at the top level; non-finite numbers are None
-        (see :mod:`stewartid.io`)."""
+        (see :mod:`stewartid.files`)."""
         from stewartid.identification.consistency import consistency_metrics
 
         document = {

@@ -21,10 +21,10 @@ from pathlib import Path
 
 import numpy as np
 
+from stewartid.assessment.validation import FRICTION_TYPES
+from stewartid.files import write_bytes_atomic, write_text_atomic
 from stewartid.identification.result import IdentificationResult
-from stewartid.io import write_bytes_atomic, write_text_atomic
 from stewartid.platform import COORDINATES
-from stewartid.reporting.validation import FRICTION_TYPES
 
 
 @dataclass(frozen=True)

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from stewartid.io import write_bytes_atomic
+from stewartid.files import write_bytes_atomic
 from stewartid.platform import COORDINATES
 from stewartid.reference.published import PAPER_ENTRIES, entry_label
 from stewartid.reporting.comparison import ComparisonResults, method_color, method_name

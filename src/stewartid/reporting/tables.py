@@ -202,7 +202,7 @@ def build_tables(results: ComparisonResults) -> list[ResultTable]:
 
 def write_tables(tables: Sequence[ResultTable], directory: str | Path) -> list[Path]:
     """Write each table as ``<name>.md`` and ``<name>.csv`` in ``directory``; return the paths."""
-    from stewartid.io import write_text_atomic
+    from stewartid.files import write_text_atomic
 
     directory = Path(directory)
     paths = []

@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from stewartid.leg_terms import leg_terms
+from stewartid.model.leg_terms import leg_terms
 from stewartid.platform import Platform
 from stewartid.simulation.hydraulics import force_limits
 
@@ -89,7 +89,7 @@ def command_tables(params, upper, base, q_cmd, qd_cmd, feedforward):
 
     Parameters
     ----------
-    params, upper, base : packed platform (see ``_kernels.model_terms``).
+    params, upper, base : packed platform (see :func:`stewartid.model.kernels.model_terms`).
     q_cmd, qd_cmd : (N, 6) commanded poses (m, rad) and rates.
     feedforward : bool
         Compute J_lq^-T G at the commanded pose (zeros otherwise).

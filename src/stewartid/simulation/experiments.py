@@ -19,10 +19,10 @@ from typing import Any
 
 import numpy as np
 
-from stewartid.dataset import Dataset, write_dataset
-from stewartid.dynamics import COULOMB_SMOOTHING
+from stewartid.datasets.dataset import Dataset, write_dataset
 from stewartid.errors import ConfigError, StewartidError
-from stewartid.io import check_output_folder, write_json_atomic
+from stewartid.files import check_output_folder, write_json_atomic
+from stewartid.model.dynamics import COULOMB_SMOOTHING
 from stewartid.platform import Platform
 from stewartid.simulation import plant
 from stewartid.simulation.controller import command_tables, controller_parameters
@@ -262,7 +262,7 @@ def simulate_experiments(platform: Platform, coulomb: float | None = None,
     SimulationResult
     """
     import stewartid
-    from stewartid.linearization import gravity_stiffness, nominal_matrices
+    from stewartid.model.linearization import gravity_stiffness, nominal_matrices
 
     updates: dict[str, Any] = {}
     if coulomb is not None:

@@ -20,7 +20,7 @@ N m s/rad at Fc = 5 N m, about ten times the viscous gimbal friction), which the
 include (they are taken at rest, where that damping is largest).
 
 Friction: viscous on the four gimbal axes of each leg, Coulomb on all five rotational axes,
-regularised as Fc w / sqrt(w^2 + s^2) (:func:`stewartid._kernels.joint_friction`). Within
+regularised as Fc w / sqrt(w^2 + s^2) (:func:`stewartid.model.compiled.joint_friction`). Within
 |w| < s a joint behaves as a very stiff viscous damper: it sticks (creeps at a rate below
 s, 1e-4 rad/s) until the applied torque exceeds Fc, then slips with the full Coulomb torque
 opposing the motion, so the stick-slip transitions are resolved without event detection.
@@ -33,7 +33,7 @@ import math
 import numpy as np
 from numba import njit
 
-from stewartid import _kernels
+from stewartid.model import compiled
 from stewartid.simulation.controller import pid_force, valve_command
 from stewartid.simulation.hydraulics import H_MID, H_STROKE, actuator_force, pressure_rates
 
@@ -91,7 +91,7 @@ def rhs(y, dy, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, hyd
     """
     q = y[S_Q:S_Q + 6]
     qd = y[S_QD:S_QD + 6]
-    _kernels.model_terms(params, upper, base, q, qd, M, h, G, J, Jj, lengths)
+    compiled.model_terms(params, upper, base, q, qd, M, h, G, J, Jj, lengths)
     for i in range(6):
         s = 0.0
         for c in range(6):
@@ -128,10 +128,10 @@ def rhs(y, dy, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, hyd
         for i in range(6):
             s += J[i, c] * force[i]
         work[c] = s
-    viscous = params[_kernels.P_VISCOUS]
-    coulomb = params[_kernels.P_COULOMB]
+    viscous = params[compiled.P_VISCOUS]
+    coulomb = params[compiled.P_COULOMB]
     for i in range(6):
-        for j in range(_kernels.N_JOINTS):
+        for j in range(compiled.N_JOINTS):
             w = 0.0
             for c in range(6):
                 w += Jj[i, j, c] * qd[c]

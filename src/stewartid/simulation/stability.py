@@ -16,8 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewartid.dynamics import COULOMB_SMOOTHING, ModelTerms
 from stewartid.errors import ConfigError
+from stewartid.model.dynamics import COULOMB_SMOOTHING, ModelTerms
 from stewartid.platform import Platform
 from stewartid.simulation import plant
 from stewartid.simulation.controller import command_tables, controller_parameters

@@ -16,7 +16,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from stewartid.io import write_text_atomic
+from stewartid.files import write_text_atomic
 from stewartid.reporting.comparison import method_color, method_name, report_order
 from stewartid.reporting.tables import ResultTable, to_markdown, write_tables
 from stewartid.studies.spec import PARAMETERS, StudySpec
@@ -251,7 +251,7 @@ def write_study_report(rows: Any, spec: StudySpec, directory: str | Path,
     list of Path
         Every file written.
     """
-    from stewartid.reporting.report import render_html
+    from stewartid.reporting.document import render_html
 
     directory = Path(directory)
     methods = report_order(spec.methods)

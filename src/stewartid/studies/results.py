@@ -48,7 +48,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from stewartid.io import write_bytes_atomic
+from stewartid.files import write_bytes_atomic
 from stewartid.reference.published import PAPER_ENTRIES, entry_label
 from stewartid.studies.spec import PARAMETERS
 

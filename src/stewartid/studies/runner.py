@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from stewartid.errors import ConfigError, OutputExistsError
-from stewartid.io import write_json_atomic
+from stewartid.files import write_json_atomic
 from stewartid.studies.grid import StudyTask, expand_grid
 from stewartid.studies.results import RESULTS_NAME, finished_tasks, read_results, write_part
 from stewartid.studies.spec import StudySpec
@@ -128,7 +128,7 @@ def _check_folder(spec: StudySpec, directory: Path, resume: bool) -> None:
 def _worker_environment() -> dict[str, str]:
     # the same one-thread limits as the process pool of ``reproduce``: parallelism is across
     # processes, and multithreaded BLAS in every worker only oversubscribes the cores
-    from stewartid.reproduction.run import _WORKER_THREADS
+    from stewartid.reports.reproduction.run import _WORKER_THREADS
 
     return dict(_WORKER_THREADS)
 

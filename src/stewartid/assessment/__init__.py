@@ -1,0 +1,1 @@
+"""Assessment of identified models: prediction of data the fit did not see."""

@@ -1,0 +1,415 @@
+"""Measured experiments in the interchange format: reading, validation, writing.
+
+One table per experiment (CSV or Parquet) with the columns
+
+    t, x, y, z, rx, ry, rz, l1..l6, f1..f6
+
+time (s); pose of the reference point in the paper frame (m, rad; absolute, z down); leg
+lengths (m); actuator forces along the legs (N, positive extends the leg). Either the pose or
+the leg lengths may be missing: forward or inverse kinematics fill them in from the platform
+description. Several files are several experiments.
+
+Validation happens here, at the boundary, so that identification code can trust its input:
+required columns, finite values, strictly increasing time, a uniform sample period, at least
+:data:`MIN_SAMPLES` samples, and a sample rate in :data:`SAMPLE_RATE_RANGE_HZ` (a time column
+in ms or µs read as seconds falls outside). Every identification method here assumes a fixed
+sample period: time stamps that jitter around a uniform sample clock (every sample within
+half a period of its slot, none skipped) are timing noise of the logger and are replaced by
+the least-squares uniform clock; any other non-uniform time base is resampled onto a uniform
+grid (linear interpolation at the median sample period). Both with a :class:`DataWarning`.
+With a platform description, the data are checked against it (:mod:`stewartid.datasets.plausibility`).
+Logs in other layouts or units are read through a :class:`~stewartid.datasets.log_format.LogFormat`
+(``docs/logs.md``).
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from stewartid.datasets.arrays import median
+from stewartid.datasets.log_format import LogFormat, read_table
+from stewartid.errors import DataError, KinematicsError
+from stewartid.files import write_bytes_atomic
+from stewartid.platform import COORDINATES, Platform
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+#: All columns of the interchange format, in order.
+COLUMNS = ("t", *COORDINATES, "l1", "l2", "l3", "l4", "l5", "l6",
+           "f1", "f2", "f3", "f4", "f5", "f6")
+POSE_COLUMNS = COLUMNS[1:7]
+LENGTH_COLUMNS = COLUMNS[7:13]
+FORCE_COLUMNS = COLUMNS[13:19]
+
+#: Fewest samples an experiment may have (a handful of periods of the slowest method's window).
+MIN_SAMPLES = 64
+
+#: Largest relative deviation of a sample period from the median before the time base counts
+#: as non-uniform (tolerates the rounding of t in text files written with enough digits).
+UNIFORM_TOLERANCE = 1e-3
+
+#: Plausible sample rates of a hexapod log (Hz); outside, the time column is in another unit.
+SAMPLE_RATE_RANGE_HZ = (10.0, 1e6)
+
+SUFFIXES = {".csv": "csv", ".parquet": "parquet", ".pq": "parquet"}
+
+
+class DataWarning(UserWarning):
+    """A data set was usable only after a correction (for instance resampling)."""
+
+
+@dataclass(frozen=True)
+class Dataset:
+    """One experiment: measured pose, leg lengths and actuator forces on a uniform time base.
+
+    Attributes
+    ----------
+    t : ndarray, shape (N,)
+        Time (s), strictly increasing with a uniform period.
+    pose : ndarray, shape (N, 6)
+        Pose q = [x, y, z, rx, ry, rz] of the reference point, paper frame (m, rad; absolute,
+        z down).
+    lengths : ndarray, shape (N, 6)
+        Leg lengths (m).
+    forces : ndarray, shape (N, 6)
+        Actuator forces along the legs (N, positive extends the leg).
+    name : str
+        Label of the experiment (file stem when read from a file).
+    """
+
+    t: np.ndarray
+    pose: np.ndarray
+    lengths: np.ndarray
+    forces: np.ndarray
+    name: str = "exp"
+
+    def __post_init__(self) -> None:
+        n = np.shape(self.t)[0] if np.ndim(self.t) == 1 else -1
+        if n < 0:
+            raise DataError(f"{self.name}: t must be one-dimensional; got shape {np.shape(self.t)}.")
+        for field in ("pose", "lengths", "forces"):
+            value = np.asarray(getattr(self, field), dtype=float)
+            if value.shape != (n, 6):
+                raise DataError(f"{self.name}: {field} must have shape ({n}, 6) to match t; "
+                                f"got {value.shape}.")
+            object.__setattr__(self, field, value)
+        object.__setattr__(self, "t", np.asarray(self.t, dtype=float))
+
+    @property
+    def sample_rate(self) -> float:
+        """Sample rate (Hz), from the mean period."""
+        return float((len(self.t) - 1) / (self.t[-1] - self.t[0]))
+
+    @property
+    def duration(self) -> float:
+        """Record length t[-1] - t[0] (s)."""
+        return float(self.t[-1] - self.t[0])
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    def to_frame(self) -> pd.DataFrame:
+        """The experiment as a table with the interchange columns."""
+        import pandas as pd
+
+        data = np.column_stack([self.t, self.pose, self.lengths, self.forces])
+        return pd.DataFrame(data, columns=list(COLUMNS))
+
+
+def _format_of(path: Path, format: str | None) -> str:
+    if format is not None:
+        if format not in ("csv", "parquet"):
+            raise DataError(f"unknown data format {format!r} for {path}; expected 'csv' or "
+                            "'parquet'.")
+        return format
+    try:
+        return SUFFIXES[path.suffix.lower()]
+    except KeyError:
+        raise DataError(f"{path}: unknown file type {path.suffix!r}; expected one of "
+                        f"{', '.join(SUFFIXES)} (or pass format='csv'|'parquet').") from None
+
+
+def _check_time(t: np.ndarray, where: str) -> bool:
+    """Validate the time column; return True when it is uniform."""
+    if len(t) < MIN_SAMPLES:
+        raise DataError(f"{where}: only {len(t)} samples; at least {MIN_SAMPLES} are needed "
+                        "(record a longer experiment).")
+    dt = np.diff(t)
+    if np.any(dt <= 0):
+        bad = int(np.argmax(dt <= 0)) + 1
+        raise DataError(f"{where}: column 't' must be strictly increasing; row {bad} has "
+                        f"t = {t[bad]!r} after t = {t[bad - 1]!r} (sort the rows and drop "
+                        "duplicate time stamps).")
+    period = median(dt)
+    low, high = SAMPLE_RATE_RANGE_HZ
+    if not low <= 1.0 / period <= high:
+        units = [unit for unit, factor in (("ms", 1e-3), ("us", 1e-6))
+                 if low <= 1.0 / (period * factor) <= high]
+        fix = f"map it with --columns t=:{units[0]}" if units else "give it in seconds"
+        raise DataError(f"{where}: column 't' has a sample period of {period:.6g} s "
+                        f"({1.0 / period:.3g} Hz), implausible for a hexapod log; is it in "
+                        f"another unit? {fix}.")
+    return bool(np.max(np.abs(dt - period)) <= UNIFORM_TOLERANCE * period)
+
+
+def _uniform_clock(t: np.ndarray, where: str) -> np.ndarray | None:
+    """The least-squares uniform clock t0 + T i of jittery time stamps, or None when the time
+    base is not a uniform clock with timing noise (a sample off its slot by half a period or
+    more, or a skipped slot)."""
+    index = np.arange(len(t), dtype=float)
+    index -= index.mean()
+    period = float(index @ (t - t.mean()) / (index @ index))
+    clock = t.mean() + period * index
+    deviation = np.abs(t - clock)
+    if np.max(deviation) >= 0.5 * period or np.max(np.diff(t)) >= 1.9 * period:
+        return None
+    warnings.warn(f"{where}: time stamps jitter by up to {np.max(deviation) * 1e3:.3g} ms "
+                  f"around a uniform {1.0 / period:.6g} Hz clock; read as timing noise and "
+                  "replaced by that clock.", DataWarning, stacklevel=4)
+    return clock
+
+
+def _resample(t: np.ndarray, columns: dict[str, np.ndarray], where: str
+              ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    period = median(np.diff(t))
+    n = int(np.floor((t[-1] - t[0]) / period + 1e-9)) + 1
+    grid = t[0] + period * np.arange(n)
+    warnings.warn(f"{where}: time base is not uniform (sample periods from "
+                  f"{np.min(np.diff(t)):.6g} s to {np.max(np.diff(t)):.6g} s); resampled "
+                  f"linearly onto {n} samples at the median period {period:.6g} s.",
+                  DataWarning, stacklevel=4)
+    return grid, {k: np.interp(grid, t, v) for k, v in columns.items()}
+
+
+def dataset_from_frame(frame: pd.DataFrame | Mapping[str, np.ndarray],
+                       platform: Platform | None = None, name: str = "exp",
+                       where: str | None = None) -> Dataset:
+    """Validate a table in the interchange format and build a :class:`Dataset`.
+
+    Parameters
+    ----------
+    frame : DataFrame, or mapping of str to ndarray of shape (N,)
+        Columns ``t``, ``f1..f6`` and at least one of the groups ``x..rz`` or ``l1..l6``.
+        Unknown extra columns are ignored.
+    platform : Platform, optional
+        Needed only when the pose or the leg lengths are missing.
+    name : str
+        Experiment label.
+    where : str, optional
+        Source named in error messages (file path); ``name`` by default.
+
+    Raises
+    ------
+    DataError
+        Missing columns, non-finite or non-numeric values, non-increasing time, too few samples.
+    """
+    where = where or name
+    present = set(frame.keys())
+    missing = [c for c in ("t", *FORCE_COLUMNS) if c not in present]
+    if missing:
+        raise DataError(f"{where}: missing required column(s) {', '.join(missing)}; expected "
+                        f"columns {', '.join(COLUMNS)} (other names or units: --columns, "
+                        "docs/logs.md).")
+    has_pose = all(c in present for c in POSE_COLUMNS)
+    has_lengths = all(c in present for c in LENGTH_COLUMNS)
+    if not (has_pose or has_lengths):
+        lacking = [c for c in POSE_COLUMNS + LENGTH_COLUMNS if c not in present]
+        raise DataError(f"{where}: needs either the pose columns x, y, z, rx, ry, rz or the leg "
+                        f"lengths l1..l6; missing {', '.join(lacking)}.")
+    wanted = ["t", *(POSE_COLUMNS if has_pose else ()), *(LENGTH_COLUMNS if has_lengths else ()),
+              *FORCE_COLUMNS]
+    columns: dict[str, np.ndarray] = {}
+    for c in wanted:
+        column = frame[c]
+        if isinstance(column, np.ndarray):
+            values = column.astype(float)
+        else:
+            import pandas as pd
+
+            values = pd.to_numeric(column, errors="coerce").to_numpy(dtype=float)
+        finite = np.isfinite(values)
+        if not np.all(finite):
+            row = int(np.argmin(finite))
+            value = column[row] if isinstance(column, np.ndarray) else column.iloc[row]
+            raise DataError(f"{where}: column {c!r} has a missing, non-numeric or non-finite "
+                            f"value at row {row} ({value!r}); clean or drop that row.")
+        columns[c] = values
+    t = columns.pop("t")
+    if not _check_time(t, where):
+        clock = _uniform_clock(t, where)
+        if clock is None:
+            t, columns = _resample(t, columns, where)
+        else:
+            t = clock
+    forces = np.column_stack([columns[c] for c in FORCE_COLUMNS])
+    pose = np.column_stack([columns[c] for c in POSE_COLUMNS]) if has_pose else None
+    lengths = np.column_stack([columns[c] for c in LENGTH_COLUMNS]) if has_lengths else None
+    if platform is not None:
+        from stewartid.datasets import plausibility as checks
+
+        if pose is not None:
+            checks.check_pose(pose, platform, where)
+        if lengths is not None:
+            checks.check_leg_lengths(lengths, platform, where)
+    if pose is None or lengths is None:
+        if platform is None:
+            group = "pose (x..rz)" if pose is None else "leg lengths (l1..l6)"
+            raise DataError(f"{where}: the {group} is missing and no platform description was "
+                            "given to compute it; pass platform=... (CLI: --platform).")
+        from stewartid.model.kinematics import forward_kinematics, leg_lengths
+
+        if pose is None:
+            try:
+                pose = _forward_kinematics_tracked(platform, lengths, forward_kinematics)
+            except KinematicsError as exc:
+                raise DataError(f"{where}: cannot compute the pose from l1..l6: {exc}") from exc
+        else:
+            lengths = leg_lengths(platform, pose)
+    if platform is not None:
+        checks.check_dataset(pose, lengths, forces, platform, where,
+                             both_logged=has_pose and has_lengths)
+    return Dataset(t=t, pose=pose, lengths=lengths, forces=forces, name=name)
+
+
+def _forward_kinematics_tracked(platform: Platform, lengths: np.ndarray, solve) -> np.ndarray:
+    # Start every sample at the neutral pose but refine from the previous solution in blocks:
+    # consecutive samples are close, so Newton converges in a couple of iterations even for
+    # large excursions that would stall from neutral.
+    pose = np.empty_like(lengths)
+    block = 2048
+    start = platform.neutral_pose
+    for i in range(0, len(lengths), block):
+        chunk = lengths[i:i + block]
+        pose[i:i + block] = solve(platform, chunk, initial=start)
+        start = pose[i + len(chunk) - 1]
+    return pose
+
+
+def read_dataset(path: str | Path, platform: Platform | None = None,
+                 format: str | None = None, log_format: LogFormat | None = None) -> Dataset:
+    """Read and validate one experiment from a CSV or Parquet file.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.csv`` or ``.parquet`` file in the interchange format, or in the layout and units
+        that ``log_format`` describes. The CSV delimiter (``,`` ``;`` tab) and decimal mark
+        are detected.
+    platform : Platform, optional
+        Platform description, used when the pose or the leg lengths are missing, and to
+        check the data against it (:mod:`stewartid.datasets.plausibility`).
+    format : {'csv', 'parquet'}, optional
+        Overrides the file suffix.
+    log_format : LogFormat, optional
+        Column mapping with units (:mod:`stewartid.datasets.log_format`).
+
+    Returns
+    -------
+    Dataset
+        Named after the file stem.
+
+    Raises
+    ------
+    DataError
+        The file cannot be parsed or fails validation; the message names file and column.
+    """
+    path = Path(path)
+    kind = _format_of(path, format)
+    if not path.is_file():
+        raise DataError(f"{path}: no such data file.")
+    frame = read_table(path, kind, log_format)
+    return dataset_from_frame(frame, platform, name=path.stem, where=str(path))
+
+
+def expand_paths(paths: Iterable[str | Path]) -> list[Path]:
+    """Data files named by ``paths``; a directory stands for its ``*.csv`` and ``*.parquet``."""
+    out: list[Path] = []
+    for p in map(Path, paths):
+        if p.is_dir():
+            found = sorted(f for f in p.iterdir() if f.suffix.lower() in SUFFIXES)
+            if not found:
+                raise DataError(f"{p}: directory holds no .csv or .parquet data files.")
+            out.extend(found)
+        else:
+            out.append(p)
+    return out
+
+
+def read_datasets(paths: str | Path | Sequence[str | Path],
+                  platform: Platform | None = None,
+                  log_format: LogFormat | None = None) -> list[Dataset]:
+    """Read several experiments (one file each; a directory means all data files in it),
+    with the ``platform`` and ``log_format`` of :func:`read_dataset`.
+
+    Returns
+    -------
+    list of Dataset
+        In the order given (directory contents sorted by name).
+    """
+    if isinstance(paths, str | Path):
+        paths = [paths]
+    files = expand_paths(paths)
+    if not files:
+        raise DataError("no data files given; pass one or more .csv/.parquet files.")
+    return [read_dataset(f, platform, log_format=log_format) for f in files]
+
+
+def write_dataset(dataset: Dataset, path: str | Path, format: str | None = None) -> Path:
+    """Write an experiment in the interchange format, atomically.
+
+    Through :func:`stewartid.files.write_bytes_atomic`, so readers never see a half-written
+    file.
+
+    Parameters
+    ----------
+    dataset : Dataset
+    path : str or Path
+    format : {'csv', 'parquet'}, optional
+        By default from the suffix of ``path``.
+
+    Returns
+    -------
+    Path
+        The written file.
+    """
+    import pyarrow as pa
+
+    path = Path(path)
+    kind = _format_of(path, format)
+    data = np.column_stack([dataset.t, dataset.pose, dataset.lengths, dataset.forces]).T
+    table = pa.table(dict(zip(COLUMNS, data, strict=True)))
+    buffer = pa.BufferOutputStream()
+    if kind == "csv":
+        import pyarrow.csv
+
+        # Arrow writes the shortest decimal that reads back to the same double: the round
+        # trip is bit-exact, at a tenth of the time of printf-style formatting
+        pyarrow.csv.write_csv(table, buffer, pyarrow.csv.WriteOptions(quoting_style="none"))
+    else:
+        import pyarrow.parquet
+
+        pyarrow.parquet.write_table(table, buffer)
+    return write_bytes_atomic(path, buffer.getvalue().to_pybytes())
+
+
+__all__ = [
+    "COLUMNS",
+    "FORCE_COLUMNS",
+    "LENGTH_COLUMNS",
+    "MIN_SAMPLES",
+    "POSE_COLUMNS",
+    "DataWarning",
+    "Dataset",
+    "dataset_from_frame",
+    "expand_paths",
+    "read_dataset",
+    "read_datasets",
+    "write_dataset",
+]

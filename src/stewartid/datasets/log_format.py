@@ -1,0 +1,446 @@
+"""Controller logs into the interchange format: column mapping with units, delimiter and
+encoding detection, actuator forces from chamber pressures.
+
+A :class:`LogFormat` says which column of a log holds each interchange column (``t``, ``x``
+.. ``rz``, ``l1`` .. ``l6``, ``f1`` .. ``f6``), in which unit, and optionally with a scale
+(``-1`` flips a sign convention) and an offset (added in SI units after the conversion, e.g.
+the leg length at zero stroke). Logs with chamber pressures instead of forces map ``pa1`` ..
+``pa6`` (piston side, extends the leg) and ``pb1`` .. ``pb6`` (rod side); the force is then
+``f = pa * piston_area - pb * annulus_area``. It is read from a TOML file or from an inline
+``KEY=VALUE,...`` string (the CLI's ``--columns``); the format is in ``docs/logs.md``.
+
+Without a log format, CSV files are still read with their delimiter (``,`` ``;`` or tab) and
+decimal mark detected, and in UTF-8 (UTF-16 or UTF-8 with a byte-order mark are recognised);
+another encoding is named in the error with the fix.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import re
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from stewartid.datasets.plain_csv import read_plain_csv
+from stewartid.errors import ConfigError, DataError
+from stewartid.fields import read_toml_text
+from stewartid.platform import COORDINATES
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+#: Interchange columns a log format may map, in order, with the chamber pressures.
+PRESSURE_COLUMNS = tuple(f"pa{k}" for k in range(1, 7)) + tuple(f"pb{k}" for k in range(1, 7))
+_TIME, _POSITIONS, _ANGLES = ("t",), COORDINATES[:3], COORDINATES[3:]
+_LENGTHS = tuple(f"l{k}" for k in range(1, 7))
+_FORCES = tuple(f"f{k}" for k in range(1, 7))
+MAPPABLE = (*_TIME, *_POSITIONS, *_ANGLES, *_LENGTHS, *_FORCES, *PRESSURE_COLUMNS)
+
+#: Units understood for each quantity, as factors to SI (keys are matched case-insensitively).
+UNITS: dict[str, dict[str, float]] = {
+    "time": {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6},
+    "length": {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "µm": 1e-6},
+    "angle": {"rad": 1.0, "mrad": 1e-3, "deg": math.pi / 180.0},
+    "force": {"n": 1.0, "kn": 1e3},
+    "pressure": {"pa": 1.0, "kpa": 1e3, "mpa": 1e6, "bar": 1e5, "psi": 6894.757293168},
+}
+_QUANTITY = {**dict.fromkeys(_TIME, "time"), **dict.fromkeys(_POSITIONS + _LENGTHS, "length"),
+             **dict.fromkeys(_ANGLES, "angle"), **dict.fromkeys(_FORCES, "force"),
+             **dict.fromkeys(PRESSURE_COLUMNS, "pressure")}
+_SI = {"time": "s", "length": "m", "angle": "rad", "force": "N", "pressure": "Pa"}
+
+#: Keys of the ``[log]`` section (inline: the same names).
+LOG_KEYS = ("delimiter", "encoding", "decimal", "skip_rows")
+#: Keys of the ``[pressures]`` section (m^2).
+AREA_KEYS = ("piston_area", "annulus_area")
+DELIMITERS = (",", ";", "\t")
+
+
+@dataclass(frozen=True)
+class ColumnSource:
+    """Where one interchange column comes from.
+
+    Attributes
+    ----------
+    name : str
+        Column of the log ("" keeps the interchange name).
+    unit : str
+        Unit of the log's column (a key of :data:`UNITS` for its quantity).
+    scale : float
+        Multiplier after the unit conversion (-1 flips a sign convention).
+    offset : float
+        Added after conversion and scale, in SI units (s, m, rad, N, Pa).
+    """
+
+    name: str = ""
+    unit: str = ""
+    scale: float = 1.0
+    offset: float = 0.0
+
+
+@dataclass(frozen=True)
+class LogFormat:
+    """How to read a controller's log: columns with units, delimiter, encoding, areas.
+
+    Attributes
+    ----------
+    columns : mapping of str to ColumnSource
+        Interchange column (see :data:`MAPPABLE`) to its source in the log.
+    delimiter, encoding, decimal : str or None
+        Detected when None (``,`` ``;`` or tab; UTF-8/UTF-16 by byte-order mark; ``.`` or
+        ``,`` from the first data line).
+    skip_rows : int
+        Lines before the header line (a logger's preamble).
+    piston_area, annulus_area : float or None
+        Piston-side and rod-side areas of a cylinder (m^2), needed for pressures.
+    source : str
+        Where the format came from, named in error messages.
+    """
+
+    columns: Mapping[str, ColumnSource] = field(default_factory=dict)
+    delimiter: str | None = None
+    encoding: str | None = None
+    decimal: str | None = None
+    skip_rows: int = 0
+    piston_area: float | None = None
+    annulus_area: float | None = None
+    source: str = "--columns"
+
+    def to_interchange(self, frame: pd.DataFrame, where: str) -> pd.DataFrame:
+        """The log's table with interchange column names, in SI units.
+
+        Parameters
+        ----------
+        frame : DataFrame
+            The log as read.
+        where : str
+            File named in error messages.
+
+        Returns
+        -------
+        DataFrame
+            Mapped columns converted to SI; unmapped columns unchanged; ``f1..f6`` from
+            the chamber pressures when the log has pressures and no forces.
+
+        Raises
+        ------
+        DataError
+            A mapped column is missing or not numeric, or pressures come without areas.
+        """
+        import pandas as pd
+
+        out = frame.copy()
+        for target, source in self.columns.items():
+            name = source.name or target
+            if name not in frame.columns:
+                raise DataError(f"{where}: no column {name!r} (mapped to {target} by "
+                                f"{self.source}); the file has {_listing(frame.columns)}.")
+            values = pd.to_numeric(frame[name], errors="coerce").to_numpy(dtype=float)
+            bad = np.isnan(values) & frame[name].notna().to_numpy()
+            if np.any(bad):
+                row = int(np.argmax(bad))
+                raise DataError(f"{where}: column {name!r} has the non-numeric value "
+                                f"{frame[name].iloc[row]!r} at row {row}; clean that row or "
+                                "set the decimal mark / delimiter (docs/logs.md).")
+            factor = UNITS[_QUANTITY[target]][source.unit.lower()] if source.unit else 1.0
+            out[target] = values * factor * source.scale + source.offset
+        if not all(f in out.columns for f in _FORCES) and all(
+                p in out.columns for p in PRESSURE_COLUMNS):
+            if self.piston_area is None or self.annulus_area is None:
+                raise DataError(f"{where}: forces from chamber pressures need piston_area and "
+                                f"annulus_area (m^2) in {self.source} (docs/logs.md).")
+            for k in range(1, 7):
+                pressure_a = pd.to_numeric(out[f"pa{k}"], errors="coerce")
+                pressure_b = pd.to_numeric(out[f"pb{k}"], errors="coerce")
+                out[f"f{k}"] = pressure_a * self.piston_area - pressure_b * self.annulus_area
+        return out
+
+
+def _listing(columns: Any, limit: int = 8) -> str:
+    names = [str(c) for c in columns]
+    shown = ", ".join(repr(n) for n in names[:limit])
+    return shown + (f" and {len(names) - limit} more" if len(names) > limit else "")
+
+
+# -- building a LogFormat -------------------------------------------------------------------
+
+def _expand(key: str, source: str) -> list[str]:
+    """Interchange columns named by ``key``: one name, or a range ``first..last``."""
+    if ".." in key:
+        first, _, last = key.partition("..")
+        if first in MAPPABLE and last in MAPPABLE and MAPPABLE.index(first) <= MAPPABLE.index(
+                last):
+            return list(MAPPABLE[MAPPABLE.index(first):MAPPABLE.index(last) + 1])
+    elif key in MAPPABLE:
+        return [key]
+    raise ConfigError(f"{source}: unknown column {key!r}; map one of {', '.join(MAPPABLE)} "
+                      "or a range such as l1..l6.")
+
+
+def _column_source(target: str, value: Any, source: str, index: int | None) -> ColumnSource:
+    """One :class:`ColumnSource` from a TOML value: "NAME", "NAME:UNIT", ":UNIT" or a table
+    with name, unit, scale, offset. ``{k}`` in a name is the leg number of ``target``."""
+    if isinstance(value, str):
+        name, unit = value, ""
+        head, colon, tail = value.rpartition(":")
+        if colon and any(tail.lower() in units for units in UNITS.values()):
+            name, unit = head, tail
+        value = {"name": name, "unit": unit}
+    if not isinstance(value, Mapping):
+        raise ConfigError(f"{source}: {target} must be \"NAME\", \"NAME:UNIT\" or a table "
+                          f"{{name = ..., unit = ..., scale = ..., offset = ...}}; got {value!r}.")
+    unknown = sorted(set(value) - {"name", "unit", "scale", "offset"})
+    if unknown:
+        raise ConfigError(f"{source}: {target} has unknown key {unknown[0]!r}; valid keys are "
+                          "name, unit, scale, offset.")
+    name, unit = str(value.get("name", "")), str(value.get("unit", ""))
+    units = UNITS[_QUANTITY[target]]
+    if unit and unit.lower() not in units:
+        raise ConfigError(f"{source}: unit {unit!r} does not fit {target} "
+                          f"({_QUANTITY[target]}); use one of {', '.join(units)}.")
+    if "{k}" in name:
+        if index is None:
+            raise ConfigError(f"{source}: {{k}} in {name!r} needs a range key such as l1..l6.")
+        leg = re.search(r"\d$", target)
+        name = name.replace("{k}", leg.group() if leg else str(index))
+    numbers = {}
+    for key, default in (("scale", 1.0), ("offset", 0.0)):
+        number = value.get(key, default)
+        if isinstance(number, bool) or not isinstance(number, int | float) or not math.isfinite(
+                number):
+            raise ConfigError(f"{source}: {target} {key} must be a finite number; got "
+                              f"{number!r}.")
+        numbers[key] = float(number)
+    return ColumnSource(name=name, unit=unit, **numbers)
+
+
+def log_format_from_mapping(document: Mapping[str, Any], source: str) -> LogFormat:
+    """Build a :class:`LogFormat` from a parsed TOML document with the sections ``[log]``,
+    ``[columns]`` and ``[pressures]`` (all optional).
+
+    Raises
+    ------
+    ConfigError
+        Unknown section or key, unknown unit, or a value of the wrong type.
+    """
+    sections = {"log": LOG_KEYS, "columns": None, "pressures": AREA_KEYS}
+    unknown = sorted(set(document) - set(sections))
+    if unknown:
+        raise ConfigError(f"{source}: unknown section [{unknown[0]}]; valid sections are "
+                          "[log], [columns], [pressures].")
+    settings: dict[str, Any] = {}
+    for section, keys in (("log", LOG_KEYS), ("pressures", AREA_KEYS)):
+        table = document.get(section, {})
+        bad = sorted(set(table) - set(keys))
+        if bad:
+            raise ConfigError(f"{source}: [{section}] has unknown key {bad[0]!r}; valid keys "
+                              f"are {', '.join(keys)}.")
+        settings.update(table)
+    columns: dict[str, ColumnSource] = {}
+    for key, value in document.get("columns", {}).items():
+        targets = _expand(key, source)
+        for index, target in enumerate(targets, start=1):
+            columns[target] = _column_source(target, value, source,
+                                             index if len(targets) > 1 else None)
+    return LogFormat(columns=columns, source=source, **_checked_settings(settings, source))
+
+
+def _checked_settings(settings: dict[str, Any], source: str) -> dict[str, Any]:
+    delimiter = settings.get("delimiter")
+    if delimiter is not None:
+        delimiter = {"tab": "\t", "\\t": "\t"}.get(delimiter, delimiter)
+        if delimiter not in DELIMITERS:
+            raise ConfigError(f"{source}: delimiter must be ',', ';' or 'tab'; got "
+                              f"{settings['delimiter']!r}.")
+        settings["delimiter"] = delimiter
+    if settings.get("decimal") not in (None, ".", ","):
+        raise ConfigError(f"{source}: decimal must be '.' or ','; got {settings['decimal']!r}.")
+    encoding = settings.get("encoding")
+    if encoding is not None:
+        try:
+            "".encode(str(encoding))
+        except LookupError:
+            raise ConfigError(f"{source}: unknown encoding {encoding!r}; use e.g. 'utf-8', "
+                              "'latin-1' or 'cp1252'.") from None
+    rows = settings.get("skip_rows", 0)
+    try:
+        rows = int(rows)
+    except (TypeError, ValueError):
+        rows = -1
+    if rows < 0:
+        raise ConfigError(f"{source}: skip_rows must be an integer >= 0; got "
+                          f"{settings['skip_rows']!r}.")
+    settings["skip_rows"] = rows
+    for key in AREA_KEYS:
+        area = settings.get(key)
+        if area is not None:
+            try:
+                area = float(area)
+            except (TypeError, ValueError):
+                area = math.nan
+            if not 1e-6 <= area <= 10.0:
+                raise ConfigError(f"{source}: {key} must be a cylinder area in m^2 between "
+                                  f"1e-6 and 10; got {settings[key]!r} (mm^2 or cm^2?).")
+            settings[key] = area
+    return settings
+
+
+def load_log_format(spec: str | Path) -> LogFormat:
+    """A :class:`LogFormat` from a TOML file or an inline ``KEY=VALUE,...`` string.
+
+    Parameters
+    ----------
+    spec : str or Path
+        Path of a ``.toml`` file, or entries such as ``"t=Time:ms,l1..l6=Leg{k}:mm,
+        delimiter=;"``: each key is an interchange column (or range) mapped as in the
+        ``[columns]`` section, or a key of ``[log]`` / ``[pressures]``.
+
+    Raises
+    ------
+    ConfigError
+        The file is missing, not UTF-8, not valid TOML, or any entry is invalid.
+    """
+    text = str(spec)
+    if isinstance(spec, Path) or text.lower().endswith(".toml") or Path(text).is_file():
+        path = Path(spec)
+        if not path.is_file():
+            raise ConfigError(f"column mapping file {text!r} not found; give a TOML file "
+                              "(docs/logs.md) or inline entries such as t=Time:ms.")
+        return log_format_from_mapping(parse_toml(path), str(path))
+    document: dict[str, dict[str, Any]] = {"log": {}, "columns": {}, "pressures": {}}
+    for entry in filter(None, (e.strip() for e in text.split(","))):
+        key, equals, value = (part.strip() for part in entry.partition("="))
+        if not equals:
+            raise ConfigError(f"--columns: entry {entry!r} must read KEY=VALUE, e.g. t=Time:ms "
+                              "or l1..l6=:mm.")
+        section = "log" if key in LOG_KEYS else "pressures" if key in AREA_KEYS else "columns"
+        document[section][key] = value
+    return log_format_from_mapping(document, "--columns")
+
+
+def parse_toml(path: Path) -> dict[str, Any]:
+    """Parse a TOML file; a file that is not UTF-8 or not TOML is a ConfigError naming it."""
+    try:
+        return tomllib.loads(read_toml_text(path))
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path} is not valid TOML: {exc}.") from None
+
+
+# -- reading a log ---------------------------------------------------------------------------
+
+def decode_text(data: bytes, where: str, encoding: str | None = None) -> str:
+    """Text of a log: the given encoding, else by byte-order mark, else strict UTF-8.
+
+    Raises
+    ------
+    DataError
+        Naming the file, the line of the first undecodable byte and the fix.
+    """
+    if encoding is None:
+        if data.startswith((b"\xff\xfe", b"\xfe\xff")):
+            encoding = "utf-16"
+        else:
+            encoding = "utf-8-sig"
+    try:
+        return data.decode(encoding)
+    except UnicodeDecodeError as exc:
+        line = data[:exc.start].count(b"\n") + 1
+        raise DataError(f"{where}: not {encoding.removesuffix('-sig')} text (byte "
+                        f"0x{data[exc.start]:02x} on line {line}); name its encoding, e.g. "
+                        "--columns encoding=latin-1.") from None
+
+
+def detect_delimiter(lines: list[str]) -> str:
+    """The delimiter among ``,`` ``;`` tab that splits the header and the next lines into
+    the same, largest number of fields; ``,`` when none does."""
+    best, best_count = ",", 0
+    for delimiter in DELIMITERS:
+        counts = {line.count(delimiter) for line in lines if line.strip()}
+        count = counts.pop() if len(counts) == 1 else 0
+        if count > best_count:
+            best, best_count = delimiter, count
+    return best
+
+
+_DECIMAL_COMMA = re.compile(r"^\s*[+-]?\d+,\d+([eE][+-]?\d+)?\s*$")
+
+
+def read_table(path: Path, kind: str, log_format: LogFormat | None = None
+               ) -> pd.DataFrame | dict[str, np.ndarray]:
+    """Read a log (CSV or Parquet) and map it to the interchange columns in SI units.
+
+    Parameters
+    ----------
+    path : Path
+    kind : {'csv', 'parquet'}
+    log_format : LogFormat, optional
+        Column mapping, units, delimiter, encoding; detection and identity mapping otherwise.
+
+    Returns
+    -------
+    DataFrame, or dict of str to ndarray
+        The table; a plain CSV file in the interchange format without a log format comes as
+        its float columns (:mod:`stewartid.datasets.plain_csv`).
+
+    Raises
+    ------
+    DataError
+        The file cannot be decoded or parsed, or the mapping does not fit it.
+    """
+    log_format = log_format or LogFormat()
+    where = str(path)
+    if kind == "csv":
+        try:
+            text = decode_text(path.read_bytes(), where, log_format.encoding)
+        except OSError as exc:
+            raise DataError(f"{path}: cannot be read as {kind}: {exc}") from exc
+        lines = _head_lines(text, log_format.skip_rows + 6)[log_format.skip_rows:]
+        delimiter = log_format.delimiter or detect_delimiter(lines)
+        decimal = log_format.decimal
+        if decimal is None:
+            fields = lines[1].split(delimiter) if len(lines) > 1 else []
+            decimal = "," if delimiter != "," and any(
+                _DECIMAL_COMMA.match(f) for f in fields) else "."
+        if (delimiter, decimal) == (",", ".") and not log_format.columns and (
+                log_format.skip_rows == 0):
+            columns = read_plain_csv(text.encode("utf-8"))
+            # forces from pressures, and every message about a bad file, come from below
+            if columns is not None and all(f in columns for f in _FORCES):
+                return columns
+    import pandas as pd
+
+    try:
+        if kind == "parquet":
+            frame = pd.read_parquet(path)
+        else:
+            frame = pd.read_csv(io.StringIO(text), sep=delimiter, decimal=decimal,
+                                skiprows=log_format.skip_rows, skipinitialspace=True)
+    except (ValueError, OSError, pd.errors.ParserError) as exc:
+        if isinstance(exc, DataError):
+            raise
+        raise DataError(f"{path}: cannot be read as {kind}: {exc}") from exc
+    frame.columns = [str(c).strip() for c in frame.columns]
+    return log_format.to_interchange(frame, where)
+
+
+def _head_lines(text: str, count: int) -> list[str]:
+    """``text.splitlines()[:count]`` without splitting the whole text."""
+    size = 4096
+    while True:
+        lines = text[:size].splitlines()
+        if size >= len(text):
+            return lines[:count]
+        if len(lines) > count:  # the last line of the prefix may be cut short
+            return lines[:count]
+        size *= 4
+
+
+__all__ = ["MAPPABLE", "PRESSURE_COLUMNS", "UNITS", "ColumnSource", "LogFormat",
+           "decode_text", "detect_delimiter", "load_log_format", "log_format_from_mapping",
+           "parse_toml", "read_table"]

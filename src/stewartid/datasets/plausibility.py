@@ -1,0 +1,349 @@
+"""Physical consistency of measured data with the platform description.
+
+A log with a unit, a frame, a leg numbering or a platform file wrong is still a table of
+finite numbers, and an identification on it runs to the end with a wrong answer. These checks
+compare the data with what the platform description implies, where the two meet:
+
+- leg lengths near the neutral leg length, positions near the neutral pose, angles small;
+- logged leg lengths against the inverse kinematics of the logged pose (both present);
+- static balance: the mean actuator forces against the weight of the platform and legs;
+- the identified Mt, Bt against the nominal ones of the platform description.
+
+Each failure is a :class:`~stewartid.errors.DataError` naming the likely cause and the fix;
+a mismatch a user may mean (a payload missing from the platform file, a constant leg-length
+calibration offset, an identified matrix a little off) is a
+:class:`~stewartid.datasets.dataset.DataWarning`. The thresholds below are the documented factors.
+"""
+
+from __future__ import annotations
+
+import itertools
+import warnings
+
+import numpy as np
+
+from stewartid.datasets.arrays import median
+from stewartid.errors import DataError
+from stewartid.platform import Platform
+
+#: Largest |rx|, |ry|, |rz| (rad) a hexapod reaches; larger values are angles in degrees.
+MAX_ANGLE_RAD = 1.0
+#: Largest distance of the logged position from neutral, as a fraction of neutral_height.
+MAX_POSITION_OFFSET = 0.5
+#: Largest relative deviation of the median leg length from the neutral leg length.
+MAX_LENGTH_DEVIATION = 0.5
+#: Inverse kinematics: the varying part of (logged - computed) leg lengths may reach the
+#: larger of this (m) and IK_EXCURSION_FRACTION of the legs' RMS excursion.
+IK_TOLERANCE_M = 0.5e-3
+IK_EXCURSION_FRACTION = 0.1
+#: A constant leg-length offset above IK_TOLERANCE_M is a warning; above this fraction of the
+#: neutral leg length it is an error (strokes logged instead of gimbal-to-gimbal lengths).
+MAX_LENGTH_OFFSET = 0.05
+#: Static balance: relative deviation of the mean vertical force from the weight that gives
+#: a warning, and one that gives an error.
+BALANCE_WARNING = 0.05
+BALANCE_ERROR = 0.2
+#: A single leg's mean force may differ from its static share by this fraction.
+LEG_BALANCE_ERROR = 0.5
+#: Identified diagonal of Mt or Bt beyond this factor of the nominal one: a warning.
+NOMINAL_WARNING_FACTOR = 2.0
+#: Identified diagonal of Mt beyond this factor of the nominal one: an error (units).
+NOMINAL_ERROR_FACTOR = 10.0
+
+#: Samples used by the checks (an evenly strided subset keeps them fast on long logs).
+CHECK_SAMPLES = 2000
+_FLIP_Z_UP = np.array([1.0, -1.0, -1.0, 1.0, -1.0, -1.0])
+
+
+def _warn(message: str) -> None:
+    from stewartid.datasets.dataset import DataWarning
+
+    warnings.warn(message, DataWarning, stacklevel=3)
+
+
+def _subsample(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
+    stride = max(1, int(np.ceil(len(arrays[0]) / CHECK_SAMPLES)))
+    return tuple(a[::stride] for a in arrays)
+
+
+def check_leg_lengths(lengths: np.ndarray, platform: Platform, where: str) -> None:
+    """Logged leg lengths must be near the platform's neutral leg length.
+
+    Parameters
+    ----------
+    lengths : ndarray, shape (N, 6)
+        Logged leg lengths (m).
+    platform : Platform
+    where : str
+        File named in the message.
+
+    Raises
+    ------
+    DataError
+        Lengths in mm or cm, strokes instead of gimbal-to-gimbal lengths, wrong platform.
+    """
+    neutral = platform.neutral_leg_length
+    ratio = median(lengths) / neutral
+    if abs(ratio - 1.0) <= MAX_LENGTH_DEVIATION:
+        return
+    if abs(ratio / 1000.0 - 1.0) <= MAX_LENGTH_DEVIATION:
+        cause = "they look like millimetres: map them with --columns l1..l6=:mm"
+    elif abs(ratio / 100.0 - 1.0) <= MAX_LENGTH_DEVIATION:
+        cause = "they look like centimetres: map them with --columns l1..l6=:cm"
+    elif ratio < 1.0:
+        cause = ("actuator strokes instead of gimbal-to-gimbal lengths? add the length at zero "
+                 "stroke as an offset (docs/logs.md), or check --platform")
+    else:
+        cause = "check the length unit (m) and --platform"
+    raise DataError(f"{where}: leg lengths l1..l6 have median {median(lengths):.4g}, but "
+                    f"platform '{platform.name}' has {neutral:.4g} m legs at neutral; {cause}.")
+
+
+def check_pose(pose: np.ndarray, platform: Platform, where: str) -> None:
+    """A logged pose must be near the neutral pose, in metres and radians, z down.
+
+    Parameters
+    ----------
+    pose : ndarray, shape (N, 6)
+        Logged pose q = [x, y, z, rx, ry, rz] (m, rad; absolute, paper frame).
+    platform : Platform
+    where : str
+
+    Raises
+    ------
+    DataError
+        Angles in degrees; positions in mm, relative to neutral or in a z-up frame.
+    """
+    angles = np.max(np.abs(pose[:, 3:]), axis=0)
+    if np.max(angles) > MAX_ANGLE_RAD:
+        name = ("rx", "ry", "rz")[int(np.argmax(angles))]
+        raise DataError(f"{where}: column {name} reaches {np.max(angles):.4g} rad, beyond any "
+                        f"hexapod (> {MAX_ANGLE_RAD} rad); angles in degrees? map them with "
+                        "--columns rx..rz=:deg.")
+    neutral = platform.neutral_pose
+    height = platform.geometry.neutral_height
+    offset = np.max(np.abs(pose[:, :3] - neutral[:3]))
+    if offset <= MAX_POSITION_OFFSET * height:
+        return
+    z = median(pose[:, 2])
+    if abs(z) < MAX_POSITION_OFFSET * height:
+        cause = (f"the pose looks relative to neutral; add offset = {neutral[2]:.6g} to z "
+                 "(docs/logs.md)")
+    elif abs(z + neutral[2]) < MAX_POSITION_OFFSET * height:
+        cause = ("z points up; the paper frame is z down (docs/conventions.md): map y, z, ry, "
+                 "rz with scale = -1")
+    elif abs(z / (1000.0 * neutral[2]) - 1.0) < MAX_POSITION_OFFSET:
+        cause = "x, y, z look like millimetres: map them with --columns x..z=:mm"
+    else:
+        cause = "check the position unit (m), the frame and --platform"
+    raise DataError(f"{where}: the position is {offset:.4g} m from the neutral pose of platform "
+                    f"'{platform.name}' (z = {neutral[2]:.6g} m); {cause}.")
+
+
+def _ik_misfit(pose: np.ndarray, lengths: np.ndarray, platform: Platform
+               ) -> tuple[float, np.ndarray]:
+    """RMS of the varying part of lengths - IK(pose) (m) and its constant part per leg."""
+    from stewartid.model.kinematics import leg_lengths
+
+    residual = lengths - leg_lengths(platform, pose)
+    constant = residual.mean(axis=0)
+    return float(np.sqrt(np.mean((residual - constant) ** 2))), constant
+
+
+def check_inverse_kinematics(pose: np.ndarray, lengths: np.ndarray, platform: Platform,
+                             where: str) -> None:
+    """Logged leg lengths must match the inverse kinematics of the logged pose.
+
+    Parameters
+    ----------
+    pose : ndarray, shape (N, 6)
+        Logged pose (m, rad).
+    lengths : ndarray, shape (N, 6)
+        Logged leg lengths (m).
+    platform : Platform
+    where : str
+
+    Raises
+    ------
+    DataError
+        Naming the likely cause (a unit, the frame, the leg numbering, the platform file).
+
+    Warns
+    -----
+    DataWarning
+        For a constant offset between logged and computed lengths (sensor calibration).
+    """
+    pose, lengths = _subsample(pose, lengths)
+    excursion = float(np.sqrt(np.mean((lengths - lengths.mean(axis=0)) ** 2)))
+    tolerance = max(IK_TOLERANCE_M, IK_EXCURSION_FRACTION * excursion)
+    limit = MAX_LENGTH_OFFSET * platform.neutral_leg_length
+
+    def fits(candidate_pose: np.ndarray, candidate_lengths: np.ndarray) -> bool:
+        misfit, constant = _ik_misfit(candidate_pose, candidate_lengths, platform)
+        return misfit <= tolerance and np.max(np.abs(constant)) <= limit
+
+    misfit, constant = _ik_misfit(pose, lengths, platform)
+    if misfit <= tolerance and np.max(np.abs(constant)) <= limit:
+        if np.max(np.abs(constant)) > IK_TOLERANCE_M:
+            leg = int(np.argmax(np.abs(constant)))
+            _warn(f"{where}: l{leg + 1} is {constant[leg] * 1e3:+.3g} mm off the inverse "
+                  "kinematics of the logged pose, constantly (a calibration offset?); the "
+                  "pose is used.")
+        return
+    degrees = pose.copy()
+    degrees[:, 3:] *= np.pi / 180.0
+    millimetres = pose.copy()
+    millimetres[:, :3] /= 1000.0
+    candidates = [
+        ("rx, ry, rz look like degrees: map them with --columns rx..rz=:deg", degrees, lengths),
+        ("x, y, z look like millimetres: map them with --columns x..z=:mm", millimetres,
+         lengths),
+        ("the pose is in a z-up frame; the paper frame is z down (docs/conventions.md)",
+         pose * _FLIP_Z_UP, lengths),
+    ]
+    cause = next((cause for cause, candidate_pose, candidate_lengths in candidates
+                  if fits(candidate_pose, candidate_lengths)), None)
+    cause = cause or _leg_order(pose, lengths, platform, fits) or (
+        "wrong platform file (--platform), leg numbering or frame? see docs/logs.md")
+    raise DataError(f"{where}: leg lengths l1..l6 differ from the inverse kinematics of the "
+                    f"logged pose by {misfit * 1e3:.3g} mm RMS (tolerance "
+                    f"{tolerance * 1e3:.2g} mm); {cause}.")
+
+
+def _leg_order(pose: np.ndarray, lengths: np.ndarray, platform: Platform, fits) -> str | None:
+    """A renumbering of the logged legs that matches the inverse kinematics, as a message."""
+    from stewartid.model.kinematics import leg_lengths
+
+    computed = leg_lengths(platform, pose)
+    computed = computed - computed.mean(axis=0)
+    logged = lengths - lengths.mean(axis=0)
+    cost = np.sqrt(np.mean((logged[:, :, None] - computed[:, None, :]) ** 2, axis=0))
+    totals = {p: sum(cost[j, p[j]] for j in range(6)) for p in itertools.permutations(range(6))}
+    lowest = min(totals.values())
+    # legs that move alike in one experiment tie; the renumbering that moves fewest wins
+    best = min((p for p, total in totals.items() if total <= lowest + IK_TOLERANCE_M),
+               key=lambda p: sum(j != p[j] for j in range(6)))
+    if best == tuple(range(6)) or not fits(pose, lengths[:, np.argsort(best)]):
+        return None
+    mapping = ",".join(f"l{best[j] + 1}=l{j + 1}" for j in range(6) if best[j] != j)
+    return (f"the legs are numbered differently from docs/conventions.md: map them with "
+            f"--columns {mapping}")
+
+
+def check_static_balance(pose: np.ndarray, forces: np.ndarray, platform: Platform,
+                         where: str) -> None:
+    """The mean actuator forces must carry the weight the platform description implies.
+
+    Over a record of whole excitation periods the inertial and viscous forces average out,
+    so the mean generalised leg force J_lq(q)^T f balances the gravity term G(q).
+
+    Parameters
+    ----------
+    pose : ndarray, shape (N, 6)
+        Pose (m, rad).
+    forces : ndarray, shape (N, 6)
+        Actuator forces along the legs (N, positive extends).
+    platform : Platform
+    where : str
+
+    Raises
+    ------
+    DataError
+        Forces near zero, in kN, of the opposite sign, a single dead channel, or a weight
+        more than :data:`BALANCE_ERROR` off (wrong platform file).
+
+    Warns
+    -----
+    DataWarning
+        A weight off by more than :data:`BALANCE_WARNING` (a payload not in the file?).
+    """
+    from stewartid.model.kinematics import _leg_terms
+
+    pose, forces = _subsample(pose, forces)
+    # the pose-only leg terms that preparation uses too: no mass matrix, no compiled kernel
+    gravity, leg_jacobian, _, _ = _leg_terms(platform, np.ascontiguousarray(pose))
+    generalized = np.einsum("nij,ni->nj", leg_jacobian, forces)
+    weight = -float(np.mean(gravity[:, 2]))
+    ratio = round(-float(np.mean(generalized[:, 2])) / weight, 6) + 0.0  # no "-0"
+    what = (f"{where}: the forces f1..f6 carry {ratio:.3g} times the weight of platform "
+            f"'{platform.name}' ({weight:.4g} N)")
+    if abs(ratio * 1000.0 - 1.0) <= BALANCE_ERROR:
+        raise DataError(f"{what}; forces in kN? map them with --columns f1..f6=:kN.")
+    if abs(ratio) < 0.02:
+        raise DataError(f"{what}; force channels unplugged or not logged?")
+    if abs(ratio + 1.0) <= BALANCE_ERROR:
+        raise DataError(f"{what}; positive must extend the leg: map f1..f6 with scale = -1 "
+                        "(docs/logs.md).")
+    if abs(ratio - 1.0) > BALANCE_ERROR:
+        raise DataError(f"{what}; wrong platform file (--platform) or force unit (N)?")
+    static = np.linalg.solve(np.transpose(leg_jacobian, (0, 2, 1)), gravity[..., None])[..., 0]
+    shares = forces.mean(axis=0) / static.mean(axis=0)
+    leg = int(np.argmax(np.abs(shares - 1.0)))
+    if abs(shares[leg] - 1.0) > LEG_BALANCE_ERROR:
+        raise DataError(f"{where}: column f{leg + 1} carries {shares[leg]:.3g} times its static "
+                        "load, the other legs about their share; check that channel "
+                        "(unplugged, unit, sign).")
+    if abs(ratio - 1.0) > BALANCE_WARNING:
+        _warn(f"{what}: a payload missing from [inertia] platform_mass?")
+
+
+def check_dataset(pose: np.ndarray, lengths: np.ndarray, forces: np.ndarray,
+                  platform: Platform, where: str, both_logged: bool) -> None:
+    """The consistency checks that need pose, lengths and forces together.
+
+    Parameters
+    ----------
+    pose, lengths, forces : ndarray, shape (N, 6)
+        m and rad; m; N.
+    platform : Platform
+    where : str
+    both_logged : bool
+        True when the log held both the pose and the leg lengths (then they must agree).
+    """
+    if both_logged:
+        check_inverse_kinematics(pose, lengths, platform, where)
+    check_static_balance(pose, forces, platform, where)
+
+
+def check_identified(M: np.ndarray, B: np.ndarray, platform: Platform) -> None:
+    """Identified Mt, Bt against the nominal ones of the platform description.
+
+    Parameters
+    ----------
+    M, B : ndarray, shape (6, 6)
+        Identified inertia (kg, kg m, kg m^2) and viscous (N s/m, N m s/rad) matrices.
+    platform : Platform
+
+    Raises
+    ------
+    DataError
+        A diagonal entry of Mt beyond :data:`NOMINAL_ERROR_FACTOR` of the nominal one.
+
+    Warns
+    -----
+    DataWarning
+        A diagonal entry of Mt or Bt beyond :data:`NOMINAL_WARNING_FACTOR`.
+    """
+    from stewartid.model.linearization import nominal_matrices
+
+    nominal = dict(zip(("Mt", "Bt"), nominal_matrices(platform), strict=True))
+    hint = ("check the units (t s, x..z m, rx..rz rad, f N), the friction model and "
+            "--platform (docs/logs.md)")
+    for label, identified in (("Mt", M), ("Bt", B)):
+        reference = np.diag(nominal[label])
+        values = np.diag(identified)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratios = np.where(reference > 0, values / reference, 1.0)
+        worst = int(np.argmax(np.abs(np.log(np.abs(ratios) + 1e-300))))
+        factor = ratios[worst]
+        entry = (f"identified {label}({worst + 1},{worst + 1}) = {values[worst]:.5g} is "
+                 f"{factor:.3g} times the nominal {reference[worst]:.5g} of platform "
+                 f"'{platform.name}'")
+        if label == "Mt" and not 1 / NOMINAL_ERROR_FACTOR <= factor <= NOMINAL_ERROR_FACTOR:
+            raise DataError(f"{entry}; {hint}.")
+        if not 1 / NOMINAL_WARNING_FACTOR <= factor <= NOMINAL_WARNING_FACTOR:
+            _warn(f"{entry}; {hint}.")
+
+
+__all__ = ["check_dataset", "check_identified", "check_inverse_kinematics",
+           "check_leg_lengths", "check_pose", "check_static_balance"]

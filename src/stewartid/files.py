@@ -1,0 +1,165 @@
+"""Every file the package writes goes through here: atomic writes and one JSON conversion.
+
+Atomic: the bytes go to a temporary file in the target folder which is then renamed over the
+target, so a reader never sees a half-written data set, table, figure, report or JSON file,
+and an interrupted run leaves the previous file intact.
+
+JSON: :func:`to_jsonable` turns arrays, NumPy scalars, tuples and paths into plain JSON
+values. JSON has no non-finite numbers, so NaN and ±infinity are written as ``null``
+(readers turn ``null`` back into NaN: :meth:`IdentificationResult.from_dict
+<stewartid.identification.result.IdentificationResult.from_dict>` and
+:func:`stewartid.reports.reproduction.document.load_results` do). Any other object is a bug and
+raises TypeError.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from collections.abc import Callable, Iterable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stewartid.errors import OutputExistsError
+
+
+def write_bytes_atomic(path: str | Path, data: bytes) -> Path:
+    """Write ``data`` to ``path`` through a temporary file in the same folder and a rename.
+
+    The folder is created if missing; the file gets the usual permissions (umask).
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            stream.write(data)
+        # mkstemp creates the file private (0600); give it the usual permissions
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(temporary, 0o666 & ~umask)
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def write_text_atomic(path: str | Path, text: str) -> Path:
+    """Write UTF-8 ``text`` to ``path`` atomically."""
+    return write_bytes_atomic(path, text.encode("utf-8"))
+
+
+def to_jsonable(value: Any) -> Any:
+    """``value`` as plain JSON values: arrays and tuples become lists, NumPy scalars Python
+    numbers, paths strings, dict keys strings, and NaN or ±infinity ``None`` (``null``).
+
+    Raises
+    ------
+    TypeError
+        For any other object.
+    """
+    if isinstance(value, np.ndarray):
+        return to_jsonable(value.tolist())
+    if isinstance(value, dict):
+        return {str(k): to_jsonable(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [to_jsonable(v) for v in value]
+    if isinstance(value, np.generic):
+        return to_jsonable(value.item())
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, str | int | bool) or value is None:
+        return value
+    if isinstance(value, Path):
+        return str(value)
+    raise TypeError(f"cannot write a {type(value).__name__} as JSON: {value!r}")
+
+
+def write_json_atomic(path: str | Path, document: Any) -> Path:
+    """Write ``document`` (converted by :func:`to_jsonable`) as indented JSON, atomically."""
+    text = json.dumps(to_jsonable(document), indent=1, allow_nan=False)
+    return write_text_atomic(path, text + "\n")
+
+
+def check_output_folder(directory: str | Path, force: bool,
+                        is_result: Callable[[Path], bool] | None = None) -> None:
+    """Refuse to write into a folder that already holds results, unless ``force``.
+
+    Parameters
+    ----------
+    directory : str or Path
+        The output folder (need not exist).
+    force : bool
+        Overwrite: existing files are then replaced one by one, nothing else is deleted.
+    is_result : callable, optional
+        Which files count as results; by default every entry (the folder must be empty).
+
+    Raises
+    ------
+    OutputExistsError
+        If ``directory`` is a file, or holds results and not ``force``.
+    """
+    directory = Path(directory)
+    if directory.exists() and not directory.is_dir():
+        raise OutputExistsError(f"output path {str(directory)!r} exists and is not a folder; "
+                                "choose another folder.")
+    if force or not directory.is_dir():
+        return
+    existing = sorted(p.name for p in directory.iterdir() if is_result is None or is_result(p))
+    if existing:
+        what = "is not empty" if is_result is None else "already holds results"
+        raise OutputExistsError(f"output folder {str(directory)!r} {what} ({existing[0]}); "
+                                "choose another folder or pass --force to overwrite.")
+
+
+def check_output_file(path: str | Path, force: bool, inputs: Iterable[str | Path] = (),
+                      is_result: Callable[[Path], bool] | None = None,
+                      option: str = "--out") -> None:
+    """Check, before any computation, that ``path`` can take an output file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The output file (its folder is created when written if missing).
+    force : bool
+        Overwrite an existing file that is not an earlier result. Inputs are never
+        overwritten, whatever ``force``.
+    inputs : iterable of str or Path
+        Files the command reads.
+    is_result : callable, optional
+        Which existing files are earlier results of the same command, overwritten without
+        ``force``; by default none is.
+    option : str
+        Option named in the messages.
+
+    Raises
+    ------
+    OutputExistsError
+        ``path`` is a folder, one of ``inputs``, an existing file that is not an earlier
+        result (without ``force``), or lies under a file or a folder that cannot be written.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise OutputExistsError(f"{option} {str(path)!r} is a folder; give a file name, e.g. "
+                                f"{str(path / 'result.json')!r}.")
+    target = path.resolve()
+    for source in inputs:
+        if Path(source).resolve() == target:
+            raise OutputExistsError(f"{option} {str(path)!r} is one of the input files; give "
+                                    "another file name.")
+    if path.exists() and not force and not (is_result is not None and is_result(path)):
+        raise OutputExistsError(f"{option} {str(path)!r} exists and is not an earlier result; "
+                                "give another file name or pass --force to overwrite it.")
+    folder = next(p for p in target.parents if p.exists())
+    if not folder.is_dir() or not os.access(folder, os.W_OK):
+        raise OutputExistsError(f"{option} {str(path)!r}: {str(folder)!r} is not a writable "
+                                "folder; give another file name.")
+
+
+__all__ = ["check_output_file", "check_output_folder", "to_jsonable", "write_bytes_atomic",
+           "write_json_atomic", "write_text_atomic"]

@@ -1,0 +1,203 @@
+"""Constant-direction intervals of one measured experiment, with the noise levels that
+decide them: the first step of Method B.
+
+The pose is smoothed and differentiated (Savitzky-Golay, window from the excitation
+frequency estimated from the data), mapped to the rates of the 30 joint axes and the 6
+actuators, and cut where any active joint reverses (:mod:`.intervals`). The noise of each
+rate is estimated from the data (:mod:`.noise`), so that a reversal inside the noise band
+stays outside every interval.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from typing import NamedTuple
+
+import numpy as np
+
+from stewartid.datasets.dataset import DataWarning
+from stewartid.errors import IdentificationError
+from stewartid.identification.preparation import Experiment
+from stewartid.identification.wavelet.intervals import constant_direction_intervals, joint_rates
+from stewartid.identification.wavelet.noise import joint_rate_noise, white_noise_covariance
+from stewartid.model.kinematics import joint_rate_jacobians
+from stewartid.platform import COORDINATES, Platform
+from stewartid.signals.differentiation import default_window, differentiate, estimate_frequency
+
+
+class Detection(NamedTuple):
+    """Constant-direction intervals of one experiment and what their detection measured.
+
+    Attributes
+    ----------
+    intervals : ndarray, shape (M, 2)
+        Usable [start, stop] (s).
+    info : dict
+        Counts, lengths, the differentiation window, the pose-noise covariance and the
+        white-noise variance of the generalized force.
+    joint_rates : ndarray, shape (N, 6, 5)
+        Smoothed joint-axis rates (rad/s).
+    rate_noise : ndarray, shape (6, 5)
+        Their noise levels (rad/s).
+    q_dot, q_ddot : ndarray, shape (N, 6)
+        Savitzky-Golay derivatives of the pose.
+    """
+
+    intervals: np.ndarray
+    info: dict
+    joint_rates: np.ndarray
+    rate_noise: np.ndarray
+    q_dot: np.ndarray
+    q_ddot: np.ndarray
+
+
+#: Samples per block when joint Jacobians are formed on the fly (1.4 kB a sample).
+BLOCK_SAMPLES = 65536
+
+
+#: Joints whose rate RMS is below this multiple of its noise level count as idle.
+IDLE_NOISE_RATIO = 2.0
+#: A DOF moved by the experiments that gave intervals less than this fraction of its largest
+#: motion in any experiment has lost its excitation.
+COVERAGE_FRACTION = 0.1
+
+
+def raise_no_interval(infos: Sequence[dict]) -> None:
+    """Raise the error for data without a single usable interval (``infos`` of
+    :func:`detect_intervals`), naming the longest found and what was needed."""
+    longest = max(info["longest_interval"] for info in infos)
+    needed = min(info["shortest_usable"] for info in infos)
+    raise IdentificationError(
+        f"no constant-direction interval long enough for the smallest wavelet scale "
+        f"in any experiment (longest {longest:.3g} s, at least {needed:.3g} s needed); "
+        "excite with a slower single-frequency sine, lower 'margin' or "
+        "'min_support_samples', raise 'ignore_below' to leave idle joints out, or "
+        "record at a higher sample rate.")
+
+
+def check_coverage(names: Sequence[str], motion: np.ndarray, counts: Sequence[int]) -> None:
+    """Warn for every experiment without a usable interval; raise when those left out were
+    the only ones to move a DOF (its entries would rest on noise, with small standard errors).
+
+    Parameters
+    ----------
+    names : sequence of str
+        Experiment names.
+    motion : ndarray, shape (n_experiments, 6)
+        RMS of each pose coordinate about its mean (m, rad).
+    counts : sequence of int
+        Usable intervals per experiment.
+    """
+    counts = np.asarray(counts)
+    for name, count in zip(names, counts, strict=True):
+        if count == 0:
+            warnings.warn(f"{name}: no usable constant-direction interval (joint rates within "
+                          f"their noise, or reversals too close together); it adds nothing "
+                          f"to Method B", DataWarning, stacklevel=3)
+    largest = motion.max(axis=0)
+    kept = motion[counts > 0].max(axis=0) if np.any(counts > 0) else np.zeros(6)
+    lost = [c for c, k, top in zip(COORDINATES, kept, largest, strict=True)
+            if top > 0 and k < COVERAGE_FRACTION * top]
+    if lost:
+        raise IdentificationError(
+            f"DOF {', '.join(lost)} lost its excitation: the experiments that move it most "
+            f"({', '.join(n for n, c in zip(names, counts, strict=True) if c == 0)}) gave no "
+            f"usable constant-direction interval; check their joint-rate noise in the "
+            f"diagnostics, or lower hysteresis / margin")
+
+
+def _joint_rates_in_blocks(experiment: Experiment, platform: Platform, q_dot: np.ndarray
+                           ) -> tuple[np.ndarray, np.ndarray]:
+    """Joint rates (N, 36) and the mean joint-axis Jacobian (1, 6, 5, 6) of an experiment.
+
+    The joint Jacobians (N, 6, 5, 6) of a long record would take 1.4 kB a sample; unless the
+    experiment already holds them they are formed block by block and dropped.
+    """
+    if "joint_jacobians" in vars(experiment):
+        jacobians = experiment.joint_jacobians
+        return (joint_rates(platform, experiment.q, q_dot, jacobians, experiment.leg_jacobian),
+                jacobians.mean(axis=0, keepdims=True))
+    n = len(experiment.q)
+    rates = np.empty((n, 36))
+    total = np.zeros((6, 5, 6))
+    for start in range(0, n, BLOCK_SAMPLES):
+        block = slice(start, min(start + BLOCK_SAMPLES, n))
+        jacobians = joint_rate_jacobians(platform, experiment.q[block])
+        rates[block] = joint_rates(platform, experiment.q[block], q_dot[block], jacobians,
+                                   experiment.leg_jacobian[block])
+        total += jacobians.sum(axis=0)
+    return rates, (total / max(n, 1))[None]
+
+
+def detect_intervals(experiment: Experiment, platform: Platform, *, window: float | None,
+                     margin: float | None, margin_periods: float, hysteresis: float,
+                     ignore_below: float, min_interval: float | None,
+                     min_support_samples: int, smallest: float) -> Detection:
+    """Usable constant-direction intervals of one experiment.
+
+    Parameters
+    ----------
+    experiment : Experiment
+    platform : Platform
+    window : float or None
+        Savitzky-Golay window (s); None: from the estimated excitation frequency.
+    margin : float or None
+        Time cut from both ends of every interval (s); None: ``margin_periods`` periods of
+        the estimated excitation frequency.
+    margin_periods : float
+    hysteresis : float
+        Multiple of each rate's noise level inside which its direction counts as unknown.
+    ignore_below : float
+        Joints whose rate RMS is below this fraction of the largest of their kind are left out.
+    min_interval : float or None
+        Shortest usable interval (s); None: half the median interval.
+    min_support_samples : int
+        Fewest samples the smallest test function's support may cover.
+    smallest : float
+        The smallest support as a fraction of an interval (1 for a whole interval).
+
+    Returns
+    -------
+    Detection
+    """
+    t, q, period = experiment.t, experiment.q, experiment.period
+    rate = 1.0 / period
+    if window is None or margin is None:
+        frequency = estimate_frequency(q, rate)
+        window = default_window(frequency) if window is None else window
+        margin = margin_periods / frequency if margin is None else margin
+    q_smooth, q_dot, q_ddot = differentiate(q, rate, window)
+    rates, mean_jacobian = _joint_rates_in_blocks(experiment, platform, q_dot)
+    noise = white_noise_covariance(q, q_smooth)
+    y = experiment.generalized_force
+    force_noise = np.diag(white_noise_covariance(y, differentiate(y, rate, window)[0]))
+    rate_noise = joint_rate_noise(noise, rate, window, mean_jacobian,
+                                  experiment.leg_jacobian)
+    # a joint whose rate is no larger than its noise has no direction to keep, whatever its
+    # share of the largest rate (pure heave with 20 um pose noise leaves three axes per leg at
+    # 1.0x their noise and 1 % of the largest rate; on some seeds they broke every interval)
+    # (an infinite threshold leaves them out; their rates still give the friction pattern)
+    idle = np.sqrt(np.mean(np.square(rates), axis=0)) < IDLE_NOISE_RATIO * rate_noise
+    found = constant_direction_intervals(t, rates, margin=margin, ignore_below=ignore_below,
+                                         hysteresis=np.where(idle, np.inf,
+                                                             hysteresis * rate_noise))
+    lengths = found[:, 1] - found[:, 0]
+    shortest = (min_interval if min_interval is not None
+                else 0.5 * float(np.median(lengths)) if len(lengths) else 0.0)
+    # the smallest support must cover min_support_samples samples
+    needed = min_support_samples * period / smallest
+    intervals = found[lengths >= max(shortest, needed)]
+    info = {"name": experiment.name, "intervals_found": int(len(found)),
+            "longest_interval": float(lengths.max()) if len(lengths) else 0.0,
+            "shortest_usable": float(max(shortest, needed)),
+            "intervals": intervals, "differentiation_window": float(window),
+            "noise_covariance": noise, "force_noise_variance": force_noise}
+    # a floor keeps the direction weights of noise-free data finite
+    return Detection(intervals=intervals, info=info,
+                     joint_rates=rates[:, :30].reshape(len(t), 6, 5),
+                     rate_noise=np.maximum(rate_noise[:30].reshape(6, 5), 1e-12),
+                     q_dot=q_dot, q_ddot=q_ddot)
+
+
+__all__ = ["Detection", "detect_intervals"]

@@ -1,0 +1,449 @@
+"""Method B: wavelet transform on constant-direction intervals (Zhang 2020).
+
+In a constant-direction interval (no joint reverses, :mod:`.intervals`) the Coulomb friction
+of every joint is constant, and so is what remains of gravity after the pose-dependent G(q)
+has been subtracted. The linearised equation of motion
+
+    Mt q_ddot + Bt q_dot + c = y,        y = J_lq(q)^T f_a - G(q),   c constant,
+
+transformed with a wavelet psi whose moments of order 0 and 1 vanish and whose support lies
+inside the interval, loses the constant:
+
+    [Mt Bt] [W_psi q_ddot ; W_psi q_dot](a, b) = W_psi y (a, b).
+
+Stacking the equations of many (a, b) points from all intervals of all experiments gives a
+least-squares problem for the 72 entries of Mt and Bt.
+
+Variants (``variant``):
+
+``"position"`` (default)
+    No numerical differentiation: integration by parts moves both derivatives onto the
+    wavelet, W_psi q_ddot = W_psi'' q / a^2 and W_psi q_dot = -W_psi' q / a.
+``"paper"``
+    Zhang's equations: W_psi q_ddot and W_psi q_dot = -a W_psi1 q_ddot, with the
+    acceleration from a Savitzky-Golay differentiator (``differentiation_window``).
+``"derivative"``
+    W_psi q_ddot and W_psi q_dot with both signals from the Savitzky-Golay differentiator.
+
+Wavelets (``wavelet``): ``"polynomial"`` (default), psi = g'' with g = (1 - x^2)^p on [-1, 1],
+compactly supported, so the largest scale spans a whole interval (the modulating-function
+idea); ``"mexican_hat"``, the paper's Gaussian wavelet, truncated at +-``truncation`` scales
+(a tenth of the interval at the default 5); the polynomial one is the more accurate.
+
+Default (``test_functions=8``): per interval a family of orthonormalised zero-mean test
+functions spanning the whole interval, the weak form of :mod:`.weak_form`, solved by
+generalized least squares with the force and pose noise estimated from the data and the pose
+noise's bias removed (:mod:`.weak_form_solver`); ``test_functions=None`` uses (a, b) points
+(:mod:`.point_equations`), as the paper does.
+
+Couplings (the paper's Mt(2,4) case): an entry and its transpose come from different
+equations (Mt(5,1) from pitch under surge, Mt(1,5) from surge under pitch), the rotational
+ones the sensitive; ``pair_selection`` combines them
+(:func:`~stewartid.identification.solvers.select_symmetric_pairs`), ``symmetric=True``
+imposes symmetry in the solve instead.
+
+Standard errors are cluster-robust over intervals (the equations of one interval share
+samples and friction state).
+
+References
+----------
+Zhang, C. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
+Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stewartid.datasets.dataset import Dataset
+from stewartid.identification.base import BaseIdentifier, check_parameter
+from stewartid.identification.least_squares import JOINT_TYPES
+from stewartid.identification.preparation import Experiment, prepare
+from stewartid.identification.registry import Preset, register_method
+from stewartid.identification.result import IdentificationResult
+from stewartid.identification.solvers import (
+    bias_compensated_least_squares,
+    regressor_names,
+    select_symmetric_pairs,
+    solve_least_squares,
+)
+from stewartid.identification.wavelet.detection import (
+    Detection,
+    check_coverage,
+    detect_intervals,
+    raise_no_interval,
+)
+from stewartid.identification.wavelet.gls import solve_weak_form
+from stewartid.identification.wavelet.noise import generalized_force_sensitivity
+from stewartid.identification.wavelet.point_equations import EXACT_DEGREE, point_equations
+from stewartid.identification.wavelet.weak_form import interval_equations
+from stewartid.model.kinematics import joint_rate_jacobians
+from stewartid.platform import COORDINATES, Platform
+from stewartid.signals.wavelets import MotherWavelet, PolynomialWavelet, make_wavelet
+
+#: Citation of the method.
+REFERENCE = ("Zhang, C. A Parameter Identification Method for Stewart Manipulator Based on "
+             "Wavelet Transform. Mathematics 8(2), 257 (2020). doi:10.3390/math8020257")
+VARIANTS = ("position", "paper", "derivative")
+#: Default interval margin, in periods of the estimated excitation frequency.
+MARGIN_PERIODS = 0.015
+PAIR_SELECTIONS = ("pooled", "std_error", "none")
+FRICTION_MODELS = ("free", "shared", "uniform")
+
+
+@register_method(
+    name="wavelet", letter="B", color="#d62728",
+    display_name="Method B (wavelet)",
+    description="wavelet transform on constant-direction intervals, derivatives moved onto "
+                "compact polynomial wavelets (the package's Method B)",
+    reference=REFERENCE,
+    presets={"wavelet-paper": Preset(
+        settings={"variant": "paper", "wavelet": "mexican_hat", "test_functions": None},
+        display_name="Method B, paper's equations (Mexican hat)",
+        description="Method B with the paper's own equations: Mexican hat, W q_ddot and "
+                    "a W1 q_ddot from a Savitzky-Golay acceleration",
+        color="#ff7f0e")})
+class WaveletIdentifier(BaseIdentifier):
+    """Identify Mt and Bt by the wavelet method of Zhang (2020) (Method B).
+
+    Parameters
+    ----------
+    wavelet : {"polynomial", "mexican_hat"}
+        Mother wavelet (see the module docstring).
+    wavelet_order : int
+        Exponent p of the polynomial wavelet, 5..20.
+    truncation : float
+        Half-width (scales) at which the Mexican hat is cut.
+    variant : {"position", "paper", "derivative"}
+        How W q_ddot and W q_dot are obtained (see the module docstring).
+    test_functions : int or None
+        Number K of orthonormalised zero-mean test functions per interval, 1..12
+        (:mod:`~stewartid.identification.wavelet.weak_form`; default 8). None: the wavelet transform
+        at (a, b) points set by ``scale_fractions`` and ``shifts_per_scale``, as in the paper.
+        Needs the polynomial wavelet and the position variant.
+    friction : {"free", "shared", "uniform"}
+        With ``test_functions``: "free" (default) leaves every interval constant free (the
+        paper's invariance to any friction law: only q_dot's shape inside an interval informs
+        Bt); "shared" models the constants as an offset per experiment plus the Coulomb
+        level of each joint type through the joint Jacobians, with a scatter estimated from
+        the data, and estimates the levels (``coulomb_``): more precise Bt under noise, biased
+        where the plant's friction departs from that structure (docs/benchmarks.md);
+        "uniform" one level for every axis, as the platform file's ``coulomb``.
+    scale_fractions : tuple of float
+        Wavelet support as fractions of each interval's length, each in (0, 1].
+    shifts_per_scale : int
+        Shifts per scale and interval.
+    margin : float or None
+        Time (s) cut from both ends of every constant-direction interval. None (default):
+        :data:`MARGIN_PERIODS` periods of the estimated excitation frequency (0.03 s at
+        0.5 Hz): idle joints' friction reverses late, but longer intervals inform more
+        (paper platform, 30 N m: noise-free 0.23 / 0.37 % at 0.1 / 0.03 s; reference
+        noise, Bt diagonal 19 / 11 % worst of 8 seeds).
+    ignore_below : float
+        Joints whose rate RMS is below this fraction of the largest of their kind are left
+        out of the interval detection (they barely move, and their sign flips at odd times).
+    min_interval : float or None
+        Shortest usable interval (s); None: half the median interval of each experiment.
+    min_support_samples : int
+        Fewest samples the smallest wavelet's support may cover; intervals too short for it
+        are dropped.
+    differentiation_window : float or None
+        Savitzky-Golay window (s) for the joint rates of the interval detection and, in the
+        ``"paper"`` and ``"derivative"`` variants, for q_dot and q_ddot. None (default): a
+        fifth of the period of the experiment's dominant frequency, estimated from the data,
+        which keeps measurement noise out of the joint rates without moving their zeros.
+    hysteresis : float
+        A joint's direction counts as known only while its rate exceeds this many times the
+        rate's noise level (estimated from the data,
+        :func:`~stewartid.identification.wavelet.noise.joint_rate_noise`); reversals inside the
+        noise band are kept out of every interval (see
+        :func:`~stewartid.identification.wavelet.intervals.constant_direction_intervals`).
+    odd_companion : bool
+        ``test_functions=None``: also use the polynomial wavelet's odd companion g'''
+        (:class:`~stewartid.signals.wavelets.PolynomialWavelet`; ``wavelet_order`` >= 8).
+    noise_correction : bool
+        Position variant: weight by and remove the pose noise's contribution to the normal
+        equations (errors in variables, noise estimated from the data; :mod:`.weak_form_solver`,
+        :func:`~stewartid.identification.solvers.bias_compensated_least_squares`).
+    symmetric : bool
+        Impose Mt = Mt^T and Bt = Bt^T in the solve.
+    pair_selection : {"pooled", "std_error", "none"}
+        Symmetric pairs (not with ``symmetric``): "pooled" (default) the inverse-variance mean
+        of members within 3 standard errors, else the translational one; "std_error" the
+        better-determined member.
+    gravity : bool
+        Subtract the model's pose-dependent gravity G(q) before identification.
+
+    Attributes
+    ----------
+    M_, B_ : ndarray, shape (6, 6)
+    std_errors_ : dict of ndarray (6, 6)
+    condition_number_ : float
+    result_ : IdentificationResult
+        ``diagnostics`` holds, per experiment, the intervals and the (a, b) points used, the
+        joints left out, and which member of each symmetric pair was taken.
+
+    References
+    ----------
+    Zhang (2020), see the module docstring.
+    """
+
+    def __init__(self, wavelet: str = "polynomial", wavelet_order: int = 6,
+                 truncation: float = 5.0, variant: str = "position",
+                 scale_fractions: tuple[float, ...] = (1.0, 0.8, 0.6),
+                 shifts_per_scale: int = 5, test_functions: int | None = 8,
+                 friction: str = "free", margin: float | None = None, ignore_below: float = 0.01,
+                 min_interval: float | None = None, min_support_samples: int = 32,
+                 differentiation_window: float | None = None, hysteresis: float = 4.0,
+                 odd_companion: bool = False, noise_correction: bool = True,
+                 symmetric: bool = False,
+                 pair_selection: str = "pooled", gravity: bool = True):
+        self.wavelet = wavelet
+        self.wavelet_order = wavelet_order
+        self.truncation = truncation
+        self.variant = variant
+        self.scale_fractions = scale_fractions
+        self.shifts_per_scale = shifts_per_scale
+        self.test_functions = test_functions
+        self.friction = friction
+        self.margin = margin
+        self.ignore_below = ignore_below
+        self.min_interval = min_interval
+        self.min_support_samples = min_support_samples
+        self.differentiation_window = differentiation_window
+        self.hysteresis = hysteresis
+        self.odd_companion = odd_companion
+        self.noise_correction = noise_correction
+        self.symmetric = symmetric
+        self.pair_selection = pair_selection
+        self.gravity = gravity
+
+    # ------------------------------------------------------------------ settings
+    def _validate_params(self) -> None:
+        name = type(self).__name__
+        check_parameter(name, "wavelet", self.wavelet,
+                        self.wavelet in ("polynomial", "mexican_hat"),
+                        "'polynomial' or 'mexican_hat'")
+        check_parameter(name, "variant", self.variant, self.variant in VARIANTS,
+                        f"one of {VARIANTS}")
+        fractions = np.atleast_1d(np.asarray(self.scale_fractions, dtype=float))
+        check_parameter(name, "scale_fractions", self.scale_fractions,
+                        fractions.size > 0 and bool(np.all((fractions > 0) & (fractions <= 1))),
+                        "a non-empty sequence of fractions in (0, 1]")
+        check_parameter(name, "shifts_per_scale", self.shifts_per_scale,
+                        isinstance(self.shifts_per_scale, int | np.integer)
+                        and 1 <= self.shifts_per_scale <= 1000, "an integer in [1, 1000]")
+        check_parameter(name, "margin", self.margin,
+                        self.margin is None
+                        or (isinstance(self.margin, int | float) and self.margin >= 0),
+                        "None or a float in [0, inf) (s)")
+        check_parameter(name, "ignore_below", self.ignore_below,
+                        isinstance(self.ignore_below, int | float)
+                        and 0 <= self.ignore_below < 1, "a float in [0, 1)")
+        check_parameter(name, "min_interval", self.min_interval,
+                        self.min_interval is None or (isinstance(self.min_interval, int | float)
+                                                      and self.min_interval > 0),
+                        "None or a float in (0, inf) (s)")
+        check_parameter(name, "min_support_samples", self.min_support_samples,
+                        isinstance(self.min_support_samples, int | np.integer)
+                        and self.min_support_samples >= 8, "an integer >= 8")
+        check_parameter(name, "differentiation_window", self.differentiation_window,
+                        self.differentiation_window is None
+                        or (isinstance(self.differentiation_window, int | float)
+                            and self.differentiation_window > 0),
+                        "None or a float in (0, inf) (s)")
+        check_parameter(name, "hysteresis", self.hysteresis,
+                        isinstance(self.hysteresis, int | float) and self.hysteresis >= 0,
+                        "a float in [0, inf)")
+        check_parameter(name, "test_functions", self.test_functions,
+                        self.test_functions is None
+                        or (isinstance(self.test_functions, int | np.integer)
+                            and 1 <= self.test_functions <= 12), "None or an integer in [1, 12]")
+        check_parameter(name, "friction", self.friction, self.friction in FRICTION_MODELS
+                        and (self.friction == "free" or self.test_functions is not None),
+                        f"one of {FRICTION_MODELS}, 'free' when test_functions is None")
+        if self.test_functions is not None:
+            check_parameter(name, "wavelet", self.wavelet, self.wavelet == "polynomial",
+                            "'polynomial' when test_functions is set (use test_functions=None "
+                            "for the Mexican hat)")
+            check_parameter(name, "variant", self.variant, self.variant == "position",
+                            "'position' when test_functions is set (use test_functions=None "
+                            "for the paper's equations)")
+            check_parameter(name, "wavelet_order", self.wavelet_order,
+                            isinstance(self.wavelet_order, int | np.integer)
+                            and self.wavelet_order >= 3,
+                            "an integer >= 3 when test_functions is set")
+        check_parameter(name, "pair_selection", self.pair_selection,
+                        self.pair_selection in PAIR_SELECTIONS, f"one of {PAIR_SELECTIONS}")
+        make_wavelet(self.wavelet, **self._wavelet_options())
+
+    def _wavelet_options(self) -> dict:
+        if self.wavelet == "polynomial":
+            return {"order": self.wavelet_order}
+        return {"truncation": self.truncation}
+
+    # ------------------------------------------------------------------ equations
+    def _intervals(self, experiment: Experiment, platform: Platform, smallest: float
+                   ) -> Detection:
+        """Usable intervals of one experiment with this estimator's settings."""
+        return detect_intervals(
+            experiment, platform, window=self.differentiation_window, margin=self.margin,
+            margin_periods=MARGIN_PERIODS, hysteresis=self.hysteresis,
+            ignore_below=self.ignore_below, min_interval=self.min_interval,
+            min_support_samples=self.min_support_samples, smallest=smallest)
+
+    def _experiment_equations(self, experiment: Experiment, wavelet: MotherWavelet,
+                              platform: Platform):
+        """Wavelet equations of one experiment at (a, b) points (``test_functions=None``)."""
+        found = self._intervals(experiment, platform, min(self.scale_fractions))
+        wavelets = [wavelet]
+        if self.odd_companion and isinstance(wavelet, PolynomialWavelet):
+            wavelets.append(PolynomialWavelet(wavelet.order, odd=True))
+        return point_equations(experiment, found, wavelets, tuple(self.scale_fractions),
+                               int(self.shifts_per_scale), self.variant)
+
+    def _fit_weak_form(self, datasets: list[Dataset], platform: Platform,
+                       wavelet: MotherWavelet) -> tuple[IdentificationResult, dict]:
+        """The default path: orthonormal test-function families per interval
+        (:mod:`~stewartid.identification.wavelet.weak_form`). One experiment at a time, its arrays
+        dropped once its equations are formed, so that long logs fit in memory."""
+        infos, equations, sensitivities, motion = [], [], [], []
+        for k, dataset in enumerate(datasets):
+            (experiment,) = prepare([dataset], platform, gravity=self.gravity)
+            if self.noise_correction:
+                sensitivities.append(generalized_force_sensitivity(
+                    platform, dataset.pose, dataset.forces, self.gravity))
+            found = self._intervals(experiment, platform, 1.0)
+
+            def jacobians(indices: np.ndarray, q: np.ndarray = experiment.q) -> np.ndarray:
+                return joint_rate_jacobians(platform, q[indices])
+
+            for interval in found.intervals:
+                rows = interval_equations(
+                    experiment.t, experiment.q, experiment.generalized_force,
+                    jacobians if self.friction != "free" else None,
+                    found.joint_rates, found.rate_noise, interval,
+                    int(self.wavelet_order), int(self.test_functions), k,
+                    uniform=self.friction == "uniform")
+                if rows is not None:
+                    equations.append(rows)
+            infos.append(found.info)
+            motion.append(np.std(experiment.q, axis=0))
+            del experiment, found
+        if not equations:
+            raise_no_interval(infos)
+        check_coverage([i["name"] for i in infos], np.array(motion),
+                       [sum(e.experiment == k for e in equations) for k in range(len(infos))])
+        pose, white = ([[i[key] for i in infos] for key in ("noise_covariance",
+                        "force_noise_variance")] if self.noise_correction else (None, None))
+        solution = solve_weak_form(equations, len(datasets), self.friction != "free", pose_covariance=pose,
+                                   force_sensitivity=sensitivities or None, force_variance=white)
+        M, B = solution.theta[:, :6].copy(), solution.theta[:, 6:12].copy()
+        std_M, std_B = solution.theta_std[:, :6].copy(), solution.theta_std[:, 6:12].copy()
+        chosen = self._combine_pairs(M, B, std_M, std_B)
+        levels, levels_std = (dict(zip(JOINT_TYPES, np.resize(v, 3).tolist(), strict=True))
+                              for v in (solution.coulomb, solution.coulomb_std))  # uniform: 1
+        diagnostics = {
+            "position_noise_std": [np.sqrt(np.diag(i["noise_covariance"])).tolist()
+                                   for i in infos],
+            "wavelet": wavelet.to_dict(), "test_functions": int(self.test_functions),
+            "n_equations": solution.n_equations, "n_intervals": len(equations),
+            "experiments": [{"name": i["name"], "intervals_found": i["intervals_found"],
+                             "intervals": i["intervals"].tolist()} for i in infos],
+            "pair_choice": chosen, "coordinates": list(COORDINATES),
+            "friction_model": self.friction, "coulomb": levels, "coulomb_std": levels_std,
+            "offsets": solution.offsets, "noise_std": solution.noise_std,
+            "constant_scatter": solution.constant_scatter,
+            "pose_noise_share": solution.pose_noise_share}
+        result = IdentificationResult(
+            M=M, B=B, std_errors_M=std_M, std_errors_B=std_B,
+            condition_number=solution.condition_number, residual_rms=solution.noise_std,
+            method=self.method, settings=self._settings(), diagnostics=diagnostics)
+        return result, {"coulomb_": levels, "coulomb_std_": levels_std}
+
+    def _combine_pairs(self, M: np.ndarray, B: np.ndarray, std_M: np.ndarray,
+                       std_B: np.ndarray) -> dict:
+        """Symmetric pairs, in place: the better-determined member (``pair_selection``), or
+        with ``symmetric`` the inverse-variance weighted mean of both."""
+        if self.symmetric:
+            for matrix, std in ((M, std_M), (B, std_B)):
+                w = 1.0 / np.maximum(std, 1e-300) ** 2
+                matrix[:] = (w * matrix + w.T * matrix.T) / (w + w.T)
+                std[:] = 1.0 / np.sqrt(w + w.T)
+            return {}
+        if self.pair_selection in ("std_error", "pooled"):
+            pool = self.pair_selection == "pooled"
+            return {"M": select_symmetric_pairs(M, std_M, pool=pool),
+                    "B": select_symmetric_pairs(B, std_B, pool=pool)}
+        return {}
+
+    def _settings(self) -> dict:
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.get_params().items()}
+
+    def _fit(self, datasets: list[Dataset], platform: Platform
+             ) -> tuple[IdentificationResult, dict]:
+        wavelet = make_wavelet(self.wavelet, **self._wavelet_options())
+        if self.test_functions is not None:
+            return self._fit_weak_form(datasets, platform, wavelet)
+        experiments = prepare(datasets, platform, gravity=self.gravity)
+        phi, target, cluster, infos, noise_xx, noise_xy = [], [], [], [], [], []
+        offset = 0
+        for dataset, experiment in zip(datasets, experiments, strict=True):
+            x, y, owner, products, info = self._experiment_equations(experiment, wavelet,
+                                                                     platform)
+            phi.append(x)
+            target.append(y)
+            cluster.append(owner + offset)
+            offset += len(info["intervals"])
+            infos.append(info)
+            if len(x) and self.noise_correction and self.variant == "position":
+                sigma = info["noise_covariance"]
+                sens = generalized_force_sensitivity(platform, dataset.pose, dataset.forces,
+                                                     self.gravity)
+                # per row: E[e_x e_x^T] (12, 12) and E[e_x e_y^T] (12, 6)
+                noise_xx.append(np.einsum("kuv,ij->kuivj", products[:, :2, :2], sigma
+                                          ).reshape(len(x), 12, 12))
+                noise_xy.append(np.einsum("ku,ij->kuij", products[:, :2, 2],
+                                          sigma @ sens.T).reshape(len(x), 12, 6))
+            else:
+                noise_xx.append(np.zeros((len(x), 12, 12)))
+                noise_xy.append(np.zeros((len(x), 12, 6)))
+        phi, target, cluster = np.vstack(phi), np.vstack(target), np.concatenate(cluster)
+        noise_xx, noise_xy = np.concatenate(noise_xx), np.concatenate(noise_xy)
+        if len(phi) == 0:
+            raise_no_interval(infos)
+        check_coverage([i["name"] for i in infos], np.array([np.std(e.q, axis=0) for e in
+                       experiments]), [len(i["intervals"]) for i in infos])
+        names = regressor_names("q_ddot", "q_dot")
+        solution = solve_least_squares(phi, target, symmetric=bool(self.symmetric),
+                                       regressor_names=names)
+        theta, std = solution.theta, solution.theta_std
+        if not self.symmetric:
+            theta, std = bias_compensated_least_squares(phi, target, cluster, noise_xx,
+                                                        noise_xy)
+        M, B = theta[:, :6].copy(), theta[:, 6:12].copy()
+        std_M, std_B = std[:, :6].copy(), std[:, 6:12].copy()
+        chosen = {} if self.symmetric else self._combine_pairs(M, B, std_M, std_B)
+        residual = target - phi @ theta.T
+        noise = [info["noise_covariance"] for info in infos]
+        diagnostics = {
+            "position_noise_std": [np.sqrt(np.diag(c)).tolist() for c in noise],
+            "wavelet": wavelet.to_dict(),
+            "n_equations": int(len(phi)),
+            "n_intervals": int(offset),
+            "experiments": [
+                {"name": info["name"], "intervals_found": info["intervals_found"],
+                 "intervals": info["intervals"].tolist(),
+                 "scales": info["scales"].tolist(), "shifts": info["shifts"].tolist()}
+                for info in infos],
+            "pair_choice": chosen, "coordinates": list(COORDINATES)}
+        return IdentificationResult(
+            M=M, B=B, std_errors_M=std_M, std_errors_B=std_B,
+            condition_number=solution.condition_number,
+            residual_rms=np.sqrt(np.mean(residual ** 2, axis=0)), method=self.method,
+            settings=self._settings(),
+            diagnostics=diagnostics), {}
+
+
+__all__ = ["EXACT_DEGREE", "FRICTION_MODELS", "MARGIN_PERIODS", "PAIR_SELECTIONS", "VARIANTS",
+           "WaveletIdentifier", "select_symmetric_pairs"]

@@ -1,0 +1,304 @@
+"""Constant-direction intervals: time spans in which no joint reverses.
+
+Zhang (2020, Section 3) calls a time interval in which the velocity of every joint keeps its
+sign a *constant direction space*. Inside it each joint's Coulomb friction is a constant
+(up to the slow change of the joint Jacobians with the pose), so a wavelet with vanishing
+moments of order 0 and 1 removes it together with gravity.
+
+The joints of a 6-6 platform with two-part legs are, per leg, five rotational axes (two at the
+lower gimbal, two at the upper gimbal, the revolute about the leg; order of
+:data:`stewartid.model.kinematics.JOINT_AXES`) and the actuator. :func:`joint_rates` returns their
+rates from a pose/velocity history, :func:`constant_direction_intervals` the intervals, and
+:func:`check_intervals` tells whether a trajectory design yields enough of them, and
+:func:`wavelet_points` places the wavelets' (a, b) points inside them.
+
+Joints that barely move deserve care: a rate whose amplitude is a tiny fraction of the
+others' crosses zero at odd times (noise, second-order motion), which would cut every interval
+into pieces. ``ignore_below`` leaves such joints out; their friction then may switch inside an
+interval, but it is small where the rate is small only if the joint is truly idle, so the
+default keeps every joint and the option is documented as a trade-off.
+
+References
+----------
+Zhang, C. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
+Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, NamedTuple
+
+import numpy as np
+
+from stewartid.errors import ConfigError, DataError
+from stewartid.model.kinematics import JOINT_AXES
+from stewartid.platform import Platform
+
+if TYPE_CHECKING:
+    from stewartid.signals.wavelets import MotherWavelet
+
+#: Names of the 36 joint rates returned by :func:`joint_rates`: 30 rotational axes
+#: (leg-major, axes as JOINT_AXES) followed by the 6 actuators.
+JOINT_RATE_NAMES = tuple(
+    [f"leg{leg + 1}_{axis}" for leg in range(6) for axis in JOINT_AXES]
+    + [f"actuator{leg + 1}" for leg in range(6)]
+)
+
+
+def joint_rates(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
+                joint_jacobians: np.ndarray | None = None,
+                leg_jacobian: np.ndarray | None = None) -> np.ndarray:
+    """Rates of the 30 rotational joint axes and the 6 actuators.
+
+    Parameters
+    ----------
+    platform : Platform
+    q : ndarray, shape (N, 6)
+        Poses (m, rad).
+    q_dot : ndarray, shape (N, 6)
+        Pose rates (m/s, rad/s).
+    joint_jacobians : ndarray, shape (N, 6, 5, 6), optional
+        Joint-axis Jacobians at ``q`` if already computed
+        (:func:`stewartid.model.kinematics.joint_rate_jacobians`).
+    leg_jacobian : ndarray, shape (N, 6, 6), optional
+        Leg Jacobians J_lq at ``q`` if already computed.
+
+    Returns
+    -------
+    ndarray, shape (N, 36)
+        Columns as :data:`JOINT_RATE_NAMES`: joint axis rates (rad/s), then actuator
+        (leg-length) rates (m/s).
+    """
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    q_dot = np.atleast_2d(np.asarray(q_dot, dtype=float))
+    if q.shape != q_dot.shape or q.shape[1:] != (6,):
+        raise DataError(f"q and q_dot must both have shape (N, 6); got {q.shape} and "
+                        f"{q_dot.shape}.")
+    if joint_jacobians is None or leg_jacobian is None:
+        from stewartid.model.dynamics import ModelTerms
+
+        terms = ModelTerms(platform, q)
+        joint_jacobians, leg_jacobian = terms.joint_jacobians, terms.leg_jacobian
+    axes = np.einsum("nlaj,nj->nla", joint_jacobians, q_dot).reshape(len(q), 30)
+    legs = np.einsum("nlj,nj->nl", leg_jacobian, q_dot)
+    return np.concatenate([axes, legs], axis=1)
+
+
+def active_joints(rates: np.ndarray, ignore_below: float = 0.0) -> np.ndarray:
+    """Mask of the joints whose rate amplitude is not negligible.
+
+    A joint is ignored when the RMS of its rate is below ``ignore_below`` times the largest
+    RMS among joints of the same kind (rotational axes in rad/s compared with each other,
+    actuators in m/s with each other; the 30 + 6 layout of :func:`joint_rates` is assumed when
+    there are 36 columns, otherwise all columns are one kind).
+
+    Parameters
+    ----------
+    rates : ndarray, shape (N, J)
+    ignore_below : float
+        Relative threshold in [0, 1); 0 keeps every joint.
+
+    Returns
+    -------
+    ndarray of bool, shape (J,)
+    """
+    if not 0.0 <= ignore_below < 1.0:
+        raise ConfigError(
+            f"ignore_below must be a fraction in [0, 1); got {ignore_below!r}."
+        )
+    rms = np.sqrt(np.mean(np.square(rates), axis=0))
+    groups = [slice(0, 30), slice(30, 36)] if rates.shape[1] == 36 else [slice(None)]
+    mask = np.ones(rates.shape[1], dtype=bool)
+    for g in groups:
+        top = rms[g].max() if rms[g].size else 0.0
+        mask[g] = rms[g] > ignore_below * top if top > 0 else False
+    return mask
+
+
+def constant_direction_intervals(t: np.ndarray, rates: np.ndarray, margin: float = 0.02,
+                                 min_duration: float = 0.0, ignore_below: float = 0.0,
+                                 hysteresis: np.ndarray | float = 0.0) -> np.ndarray:
+    """Time intervals in which every (active) joint rate keeps its sign.
+
+    Parameters
+    ----------
+    t : ndarray, shape (N,)
+        Strictly increasing sample times (s).
+    rates : ndarray, shape (N, J)
+        Joint rates, e.g. from :func:`joint_rates`; any units, only signs matter.
+    margin : float
+        Time (s) cut from both ends of every interval, so that a friction reversal that lags
+        the zero crossing of the measured rate (stiction, filtering, sensor noise) stays
+        outside.
+    min_duration : float
+        Intervals shorter than this (s, after the margins) are dropped.
+    ignore_below : float
+        Leave out joints whose rate RMS is below this fraction of the largest of their kind
+        (see :func:`active_joints`).
+    hysteresis : float or ndarray, shape (J,)
+        Rate thresholds (units of ``rates``) for noisy measurements: a joint's direction
+        counts as known only while |rate| exceeds its threshold, and a reversal is confirmed
+        when the rate passes the opposite threshold. The interval before a reversal ends at
+        the last sample where the old direction was still confirmed, the next one starts at
+        the confirmation, so the unknown crossing time stays outside both. Joints that never
+        exceed their threshold are left out. 0 (default): plain signs.
+
+    Returns
+    -------
+    ndarray, shape (M, 2)
+        [start, stop] times (s) of the intervals, in time order. A rate that touches zero
+        without changing sign does not end an interval. The first and last runs are kept: a record that
+        starts or ends mid-interval still gives a usable, shorter, interval.
+    """
+    t = np.asarray(t, dtype=float)
+    rates = np.asarray(rates, dtype=float)
+    if rates.ndim == 1:
+        rates = rates[:, None]
+    if rates.shape[0] != t.shape[0] or t.ndim != 1:
+        raise DataError(f"rates must have one row per sample: t has {t.shape}, rates "
+                        f"{rates.shape}.")
+    if margin < 0 or min_duration < 0:
+        raise ConfigError(
+            f"margin and min_duration must be >= 0 s; got {margin!r} and {min_duration!r}."
+        )
+    mask = active_joints(rates, ignore_below)
+    threshold = np.broadcast_to(np.asarray(hysteresis, dtype=float), (rates.shape[1],))
+    if np.any(threshold < 0):
+        raise ConfigError("hysteresis thresholds must be >= 0.")
+    confirmed = np.abs(rates) > threshold
+    mask &= confirmed.any(axis=0)
+    used, confirmed, threshold = rates[:, mask], confirmed[:, mask], threshold[mask]
+    n = len(t)
+    if used.shape[1] == 0 or n < 2:
+        return np.empty((0, 2))
+    index = np.arange(n)[:, None]
+    # last sample (up to each one) at which each joint's direction was confirmed
+    last = np.maximum.accumulate(np.where(confirmed, index, -1), axis=0)
+    state = np.where(last >= 0, np.sign(np.take_along_axis(used, np.maximum(last, 0), 0)),
+                     0.0)
+    valid = np.all(state != 0, axis=1)
+    changed = np.zeros_like(state, dtype=bool)
+    changed[1:] = state[1:] != state[:-1]
+    breaks = np.flatnonzero(changed.any(axis=1) | ~valid)
+    starts = np.concatenate([[0], breaks])
+    ends = np.concatenate([breaks, [n]])  # exclusive
+    out = []
+    for k1, k2 in zip(starts, ends, strict=True):
+        if k2 - k1 < 1 or not valid[k1]:
+            continue
+        stop = k2 - 1
+        if k2 < n and valid[k2]:
+            # end where the reversing joints last confirmed their old direction
+            stop = int(last[k2 - 1, changed[k2]].min())
+        if stop > k1:
+            out.append((t[k1] + margin, t[stop] - margin))
+    out = np.array(out, dtype=float).reshape(-1, 2)
+    duration = out[:, 1] - out[:, 0]
+    return out[(duration > 0) & (duration >= min_duration)]
+
+
+class IntervalCheck(NamedTuple):
+    """Result of :func:`check_intervals`.
+
+    Attributes
+    ----------
+    ok : bool
+        True when at least ``min_count`` intervals of ``min_duration`` exist.
+    count : int
+        Intervals at least ``min_duration`` long.
+    longest : float
+        Longest interval (s), 0 if none.
+    coverage : float
+        Fraction of the record covered by such intervals.
+    message : str
+        One line that says what was found and, when not ok, what to change.
+    """
+
+    ok: bool
+    count: int
+    longest: float
+    coverage: float
+    message: str
+
+
+def check_intervals(t: np.ndarray, rates: np.ndarray, min_duration: float,
+                    min_count: int = 1, margin: float = 0.02,
+                    ignore_below: float = 0.0) -> IntervalCheck:
+    """Does a trajectory yield constant-direction intervals long enough for identification?
+
+    Parameters
+    ----------
+    t : ndarray, shape (N,)
+    rates : ndarray, shape (N, J)
+    min_duration : float
+        Shortest usable interval (s), e.g. twice the smallest wavelet scale times its support.
+    min_count : int
+        How many such intervals are required.
+    margin, ignore_below : float
+        As in :func:`constant_direction_intervals`.
+
+    Returns
+    -------
+    IntervalCheck
+    """
+    t = np.asarray(t, dtype=float)
+    all_intervals = constant_direction_intervals(t, rates, margin, 0.0, ignore_below)
+    lengths = all_intervals[:, 1] - all_intervals[:, 0] if len(all_intervals) else np.zeros(0)
+    good = lengths >= min_duration
+    count = int(good.sum())
+    longest = float(lengths.max()) if lengths.size else 0.0
+    span = t[-1] - t[0] if len(t) > 1 else 0.0
+    coverage = float(lengths[good].sum() / span) if span > 0 else 0.0
+    ok = count >= min_count
+    if ok:
+        message = (f"{count} constant-direction intervals of at least {min_duration:.3g} s "
+                   f"(longest {longest:.3g} s, {100 * coverage:.0f} % of the record).")
+    else:
+        message = (f"only {count} constant-direction interval(s) of at least "
+                   f"{min_duration:.3g} s (longest {longest:.3g} s) where {min_count} are "
+                   "needed: excite with a slower sine of one frequency in all joints, a "
+                   "smaller wavelet scale, a smaller margin, or ignore idle joints "
+                   "(ignore_below).")
+    return IntervalCheck(ok, count, longest, coverage, message)
+
+
+def wavelet_points(intervals: np.ndarray, wavelet: MotherWavelet,
+                   scale_fractions: tuple[float, ...], shifts_per_scale: int,
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(a, b) points whose wavelet support lies inside an interval.
+
+    Parameters
+    ----------
+    intervals : ndarray, shape (M, 2)
+        [start, stop] (s).
+    wavelet : MotherWavelet
+    scale_fractions : tuple of float
+        Support length as a fraction of the interval length, each in (0, 1].
+    shifts_per_scale : int
+        Shifts per scale and interval (one if the support fills the interval).
+
+    Returns
+    -------
+    scales, shifts : ndarray, shape (K,)
+        a and b (s).
+    interval_index : ndarray of int, shape (K,)
+        Row of ``intervals`` each point belongs to.
+    """
+    scales, shifts, owner = [], [], []
+    for m, (start, stop) in enumerate(intervals):
+        length = stop - start
+        for fraction in scale_fractions:
+            a = fraction * length / (2.0 * wavelet.half_width)
+            free = length - 2.0 * a * wavelet.half_width
+            count = shifts_per_scale if free > 1e-9 * length else 1
+            b = start + a * wavelet.half_width + np.linspace(0.0, max(free, 0.0), count)
+            scales.append(np.full(count, a))
+            shifts.append(b)
+            owner.append(np.full(count, m))
+    if not scales:
+        return np.zeros(0), np.zeros(0), np.zeros(0, dtype=int)
+    return np.concatenate(scales), np.concatenate(shifts), np.concatenate(owner)
+
+
+__all__ = ["JOINT_RATE_NAMES", "IntervalCheck", "active_joints", "check_intervals",
+           "constant_direction_intervals", "joint_rates", "wavelet_points"]

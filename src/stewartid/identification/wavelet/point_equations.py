@@ -1,0 +1,98 @@
+"""Method B's equations at chosen (scale, shift) points: the paper's wavelet transform.
+
+Inside every constant-direction interval, for every fraction s of ``scale_fractions`` the
+scale is a = s T / (2 h) (T the interval length, h the wavelet's half-width in scales), and
+``shifts_per_scale`` shifts spread over the positions that keep the support inside the
+interval (:func:`~stewartid.identification.wavelet.intervals.wavelet_points`). Each (a, b) gives the
+equation [Mt Bt] [W_psi q_ddot ; W_psi q_dot](a, b) = W_psi y (a, b), with the derivatives
+obtained as ``variant`` says (see :mod:`.wavelet`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from stewartid.identification.preparation import Experiment
+from stewartid.identification.wavelet.detection import Detection
+from stewartid.identification.wavelet.intervals import wavelet_points
+from stewartid.signals.wavelets import MotherWavelet, transform_matrix
+
+#: Polynomial degree up to which every transform row integrates exactly (moment-corrected
+#: quadrature, see :func:`~stewartid.signals.wavelets.transform_matrix`).
+EXACT_DEGREE = 5
+
+
+def point_equations(experiment: Experiment, found: Detection,
+                    wavelets: Sequence[MotherWavelet], scale_fractions: tuple[float, ...],
+                    shifts_per_scale: int, variant: str):
+    """Wavelet equations of one experiment.
+
+    Parameters
+    ----------
+    experiment : Experiment
+    found : Detection
+        Its intervals and Savitzky-Golay derivatives.
+    wavelets : sequence of MotherWavelet
+        Every wavelet is applied at every (a, b) point.
+    scale_fractions : tuple of float
+    shifts_per_scale : int
+    variant : {"position", "paper", "derivative"}
+
+    Returns
+    -------
+    regressors : ndarray, shape (K, 12)
+    targets : ndarray, shape (K, 6)
+    owner : ndarray of int, shape (K,)
+        Interval of each row.
+    products : ndarray, shape (K, 3, 3)
+        Inner products of the rows acting on q (acceleration, velocity) and on y: the
+        covariances of transformed white pose noise (zero outside the position variant).
+    info : dict
+        The detection's info with the ``scales`` and ``shifts`` used.
+    """
+    t, q = experiment.t, experiment.q
+    intervals, info, q_dot, q_ddot = found.intervals, found.info, found.q_dot, found.q_ddot
+    scales, shifts, owner = wavelet_points(intervals, wavelets[0], scale_fractions,
+                                           shifts_per_scale)
+    info["scales"], info["shifts"] = scales, shifts
+    if len(scales) == 0:
+        return np.zeros((0, 12)), np.zeros((0, 6)), owner, np.zeros((0, 3, 3)), info
+    a = scales[:, None]
+    qc = q - q.mean(axis=0)
+    rows, targets, products = [], [], []
+    for psi in wavelets:
+        def matrix(derivative, psi=psi):
+            return transform_matrix(t, scales, shifts, psi, derivative,
+                                    exact_degree=EXACT_DEGREE)
+
+        w0 = matrix(0)
+        targets.append(w0 @ experiment.generalized_force)
+        if variant == "position":
+            # constants vanish analytically (and, with the moment correction, to
+            # rounding); removing the mean also keeps the Mexican hat's truncation error
+            # proportional to the motion, not the offset
+            from scipy import sparse  # only this path builds sparse matrices
+
+            w2 = sparse.diags(1.0 / scales ** 2) @ matrix(2)
+            w1 = sparse.diags(-1.0 / scales) @ matrix(1)
+            w_acc, w_vel = w2 @ qc, w1 @ qc
+            # inner products of the rows acting on q (acc, vel) and on y (target): the
+            # covariances of the transformed white pose noise
+            operators = (w2, w1, w0)
+            products.append(np.stack([
+                np.stack([np.asarray(u.multiply(v).sum(axis=1)).ravel()
+                          for v in operators], axis=-1) for u in operators], axis=-2))
+        else:
+            w_acc = w0 @ q_ddot
+            w_vel = (-a * (matrix(-1) @ q_ddot) if variant == "paper"
+                     else w0 @ q_dot)
+            products.append(np.zeros((len(scales), 3, 3)))
+        rows.append(np.hstack([w_acc, w_vel]))
+    owner = np.tile(owner, len(wavelets))
+    return (np.vstack(rows), np.vstack(targets), owner, np.concatenate(products),
+            info)
+
+
+__all__ = ["EXACT_DEGREE", "point_equations"]

@@ -1,0 +1,208 @@
+"""Weak-form equations on constant-direction intervals, and their noise-aware solution.
+
+The default Method B. Inside a constant-direction interval the equation of motion is
+
+    Mt q_ddot + Bt q_dot + c_m = y,        y = J_lq(q)^T f_a - G(q),
+
+with c_m the interval's constant (Coulomb friction of the moving joints, what the gravity
+model leaves over). Multiplying by a test function phi that vanishes with its first
+derivative at the interval's ends and integrating by parts moves both derivatives onto phi,
+
+    Mt <phi'', q> - Bt <phi', q> + c_m <phi, 1> = <phi, y>,
+
+so no signal is differentiated numerically (the modulating-function, or weak, form; the
+paper's wavelet transform is the special case of one dilated and shifted wavelet).
+
+Test functions, per interval of half-length L and centre c, x = (t - c) / L:
+
+- a family of ``size`` zero-mean functions phi_k = d/dt [(1 - x^2)^p x^k], k = 0..size-1,
+  orthonormalised on the samples (so that white force noise stays white and equally
+  weighted, as in WENDy), which remove c_m exactly: these rows are Coulomb-invariant;
+- one mean row, the bump (1 - x^2)^p orthogonalised against the family, which keeps c_m.
+
+The mean rows say what the interval constants hold. With ``shared_friction`` the constant is
+modelled as c_m = o_e + sum_types F_type W_m,type + delta_m: an offset per experiment, the
+Coulomb level of each joint type (lower gimbal, upper gimbal, revolute) mapped through the
+joint Jacobians with the interval's joint directions, and a random deviation delta_m of
+variance tau^2 per channel estimated from the data (idle joints, a friction law other than
+Coulomb's). Inside one interval the mean viscous force cannot be told from the constant; the
+friction structure across intervals and experiments gives that information back, and tau^2
+decides how much it is trusted: a plant whose friction does not fit the structure gets a
+large tau^2 and the estimate falls back on the invariant rows alone.
+
+The solve (:mod:`~stewartid.identification.wavelet.gls`) is generalized least squares
+over all channels at once (the Coulomb levels are shared by the channels), each interval's
+rows weighted by their covariance: the force noise, and the pose noise the test functions'
+derivatives carry into the regressors, whose bias it also compensates.
+
+References
+----------
+Zhang, C. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
+Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
+
+Bortz, D. M., Messenger, D. A., Dukic, V. "Direct Estimation of Parameters in ODE Models Using
+WENDy: Weak-Form Estimation of Nonlinear Dynamics." Bull. Math. Biol. 85, 110 (2023).
+doi:10.1007/s11538-023-01208-6
+
+Shinbrot, M. "On the analysis of linear and nonlinear systems." Trans. ASME 79, 547 (1957).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+from numpy.polynomial import polynomial
+
+from stewartid.identification.least_squares import JOINT_TYPES
+
+
+@lru_cache(maxsize=32)
+def _family_coefficients(order: int, size: int) -> tuple[np.ndarray, ...]:
+    """Power-series coefficients (degree + 1, size + 1) of g, g', g'', g''' on [-1, 1].
+
+    Column 0 is the bump (1 - x^2)^order; column k + 1 is (1 - x^2)^order x^k, whose
+    derivative is the k-th zero-mean test function.
+    """
+    bump = polynomial.polypow([1.0, 0.0, -1.0], order)
+    columns = [bump] + [np.r_[np.zeros(k), bump] for k in range(size)]
+    degree = 2 * order + size + 1
+    out = []
+    for derivative in range(4):
+        block = np.zeros((degree, size + 1))
+        for j, c in enumerate(columns):
+            d = polynomial.polyder(c, derivative) if derivative else c
+            block[:len(d), j] = d
+        out.append(block)
+    return tuple(out)
+
+
+@dataclass(frozen=True)
+class IntervalEquations:
+    """Weak-form equations of one constant-direction interval.
+
+    Attributes
+    ----------
+    regressors : ndarray, shape (K, 12)
+        Invariant rows: [<phi_k'', q>, -<phi_k', q>] (m s^-1, rad s^-1 times s^0 ...: the
+        units of q_ddot and q_dot times seconds).
+    targets : ndarray, shape (K, 6)
+        <phi_k, y> (N s, N m s).
+    mean_regressors : ndarray, shape (12,)
+        The mean row's [<g'', q>, -<g', q>].
+    mean_target : ndarray, shape (6,)
+        <g, y>.
+    weight : float
+        <g, 1> (s^(1/2)): the mean row's coefficient of the interval constant.
+    coulomb : ndarray, shape (n_types, 6), or (1, 6) with one level for every axis
+        <g, W_type>: generalized Coulomb force per unit level of each joint type, with the
+        interval's joint directions.
+    experiment : int
+        Index of the experiment the interval belongs to.
+    noise_gram : ndarray, shape (3, 3, K + 1, K + 1)
+        Gram matrices <phi^(a), phi^(b)> of the rows' test functions and their first and
+        second derivatives (a, b = 0, 1, 2), invariant rows then the mean row: what white
+        pose noise puts into the rows (:mod:`~stewartid.identification.wavelet.gls`).
+    """
+
+    regressors: np.ndarray
+    targets: np.ndarray
+    mean_regressors: np.ndarray
+    mean_target: np.ndarray
+    weight: float
+    coulomb: np.ndarray
+    experiment: int
+    noise_gram: np.ndarray
+
+
+def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
+                       joint_jacobians: np.ndarray | Callable[[np.ndarray], np.ndarray] | None,
+                       joint_rates: np.ndarray,
+                       rate_noise: np.ndarray, interval: Sequence[float], order: int, size: int,
+                       experiment: int = 0, uniform: bool = False) -> IntervalEquations | None:
+    """Weak-form equations of one interval (see the module docstring).
+
+    Parameters
+    ----------
+    t : ndarray, shape (N,)
+        Uniform sample times (s).
+    q : ndarray, shape (N, 6)
+        Measured pose (m, rad).
+    y : ndarray, shape (N, 6)
+        Generalized force J^T f - G(q) (N, N m).
+    joint_jacobians : ndarray, shape (N, 6, 5, 6), or callable
+        Joint-axis rate Jacobians (rad/s per unit q_dot), or a function returning them
+        (n, 6, 5, 6) at the sample indices it is given (long records need not hold them).
+        None: no friction structure (``coulomb`` zero; the mean row is then unused).
+    joint_rates : ndarray, shape (N, 6, 5)
+        Smoothed joint-axis rates (rad/s); only their mean over the interval is used, for the
+        joint directions.
+    rate_noise : ndarray, shape (6, 5)
+        Noise level of those rates (rad/s): a joint whose mean rate is within it counts as
+        idle (its direction weighs |mean| / noise).
+    interval : (start, stop)
+        s.
+    order : int
+        Exponent p of the bump (1 - x^2)^p, >= 3 so that phi and phi' vanish at the ends.
+    size : int
+        Number of invariant test functions K.
+    experiment : int
+        Stored in the result.
+    uniform : bool
+        One Coulomb level for every joint axis: ``coulomb`` summed over the joint types.
+
+    Returns
+    -------
+    IntervalEquations or None
+        None when the interval holds fewer than 4 (K + 1) samples.
+    """
+    start, stop = float(interval[0]), float(interval[1])
+    sel = np.flatnonzero((t > start) & (t < stop))
+    if len(sel) < 4 * (size + 1):
+        return None
+    h = float(t[1] - t[0])
+    half, centre = 0.5 * (stop - start), 0.5 * (start + stop)
+    x = (t[sel] - centre) / half
+    vander = polynomial.polyvander(x, _family_coefficients(order, size)[0].shape[0] - 1)
+    # rows: test functions and their time derivatives, times the quadrature step
+    g0, g1, g2, g3 = (vander @ c * (h / half ** d)
+                      for d, c in enumerate(_family_coefficients(order, size)))
+    phi0, phi1, phi2 = g1[:, 1:].T, g2[:, 1:].T, g3[:, 1:].T
+    u, s, _ = np.linalg.svd(phi0, full_matrices=False)
+    transform = (u / s).T  # orthonormal rows
+    phi0, phi1, phi2 = transform @ phi0, transform @ phi1, transform @ phi2
+    bump0, bump1, bump2 = g0[:, 0], g1[:, 0], g2[:, 0]
+    projection = phi0 @ bump0
+    bump0, bump1, bump2 = bump0 - projection @ phi0, bump1 - projection @ phi1, \
+        bump2 - projection @ phi2
+    norm = np.linalg.norm(bump0)
+    bump0, bump1, bump2 = bump0 / norm, bump1 / norm, bump2 / norm
+    # constants and straight lines vanish against phi'' and phi', so the offset only costs
+    # rounding; removing the mean keeps it from being amplified
+    qc = q[sel] - q[sel].mean(axis=0)
+    ys = y[sel]
+    mean_rate = joint_rates[sel].mean(axis=0)
+    direction = mean_rate / np.sqrt(mean_rate ** 2 + rate_noise ** 2)
+    if joint_jacobians is None:
+        coulomb = np.zeros((len(JOINT_TYPES), 6))
+    else:
+        jacobians = (joint_jacobians(sel) if callable(joint_jacobians)
+                     else joint_jacobians[sel])
+        pattern = np.einsum("la,nlac->nac", direction, jacobians)              # (n, 5, 6)
+        coulomb = np.array([bump0 @ pattern[:, list(axes)].sum(axis=1)
+                            for axes in JOINT_TYPES.values()])
+        if uniform:
+            coulomb = coulomb.sum(axis=0, keepdims=True)
+    family = np.stack([np.vstack([phi0, bump0]), np.vstack([phi1, bump1]),
+                       np.vstack([phi2, bump2])])                            # (3, K + 1, n)
+    gram = np.einsum("arn,bsn->abrs", family, family)
+    return IntervalEquations(
+        regressors=np.hstack([phi2 @ qc, -(phi1 @ qc)]), targets=phi0 @ ys,
+        mean_regressors=np.r_[bump2 @ qc, -(bump1 @ qc)], mean_target=bump0 @ ys,
+        weight=float(bump0.sum()), coulomb=coulomb, experiment=int(experiment),
+        noise_gram=gram)
+
+
+__all__ = ["IntervalEquations", "interval_equations"]

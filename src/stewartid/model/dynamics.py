@@ -1,0 +1,156 @@
+"""Rigid-body dynamics of the platform with six two-part legs and joint friction.
+
+Equation of motion in the paper's frame and coordinates (z down, q = [x y z rx ry rz]):
+
+    M(q) q_ddot + h(q, q_dot) + G(q) + F(q, q_dot) = J_lq(q)^T f_a
+
+M is the mass matrix of platform and legs, h the velocity-product (Coriolis and
+centrifugal) forces, G gravity (g = 9.81 m/s^2 along +z), F joint friction (viscous on the
+four gimbal axes, Coulomb on all five rotational axes of each leg), f_a the actuator forces
+(N, positive extends the leg). Body equations are Newton-Euler per body, projected with the
+velocity Jacobians (Kane's method), compiled with numba in :mod:`stewartid.model.compiled`.
+
+Coulomb regularisation: a joint's Coulomb torque is Fc * w / sqrt(w^2 + s^2), w the joint
+rate, s = ``coulomb_smoothing`` (rad/s, default 1e-4): exact sign(w) for |w| >> s, smooth and
+odd through zero so an ODE solver can step over reversals. The plant simulator offers a
+stick-slip aware alternative.
+
+All functions take q, q_dot, q_ddot of shape (6,) or (N, 6) and return matching shapes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stewartid.model.kinematics import _batch, _terms
+from stewartid.platform import Platform
+
+#: Default Coulomb regularisation rate (rad/s).
+COULOMB_SMOOTHING = 1e-4
+
+
+class ModelTerms:
+    """Every term of the equation of motion at a batch of samples.
+
+    Attributes
+    ----------
+    mass_matrix : ndarray, shape (N, 6, 6)
+    velocity_product : ndarray, shape (N, 6)
+    gravity : ndarray, shape (N, 6)
+    leg_jacobian : ndarray, shape (N, 6, 6)
+    joint_jacobians : ndarray, shape (N, 6, 5, 6)
+    leg_lengths : ndarray, shape (N, 6)
+    """
+
+    def __init__(self, platform: Platform, q: np.ndarray, q_dot: np.ndarray | None = None):
+        (self.mass_matrix, self.velocity_product, self.gravity, self.leg_jacobian,
+         self.joint_jacobians, self.leg_lengths), self.single = _terms(platform, q, q_dot)
+
+
+def _out(x: np.ndarray, single: bool) -> np.ndarray:
+    return x[0] if single else x
+
+
+def mass_matrix(platform: Platform, q: np.ndarray) -> np.ndarray:
+    """Mass matrix M(q), symmetric positive definite; shape (6, 6) or (N, 6, 6)."""
+    t = ModelTerms(platform, q)
+    return _out(t.mass_matrix, t.single)
+
+
+def velocity_product_forces(platform: Platform, q: np.ndarray, q_dot: np.ndarray) -> np.ndarray:
+    """Coriolis and centrifugal forces h(q, q_dot) (N, N m); shape (6,) or (N, 6)."""
+    t = ModelTerms(platform, q, q_dot)
+    return _out(t.velocity_product, t.single)
+
+
+def gravity_forces(platform: Platform, q: np.ndarray) -> np.ndarray:
+    """Gravity term G(q) of platform and both leg parts (N, N m); shape (6,) or (N, 6).
+
+    G_z is negative: gravity pulls along +z (down) and G sits on the left-hand side.
+    """
+    t = ModelTerms(platform, q)
+    return _out(t.gravity, t.single)
+
+
+def friction_forces(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
+                    coulomb_smoothing: float = COULOMB_SMOOTHING) -> np.ndarray:
+    """Joint friction F(q, q_dot) mapped to generalized forces (N, N m).
+
+    Viscous ``gimbal_viscous`` on the 4 gimbal axes per leg and Coulomb ``coulomb`` on all 5
+    rotational axes, regularised as described in the module docstring.
+    """
+    t = ModelTerms(platform, q, q_dot)
+    return _out(_joint_friction(platform, t, q_dot, coulomb_smoothing), t.single)
+
+
+def _joint_friction(platform: Platform, terms: ModelTerms, q_dot: np.ndarray,
+                    coulomb_smoothing: float) -> np.ndarray:
+    """Generalized joint friction (N, 6) at the samples of ``terms``."""
+    from stewartid.model import compiled  # numba, started only when a model term is computed
+
+    qd2, _ = _batch(q_dot, "q_dot")
+    return compiled.batch_friction(platform.parameters(), terms.joint_jacobians, qd2,
+                                   float(coulomb_smoothing))
+
+
+def inverse_dynamics(platform: Platform, q: np.ndarray, q_dot: np.ndarray, q_ddot: np.ndarray,
+                     friction: bool = True,
+                     coulomb_smoothing: float = COULOMB_SMOOTHING) -> np.ndarray:
+    """Actuator forces f_a (N) that produce ``q_ddot`` at state (q, q_dot).
+
+    Returns
+    -------
+    ndarray, shape (6,) or (N, 6)
+        Force along each leg, positive extending.
+    """
+    t = ModelTerms(platform, q, q_dot)
+    qdd2, _ = _batch(q_ddot, "q_ddot")
+    rhs = np.einsum("nij,nj->ni", t.mass_matrix, qdd2) + t.velocity_product + t.gravity
+    if friction:
+        rhs += _joint_friction(platform, t, q_dot, coulomb_smoothing)
+    f = np.linalg.solve(np.swapaxes(t.leg_jacobian, 1, 2), rhs[..., None])[..., 0]
+    return _out(f, t.single)
+
+
+def forward_dynamics(platform: Platform, q: np.ndarray, q_dot: np.ndarray, forces: np.ndarray,
+                     friction: bool = True,
+                     coulomb_smoothing: float = COULOMB_SMOOTHING) -> np.ndarray:
+    """Accelerations q_ddot (m/s^2, rad/s^2) under actuator forces ``forces`` (N).
+
+    Returns
+    -------
+    ndarray, shape (6,) or (N, 6)
+    """
+    t = ModelTerms(platform, q, q_dot)
+    f2, _ = _batch(forces, "forces")
+    rhs = np.einsum("nji,nj->ni", t.leg_jacobian, f2) - t.velocity_product - t.gravity
+    if friction:
+        rhs -= _joint_friction(platform, t, q_dot, coulomb_smoothing)
+    qdd = np.linalg.solve(t.mass_matrix, rhs[..., None])[..., 0]
+    return _out(qdd, t.single)
+
+
+def kinetic_energy(platform: Platform, q: np.ndarray, q_dot: np.ndarray) -> np.ndarray:
+    """Kinetic energy 1/2 q_dot^T M(q) q_dot (J); shape () or (N,)."""
+    t = ModelTerms(platform, q)
+    qd2, _ = _batch(q_dot, "q_dot")
+    T = 0.5 * np.einsum("ni,nij,nj->n", qd2, t.mass_matrix, qd2)
+    return T[0] if t.single else T
+
+
+def potential_energy(platform: Platform, q: np.ndarray) -> np.ndarray:
+    """Gravitational potential energy of platform and leg parts (J), zero at z = 0.
+
+    z points down, so V = -g * sum(m z_com). Shape () or (N,).
+    """
+    from stewartid.model.kinematics import inverse_kinematics
+    from stewartid.platform import GRAVITY
+
+    q2, single = _batch(q)
+    legs = inverse_kinematics(platform, q2)
+    i = platform.inertia
+    z_lower = platform.base_joints[None, :, 2] + i.lower_leg_com * legs.directions[..., 2]
+    z_upper = legs.upper_joints[..., 2] - i.upper_leg_com * legs.directions[..., 2]
+    V = -GRAVITY * (i.platform_mass * q2[:, 2] + i.lower_leg_mass * z_lower.sum(1)
+                    + i.upper_leg_mass * z_upper.sum(1))
+    return V[0] if single else V

@@ -1,0 +1,218 @@
+"""Kinematics of the 6-6 Stewart platform, batched over samples (time on axis 0).
+
+Pose q = [x, y, z, rx, ry, rz] of the reference point in the paper frame (x forward,
+y right, z down; m and rad; R = Rz(rz) Ry(ry) Rx(rx)). Rates q_dot are the time
+derivatives of q (Euler-angle rates, equal to the angular velocity at neutral).
+
+All functions accept a single pose of shape (6,) or a batch of shape (N, 6) and return
+arrays with the same leading shape.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from stewartid.errors import KinematicsError
+from stewartid.model.leg_terms import LegTerms, leg_terms
+from stewartid.platform import Platform
+
+#: Names of the five rotational joint axes of a leg, in the order of joint_rate_jacobians.
+JOINT_AXES = ("lower_1", "lower_2", "upper_1", "upper_2", "revolute")
+
+
+def _batch(q: np.ndarray, name: str = "q") -> tuple[np.ndarray, bool]:
+    q = np.asarray(q, dtype=float)
+    single = q.ndim == 1
+    q2 = np.ascontiguousarray(q[None] if single else q)
+    if q2.ndim != 2 or q2.shape[1] != 6:
+        raise ValueError(f"{name} must have shape (6,) or (N, 6); got {q.shape}.")
+    return q2, single
+
+
+def rotation_matrix(angles: np.ndarray) -> np.ndarray:
+    """Rotation matrices R = Rz(rz) Ry(ry) Rx(rx).
+
+    Parameters
+    ----------
+    angles : ndarray, shape (3,) or (N, 3)
+        Roll, pitch, yaw (rad).
+
+    Returns
+    -------
+    ndarray, shape (3, 3) or (N, 3, 3)
+    """
+    a = np.asarray(angles, dtype=float)
+    cx, sx = np.cos(a[..., 0]), np.sin(a[..., 0])
+    cy, sy = np.cos(a[..., 1]), np.sin(a[..., 1])
+    cz, sz = np.cos(a[..., 2]), np.sin(a[..., 2])
+    R = np.stack([
+        np.stack([cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx], -1),
+        np.stack([sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx], -1),
+        np.stack([-sy, cy * sx, cy * cx], -1),
+    ], -2)
+    return R
+
+
+class LegState(NamedTuple):
+    """Result of :func:`inverse_kinematics`.
+
+    Attributes
+    ----------
+    lengths : ndarray, shape (N, 6)
+        Leg lengths (m), lower gimbal point to upper gimbal point.
+    directions : ndarray, shape (N, 6, 3)
+        Unit leg vectors, base joint towards platform joint.
+    upper_joints : ndarray, shape (N, 6, 3)
+        Upper joint positions in the fixed frame (m).
+    """
+
+    lengths: np.ndarray
+    directions: np.ndarray
+    upper_joints: np.ndarray
+
+
+def inverse_kinematics(platform: Platform, q: np.ndarray) -> LegState:
+    """Leg lengths, directions and joint positions for poses ``q``.
+
+    Parameters
+    ----------
+    platform : Platform
+    q : ndarray, shape (6,) or (N, 6)
+        Poses (m, rad).
+
+    Returns
+    -------
+    LegState
+        With a leading sample axis of length N (1 for a single pose).
+    """
+    q2, _ = _batch(q)
+    R = rotation_matrix(q2[:, 3:])
+    upper = q2[:, None, :3] + np.einsum("nij,kj->nki", R, platform.upper_joints)
+    legs = upper - platform.base_joints[None]
+    lengths = np.linalg.norm(legs, axis=-1)
+    return LegState(lengths, legs / lengths[..., None], upper)
+
+
+def leg_lengths(platform: Platform, q: np.ndarray) -> np.ndarray:
+    """Leg lengths (m) for poses ``q``: shape (6,) for one pose, (N, 6) for a batch."""
+    q2, single = _batch(q)
+    lengths = inverse_kinematics(platform, q2).lengths
+    return lengths[0] if single else lengths
+
+
+def _terms(platform: Platform, q: np.ndarray, qd: np.ndarray | None = None):
+    from stewartid.model import compiled  # numba: only the full model terms need it
+
+    q2, single = _batch(q)
+    qd2 = np.zeros_like(q2) if qd is None else _batch(qd, "q_dot")[0]
+    if qd2.shape != q2.shape:
+        raise ValueError(f"q_dot must have the shape of q {q2.shape}; got {qd2.shape}.")
+    return compiled.batch_terms(platform.parameters(), platform.upper_joints,
+                                platform.base_joints, q2, qd2), single
+
+
+def _leg_terms(platform: Platform, q: np.ndarray, joints: bool = False,
+               pose_terms: bool = True) -> LegTerms:
+    """(G, J_leg, lengths, J_joint) at poses q (N, 6), without the inertia terms; J_joint is
+    empty unless ``joints``, G and J_leg unless ``pose_terms``."""
+    return leg_terms(platform.parameters(), platform.upper_joints, platform.base_joints, q,
+                     joints, pose_terms)
+
+
+def leg_jacobian(platform: Platform, q: np.ndarray) -> np.ndarray:
+    """Leg Jacobian J_lq: leg-length rates = J_lq q_dot.
+
+    Parameters
+    ----------
+    platform : Platform
+    q : ndarray, shape (6,) or (N, 6)
+
+    Returns
+    -------
+    ndarray, shape (6, 6) or (N, 6, 6)
+        Row k: d l_k / d q (m/m, m/rad). J_lq^T f maps actuator forces (N) to generalized
+        forces (N, N m).
+    """
+    q2, single = _batch(q)
+    J_leg = _leg_terms(platform, q2)[1]
+    return J_leg[0] if single else J_leg
+
+
+def joint_rate_jacobians(platform: Platform, q: np.ndarray) -> np.ndarray:
+    """Jacobians of the five rotational joint axes of every leg.
+
+    Joint rates (rad/s) = J[..., leg, axis, :] @ q_dot, axes ordered as :data:`JOINT_AXES`:
+    two lower gimbal axes, two upper gimbal axes, the revolute about the leg. The gimbal
+    axes are an orthonormal leg frame e1 = unit(z x u) (horizontal), e2 = u x e1; see
+    ``docs/conventions.md``.
+
+    Returns
+    -------
+    ndarray, shape (6, 5, 6) or (N, 6, 5, 6)
+    """
+    q2, single = _batch(q)
+    J_joint = _leg_terms(platform, q2, joints=True, pose_terms=False)[3]
+    return J_joint[0] if single else J_joint
+
+
+def forward_kinematics(platform: Platform, lengths: np.ndarray, initial: np.ndarray | None = None,
+                       tolerance: float = 1e-12, max_iterations: int = 30) -> np.ndarray:
+    """Poses from leg lengths by Newton-Raphson, all samples at once.
+
+    Parameters
+    ----------
+    platform : Platform
+    lengths : ndarray, shape (6,) or (N, 6)
+        Measured leg lengths (m), legs numbered as in ``docs/conventions.md``.
+    initial : ndarray, shape (6,) or (N, 6), optional
+        Starting poses; the neutral pose by default.
+    tolerance : float
+        Convergence threshold on the largest leg-length residual (m).
+    max_iterations : int
+        Newton iterations before giving up.
+
+    Returns
+    -------
+    ndarray, shape (6,) or (N, 6)
+        Poses (m, rad).
+
+    Raises
+    ------
+    KinematicsError
+        If some sample does not converge or meets a singular Jacobian.
+    """
+    l2, single = _batch(lengths, "lengths")
+    if not np.all(np.isfinite(l2)) or np.any(l2 <= 0):
+        raise KinematicsError("leg lengths must be finite and positive for forward kinematics.")
+    q = np.tile(platform.neutral_pose, (len(l2), 1)) if initial is None else \
+        np.array(np.broadcast_to(_batch(initial, "initial")[0], l2.shape))
+    residual = np.inf
+    active = np.arange(len(q))  # samples not yet converged: only they are iterated
+    for _ in range(max_iterations):
+        _, J, current, _ = _leg_terms(platform, q[active])
+        error = current - l2[active]
+        residual_active = np.max(np.abs(error), axis=1)
+        keep = residual_active >= tolerance
+        active, J, error = active[keep], J[keep], error[keep]
+        if len(active) == 0:
+            return q[0] if single else q
+        cond = np.linalg.cond(J)
+        singular = ~np.isfinite(cond) | (cond > 1e12)
+        if np.any(singular):
+            worst = int(np.argmax(singular))
+            raise KinematicsError(
+                f"forward kinematics met a singular leg Jacobian at sample {active[worst]} "
+                f"(condition number {cond[worst]:.3g}); check the leg lengths and the "
+                "platform description, or give a better initial pose."
+            )
+        q[active] -= np.linalg.solve(J, error[..., None])[..., 0]
+        residual = np.zeros(len(q))
+        residual[active] = residual_active[keep]
+    bad = int(np.argmax(residual))
+    raise KinematicsError(
+        f"forward kinematics did not converge in {max_iterations} iterations at sample {bad} "
+        f"(leg-length residual {residual[bad]:.3g} m); the lengths may be unreachable for "
+        "this platform, or the initial pose too far away."
+    )

@@ -1,0 +1,73 @@
+"""Linearisation of the platform dynamics about a pose: the paper's Mt, Bt and the gravity
+stiffness K_G.
+
+About an equilibrium pose q0 with small motion, the equation of motion becomes
+
+    Mt q_ddot + Bt q_dot + G(q0) + K_G (q - q0) + Fc = J_lq^T f_a,
+
+with Mt = M(q0), Bt = c * sum over legs and gimbal axes of J_j^T J_j (the viscous gimbal
+friction), and K_G = dG/dq at q0. These are the "true values calculated with a formula" of
+Zhang (2020), Tables 3-6.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stewartid.model.dynamics import ModelTerms
+from stewartid.model.kernels import GIMBAL_AXES, model_terms
+from stewartid.model.kinematics import joint_rate_jacobians
+from stewartid.platform import Platform
+
+
+def viscous_matrix(platform: Platform, q: np.ndarray) -> np.ndarray:
+    """Bt(q) = c * sum_{legs, gimbal axes} J_j^T J_j; shape (6, 6) or (N, 6, 6)."""
+    return _viscous(platform, joint_rate_jacobians(platform, q))
+
+
+def _viscous(platform: Platform, joint_jacobians: np.ndarray) -> np.ndarray:
+    """Bt from joint-axis Jacobians of shape (..., 6, 5, 6); shape (..., 6, 6)."""
+    J = joint_jacobians[..., list(GIMBAL_AXES), :]
+    return platform.friction.gimbal_viscous * np.einsum("...lai,...laj->...ij", J, J)
+
+
+def nominal_matrices(platform: Platform, pose: np.ndarray | None = None
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """Nominal inertial and viscous matrices (Mt, Bt) of the linearised model.
+
+    Parameters
+    ----------
+    platform : Platform
+    pose : ndarray, shape (6,), optional
+        Linearisation pose (m, rad); the neutral pose by default.
+
+    Returns
+    -------
+    Mt : ndarray, shape (6, 6)
+        kg, kg m, kg m^2 blocks (the mass matrix at ``pose``).
+    Bt : ndarray, shape (6, 6)
+        N s/m, N s/rad, N m s/rad blocks.
+    """
+    q0 = platform.neutral_pose if pose is None else np.asarray(pose, dtype=float)
+    M, h, G, J_leg, J_joint, lengths = (np.empty(shape) for shape in
+                                        ((6, 6), 6, 6, (6, 6), (6, 5, 6), 6))
+    # one pose: the kernel interpreted, which spares the command line numba's start
+    model_terms(platform.parameters(), platform.upper_joints, platform.base_joints, q0,
+                np.zeros(6), M, h, G, J_leg, J_joint, lengths)
+    return M, _viscous(platform, J_joint)
+
+
+def gravity_stiffness(platform: Platform, pose: np.ndarray | None = None,
+                      step: float = 1e-6) -> np.ndarray:
+    """Gravity stiffness K_G = dG/dq at ``pose`` by central differences of the exact G(q).
+
+    Returns
+    -------
+    ndarray, shape (6, 6)
+        Column j is dG/dq_j (N/m, N/rad, N m/m, N m/rad).
+    """
+    q0 = platform.neutral_pose if pose is None else np.asarray(pose, dtype=float)
+    steps = step * np.eye(6)
+    G_plus = ModelTerms(platform, q0 + steps).gravity
+    G_minus = ModelTerms(platform, q0 - steps).gravity
+    return ((G_plus - G_minus) / (2 * step)).T

@@ -1,0 +1,305 @@
+"""The platform as a MuJoCo model: an independent engine for the same mechanism.
+
+:func:`build_mjcf` writes MJCF for a :class:`~stewartid.platform.Platform`;
+:func:`load_model` compiles it. The helpers below move poses, rates and forces between
+our coordinates and MuJoCo's, so the two engines can be compared term by term (tests) and
+timed on the same load (``benchmarks/bench_plant_vs_mujoco.py``). MuJoCo is an optional
+dependency, imported only when a function needs it: ``pip install "stewartid[mujoco]"``.
+
+Frames
+------
+MuJoCo's world is the paper frame turned half a turn about x (z up, so its viewer shows the
+platform upright and its default gravity (0, 0, -9.81) is the paper's +9.81 along z down)::
+
+    p_mujoco = T p_paper,   T = diag(1, -1, -1)   (a proper rotation, R_x(pi)).
+
+Bodies follow the same rule: the platform body's local frame is T applied to the paper's
+platform frame, so its world orientation is T R T. For a pose q = [x, y, z, rx, ry, rz],
+the MuJoCo image has position T [x, y, z] and roll-pitch-yaw (rx, -ry, -rz); generalized
+forces and rates transform with the same diag(1, -1, -1, 1, -1, -1) (the matrix
+``T_M_T`` of ``MODEL.md``, used there to compare the z-up and z-down mass matrices).
+
+Mechanism
+---------
+Each leg is an open chain from the base, closed on the platform by a weld:
+
+* ``leg<k>_cylinder`` at the base joint B: hinges ``leg<k>_lower1`` (axis e1) then
+  ``leg<k>_lower2`` (axis e2, carried by the first), a Cardan joint. Mass, centre of mass
+  B + d_l u and transverse inertia of the lower part.
+* ``leg<k>_rod``: slide ``leg<k>_slide`` along the leg (qpos = l - l_0, l_0 the neutral
+  leg length), driven by the ideal force actuator ``leg<k>`` (``<motor>``, N, positive
+  extends). Mass, centre of mass A - d_u u and transverse inertia of the upper part.
+* ``leg<k>_end`` at the upper joint A: hinges ``leg<k>_upper1`` (e1), ``leg<k>_upper2``
+  (e2), a second Cardan joint, then ``leg<k>_revolute`` about the leg; welded to the
+  platform (6 constraint rows).
+
+The platform is a free body at the reference point (its centre of mass). The axes are the
+orthonormal leg frame of ``docs/conventions.md`` (e1 = unit(z x u), e2 = u x e1, u) at the
+neutral pose, which is every joint's zero. Away from it the Cardan axes move with the
+bodies that carry them while our model re-evaluates e1, e2 from the current leg direction:
+the axes agree at the gimbal's zero and differ by an angle of the order of the gimbal
+deflection. Masses, gravity and the leg Jacobian do not depend on the choice of axes; the
+joint friction does. The lower pair's total dissipation is invariant to first order (any
+orthonormal pair across the leg), but the upper chain's three hinges stop being orthogonal
+(upper 1 and the revolute axis tilt by the upper 2 angle), so a revolute rate leaks into the
+damped gimbal rates at first order: the viscous matrix V^T D V differs from our Bt by about
+0.2-0.4 times the largest gimbal angle (relative to its largest entry; about 0.3 % at 10 mrad).
+
+Friction: joint damping ``gimbal_viscous`` on the four gimbal hinges, none on the revolute
+or the slide; Coulomb ``coulomb`` as MuJoCo ``frictionloss`` on all five hinges (MuJoCo
+resolves it as a constraint, not regularised as our ``Fc w / sqrt(w^2 + s^2)``).
+
+Closure stiffness: MuJoCo's equality constraints are soft. With time constant tau and
+impedance d a weld row obeys r'' = -b r' - k r + (1 - d)/d A_ii lambda (k ~ 1/tau^2, A_ii the
+row's inverse effective mass, lambda its force), so its violation under load is of order
+(1 - d) tau^2 A_ii lambda. At the defaults (tau = 2 timestep, d = 0.9999) a 2 s closed-loop
+run at 0.5 ms keeps the position rows within 5e-8 m and the rotational rows within 6e-6 rad.
+
+Masses the chain needs: MuJoCo requires mass and inertia on every moving body, so each
+``end`` body carries ``END_MASS_FRACTION`` of the platform's mass (isotropic inertia of a
+0.3 m sphere; the rotational rows' compliance scales with 1/A_ii, hence not smaller), taken
+from the platform body, whose mass, centre of mass and inertia are reduced so that the
+platform and the six ends together have exactly the description's mass and inertia. Leg
+parts get a token inertia about the leg axis (1e-9 of the transverse one) where our model has
+none: the lower Cardan joint lets a leg spin only at second order in its deflection.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from stewartid.model.kinematics import inverse_kinematics
+from stewartid.platform import GRAVITY, Platform
+
+if TYPE_CHECKING:  # pragma: no cover - typing only
+    import mujoco
+
+#: MuJoCo world coordinates = T @ paper coordinates (half a turn about x).
+T = np.diag([1.0, -1.0, -1.0])
+#: The same change of frame for 6-vectors of poses, rates and generalized forces.
+T6 = np.diag([1.0, -1.0, -1.0, 1.0, -1.0, -1.0])
+#: Share of the platform's mass carried by each leg's end body (see the module docstring).
+END_MASS_FRACTION = 1e-4
+#: Radius (m) of the sphere whose inertia the end bodies carry: large enough that the
+#: welds' rotational rows, whose compliance scales with 1/inertia, stay below 1e-5 rad.
+END_RADIUS = 0.3
+#: Integrators accepted by :func:`build_mjcf` (MuJoCo's names).
+INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast")
+
+
+def require_mujoco() -> Any:
+    """Import MuJoCo, or explain which extra installs it.
+
+    Returns
+    -------
+    module
+        The ``mujoco`` package.
+
+    Raises
+    ------
+    ImportError
+        If MuJoCo is not installed.
+    """
+    try:
+        import mujoco
+    except ImportError as exc:  # pragma: no cover - depends on the environment
+        raise ImportError(
+            "the MuJoCo model needs the optional dependency mujoco>=3.1; install it with "
+            'pip install "stewartid[mujoco]"') from exc
+    return mujoco
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v)
+
+
+def leg_frames(platform: Platform) -> np.ndarray:
+    """Orthonormal leg frames at the neutral pose, paper frame.
+
+    Returns
+    -------
+    ndarray, shape (6, 3, 3)
+        Columns e1 = unit(z x u), e2 = u x e1, u for each leg (u from base to platform
+        joint), as in ``docs/conventions.md``.
+    """
+    legs = inverse_kinematics(platform, platform.neutral_pose)
+    frames = np.empty((6, 3, 3))
+    for k, u in enumerate(legs.directions[0]):
+        e1 = _unit(np.cross([0.0, 0.0, 1.0], u))
+        frames[k] = np.column_stack([e1, np.cross(u, e1), u])
+    return frames
+
+
+def _vec(v: Any) -> str:
+    return " ".join(f"{float(x):.17g}" for x in np.ravel(v))
+
+
+def _platform_inertial(platform: Platform) -> tuple[float, np.ndarray, np.ndarray, float, float]:
+    """Mass, centre of mass and full inertia of the platform body once the ends are removed.
+
+    Returns
+    -------
+    mass : float
+        kg.
+    com : ndarray, shape (3,)
+        m, platform body frame (MuJoCo orientation).
+    inertia : ndarray, shape (6,)
+        Ixx, Iyy, Izz, Ixy, Ixz, Iyz about ``com`` (kg m^2), MuJoCo's ``fullinertia``.
+    end_mass, end_inertia : float
+        kg and kg m^2 of each end body.
+    """
+    i = platform.inertia
+    end_mass = END_MASS_FRACTION * i.platform_mass
+    end_inertia = 0.4 * end_mass * END_RADIUS ** 2
+    r = platform.upper_joints @ T  # rows: T a_k (T is symmetric)
+    mass = i.platform_mass - 6 * end_mass
+    com = -end_mass * r.sum(axis=0) / mass
+    # inertia about the reference point, less the ends (parallel-axis theorem), then moved to
+    # the remaining body's own centre of mass
+    I_ref = np.diag(i.platform_inertia).astype(float)
+    for rk in r:
+        I_ref -= end_mass * (rk @ rk * np.eye(3) - np.outer(rk, rk)) + end_inertia * np.eye(3)
+    I_com = I_ref - mass * (com @ com * np.eye(3) - np.outer(com, com))
+    full = np.array([I_com[0, 0], I_com[1, 1], I_com[2, 2], I_com[0, 1], I_com[0, 2],
+                     I_com[1, 2]])
+    return mass, com, full, end_mass, end_inertia
+
+
+def build_mjcf(platform: Platform, *, integrator: str = "RK4", timestep: float = 5e-4,
+               constraint_timeconst: float | None = None, constraint_impedance: float = 0.9999,
+               coulomb: bool = True) -> str:
+    """MJCF text of the platform's mechanism (frames and bodies in the module docstring).
+
+    Parameters
+    ----------
+    platform : Platform
+        Geometry, masses and joint friction; ``[hydraulics]`` and ``[controller]`` are not
+        used (the legs have ideal force actuators).
+    integrator : {"RK4", "implicitfast", "implicit", "Euler"}
+        MuJoCo integrator.
+    timestep : float
+        Integration step (s).
+    constraint_timeconst : float, optional
+        Time constant of the weld constraints that close the legs on the platform (s);
+        ``2 * timestep`` by default, the smallest MuJoCo recommends for stability.
+    constraint_impedance : float
+        Impedance d of the welds, in (0, 1): the share of the constraint the solver enforces
+        rigidly; closer to 1 is stiffer.
+    coulomb : bool
+        Model the Coulomb friction as ``frictionloss`` on the five hinges of each leg
+        (adds up to 30 constraint rows when ``[friction] coulomb`` > 0).
+
+    Returns
+    -------
+    str
+        MJCF XML.
+    """
+    if integrator not in INTEGRATORS:
+        raise ValueError(f"integrator must be one of {INTEGRATORS}; got {integrator!r}.")
+    if not (timestep > 0 and math.isfinite(timestep)):
+        raise ValueError(f"timestep must be > 0 s; got {timestep!r}.")
+    tau = 2.0 * timestep if constraint_timeconst is None else float(constraint_timeconst)
+    if not 0.0 < constraint_impedance < 1.0:
+        raise ValueError(f"constraint_impedance must lie in (0, 1); got {constraint_impedance!r}.")
+    g = platform.geometry
+    i = platform.inertia
+    damping = platform.friction.gimbal_viscous
+    friction = platform.friction.coulomb if coulomb else 0.0
+    frictionloss = f' frictionloss="{friction:.17g}"' if friction > 0 else ""
+    l0 = platform.neutral_leg_length
+    frames = leg_frames(platform)
+    base = platform.base_joints
+    p0 = T @ platform.neutral_pose[:3]
+    mass, com, full, end_mass, end_inertia = _platform_inertial(platform)
+    # MuJoCo refuses a zero principal inertia; our leg parts have none about the leg axis,
+    # about which the Cardan joints let them turn only at second order in the deflection,
+    # so a token value changes nothing measurable (1e-9 of the transverse inertia).
+    axial = f"{max(1e-9 * max(i.lower_leg_inertia, i.upper_leg_inertia), 1e-10):.3g}"
+    lower_t = max(i.lower_leg_inertia, 1e-10)
+    upper_t = max(i.upper_leg_inertia, 1e-10)
+    imp = f"{constraint_impedance:.17g}"
+
+    lines = [
+        f'<mujoco model="stewartid-{platform.name}">',
+        '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
+        f'  <option timestep="{timestep:.17g}" integrator="{integrator}" '
+        f'gravity="0 0 {-GRAVITY:.17g}" jacobian="dense" solver="Newton" '
+        'iterations="50" tolerance="1e-12">',
+        '    <flag contact="disable"/>',
+        "  </option>",
+        "  <default>",
+        '    <geom contype="0" conaffinity="0" group="1"/>',
+        "  </default>",
+        "  <worldbody>",
+        f'    <light pos="0 0 {3 * (g.neutral_height + g.reference_height):.6g}"/>',
+        f'    <geom name="base" type="cylinder" size="{g.lower_radius:.6g} 0.02" '
+        'pos="0 0 -0.02" rgba="0.4 0.4 0.4 1"/>',
+        f'    <body name="platform" pos="{_vec(p0)}">',
+        "      <freejoint name=\"platform\"/>",
+        f'      <inertial pos="{_vec(com)}" mass="{mass:.17g}" fullinertia="{_vec(full)}"/>',
+        f'      <geom type="cylinder" size="{g.upper_radius:.6g} 0.05" '
+        f'pos="0 0 {-g.reference_height:.17g}" rgba="0.2 0.4 0.8 0.6"/>',
+        "    </body>",
+    ]
+    for k in range(6):
+        n = k + 1
+        R0 = T @ frames[k]  # leg frame in MuJoCo world coordinates, columns e1, e2, u
+        lines += [
+            f'    <body name="leg{n}_cylinder" pos="{_vec(T @ base[k])}" '
+            f'xyaxes="{_vec(R0[:, 0])} {_vec(R0[:, 1])}">',
+            f'      <joint name="leg{n}_lower1" type="hinge" axis="1 0 0" '
+            f'damping="{damping:.17g}"{frictionloss}/>',
+            f'      <joint name="leg{n}_lower2" type="hinge" axis="0 1 0" '
+            f'damping="{damping:.17g}"{frictionloss}/>',
+            f'      <inertial pos="0 0 {i.lower_leg_com:.17g}" mass="{i.lower_leg_mass:.17g}" '
+            f'diaginertia="{lower_t:.17g} {lower_t:.17g} {axial}"/>',
+            f'      <geom type="capsule" size="0.06" fromto="0 0 0 0 0 {0.55 * l0:.6g}" '
+            'rgba="0.6 0.6 0.6 1"/>',
+            f'      <body name="leg{n}_rod" pos="0 0 {l0:.17g}">',
+            f'        <joint name="leg{n}_slide" type="slide" axis="0 0 1"/>',
+            f'        <inertial pos="0 0 {-i.upper_leg_com:.17g}" '
+            f'mass="{i.upper_leg_mass:.17g}" diaginertia="{upper_t:.17g} {upper_t:.17g} '
+            f'{axial}"/>',
+            f'        <geom type="capsule" size="0.035" fromto="0 0 {-0.55 * l0:.6g} 0 0 0" '
+            'rgba="0.8 0.8 0.8 1"/>',
+            f'        <body name="leg{n}_end">',
+            f'          <joint name="leg{n}_upper1" type="hinge" axis="1 0 0" '
+            f'damping="{damping:.17g}"{frictionloss}/>',
+            f'          <joint name="leg{n}_upper2" type="hinge" axis="0 1 0" '
+            f'damping="{damping:.17g}"{frictionloss}/>',
+            f'          <joint name="leg{n}_revolute" type="hinge" axis="0 0 1"{frictionloss}/>',
+            f'          <inertial pos="0 0 0" mass="{end_mass:.17g}" '
+            f'diaginertia="{end_inertia:.17g} {end_inertia:.17g} {end_inertia:.17g}"/>',
+            "        </body>",
+            "      </body>",
+            "    </body>",
+        ]
+    lines += ["  </worldbody>", "  <equality>"]
+    for k in range(6):
+        # relpose omitted: the relative pose of the neutral configuration (qpos0), where every
+        # chain meets the platform exactly; anchor 0 puts the position rows at the joint A
+        lines.append(f'    <weld name="leg{k + 1}" body1="platform" body2="leg{k + 1}_end" '
+                     f'anchor="0 0 0" solref="{tau:.17g} 1" solimp="{imp} {imp} 0.001 0.5 2"/>')
+    lines += ["  </equality>", "  <actuator>"]
+    for k in range(6):
+        lines.append(f'    <motor name="leg{k + 1}" joint="leg{k + 1}_slide" gear="1"/>')
+    lines += ["  </actuator>", "</mujoco>", ""]
+    return "\n".join(lines)
+
+
+def load_model(platform: Platform, **options: Any) -> mujoco.MjModel:
+    """Compile :func:`build_mjcf` (same keyword options) into a ``mujoco.MjModel``.
+
+    Raises
+    ------
+    ImportError
+        If MuJoCo is not installed (``pip install "stewartid[mujoco]"``).
+    """
+    mj = require_mujoco()
+    return mj.MjModel.from_xml_string(build_mjcf(platform, **options))
+
+
+# -- moving states and forces between the engines -------------------------------------------

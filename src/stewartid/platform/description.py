@@ -1,0 +1,283 @@
+"""The platform description: geometry, inertia and joint friction of a 6-6 Stewart platform.
+
+A :class:`Platform` is a frozen dataclass built from a TOML file (format in
+``docs/platform-format.md``) or from the shipped ``paper`` preset (Zhang 2020, Tables 1-2).
+It checks itself when built: unknown keys, missing keys, wrong types, negative masses and
+geometries whose legs cannot be built are refused with one message naming the key.
+
+Frame (the paper's): x forward, y right, z down; origin at the centre of the base joint
+plane. Leg numbering follows ``docs/conventions.md`` and is part of the data format.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stewartid.errors import ConfigError
+from stewartid.fields import read_toml_text, section_from_mapping, section_to_mapping
+from stewartid.platform.ranges import check_physical_ranges
+from stewartid.platform.sections import (
+    Controller,
+    Friction,
+    Geometry,
+    Hydraulics,
+    Inertia,
+    Limits,
+    Sensors,
+)
+
+#: Standard gravity used throughout the model (m/s^2), as in the paper's model.
+GRAVITY = 9.81
+
+#: Names of the six generalized coordinates of the pose q, in the paper's order (m, m, m,
+#: rad, rad, rad): the one definition used by data files, identifiers, tables and figures.
+COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
+
+
+#: TOML sections of a platform description, in file order, with their dataclass.
+SECTIONS: dict[str, type] = {"geometry": Geometry, "inertia": Inertia, "friction": Friction,
+                             "hydraulics": Hydraulics, "controller": Controller,
+                             "sensors": Sensors, "limits": Limits}
+#: Sections that must be present in every file; the others take their documented defaults.
+REQUIRED_SECTIONS = ("geometry", "inertia", "friction")
+
+
+@dataclasses.dataclass(frozen=True)
+class Platform:
+    """A complete, validated description of a Stewart platform.
+
+    Attributes
+    ----------
+    geometry, inertia, friction : Geometry, Inertia, Friction
+        The required sections of the TOML description.
+    hydraulics, controller, sensors : Hydraulics, Controller, Sensors
+        Plant simulator settings; documented defaults when absent from the file.
+    limits : Limits
+        Operating limits of excitation design; derived defaults when absent.
+    name : str
+        Label used in reports ("paper" for the preset, the file stem otherwise).
+    """
+
+    geometry: Geometry
+    inertia: Inertia
+    friction: Friction
+    hydraulics: Hydraulics = dataclasses.field(default_factory=Hydraulics)
+    controller: Controller = dataclasses.field(default_factory=Controller)
+    sensors: Sensors = dataclasses.field(default_factory=Sensors)
+    limits: Limits = dataclasses.field(default_factory=Limits)
+    name: str = "platform"
+
+    def __post_init__(self) -> None:
+        check_physical_ranges({name: getattr(self, name) for name in SECTIONS})
+        _check_buildable(self)
+
+    # -- derived geometry -------------------------------------------------------------------
+    @property
+    def upper_joints(self) -> np.ndarray:
+        """Upper joint positions in the platform frame, relative to the reference point.
+
+        Returns
+        -------
+        ndarray, shape (6, 3)
+            Row k is leg k+1's upper gimbal point (m), platform body frame (z down).
+        """
+        g = self.geometry
+        angles = _upper_angles(g.upper_half_angle)
+        return np.column_stack([
+            g.upper_radius * np.cos(angles),
+            g.upper_radius * np.sin(angles),
+            np.full(6, g.reference_height),
+        ])
+
+    @property
+    def base_joints(self) -> np.ndarray:
+        """Lower (base) joint positions in the fixed frame.
+
+        Returns
+        -------
+        ndarray, shape (6, 3)
+            Row k is leg k+1's lower gimbal point (m); z = 0 is the base joint plane.
+        """
+        g = self.geometry
+        angles = _lower_angles(g.lower_half_angle)
+        return np.column_stack([
+            g.lower_radius * np.cos(angles),
+            g.lower_radius * np.sin(angles),
+            np.zeros(6),
+        ])
+
+    @property
+    def neutral_pose(self) -> np.ndarray:
+        """Pose q = [x, y, z, rx, ry, rz] at neutral (m, rad): z = -(neutral_height + reference_height)."""
+        g = self.geometry
+        return np.array([0.0, 0.0, -(g.neutral_height + g.reference_height), 0.0, 0.0, 0.0])
+
+    @property
+    def neutral_leg_length(self) -> float:
+        """Length of each leg at the neutral pose (m)."""
+        return float(np.linalg.norm(self.upper_joints[0] + self.neutral_pose[:3]
+                                    - self.base_joints[0]))
+
+    def parameters(self) -> np.ndarray:
+        """Mass and friction parameters packed for the compiled kernels.
+
+        Returns
+        -------
+        ndarray, shape (13,)
+            [m, Ixx, Iyy, Izz, m_upper, m_lower, d_upper, d_lower, I_upper, I_lower,
+            gimbal_viscous, coulomb, gravity].
+        """
+        i, f = self.inertia, self.friction
+        return np.array([
+            i.platform_mass, *i.platform_inertia, i.upper_leg_mass, i.lower_leg_mass,
+            i.upper_leg_com, i.lower_leg_com, i.upper_leg_inertia, i.lower_leg_inertia,
+            f.gimbal_viscous, f.coulomb, GRAVITY,
+        ])
+
+    # -- construction and serialisation -----------------------------------------------------
+    def replace(self, **sections_or_values: Any) -> Platform:
+        """Return a copy with whole sections, or single values as ``section__key=value``, replaced.
+
+        Examples
+        --------
+        >>> paper = load_platform("paper")
+        >>> paper.replace(friction__coulomb=30.0).friction.coulomb
+        30.0
+        """
+        updates: dict[str, Any] = {}
+        for key, value in sections_or_values.items():
+            if "__" in key:
+                section, field = key.split("__", 1)
+                table = section_to_mapping(updates.get(section, getattr(self, section)))
+                table[field] = value
+                updates[section] = section_from_mapping(SECTIONS[section], table, section)
+            else:
+                updates[key] = value
+        return dataclasses.replace(self, **updates)
+
+    def to_dict(self) -> dict[str, Any]:
+        """All sections as plain dictionaries (JSON/TOML ready)."""
+        return {name: section_to_mapping(getattr(self, name)) for name in SECTIONS}
+
+    def to_toml(self) -> str:
+        """The description as TOML text that :func:`load_platform` reads back identically."""
+        lines = [f"# stewartid platform description: {self.name}"]
+        for name, table in self.to_dict().items():
+            lines.append(f"\n[{name}]")
+            for key, value in table.items():
+                if value is not None:  # a derived default: TOML has no null
+                    lines.append(f"{key} = {_toml_value(value)}")
+        return "\n".join(lines) + "\n"
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    return repr(value)
+
+
+def _upper_angles(half_angle: float) -> np.ndarray:
+    centres = np.repeat(np.deg2rad([0.0, 120.0, 240.0]), 2)
+    return centres + np.tile([-half_angle, half_angle], 3)
+
+
+def _lower_angles(half_angle: float) -> np.ndarray:
+    centres = np.deg2rad([300.0, 60.0, 60.0, 180.0, 180.0, 300.0])
+    return centres + half_angle * np.array([1.0, -1.0, 1.0, -1.0, 1.0, -1.0])
+
+
+def _check_buildable(platform: Platform) -> None:
+    """Refuse geometries whose six legs cannot be built as the numbering assumes."""
+    g = platform.geometry
+    for key in ("upper_half_angle", "lower_half_angle"):
+        value = getattr(g, key)
+        if not value < math.pi / 6:
+            raise ConfigError(
+                f"[geometry] {key} = {value} rad: the two joints of a pair must stay within "
+                f"their 120 deg sector, so it must be < pi/6 = {math.pi / 6:.4f} rad."
+            )
+    length = platform.neutral_leg_length
+    for key in ("upper_leg_com", "lower_leg_com"):
+        value = getattr(platform.inertia, key)
+        if not value < length:
+            raise ConfigError(
+                f"[inertia] {key} = {value} m lies beyond the leg, whose neutral length is "
+                f"{length:.4f} m; give the distance from the gimbal point along the leg."
+            )
+
+
+def platform_from_mapping(document: Any, name: str = "platform") -> Platform:
+    """Build a :class:`Platform` from a parsed TOML document (a mapping of sections).
+
+    Raises
+    ------
+    ConfigError
+        If a section is missing or unknown, or any key fails validation.
+    """
+    if not isinstance(document, dict):
+        raise ConfigError("a platform description must be a TOML document of tables.")
+    unknown = sorted(set(document) - set(SECTIONS))
+    if unknown:
+        raise ConfigError(
+            f"unknown section [{unknown[0]}]; valid sections are: "
+            + ", ".join(f"[{s}]" for s in SECTIONS) + "."
+        )
+    for section in REQUIRED_SECTIONS:
+        if section not in document:
+            raise ConfigError(f"missing section [{section}]; see docs/platform-format.md.")
+    sections = {
+        key: section_from_mapping(cls, document[key], key)
+        for key, cls in SECTIONS.items() if key in document
+    }
+    return Platform(name=name, **sections)
+
+
+def load_platform(source: str | Path) -> Platform:
+    """Load a platform description.
+
+    Parameters
+    ----------
+    source : str or Path
+        ``"paper"`` for the shipped preset of Zhang (2020), Tables 1-2, or the path of a
+        TOML file.
+
+    Returns
+    -------
+    Platform
+
+    Raises
+    ------
+    ConfigError
+        If the file does not exist, is not valid TOML, or fails validation.
+    """
+    if str(source) == "paper":
+        text = resources.files("stewartid").joinpath("data/paper.toml").read_text()
+        return _parse(text, "paper", "the paper preset")
+    path = Path(source)
+    if not path.is_file():
+        raise ConfigError(
+            f"platform file {str(path)!r} not found; give a TOML file or 'paper' for the preset."
+        )
+    return _parse(read_toml_text(path), path.stem, str(path))
+
+
+def _parse(text: str, name: str, where: str) -> Platform:
+    try:
+        document = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{where} is not valid TOML: {exc}.") from None
+    try:
+        return platform_from_mapping(document, name)
+    except ConfigError as exc:
+        raise ConfigError(f"{where}: {exc}") from None

@@ -1,0 +1,1 @@
+"""The identification report of ``stewartid identify --report``."""

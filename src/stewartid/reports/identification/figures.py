@@ -1,0 +1,122 @@
+"""The figures of the identification report (:mod:`.user_report`), in report order.
+
+The drawing itself is :mod:`.identification_figures` and :mod:`.figures`; this module decides
+what is drawn, with which data and caption.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from stewartid.datasets.dataset import Dataset
+from stewartid.platform import Platform
+
+if TYPE_CHECKING:
+    from stewartid.reports.identification.report import MethodReport
+
+
+class FigureDrawer:
+    """Draws the figures into one folder and keeps their captions in report order.
+
+    Drawing in worker processes while the methods are fitted was measured on the 2-core
+    machine (docs/benchmarks.md): each worker pays its own imports, and under load the extra
+    process slows the fits more than it saves, so the figures are drawn here.
+    """
+
+    def __init__(self, folder: Path):
+        self.folder = folder
+        self.entries: dict[str, tuple[str, str]] = {}
+        self.files: list[Path] = []
+
+    def add(self, key: str, caption: str, function: Callable[..., list[Path]],
+            *args: Any) -> None:
+        """Draw ``function(*args)`` as ``figures/<key>.png`` and ``.svg`` with ``caption``."""
+        self.entries[key] = (f"figures/{key}.png", caption)
+        self.files += function(*args, directory=self.folder, stem=key)
+
+
+def data_figures(drawer: FigureDrawer, datasets: Sequence[Dataset], platform: Platform,
+                 rows: Sequence[dict[str, Any]]) -> None:
+    """The figures of the data alone: excitation and spectrum."""
+    from stewartid.reporting.figures import ExperimentTrace, plot_excitation
+    from stewartid.reports.identification import method_figures as plots
+
+    neutral = np.asarray(platform.neutral_pose, dtype=float)
+    traces = [ExperimentTrace(name=d.name, excited=row["excited"], t=d.t, pose=d.pose,
+                              neutral=neutral) for d, row in zip(datasets, rows, strict=True)]
+    drawer.add("excitation", "Measured motion of the most excited coordinate of each "
+               "experiment (displacement from the neutral pose).", plot_excitation, traces)
+    drawer.add("spectrum", "Amplitude spectrum of the motion of every coordinate; dashed: the "
+               "dominant excitation frequency.", plots.plot_spectra,
+               [d.name for d in datasets], [d.pose for d in datasets],
+               [d.sample_rate for d in datasets], [row["frequency_hz"] for row in rows])
+
+
+def result_figures(drawer: FigureDrawer, runs: Sequence[MethodReport],
+                   datasets: Sequence[Dataset], platform: Platform,
+                   nominal: tuple[np.ndarray, np.ndarray], trusted: str,
+                   rows: Sequence[dict[str, Any]]) -> None:
+    """The figures of the identification: intervals, matrices, residuals, validation, the
+    comparison of methods and friction."""
+    from stewartid.identification.preparation import prepare
+    from stewartid.identification.wavelet.intervals import joint_rates
+    from stewartid.reporting.figures import ExperimentTrace, plot_joint_rates
+    from stewartid.reports.identification import method_figures as plots
+    from stewartid.reports.identification.text import used_intervals
+    from stewartid.signals.differentiation import differentiate
+
+    ok = [run for run in runs if run.result is not None]
+    best = next(run for run in ok if run.name == trusted)
+    frequencies = [row["frequency_hz"] for row in rows]
+    owner, intervals, points = used_intervals(runs, trusted, datasets)
+    first = prepare([datasets[0]], platform)[0]
+    _, q_dot, _ = differentiate(first.q, first.sample_rate, 0.2 / frequencies[0])
+    trace = ExperimentTrace(
+        name=datasets[0].name, excited=rows[0]["excited"], t=first.t, pose=first.q,
+        neutral=np.asarray(platform.neutral_pose, dtype=float),
+        joint_rates=joint_rates(platform, first.q, q_dot, first.joint_jacobians,
+                                first.leg_jacobian),
+        intervals=intervals[0] if intervals else None)
+    drawer.add("joint_rates", f"Joint rates of {datasets[0].name}; shaded: the "
+               f"constant-direction intervals {owner} used." if intervals else
+               f"Joint rates of {datasets[0].name} (no method here uses constant-direction "
+               "intervals).", plot_joint_rates, trace)
+    if intervals:
+        drawer.add("intervals", "Constant-direction intervals used in every experiment"
+                   + (", with the (a, b) points (bar: scale a)."
+                      if any(p is not None for p in points)
+                      else "; the test functions span each whole interval."),
+                   plots.plot_intervals, [d.name for d in datasets],
+                   [(float(d.t[0]), float(d.t[-1])) for d in datasets], intervals, points)
+    colours = {run.display_name: run.color for run in ok}
+    estimates = {run.display_name: (run.result.M, run.result.B, run.result.std_errors_M,
+                                    run.result.std_errors_B) for run in ok}
+    drawer.add("matrices", "Identified over nominal for every entry with a non-zero nominal "
+               "value, ±2 standard errors.", plots.plot_matrices, estimates, colours, *nominal)
+    drawer.add("residuals", f"Residuals of {best.display_name} fitted on all data, over time "
+               "and their spectrum.", plots.plot_residuals, best.in_sample, frequencies)
+    shown = {run.display_name: run.validation for run in ok}
+    if best.validation_unconstrained is not None:
+        shown = {f"{best.display_name}, consistent": best.validation,
+                 f"{best.display_name}, unconstrained": best.validation_unconstrained}
+        colours = {**colours, f"{best.display_name}, consistent": best.color,
+                   f"{best.display_name}, unconstrained": "#555555"}
+    drawer.add("validation", "Held-out measured and predicted generalized force.",
+               plots.plot_validation, shown, colours)
+    if len(ok) > 1:
+        drawer.add("methods", "Held-out unexplained force per DOF and method.",
+                   plots.plot_unexplained,
+                   {run.display_name: run.validation.vaf_percent for run in ok}, colours)
+    friction = {run.display_name: run.coulomb for run in ok
+                if np.all(np.isfinite(run.coulomb[0]))}
+    if friction:
+        drawer.add("friction", "Coulomb levels per joint type, ±2 standard errors; dashed: "
+                   "the platform description's level.", plots.plot_friction, friction,
+                   colours, float(platform.friction.coulomb))
+
+
+__all__ = ["FigureDrawer", "data_figures", "result_figures"]

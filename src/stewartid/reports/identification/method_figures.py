@@ -1,0 +1,317 @@
+"""Figures of an identification report on measured data, each written as PNG and SVG.
+
+Drawn like every figure of the package (:mod:`stewartid.reporting.figures`): a
+:class:`matplotlib.figure.Figure` inside ``rc_context(STYLE)``, no pyplot, lines thinned to a
+few thousand points, saved by :func:`~stewartid.reporting.figures.save_figure`. Every
+function returns the written paths. The layouts are regular grids with fixed margins rather
+than matplotlib's constrained layout, which would triple the drawing time of a report.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from stewartid.assessment.validation import FRICTION_TYPES, ValidationResult
+from stewartid.platform import COORDINATES
+from stewartid.reporting.figures import _every, _figure, _styled, save_figure
+
+#: Display unit and scale of a displacement in each coordinate.
+DISPLACEMENT_UNITS = (("mm", 1e3),) * 3 + (("mrad", 1e3),) * 3
+#: Unit of the generalized force in each equation.
+FORCE_UNITS = ("N",) * 3 + ("N·m",) * 3
+
+
+def _grid(figure, count: int, columns: int = 3, top: float = 0.9, **options):
+    """A grid of ``count`` axes with fixed margins (hidden axes fill the last row)."""
+    rows = int(np.ceil(count / columns))
+    margins = {"left": 0.07, "right": 0.98, "bottom": 0.08, "top": top, "hspace": 0.45,
+               "wspace": 0.3, **options}
+    axes = figure.subplots(rows, columns, squeeze=False, gridspec_kw=margins)
+    for axis in list(axes.flat)[count:]:
+        axis.set_visible(False)
+    return axes
+
+
+def _log_floor(axis, values: np.ndarray, decades: float | None = 5.0) -> None:
+    """Show ``decades`` decades below the largest value (None: all; the numerical floor of a
+    noise-free record is not the interesting part) with plain tick labels (``0.001``: mathtext powers of
+    ten take most of a log axis's drawing time)."""
+    from matplotlib.ticker import FuncFormatter, NullLocator
+
+    top = float(np.nanmax(values)) if np.size(values) else 1.0
+    if top > 0 and decades is not None:
+        axis.set_ylim(top * 10 ** -decades, top * 3)
+    axis.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+    axis.yaxis.set_minor_locator(NullLocator())
+
+
+@_styled
+def plot_spectra(names: Sequence[str], poses: Sequence[np.ndarray], sample_rates: Sequence[float],
+                 frequencies_hz: Sequence[float], directory: str | Path,
+                 stem: str = "spectrum") -> list[Path]:
+    """Amplitude spectrum of the displacement of every coordinate, one panel per experiment.
+
+    Parameters
+    ----------
+    names : sequence of str
+    poses : sequence of ndarray, shape (N_k, 6)
+        Measured poses (m, rad).
+    sample_rates : sequence of float
+        Hz.
+    frequencies_hz : sequence of float
+        Dominant excitation frequency of each experiment (Hz), marked and used for the range.
+    """
+    figure = _figure(figsize=(13, 3.3 * int(np.ceil(len(names) / 3)) + 0.6))
+    axes = _grid(figure, len(names))
+    colours = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b"]
+    for axis, name, q, rate, f0 in zip(axes.flat, names, poses, sample_rates, frequencies_hz,
+                                       strict=False):
+        n = len(q)
+        window = np.hanning(n)[:, None]
+        spectrum = 2 * np.abs(np.fft.rfft((q - q.mean(axis=0)) * window, axis=0)) / window.sum()
+        frequency = np.fft.rfftfreq(n, 1.0 / rate)
+        keep = (frequency > 0) & (frequency <= min(20 * f0, rate / 2))
+        shown = spectrum[keep] * np.array([scale for _, scale in DISPLACEMENT_UNITS])
+        for k in range(6):
+            axis.semilogy(frequency[keep], shown[:, k], color=colours[k], lw=0.9,
+                          label=f"{COORDINATES[k]} ({DISPLACEMENT_UNITS[k][0]})")
+        _log_floor(axis, shown)
+        axis.axvline(f0, color="k", lw=0.6, ls="--")
+        axis.set_title(f"{name}: dominant {f0:.4g} Hz")
+        axis.set_xlabel("frequency (Hz)")
+        axis.set_ylabel("amplitude (mm, mrad)")
+    axes[0, 0].legend(loc="upper right", ncol=2, framealpha=0.9)
+    figure.suptitle("Spectrum of the measured motion (Hann window)")
+    return save_figure(figure, directory, stem, tight=False)
+
+
+@_styled
+def plot_intervals(names: Sequence[str], spans: Sequence[tuple[float, float]],
+                   intervals: Sequence[np.ndarray], points: Sequence[np.ndarray | None],
+                   directory: str | Path, stem: str = "intervals") -> list[Path]:
+    """The constant-direction intervals an identification used, one lane per experiment, and
+    the (a, b) points where the method used them (shift b on the time axis, scale a as the
+    marker's half-width bar).
+
+    Parameters
+    ----------
+    names : sequence of str
+    spans : sequence of (float, float)
+        First and last time of each record (s).
+    intervals : sequence of ndarray, shape (M_k, 2)
+        [start, stop] (s).
+    points : sequence of ndarray, shape (K_k, 2), or None
+        (a, b) pairs (s, s).
+    """
+    height = 0.55 * len(names) + 1.6
+    figure = _figure(figsize=(11, height))
+    axis = figure.subplots(gridspec_kw={"left": 0.1, "right": 0.98, "bottom": 0.9 / height,
+                                        "top": 1 - 0.7 / height})
+    for row, (span, found, used) in enumerate(zip(spans, intervals, points, strict=True)):
+        axis.plot(span, [row, row], color="#cccccc", lw=6, solid_capstyle="butt")
+        for k, (start, stop) in enumerate(np.asarray(found).reshape(-1, 2)):
+            axis.plot([start, stop], [row, row], color="#3182bd", lw=6, solid_capstyle="butt",
+                      label="constant-direction interval" if row == 0 and k == 0 else None)
+        if used is not None and len(used):
+            used = np.asarray(used).reshape(-1, 2)
+            offsets = row + 0.3 * (used[:, 0] / used[:, 0].max())
+            axis.errorbar(used[:, 1], offsets, xerr=used[:, 0], fmt="o", ms=2, lw=0.5,
+                          color="#e6550d", label="(a, b) points" if row == 0 else None)
+    axis.set_yticks(range(len(names)), names)
+    axis.invert_yaxis()
+    axis.set_xlabel("time (s)")
+    axis.set_title("Intervals in which no active joint reverses (grey: the record)")
+    if axis.get_legend_handles_labels()[0]:
+        axis.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), ncol=2, framealpha=0.9,
+                    fontsize=8)
+    return save_figure(figure, directory, stem, tight=False)
+
+
+def _significant(nominal: np.ndarray) -> list[tuple[int, int]]:
+    """Entries whose nominal value is not negligible (above 1e-6 of the largest)."""
+    scale = np.abs(nominal).max()
+    return [(i, j) for i in range(6) for j in range(6)
+            if scale > 0 and abs(nominal[i, j]) > 1e-6 * scale]
+
+
+@_styled
+def plot_matrices(estimates: Mapping[str, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]],
+                  colours: Mapping[str, str], M_nominal: np.ndarray, B_nominal: np.ndarray,
+                  directory: str | Path, stem: str = "matrices") -> list[Path]:
+    """Identified / nominal for every entry with a non-negligible nominal value, with error
+    bars of two standard errors, per method.
+
+    Parameters
+    ----------
+    estimates : mapping of label to (M, B, std_M, std_B), each ndarray (6, 6)
+    colours : mapping of label to colour
+    M_nominal, B_nominal : ndarray, shape (6, 6)
+    """
+    figure = _figure(figsize=(13, 7.5))
+    axes = figure.subplots(2, 1, gridspec_kw={"left": 0.07, "right": 0.98, "bottom": 0.1,
+                                              "top": 0.95, "hspace": 0.45})
+    width = 0.8 / max(len(estimates), 1)
+    for axis, index, nominal, name in ((axes[0], 0, M_nominal, "Mt"),
+                                       (axes[1], 1, B_nominal, "Bt")):
+        entries = _significant(nominal)
+        x = np.arange(len(entries))
+        for k, (label, values) in enumerate(estimates.items()):
+            matrix, std = values[index], values[index + 2]
+            ratio = np.array([matrix[e] / nominal[e] for e in entries])
+            bars = np.array([2 * std[e] / abs(nominal[e]) for e in entries])
+            axis.errorbar(x + (k - (len(estimates) - 1) / 2) * width, ratio, yerr=bars, fmt="o",
+                          ms=4, capsize=2, color=colours[label], label=label)
+        axis.axhline(1.0, color="k", lw=0.8)
+        axis.set_xticks(x, [f"{name}({i + 1},{j + 1})\n{nominal[i, j]:,.0f}" for i, j in entries],
+                        fontsize=7)
+        axis.set_ylabel(f"identified / nominal {name} (−)")
+        axis.set_title(f"{name}: identified over nominal (nominal under each entry), "
+                       "bars ±2 standard errors")
+    axes[0].legend(loc="best", framealpha=0.9)
+    return save_figure(figure, directory, stem, tight=False)
+
+
+def _concatenated(validation: ValidationResult, values: Sequence[np.ndarray]):
+    """Segments end to end: time axis (s from the first sample) and stacked values."""
+    times, offset = [], 0.0
+    for segment in validation.segments:
+        times.append(segment.t - segment.t[0] + offset)
+        offset = times[-1][-1] + (segment.t[1] - segment.t[0])
+    return np.concatenate(times), np.concatenate(values)
+
+
+@_styled
+def plot_residuals(validation: ValidationResult, frequencies_hz: Sequence[float],
+                   directory: str | Path, stem: str = "residuals") -> list[Path]:
+    """Residual of every equation over time (all experiments end to end) and its amplitude
+    spectrum, with the excitation frequencies and their harmonics marked."""
+    residual = [m - p for m, p in zip(validation.measured, validation.predicted, strict=True)]
+    t, values = _concatenated(validation, residual)
+    figure = _figure(figsize=(13, 12))
+    axes = _grid(figure, 12, columns=2, top=0.95, bottom=0.05, hspace=0.35, wspace=0.2,
+                 width_ratios=[2.2, 1])
+    step = _every(t, 6000)
+    rate = 1.0 / (validation.segments[0].t[1] - validation.segments[0].t[0])
+    top = 10 * max(frequencies_hz)
+    for c in range(6):
+        axes[c, 0].plot(t[step], values[step, c], color="#444444", lw=0.6)
+        axes[c, 0].set_ylabel(f"{COORDINATES[c]} ({FORCE_UNITS[c]})")
+        peaks = []
+        for piece in (r[:, c] for r in residual):
+            window = np.hanning(len(piece))
+            amplitude = 2 * np.abs(np.fft.rfft((piece - piece.mean()) * window)) / window.sum()
+            frequency = np.fft.rfftfreq(len(piece), 1.0 / rate)
+            keep = frequency <= top
+            axes[c, 1].semilogy(frequency[keep], amplitude[keep], lw=0.5, color="#444444",
+                                alpha=0.5)
+            peaks.append(amplitude[keep])
+        _log_floor(axes[c, 1], np.concatenate(peaks), decades=4.0)
+        for f in sorted(set(np.round(frequencies_hz, 6))):
+            for harmonic in range(1, int(top / f) + 1):
+                axes[c, 1].axvline(harmonic * f, color="#d62728", lw=0.5, ls=":")
+    axes[0, 0].set_title("Residual (measured − model) over time; experiments end to end")
+    axes[0, 1].set_title("Residual spectrum per segment; dotted: excitation harmonics")
+    axes[-1, 0].set_xlabel("time across the experiments (s)")
+    axes[-1, 1].set_xlabel("frequency (Hz)")
+    return save_figure(figure, directory, stem, tight=False)
+
+
+@_styled
+def plot_validation(validations: Mapping[str, ValidationResult], colours: Mapping[str, str],
+                    directory: str | Path, stem: str = "validation") -> list[Path]:
+    """Measured versus predicted generalized force on held-out segments: per DOF, every
+    segment of the experiment in which that DOF moves the force most.
+
+    Parameters
+    ----------
+    validations : mapping of label to ValidationResult
+        The first one gives the measured force; all share the same segments.
+    colours : mapping of label to colour
+    """
+    first = next(iter(validations.values()))
+    figure = _figure(figsize=(13, 9))
+    axes = _grid(figure, 6, top=0.91)
+    styles = ["-", "--", "-.", ":"]
+    for c, axis in enumerate(axes.flat[:6]):
+        energy: dict[int, float] = {}
+        for segment, measured in zip(first.segments, first.measured, strict=True):
+            energy[segment.experiment] = energy.get(segment.experiment, 0.0) + float(
+                np.sum(measured[:, c] ** 2))
+        chosen = max(energy, key=energy.__getitem__)
+        picks = [k for k, s in enumerate(first.segments) if s.experiment == chosen]
+        for n, k in enumerate(picks):
+            segment = first.segments[k]
+            step = _every(segment.t, 1500)
+            axis.plot(segment.t[step], first.measured[k][step, c], color="#999999", lw=2.2,
+                      label="measured" if n == 0 else None)
+            for m, (label, validation) in enumerate(validations.items()):
+                axis.plot(segment.t[step], validation.predicted[k][step, c], lw=1.0,
+                          ls=styles[m % len(styles)], color=colours[label],
+                          label=f"{label} (VAF {validation.vaf_percent[c]:.2f} %)"
+                          if n == 0 else None)
+        axis.set_title(f"{COORDINATES[c]} equation, {first.segments[picks[0]].name.split('[')[0]}")
+        axis.set_xlabel("time (s)")
+        axis.set_ylabel(f"force ({FORCE_UNITS[c]})")
+        axis.legend(loc="upper right", fontsize=7, framealpha=0.9)
+    figure.suptitle("Held-out data: measured generalized force and the identified model's "
+                    "prediction (each segment predicted by the fit without it)")
+    return save_figure(figure, directory, stem, tight=False)
+
+
+@_styled
+def plot_unexplained(vaf: Mapping[str, np.ndarray], colours: Mapping[str, str],
+                     directory: str | Path, stem: str = "methods") -> list[Path]:
+    """Held-out unexplained force, 100 − VAF (%), per DOF and method (log scale)."""
+    figure = _figure(figsize=(9, 4))
+    axis = figure.subplots(gridspec_kw={"left": 0.1, "right": 0.98, "bottom": 0.1,
+                                        "top": 0.9})
+    width = 0.8 / max(len(vaf), 1)
+    x = np.arange(6)
+    for k, (label, values) in enumerate(vaf.items()):
+        axis.bar(x + (k - (len(vaf) - 1) / 2) * width,
+                 np.maximum(100.0 - np.asarray(values), 1e-5), width, color=colours[label],
+                 label=label)
+    axis.set_yscale("log")
+    _log_floor(axis, np.zeros(0), decades=None)
+    axis.set_xticks(x, COORDINATES)
+    axis.set_ylabel("100 − VAF (%), held out")
+    axis.set_title("Force the model does not explain on data it was not fitted on "
+                   "(lower is better)")
+    axis.legend(loc="best", framealpha=0.9)
+    return save_figure(figure, directory, stem, tight=False)
+
+
+@_styled
+def plot_friction(levels: Mapping[str, tuple[np.ndarray, np.ndarray]],
+                  colours: Mapping[str, str], nominal: float | None, directory: str | Path,
+                  stem: str = "friction") -> list[Path]:
+    """Coulomb level per joint type with ±2 standard errors, per method that estimates it.
+
+    Parameters
+    ----------
+    levels : mapping of label to (levels, standard errors), each ndarray (3,) (N m)
+    nominal : float or None
+        The platform description's Coulomb level (N m per joint axis), drawn as a line.
+    """
+    figure = _figure(figsize=(7, 3.6))
+    axis = figure.subplots(gridspec_kw={"left": 0.12, "right": 0.98, "bottom": 0.12,
+                                        "top": 0.9})
+    width = 0.8 / max(len(levels), 1)
+    x = np.arange(len(FRICTION_TYPES))
+    for k, (label, (value, std)) in enumerate(levels.items()):
+        axis.bar(x + (k - (len(levels) - 1) / 2) * width, value, width, yerr=2 * std,
+                 capsize=3, color=colours[label], label=label)
+    if nominal is not None:
+        axis.axhline(nominal, color="k", lw=0.8, ls="--", label="platform description")
+    axis.set_xticks(x, [name.replace("_", " ") for name in FRICTION_TYPES])
+    axis.set_ylabel("Coulomb level (N·m per joint axis)")
+    axis.set_title("Coulomb friction per joint type, ±2 standard errors")
+    axis.legend(loc="best", framealpha=0.9)
+    return save_figure(figure, directory, stem, tight=False)
+
+
+__all__ = ["plot_friction", "plot_intervals", "plot_matrices", "plot_residuals",
+           "plot_spectra", "plot_unexplained", "plot_validation"]

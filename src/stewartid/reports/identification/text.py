@@ -1,0 +1,426 @@
+"""The text of the identification report (:mod:`.user_report`): data summary, which method
+to trust and why, and ``report.md``.
+
+Every statement is computed from the numbers of the run (no fixed verdicts): if a result
+changes, so does the sentence about it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from stewartid.assessment.validation import FRICTION_TYPES, friction_signature
+from stewartid.datasets.dataset import Dataset
+from stewartid.identification.consistency import consistency_metrics, is_consistent
+from stewartid.identification.result import IdentificationResult
+from stewartid.platform import COORDINATES, Platform
+from stewartid.reporting.tables import ResultTable, to_markdown
+
+if TYPE_CHECKING:
+    from stewartid.reports.identification.report import IdentificationReport, MethodReport
+
+_UNITS = ("mm",) * 3 + ("mrad",) * 3
+#: Held-out VAF (%) in the worst DOF above which a model "predicts closely", "adequately".
+CLOSE_VAF, ADEQUATE_VAF = 99.0, 95.0
+#: A Coulomb level counts as present above this many standard errors.
+SIGNIFICANT = 3.0
+
+
+def data_rows(datasets: Sequence[Dataset], platform: Platform) -> list[dict[str, Any]]:
+    """Per experiment: samples, duration (s), sample rate (Hz), dominant frequency (Hz), the
+    most excited coordinate (rotations weighted by the upper joint radius), its amplitude
+    (mm or mrad) and the noise estimated from the data: pose (um, urad) and leg forces (N)."""
+    from stewartid.identification.wavelet.noise import white_noise_covariance
+    from stewartid.signals.differentiation import differentiate, estimate_frequency
+
+    rows = []
+    lever = np.array([1.0] * 3 + [platform.geometry.upper_radius] * 3)
+    for d in datasets:
+        frequency = estimate_frequency(d.pose, d.sample_rate)
+        window = 0.2 / frequency
+        smooth_pose = differentiate(d.pose, d.sample_rate, window)[0]
+        smooth_force = differentiate(d.forces, d.sample_rate, window)[0]
+        spread = d.pose.std(axis=0) * lever
+        excited = int(np.argmax(spread))
+        rows.append({
+            "name": d.name, "samples": len(d), "duration_s": d.duration,
+            "sample_rate_hz": d.sample_rate, "frequency_hz": frequency, "excited": excited,
+            "amplitude": 0.5 * float(np.ptp(d.pose[:, excited])) * 1e3,
+            "pose_noise": np.sqrt(np.diag(white_noise_covariance(d.pose, smooth_pose))),
+            "force_noise": np.sqrt(np.diag(white_noise_covariance(d.forces,
+                                                                     smooth_force)))})
+    return rows
+
+
+def used_intervals(runs: Sequence[MethodReport], trusted: str, datasets: Sequence[Dataset]
+                   ) -> tuple[str, list[np.ndarray], list[np.ndarray | None]]:
+    """Constant-direction intervals (M_k, 2) and (a, b) points (K_k, 2) per experiment, as
+    the diagnostics record them, of the trusted method or else the first that uses them.
+
+    Returns
+    -------
+    display_name : str
+        Of the method they come from ("" if no method uses intervals).
+    intervals, points : list
+        Empty if no method uses intervals.
+    """
+    def recorded(run: MethodReport) -> list[dict]:
+        experiments = [] if run.result is None else run.result.diagnostics.get("experiments")
+        experiments = experiments or []
+        ok = len(experiments) == len(datasets) and all("intervals" in e for e in experiments)
+        return experiments if ok else []
+
+    ordered = sorted(runs, key=lambda run: run.name != trusted)
+    chosen = next((run for run in ordered if recorded(run)), None)
+    if chosen is None:
+        return "", [], []
+    experiments = recorded(chosen)
+    intervals = [np.asarray(e["intervals"], dtype=float).reshape(-1, 2) for e in experiments]
+    points = [np.column_stack([np.asarray(e["scales"], dtype=float),
+                               np.asarray(e["shifts"], dtype=float)])
+              if "scales" in e and "shifts" in e else None for e in experiments]
+    return chosen.display_name, intervals, points
+
+
+def _worst(run: MethodReport) -> tuple[float, str]:
+    """Held-out VAF (%) of the worst DOF and its name."""
+    vaf = run.validation.vaf_percent
+    k = int(np.nanargmin(vaf))
+    return float(vaf[k]), COORDINATES[k]
+
+
+def _relative_std(result: IdentificationResult) -> float:
+    """Median relative standard error of the diagonals of Mt and Bt."""
+    values = np.concatenate([np.diag(result.std_errors_M) / np.abs(np.diag(result.M)),
+                             np.diag(result.std_errors_B) / np.abs(np.diag(result.B))])
+    return float(np.nanmedian(values))
+
+
+def _definite(result: IdentificationResult) -> bool:
+    """Symmetric part of Mt positive definite and of Bt positive semidefinite (what the
+    energy of the model needs; a small asymmetry is reported, not disqualifying)."""
+    metrics = consistency_metrics(result.M, result.B)
+    scale = float(np.abs(result.B).max())
+    return bool(metrics["M_min_eigenvalue"] > 0
+                and metrics["B_min_eigenvalue"] >= -1e-9 * scale)
+
+
+def _changed(projection: Any) -> str:
+    """The largest change of the consistent fit, in standard errors, for a sentence."""
+    change = projection.max_change
+    return "less than 0.001" if change < 1e-3 else f"{change:.3g}"
+
+
+def _friction_found(run: MethodReport) -> bool:
+    levels, std = run.coulomb
+    return bool(np.any(np.isfinite(levels) & (levels > SIGNIFICANT * np.nan_to_num(std))))
+
+
+def _friction_text(run: MethodReport) -> str:
+    levels, std = run.coulomb
+    return ", ".join(f"{name.replace('_', ' ')} {v:.3g} ± {s:.2g} N·m"
+                     for name, v, s in zip(FRICTION_TYPES, levels, std, strict=True))
+
+
+def _quality(vaf: float) -> str:
+    if vaf >= CLOSE_VAF:
+        return "predicts the held-out force closely"
+    if vaf >= ADEQUATE_VAF:
+        return "predicts the held-out force adequately"
+    return ("predicts the held-out force poorly: the model misses part of the dynamics "
+            "(see the residual spectrum and the friction section)")
+
+
+def method_lines(run: MethodReport) -> list[str]:
+    """What to know about one method's result, one Markdown sentence group each."""
+    result = run.result
+    vaf, dof = _worst(run)
+    lines = [f"**{run.display_name}** {_quality(vaf)}: VAF ≥ {vaf:.2f} % in every DOF "
+             f"(worst {dof}) over {run.validation.folds} folds."]
+    metrics = consistency_metrics(result.M, result.B)
+    if is_consistent(result.M, result.B):
+        lines.append(f"Its Mt is symmetric positive definite (smallest eigenvalue "
+                     f"{metrics['M_min_eigenvalue']:,.4g}) and its Bt symmetric positive "
+                     f"semidefinite (smallest eigenvalue {metrics['B_min_eigenvalue']:,.4g}).")
+    else:
+        lines.append(f"Its matrices are not physically consistent (Mt smallest eigenvalue "
+                     f"{metrics['M_min_eigenvalue']:,.4g}, asymmetry "
+                     f"{metrics['M_asymmetry']:.2g}; Bt {metrics['B_min_eigenvalue']:,.4g}, "
+                     f"{metrics['B_asymmetry']:.2g}); `--consistent` gives the nearest "
+                     "consistent pair.")
+    if run.projection is not None:
+        lines.append(f"The consistent fit (`--consistent`) moves no entry by more than "
+                     f"{_changed(run.projection)} standard errors; held-out VAF in the worst DOF "
+                     f"{np.min(run.validation_unconstrained.vaf_percent):.3f} % → "
+                     f"{np.min(run.validation.vaf_percent):.3f} %.")
+    lines.append(f"Median relative standard error of the diagonal entries: "
+                 f"{100 * _relative_std(result):.2g} %.")
+    if np.all(np.isfinite(run.coulomb[0])):
+        lines.append(f"Coulomb friction: {_friction_text(run)}.")
+    else:
+        share = friction_signature(run.validation)
+        lines.append(f"It does not estimate friction; {100 * share:.0f} % of its held-out "
+                     "residual has the shape of Coulomb joint friction (`--method all` "
+                     "compares it with a method that estimates friction).")
+    return lines
+
+
+def choose_trusted(runs: Sequence[MethodReport], nominal: tuple[np.ndarray, np.ndarray]
+                   ) -> tuple[str, list[str]]:
+    """Which method to trust on these data, and why, in plain language.
+
+    Rule: among the methods whose matrices are physically plausible (symmetric parts of Mt
+    positive definite and of Bt positive semidefinite; all methods, if none is), the one whose
+    worst DOF leaves the least force unexplained on held-out data; methods within
+    25 % of that are tied and the one with the smaller median relative standard error wins.
+    The reasons name what set the others back: failure, inconsistency, friction pulled into
+    Bt or left in the residuals.
+
+    Returns
+    -------
+    name : str
+    lines : list of str
+        Markdown sentences.
+    """
+    ok = [run for run in runs if run.result is not None]
+    if len(ok) == 1:
+        return ok[0].name, method_lines(ok[0])
+
+    def unexplained(run: MethodReport) -> float:
+        return 100.0 - _worst(run)[0]
+
+    pool = [run for run in ok if _definite(run.result)] or ok
+    floor = min(unexplained(run) for run in pool)
+    tied = [run for run in pool if unexplained(run) <= 1.25 * floor + 1e-12]
+    best = min(tied, key=lambda run: _relative_std(run.result))
+    vaf, dof = _worst(best)
+    lines = [f"**Trust {best.display_name} on these data.** On held-out segments it leaves "
+             f"{100 - vaf:.3g} % of the force unexplained in its worst DOF ({dof}), the least "
+             "of the physically plausible methods" + (" (tied methods: the smaller standard "
+                                                        "errors decide)." if len(tied) > 1
+                                                        else ".")]
+    friction_models = [run for run in ok if _friction_found(run)]
+    if friction_models:
+        lines.append(f"Coulomb friction is present: {friction_models[0].display_name} finds "
+                     f"{_friction_text(friction_models[0])}.")
+    reference_B = np.diag(best.result.B)
+    for run in ok:
+        if run is best:
+            continue
+        worst, where = _worst(run)
+        ratio = (100 - worst) / max(100 - vaf, 1e-12)
+        text = (f"{run.display_name} leaves {100 - worst:.3g} % unexplained in its worst DOF "
+                f"({where}), {ratio:.3g}× as much")
+        if run not in pool:
+            text += ("; its Mt or Bt has a negative eigenvalue, which no physical "
+                     "platform has")
+        if friction_models and not np.all(np.isfinite(run.coulomb[0])):
+            excess = float(np.mean(np.diag(run.result.B) / reference_B) - 1.0)
+            share = friction_signature(run.validation)
+            if excess > 0.05:
+                text += (f"; it does not model Coulomb friction, and its Bt diagonal is "
+                         f"{100 * excess:.0f} % above that of {best.display_name}: the "
+                         "friction's first harmonic is read as viscous damping, which pulls "
+                         "Bt up")
+            else:
+                text += ("; it does not model Coulomb friction, which stays in its residuals "
+                         f"({100 * share:.0f} % of its held-out residual has the shape of "
+                         "Coulomb friction)")
+        lines.append(text + ".")
+    for run in runs:
+        if run.result is None:
+            lines.append(f"{run.display_name} could not be applied to these data: {run.error}")
+    return best.name, lines
+
+
+def _number(value: float) -> str:
+    if not np.isfinite(value):
+        return "n/a"
+    return f"{value:,.1f}" if abs(value) >= 100 else f"{value:.4g}"
+
+
+def matrix_table(title: str, matrix: np.ndarray, std: np.ndarray | None = None) -> str:
+    """A 6x6 matrix (± standard errors) as a Markdown table under a heading."""
+    rows = []
+    for name, values, errors in zip(COORDINATES, matrix,
+                                    std if std is not None else [None] * 6, strict=True):
+        cells = [_number(v) + ("" if errors is None else f" ± {errors:.2g}")
+                 for v, errors in zip(values, errors if errors is not None else [None] * 6,
+                                      strict=True)]
+        rows.append((name, *cells))
+    table = ResultTable("matrix", title, ("", *COORDINATES), ("text",) + ("value",) * 6,
+                        tuple(rows))
+    return to_markdown(table, heading_level=4)
+
+
+def _figure(figures: Mapping[str, tuple[str, str]], key: str) -> list[str]:
+    if key not in figures:
+        return []
+    path, caption = figures[key]
+    svg = path[:-4] + ".svg"
+    return [f"![{caption}]({path})", "", f"*{caption}* ([SVG]({svg}))", ""]
+
+
+def _data_section(rows: Sequence[dict[str, Any]]) -> list[str]:
+    table = ResultTable("data", "Experiments", (
+        "experiment", "samples", "duration (s)", "rate (Hz)", "frequency (Hz)", "excited",
+        "amplitude", "pose noise (µm, µrad)", "leg-force noise (N)"),
+        ("text",) * 9, tuple(
+            (r["name"], str(r["samples"]), f"{r['duration_s']:.3g}",
+             f"{r['sample_rate_hz']:.4g}", f"{r['frequency_hz']:.4g}",
+             COORDINATES[r["excited"]], f"{r['amplitude']:.3g} {_UNITS[r['excited']]}",
+             " / ".join(f"{v * 1e6:.2g}" for v in r["pose_noise"]),
+             " / ".join(f"{v:.2g}" for v in r["force_noise"])) for r in rows))
+    return [to_markdown(table), "Noise is estimated from each record (second differences of "
+            "what a smoothing filter leaves), per coordinate x / y / z / rx / ry / rz and per "
+            "leg 1-6; values near zero mean noise-free data.", ""]
+
+
+def render_report(report: IdentificationReport, datasets: Sequence[Dataset],
+                  platform: Platform, nominal: tuple[np.ndarray, np.ndarray],
+                  nominal_source: str, rows: Sequence[dict[str, Any]],
+                  figures: Mapping[str, tuple[str, str]], sources: Sequence[str], folds: int,
+                  seconds: float) -> str:
+    """``report.md``: every section, figures referenced by relative path."""
+    from stewartid import __version__
+
+    best = next(run for run in report.runs if run.name == report.trusted)
+    ok = [run for run in report.runs if run.result is not None]
+    several = len(report.runs) > 1
+    lines = [f"# Identification report: {platform.name}", "",
+             f"{len(datasets)} experiments identified with "
+             + ", ".join(run.display_name for run in report.runs)
+             + f" (stewartid {__version__}, {seconds:.1f} s).", ""]
+    if sources:
+        lines += ["Data: " + ", ".join(f"`{s}`" for s in sources) + ".", ""]
+    lines += ["## Summary", ""] + [f"- {line}" for line in report.verdict] + [""]
+    lines += ["## Data", ""] + _data_section(rows)
+    lines += _figure(figures, "excitation") + _figure(figures, "spectrum")
+    lines += ["## Joint rates and constant-direction intervals", ""]
+    owner, intervals, points = used_intervals(report.runs, report.trusted, datasets)
+    if intervals:
+        counts = ", ".join(f"{d.name} {len(i)}" for d, i in zip(datasets, intervals,
+                                                                strict=True))
+        lines += [f"{owner} used {sum(len(i) for i in intervals)} intervals in "
+                  f"which no active joint reverses ({counts}); "
+                  + ("the (a, b) points are marked." if any(p is not None for p in points)
+                     else "its test functions span each whole interval, so there are no "
+                          "separate (a, b) points."), ""]
+    lines += _figure(figures, "joint_rates") + _figure(figures, "intervals")
+    lines += ["## Identified Mt and Bt", "",
+              f"Nominal values: {nominal_source}. Standard errors as the method computes them "
+              "from its residuals; a symmetric pair that disagrees by more than its standard "
+              "errors shows they understate the error.", ""]
+    for run in ok:
+        lines += [f"### {run.display_name}", ""]
+        lines += [matrix_table("Mt (kg, kg·m, kg·m²) ± standard error", run.result.M,
+                               run.result.std_errors_M),
+                  matrix_table("Bt (N·s/m, N·s, N·m·s) ± standard error", run.result.B,
+                               run.result.std_errors_B)]
+    lines += [matrix_table("Nominal Mt", nominal[0]), matrix_table("Nominal Bt", nominal[1])]
+    lines += _figure(figures, "matrices")
+    lines += ["## Residuals", "",
+              f"Measured minus modelled generalized force of {best.display_name} fitted on all "
+              "data (both filtered alike; one constant per segment removed). Peaks at the "
+              "odd harmonics of the excitation are the signature of unmodelled Coulomb "
+              "friction.", ""]
+    lines += _figure(figures, "residuals")
+    lines += _validation_section(report, folds) + _figure(figures, "validation")
+    lines += _consistency_section(ok)
+    lines += ["## Friction", ""]
+    for run in ok:
+        if np.all(np.isfinite(run.coulomb[0])):
+            lines.append(f"- {run.display_name}: {_friction_text(run)} (platform description: "
+                         f"{platform.friction.coulomb:g} N·m per joint axis).")
+        else:
+            lines.append(f"- {run.display_name} does not estimate friction (its prediction "
+                         "contains none); "
+                         f"{100 * friction_signature(run.validation):.0f} % of its held-out "
+                         "residual has the shape of Coulomb friction.")
+    lines += [""] + _figure(figures, "friction")
+    if several:
+        lines += ["## Methods compared", ""] + [f"- {line}" for line in report.verdict] + [""]
+        lines += _figure(figures, "methods")
+    lines += _files_section(report)
+    return "\n".join(lines).rstrip() + "\n"
+
+
+def _validation_section(report: IdentificationReport, folds: int) -> list[str]:
+    lines = ["## Validation on held-out data", "",
+             f"Every experiment is cut into {folds} segments of equal length; each segment is "
+             "predicted by the method refitted on all other segments. The prediction is "
+             "Mt q̈ + Bt q̇, plus the Coulomb friction where the method estimates it; one "
+             "constant per segment (static-load residual, sensor offsets) is not part of the "
+             "model. Force and motion are filtered with the same zero-phase kernel of 0.2 "
+             "excitation periods. VAF = 100 (1 − Σe² / Σy²) %, NRMSE = rms(e) / range(y), "
+             "per DOF over all held-out segments.", ""]
+    vaf_rows, nrmse_rows = [], []
+    for run in report.runs:
+        variants = [("", run.validation)]
+        if run.validation_unconstrained is not None:
+            variants = [(", consistent", run.validation),
+                        (", unconstrained", run.validation_unconstrained)]
+        for suffix, validation in variants:
+            if validation is not None:
+                vaf_rows.append((run.display_name + suffix,
+                                 *(f"{v:.3f}" for v in validation.vaf_percent)))
+                nrmse_rows.append((run.display_name + suffix,
+                                   *(f"{v:.2g}" for v in validation.nrmse)))
+    kinds = ("text",) + ("value",) * 6
+    return lines + [
+        to_markdown(ResultTable("vaf", "Held-out VAF per DOF (%)", ("method", *COORDINATES),
+                                kinds, tuple(vaf_rows))),
+        to_markdown(ResultTable("nrmse", "Held-out NRMSE per DOF", ("method", *COORDINATES),
+                                kinds, tuple(nrmse_rows)))]
+
+
+def _consistency_section(runs: Sequence[MethodReport]) -> list[str]:
+    lines = ["## Physical consistency", "",
+             "Mt must be symmetric positive definite and Bt symmetric positive semidefinite. "
+             "Smallest eigenvalues are of the symmetric parts; asymmetry is the relative "
+             "Frobenius norm of the antisymmetric part.", ""]
+    rows = []
+    for run in runs:
+        for label, result in (("", run.unconstrained), (", consistent", run.result)):
+            if label and run.projection is None:
+                continue
+            m = consistency_metrics(result.M, result.B)
+            rows.append((run.display_name + label, _number(m["M_min_eigenvalue"]),
+                         f"{m['M_asymmetry']:.2g}", _number(m["B_min_eigenvalue"]),
+                         f"{m['B_asymmetry']:.2g}",
+                         "yes" if is_consistent(result.M, result.B) else "no"))
+    lines.append(to_markdown(ResultTable(
+        "consistency", "Consistency", ("estimate", "Mt min eigenvalue", "Mt asymmetry",
+                                       "Bt min eigenvalue", "Bt asymmetry", "consistent"),
+        ("text",) + ("value",) * 5, tuple(rows))))
+    for run in runs:
+        if run.projection is None:
+            continue
+        before = run.validation_unconstrained.vaf_percent
+        after = run.validation.vaf_percent
+        lines += [f"`--consistent` ({run.display_name}, solver {run.projection.solver}): the "
+                  "nearest consistent pair in standard errors of the estimate moves no entry "
+                  f"by more than {_changed(run.projection)} standard errors; held-out "
+                  f"VAF in the worst DOF {np.min(before):.3f} % → {np.min(after):.3f} %.", ""]
+    return lines
+
+
+def _files_section(report: IdentificationReport) -> list[str]:
+    lines = ["## Files", "",
+             f"- [result.json](result.json): {report.trusted}'s result with its `validation` "
+             "and `consistency` objects",
+             "- [identification.mat](identification.mat): every method's matrices, standard "
+             "errors, validation and friction (MATLAB)"]
+    for run in report.runs:
+        if run.result is not None:
+            links = ", ".join(f"[{run.name}_{key}.csv]({run.name}_{key}.csv)"
+                              for key in ("M", "B", "std_errors_M", "std_errors_B"))
+            lines.append(f"- {run.display_name}: {links}")
+    return lines + [""]
+
+
+__all__ = ["choose_trusted", "data_rows", "matrix_table", "method_lines", "render_report",
+           "used_intervals"]
