@@ -1,0 +1,174 @@
+"""The package's layout rules, read from the source's syntax trees.
+
+- no private name (``_x``, or a module ``_x``) imported from another package;
+- no import circle between modules (imports inside functions count; ``TYPE_CHECKING``
+  blocks do not, since they never run);
+- no function over 80 body lines (docstring excluded), no module over 450 lines.
+"""
+
+from __future__ import annotations
+
+import ast
+from collections import defaultdict
+from pathlib import Path
+
+import pytest
+
+SOURCE = Path(__file__).resolve().parents[1] / "src"
+MAX_FUNCTION_BODY = 80
+MAX_MODULE_LINES = 450
+
+
+def _modules() -> dict[str, tuple[Path, bool]]:
+    """Dotted module name -> (file, is a package's ``__init__``)."""
+    found = {}
+    for path in sorted((SOURCE / "stewartid").rglob("*.py")):
+        parts = list(path.relative_to(SOURCE).with_suffix("").parts)
+        package = parts[-1] == "__init__"
+        found[".".join(parts[:-1] if package else parts)] = (path, package)
+    return found
+
+
+MODULES = _modules()
+
+
+def _type_checking_nodes(tree: ast.AST) -> set[int]:
+    skipped = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
+            skipped.update(id(inner) for child in node.body for inner in ast.walk(child))
+    return skipped
+
+
+def _imports(module: str) -> list[tuple[str, str, int]]:
+    """(imported module, imported name or '', line) of every stewartid import in ``module``."""
+    path, package = MODULES[module]
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    skipped = _type_checking_nodes(tree)
+    found = []
+    for node in ast.walk(tree):
+        if id(node) in skipped:
+            continue
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = module.split(".") if package else module.split(".")[:-1]
+                base = base[:len(base) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            if target.split(".")[0] == "stewartid":
+                found += [(target, alias.name, node.lineno) for alias in node.names]
+        elif isinstance(node, ast.Import):
+            found += [(alias.name, "", node.lineno) for alias in node.names
+                      if alias.name.split(".")[0] == "stewartid"]
+    return found
+
+
+def _package_of(module: str) -> str:
+    return module if MODULES[module][1] else module.rpartition(".")[0]
+
+
+def _private(name: str) -> bool:
+    return name.startswith("_") and not (name.startswith("__") and name.endswith("__"))
+
+
+def _edges() -> dict[str, set[str]]:
+    edges = defaultdict(set)
+    for module in MODULES:
+        for target, name, _ in _imports(module):
+            if f"{target}.{name}" in MODULES:
+                edges[module].add(f"{target}.{name}")
+            elif target in MODULES:
+                edges[module].add(target)
+    for module in edges:
+        edges[module].discard(module)
+    return edges
+
+
+def _circles(edges: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected components of more than one module (Tarjan, iterative)."""
+    index, low, stack, on_stack, circles = {}, {}, [], set(), []
+    for root in MODULES:
+        if root in index:
+            continue
+        work = [(root, iter(sorted(edges.get(root, ()))))]
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, children = work[-1]
+            for child in children:
+                if child not in index:
+                    index[child] = low[child] = len(index)
+                    stack.append(child)
+                    on_stack.add(child)
+                    work.append((child, iter(sorted(edges.get(child, ())))))
+                    break
+                if child in on_stack:
+                    low[node] = min(low[node], index[child])
+            else:
+                work.pop()
+                if work:
+                    low[work[-1][0]] = min(low[work[-1][0]], low[node])
+                if low[node] == index[node]:
+                    component = []
+                    while True:
+                        member = stack.pop()
+                        on_stack.discard(member)
+                        component.append(member)
+                        if member == node:
+                            break
+                    if len(component) > 1:
+                        circles.append(sorted(component))
+    return circles
+
+
+def test_the_rules_see_the_whole_package():
+    assert len(MODULES) > 50
+    assert "stewartid.model.kinematics" in MODULES
+
+
+def test_no_private_name_crosses_a_package():
+    crossings = []
+    for module in MODULES:
+        for target, name, line in _imports(module):
+            owner = target if target in MODULES and MODULES[target][1] else \
+                target.rpartition(".")[0]
+            if f"{target}.{name}" in MODULES and MODULES[f"{target}.{name}"][1]:
+                owner = f"{target}.{name}"
+            hidden = _private(name) or any(_private(part) for part in target.split("."))
+            if hidden and owner != _package_of(module):
+                crossings.append(f"{module}:{line} imports {target}.{name}")
+    assert crossings == []
+
+
+def test_no_import_circle():
+    assert _circles(_edges()) == []
+
+
+def test_the_circle_finder_finds_a_circle():
+    assert _circles({"stewartid.errors": {"stewartid.files"},
+                     "stewartid.files": {"stewartid.errors"}}) == [
+        ["stewartid.errors", "stewartid.files"]]
+
+
+def _body_lines(function: ast.FunctionDef | ast.AsyncFunctionDef) -> int:
+    body = function.body
+    first = body[0]
+    if isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant) \
+            and isinstance(first.value.value, str):
+        if len(body) == 1:
+            return 0
+        first = body[1]
+    return function.end_lineno - first.lineno + 1
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_functions_and_modules_are_short(module):
+    path, _ = MODULES[module]
+    text = path.read_text(encoding="utf-8")
+    assert len(text.splitlines()) <= MAX_MODULE_LINES
+    long = [f"{node.name} ({_body_lines(node)} lines)" for node in ast.walk(ast.parse(text))
+            if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef)
+            and _body_lines(node) > MAX_FUNCTION_BODY]
+    assert long == []
