@@ -61,10 +61,8 @@ class Inertia(Section):
     platform_inertia: tuple[float, float, float] = spec(
         "kg m^2", "principal inertias of the platform about its centre of mass",
         ListOf(positive(1e-6, 1e9), length=3))
-    upper_leg_mass: float = spec("kg", "mass of a leg's upper part (piston rod)",
-                                 nonnegative(0.0, 1e5))
-    lower_leg_mass: float = spec("kg", "mass of a leg's lower part (cylinder)",
-                                 nonnegative(0.0, 1e5))
+    upper_leg_mass: float = spec("kg", "mass of a leg's upper part (piston rod)", nonnegative(0.0, 1e5))
+    lower_leg_mass: float = spec("kg", "mass of a leg's lower part (cylinder)", nonnegative(0.0, 1e5))
     upper_leg_com: float = spec("m", "upper gimbal point to the upper part's centre of mass",
                                 nonnegative(0.0, 50.0))
     lower_leg_com: float = spec("m", "lower gimbal point to the lower part's centre of mass",
@@ -104,10 +102,8 @@ class Hydraulics(Section):
 
     mode: str = spec("-", "'hydraulic' (valve, cylinder, oil) or 'ideal' (the demanded force "
                      "is applied exactly)", Options(ACTUATOR_MODES), default="hydraulic")
-    supply_pressure: float = spec("Pa", "supply pressure p_s", positive(1e5, 1e8),
-                                  default=21.0e6)
-    return_pressure: float = spec("Pa", "return (tank) pressure p_r", nonnegative(0.0, 1e7),
-                                  default=0.5e6)
+    supply_pressure: float = spec("Pa", "supply pressure p_s", positive(1e5, 1e8), default=21.0e6)
+    return_pressure: float = spec("Pa", "return (tank) pressure p_r", nonnegative(0.0, 1e7), default=0.5e6)
     bore_diameter: float = spec("m", "cylinder bore (piston side area A_A = pi D^2 / 4)",
                                 positive(1e-3, 2.0), default=0.100)
     rod_diameter: float = spec("m", "piston rod diameter (rod side area A_B = A_A - pi d^2/4)",
@@ -126,8 +122,7 @@ class Hydraulics(Section):
                                             positive(1e4, 1e8), default=7.0e6)
     valve_bandwidth: float = spec("Hz", "natural frequency of the spool (second-order model)",
                                   positive(0.1, 1e4), default=80.0)
-    valve_damping: float = spec("-", "damping ratio of the spool", positive(0.01, 10.0),
-                                default=0.7)
+    valve_damping: float = spec("-", "damping ratio of the spool", positive(0.01, 10.0), default=0.7)
     leakage: float = spec("m^3/(s Pa)", "internal (cross-piston) leakage coefficient",
                           nonnegative(0.0, 1e-8), default=2.0e-13)
     orifice_transition_pressure: float = spec(
@@ -170,8 +165,7 @@ class Controller(Section):
 
     proportional_gain: float = spec("N/m", "PID proportional gain on the leg-length error",
                                     positive(1e-3, 1e12), default=1.0e7)
-    integral_gain: float = spec("N/(m s)", "PID integral gain", nonnegative(0.0, 1e14),
-                                default=5.0e7)
+    integral_gain: float = spec("N/(m s)", "PID integral gain", nonnegative(0.0, 1e14), default=5.0e7)
     derivative_gain: float = spec("N s/m", "PID derivative gain (on the leg-rate error)",
                                   nonnegative(0.0, 1e10), default=4.0e5)
     gravity_feedforward: bool = spec("-", "add the static leg forces that hold the commanded "
