@@ -248,8 +248,8 @@ class WaveletIdentifier(BaseIdentifier):
             validate_parameters({"wavelet": [Options(("polynomial",))],
                                  "variant": [Options(("position",))],
                                  "wavelet_order": [Interval(Integral, 3, None)]}, params, owner,
-                                condition="test_functions is set (test_functions=None takes "
-                                          "the paper's equations and the Mexican hat)")
+                                condition="test_functions is set (use test_functions=None "
+                                          "for the paper's equations or the Mexican hat)")
         make_wavelet(self.wavelet, **self._wavelet_options())
 
     def _wavelet_options(self) -> dict:
