@@ -83,3 +83,19 @@ def test_fit_returns_self_with_learned_attributes(spec, data, paper):
     # a clone of a fitted estimator has its settings but nothing learned
     copy = clone(estimator)
     assert copy.get_params() == estimator.get_params() and not hasattr(copy, "M_")
+
+
+def test_declared_constraints_name_settings_and_accept_the_defaults(spec):
+    estimator = spec.create()
+    constraints = type(estimator)._parameter_constraints
+    assert constraints and set(constraints) <= set(estimator.get_params())
+    estimator._validate_params()  # the defaults (a preset's too) satisfy their constraints
+
+
+def test_a_bad_setting_is_refused_in_one_message_form(spec, paper):
+    name = next(iter(type(spec.create())._parameter_constraints))
+    estimator = spec.create(**{name: object()})
+    owner = type(estimator).__name__
+    with pytest.raises(ConfigError, match=rf"^The '{name}' parameter of {owner} must be .+\. "
+                                          r"Got <object object at \w+> instead\.$"):
+        estimator.fit([], paper)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import signal
 
 import numpy as np
@@ -14,7 +15,7 @@ from typer.testing import CliRunner
 
 from stewartid.cli import app
 from stewartid.errors import ConfigError, OutputExistsError
-from stewartid.studies import expand_grid, parse_study, read_results, run_study
+from stewartid.studies import expand_grid, load_study, parse_study, read_results, run_study
 from stewartid.studies.results import ENTRY_COLUMNS, columns, finished_tasks, write_part
 from stewartid.studies.task import error_columns
 
@@ -151,6 +152,26 @@ def test_cli_refuses_a_folder_holding_a_study(tmp_path):
     result = CliRunner().invoke(app, ["study", str(study_file), "--out", str(out),
                                       "--workers", "2", "--scheduler", "tcp://nowhere:1"])
     assert result.exit_code == 2 and "cannot be used with --scheduler" in result.output
+
+
+def test_study_file_that_is_not_utf8_is_one_error_line(tmp_path):
+    study_file = tmp_path / "étude.toml"
+    study_file.write_bytes('[study]\nmethods = ["ls"]\ntitle = "Étude à 5 N m"\n'
+                           .encode("latin-1"))
+    result = CliRunner().invoke(app, ["study", str(study_file), "--out", str(tmp_path / "out")])
+    lines = result.stderr.strip().splitlines()
+    assert result.exit_code == 2 and len(lines) == 1, result.output
+    assert re.fullmatch(r"error: study file .*étude\.toml: not UTF-8 \(byte 0xc9 on line 3\); "
+                        r"TOML files are UTF-8: re-save it as UTF-8\.", lines[0]), lines[0]
+    assert "Traceback" not in result.output and not (tmp_path / "out").exists()
+
+
+def test_study_file_with_a_syntax_error_names_line_and_column(tmp_path):
+    study_file = tmp_path / "study.toml"
+    study_file.write_text('[study]\nmethods = ["ls"]\nduration = 2.5 = 3\n')
+    with pytest.raises(ConfigError, match=r"study file .*study\.toml is not valid TOML: .*line 3, "
+                                          r"column \d+"):
+        load_study(study_file)
 
 
 def test_resume_refuses_other_fixed_settings(tmp_path):

@@ -1,36 +1,301 @@
-"""Validation of TOML sections into frozen dataclasses.
+"""One vocabulary of constraints for every value the package takes from outside.
 
-A section is a frozen dataclass whose fields carry their unit, a one-line description and a
-constraint in ``dataclasses.field(metadata=...)``. :func:`section_from_mapping` turns a TOML
-table into such a dataclass and refuses unknown keys, missing keys, wrong types and values
-out of range with one message naming the key, so every section of a platform description
-is checked by the same code.
+A constraint says which values a setting accepts and is declared once, beside what it
+constrains, in the manner of scikit-learn's ``_parameter_constraints``:
+
+- a field of a platform section: :func:`spec` (unit, description, constraint, default);
+- a hyper-parameter of an identifier: ``_parameter_constraints`` next to its ``__init__``;
+- a parameter of a study point: a :class:`FieldSpec` in the study's parameter table;
+- a command-line flag: the constraint given to :func:`check` beside the flag.
+
+A setting is valid if it satisfies one of its constraints (``None`` in the list allows None).
+Every refusal has one form, scikit-learn's: *"The 'order' parameter of FourierIdentifier
+must be an integer >= 3. Got 2 instead."*, *"[inertia] platform_mass must be > 0 (kg). Got
+-1.0 instead."*, *"--budget must be > 0. Got -5.0 instead."* A number may also carry a
+physical range, wide enough for any hexapod from a desktop positioner to a large shaking
+table: a value outside it is almost always a unit mistake (a file in millimetres, a mass in
+grams) and is refused with a hint to check its unit.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Mapping
-from pathlib import Path
+from collections.abc import Mapping, Sequence
+from numbers import Integral, Real
 from typing import Any, TypeVar
+
+import numpy as np
 
 from stewartid.errors import ConfigError
 
 T = TypeVar("T")
 
-#: Constraint names understood in field metadata under ``"check"``.
-_CHECKS = {
-    "positive": (lambda v: v > 0, "> 0"),
-    "nonnegative": (lambda v: v >= 0, ">= 0"),
-    "fraction": (lambda v: 0 <= v < 1, "in [0, 1)"),
-    "any": (lambda v: True, "any finite value"),
-}
+_OPEN_LEFT = {"left": False, "both": False, "right": True, "neither": True}
+_OPEN_RIGHT = {"left": True, "both": False, "right": False, "neither": True}
 
 
-def spec(unit: str, doc: str, check: str = "positive", default: Any = dataclasses.MISSING,
-         length: int | None = None) -> Any:
-    """Declare a section field.
+def _is_number(value: Any, kind: type = Real) -> bool:
+    return isinstance(value, kind) and not isinstance(value, bool | np.bool_)
+
+
+@dataclasses.dataclass(frozen=True)
+class Interval:
+    """Finite numbers of a type between two bounds, each open or closed.
+
+    Parameters
+    ----------
+    kind : {numbers.Real, numbers.Integral}
+        Real numbers or integers (booleans are neither).
+    low, high : float or None
+        Bounds; None for no bound.
+    closed : {"left", "right", "both", "neither"}
+        Which bounds belong to the interval.
+    physical : (float, float), optional
+        Closed range, in the value's SI unit, of the values a real machine can have; a value
+        inside the interval but outside this range is refused as a probable unit mistake.
+    """
+
+    kind: type
+    low: float | None = None
+    high: float | None = None
+    closed: str = "left"
+    physical: tuple[float, float] | None = None
+
+    def is_satisfied_by(self, value: Any) -> bool:
+        if not _is_number(value, self.kind) or not math.isfinite(value):
+            return False
+        if self.low is not None and (value < self.low
+                                     or (_OPEN_LEFT[self.closed] and value == self.low)):
+            return False
+        return self.high is None or not (value > self.high
+                                         or (_OPEN_RIGHT[self.closed] and value == self.high))
+
+    @property
+    def bounds(self) -> str:
+        """The bounds in words: ``"> 0"``, ``">= 3"``, ``"in [0, 1)"`` or ``""``."""
+        if self.low is not None and self.high is not None:
+            left = "(" if _OPEN_LEFT[self.closed] else "["
+            right = ")" if _OPEN_RIGHT[self.closed] else "]"
+            return f"in {left}{self.low:g}, {self.high:g}{right}"
+        if self.low is not None:
+            return f"{'>' if _OPEN_LEFT[self.closed] else '>='} {self.low:g}"
+        if self.high is not None:
+            return f"{'<' if _OPEN_RIGHT[self.closed] else '<='} {self.high:g}"
+        return ""
+
+    def describe(self, value: Any) -> str:
+        # integers are always named; real numbers only when the value given is not one
+        if self.kind is Integral:
+            noun = "an integer"
+        else:
+            noun = "" if _is_number(value) else "a number"
+            noun = noun or ("" if self.bounds else "a finite number")
+        return " ".join(part for part in (noun, self.bounds) if part)
+
+    def check_physical(self, subject: str, value: Any, unit: str) -> None:
+        """Refuse ``value`` (which satisfies the interval) outside the physical range."""
+        if self.physical is None:
+            return
+        low, high = self.physical
+        if not low <= value <= high:
+            raise ConfigError(f"{subject} = {value:g} {unit} is outside the physical range "
+                              f"{low:g} to {high:g} {unit}; check its unit (SI).")
+
+
+@dataclasses.dataclass(frozen=True)
+class ListOf:
+    """A list (tuple, one-dimensional array) of numbers, each in ``item``.
+
+    Parameters
+    ----------
+    item : Interval
+    length : int, optional
+        The required number of elements; any number but zero when None.
+    """
+
+    item: Interval
+    length: int | None = None
+
+    def has_shape(self, value: Any) -> bool:
+        if not isinstance(value, list | tuple | np.ndarray) or np.ndim(value) != 1:
+            return False
+        return len(value) == self.length if self.length is not None else len(value) > 0
+
+    def is_satisfied_by(self, value: Any) -> bool:
+        return self.has_shape(value) and all(self.item.is_satisfied_by(v) for v in value)
+
+    def describe(self, value: Any) -> str:
+        count = f"{self.length} " if self.length is not None else "non-empty list of "
+        nouns = "integers" if self.item.kind is Integral else "numbers"
+        text = f"a list of {count}{nouns}" if self.length is not None else f"a {count}{nouns}"
+        return f"{text} {self.item.bounds}".rstrip()
+
+
+@dataclasses.dataclass(frozen=True)
+class Options:
+    """One of a few values (compared with ``==``)."""
+
+    values: tuple
+
+    def is_satisfied_by(self, value: Any) -> bool:
+        return isinstance(value, Real | str) and value in self.values
+
+    def describe(self, value: Any) -> str:
+        if len(self.values) == 1:
+            return repr(self.values[0])
+        return "one of " + ", ".join(repr(v) for v in self.values)
+
+
+@dataclasses.dataclass(frozen=True)
+class InstanceOf:
+    """Any instance of ``kind``, described by ``noun``."""
+
+    kind: type | tuple[type, ...]
+    noun: str
+
+    def is_satisfied_by(self, value: Any) -> bool:
+        return isinstance(value, self.kind)
+
+    def describe(self, value: Any) -> str:
+        return self.noun
+
+
+Constraint = Interval | ListOf | Options | InstanceOf
+
+#: true or false (a TOML boolean).
+BOOLEAN = InstanceOf(bool, "true or false")
+#: A string.
+TEXT = InstanceOf(str, "a string")
+
+
+def positive(low: float | None = None, high: float | None = None) -> Interval:
+    """Real numbers > 0, within the physical range [low, high] when given."""
+    return Interval(Real, 0.0, None, "neither", None if low is None else (low, high))
+
+
+def nonnegative(low: float | None = None, high: float | None = None) -> Interval:
+    """Real numbers >= 0, within the physical range [low, high] when given."""
+    return Interval(Real, 0.0, None, "left", None if low is None else (low, high))
+
+
+def finite(low: float | None = None, high: float | None = None) -> Interval:
+    """Any finite real number, within the physical range [low, high] when given."""
+    return Interval(Real, None, None, "neither", None if low is None else (low, high))
+
+
+def constraint_error(subject: str, expected: str, value: Any) -> ConfigError:
+    """The one refusal: ``"{subject} must be {expected}. Got {value!r} instead."``."""
+    return ConfigError(f"{subject} must be {expected}. Got {value!r} instead.")
+
+
+def check(subject: str, value: Any, constraints: Sequence[Constraint | None], unit: str = "",
+          condition: str = "") -> None:
+    """Refuse ``value`` unless it satisfies one of ``constraints`` and its physical range.
+
+    Parameters
+    ----------
+    subject : str
+        What the value is, as the message names it: ``"The 'order' parameter of
+        FourierIdentifier"``, ``"[inertia] platform_mass"``, ``"--budget"``.
+    value : object
+    constraints : sequence of constraint or None
+        The value is valid if it satisfies one; None allows None.
+    unit : str
+        SI unit shown after the expected values (``"-"`` or ``""``: none).
+    condition : str
+        When the constraints apply, shown after them (``"test_functions is None"``).
+
+    Raises
+    ------
+    ConfigError
+        In the form "{subject} must be {expected}. Got {value!r} instead.", or, for a number
+        outside its physical range, naming the range and the unit to check.
+    """
+    if value is None and None in constraints:
+        return
+    allowed = [c for c in constraints if c is not None]
+    for constraint in allowed:
+        if constraint.is_satisfied_by(value):
+            if isinstance(constraint, Interval):
+                constraint.check_physical(subject, value, unit)
+            elif isinstance(constraint, ListOf):
+                for index, item in enumerate(value):
+                    constraint.item.check_physical(f"{subject}[{index}]", item, unit)
+            return
+    if len(allowed) == 1 and isinstance(allowed[0], ListOf) and allowed[0].has_shape(value):
+        # the list has the right shape: name the element at fault
+        for index, item in enumerate(value):
+            check(f"{subject}[{index}]", item, [allowed[0].item], unit, condition)
+    phrases = [c.describe(value) for c in allowed] + (["None"] if None in constraints else [])
+    expected = phrases[0] if len(phrases) == 1 else f"{', '.join(phrases[:-1])} or {phrases[-1]}"
+    if unit not in ("", "-"):
+        expected += f" ({unit})"
+    if condition:
+        expected += f" when {condition}"
+    raise constraint_error(subject, expected, value)
+
+
+def validate_parameters(constraints: Mapping[str, Sequence[Constraint | None]],
+                        params: Mapping[str, Any], owner: str, condition: str = "") -> None:
+    """Check each of ``params`` named in ``constraints`` (scikit-learn's parameter check).
+
+    Raises
+    ------
+    ConfigError
+        "The 'name' parameter of {owner} must be ... Got ... instead."
+    """
+    for name, allowed in constraints.items():
+        check(f"The {name!r} parameter of {owner}", params[name], allowed, condition=condition)
+
+
+@dataclasses.dataclass(frozen=True)
+class FieldSpec:
+    """A declared value: its unit, a one-line description and its constraint.
+
+    Attributes
+    ----------
+    unit : str
+        SI unit (``"-"`` for none), shown in messages, tables and documentation.
+    doc : str
+        One-line description.
+    constraint : constraint
+        The values it takes (:class:`Interval`, :class:`ListOf`, :class:`Options`,
+        :class:`InstanceOf`).
+    """
+
+    unit: str
+    doc: str
+    constraint: Constraint
+
+    def check(self, subject: str, value: Any) -> Any:
+        """``value`` checked, with integers of a real field as floats and lists as tuples.
+
+        Raises
+        ------
+        ConfigError
+            Naming ``subject`` (see :func:`check`).
+        """
+        value = self.normalise(value)
+        check(subject, value, [self.constraint], self.unit)
+        return value
+
+    def normalise(self, value: Any) -> Any:
+        """``value`` in its stored form: numbers of a real field as floats, lists as tuples;
+        a value of another type unchanged (for :meth:`check` to refuse)."""
+        constraint = self.constraint
+        if isinstance(constraint, ListOf) and constraint.has_shape(value):
+            return tuple(self._number(v, constraint.item) for v in value)
+        return self._number(value, constraint) if isinstance(constraint, Interval) else value
+
+    @staticmethod
+    def _number(value: Any, interval: Interval) -> Any:
+        return float(value) if interval.kind is Real and _is_number(value) else value
+
+
+def spec(unit: str, doc: str, constraint: Constraint, default: Any = dataclasses.MISSING
+         ) -> Any:
+    """Declare a section field (a :class:`FieldSpec` in the field's metadata).
 
     Parameters
     ----------
@@ -38,63 +303,42 @@ def spec(unit: str, doc: str, check: str = "positive", default: Any = dataclasse
         SI unit of the value, shown in error messages and documentation.
     doc : str
         One-line description.
-    check : {"positive", "nonnegative", "fraction", "any"}
-        Range constraint applied to the value (to every element for arrays).
+    constraint : constraint
+        Values the field takes, with the physical range of a number
+        (e.g. ``positive(0.01, 50.0)``, ``ListOf(positive(1e-6, 1e9), length=3)``).
     default : optional
-        Default value; fields without one are required in TOML.
-    length : int, optional
-        For array-valued fields, the required number of elements.
+        Default value; fields without one are required in TOML. A default of None (a value
+        derived from other sections) is not checked.
     """
-    metadata = {"unit": unit, "doc": doc, "check": check, "length": length}
-    if default is dataclasses.MISSING:
-        return dataclasses.field(metadata=metadata)
+    metadata = {"spec": FieldSpec(unit, doc, constraint)}
     if isinstance(default, list | tuple):
-        value = tuple(default)
-        return dataclasses.field(default=value, metadata=metadata)
+        default = tuple(default)
     return dataclasses.field(default=default, metadata=metadata)
 
 
-def _coerce(name: str, value: Any, field: dataclasses.Field, where: str) -> Any:
-    meta = field.metadata
-    length = meta.get("length")
-    ok, expected = _CHECKS[meta.get("check", "any")]
-    kind = field.type if isinstance(field.type, str) else getattr(field.type, "__name__", "")
+def field_spec(field: dataclasses.Field) -> FieldSpec:
+    """The :class:`FieldSpec` of a field declared with :func:`spec`."""
+    return field.metadata["spec"]
 
-    def number(v: Any, label: str) -> float:
-        if isinstance(v, bool) or not isinstance(v, int | float):
-            raise ConfigError(
-                f"[{where}] {label} must be a number in {meta['unit']}; got {v!r} "
-                f"({type(v).__name__}). Write it as e.g. {label} = 1.0"
-            )
-        v = float(v)
-        if not math.isfinite(v) or not ok(v):
-            raise ConfigError(
-                f"[{where}] {label} must be {expected} ({meta['unit']}); got {v!r}."
-            )
-        return v
 
-    if "bool" in kind:
-        if not isinstance(value, bool):
-            raise ConfigError(f"[{where}] {name} must be true or false; got {value!r}.")
-        return value
-    if "int" in kind and "tuple" not in kind:
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise ConfigError(f"[{where}] {name} must be an integer; got {value!r}.")
-        if not ok(value):
-            raise ConfigError(f"[{where}] {name} must be {expected}; got {value!r}.")
-        return value
-    if "str" in kind:
-        if not isinstance(value, str):
-            raise ConfigError(f"[{where}] {name} must be a string; got {value!r}.")
-        return value
-    if length is not None:
-        if not isinstance(value, list | tuple) or len(value) != length:
-            raise ConfigError(
-                f"[{where}] {name} must be a list of {length} numbers in {meta['unit']}; "
-                f"got {value!r}."
-            )
-        return tuple(number(v, f"{name}[{i}]") for i, v in enumerate(value))
-    return number(value, name)
+class Section:
+    """Base of a frozen section dataclass that checks every field when built.
+
+    A subclass is a ``@dataclasses.dataclass(frozen=True)`` declared with :func:`spec`
+    fields and names its TOML table in ``section``; a subclass with checks across fields
+    calls ``super().__post_init__()`` first.
+    """
+
+    #: Name of the TOML table, used in messages (``[geometry] upper_radius ...``).
+    section = "section"
+
+    def __post_init__(self) -> None:
+        for field in dataclasses.fields(self):
+            value = getattr(self, field.name)
+            if value is None and field.default is None:
+                continue
+            check(f"[{self.section}] {field.name}", value, [field_spec(field).constraint],
+                  field_spec(field).unit)
 
 
 def section_from_mapping(cls: type[T], table: Any, where: str) -> T:
@@ -103,7 +347,7 @@ def section_from_mapping(cls: type[T], table: Any, where: str) -> T:
     Parameters
     ----------
     cls : type
-        Frozen dataclass declared with :func:`spec` fields.
+        Frozen :class:`Section` dataclass declared with :func:`spec` fields.
     table : Mapping
         The parsed TOML table.
     where : str
@@ -125,30 +369,11 @@ def section_from_mapping(cls: type[T], table: Any, where: str) -> T:
     values = {}
     for name, field in fields.items():
         if name in table:
-            values[name] = _coerce(name, table[name], field, where)
+            values[name] = field_spec(field).normalise(table[name])
         elif field.default is dataclasses.MISSING:
-            raise ConfigError(
-                f"[{where}] is missing required key {name!r} ({field.metadata['doc']}, "
-                f"{field.metadata['unit']})."
-            )
+            raise ConfigError(f"[{where}] is missing required key {name!r} "
+                              f"({field_spec(field).doc}, {field_spec(field).unit}).")
     return cls(**values)
-
-
-def read_toml_text(path: str | Path) -> str:
-    """The text of a TOML file, which must be UTF-8 (a byte-order mark is allowed).
-
-    Raises
-    ------
-    ConfigError
-        Naming the file and the line of the first byte that is not UTF-8, with the fix.
-    """
-    data = Path(path).read_bytes()
-    try:
-        return data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = data[:exc.start].count(b"\n") + 1
-        raise ConfigError(f"{path}: not UTF-8 (byte 0x{data[exc.start]:02x} on line {line}); "
-                          "TOML files are UTF-8: re-save it as UTF-8.") from None
 
 
 def section_to_mapping(section: Any) -> dict[str, Any]:
@@ -158,3 +383,9 @@ def section_to_mapping(section: Any) -> dict[str, Any]:
         value = getattr(section, f.name)
         out[f.name] = list(value) if isinstance(value, tuple) else value
     return out
+
+
+__all__ = ["BOOLEAN", "TEXT", "Constraint", "FieldSpec", "InstanceOf", "Interval", "ListOf",
+           "Options", "Section", "check", "constraint_error", "field_spec", "finite",
+           "nonnegative", "positive", "section_from_mapping", "section_to_mapping", "spec",
+           "validate_parameters"]

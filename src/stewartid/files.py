@@ -1,4 +1,8 @@
-"""Every file the package writes goes through here: atomic writes and one JSON conversion.
+"""Every file the package writes goes through here, and every TOML file it reads.
+
+TOML: :func:`read_toml` is the one reader of platform descriptions, study files and column
+mappings; a file that is not UTF-8 or not TOML is refused in one line naming the file, the
+place and the fix.
 
 Atomic: the bytes go to a temporary file in the target folder which is then renamed over the
 target, so a reader never sees a half-written data set, table, figure, report or JSON file,
@@ -18,13 +22,14 @@ import json
 import math
 import os
 import tempfile
+import tomllib
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from stewartid.errors import OutputExistsError
+from stewartid.errors import ConfigError, OutputExistsError
 
 
 def write_bytes_atomic(path: str | Path, data: bytes) -> Path:
@@ -161,5 +166,34 @@ def check_output_file(path: str | Path, force: bool, inputs: Iterable[str | Path
                                 "folder; give another file name.")
 
 
-__all__ = ["check_output_file", "check_output_folder", "to_jsonable", "write_bytes_atomic",
-           "write_json_atomic", "write_text_atomic"]
+def read_toml(path: str | Path, what: str) -> dict[str, Any]:
+    """The parsed TOML file ``path``, which must be UTF-8 (a byte-order mark is allowed).
+
+    Parameters
+    ----------
+    path : str or Path
+        An existing file (callers say, in their own words, which file is missing).
+    what : str
+        What the file is, first in the messages: ``"platform file"``, ``"study file"``.
+
+    Raises
+    ------
+    ConfigError
+        Naming the file and the line of the first byte that is not UTF-8, with the fix; or
+        naming the file, line and column of a TOML syntax error.
+    """
+    data = Path(path).read_bytes()
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data[:exc.start].count(b"\n") + 1
+        raise ConfigError(f"{what} {path}: not UTF-8 (byte 0x{data[exc.start]:02x} on line "
+                          f"{line}); TOML files are UTF-8: re-save it as UTF-8.") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:  # the message ends "(at line L, column C)"
+        raise ConfigError(f"{what} {path} is not valid TOML: {exc}.") from None
+
+
+__all__ = ["check_output_file", "check_output_folder", "read_toml", "to_jsonable",
+           "write_bytes_atomic", "write_json_atomic", "write_text_atomic"]

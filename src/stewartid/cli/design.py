@@ -52,31 +52,30 @@ def design(
     couplings 8 %), written as command files (pose and leg lengths) with a report against
     the paper's set."""
     import dataclasses
+    from numbers import Real
 
     from rich.progress import Progress
 
     from stewartid.design.report import identify_command
     from stewartid.design.run import run_design
-    from stewartid.errors import ConfigError
+    from stewartid.fields import Interval, Options, check, nonnegative, positive
     from stewartid.identification.registry import registered_methods
     from stewartid.platform import load_platform
     from stewartid.simulation.sensors import SensorNoise, reference_noise
 
     description = load_platform(platform)
-    names = [m.name for m in registered_methods()]
-    if method not in names:
-        raise ConfigError(f"--method must be one of {', '.join(names)}; got {method!r}.")
-    for name, value in (("--budget", budget), ("--rate", rate)):
-        if not value > 0:
-            raise ConfigError(f"{name} must be > 0; got {value!r}.")
-    if seeds < 2:
-        raise ConfigError(f"--seeds must be >= 2 (a spread needs two realisations); got {seeds}.")
-    if workers is not None and workers < 1:
-        raise ConfigError(f"--workers must be >= 1; got {workers}.")
-    for name, value in (("--coulomb", coulomb), ("--length-noise", length_noise),
-                        ("--force-noise", force_noise)):
-        if value is not None and not value >= 0:
-            raise ConfigError(f"{name} must be >= 0; got {value!r}.")
+    # typer has parsed the types: integer flags are checked on their range (Real)
+    for flag, value, constraint, unit in (
+            ("--method", method, Options(tuple(m.name for m in registered_methods())), ""),
+            ("--budget", budget, positive(), "s"),
+            ("--rate", rate, positive(), "Hz"),
+            ("--seeds", seeds, Interval(Real, 2, None), ""),  # a spread needs two realisations
+            ("--workers", workers, Interval(Real, 1, None), ""),
+            ("--coulomb", coulomb, nonnegative(), "N m"),
+            ("--length-noise", length_noise, nonnegative(), "m"),
+            ("--force-noise", force_noise, nonnegative(), "N")):
+        if value is not None:  # an optional flag not given
+            check(flag, value, [constraint], unit)
     if coulomb is not None:
         description = description.replace(friction__coulomb=coulomb)
     noise, reference = SensorNoise.from_sensors(description.sensors), reference_noise(description)

@@ -52,7 +52,7 @@ def simulate(
 
     from rich.progress import Progress
 
-    from stewartid.errors import ConfigError
+    from stewartid.fields import Options, check, nonnegative, positive
     from stewartid.files import check_output_folder
     from stewartid.platform import load_platform
     from stewartid.simulation import SensorNoise, simulate_experiments, write_experiments
@@ -60,16 +60,17 @@ def simulate(
     from stewartid.simulation.sensors import reference_noise
 
     description = load_platform(platform)
-    if format not in ("csv", "parquet"):
-        raise ConfigError(f"--format must be 'csv' or 'parquet'; got {format!r}.")
+    check("--format", format, [Options(("csv", "parquet"))])
     # before the simulation, which takes a while; write_experiments checks again
     check_output_folder(out, force, is_experiment_file)
-    for name, value in (("--coulomb", coulomb), ("--viscous", viscous),
-                        ("--length-noise", length_noise), ("--force-noise", force_noise)):
-        if value is not None and not value >= 0:
-            raise ConfigError(f"{name} must be >= 0; got {value!r}.")
-    if not duration > 0:
-        raise ConfigError(f"--duration must be > 0 s; got {duration!r}.")
+    for flag, value, constraint, unit in (
+            ("--coulomb", coulomb, nonnegative(), "N m"),
+            ("--viscous", viscous, nonnegative(), "N m s/rad"),
+            ("--length-noise", length_noise, nonnegative(), "m"),
+            ("--force-noise", force_noise, nonnegative(), "N"),
+            ("--duration", duration, positive(), "s")):
+        if value is not None:  # an optional flag not given
+            check(flag, value, [constraint], unit)
     noise = SensorNoise.from_sensors(description.sensors)
     if noise_on:
         noise = reference_noise(description)

@@ -19,7 +19,6 @@ from __future__ import annotations
 import io
 import math
 import re
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,7 +28,7 @@ import numpy as np
 
 from stewartid.datasets.plain_csv import read_plain_csv
 from stewartid.errors import ConfigError, DataError
-from stewartid.fields import read_toml_text
+from stewartid.files import read_toml
 from stewartid.platform import COORDINATES
 
 if TYPE_CHECKING:
@@ -312,7 +311,7 @@ def load_log_format(spec: str | Path) -> LogFormat:
         if not path.is_file():
             raise ConfigError(f"column mapping file {text!r} not found; give a TOML file "
                               "(docs/logs.md) or inline entries such as t=Time:ms.")
-        return log_format_from_mapping(parse_toml(path), str(path))
+        return log_format_from_mapping(read_toml(path, "column mapping file"), str(path))
     document: dict[str, dict[str, Any]] = {"log": {}, "columns": {}, "pressures": {}}
     for entry in filter(None, (e.strip() for e in text.split(","))):
         key, equals, value = (part.strip() for part in entry.partition("="))
@@ -322,14 +321,6 @@ def load_log_format(spec: str | Path) -> LogFormat:
         section = "log" if key in LOG_KEYS else "pressures" if key in AREA_KEYS else "columns"
         document[section][key] = value
     return log_format_from_mapping(document, "--columns")
-
-
-def parse_toml(path: Path) -> dict[str, Any]:
-    """Parse a TOML file; a file that is not UTF-8 or not TOML is a ConfigError naming it."""
-    try:
-        return tomllib.loads(read_toml_text(path))
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path} is not valid TOML: {exc}.") from None
 
 
 # -- reading a log ---------------------------------------------------------------------------
@@ -443,4 +434,4 @@ def _head_lines(text: str, count: int) -> list[str]:
 
 __all__ = ["MAPPABLE", "PRESSURE_COLUMNS", "UNITS", "ColumnSource", "LogFormat",
            "decode_text", "detect_delimiter", "load_log_format", "log_format_from_mapping",
-           "parse_toml", "read_table"]
+           "read_table"]

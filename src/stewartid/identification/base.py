@@ -1,22 +1,25 @@
 """The estimator base class every identifier derives from (scikit-learn estimator contract).
 
-``__init__`` of a subclass stores its settings only; :meth:`BaseIdentifier.fit` validates
-settings and data, calls the subclass's ``_fit`` and sets every learned attribute (names
-ending in ``_``) in one place; reading one before ``fit`` raises
-:class:`~stewartid.errors.NotFittedError`. ``get_params``/``set_params`` follow scikit-learn,
-so ``sklearn.base.clone`` works on every identifier.
+``__init__`` of a subclass stores its settings only, and the class declares their
+constraints next to it in ``_parameter_constraints`` (the vocabulary of
+:mod:`stewartid.fields`); :meth:`BaseIdentifier.fit` validates settings and data, calls the
+subclass's ``_fit`` and sets every learned attribute (names ending in ``_``) in one place;
+reading one before ``fit`` raises :class:`~stewartid.errors.NotFittedError`.
+``get_params``/``set_params`` follow scikit-learn, so ``sklearn.base.clone`` works on every
+identifier.
 """
 
 from __future__ import annotations
 
 import inspect
+from collections.abc import Sequence
+from numbers import Integral
 from pathlib import Path
 from typing import Any, ClassVar
 
-import numpy as np
-
 from stewartid.datasets.dataset import Dataset
 from stewartid.errors import ConfigError, NotFittedError
+from stewartid.fields import Constraint, Interval, positive, validate_parameters
 from stewartid.identification.preparation import resolve_datasets, resolve_platform
 from stewartid.identification.result import IdentificationResult
 from stewartid.platform import Platform
@@ -39,6 +42,10 @@ class BaseIdentifier:
 
     #: Registry name of the method, stored in the result (set by ``register_method``).
     method: ClassVar[str] = "base"
+
+    #: Constraints of the settings, by name (a setting is valid if it satisfies one of its
+    #: list; None allows None), checked by :meth:`fit`.
+    _parameter_constraints: ClassVar[dict[str, Sequence[Constraint | None]]] = {}
 
     @classmethod
     def _param_names(cls) -> list[str]:
@@ -78,7 +85,15 @@ class BaseIdentifier:
         raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     def _validate_params(self) -> None:
-        """Check the settings; subclasses raise ConfigError with the sklearn-style message."""
+        """Check the settings against ``_parameter_constraints``; a subclass with rules across
+        settings extends this after calling it.
+
+        Raises
+        ------
+        ConfigError
+            "The 'name' parameter of Class must be ... Got ... instead."
+        """
+        validate_parameters(self._parameter_constraints, self.get_params(), type(self).__name__)
 
     def fit(self, datasets: Any, platform: Platform | str | Path) -> BaseIdentifier:
         """Identify Mt and Bt from experiments.
@@ -115,20 +130,12 @@ class BaseIdentifier:
         raise NotImplementedError
 
 
-def check_parameter(owner: str, name: str, value: Any, ok: bool, expected: str) -> None:
-    """Raise ConfigError in the form "The 'name' parameter of Owner must be ... Got ... instead."."""
-    if not ok:
-        raise ConfigError(f"The {name!r} parameter of {owner} must be {expected}. "
-                          f"Got {value!r} instead.")
+#: Constraints of the Savitzky-Golay settings of the time-domain methods: the window (s),
+#: None for the default, and the polynomial order.
+DIFFERENTIATION_CONSTRAINTS: dict[str, list[Constraint | None]] = {
+    "window": [positive(), None],
+    "order": [Interval(Integral, 3, None)],
+}
 
 
-def check_differentiation(owner: str, window: Any, order: Any) -> None:
-    """Check the Savitzky-Golay settings ``window`` (s, or None) and ``order`` of ``owner``."""
-    check_parameter(owner, "window", window,
-                    window is None or (np.isfinite(window) and window > 0),
-                    "a positive float (s) or None")
-    check_parameter(owner, "order", order,
-                    isinstance(order, int | np.integer) and order >= 3, "an int >= 3")
-
-
-__all__ = ["BaseIdentifier", "check_differentiation", "check_parameter"]
+__all__ = ["DIFFERENTIATION_CONSTRAINTS", "BaseIdentifier"]

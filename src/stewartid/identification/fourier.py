@@ -35,16 +35,14 @@ Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
 from __future__ import annotations
 
 from collections.abc import Sequence
+from numbers import Integral
 
 import numpy as np
 
 from stewartid.datasets.dataset import Dataset
 from stewartid.errors import ConfigError, DataError
-from stewartid.identification.base import (
-    BaseIdentifier,
-    check_differentiation,
-    check_parameter,
-)
+from stewartid.fields import Interval, ListOf, positive
+from stewartid.identification.base import DIFFERENTIATION_CONSTRAINTS, BaseIdentifier
 from stewartid.identification.preparation import prepare
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
@@ -148,17 +146,15 @@ class FourierIdentifier(BaseIdentifier):
         self.symmetric = symmetric
         self.periods_per_segment = periods_per_segment
 
+    _parameter_constraints = {
+        "frequency_hz": [positive(), ListOf(positive()), None],
+        **DIFFERENTIATION_CONSTRAINTS,
+        "periods_per_segment": [Interval(Integral, 1, None)],
+    }
+
     def _validate_params(self) -> None:
-        owner = type(self).__name__
+        super()._validate_params()
         freqs = self._given_frequencies()
-        check_parameter(owner, "frequency_hz", self.frequency_hz,
-                        freqs is None or (len(freqs) > 0 and all(
-                            np.isfinite(f) and f > 0 for f in freqs)),
-                        "a positive float, a sequence of them, or None")
-        check_differentiation(owner, self.window, self.order)
-        check_parameter(owner, "periods_per_segment", self.periods_per_segment,
-                        isinstance(self.periods_per_segment, int | np.integer)
-                        and self.periods_per_segment >= 1, "an int >= 1")
         if self.stiffness and freqs is not None and len(freqs) < 2:
             raise ConfigError(
                 "a stiffness matrix cannot be separated from inertia at a single excitation "

@@ -31,14 +31,13 @@ inverse dynamic identification model with least squares.
 
 from __future__ import annotations
 
+from numbers import Integral
+
 import numpy as np
 
 from stewartid.datasets.dataset import Dataset
-from stewartid.identification.base import (
-    BaseIdentifier,
-    check_differentiation,
-    check_parameter,
-)
+from stewartid.fields import Interval, Options, nonnegative
+from stewartid.identification.base import DIFFERENTIATION_CONSTRAINTS, BaseIdentifier
 from stewartid.identification.preparation import prepare
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
@@ -138,17 +137,12 @@ class LeastSquaresIdentifier(BaseIdentifier):
         self.decimate = decimate
         self.differentiation = differentiation
 
-    def _validate_params(self) -> None:
-        owner = type(self).__name__
-        check_differentiation(owner, self.window, self.order)
-        check_parameter(owner, "coulomb_smoothing", self.coulomb_smoothing,
-                        np.isfinite(self.coulomb_smoothing) and self.coulomb_smoothing >= 0,
-                        "a float in the range [0, inf)")
-        check_parameter(owner, "differentiation", self.differentiation,
-                        self.differentiation in ("kernel", "savgol"), "'kernel' or 'savgol'")
-        check_parameter(owner, "decimate", self.decimate,
-                        isinstance(self.decimate, int | np.integer) and self.decimate >= 1,
-                        "an int >= 1")
+    _parameter_constraints = {
+        **DIFFERENTIATION_CONSTRAINTS,
+        "coulomb_smoothing": [nonnegative()],
+        "differentiation": [Options(("kernel", "savgol"))],
+        "decimate": [Interval(Integral, 1, None)],
+    }
 
     def _fit(self, datasets: list[Dataset], platform: Platform
              ) -> tuple[IdentificationResult, dict]:

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import tomllib
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -21,8 +20,8 @@ from typing import Any
 import numpy as np
 
 from stewartid.errors import ConfigError
-from stewartid.fields import read_toml_text, section_from_mapping, section_to_mapping
-from stewartid.platform.ranges import check_physical_ranges
+from stewartid.fields import section_from_mapping, section_to_mapping
+from stewartid.files import read_toml
 from stewartid.platform.sections import (
     Controller,
     Friction,
@@ -42,9 +41,8 @@ COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
 
 
 #: TOML sections of a platform description, in file order, with their dataclass.
-SECTIONS: dict[str, type] = {"geometry": Geometry, "inertia": Inertia, "friction": Friction,
-                             "hydraulics": Hydraulics, "controller": Controller,
-                             "sensors": Sensors, "limits": Limits}
+SECTIONS: dict[str, type] = {cls.section: cls for cls in (Geometry, Inertia, Friction, Hydraulics,
+                                                          Controller, Sensors, Limits)}
 #: Sections that must be present in every file; the others take their documented defaults.
 REQUIRED_SECTIONS = ("geometry", "inertia", "friction")
 
@@ -75,7 +73,7 @@ class Platform:
     name: str = "platform"
 
     def __post_init__(self) -> None:
-        check_physical_ranges({name: getattr(self, name) for name in SECTIONS})
+        # each section checked its own fields (sign, physical range) when it was built
         _check_buildable(self)
 
     # -- derived geometry -------------------------------------------------------------------
@@ -262,21 +260,17 @@ def load_platform(source: str | Path) -> Platform:
         If the file does not exist, is not valid TOML, or fails validation.
     """
     if str(source) == "paper":
-        text = resources.files("stewartid").joinpath("data/paper.toml").read_text()
-        return _parse(text, "paper", "the paper preset")
+        with resources.as_file(resources.files("stewartid") / "data/paper.toml") as path:
+            return _build(read_toml(path, "the paper preset"), "paper", "the paper preset")
     path = Path(source)
     if not path.is_file():
         raise ConfigError(
             f"platform file {str(path)!r} not found; give a TOML file or 'paper' for the preset."
         )
-    return _parse(read_toml_text(path), path.stem, str(path))
+    return _build(read_toml(path, "platform file"), path.stem, str(path))
 
 
-def _parse(text: str, name: str, where: str) -> Platform:
-    try:
-        document = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{where} is not valid TOML: {exc}.") from None
+def _build(document: dict[str, Any], name: str, where: str) -> Platform:
     try:
         return platform_from_mapping(document, name)
     except ConfigError as exc:

@@ -1,8 +1,12 @@
 """The sections of a platform description: one frozen dataclass per TOML table.
 
-Each field carries its unit, description, check and default (:func:`stewartid.fields.spec`);
-:mod:`stewartid.platform` assembles them into a :class:`~stewartid.platform.Platform`. The
-format is documented in ``docs/platform-format.md``.
+Each field is declared once, with its unit, description, constraint (sign and physical
+range, in the field's SI unit) and default (:func:`stewartid.fields.spec`); a section checks
+every field when built (:class:`stewartid.fields.Section`). The physical ranges are wide on
+purpose: they catch factors of a thousand (a file in millimetres, a mass in grams, a pressure
+in bar), not unusual designs. :mod:`stewartid.platform.description` assembles the sections
+into a :class:`~stewartid.platform.Platform`; the format is documented in
+``docs/platform-format.md``.
 """
 
 from __future__ import annotations
@@ -11,62 +15,80 @@ import dataclasses
 import math
 
 from stewartid.errors import ConfigError
-from stewartid.fields import spec
-
-
-@dataclasses.dataclass(frozen=True)
-class Geometry:
-    """Joint layout of a 6-6 hexapod (paper, Table 1)."""
-
-    upper_radius: float = spec("m", "radius of the circle through the upper (platform) joints")
-    lower_radius: float = spec("m", "radius of the circle through the lower (base) joints")
-    neutral_height: float = spec("m", "lower joint plane to upper joint plane at neutral")
-    upper_half_angle: float = spec("rad", "half the angle between the two joints of an upper pair")
-    lower_half_angle: float = spec("rad", "half the angle between the two joints of a lower pair")
-    reference_height: float = spec(
-        "m", "upper joint plane to the reference point (platform centre of mass), away from "
-        "the base", check="nonnegative")
-
-
-@dataclasses.dataclass(frozen=True)
-class Inertia:
-    """Masses and inertias of the platform and of the two parts of each leg (paper, Table 2)."""
-
-    platform_mass: float = spec("kg", "mass of the moving platform")
-    platform_inertia: tuple[float, float, float] = spec(
-        "kg m^2", "principal inertias of the platform about its centre of mass", length=3)
-    upper_leg_mass: float = spec("kg", "mass of a leg's upper part (piston rod)",
-                                 check="nonnegative")
-    lower_leg_mass: float = spec("kg", "mass of a leg's lower part (cylinder)",
-                                 check="nonnegative")
-    upper_leg_com: float = spec("m", "upper gimbal point to the upper part's centre of mass",
-                                check="nonnegative")
-    lower_leg_com: float = spec("m", "lower gimbal point to the lower part's centre of mass",
-                                check="nonnegative")
-    upper_leg_inertia: float = spec(
-        "kg m^2", "transverse inertia of the upper part about its centre of mass",
-        check="nonnegative")
-    lower_leg_inertia: float = spec(
-        "kg m^2", "transverse inertia of the lower part about its centre of mass",
-        check="nonnegative")
-
-
-@dataclasses.dataclass(frozen=True)
-class Friction:
-    """Joint friction: viscous on the four gimbal axes, Coulomb on all five rotational axes."""
-
-    gimbal_viscous: float = spec("N m s/rad", "viscous coefficient of each gimbal axis",
-                                 check="nonnegative")
-    coulomb: float = spec("N m", "Coulomb friction torque of each rotational joint axis",
-                          check="nonnegative", default=0.0)
-
+from stewartid.fields import (
+    BOOLEAN,
+    ListOf,
+    Options,
+    Section,
+    finite,
+    nonnegative,
+    positive,
+    spec,
+)
 
 #: Actuator models understood by [hydraulics] mode.
 ACTUATOR_MODES = ("hydraulic", "ideal")
 
 
 @dataclasses.dataclass(frozen=True)
-class Hydraulics:
+class Geometry(Section):
+    """Joint layout of a 6-6 hexapod (paper, Table 1)."""
+
+    section = "geometry"
+
+    upper_radius: float = spec("m", "radius of the circle through the upper (platform) joints",
+                               positive(0.01, 50.0))
+    lower_radius: float = spec("m", "radius of the circle through the lower (base) joints",
+                               positive(0.01, 50.0))
+    neutral_height: float = spec("m", "lower joint plane to upper joint plane at neutral",
+                                 positive(0.01, 50.0))
+    upper_half_angle: float = spec("rad", "half the angle between the two joints of an upper "
+                                   "pair", positive(0.0, math.pi / 2))
+    lower_half_angle: float = spec("rad", "half the angle between the two joints of a lower "
+                                   "pair", positive(0.0, math.pi / 2))
+    reference_height: float = spec(
+        "m", "upper joint plane to the reference point (platform centre of mass), away from "
+        "the base", nonnegative(0.0, 50.0))
+
+
+@dataclasses.dataclass(frozen=True)
+class Inertia(Section):
+    """Masses and inertias of the platform and of the two parts of each leg (paper, Table 2)."""
+
+    section = "inertia"
+
+    platform_mass: float = spec("kg", "mass of the moving platform", positive(0.01, 1e6))
+    platform_inertia: tuple[float, float, float] = spec(
+        "kg m^2", "principal inertias of the platform about its centre of mass",
+        ListOf(positive(1e-6, 1e9), length=3))
+    upper_leg_mass: float = spec("kg", "mass of a leg's upper part (piston rod)", nonnegative(0.0, 1e5))
+    lower_leg_mass: float = spec("kg", "mass of a leg's lower part (cylinder)", nonnegative(0.0, 1e5))
+    upper_leg_com: float = spec("m", "upper gimbal point to the upper part's centre of mass",
+                                nonnegative(0.0, 50.0))
+    lower_leg_com: float = spec("m", "lower gimbal point to the lower part's centre of mass",
+                                nonnegative(0.0, 50.0))
+    upper_leg_inertia: float = spec(
+        "kg m^2", "transverse inertia of the upper part about its centre of mass",
+        nonnegative(0.0, 1e7))
+    lower_leg_inertia: float = spec(
+        "kg m^2", "transverse inertia of the lower part about its centre of mass",
+        nonnegative(0.0, 1e7))
+
+
+@dataclasses.dataclass(frozen=True)
+class Friction(Section):
+    """Joint friction: viscous on the four gimbal axes, Coulomb on all five rotational axes."""
+
+    section = "friction"
+
+    gimbal_viscous: float = spec("N m s/rad", "viscous coefficient of each gimbal axis",
+                                 nonnegative(0.0, 1e9))
+    coulomb: float = spec("N m", "Coulomb friction torque of each rotational joint axis",
+                          nonnegative(0.0, 1e7), default=0.0)
+
+
+@dataclasses.dataclass(frozen=True)
+class Hydraulics(Section):
     """Hydraulic actuators of the legs: servo-valve, cylinder and oil (same for all six legs).
 
     Defaults size a flight-simulator class hexapod of about 14 t: a 21 MPa supply, 100/70 mm
@@ -76,39 +98,40 @@ class Hydraulics:
     the hydraulic natural frequency of a leg is about 15-25 Hz.
     """
 
+    section = "hydraulics"
+
     mode: str = spec("-", "'hydraulic' (valve, cylinder, oil) or 'ideal' (the demanded force "
-                     "is applied exactly)", check="any", default="hydraulic")
-    supply_pressure: float = spec("Pa", "supply pressure p_s", default=21.0e6)
-    return_pressure: float = spec("Pa", "return (tank) pressure p_r", check="nonnegative",
-                                  default=0.5e6)
+                     "is applied exactly)", Options(ACTUATOR_MODES), default="hydraulic")
+    supply_pressure: float = spec("Pa", "supply pressure p_s", positive(1e5, 1e8), default=21.0e6)
+    return_pressure: float = spec("Pa", "return (tank) pressure p_r", nonnegative(0.0, 1e7), default=0.5e6)
     bore_diameter: float = spec("m", "cylinder bore (piston side area A_A = pi D^2 / 4)",
-                                default=0.100)
+                                positive(1e-3, 2.0), default=0.100)
     rod_diameter: float = spec("m", "piston rod diameter (rod side area A_B = A_A - pi d^2/4)",
-                               default=0.070)
-    stroke: float = spec("m", "usable stroke, centred on the neutral leg length", default=1.0)
+                               positive(1e-3, 2.0), default=0.070)
+    stroke: float = spec("m", "usable stroke, centred on the neutral leg length",
+                         positive(1e-3, 20.0), default=1.0)
     dead_volume: float = spec("m^3", "oil volume of each chamber at its end of stroke, with "
-                              "the hose to the valve", default=0.5e-3)
+                              "the hose to the valve", positive(1e-9, 1.0), default=0.5e-3)
     bulk_modulus: float = spec("Pa", "effective bulk modulus of the oil (with hose "
-                               "compliance)", default=1.2e9)
+                               "compliance)", positive(1e7, 1e10), default=1.2e9)
     valve_rated_flow: float = spec("m^3/s", "valve flow at full opening and rated pressure "
-                                   "drop (200 L/min)", default=200.0 / 60000.0)
+                                   "drop (200 L/min)", positive(1e-7, 1.0),
+                                   default=200.0 / 60000.0)
     valve_rated_pressure_drop: float = spec("Pa", "total valve pressure drop (both metering "
                                             "edges) at which the rated flow is given",
-                                            default=7.0e6)
+                                            positive(1e4, 1e8), default=7.0e6)
     valve_bandwidth: float = spec("Hz", "natural frequency of the spool (second-order model)",
-                                  default=80.0)
-    valve_damping: float = spec("-", "damping ratio of the spool", default=0.7)
+                                  positive(0.1, 1e4), default=80.0)
+    valve_damping: float = spec("-", "damping ratio of the spool", positive(0.01, 10.0), default=0.7)
     leakage: float = spec("m^3/(s Pa)", "internal (cross-piston) leakage coefficient",
-                          check="nonnegative", default=2.0e-13)
+                          nonnegative(0.0, 1e-8), default=2.0e-13)
     orifice_transition_pressure: float = spec(
         "Pa", "pressure drop below which orifice flow turns from turbulent (square root) to "
         "laminar (linear), which keeps the flow law differentiable at zero drop",
-        default=1.0e5)
+        positive(1.0, 1e7), default=1.0e5)
 
     def __post_init__(self) -> None:
-        if self.mode not in ACTUATOR_MODES:
-            raise ConfigError(f"[hydraulics] mode must be one of {ACTUATOR_MODES}; "
-                              f"got {self.mode!r}.")
+        super().__post_init__()
         if not self.rod_diameter < self.bore_diameter:
             raise ConfigError(f"[hydraulics] rod_diameter = {self.rod_diameter} m must be "
                               f"smaller than bore_diameter = {self.bore_diameter} m.")
@@ -128,7 +151,7 @@ class Hydraulics:
 
 
 @dataclasses.dataclass(frozen=True)
-class Controller:
+class Controller(Section):
     """Leg-length servo: PID on each leg length giving a force demand, plus an inner force loop.
 
     The PID output is the force demand of the leg (N). In ``ideal`` actuator mode it is
@@ -138,41 +161,45 @@ class Controller:
     about 1 % of its amplitude.
     """
 
+    section = "controller"
+
     proportional_gain: float = spec("N/m", "PID proportional gain on the leg-length error",
-                                    default=1.0e7)
-    integral_gain: float = spec("N/(m s)", "PID integral gain", check="nonnegative",
-                                default=5.0e7)
+                                    positive(1e-3, 1e12), default=1.0e7)
+    integral_gain: float = spec("N/(m s)", "PID integral gain", nonnegative(0.0, 1e14), default=5.0e7)
     derivative_gain: float = spec("N s/m", "PID derivative gain (on the leg-rate error)",
-                                  check="nonnegative", default=4.0e5)
+                                  nonnegative(0.0, 1e10), default=4.0e5)
     gravity_feedforward: bool = spec("-", "add the static leg forces that hold the commanded "
-                                     "pose against gravity", check="any", default=True)
+                                     "pose against gravity", BOOLEAN, default=True)
     force_loop_gain: float = spec("1/N", "inner force loop (hydraulic mode): valve opening, "
                                   "as a fraction of full opening, per newton of force error",
-                                  default=1.0e-5)
+                                  positive(1e-12, 1.0), default=1.0e-5)
 
 
 @dataclasses.dataclass(frozen=True)
-class Sensors:
+class Sensors(Section):
     """Sampling and sensor imperfections of the recorded data (defaults: ideal sensors)."""
 
-    sample_rate: float = spec("Hz", "sampling rate of the recorded signals", default=1000.0)
+    section = "sensors"
+
+    sample_rate: float = spec("Hz", "sampling rate of the recorded signals",
+                              positive(1.0, 1e6), default=1000.0)
     length_noise: float = spec("m", "standard deviation of the leg-length sensor noise",
-                               check="nonnegative", default=0.0)
-    length_bias: float = spec("m", "constant offset of every leg-length sensor", check="any",
-                              default=0.0)
+                               nonnegative(0.0, 0.1), default=0.0)
+    length_bias: float = spec("m", "constant offset of every leg-length sensor",
+                              finite(-1.0, 1.0), default=0.0)
     length_resolution: float = spec("m", "quantisation step of the leg-length sensors "
-                                    "(0: none)", check="nonnegative", default=0.0)
+                                    "(0: none)", nonnegative(0.0, 0.1), default=0.0)
     force_noise: float = spec("N", "standard deviation of the actuator force measurement "
                               "noise (force-equivalent of the pressure transducers)",
-                              check="nonnegative", default=0.0)
-    force_bias: float = spec("N", "constant offset of every force measurement", check="any",
-                             default=0.0)
+                              nonnegative(0.0, 1e7), default=0.0)
+    force_bias: float = spec("N", "constant offset of every force measurement",
+                             finite(-1e7, 1e7), default=0.0)
     force_resolution: float = spec("N", "quantisation step of the force measurement (0: none)",
-                                   check="nonnegative", default=0.0)
+                                   nonnegative(0.0, 1e7), default=0.0)
 
 
 @dataclasses.dataclass(frozen=True)
-class Limits:
+class Limits(Section):
     """Operating limits an excitation must respect (``stewartid design`` and its checks).
 
     Keys left out are derived from the other sections by
@@ -181,24 +208,31 @@ class Limits:
     through the piston area, the force from the smaller of the cylinder's stall forces.
     """
 
+    section = "limits"
+
     stroke_min: float | None = spec("m", "shortest allowed leg length (default: neutral "
-                                    "length - stroke / 2)", default=None)
+                                    "length - stroke / 2)", positive(0.01, 100.0), default=None)
     stroke_max: float | None = spec("m", "longest allowed leg length (default: neutral "
-                                    "length + stroke / 2)", default=None)
+                                    "length + stroke / 2)", positive(0.01, 100.0), default=None)
     leg_velocity: float | None = spec("m/s", "largest leg-length rate (default: rated valve "
-                                      "flow / piston area)", default=None)
-    leg_acceleration: float = spec("m/s^2", "largest leg-length acceleration", default=5.0)
+                                      "flow / piston area)", positive(1e-4, 100.0),
+                                      default=None)
+    leg_acceleration: float = spec("m/s^2", "largest leg-length acceleration",
+                                   positive(1e-3, 1e4), default=5.0)
     actuator_force: float | None = spec("N", "largest |actuator force| (default: the smaller "
                                         "of the extending and retracting stall forces)",
-                                        default=None)
+                                        positive(1.0, 1e9), default=None)
     gimbal_angle: float = spec("rad", "largest deflection of a leg from its neutral "
-                               "direction, at either gimbal", default=0.35)
+                               "direction, at either gimbal", positive(1e-3, math.pi / 2),
+                               default=0.35)
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         if (self.stroke_min is not None and self.stroke_max is not None
                 and not self.stroke_min < self.stroke_max):
             raise ConfigError(f"[limits] stroke_min = {self.stroke_min} m must be below "
                               f"stroke_max = {self.stroke_max} m.")
 
 
-__all__ = ["Geometry", "Inertia", "Friction", "Hydraulics", "Controller", "Sensors", "Limits"]
+__all__ = ["ACTUATOR_MODES", "Controller", "Friction", "Geometry", "Hydraulics", "Inertia",
+           "Limits", "Sensors"]

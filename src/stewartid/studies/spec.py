@@ -24,63 +24,51 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import tomllib
 from collections.abc import Mapping
+from numbers import Integral
 from pathlib import Path
 from typing import Any
 
 from stewartid.errors import ConfigError
+from stewartid.fields import (
+    TEXT,
+    FieldSpec,
+    InstanceOf,
+    Interval,
+    Options,
+    check,
+    nonnegative,
+    positive,
+)
+from stewartid.files import read_toml
 from stewartid.platform import Platform, load_platform
-
-
-@dataclasses.dataclass(frozen=True)
-class Parameter:
-    """A parameter of a study point: a column of the results.
-
-    Attributes
-    ----------
-    unit : str
-    doc : str
-    minimum : float
-        Smallest allowed value.
-    strict : bool
-        True if the minimum itself is excluded.
-    """
-
-    unit: str
-    doc: str
-    minimum: float = 0.0
-    strict: bool = False
-
-    def check(self, name: str, value: Any, where: str) -> float:
-        """``value`` as a float, or ConfigError naming ``where`` and ``name``."""
-        bound = f"> {self.minimum:g}" if self.strict else f">= {self.minimum:g}"
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            raise ConfigError(f"{where}: {name} must be a number {bound} ({self.unit}); got "
-                              f"{value!r}.")
-        value = float(value)
-        if not math.isfinite(value) or value < self.minimum or (self.strict
-                                                                and value == self.minimum):
-            raise ConfigError(f"{where}: {name} must be {bound} ({self.unit}); got {value!r}.")
-        return value
-
+from stewartid.platform.sections import ACTUATOR_MODES
 
 #: Parameters of a study point, in column order. ``coulomb`` and ``viscous`` default to the
 #: platform's friction; ``noise_scale`` multiplies the reference sensor noise
 #: (:func:`stewartid.simulation.sensors.reference_noise`).
-PARAMETERS: dict[str, Parameter] = {
-    "coulomb": Parameter("N m", "Coulomb friction per joint axis"),
-    "viscous": Parameter("N m s/rad", "viscous friction per gimbal axis"),
-    "noise_scale": Parameter("-", "multiple of the reference sensor noise"),
-    "frequency": Parameter("Hz", "excitation sine frequency", strict=True),
-    "duration": Parameter("s", "record length of each experiment", strict=True),
+PARAMETERS: dict[str, FieldSpec] = {
+    "coulomb": FieldSpec("N m", "Coulomb friction per joint axis", nonnegative()),
+    "viscous": FieldSpec("N m s/rad", "viscous friction per gimbal axis", nonnegative()),
+    "noise_scale": FieldSpec("-", "multiple of the reference sensor noise", nonnegative()),
+    "frequency": FieldSpec("Hz", "excitation sine frequency", positive()),
+    "duration": FieldSpec("s", "record length of each experiment", positive()),
 }
 
 #: Defaults of the parameters that do not come from the platform.
 DEFAULTS = {"noise_scale": 0.0, "frequency": 0.5, "duration": 20.0}
 
+#: Constraints of the keys of ``[study]`` other than the methods and the point parameters.
+STUDY_CONSTRAINTS = {
+    "platform": InstanceOf(str, "\"paper\" or a TOML path"),
+    "seeds": Interval(Integral, 1, None),
+    "first_seed": Interval(Integral, 0, None),
+    "actuator": Options(ACTUATOR_MODES),
+    "title": TEXT,
+}
+
 #: Keys of ``[study]`` other than the point parameters.
-STUDY_KEYS = ("platform", "methods", "seeds", "first_seed", "actuator", "title")
+STUDY_KEYS = ("methods", *STUDY_CONSTRAINTS)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -165,13 +153,6 @@ def _methods(value: Any, where: str) -> tuple[str, ...]:
     return tuple(value)
 
 
-def _integer(value: Any, name: str, minimum: int, where: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
-        raise ConfigError(f"{where}: [study] {name} must be an integer >= {minimum}; got "
-                          f"{value!r}.")
-    return value
-
-
 def _grid(table: Mapping[str, Any], where: str) -> dict[str, tuple[float, ...]]:
     grid = {}
     for name, values in table.items():
@@ -182,7 +163,7 @@ def _grid(table: Mapping[str, Any], where: str) -> dict[str, tuple[float, ...]]:
             raise ConfigError(f"{where}: [grid] {name} must be a non-empty list of values in "
                               f"{PARAMETERS[name].unit}, e.g. {name} = [0.0, 1.0]; got "
                               f"{values!r}.")
-        checked = tuple(PARAMETERS[name].check(f"{name}[{k}]", v, f"{where}: [grid]")
+        checked = tuple(PARAMETERS[name].check(f"{where}: [grid] {name}[{k}]", v)
                         for k, v in enumerate(values))
         if len(set(checked)) != len(checked):
             raise ConfigError(f"{where}: [grid] {name} lists a value twice: {values!r}.")
@@ -240,10 +221,10 @@ def parse_study(document: Mapping[str, Any], where: str = "study file",
         raise ConfigError(f"{where}: [study] is missing required key 'methods' (the methods "
                           "to run, e.g. methods = [\"wavelet\", \"fourier\", \"ls\"]).")
     methods = _methods(study["methods"], where)
+    for key, constraint in STUDY_CONSTRAINTS.items():
+        if key in study:
+            check(f"{where}: [study] {key}", study[key], [constraint])
     platform = study.get("platform", "paper")
-    if not isinstance(platform, str):
-        raise ConfigError(f"{where}: [study] platform must be \"paper\" or a TOML path; got "
-                          f"{platform!r}.")
     if platform != "paper":
         platform = str((Path(base) / platform).resolve())
     description = load_platform(platform)
@@ -254,24 +235,16 @@ def parse_study(document: Mapping[str, Any], where: str = "study file",
                           "keep one.")
     defaults = {**DEFAULTS, "coulomb": description.friction.coulomb,
                 "viscous": description.friction.gimbal_viscous}
-    fixed = {name: PARAMETERS[name].check(name, study[name], f"{where}: [study]")
+    fixed = {name: PARAMETERS[name].check(f"{where}: [study] {name}", study[name])
              if name in study else float(defaults[name])
              for name in PARAMETERS if name not in grid}
-    actuator = study.get("actuator")
-    if actuator not in (None, "hydraulic", "ideal"):
-        raise ConfigError(f"{where}: [study] actuator must be \"hydraulic\" or \"ideal\"; got "
-                          f"{actuator!r}.")
-    title = study.get("title", "Identification study")
-    if not isinstance(title, str):
-        raise ConfigError(f"{where}: [study] title must be a string; got {title!r}.")
-    seeds = _integer(study.get("seeds", 1), "seeds", 1, where)
-    first_seed = _integer(study.get("first_seed", 0), "first_seed", 0, where)
+    seeds, first_seed = study.get("seeds", 1), study.get("first_seed", 0)
     return StudySpec(platform=platform, methods=methods,
                      seeds=tuple(range(first_seed, first_seed + seeds)), fixed=fixed,
-                     grid=grid, actuator=actuator,
+                     grid=grid, actuator=study.get("actuator"),
                      method_settings=_method_settings(_table(document, "settings", where),
                                                       methods, where),
-                     title=title)
+                     title=study.get("title", "Identification study"))
 
 
 def load_study(path: str | Path) -> StudySpec:
@@ -286,11 +259,8 @@ def load_study(path: str | Path) -> StudySpec:
     if not path.is_file():
         raise ConfigError(f"study file {str(path)!r} not found; give the path of a TOML study "
                           "file (see docs/studies.md).")
-    try:
-        document = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML ({exc}).") from None
-    return parse_study(document, str(path), path.parent)
+    return parse_study(read_toml(path, "study file"), str(path), path.parent)
 
 
-__all__ = ["DEFAULTS", "PARAMETERS", "Parameter", "StudySpec", "load_study", "parse_study"]
+__all__ = ["DEFAULTS", "PARAMETERS", "STUDY_CONSTRAINTS", "StudySpec", "load_study",
+           "parse_study"]

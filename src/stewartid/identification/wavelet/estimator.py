@@ -53,10 +53,13 @@ Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
 
 from __future__ import annotations
 
+from numbers import Integral, Real
+
 import numpy as np
 
 from stewartid.datasets.dataset import Dataset
-from stewartid.identification.base import BaseIdentifier, check_parameter
+from stewartid.fields import Interval, ListOf, Options, nonnegative, positive, validate_parameters
+from stewartid.identification.base import BaseIdentifier
 from stewartid.identification.least_squares import JOINT_TYPES
 from stewartid.identification.preparation import Experiment, prepare
 from stewartid.identification.registry import Preset, register_method
@@ -219,62 +222,34 @@ class WaveletIdentifier(BaseIdentifier):
         self.gravity = gravity
 
     # ------------------------------------------------------------------ settings
+    _parameter_constraints = {
+        "wavelet": [Options(("polynomial", "mexican_hat"))],
+        "variant": [Options(VARIANTS)],
+        "scale_fractions": [Interval(Real, 0, 1, "right"), ListOf(Interval(Real, 0, 1, "right"))],
+        "shifts_per_scale": [Interval(Integral, 1, 1000, "both")],
+        "margin": [nonnegative(), None],
+        "ignore_below": [Interval(Real, 0, 1, "left")],
+        "min_interval": [positive(), None],
+        "min_support_samples": [Interval(Integral, 8, None)],
+        "differentiation_window": [positive(), None],
+        "hysteresis": [nonnegative()],
+        "test_functions": [Interval(Integral, 1, 12, "both"), None],
+        "friction": [Options(FRICTION_MODELS)],
+        "pair_selection": [Options(PAIR_SELECTIONS)],
+    }
+
     def _validate_params(self) -> None:
-        name = type(self).__name__
-        check_parameter(name, "wavelet", self.wavelet,
-                        self.wavelet in ("polynomial", "mexican_hat"),
-                        "'polynomial' or 'mexican_hat'")
-        check_parameter(name, "variant", self.variant, self.variant in VARIANTS,
-                        f"one of {VARIANTS}")
-        fractions = np.atleast_1d(np.asarray(self.scale_fractions, dtype=float))
-        check_parameter(name, "scale_fractions", self.scale_fractions,
-                        fractions.size > 0 and bool(np.all((fractions > 0) & (fractions <= 1))),
-                        "a non-empty sequence of fractions in (0, 1]")
-        check_parameter(name, "shifts_per_scale", self.shifts_per_scale,
-                        isinstance(self.shifts_per_scale, int | np.integer)
-                        and 1 <= self.shifts_per_scale <= 1000, "an integer in [1, 1000]")
-        check_parameter(name, "margin", self.margin,
-                        self.margin is None
-                        or (isinstance(self.margin, int | float) and self.margin >= 0),
-                        "None or a float in [0, inf) (s)")
-        check_parameter(name, "ignore_below", self.ignore_below,
-                        isinstance(self.ignore_below, int | float)
-                        and 0 <= self.ignore_below < 1, "a float in [0, 1)")
-        check_parameter(name, "min_interval", self.min_interval,
-                        self.min_interval is None or (isinstance(self.min_interval, int | float)
-                                                      and self.min_interval > 0),
-                        "None or a float in (0, inf) (s)")
-        check_parameter(name, "min_support_samples", self.min_support_samples,
-                        isinstance(self.min_support_samples, int | np.integer)
-                        and self.min_support_samples >= 8, "an integer >= 8")
-        check_parameter(name, "differentiation_window", self.differentiation_window,
-                        self.differentiation_window is None
-                        or (isinstance(self.differentiation_window, int | float)
-                            and self.differentiation_window > 0),
-                        "None or a float in (0, inf) (s)")
-        check_parameter(name, "hysteresis", self.hysteresis,
-                        isinstance(self.hysteresis, int | float) and self.hysteresis >= 0,
-                        "a float in [0, inf)")
-        check_parameter(name, "test_functions", self.test_functions,
-                        self.test_functions is None
-                        or (isinstance(self.test_functions, int | np.integer)
-                            and 1 <= self.test_functions <= 12), "None or an integer in [1, 12]")
-        check_parameter(name, "friction", self.friction, self.friction in FRICTION_MODELS
-                        and (self.friction == "free" or self.test_functions is not None),
-                        f"one of {FRICTION_MODELS}, 'free' when test_functions is None")
-        if self.test_functions is not None:
-            check_parameter(name, "wavelet", self.wavelet, self.wavelet == "polynomial",
-                            "'polynomial' when test_functions is set (use test_functions=None "
-                            "for the Mexican hat)")
-            check_parameter(name, "variant", self.variant, self.variant == "position",
-                            "'position' when test_functions is set (use test_functions=None "
-                            "for the paper's equations)")
-            check_parameter(name, "wavelet_order", self.wavelet_order,
-                            isinstance(self.wavelet_order, int | np.integer)
-                            and self.wavelet_order >= 3,
-                            "an integer >= 3 when test_functions is set")
-        check_parameter(name, "pair_selection", self.pair_selection,
-                        self.pair_selection in PAIR_SELECTIONS, f"one of {PAIR_SELECTIONS}")
+        super()._validate_params()
+        owner, params = type(self).__name__, self.get_params()
+        if self.test_functions is None:  # the point equations have no interval constants
+            validate_parameters({"friction": [Options(("free",))]}, params, owner,
+                                condition="test_functions is None")
+        else:
+            validate_parameters({"wavelet": [Options(("polynomial",))],
+                                 "variant": [Options(("position",))],
+                                 "wavelet_order": [Interval(Integral, 3, None)]}, params, owner,
+                                condition="test_functions is set (use test_functions=None "
+                                          "for the paper's equations or the Mexican hat)")
         make_wavelet(self.wavelet, **self._wavelet_options())
 
     def _wavelet_options(self) -> dict:
