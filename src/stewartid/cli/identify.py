@@ -153,7 +153,7 @@ def identify(
 
     names = methods_for(method)
     accepted = {name for each in names
-                for name in method_spec(each).estimator_class._param_names()}
+                for name in method_spec(each).estimator_class.param_names()}
     options = {"--no-gravity": ("gravity", not no_gravity, no_gravity),
                "--symmetric": ("symmetric", symmetric, symmetric),
                "--frequency": ("frequency_hz", frequency or None, bool(frequency)),

@@ -169,7 +169,7 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
     from stewartid.identification.registry import create_identifier, method_spec
 
     spec = method_spec(name)
-    accepted = spec.estimator_class._param_names()
+    accepted = spec.estimator_class.param_names()
     own = {k: v for k, v in settings.items() if k in accepted}
     start = time.perf_counter()
     try:
