@@ -90,26 +90,6 @@ class MethodRun:
     seconds: float = 0.0
 
     @property
-    def M(self) -> np.ndarray:
-        """Identified inertial matrix, shape (6, 6)."""
-        return self.result.M
-
-    @property
-    def B(self) -> np.ndarray:
-        """Identified viscous matrix, shape (6, 6)."""
-        return self.result.B
-
-    @property
-    def std_errors_M(self) -> np.ndarray:
-        """Standard errors of ``M``, shape (6, 6)."""
-        return self.result.std_errors_M
-
-    @property
-    def std_errors_B(self) -> np.ndarray:
-        """Standard errors of ``B``, shape (6, 6)."""
-        return self.result.std_errors_B
-
-    @property
     def diagnostics(self) -> dict[str, Any]:
         """The run's ``diagnostics`` in ``results.json``: condition number, RMS residual per
         equation, the method's settings and its own diagnostics (``details``), JSON-able."""
@@ -120,8 +100,8 @@ class MethodRun:
                 "details": to_jsonable(result.diagnostics)}
 
     def matrix(self, name: str) -> np.ndarray:
-        """``M`` or ``B`` by name."""
-        return self.M if name == "M" else self.B
+        """The identified ``M`` or ``B`` by name, shape (6, 6)."""
+        return self.result.M if name == "M" else self.result.B
 
     def value(self, key: EntryKey) -> float:
         """Identified value of one entry."""
@@ -131,7 +111,7 @@ class MethodRun:
     def std_error(self, key: EntryKey) -> float:
         """Standard error of one entry; NaN when the method gives none."""
         matrix, row, col = key
-        std = self.std_errors_M if matrix == "M" else self.std_errors_B
+        std = self.result.std_errors_M if matrix == "M" else self.result.std_errors_B
         return float(np.asarray(std)[row, col])
 
 

@@ -42,13 +42,13 @@ def run_record(results: ComparisonResults, run: MethodRun) -> dict[str, Any]:
             published[entry_label(key)] = {"value": entry.value, "eps": entry.eps}
     return {
         "method": run.method, "coulomb": run.coulomb,
-        "M": run.M.tolist(), "B": run.B.tolist(),
-        "std_errors_M": run.std_errors_M, "std_errors_B": run.std_errors_B,
+        "M": run.result.M.tolist(), "B": run.result.B.tolist(),
+        "std_errors_M": run.result.std_errors_M, "std_errors_B": run.result.std_errors_B,
         "eps": {entry_label(k): v for k, v in eps.items()},
         "max_eps": eps[worst], "max_eps_entry": entry_label(worst),
         "eps_all_entries": {
-            "M": relative_error_percent(run.M, results.nominal_M),
-            "B": relative_error_percent(run.B, results.nominal_B)},
+            "M": relative_error_percent(run.result.M, results.nominal_M),
+            "B": relative_error_percent(run.result.B, results.nominal_B)},
         "published": published or None,
         "seconds": run.seconds,
         "diagnostics": run.diagnostics,
