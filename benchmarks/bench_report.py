@@ -17,7 +17,8 @@ import time
 from pathlib import Path
 
 from stewartid.platform import load_platform
-from stewartid.reports.identification.report import methods_for, write_identification_report
+from stewartid.reports.identification.report import write_identification_report
+from stewartid.reports.identification.run import methods_for
 from stewartid.simulation import simulate_experiments
 from stewartid.simulation.sensors import reference_noise
 

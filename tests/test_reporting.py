@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from stewartid.files import write_text_atomic
+from stewartid.identification.result import IdentificationResult
 from stewartid.model.linearization import nominal_matrices
 from stewartid.reference.published import load_published
 from stewartid.reporting.comparison import ComparisonResults, MethodRun
@@ -43,18 +44,25 @@ def scaled(matrix: np.ndarray, entries: dict[tuple[int, int], float]) -> np.ndar
     return out
 
 
+def method_run(method: str, coulomb: float, M: np.ndarray, B: np.ndarray) -> MethodRun:
+    """A run of ``method`` that found ``M`` and ``B`` (no standard errors)."""
+    nan = np.full((6, 6), np.nan)
+    return MethodRun(method, coulomb, IdentificationResult(M, B, nan, nan, 1.0,
+                                                           np.zeros(6), method))
+
+
 @pytest.fixture(scope="module")
 def results(nominal):
     M0, B0 = nominal
     runs = (
         # Method B: 0.5 % on Mt(2,4) at 5 N·m, 0.8 % on Bt(1,1) at 30 N·m
-        MethodRun("wavelet", 5.0, scaled(M0, {(1, 3): 0.005}), B0.copy()),
-        MethodRun("wavelet", 30.0, M0.copy(), scaled(B0, {(0, 0): -0.008})),
+        method_run("wavelet", 5.0, scaled(M0, {(1, 3): 0.005}), B0.copy()),
+        method_run("wavelet", 30.0, M0.copy(), scaled(B0, {(0, 0): -0.008})),
         # Method A: accurate diagonal, biased Bt(3,3) and coupling at 5 N·m
-        MethodRun("fourier", 5.0, scaled(M0, {(0, 0): 0.001, (4, 0): -0.1}),
-                  scaled(B0, {(2, 2): 0.4})),
+        method_run("fourier", 5.0, scaled(M0, {(0, 0): 0.001, (4, 0): -0.1}),
+                   scaled(B0, {(2, 2): 0.4})),
         # ... and a run where the diagonal is the worst entry
-        MethodRun("fourier", 0.0, scaled(M0, {(3, 3): 0.05}), B0.copy()),
+        method_run("fourier", 0.0, scaled(M0, {(3, 3): 0.05}), B0.copy()),
     )
     return ComparisonResults(runs, M0, B0, load_published(), {"seed": 3, "quick": True})
 
@@ -107,8 +115,8 @@ def test_fourier_summary_checks_the_pattern_both_ways(results):
     # without Coulomb friction no pattern is claimed
     assert "pattern" not in at_zero and "5.00 % (Mt(4,4)" in at_zero
     diagonal_worst = ComparisonResults(
-        (MethodRun("fourier", 5.0, scaled(results.nominal_M, {(3, 3): 0.05}),
-                   results.nominal_B.copy()),), results.nominal_M, results.nominal_B,
+        (method_run("fourier", 5.0, scaled(results.nominal_M, {(3, 3): 0.05}),
+                    results.nominal_B.copy()),), results.nominal_M, results.nominal_B,
         results.published)
     assert "does not show" in fourier_summary(diagonal_worst)[0]
 

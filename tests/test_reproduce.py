@@ -120,7 +120,7 @@ def test_results_reload_and_tables_agree(quick_run):
     with open(out / "tables" / "table4.csv", newline="", encoding="utf-8") as stream:
         rows = list(csv.DictReader(stream))
     assert [row["Parameter"] for row in rows][:2] == ["Mt(1,1)", "Mt(2,2)"]
-    assert float(rows[0]["B: ours"]) == pytest.approx(run.M[0, 0])
+    assert float(rows[0]["B: ours"]) == pytest.approx(run.result.M[0, 0])
     assert float(rows[0]["B: paper"]) == 14242.0
 
 

@@ -156,6 +156,22 @@ def coulomb_levels(result: IdentificationResult) -> np.ndarray | None:
     return values if np.all(np.isfinite(values)) else None
 
 
+def coulomb_estimate(result: IdentificationResult) -> tuple[np.ndarray, np.ndarray]:
+    """Coulomb level and standard error per joint type (N m), NaN where not estimated.
+
+    Returns
+    -------
+    levels, std_errors : ndarray, shape (3,)
+        In the order of :data:`FRICTION_TYPES`.
+    """
+    nan = np.full(len(FRICTION_TYPES), np.nan)
+    levels = coulomb_levels(result)
+    if levels is None:
+        return nan, nan
+    std = result.diagnostics.get("coulomb_std") or {}
+    return levels, np.array([std.get(k, np.nan) for k in FRICTION_TYPES], dtype=float)
+
+
 def prepare_segment(dataset: Dataset, platform: Platform, window: float, *, gravity: bool,
                     experiment: int = 0, fold: int = 0,
                     coulomb_smoothing: float = 1e-4) -> Segment:
@@ -336,6 +352,6 @@ def in_sample(segments: Sequence[Segment], result: IdentificationResult) -> Vali
 
 
 __all__ = ["DEFAULT_FOLDS", "FRICTION_TYPES", "CrossValidation", "Segment", "ValidationResult",
-           "coulomb_levels", "cross_validate", "excitation_window", "fold_bounds",
+           "coulomb_estimate", "coulomb_levels", "cross_validate", "excitation_window", "fold_bounds",
            "friction_signature", "held_out_segments", "in_sample", "predict", "prepare_segment",
            "score"]

@@ -48,14 +48,15 @@ class BaseIdentifier:
     _parameter_constraints: ClassVar[dict[str, Sequence[Constraint | None]]] = {}
 
     @classmethod
-    def _param_names(cls) -> list[str]:
+    def param_names(cls) -> list[str]:
+        """Names of the settings ``__init__`` takes, in its order."""
         signature = inspect.signature(cls.__init__)
         return [name for name in signature.parameters if name != "self"]
 
     def get_params(self, deep: bool = True) -> dict[str, Any]:
         """Settings given to ``__init__`` (``deep`` is accepted for scikit-learn; identifiers
         hold no nested estimators)."""
-        return {name: getattr(self, name) for name in self._param_names()}
+        return {name: getattr(self, name) for name in self.param_names()}
 
     def set_params(self, **params: Any) -> BaseIdentifier:
         """Change settings; returns self.
@@ -65,7 +66,7 @@ class BaseIdentifier:
         ConfigError
             For a name that is not a setting of this identifier.
         """
-        valid = self._param_names()
+        valid = self.param_names()
         for key, value in params.items():
             if key not in valid:
                 raise ConfigError(f"{type(self).__name__} has no setting {key!r}; valid "

@@ -203,7 +203,7 @@ def create_identifier(name: str, **settings: Any) -> Any:
     """
     spec = method_spec(name)
     cls = spec.estimator_class
-    valid = cls._param_names()
+    valid = cls.param_names()
     unknown = [key for key in settings if key not in valid]
     if unknown:
         raise ConfigError(f"method {name!r} has no setting {unknown[0]!r}; its settings are "

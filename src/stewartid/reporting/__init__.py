@@ -7,11 +7,10 @@ tables beside the paper's published values), :mod:`~stewartid.reporting.figures`
 (matplotlib figures, PNG and SVG), :mod:`~stewartid.reporting.document` (``report.md`` and a
 self-contained ``report.html``) and :mod:`~stewartid.reporting.terminal` (rich tables).
 
-The report on a user's own measured experiments (``identify --report``):
-:mod:`~stewartid.reports.identification.report` (fits, validation, consistency, files),
-:mod:`~stewartid.assessment.validation` (held-out prediction, VAF and NRMSE),
-:mod:`~stewartid.reports.identification.text` (which method to trust, ``report.md``),
-:mod:`~stewartid.reports.identification.figures` and
-:mod:`~stewartid.reports.identification.method_figures` (its figures) and
-:mod:`~stewartid.reporting.exports` (CSV and MATLAB files).
+The two products built on these parts are :mod:`stewartid.reports.identification`
+(``identify --report``: the run in :mod:`~stewartid.reports.identification.run`, the report in
+:mod:`~stewartid.reports.identification.report`, its text and figures, and
+:mod:`~stewartid.reporting.exports` for the CSV and MATLAB files) and
+:mod:`stewartid.reports.reproduction` (``reproduce``). Held-out validation and the choice of
+the method to trust are in :mod:`stewartid.assessment`.
 """

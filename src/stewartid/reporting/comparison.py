@@ -14,7 +14,9 @@ from typing import Any
 
 import numpy as np
 
+from stewartid.files import to_jsonable
 from stewartid.identification.registry import MethodSpec, registered_methods
+from stewartid.identification.result import IdentificationResult
 from stewartid.reference.published import (
     PAPER_ENTRIES,
     EntryKey,
@@ -75,28 +77,31 @@ class MethodRun:
         Registered method name (:mod:`stewartid.identification.registry`).
     coulomb : float
         Coulomb friction of the simulated plant, N·m per joint axis.
-    M, B : ndarray, shape (6, 6)
-        Identified inertial and viscous matrices (paper frame, SI units).
-    std_errors_M, std_errors_B : ndarray, shape (6, 6), optional
-        Standard errors of the entries, when the method provides them.
+    result : IdentificationResult
+        What the method found: ``M``, ``B`` (6, 6, paper frame, SI units), their standard
+        errors (NaN where the method gives none), settings and diagnostics.
     seconds : float
         Wall time of the identification (s).
-    diagnostics : dict
-        JSON-able scalars (condition number, number of equations, ...).
     """
 
     method: str
     coulomb: float
-    M: np.ndarray
-    B: np.ndarray
-    std_errors_M: np.ndarray | None = None
-    std_errors_B: np.ndarray | None = None
+    result: IdentificationResult
     seconds: float = 0.0
-    diagnostics: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def diagnostics(self) -> dict[str, Any]:
+        """The run's ``diagnostics`` in ``results.json``: condition number, RMS residual per
+        equation, the method's settings and its own diagnostics (``details``), JSON-able."""
+        result = self.result
+        return {"condition_number": float(result.condition_number),
+                "residual_rms": np.asarray(result.residual_rms, dtype=float).tolist(),
+                "settings": to_jsonable(result.settings),
+                "details": to_jsonable(result.diagnostics)}
 
     def matrix(self, name: str) -> np.ndarray:
-        """``M`` or ``B`` by name."""
-        return self.M if name == "M" else self.B
+        """The identified ``M`` or ``B`` by name, shape (6, 6)."""
+        return self.result.M if name == "M" else self.result.B
 
     def value(self, key: EntryKey) -> float:
         """Identified value of one entry."""
@@ -106,8 +111,8 @@ class MethodRun:
     def std_error(self, key: EntryKey) -> float:
         """Standard error of one entry; NaN when the method gives none."""
         matrix, row, col = key
-        std = self.std_errors_M if matrix == "M" else self.std_errors_B
-        return float("nan") if std is None else float(np.asarray(std)[row, col])
+        std = self.result.std_errors_M if matrix == "M" else self.result.std_errors_B
+        return float(np.asarray(std)[row, col])
 
 
 @dataclass(frozen=True)

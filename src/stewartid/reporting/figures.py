@@ -80,7 +80,7 @@ class ExperimentTrace:
     forces: dict[str, np.ndarray] = field(default_factory=dict)
 
 
-def _styled(plot: Callable[..., list[Path]]) -> Callable[..., list[Path]]:
+def styled(plot: Callable[..., list[Path]]) -> Callable[..., list[Path]]:
     """Draw and save inside ``rc_context(STYLE)``: the caller's settings are untouched."""
 
     @functools.wraps(plot)
@@ -93,7 +93,7 @@ def _styled(plot: Callable[..., list[Path]]) -> Callable[..., list[Path]]:
     return wrapper
 
 
-def _figure(**options: Any) -> Any:
+def new_figure(**options: Any) -> Any:
     """A new :class:`matplotlib.figure.Figure` (not registered with pyplot)."""
     from matplotlib.figure import Figure
 
@@ -119,7 +119,7 @@ def save_figure(figure: Any, directory: str | Path, stem: str, dpi: int = 120,
     return paths
 
 
-def _every(t: np.ndarray, max_points: int = 4000) -> slice:
+def thinning_step(t: np.ndarray, max_points: int = 4000) -> slice:
     """Sample step that keeps at most about ``max_points`` points of a line: the figures show
     0.5 Hz motion, and thinner lines keep the SVG files small and fast to write."""
     return slice(None, None, max(1, int(np.ceil(len(t) / max_points))))
@@ -133,7 +133,7 @@ def _shade_intervals(axis: Any, intervals: np.ndarray | None, label: bool) -> No
                      label="constant-direction interval" if (label and k == 0) else None)
 
 
-@_styled
+@styled
 def plot_excitation(traces: Sequence[ExperimentTrace], directory: str | Path,
                     stem: str = "excitation") -> list[Path]:
     """Commanded and measured motion of the excited coordinate in each experiment, with the
@@ -141,12 +141,12 @@ def plot_excitation(traces: Sequence[ExperimentTrace], directory: str | Path,
     count = len(traces)
     columns = min(3, count)
     rows = int(np.ceil(count / columns))
-    figure = _figure(figsize=(4.6 * columns, 3.2 * rows), layout="constrained")
+    figure = new_figure(figsize=(4.6 * columns, 3.2 * rows), layout="constrained")
     axes = figure.subplots(rows, columns, squeeze=False)
     for axis, trace in zip(axes.flat, traces, strict=False):
         k = trace.excited
         unit, scale = _DISPLAY[k]
-        step = _every(trace.t)
+        step = thinning_step(trace.t)
         t = trace.t[step]
         measured = (trace.pose[step, k] - trace.neutral[k]) * scale
         axis.plot(t, measured, color="k", lw=1.2, label="measured")
@@ -174,16 +174,16 @@ def plot_excitation(traces: Sequence[ExperimentTrace], directory: str | Path,
     return save_figure(figure, directory, stem)
 
 
-@_styled
+@styled
 def plot_joint_rates(trace: ExperimentTrace, directory: str | Path,
                      stem: str = "joint_velocities") -> list[Path]:
     """Rates of the 30 rotational joint axes and the 6 actuators of one experiment, with the
     constant-direction intervals shaded."""
     if trace.joint_rates is None:
         raise ValueError(f"trace {trace.name!r} has no joint rates to plot")
-    figure = _figure(figsize=(9, 6), layout="constrained")
+    figure = new_figure(figsize=(9, 6), layout="constrained")
     top, bottom = figure.subplots(2, 1, sharex=True)
-    step = _every(trace.t)
+    step = thinning_step(trace.t)
     t = trace.t[step]
     rotational = trace.joint_rates[step, :30]
     from matplotlib import colormaps
@@ -211,7 +211,7 @@ def plot_joint_rates(trace: ExperimentTrace, directory: str | Path,
     return save_figure(figure, directory, stem)
 
 
-@_styled
+@styled
 def plot_force_budget(trace: ExperimentTrace, directory: str | Path,
                       channels: Sequence[int] | None = None,
                       stem: str = "force_budget") -> list[Path]:
@@ -220,12 +220,12 @@ def plot_force_budget(trace: ExperimentTrace, directory: str | Path,
     if channels is None:
         coupled = {0: 4, 1: 3, 2: 2, 3: 1, 4: 0, 5: 5}[trace.excited]
         channels = sorted({trace.excited, coupled})
-    figure = _figure(figsize=(9, 3.2 * len(channels)), layout="constrained")
+    figure = new_figure(figsize=(9, 3.2 * len(channels)), layout="constrained")
     axes = figure.subplots(len(channels), 1, sharex=True, squeeze=False)
     styles = {"inertial": ("#1f77b4", 1.4), "viscous": ("#ff7f0e", 1.4),
               "coulomb": ("#d62728", 1.4), "gravity": ("#9467bd", 1.4),
               "actuators": ("#b0b0b0", 0.6)}
-    step = _every(trace.t, 6000)
+    step = thinning_step(trace.t, 6000)
     t = trace.t[step]
     for axis, channel in zip(axes[:, 0], channels, strict=True):
         big = max(np.max(np.abs(f[:, channel])) for f in trace.forces.values())
@@ -249,7 +249,7 @@ def plot_force_budget(trace: ExperimentTrace, directory: str | Path,
     return save_figure(figure, directory, stem)
 
 
-@_styled
+@styled
 def plot_scalogram(t: np.ndarray, signal: np.ndarray, points: np.ndarray,
                    directory: str | Path, wavelet: Any = "mexican_hat",
                    signal_label: str = "signal", intervals: np.ndarray | None = None,
@@ -293,7 +293,7 @@ def plot_scalogram(t: np.ndarray, signal: np.ndarray, points: np.ndarray,
     inside = ((grid_b - mother.half_width * grid_a >= t[0])
               & (grid_b + mother.half_width * grid_a <= t[-1]))
     magnitude = np.where(inside, magnitude, np.nan)
-    figure = _figure(figsize=(9, 4.2), layout="constrained")
+    figure = new_figure(figsize=(9, 4.2), layout="constrained")
     axis = figure.subplots()
     mesh = axis.pcolormesh(shifts, scales, magnitude, shading="auto", cmap="magma",
                            rasterized=True)
@@ -332,13 +332,13 @@ def _grouped_bars(axis: Any, labels: Sequence[str], series: Sequence[tuple[str, 
         axis.set_yscale("log")
 
 
-@_styled
+@styled
 def plot_errors(results: ComparisonResults, directory: str | Path,
                 stem: str = "errors") -> list[Path]:
     """ε (%) per entry, every method against the others and against the paper's published ε,
     one panel per Coulomb level (log scale)."""
     levels = results.coulomb_levels
-    figure = _figure(figsize=(14, 3.6 * len(levels)), layout="constrained")
+    figure = new_figure(figsize=(14, 3.6 * len(levels)), layout="constrained")
     axes = figure.subplots(len(levels), 1, squeeze=False)
     labels = [entry_label(k) for k in PAPER_ENTRIES]
     floor = 1e-3  # ε below this (%) is drawn at the floor so the log axis stays readable
@@ -366,12 +366,12 @@ def plot_errors(results: ComparisonResults, directory: str | Path,
     return save_figure(figure, directory, stem)
 
 
-@_styled
+@styled
 def plot_identified_vs_nominal(results: ComparisonResults, coulomb: float,
                                directory: str | Path, stem: str | None = None) -> list[Path]:
     """Identified value divided by nominal, per entry and method, at one Coulomb level; the
     nominal values are printed under the entry names (1 = exact)."""
-    figure = _figure(figsize=(13, 4.6), layout="constrained")
+    figure = new_figure(figsize=(13, 4.6), layout="constrained")
     axes = figure.subplots(1, 2)
     for axis, matrix in zip(axes, ("M", "B"), strict=True):
         keys = [k for k in PAPER_ENTRIES if k[0] == matrix]
@@ -410,6 +410,7 @@ __all__ = [
     "FORCE_COMPONENTS",
     "STYLE",
     "ExperimentTrace",
+    "new_figure",
     "plot_errors",
     "plot_excitation",
     "plot_force_budget",
@@ -417,4 +418,6 @@ __all__ = [
     "plot_joint_rates",
     "plot_scalogram",
     "save_figure",
+    "styled",
+    "thinning_step",
 ]

@@ -1,22 +1,26 @@
-"""The figures of the identification report (:mod:`.user_report`), in report order.
+"""The figures of the identification report (:mod:`.report`), in report order.
 
-The drawing itself is :mod:`.identification_figures` and :mod:`.figures`; this module decides
-what is drawn, with which data and caption.
+The drawing itself is :mod:`.method_figures` and :mod:`stewartid.reporting.figures`; this
+module decides what is drawn, with which data and caption.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from stewartid.datasets.dataset import Dataset
+from stewartid.identification.preparation import prepare
+from stewartid.identification.wavelet.intervals import joint_rates
 from stewartid.platform import Platform
-
-if TYPE_CHECKING:
-    from stewartid.reports.identification.report import MethodReport
+from stewartid.reporting.figures import ExperimentTrace, plot_excitation, plot_joint_rates
+from stewartid.reports.identification import method_figures as plots
+from stewartid.reports.identification.records import MethodReport
+from stewartid.reports.identification.text import used_intervals
+from stewartid.signals.differentiation import differentiate
 
 
 class FigureDrawer:
@@ -42,9 +46,6 @@ class FigureDrawer:
 def data_figures(drawer: FigureDrawer, datasets: Sequence[Dataset], platform: Platform,
                  rows: Sequence[dict[str, Any]]) -> None:
     """The figures of the data alone: excitation and spectrum."""
-    from stewartid.reporting.figures import ExperimentTrace, plot_excitation
-    from stewartid.reports.identification import method_figures as plots
-
     neutral = np.asarray(platform.neutral_pose, dtype=float)
     traces = [ExperimentTrace(name=d.name, excited=row["excited"], t=d.t, pose=d.pose,
                               neutral=neutral) for d, row in zip(datasets, rows, strict=True)]
@@ -62,13 +63,6 @@ def result_figures(drawer: FigureDrawer, runs: Sequence[MethodReport],
                    rows: Sequence[dict[str, Any]]) -> None:
     """The figures of the identification: intervals, matrices, residuals, validation, the
     comparison of methods and friction."""
-    from stewartid.identification.preparation import prepare
-    from stewartid.identification.wavelet.intervals import joint_rates
-    from stewartid.reporting.figures import ExperimentTrace, plot_joint_rates
-    from stewartid.reports.identification import method_figures as plots
-    from stewartid.reports.identification.text import used_intervals
-    from stewartid.signals.differentiation import differentiate
-
     ok = [run for run in runs if run.result is not None]
     best = next(run for run in ok if run.name == trusted)
     frequencies = [row["frequency_hz"] for row in rows]

@@ -16,7 +16,7 @@ import numpy as np
 
 from stewartid.assessment.validation import FRICTION_TYPES, ValidationResult
 from stewartid.platform import COORDINATES
-from stewartid.reporting.figures import _every, _figure, _styled, save_figure
+from stewartid.reporting.figures import new_figure, save_figure, styled, thinning_step
 
 #: Display unit and scale of a displacement in each coordinate.
 DISPLACEMENT_UNITS = (("mm", 1e3),) * 3 + (("mrad", 1e3),) * 3
@@ -48,7 +48,7 @@ def _log_floor(axis, values: np.ndarray, decades: float | None = 5.0) -> None:
     axis.yaxis.set_minor_locator(NullLocator())
 
 
-@_styled
+@styled
 def plot_spectra(names: Sequence[str], poses: Sequence[np.ndarray], sample_rates: Sequence[float],
                  frequencies_hz: Sequence[float], directory: str | Path,
                  stem: str = "spectrum") -> list[Path]:
@@ -64,7 +64,7 @@ def plot_spectra(names: Sequence[str], poses: Sequence[np.ndarray], sample_rates
     frequencies_hz : sequence of float
         Dominant excitation frequency of each experiment (Hz), marked and used for the range.
     """
-    figure = _figure(figsize=(13, 3.3 * int(np.ceil(len(names) / 3)) + 0.6))
+    figure = new_figure(figsize=(13, 3.3 * int(np.ceil(len(names) / 3)) + 0.6))
     axes = _grid(figure, len(names))
     colours = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b"]
     for axis, name, q, rate, f0 in zip(axes.flat, names, poses, sample_rates, frequencies_hz,
@@ -88,7 +88,7 @@ def plot_spectra(names: Sequence[str], poses: Sequence[np.ndarray], sample_rates
     return save_figure(figure, directory, stem, tight=False)
 
 
-@_styled
+@styled
 def plot_intervals(names: Sequence[str], spans: Sequence[tuple[float, float]],
                    intervals: Sequence[np.ndarray], points: Sequence[np.ndarray | None],
                    directory: str | Path, stem: str = "intervals") -> list[Path]:
@@ -107,7 +107,7 @@ def plot_intervals(names: Sequence[str], spans: Sequence[tuple[float, float]],
         (a, b) pairs (s, s).
     """
     height = 0.55 * len(names) + 1.6
-    figure = _figure(figsize=(11, height))
+    figure = new_figure(figsize=(11, height))
     axis = figure.subplots(gridspec_kw={"left": 0.1, "right": 0.98, "bottom": 0.9 / height,
                                         "top": 1 - 0.7 / height})
     for row, (span, found, used) in enumerate(zip(spans, intervals, points, strict=True)):
@@ -137,7 +137,7 @@ def _significant(nominal: np.ndarray) -> list[tuple[int, int]]:
             if scale > 0 and abs(nominal[i, j]) > 1e-6 * scale]
 
 
-@_styled
+@styled
 def plot_matrices(estimates: Mapping[str, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]],
                   colours: Mapping[str, str], M_nominal: np.ndarray, B_nominal: np.ndarray,
                   directory: str | Path, stem: str = "matrices") -> list[Path]:
@@ -150,7 +150,7 @@ def plot_matrices(estimates: Mapping[str, tuple[np.ndarray, np.ndarray, np.ndarr
     colours : mapping of label to colour
     M_nominal, B_nominal : ndarray, shape (6, 6)
     """
-    figure = _figure(figsize=(13, 7.5))
+    figure = new_figure(figsize=(13, 7.5))
     axes = figure.subplots(2, 1, gridspec_kw={"left": 0.07, "right": 0.98, "bottom": 0.1,
                                               "top": 0.95, "hspace": 0.45})
     width = 0.8 / max(len(estimates), 1)
@@ -183,17 +183,17 @@ def _concatenated(validation: ValidationResult, values: Sequence[np.ndarray]):
     return np.concatenate(times), np.concatenate(values)
 
 
-@_styled
+@styled
 def plot_residuals(validation: ValidationResult, frequencies_hz: Sequence[float],
                    directory: str | Path, stem: str = "residuals") -> list[Path]:
     """Residual of every equation over time (all experiments end to end) and its amplitude
     spectrum, with the excitation frequencies and their harmonics marked."""
     residual = [m - p for m, p in zip(validation.measured, validation.predicted, strict=True)]
     t, values = _concatenated(validation, residual)
-    figure = _figure(figsize=(13, 12))
+    figure = new_figure(figsize=(13, 12))
     axes = _grid(figure, 12, columns=2, top=0.95, bottom=0.05, hspace=0.35, wspace=0.2,
                  width_ratios=[2.2, 1])
-    step = _every(t, 6000)
+    step = thinning_step(t, 6000)
     rate = 1.0 / (validation.segments[0].t[1] - validation.segments[0].t[0])
     top = 10 * max(frequencies_hz)
     for c in range(6):
@@ -219,7 +219,7 @@ def plot_residuals(validation: ValidationResult, frequencies_hz: Sequence[float]
     return save_figure(figure, directory, stem, tight=False)
 
 
-@_styled
+@styled
 def plot_validation(validations: Mapping[str, ValidationResult], colours: Mapping[str, str],
                     directory: str | Path, stem: str = "validation") -> list[Path]:
     """Measured versus predicted generalized force on held-out segments: per DOF, every
@@ -232,7 +232,7 @@ def plot_validation(validations: Mapping[str, ValidationResult], colours: Mappin
     colours : mapping of label to colour
     """
     first = next(iter(validations.values()))
-    figure = _figure(figsize=(13, 9))
+    figure = new_figure(figsize=(13, 9))
     axes = _grid(figure, 6, top=0.91)
     styles = ["-", "--", "-.", ":"]
     for c, axis in enumerate(axes.flat[:6]):
@@ -244,7 +244,7 @@ def plot_validation(validations: Mapping[str, ValidationResult], colours: Mappin
         picks = [k for k, s in enumerate(first.segments) if s.experiment == chosen]
         for n, k in enumerate(picks):
             segment = first.segments[k]
-            step = _every(segment.t, 1500)
+            step = thinning_step(segment.t, 1500)
             axis.plot(segment.t[step], first.measured[k][step, c], color="#999999", lw=2.2,
                       label="measured" if n == 0 else None)
             for m, (label, validation) in enumerate(validations.items()):
@@ -261,11 +261,11 @@ def plot_validation(validations: Mapping[str, ValidationResult], colours: Mappin
     return save_figure(figure, directory, stem, tight=False)
 
 
-@_styled
+@styled
 def plot_unexplained(vaf: Mapping[str, np.ndarray], colours: Mapping[str, str],
                      directory: str | Path, stem: str = "methods") -> list[Path]:
     """Held-out unexplained force, 100 − VAF (%), per DOF and method (log scale)."""
-    figure = _figure(figsize=(9, 4))
+    figure = new_figure(figsize=(9, 4))
     axis = figure.subplots(gridspec_kw={"left": 0.1, "right": 0.98, "bottom": 0.1,
                                         "top": 0.9})
     width = 0.8 / max(len(vaf), 1)
@@ -284,7 +284,7 @@ def plot_unexplained(vaf: Mapping[str, np.ndarray], colours: Mapping[str, str],
     return save_figure(figure, directory, stem, tight=False)
 
 
-@_styled
+@styled
 def plot_friction(levels: Mapping[str, tuple[np.ndarray, np.ndarray]],
                   colours: Mapping[str, str], nominal: float | None, directory: str | Path,
                   stem: str = "friction") -> list[Path]:
@@ -296,7 +296,7 @@ def plot_friction(levels: Mapping[str, tuple[np.ndarray, np.ndarray]],
     nominal : float or None
         The platform description's Coulomb level (N m per joint axis), drawn as a line.
     """
-    figure = _figure(figsize=(7, 3.6))
+    figure = new_figure(figsize=(7, 3.6))
     axis = figure.subplots(gridspec_kw={"left": 0.12, "right": 0.98, "bottom": 0.12,
                                         "top": 0.9})
     width = 0.8 / max(len(levels), 1)

@@ -1,5 +1,5 @@
-"""The text of the identification report (:mod:`.user_report`): data summary, which method
-to trust and why, and ``report.md``.
+"""The text of the identification report (:mod:`.report`): data summary, which method to
+trust and why (the :class:`~stewartid.assessment.verdict.Verdict` in words), and ``report.md``.
 
 Every statement is computed from the numbers of the run (no fixed verdicts): if a result
 changes, so does the sentence about it.
@@ -8,34 +8,29 @@ changes, so does the sentence about it.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from stewartid.assessment.validation import FRICTION_TYPES, friction_signature
+from stewartid.assessment.verdict import Verdict, relative_std, worst_dof
 from stewartid.datasets.dataset import Dataset
 from stewartid.identification.consistency import consistency_metrics, is_consistent
-from stewartid.identification.result import IdentificationResult
+from stewartid.identification.wavelet.noise import white_noise_covariance
 from stewartid.platform import COORDINATES, Platform
 from stewartid.reporting.tables import ResultTable, to_markdown
-
-if TYPE_CHECKING:
-    from stewartid.reports.identification.report import IdentificationReport, MethodReport
+from stewartid.reports.identification.records import IdentificationReport, MethodReport
+from stewartid.signals.differentiation import differentiate, estimate_frequency
 
 _UNITS = ("mm",) * 3 + ("mrad",) * 3
 #: Held-out VAF (%) in the worst DOF above which a model "predicts closely", "adequately".
 CLOSE_VAF, ADEQUATE_VAF = 99.0, 95.0
-#: A Coulomb level counts as present above this many standard errors.
-SIGNIFICANT = 3.0
 
 
 def data_rows(datasets: Sequence[Dataset], platform: Platform) -> list[dict[str, Any]]:
     """Per experiment: samples, duration (s), sample rate (Hz), dominant frequency (Hz), the
     most excited coordinate (rotations weighted by the upper joint radius), its amplitude
     (mm or mrad) and the noise estimated from the data: pose (um, urad) and leg forces (N)."""
-    from stewartid.identification.wavelet.noise import white_noise_covariance
-    from stewartid.signals.differentiation import differentiate, estimate_frequency
-
     rows = []
     lever = np.array([1.0] * 3 + [platform.geometry.upper_radius] * 3)
     for d in datasets:
@@ -85,38 +80,10 @@ def used_intervals(runs: Sequence[MethodReport], trusted: str, datasets: Sequenc
     return chosen.display_name, intervals, points
 
 
-def _worst(run: MethodReport) -> tuple[float, str]:
-    """Held-out VAF (%) of the worst DOF and its name."""
-    vaf = run.validation.vaf_percent
-    k = int(np.nanargmin(vaf))
-    return float(vaf[k]), COORDINATES[k]
-
-
-def _relative_std(result: IdentificationResult) -> float:
-    """Median relative standard error of the diagonals of Mt and Bt."""
-    values = np.concatenate([np.diag(result.std_errors_M) / np.abs(np.diag(result.M)),
-                             np.diag(result.std_errors_B) / np.abs(np.diag(result.B))])
-    return float(np.nanmedian(values))
-
-
-def _definite(result: IdentificationResult) -> bool:
-    """Symmetric part of Mt positive definite and of Bt positive semidefinite (what the
-    energy of the model needs; a small asymmetry is reported, not disqualifying)."""
-    metrics = consistency_metrics(result.M, result.B)
-    scale = float(np.abs(result.B).max())
-    return bool(metrics["M_min_eigenvalue"] > 0
-                and metrics["B_min_eigenvalue"] >= -1e-9 * scale)
-
-
 def _changed(projection: Any) -> str:
     """The largest change of the consistent fit, in standard errors, for a sentence."""
     change = projection.max_change
     return "less than 0.001" if change < 1e-3 else f"{change:.3g}"
-
-
-def _friction_found(run: MethodReport) -> bool:
-    levels, std = run.coulomb
-    return bool(np.any(np.isfinite(levels) & (levels > SIGNIFICANT * np.nan_to_num(std))))
 
 
 def _friction_text(run: MethodReport) -> str:
@@ -137,7 +104,7 @@ def _quality(vaf: float) -> str:
 def method_lines(run: MethodReport) -> list[str]:
     """What to know about one method's result, one Markdown sentence group each."""
     result = run.result
-    vaf, dof = _worst(run)
+    vaf, dof = worst_dof(run.validation)
     lines = [f"**{run.display_name}** {_quality(vaf)}: VAF ≥ {vaf:.2f} % in every DOF "
              f"(worst {dof}) over {run.validation.folds} folds."]
     metrics = consistency_metrics(result.M, result.B)
@@ -157,7 +124,7 @@ def method_lines(run: MethodReport) -> list[str]:
                      f"{np.min(run.validation_unconstrained.vaf_percent):.3f} % → "
                      f"{np.min(run.validation.vaf_percent):.3f} %.")
     lines.append(f"Median relative standard error of the diagonal entries: "
-                 f"{100 * _relative_std(result):.2g} %.")
+                 f"{100 * relative_std(result):.2g} %.")
     if np.all(np.isfinite(run.coulomb[0])):
         lines.append(f"Coulomb friction: {_friction_text(run)}.")
     else:
@@ -168,72 +135,47 @@ def method_lines(run: MethodReport) -> list[str]:
     return lines
 
 
-def choose_trusted(runs: Sequence[MethodReport], nominal: tuple[np.ndarray, np.ndarray]
-                   ) -> tuple[str, list[str]]:
-    """Which method to trust on these data, and why, in plain language.
-
-    Rule: among the methods whose matrices are physically plausible (symmetric parts of Mt
-    positive definite and of Bt positive semidefinite; all methods, if none is), the one whose
-    worst DOF leaves the least force unexplained on held-out data; methods within
-    25 % of that are tied and the one with the smaller median relative standard error wins.
-    The reasons name what set the others back: failure, inconsistency, friction pulled into
-    Bt or left in the residuals.
-
-    Returns
-    -------
-    name : str
-    lines : list of str
-        Markdown sentences.
-    """
+def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
+    """The verdict in plain language, Markdown sentences: for one applicable method what to
+    know about it (:func:`method_lines`), for several which to trust and what set the others
+    back."""
     ok = [run for run in runs if run.result is not None]
     if len(ok) == 1:
-        return ok[0].name, method_lines(ok[0])
-
-    def unexplained(run: MethodReport) -> float:
-        return 100.0 - _worst(run)[0]
-
-    pool = [run for run in ok if _definite(run.result)] or ok
-    floor = min(unexplained(run) for run in pool)
-    tied = [run for run in pool if unexplained(run) <= 1.25 * floor + 1e-12]
-    best = min(tied, key=lambda run: _relative_std(run.result))
-    vaf, dof = _worst(best)
+        return method_lines(ok[0])
+    best = next(run for run in ok if run.name == verdict.trusted)
+    trusted = verdict.standings[best.name]
     lines = [f"**Trust {best.display_name} on these data.** On held-out segments it leaves "
-             f"{100 - vaf:.3g} % of the force unexplained in its worst DOF ({dof}), the least "
-             "of the physically plausible methods" + (" (tied methods: the smaller standard "
-                                                        "errors decide)." if len(tied) > 1
-                                                        else ".")]
-    friction_models = [run for run in ok if _friction_found(run)]
-    if friction_models:
-        lines.append(f"Coulomb friction is present: {friction_models[0].display_name} finds "
-                     f"{_friction_text(friction_models[0])}.")
-    reference_B = np.diag(best.result.B)
+             f"{trusted.unexplained_percent:.3g} % of the force unexplained in its worst DOF "
+             f"({trusted.worst_dof}), the least of the physically plausible methods"
+             + (" (tied methods: the smaller standard errors decide)." if len(verdict.tied) > 1
+                else ".")]
+    if verdict.friction_source is not None:
+        source = next(run for run in ok if run.name == verdict.friction_source)
+        lines.append(f"Coulomb friction is present: {source.display_name} finds "
+                     f"{_friction_text(source)}.")
     for run in ok:
         if run is best:
             continue
-        worst, where = _worst(run)
-        ratio = (100 - worst) / max(100 - vaf, 1e-12)
-        text = (f"{run.display_name} leaves {100 - worst:.3g} % unexplained in its worst DOF "
-                f"({where}), {ratio:.3g}× as much")
-        if run not in pool:
+        standing = verdict.standings[run.name]
+        text = (f"{run.display_name} leaves {standing.unexplained_percent:.3g} % unexplained in "
+                f"its worst DOF ({standing.worst_dof}), {standing.unexplained_ratio:.3g}× as much")
+        if not standing.compared:
             text += ("; its Mt or Bt has a negative eigenvalue, which no physical "
                      "platform has")
-        if friction_models and not np.all(np.isfinite(run.coulomb[0])):
-            excess = float(np.mean(np.diag(run.result.B) / reference_B) - 1.0)
-            share = friction_signature(run.validation)
-            if excess > 0.05:
-                text += (f"; it does not model Coulomb friction, and its Bt diagonal is "
-                         f"{100 * excess:.0f} % above that of {best.display_name}: the "
-                         "friction's first harmonic is read as viscous damping, which pulls "
-                         "Bt up")
-            else:
-                text += ("; it does not model Coulomb friction, which stays in its residuals "
-                         f"({100 * share:.0f} % of its held-out residual has the shape of "
-                         "Coulomb friction)")
+        if standing.friction_effect == "damping":
+            text += (f"; it does not model Coulomb friction, and its Bt diagonal is "
+                     f"{100 * standing.damping_excess:.0f} % above that of {best.display_name}: "
+                     "the friction's first harmonic is read as viscous damping, which pulls "
+                     "Bt up")
+        elif standing.friction_effect == "residuals":
+            text += ("; it does not model Coulomb friction, which stays in its residuals "
+                     f"({100 * standing.friction_share:.0f} % of its held-out residual has the "
+                     "shape of Coulomb friction)")
         lines.append(text + ".")
     for run in runs:
         if run.result is None:
             lines.append(f"{run.display_name} could not be applied to these data: {run.error}")
-    return best.name, lines
+    return lines
 
 
 def _number(value: float) -> str:
@@ -296,7 +238,8 @@ def render_report(report: IdentificationReport, datasets: Sequence[Dataset],
              + f" (stewartid {__version__}, {seconds:.1f} s).", ""]
     if sources:
         lines += ["Data: " + ", ".join(f"`{s}`" for s in sources) + ".", ""]
-    lines += ["## Summary", ""] + [f"- {line}" for line in report.verdict] + [""]
+    verdict = [f"- {line}" for line in verdict_lines(report.verdict, report.runs)]
+    lines += ["## Summary", "", *verdict, ""]
     lines += ["## Data", ""] + _data_section(rows)
     lines += _figure(figures, "excitation") + _figure(figures, "spectrum")
     lines += ["## Joint rates and constant-direction intervals", ""]
@@ -342,7 +285,7 @@ def render_report(report: IdentificationReport, datasets: Sequence[Dataset],
                          "residual has the shape of Coulomb friction.")
     lines += [""] + _figure(figures, "friction")
     if several:
-        lines += ["## Methods compared", ""] + [f"- {line}" for line in report.verdict] + [""]
+        lines += ["## Methods compared", "", *verdict, ""]
         lines += _figure(figures, "methods")
     lines += _files_section(report)
     return "\n".join(lines).rstrip() + "\n"
@@ -422,5 +365,5 @@ def _files_section(report: IdentificationReport) -> list[str]:
     return lines + [""]
 
 
-__all__ = ["choose_trusted", "data_rows", "matrix_table", "method_lines", "render_report",
-           "used_intervals"]
+__all__ = ["data_rows", "matrix_table", "method_lines", "render_report", "used_intervals",
+           "verdict_lines"]

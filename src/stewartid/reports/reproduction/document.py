@@ -17,6 +17,7 @@ import numpy as np
 
 from stewartid.errors import DataError
 from stewartid.files import to_jsonable
+from stewartid.identification.result import IdentificationResult
 from stewartid.reference.published import (
     PAPER_ENTRIES,
     entry_label,
@@ -41,13 +42,13 @@ def run_record(results: ComparisonResults, run: MethodRun) -> dict[str, Any]:
             published[entry_label(key)] = {"value": entry.value, "eps": entry.eps}
     return {
         "method": run.method, "coulomb": run.coulomb,
-        "M": run.M.tolist(), "B": run.B.tolist(),
-        "std_errors_M": run.std_errors_M, "std_errors_B": run.std_errors_B,
+        "M": run.result.M.tolist(), "B": run.result.B.tolist(),
+        "std_errors_M": run.result.std_errors_M, "std_errors_B": run.result.std_errors_B,
         "eps": {entry_label(k): v for k, v in eps.items()},
         "max_eps": eps[worst], "max_eps_entry": entry_label(worst),
         "eps_all_entries": {
-            "M": relative_error_percent(run.M, results.nominal_M),
-            "B": relative_error_percent(run.B, results.nominal_B)},
+            "M": relative_error_percent(run.result.M, results.nominal_M),
+            "B": relative_error_percent(run.result.B, results.nominal_B)},
         "published": published or None,
         "seconds": run.seconds,
         "diagnostics": run.diagnostics,
@@ -77,21 +78,26 @@ def results_document(results: ComparisonResults, runtime_s: float,
     })
 
 
+def _method_run(item: dict[str, Any]) -> MethodRun:
+    """A :class:`MethodRun` from its :func:`run_record` (the inverse, for what it keeps)."""
+    method = LEGACY_METHOD_NAMES.get(item["method"], str(item["method"]))
+    diagnostics = dict(item.get("diagnostics", {}))
+    result = IdentificationResult.from_dict({
+        **{key: item.get(key) for key in ("M", "B", "std_errors_M", "std_errors_B")},
+        "condition_number": diagnostics.get("condition_number"),
+        "residual_rms": diagnostics.get("residual_rms"), "method": method,
+        "settings": diagnostics.get("settings", {}),
+        "diagnostics": diagnostics.get("details", {})})
+    return MethodRun(method=method, coulomb=float(item["coulomb"]), result=result,
+                     seconds=float(item.get("seconds", 0.0)))
+
+
 def load_results(path: str | Path) -> ComparisonResults:
     """Rebuild the :class:`ComparisonResults` of a run from its ``results.json``."""
     path = Path(path)
     try:
         document = json.loads(path.read_text(encoding="utf-8"))
-        runs = tuple(MethodRun(
-            method=LEGACY_METHOD_NAMES.get(item["method"], str(item["method"])),
-            coulomb=float(item["coulomb"]),
-            M=np.asarray(item["M"], dtype=float), B=np.asarray(item["B"], dtype=float),
-            std_errors_M=None if item.get("std_errors_M") is None
-            else np.asarray(item["std_errors_M"], dtype=float),
-            std_errors_B=None if item.get("std_errors_B") is None
-            else np.asarray(item["std_errors_B"], dtype=float),
-            seconds=float(item.get("seconds", 0.0)),
-            diagnostics=dict(item.get("diagnostics", {}))) for item in document["runs"])
+        runs = tuple(_method_run(item) for item in document["runs"])
         nominal_M = np.asarray(document["nominal"]["M"], dtype=float)
         nominal_B = np.asarray(document["nominal"]["B"], dtype=float)
     except (KeyError, TypeError, ValueError) as exc:

@@ -98,7 +98,7 @@ def _scalogram_arguments(results: ComparisonResults, level: float, trace: Any
     run = results.run("wavelet", level) or results.run("wavelet-paper", level)
     if run is None:
         return None
-    details = run.diagnostics.get("details", {})
+    details = run.result.diagnostics
     chosen = next((e for e in details.get("experiments") or []
                    if e.get("name") == trace.name), None)
     if chosen is None:

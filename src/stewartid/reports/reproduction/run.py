@@ -30,8 +30,6 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from stewartid.files import check_output_folder, to_jsonable, write_json_atomic
 from stewartid.platform import Platform, load_platform
 from stewartid.reference.published import load_published
@@ -103,16 +101,8 @@ def identify(method: str, coulomb: float, datasets: Sequence[Any], platform: Pla
     start = time.perf_counter()
     identifier = create_identifier(method).fit(list(datasets), platform)
     seconds = time.perf_counter() - start
-    result = identifier.result_
-    diagnostics = {"condition_number": float(result.condition_number),
-                   "residual_rms": np.asarray(result.residual_rms, dtype=float).tolist(),
-                   "settings": to_jsonable(result.settings),
-                   "details": to_jsonable(result.diagnostics)}
-    return MethodRun(method=method, coulomb=float(coulomb), M=np.array(result.M, dtype=float),
-                     B=np.array(result.B, dtype=float),
-                     std_errors_M=np.array(result.std_errors_M, dtype=float),
-                     std_errors_B=np.array(result.std_errors_B, dtype=float),
-                     seconds=seconds, diagnostics=diagnostics)
+    return MethodRun(method=method, coulomb=float(coulomb), result=identifier.result_,
+                     seconds=seconds)
 
 
 # ---------------------------------------------------------------------------- orchestration

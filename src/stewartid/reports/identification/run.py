@@ -1,0 +1,245 @@
+"""One ``stewartid identify`` run: the experiments read, the method (or every method) fitted,
+the report and the result written.
+
+:func:`identify_files` is the whole command behind its flags; the command line only prints
+what it returns. Every output location is checked before anything is computed.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from stewartid.assessment.validation import DEFAULT_FOLDS
+from stewartid.datasets.dataset import expand_paths, read_datasets
+from stewartid.datasets.log_format import load_log_format
+from stewartid.datasets.meta import nominal_from_meta, platform_for_data
+from stewartid.datasets.plausibility import check_identified
+from stewartid.errors import ConfigError
+from stewartid.files import check_output_file, check_output_folder
+from stewartid.identification import registry
+from stewartid.identification.result import IdentificationResult, comparison_rows
+from stewartid.model.linearization import nominal_matrices
+from stewartid.platform import Platform
+from stewartid.reports.identification.records import IdentificationReport
+
+#: ``identify --method`` value that runs every registered method.
+ALL_METHODS = "all"
+#: Suffixes of data and description files, which a JSON result must not be named like.
+INPUT_SUFFIXES = (".csv", ".parquet", ".pq", ".toml")
+
+
+class FlagSetting(NamedTuple):
+    """The estimator setting a command-line flag sets.
+
+    Attributes
+    ----------
+    name : str
+        The setting (``"gravity"``, ``"frequency_hz"``, ...).
+    value : object
+        Its value from the flag.
+    given : bool
+        The flag was given (a setting given for a method without it is an error).
+    """
+
+    name: str
+    value: Any
+    given: bool
+
+
+@dataclass(frozen=True)
+class IdentifyRun:
+    """What :func:`identify_files` found and wrote.
+
+    Attributes
+    ----------
+    result : IdentificationResult
+        The trusted (or only) method's result.
+    report : IdentificationReport or None
+        With a report folder.
+    platform : Platform
+    experiments : int
+        Number of experiments identified.
+    nominal_M, nominal_B : ndarray, shape (6, 6)
+        The reference matrices: from a ``meta.json``/``truth.json`` beside the data, else the
+        platform description's at the neutral pose.
+    nominal_source : str
+        Where they come from.
+    """
+
+    result: IdentificationResult
+    report: IdentificationReport | None
+    platform: Platform
+    experiments: int
+    nominal_M: np.ndarray
+    nominal_B: np.ndarray
+    nominal_source: str
+
+    def comparison(self) -> list[dict[str, Any]]:
+        """The paper's 20 entries, identified against nominal
+        (:func:`~stewartid.identification.result.comparison_rows`)."""
+        result = self.result
+        return comparison_rows(result.M, result.B, self.nominal_M, self.nominal_B,
+                               result.std_errors_M, result.std_errors_B)
+
+
+def methods_for(name: str) -> tuple[str, ...]:
+    """The methods ``identify --method NAME`` runs: every registered method (presets aside)
+    for ``"all"``, else ``(NAME,)``.
+
+    Raises
+    ------
+    ConfigError
+        For an unknown name (the message lists the registered ones).
+    """
+    if name == ALL_METHODS:
+        return tuple(spec.name for spec in registry.registered_methods() if spec.preset_of is None)
+    return (registry.method_spec(name).name,)
+
+
+def settings_for(methods: Sequence[str], method: str, flags: Mapping[str, FlagSetting]
+                 ) -> dict[str, Any]:
+    """The settings the flags give the methods: those any of them has (``friction`` only when
+    given, so that a method's own default stays).
+
+    Raises
+    ------
+    ConfigError
+        A flag given for a method without its setting.
+    """
+    accepted = {name for each in methods for name in registry.method_spec(each).estimator_class.param_names()}
+    settings = {}
+    for flag, (name, value, given) in flags.items():
+        if name in accepted and (given or name != "friction"):
+            settings[name] = value
+        elif given:
+            raise ConfigError(f"{flag} does not apply to --method {method}; it has the "
+                              f"settings {', '.join(accepted)}.")
+    return settings
+
+
+def _is_result(path: Path) -> bool:
+    """True for a JSON file that ``identify --out`` wrote (overwritten without --force)."""
+    try:
+        document = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return False
+    return isinstance(document, dict) and {"M", "B", "method"} <= set(document)
+
+
+def _check_outputs(paths: Sequence[Path], inputs: Sequence[str | Path | None],
+                   out: Path | None, report: Path | None, force: bool, method: str,
+                   several: bool, folds: int | None) -> None:
+    """Refuse, before any computation, outputs that would overwrite the inputs or earlier
+    work, and options that need a report folder without one."""
+    if out is not None:
+        named = [*paths, *(p for p in inputs if p and Path(p).is_file())]
+        check_output_file(out, force, named, is_result=_is_result)
+        if out.suffix.lower() in INPUT_SUFFIXES:
+            raise ConfigError(f"--out {str(out)!r}: the result is JSON; give a .json file name.")
+    if report is not None:
+        inside = [p for p in paths if report.resolve() in p.resolve().parents]
+        if inside:
+            raise ConfigError(f"--report {str(report)!r} holds the input {str(inside[0])!r}; "
+                              "choose another folder for the report.")
+        check_output_folder(report, force)
+    elif several:
+        raise ConfigError(f"--method {method} compares the methods in a report; add "
+                          "--report DIR.")
+    elif folds is not None:
+        raise ConfigError("--folds sets the report's validation; add --report DIR.")
+
+
+def identify_files(files: Sequence[str | Path], method: str = "wavelet",
+                   platform: str | None = None, *, flags: Mapping[str, FlagSetting] | None = None,
+                   columns: str | None = None, out: Path | None = None, force: bool = False,
+                   report: Path | None = None, consistent: bool = False,
+                   folds: int | None = None) -> IdentifyRun:
+    """Identify Mt and Bt from experiment files, as ``stewartid identify`` does.
+
+    Parameters
+    ----------
+    files : sequence of str or Path
+        Data files (CSV/Parquet, one experiment each) or folders of them.
+    method : str
+        A registered method or preset, or ``"all"`` (needs ``report``).
+    platform : str, optional
+        ``"paper"`` or a platform TOML file; by default the one a ``meta.json`` beside the
+        data names (:func:`~stewartid.datasets.meta.platform_for_data`).
+    flags : mapping of str to FlagSetting, optional
+        Settings by the flag that gives them (named in the messages).
+    columns : str, optional
+        Column mapping of the logs (:func:`~stewartid.datasets.log_format.load_log_format`).
+    out : Path, optional
+        Write the result as JSON (an earlier result is overwritten; another file only with
+        ``force``).
+    force : bool
+    report : Path, optional
+        Write the identification report into this folder
+        (:func:`~stewartid.reports.identification.report.write_identification_report`).
+    consistent : bool
+        Replace Mt, Bt by the nearest consistent pair (needs the ``convex`` extra).
+    folds : int, optional
+        Validation folds of the report (default 3).
+
+    Returns
+    -------
+    IdentifyRun
+
+    Raises
+    ------
+    StewartidError
+        Bad options or outputs (before any computation), unreadable data, a method that
+        cannot be applied, or an implausible result
+        (:func:`~stewartid.datasets.plausibility.check_identified`).
+    """
+    names = methods_for(method)
+    settings = settings_for(names, method, flags or {})
+    paths = expand_paths(files)
+    description = platform_for_data(paths, platform)
+    _check_outputs(paths, (platform, columns), out, report, force, method, len(names) > 1,
+                   folds)
+    log_format = load_log_format(columns) if columns is not None else None
+    datasets = read_datasets(paths, description, log_format)
+    meta = nominal_from_meta(paths)
+
+    def check(found: IdentificationResult) -> None:
+        check_identified(found.M, found.B, description)
+
+    written = None
+    if report is not None or consistent:
+        from stewartid.identification.consistency import require_cvxpy
+        from stewartid.reports.identification.report import (
+            consistent_result,
+            write_identification_report,
+        )
+
+        if consistent:
+            require_cvxpy()
+    if report is not None:
+        written = write_identification_report(
+            datasets, description, report, names, settings, consistent,
+            DEFAULT_FOLDS if folds is None else folds, None if meta is None else meta[:2],
+            None if meta is None else meta[2], [str(p) for p in paths], check)
+        result = written.result
+    else:
+        result = registry.create_identifier(method, **settings).fit(datasets, description).result_
+        if consistent:
+            check(result)
+            result = consistent_result(result)[0]
+    check(result)
+    M_nominal, B_nominal = meta[:2] if meta is not None else nominal_matrices(description)
+    source = meta[2] if meta is not None else f"platform '{description.name}' at neutral"
+    if out is not None:
+        result.to_json(out)
+    return IdentifyRun(result, written, description, len(datasets), M_nominal, B_nominal,
+                       source)
+
+
+__all__ = ["ALL_METHODS", "INPUT_SUFFIXES", "FlagSetting", "IdentifyRun", "identify_files",
+           "methods_for", "settings_for"]
