@@ -32,6 +32,7 @@ from typing import Any
 
 from stewartid.errors import ConfigError, OutputExistsError
 from stewartid.files import write_json_atomic
+from stewartid.parallel import WORKER_THREADS
 from stewartid.studies.grid import StudyTask, expand_grid
 from stewartid.studies.results import RESULTS_NAME, finished_tasks, read_results, write_part
 from stewartid.studies.spec import StudySpec
@@ -125,14 +126,6 @@ def _check_folder(spec: StudySpec, directory: Path, resume: bool) -> None:
                           "they belong to this study. Use another folder.")
 
 
-def _worker_environment() -> dict[str, str]:
-    # the same one-thread limits as the process pool of ``reproduce``: parallelism is across
-    # processes, and multithreaded BLAS in every worker only oversubscribes the cores
-    from stewartid.reports.reproduction.run import _WORKER_THREADS
-
-    return dict(_WORKER_THREADS)
-
-
 @contextmanager
 def connect(scheduler: str | None = None, workers: int | None = None) -> Iterator[Any]:
     """A :class:`distributed.Client`: of the cluster at ``scheduler``, or of a new
@@ -163,11 +156,12 @@ def connect(scheduler: str | None = None, workers: int | None = None) -> Iterato
     count = (os.cpu_count() or 1) if workers is None else workers
     if count < 1:
         raise ConfigError(f"--workers must be >= 1; got {workers!r}.")
+    # one BLAS thread per worker, as in every process pool of the package (stewartid.parallel);
     # quiet workers: at shutdown their heartbeats to the closing scheduler log errors, and a
     # task's own failure reaches the client through its future anyway
     with LocalCluster(n_workers=count, threads_per_worker=1, processes=True,
                       dashboard_address=None, silence_logs=logging.CRITICAL,
-                      env=_worker_environment()) as cluster, Client(cluster) as client:
+                      env=dict(WORKER_THREADS)) as cluster, Client(cluster) as client:
         yield client
 
 
