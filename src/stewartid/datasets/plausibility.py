@@ -12,7 +12,7 @@ compare the data with what the platform description implies, where the two meet:
 Each failure is a :class:`~stewartid.errors.DataError` naming the likely cause and the fix;
 a mismatch a user may mean (a payload missing from the platform file, a constant leg-length
 calibration offset, an identified matrix a little off) is a
-:class:`~stewartid.datasets.dataset.DataWarning`. The thresholds below are the documented factors.
+:class:`~stewartid.errors.DataWarning`. The thresholds below are the documented factors.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ import warnings
 import numpy as np
 
 from stewartid.datasets.arrays import median
-from stewartid.errors import DataError
+from stewartid.errors import DataError, DataWarning
 from stewartid.platform import Platform
 
 #: Largest |rx|, |ry|, |rz| (rad) a hexapod reaches; larger values are angles in degrees.
@@ -56,8 +56,6 @@ _FLIP_Z_UP = np.array([1.0, -1.0, -1.0, 1.0, -1.0, -1.0])
 
 
 def _warn(message: str) -> None:
-    from stewartid.datasets.dataset import DataWarning
-
     warnings.warn(message, DataWarning, stacklevel=3)
 
 
