@@ -44,6 +44,7 @@ import numpy as np
 
 from stewartid.datasets.dataset import Dataset
 from stewartid.design.candidates import Design
+from stewartid.design.export import simulate_excitations
 from stewartid.errors import ConfigError
 from stewartid.identification.registry import create_identifier
 from stewartid.model.dynamics import inverse_dynamics
@@ -264,8 +265,6 @@ def measured_plant_datasets(platform: Platform, records: list, noise: SensorNois
 def plant_records(platform: Platform, design: Design) -> list:
     """The design played once on the plant without sensor noise: the true signals of every
     record (:class:`~stewartid.simulation.experiments.ExperimentRecord`)."""
-    from stewartid.design.export import simulate_excitations
-
     return list(simulate_excitations(platform, design.playable(platform), SensorNoise()).states)
 
 

@@ -16,10 +16,12 @@ from typing import Any
 
 import numpy as np
 
+import stewartid
 from stewartid.datasets.dataset import Dataset, write_dataset
 from stewartid.errors import ConfigError, StewartidError
 from stewartid.files import check_output_folder, write_json_atomic
 from stewartid.model.dynamics import COULOMB_SMOOTHING
+from stewartid.model.linearization import gravity_stiffness, nominal_matrices
 from stewartid.parallel import run_in_order
 from stewartid.platform import Platform
 from stewartid.simulation import plant
@@ -259,9 +261,6 @@ def simulate_experiments(platform: Platform, coulomb: float | None = None,
     -------
     SimulationResult
     """
-    import stewartid
-    from stewartid.model.linearization import gravity_stiffness, nominal_matrices
-
     updates: dict[str, Any] = {}
     if coulomb is not None:
         updates["friction__coulomb"] = float(coulomb)

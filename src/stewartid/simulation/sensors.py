@@ -14,6 +14,7 @@ import dataclasses
 import numpy as np
 
 from stewartid.errors import ConfigError
+from stewartid.model.dynamics import inverse_dynamics
 from stewartid.model.kinematics import forward_kinematics
 from stewartid.platform import Platform, Sensors
 
@@ -64,8 +65,6 @@ REFERENCE_FORCE_NOISE = 0.005
 
 def static_leg_force(platform: Platform) -> float:
     """Mean actuator force (N) holding the platform at rest at its neutral pose."""
-    from stewartid.model.dynamics import inverse_dynamics
-
     zero = np.zeros(6)
     return float(np.mean(np.abs(inverse_dynamics(platform, platform.neutral_pose, zero, zero))))
 

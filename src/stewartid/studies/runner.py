@@ -30,10 +30,13 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
 from stewartid.errors import ConfigError, OutputExistsError
 from stewartid.files import write_json_atomic
 from stewartid.parallel import WORKER_THREADS
 from stewartid.studies.grid import StudyTask, expand_grid
+from stewartid.studies.report import write_study_report
 from stewartid.studies.results import RESULTS_NAME, finished_tasks, read_results, write_part
 from stewartid.studies.spec import StudySpec
 from stewartid.studies.task import run_task
@@ -171,8 +174,6 @@ def _progress_display(enabled: bool, total: int) -> Iterator[ProgressCallback | 
     if not enabled:
         yield None
         return
-    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
-
     counts = TextColumn("{task.fields[done]} done, {task.fields[failed]} failed, "
                         "{task.fields[remaining]} remaining")
     with Progress(TextColumn("study"), BarColumn(), counts, TimeElapsedColumn()) as bar:
@@ -280,8 +281,6 @@ def run_study(spec: StudySpec, out: str | Path, *, scheduler: str | None = None,
     rows = read_results(directory, {task.key for task in tasks})
     files: list[Path] = []
     if report:
-        from stewartid.studies.report import write_study_report
-
         files = write_study_report(rows, spec, directory, total_tasks=len(tasks),
                                    failed_tasks=len(failures))
     return StudyRun(directory, spec, rows, computed, skipped, tuple(failures), files,
