@@ -22,7 +22,7 @@ from stewartid.errors import ConfigError, StewartidError
 from stewartid.files import check_output_folder, write_json_atomic
 from stewartid.model.dynamics import COULOMB_SMOOTHING
 from stewartid.model.linearization import gravity_stiffness, nominal_matrices
-from stewartid.parallel import run_in_order
+from stewartid.parallel import WORKERS_INHERIT, run_in_order, worker_count
 from stewartid.platform import Platform
 from stewartid.simulation import plant
 from stewartid.simulation.controller import command_tables, controller_parameters
@@ -332,6 +332,11 @@ def run_experiments(runs: Sequence[tuple], jobs: int | None = 1,
     """
     def finished(done: int, total: int, index: int) -> None:
         progress(done, total, runs[index][1].name)
+
+    if WORKERS_INHERIT and worker_count(jobs, len(runs)) > 1:
+        # load the compiled kernels here, once: the workers inherit them
+        platform, excitation, *_ = runs[0]
+        simulate_experiment(platform, excitation, 2.0 / platform.sensors.sample_rate)
 
     return run_in_order(_simulate_run, runs, jobs, finished if progress is not None else None)
 
