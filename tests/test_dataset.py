@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import io
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -9,12 +11,11 @@ import pytest
 from stewartid.datasets.dataset import (
     COLUMNS,
     Dataset,
-    DataWarning,
     read_dataset,
     read_datasets,
     write_dataset,
 )
-from stewartid.errors import DataError
+from stewartid.errors import DataError, DataWarning
 from stewartid.model.kinematics import leg_lengths
 
 
@@ -148,9 +149,9 @@ def test_frame_with_extra_columns_is_accepted(tmp_path, dataset):
 
 
 @pytest.mark.parametrize("layout", ["written", "spaces, CRLF, quoted names, integers, BOM"])
-def test_plain_csv_reads_as_the_pandas_reader_does(tmp_path, dataset, layout):
-    """The pandas-free reader of plain files gives the pandas reader's columns, bit for bit."""
-    from stewartid.datasets.plain_csv import read_plain_csv
+def test_csv_reader_reads_as_the_pandas_reader_does(tmp_path, dataset, layout):
+    """The pyarrow reader of CSV logs gives the pandas reader's columns, bit for bit."""
+    from stewartid.datasets.columns import read_csv_columns
 
     path = write_dataset(dataset, tmp_path / "run.csv")
     if layout != "written":
@@ -160,7 +161,7 @@ def test_plain_csv_reads_as_the_pandas_reader_does(tmp_path, dataset, layout):
                                     lineterminator="\r\n").split("\r\n", 1)
         header = ",".join(f'"{name}"' for name in header.split(","))
         path.write_bytes(b"\xef\xbb\xbf" + (header + "\r\n" + body.replace(",", ", ")).encode())
-    columns = read_plain_csv(path.read_text(encoding="utf-8-sig").encode())
+    columns = read_csv_columns(path.read_text(encoding="utf-8-sig"), "run.csv")
     frame = pd.read_csv(path, skipinitialspace=True, encoding="utf-8-sig")
     assert list(columns) == list(COLUMNS)
     for name in COLUMNS:
@@ -170,17 +171,26 @@ def test_plain_csv_reads_as_the_pandas_reader_does(tmp_path, dataset, layout):
                                                             "f6"]].to_numpy())
 
 
-def test_plain_csv_leaves_other_files_to_the_pandas_reader(tmp_path, dataset):
-    from stewartid.datasets.plain_csv import read_plain_csv
+def test_csv_reader_names_and_values_as_pandas(tmp_path, dataset):
+    """Missing values, text, infinities and column names read as the pandas reader reads
+    them; a ragged row is an error naming the file."""
+    from stewartid.datasets.columns import read_csv_columns
 
     frame = dataset.to_frame()
     cases = {"missing value": frame.assign(f2=frame["f2"].where(frame.index != 5)),
              "text": frame.assign(comment="x"), "infinity": frame.assign(f1=np.inf)}
     for case, table in cases.items():
-        assert read_plain_csv(table.to_csv(index=False).encode()) is None, case
-    assert read_plain_csv(b"t,t\n1,2\n") is None
-    assert read_plain_csv(b't, "x"\n1,2\n') is None  # pandas strips the space, then the quotes
-    assert read_plain_csv(b"t,x\n1,2\n3\n") is None
+        text = table.to_csv(index=False)
+        columns = read_csv_columns(text, case)
+        expected = pd.read_csv(io.StringIO(text), skipinitialspace=True)
+        assert list(columns) == list(expected.columns), case
+        for name in expected.columns:
+            assert np.array_equal(columns[name], expected[name].to_numpy(),
+                                  equal_nan=name != "comment"), (case, name)
+    assert list(read_csv_columns("t,t\n1,2\n", "x")) == ["t", "t.1"]
+    assert list(read_csv_columns('t, "x",\n1,2,3\n', "x")) == ["t", "x", "Unnamed: 2"]
+    with pytest.raises(DataError, match="ragged.csv: cannot be read as csv"):
+        read_csv_columns("t,x\n1,2\n3,4,5\n", "ragged.csv")
 
 
 def test_median_equals_numpys_to_the_last_bit():

@@ -15,8 +15,8 @@ from typer.testing import CliRunner
 
 from linear_model_data import make_experiment, random_matrices
 from stewartid.cli import app
-from stewartid.datasets.dataset import DataWarning, dataset_from_frame, read_datasets, write_dataset
-from stewartid.errors import ConfigError
+from stewartid.datasets.dataset import dataset_from_frame, read_datasets, write_dataset
+from stewartid.errors import ConfigError, DataWarning
 from stewartid.fields import Interval, ListOf, field_spec
 from stewartid.platform import load_platform
 from stewartid.platform.description import SECTIONS

@@ -12,9 +12,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from stewartid.datasets.dataset import DataWarning, dataset_from_frame, read_dataset
+from stewartid.datasets.dataset import dataset_from_frame, read_dataset
 from stewartid.datasets.log_format import load_log_format, log_format_from_mapping
-from stewartid.errors import ConfigError, DataError
+from stewartid.errors import ConfigError, DataError, DataWarning
 
 DOCS = Path(__file__).parents[1] / "docs" / "logs.md"
 

@@ -213,7 +213,7 @@ def test_pose_noise_attenuation_is_compensated(paper):
 def test_an_experiment_without_intervals_is_never_silent():
     """An experiment that gives no usable interval warns; when it was the only one to move a
     DOF (its entries would rest on noise, with small standard errors) the fit is refused."""
-    from stewartid.datasets.dataset import DataWarning
+    from stewartid.errors import DataWarning
     from stewartid.identification.wavelet.detection import check_coverage
 
     motion = np.eye(6) * 0.01 + 1e-6                       # experiment k moves DOF k
@@ -260,7 +260,7 @@ def test_pose_noise_beyond_the_correction_is_not_silent(paper):
     """With 0.2 mm of pose noise on 10 mm motions the compensated normal matrix is no longer
     positive definite, the attenuation stays (Mt diagonal measured 85-99 % low) and the fit
     says so."""
-    from stewartid.datasets.dataset import DataWarning
+    from stewartid.errors import DataWarning
 
     M, B = nominal_matrices(paper)
     clean = linear_model_datasets(paper, M, B, np.zeros(6), np.full(6, 300.0), frequency=1.0,

@@ -32,6 +32,11 @@ class OutputExistsError(ConfigError):
     """An output folder already holds results and overwriting was not asked for."""
 
 
+class DataWarning(UserWarning):
+    """A data set was usable only after a correction (for instance resampling), or looks
+    doubtful against the platform description."""
+
+
 class NotFittedError(StewartidError, ValueError, AttributeError):
     """A learned attribute (ending in ``_``) was read before ``fit``.
 

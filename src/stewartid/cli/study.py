@@ -7,6 +7,8 @@ from typing import Annotated
 
 import typer
 
+from stewartid.errors import StewartidError
+
 
 def study(
     file: Annotated[Path, typer.Argument(help="Study file (TOML): [study] fixed settings, "
@@ -28,7 +30,8 @@ def study(
     """Run every (grid point, seed) of a study: simulate the six experiments, identify them
     with every method, store one row per method in OUT/results.parquet and write a report
     with figures. Finished rows survive an interruption; --resume computes the others."""
-    from stewartid.errors import StewartidError
+    # the studies load in 0.06 s (with pandas, when it is not loaded yet, 0.4 s more); every
+    # command's module is imported when the command line starts
     from stewartid.studies import load_study, run_study
 
     spec = load_study(file)

@@ -16,7 +16,7 @@ in ms or µs read as seconds falls outside). Every identification method here as
 sample period: time stamps that jitter around a uniform sample clock (every sample within
 half a period of its slot, none skipped) are timing noise of the logger and are replaced by
 the least-squares uniform clock; any other non-uniform time base is resampled onto a uniform
-grid (linear interpolation at the median sample period). Both with a :class:`DataWarning`.
+grid (linear interpolation at the median sample period). Both with a :class:`~stewartid.errors.DataWarning`.
 With a platform description, the data are checked against it (:mod:`stewartid.datasets.plausibility`).
 Logs in other layouts or units are read through a :class:`~stewartid.datasets.log_format.LogFormat`
 (``docs/logs.md``).
@@ -31,11 +31,16 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
+import pyarrow as pa
+import pyarrow.csv
 
+from stewartid.datasets import plausibility as checks
 from stewartid.datasets.arrays import median
+from stewartid.datasets.columns import shown_value, to_numbers
 from stewartid.datasets.log_format import LogFormat, read_table
-from stewartid.errors import DataError, KinematicsError
+from stewartid.errors import DataError, DataWarning, KinematicsError
 from stewartid.files import write_bytes_atomic
+from stewartid.model.kinematics import forward_kinematics, leg_lengths
 from stewartid.platform import COORDINATES, Platform
 
 if TYPE_CHECKING:
@@ -59,10 +64,6 @@ UNIFORM_TOLERANCE = 1e-3
 SAMPLE_RATE_RANGE_HZ = (10.0, 1e6)
 
 SUFFIXES = {".csv": "csv", ".parquet": "parquet", ".pq": "parquet"}
-
-
-class DataWarning(UserWarning):
-    """A data set was usable only after a correction (for instance resampling)."""
 
 
 @dataclass(frozen=True)
@@ -117,7 +118,7 @@ class Dataset:
 
     def to_frame(self) -> pd.DataFrame:
         """The experiment as a table with the interchange columns."""
-        import pandas as pd
+        import pandas as pd  # 0.4 s to import, which reading and writing data never need
 
         data = np.column_stack([self.t, self.pose, self.lengths, self.forces])
         return pd.DataFrame(data, columns=list(COLUMNS))
@@ -188,15 +189,16 @@ def _resample(t: np.ndarray, columns: dict[str, np.ndarray], where: str
     return grid, {k: np.interp(grid, t, v) for k, v in columns.items()}
 
 
-def dataset_from_frame(frame: pd.DataFrame | Mapping[str, np.ndarray],
+def dataset_from_frame(frame: Mapping[str, np.ndarray] | pd.DataFrame,
                        platform: Platform | None = None, name: str = "exp",
                        where: str | None = None) -> Dataset:
     """Validate a table in the interchange format and build a :class:`Dataset`.
 
     Parameters
     ----------
-    frame : DataFrame, or mapping of str to ndarray of shape (N,)
-        Columns ``t``, ``f1..f6`` and at least one of the groups ``x..rz`` or ``l1..l6``.
+    frame : mapping of str to ndarray of shape (N,), or DataFrame
+        Columns (as :func:`~stewartid.datasets.log_format.read_table` gives them) ``t``,
+        ``f1..f6`` and at least one of the groups ``x..rz`` or ``l1..l6``.
         Unknown extra columns are ignored.
     platform : Platform, optional
         Needed only when the pose or the leg lengths are missing.
@@ -227,19 +229,14 @@ def dataset_from_frame(frame: pd.DataFrame | Mapping[str, np.ndarray],
               *FORCE_COLUMNS]
     columns: dict[str, np.ndarray] = {}
     for c in wanted:
-        column = frame[c]
-        if isinstance(column, np.ndarray):
-            values = column.astype(float)
-        else:
-            import pandas as pd
-
-            values = pd.to_numeric(column, errors="coerce").to_numpy(dtype=float)
+        column = np.asarray(frame[c])
+        values = to_numbers(column)
         finite = np.isfinite(values)
         if not np.all(finite):
             row = int(np.argmin(finite))
-            value = column[row] if isinstance(column, np.ndarray) else column.iloc[row]
             raise DataError(f"{where}: column {c!r} has a missing, non-numeric or non-finite "
-                            f"value at row {row} ({value!r}); clean or drop that row.")
+                            f"value at row {row} ({shown_value(column, row)!r}); clean or drop "
+                            "that row.")
         columns[c] = values
     t = columns.pop("t")
     if not _check_time(t, where):
@@ -252,8 +249,6 @@ def dataset_from_frame(frame: pd.DataFrame | Mapping[str, np.ndarray],
     pose = np.column_stack([columns[c] for c in POSE_COLUMNS]) if has_pose else None
     lengths = np.column_stack([columns[c] for c in LENGTH_COLUMNS]) if has_lengths else None
     if platform is not None:
-        from stewartid.datasets import plausibility as checks
-
         if pose is not None:
             checks.check_pose(pose, platform, where)
         if lengths is not None:
@@ -263,8 +258,6 @@ def dataset_from_frame(frame: pd.DataFrame | Mapping[str, np.ndarray],
             group = "pose (x..rz)" if pose is None else "leg lengths (l1..l6)"
             raise DataError(f"{where}: the {group} is missing and no platform description was "
                             "given to compute it; pass platform=... (CLI: --platform).")
-        from stewartid.model.kinematics import forward_kinematics, leg_lengths
-
         if pose is None:
             try:
                 pose = _forward_kinematics_tracked(platform, lengths, forward_kinematics)
@@ -379,23 +372,19 @@ def write_dataset(dataset: Dataset, path: str | Path, format: str | None = None)
     Path
         The written file.
     """
-    import pyarrow as pa
-
     path = Path(path)
     kind = _format_of(path, format)
     data = np.column_stack([dataset.t, dataset.pose, dataset.lengths, dataset.forces]).T
     table = pa.table(dict(zip(COLUMNS, data, strict=True)))
     buffer = pa.BufferOutputStream()
     if kind == "csv":
-        import pyarrow.csv
-
         # Arrow writes the shortest decimal that reads back to the same double: the round
         # trip is bit-exact, at a tenth of the time of printf-style formatting
         pyarrow.csv.write_csv(table, buffer, pyarrow.csv.WriteOptions(quoting_style="none"))
     else:
-        import pyarrow.parquet
+        from pyarrow import parquet  # 0.08 s to import, which writing CSV files saves
 
-        pyarrow.parquet.write_table(table, buffer)
+        parquet.write_table(table, buffer)
     return write_bytes_atomic(path, buffer.getvalue().to_pybytes())
 
 
@@ -405,7 +394,6 @@ __all__ = [
     "LENGTH_COLUMNS",
     "MIN_SAMPLES",
     "POSE_COLUMNS",
-    "DataWarning",
     "Dataset",
     "dataset_from_frame",
     "expand_paths",

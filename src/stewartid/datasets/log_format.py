@@ -16,23 +16,24 @@ another encoding is named in the error with the fix.
 
 from __future__ import annotations
 
-import io
 import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
-from stewartid.datasets.plain_csv import read_plain_csv
+from stewartid.datasets.columns import (
+    Columns,
+    read_csv_columns,
+    read_parquet_columns,
+    to_numbers,
+)
 from stewartid.errors import ConfigError, DataError
 from stewartid.files import read_toml
 from stewartid.platform import COORDINATES
-
-if TYPE_CHECKING:
-    import pandas as pd
 
 #: Interchange columns a log format may map, in order, with the chamber pressures.
 PRESSURE_COLUMNS = tuple(f"pa{k}" for k in range(1, 7)) + tuple(f"pb{k}" for k in range(1, 7))
@@ -111,19 +112,19 @@ class LogFormat:
     annulus_area: float | None = None
     source: str = "--columns"
 
-    def to_interchange(self, frame: pd.DataFrame, where: str) -> pd.DataFrame:
-        """The log's table with interchange column names, in SI units.
+    def to_interchange(self, columns: Columns, where: str) -> Columns:
+        """The log's columns with interchange names, in SI units.
 
         Parameters
         ----------
-        frame : DataFrame
-            The log as read.
+        columns : dict of str to ndarray, shape (N,) each
+            The log as read (:mod:`stewartid.datasets.columns`).
         where : str
             File named in error messages.
 
         Returns
         -------
-        DataFrame
+        dict of str to ndarray
             Mapped columns converted to SI; unmapped columns unchanged; ``f1..f6`` from
             the chamber pressures when the log has pressures and no forces.
 
@@ -132,33 +133,35 @@ class LogFormat:
         DataError
             A mapped column is missing or not numeric, or pressures come without areas.
         """
-        import pandas as pd
-
-        out = frame.copy()
+        out = dict(columns)
         for target, source in self.columns.items():
             name = source.name or target
-            if name not in frame.columns:
+            if name not in columns:
                 raise DataError(f"{where}: no column {name!r} (mapped to {target} by "
-                                f"{self.source}); the file has {_listing(frame.columns)}.")
-            values = pd.to_numeric(frame[name], errors="coerce").to_numpy(dtype=float)
-            bad = np.isnan(values) & frame[name].notna().to_numpy()
-            if np.any(bad):
-                row = int(np.argmax(bad))
+                                f"{self.source}); the file has {_listing(columns)}.")
+            values = to_numbers(columns[name])
+            bad = [row for row in np.flatnonzero(np.isnan(values))
+                   if not _missing(columns[name][row])]
+            if bad:
+                row = int(bad[0])
                 raise DataError(f"{where}: column {name!r} has the non-numeric value "
-                                f"{frame[name].iloc[row]!r} at row {row}; clean that row or "
+                                f"{columns[name][row]!r} at row {row}; clean that row or "
                                 "set the decimal mark / delimiter (docs/logs.md).")
             factor = UNITS[_QUANTITY[target]][source.unit.lower()] if source.unit else 1.0
             out[target] = values * factor * source.scale + source.offset
-        if not all(f in out.columns for f in _FORCES) and all(
-                p in out.columns for p in PRESSURE_COLUMNS):
+        if not all(f in out for f in _FORCES) and all(p in out for p in PRESSURE_COLUMNS):
             if self.piston_area is None or self.annulus_area is None:
                 raise DataError(f"{where}: forces from chamber pressures need piston_area and "
                                 f"annulus_area (m^2) in {self.source} (docs/logs.md).")
             for k in range(1, 7):
-                pressure_a = pd.to_numeric(out[f"pa{k}"], errors="coerce")
-                pressure_b = pd.to_numeric(out[f"pb{k}"], errors="coerce")
-                out[f"f{k}"] = pressure_a * self.piston_area - pressure_b * self.annulus_area
+                out[f"f{k}"] = (to_numbers(out[f"pa{k}"]) * self.piston_area
+                                - to_numbers(out[f"pb{k}"]) * self.annulus_area)
         return out
+
+
+def _missing(value: Any) -> bool:
+    """True for a missing value as read: None or NaN."""
+    return value is None or (isinstance(value, float) and math.isnan(value))
 
 
 def _listing(columns: Any, limit: int = 8) -> str:
@@ -362,8 +365,7 @@ def detect_delimiter(lines: list[str]) -> str:
 _DECIMAL_COMMA = re.compile(r"^\s*[+-]?\d+,\d+([eE][+-]?\d+)?\s*$")
 
 
-def read_table(path: Path, kind: str, log_format: LogFormat | None = None
-               ) -> pd.DataFrame | dict[str, np.ndarray]:
+def read_table(path: Path, kind: str, log_format: LogFormat | None = None) -> Columns:
     """Read a log (CSV or Parquet) and map it to the interchange columns in SI units.
 
     Parameters
@@ -375,9 +377,8 @@ def read_table(path: Path, kind: str, log_format: LogFormat | None = None
 
     Returns
     -------
-    DataFrame, or dict of str to ndarray
-        The table; a plain CSV file in the interchange format without a log format comes as
-        its float columns (:mod:`stewartid.datasets.plain_csv`).
+    dict of str to ndarray, shape (N,) each
+        The table's columns (:mod:`stewartid.datasets.columns`).
 
     Raises
     ------
@@ -386,38 +387,21 @@ def read_table(path: Path, kind: str, log_format: LogFormat | None = None
     """
     log_format = log_format or LogFormat()
     where = str(path)
-    if kind == "csv":
-        try:
-            text = decode_text(path.read_bytes(), where, log_format.encoding)
-        except OSError as exc:
-            raise DataError(f"{path}: cannot be read as {kind}: {exc}") from exc
-        lines = _head_lines(text, log_format.skip_rows + 6)[log_format.skip_rows:]
-        delimiter = log_format.delimiter or detect_delimiter(lines)
-        decimal = log_format.decimal
-        if decimal is None:
-            fields = lines[1].split(delimiter) if len(lines) > 1 else []
-            decimal = "," if delimiter != "," and any(
-                _DECIMAL_COMMA.match(f) for f in fields) else "."
-        if (delimiter, decimal) == (",", ".") and not log_format.columns and (
-                log_format.skip_rows == 0):
-            columns = read_plain_csv(text.encode("utf-8"))
-            # forces from pressures, and every message about a bad file, come from below
-            if columns is not None and all(f in columns for f in _FORCES):
-                return columns
-    import pandas as pd
-
+    if kind == "parquet":
+        return log_format.to_interchange(read_parquet_columns(str(path), where), where)
     try:
-        if kind == "parquet":
-            frame = pd.read_parquet(path)
-        else:
-            frame = pd.read_csv(io.StringIO(text), sep=delimiter, decimal=decimal,
-                                skiprows=log_format.skip_rows, skipinitialspace=True)
-    except (ValueError, OSError, pd.errors.ParserError) as exc:
-        if isinstance(exc, DataError):
-            raise
+        text = decode_text(path.read_bytes(), where, log_format.encoding)
+    except OSError as exc:
         raise DataError(f"{path}: cannot be read as {kind}: {exc}") from exc
-    frame.columns = [str(c).strip() for c in frame.columns]
-    return log_format.to_interchange(frame, where)
+    lines = _head_lines(text, log_format.skip_rows + 6)[log_format.skip_rows:]
+    delimiter = log_format.delimiter or detect_delimiter(lines)
+    decimal = log_format.decimal
+    if decimal is None:
+        fields = lines[1].split(delimiter) if len(lines) > 1 else []
+        decimal = "," if delimiter != "," and any(
+            _DECIMAL_COMMA.match(f) for f in fields) else "."
+    columns = read_csv_columns(text, where, delimiter, decimal, log_format.skip_rows)
+    return log_format.to_interchange(columns, where)
 
 
 def _head_lines(text: str, count: int) -> list[str]:

@@ -12,7 +12,7 @@ compare the data with what the platform description implies, where the two meet:
 Each failure is a :class:`~stewartid.errors.DataError` naming the likely cause and the fix;
 a mismatch a user may mean (a payload missing from the platform file, a constant leg-length
 calibration offset, an identified matrix a little off) is a
-:class:`~stewartid.datasets.dataset.DataWarning`. The thresholds below are the documented factors.
+:class:`~stewartid.errors.DataWarning`. The thresholds below are the documented factors.
 """
 
 from __future__ import annotations
@@ -23,7 +23,9 @@ import warnings
 import numpy as np
 
 from stewartid.datasets.arrays import median
-from stewartid.errors import DataError
+from stewartid.errors import DataError, DataWarning
+from stewartid.model.kinematics import _leg_terms, leg_lengths
+from stewartid.model.linearization import nominal_matrices
 from stewartid.platform import Platform
 
 #: Largest |rx|, |ry|, |rz| (rad) a hexapod reaches; larger values are angles in degrees.
@@ -56,8 +58,6 @@ _FLIP_Z_UP = np.array([1.0, -1.0, -1.0, 1.0, -1.0, -1.0])
 
 
 def _warn(message: str) -> None:
-    from stewartid.datasets.dataset import DataWarning
-
     warnings.warn(message, DataWarning, stacklevel=3)
 
 
@@ -143,8 +143,6 @@ def check_pose(pose: np.ndarray, platform: Platform, where: str) -> None:
 def _ik_misfit(pose: np.ndarray, lengths: np.ndarray, platform: Platform
                ) -> tuple[float, np.ndarray]:
     """RMS of the varying part of lengths - IK(pose) (m) and its constant part per leg."""
-    from stewartid.model.kinematics import leg_lengths
-
     residual = lengths - leg_lengths(platform, pose)
     constant = residual.mean(axis=0)
     return float(np.sqrt(np.mean((residual - constant) ** 2))), constant
@@ -212,8 +210,6 @@ def check_inverse_kinematics(pose: np.ndarray, lengths: np.ndarray, platform: Pl
 
 def _leg_order(pose: np.ndarray, lengths: np.ndarray, platform: Platform, fits) -> str | None:
     """A renumbering of the logged legs that matches the inverse kinematics, as a message."""
-    from stewartid.model.kinematics import leg_lengths
-
     computed = leg_lengths(platform, pose)
     computed = computed - computed.mean(axis=0)
     logged = lengths - lengths.mean(axis=0)
@@ -257,8 +253,6 @@ def check_static_balance(pose: np.ndarray, forces: np.ndarray, platform: Platfor
     DataWarning
         A weight off by more than :data:`BALANCE_WARNING` (a payload not in the file?).
     """
-    from stewartid.model.kinematics import _leg_terms
-
     pose, forces = _subsample(pose, forces)
     # the pose-only leg terms that preparation uses too: no mass matrix, no compiled kernel
     gravity, leg_jacobian, _, _ = _leg_terms(platform, np.ascontiguousarray(pose))
@@ -324,8 +318,6 @@ def check_identified(M: np.ndarray, B: np.ndarray, platform: Platform) -> None:
     DataWarning
         A diagonal entry of Mt or Bt beyond :data:`NOMINAL_WARNING_FACTOR`.
     """
-    from stewartid.model.linearization import nominal_matrices
-
     nominal = dict(zip(("Mt", "Bt"), nominal_matrices(platform), strict=True))
     hint = ("check the units (t s, x..z m, rx..rz rad, f N), the friction model and "
             "--platform (docs/logs.md)")

@@ -19,12 +19,19 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from scipy.interpolate import CubicSpline
 
+import stewartid
+from stewartid.datasets.columns import read_csv_columns, to_numbers
+from stewartid.datasets.log_format import decode_text
 from stewartid.design.candidates import Design
 from stewartid.errors import ConfigError, DataError
 from stewartid.files import write_text_atomic
 from stewartid.model.kinematics import forward_kinematics, inverse_kinematics
+from stewartid.model.linearization import nominal_matrices
 from stewartid.platform import COORDINATES, Platform
+from stewartid.signals.differentiation import estimate_frequency
+from stewartid.simulation.experiments import SimulationResult, noise_generator, simulate_experiment
 from stewartid.simulation.sensors import SensorNoise
 
 LENGTH_COLUMNS = tuple(f"l{k}" for k in range(1, 7))
@@ -101,8 +108,6 @@ class TabulatedExcitation:
     def evaluate(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Pose, velocity and acceleration at ``t`` (s), each (N, 6); held at the last
         sample after the end of the table."""
-        from scipy.interpolate import CubicSpline
-
         spline = CubicSpline(self.t, self.pose, axis=0, bc_type="clamped")
         inside = np.clip(np.asarray(t, dtype=float), self.t[0], self.t[-1])
         return spline(inside), spline(inside, 1), spline(inside, 2)
@@ -117,18 +122,15 @@ def read_excitation(path: str | Path, platform: Platform) -> TabulatedExcitation
         If the file cannot be read, lacks ``t`` or both column groups, has non-finite values,
         or its time is not strictly increasing.
     """
-    import pandas as pd
-
-    from stewartid.signals.differentiation import estimate_frequency
-
     path = Path(path)
     if not path.is_file():
         raise DataError(f"{path}: no such excitation file.")
+    text = decode_text(path.read_bytes(), str(path))
     try:
-        frame = pd.read_csv(path)
-    except (ValueError, pd.errors.ParserError) as exc:
-        raise DataError(f"{path}: not a readable CSV table ({exc}).") from None
-    columns = set(frame.columns)
+        frame = read_csv_columns(text, str(path))
+    except DataError as exc:
+        raise DataError(f"{path}: not a readable CSV table ({exc.__cause__}).") from None
+    columns = set(frame)
     if "t" not in columns:
         raise DataError(f"{path}: missing column 't' (s).")
     has_pose = set(COORDINATES) <= columns
@@ -136,7 +138,7 @@ def read_excitation(path: str | Path, platform: Platform) -> TabulatedExcitation
         raise DataError(f"{path}: give the pose columns {', '.join(COORDINATES)} (m, rad) or "
                         f"the leg lengths {', '.join(LENGTH_COLUMNS)} (m).")
     used = ["t", *(COORDINATES if has_pose else LENGTH_COLUMNS)]
-    values = frame[used].to_numpy(dtype=float)
+    values = np.column_stack([to_numbers(frame[name]) for name in used])
     if not np.all(np.isfinite(values)):
         raise DataError(f"{path}: non-finite values in columns {', '.join(used)}.")
     t = values[:, 0] - values[0, 0]
@@ -170,14 +172,6 @@ def simulate_excitations(platform: Platform, excitations: Sequence[Any],
     -------
     stewartid.simulation.SimulationResult
     """
-    import stewartid
-    from stewartid.model.linearization import nominal_matrices
-    from stewartid.simulation.experiments import (
-        SimulationResult,
-        noise_generator,
-        simulate_experiment,
-    )
-
     noise = SensorNoise.from_sensors(platform.sensors) if noise is None else noise
     datasets, records, sources = [], [], []
     for k, excitation in enumerate(excitations):

@@ -38,20 +38,19 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import multiprocessing
-import os
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
 
 from stewartid.datasets.dataset import Dataset
 from stewartid.design.candidates import Design
+from stewartid.design.export import simulate_excitations
 from stewartid.errors import ConfigError
 from stewartid.identification.registry import create_identifier
 from stewartid.model.dynamics import inverse_dynamics
 from stewartid.model.kinematics import inverse_kinematics, leg_jacobian
 from stewartid.model.linearization import nominal_matrices
+from stewartid.parallel import run_in_order
 from stewartid.platform import Platform
 from stewartid.reference.published import PAPER_ENTRIES, entry_label
 from stewartid.simulation.sensors import SensorNoise, measure_legs, measured_pose
@@ -266,8 +265,6 @@ def measured_plant_datasets(platform: Platform, records: list, noise: SensorNois
 def plant_records(platform: Platform, design: Design) -> list:
     """The design played once on the plant without sensor noise: the true signals of every
     record (:class:`~stewartid.simulation.experiments.ExperimentRecord`)."""
-    from stewartid.design.export import simulate_excitations
-
     return list(simulate_excitations(platform, design.playable(platform), SensorNoise()).states)
 
 
@@ -393,34 +390,20 @@ class NoiseRuns:
 
     def estimates(self, ks: Sequence[int], workers: int | None = None,
                   progress: Callable[[int, int], None] | None = None) -> np.ndarray:
-        """:meth:`fit` over ``workers`` processes, in the order of ``ks``."""
-        ks = list(ks)
+        """:meth:`fit` over ``workers`` processes (every core from :data:`PARALLEL_SEEDS`
+        realisations on, else 1), in the order of ``ks``; the noise-free data go to each
+        worker once, a task carries only its realisation's number."""
+        ks = [int(k) for k in ks]
         if workers is None:
-            workers = (os.cpu_count() or 1) if len(ks) >= PARALLEL_SEEDS else 1
-        workers = max(1, min(int(workers), len(ks)))
-        if workers == 1:
-            return self.fit(ks, progress)
-        out = np.empty((len(ks), 2, 6, 6))
-        # spawn, not fork: the parent may hold BLAS and numba threads; the records go to
-        # each worker once, the tasks carry only their realisation's number
-        context = multiprocessing.get_context("spawn")
-        with ProcessPoolExecutor(workers, mp_context=context, initializer=_hold,
-                                 initargs=(self,)) as pool:
-            tasks = {pool.submit(_fit_held, k): i for i, k in enumerate(ks)}
-            for done, task in enumerate(as_completed(tasks), start=1):
-                out[tasks[task]] = task.result()
-                if progress:
-                    progress(done, len(ks))
-        return out
+            workers = None if len(ks) >= PARALLEL_SEEDS else 1
+
+        def finished(done: int, total: int, index: int) -> None:
+            progress(done, total)
+
+        fits = run_in_order(_fit_realisation, ks, workers,
+                            finished if progress is not None else None, shared=self)
+        return np.array(fits).reshape(len(ks), 2, 6, 6)
 
 
-#: The NoiseRuns a worker process fits (set once per process by :func:`_hold`).
-_HELD: list[NoiseRuns] = []
-
-
-def _hold(runs: NoiseRuns) -> None:
-    _HELD[:] = [runs]
-
-
-def _fit_held(k: int) -> np.ndarray:
-    return _HELD[0].fit([k])[0]
+def _fit_realisation(runs: NoiseRuns, k: int) -> np.ndarray:
+    return runs.fit([k])[0]

@@ -17,6 +17,8 @@ from stewartid.design.limits import LIMIT_NAMES, LimitUse
 from stewartid.design.prediction import Prediction, identify_options
 from stewartid.files import write_text_atomic
 from stewartid.reference.published import PAPER_ENTRIES, entry_label
+from stewartid.reporting.document import render_html
+from stewartid.reporting.figures import STYLE, save_figure
 
 
 def plot_limit_use(uses: Sequence[LimitUse], names: Sequence[str], directory: str | Path
@@ -25,7 +27,6 @@ def plot_limit_use(uses: Sequence[LimitUse], names: Sequence[str], directory: st
     import matplotlib
     from matplotlib.figure import Figure
 
-    from stewartid.reporting.figures import STYLE, save_figure
 
     with matplotlib.rc_context(STYLE):
         figure = Figure(figsize=(9, 1.6 * len(uses) + 0.6))
@@ -48,7 +49,6 @@ def plot_accuracy(design: Prediction, baseline: Prediction, directory: str | Pat
     import matplotlib
     from matplotlib.figure import Figure
 
-    from stewartid.reporting.figures import STYLE, save_figure
 
     labels = [entry_label(k) for k in PAPER_ENTRIES]
     x = np.arange(len(labels))
@@ -143,8 +143,6 @@ def identify_command(method: str, run: str = "RUN") -> str:
 
 def write_design_report(directory: str | Path, markdown_text: str) -> list[Path]:
     """Write ``report.md`` and the self-contained ``report.html`` into ``directory``."""
-    from stewartid.reporting.document import render_html
-
     directory = Path(directory)
     return [write_text_atomic(directory / "report.md", markdown_text),
             write_text_atomic(directory / "report.html",

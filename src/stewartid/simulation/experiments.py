@@ -10,19 +10,19 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import multiprocessing
-import os
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+import stewartid
 from stewartid.datasets.dataset import Dataset, write_dataset
 from stewartid.errors import ConfigError, StewartidError
 from stewartid.files import check_output_folder, write_json_atomic
 from stewartid.model.dynamics import COULOMB_SMOOTHING
+from stewartid.model.linearization import gravity_stiffness, nominal_matrices
+from stewartid.parallel import WORKERS_INHERIT, run_in_order, worker_count
 from stewartid.platform import Platform
 from stewartid.simulation import plant
 from stewartid.simulation.controller import command_tables, controller_parameters
@@ -261,9 +261,6 @@ def simulate_experiments(platform: Platform, coulomb: float | None = None,
     -------
     SimulationResult
     """
-    import stewartid
-    from stewartid.model.linearization import gravity_stiffness, nominal_matrices
-
     updates: dict[str, Any] = {}
     if coulomb is not None:
         updates["friction__coulomb"] = float(coulomb)
@@ -312,7 +309,7 @@ def _simulate_run(run: tuple) -> tuple[Dataset, ExperimentRecord]:
                                noise_generator(seed, k, count), step)
 
 
-def run_experiments(runs: Sequence[tuple], jobs: int = 1,
+def run_experiments(runs: Sequence[tuple], jobs: int | None = 1,
                     progress: Callable[[int, int, str], Any] | None = None,
                     ) -> list[tuple[Dataset, ExperimentRecord]]:
     """Simulate ``runs`` in order, on up to ``jobs`` worker processes.
@@ -322,9 +319,9 @@ def run_experiments(runs: Sequence[tuple], jobs: int = 1,
     runs : sequence of tuple
         ``(platform, excitation, duration_s, noise, seed, k, count, step)``: experiment ``k``
         of ``count``, with the noise stream :func:`noise_generator` ``(seed, k, count)``.
-    jobs : int
-        Worker processes (forked where the system can, so that they start with the
-        compiled kernels of this process already loaded); 1 runs here.
+    jobs : int, optional
+        Worker processes (:func:`stewartid.parallel.run_in_order`; every core when None);
+        1 runs here.
     progress : callable, optional
         ``progress(done, total, name)`` as experiments finish.
 
@@ -333,28 +330,15 @@ def run_experiments(runs: Sequence[tuple], jobs: int = 1,
     list of (Dataset, ExperimentRecord)
         In the order of ``runs``.
     """
-    jobs = min(jobs, len(runs), os.cpu_count() or 1)
-    results: list[Any] = [None] * len(runs)
-    if jobs <= 1:
-        for k, run in enumerate(runs):
-            results[k] = _simulate_run(run)
-            if progress is not None:
-                progress(k + 1, len(runs), run[1].name)
-        return results
-    methods = multiprocessing.get_all_start_methods()
-    context = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
-    if context.get_start_method() == "fork":
-        # load the compiled kernels here, once: forked workers inherit them
+    def finished(done: int, total: int, index: int) -> None:
+        progress(done, total, runs[index][1].name)
+
+    if WORKERS_INHERIT and worker_count(jobs, len(runs)) > 1:
+        # load the compiled kernels here, once: the workers inherit them
         platform, excitation, *_ = runs[0]
         simulate_experiment(platform, excitation, 2.0 / platform.sensors.sample_rate)
-    with ProcessPoolExecutor(max_workers=jobs, mp_context=context) as pool:
-        futures = {pool.submit(_simulate_run, run): k for k, run in enumerate(runs)}
-        for done, future in enumerate(as_completed(futures), 1):
-            k = futures[future]
-            results[k] = future.result()
-            if progress is not None:
-                progress(done, len(runs), runs[k][1].name)
-    return results
+
+    return run_in_order(_simulate_run, runs, jobs, finished if progress is not None else None)
 
 
 def write_experiments(result: SimulationResult, out: str | Path, format: str = "csv",

@@ -14,6 +14,7 @@ import dataclasses
 import numpy as np
 
 from stewartid.errors import ConfigError
+from stewartid.model.dynamics import inverse_dynamics
 from stewartid.model.kinematics import forward_kinematics
 from stewartid.platform import Platform, Sensors
 
@@ -64,8 +65,6 @@ REFERENCE_FORCE_NOISE = 0.005
 
 def static_leg_force(platform: Platform) -> float:
     """Mean actuator force (N) holding the platform at rest at its neutral pose."""
-    from stewartid.model.dynamics import inverse_dynamics
-
     zero = np.zeros(6)
     return float(np.mean(np.abs(inverse_dynamics(platform, platform.neutral_pose, zero, zero))))
 
@@ -88,6 +87,54 @@ def reference_noise(platform: Platform, scale: float = 1.0) -> SensorNoise:
         SensorNoise.from_sensors(platform.sensors),
         length_noise=scale * REFERENCE_LENGTH_NOISE_M,
         force_noise=scale * REFERENCE_FORCE_NOISE * static_leg_force(platform))
+
+
+#: When :func:`sensor_noise` takes the reference noise of a channel instead of ``[sensors]``:
+#: never, always, or only where ``[sensors]`` declares no noise.
+REFERENCE_CHOICES = ("never", "always", "where_zero")
+
+
+def sensor_noise(platform: Platform, reference: str = "never", length_noise: float | None = None,
+                 force_noise: float | None = None) -> SensorNoise:
+    """The sensor errors of a run: the platform's ``[sensors]``, the reference noise
+    (:func:`reference_noise`) where ``reference`` asks, then the given standard deviations.
+
+    Parameters
+    ----------
+    platform : Platform
+    reference : {"never", "always", "where_zero"}
+        Take the reference noise standard deviation of a channel never, always
+        (``simulate --noise``), or where ``[sensors]`` declares none (``design``).
+    length_noise : float, optional
+        Leg-length noise standard deviation (m), overriding the above.
+    force_noise : float, optional
+        Force noise standard deviation (N), overriding the above.
+
+    Returns
+    -------
+    SensorNoise
+        Biases and resolutions are always the platform's.
+
+    Raises
+    ------
+    ConfigError
+        On an unknown ``reference`` or a negative or non-finite standard deviation.
+    """
+    if reference not in REFERENCE_CHOICES:
+        raise ConfigError(f"reference must be one of {', '.join(REFERENCE_CHOICES)}; got "
+                          f"{reference!r}.")
+    noise = SensorNoise.from_sensors(platform.sensors)
+    if reference != "never":
+        standard, always = reference_noise(platform), reference == "always"
+        noise = dataclasses.replace(
+            noise,
+            length_noise=noise.length_noise if noise.length_noise and not always
+            else standard.length_noise,
+            force_noise=noise.force_noise if noise.force_noise and not always
+            else standard.force_noise)
+    changes = {name: value for name, value in (("length_noise", length_noise),
+                                               ("force_noise", force_noise)) if value is not None}
+    return dataclasses.replace(noise, **changes) if changes else noise
 
 
 def measure(true: np.ndarray, noise: float, bias: float, resolution: float,

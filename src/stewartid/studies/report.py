@@ -16,8 +16,13 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+import pandas as pd
+
 from stewartid.files import write_text_atomic
 from stewartid.reporting.comparison import method_color, method_name, report_order
+from stewartid.reporting.document import render_html
+from stewartid.reporting.figures import STYLE, save_figure
 from stewartid.reporting.tables import ResultTable, to_markdown, write_tables
 from stewartid.studies.spec import PARAMETERS, StudySpec
 
@@ -64,8 +69,6 @@ def sweep_statistics(rows: Any, parameter: str, others: Sequence[str]) -> Any:
         ``<metric>_<statistic>`` for every metric of :data:`METRICS` and statistic in
         median, q25, q75, min, max (%).
     """
-    import pandas as pd
-
     good = rows[rows["failure"].isna()]
     keys = [*others, parameter, "method"]
     groups = good.groupby(keys, sort=True)
@@ -94,10 +97,8 @@ def plot_sweep(statistics: Any, parameter: str, others: Sequence[str],
                methods: Sequence[str], directory: str | Path) -> list[Path]:
     """Figure ``error_vs_<parameter>`` (PNG and SVG) from :func:`sweep_statistics`."""
     import matplotlib
-    import numpy as np
     from matplotlib.figure import Figure
 
-    from stewartid.reporting.figures import STYLE, save_figure
 
     panels = _panels(statistics, others)
     with matplotlib.rc_context(STYLE):
@@ -251,8 +252,6 @@ def write_study_report(rows: Any, spec: StudySpec, directory: str | Path,
     list of Path
         Every file written.
     """
-    from stewartid.reporting.document import render_html
-
     directory = Path(directory)
     methods = report_order(spec.methods)
     lines = [f"# {spec.title}", "",

@@ -48,6 +48,9 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+import pyarrow as pa
+import pyarrow.parquet as pq
+
 from stewartid.files import write_bytes_atomic
 from stewartid.reference.published import PAPER_ENTRIES, entry_label
 from stewartid.studies.spec import PARAMETERS
@@ -62,7 +65,6 @@ _PREFIX, _SUFFIX = "part-", ".parquet"
 
 
 def _schema() -> Any:
-    import pyarrow as pa
 
     text, number = pa.string(), pa.float64()
     return pa.schema(
@@ -93,8 +95,6 @@ def write_part(directory: str | Path, task_key: str, rows: Sequence[Mapping[str,
     ValueError
         If a row misses a column or belongs to another task (a bug in the caller).
     """
-    import pyarrow as pa
-    import pyarrow.parquet as pq
 
     schema = _schema()
     for row in rows:
@@ -132,8 +132,6 @@ def read_results(directory: str | Path, tasks: Iterable[str] | None = None) -> A
         The columns of :func:`columns`, one row per (task, method), sorted by the parameters,
         the seed and the method; empty (with the columns) if no task has finished.
     """
-    import pyarrow as pa
-    import pyarrow.parquet as pq
 
     folder = Path(directory) / RESULTS_NAME
     paths = sorted(folder.glob(f"{_PREFIX}*{_SUFFIX}")) if folder.is_dir() else []

@@ -30,9 +30,13 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
 from stewartid.errors import ConfigError, OutputExistsError
 from stewartid.files import write_json_atomic
+from stewartid.parallel import WORKER_THREADS
 from stewartid.studies.grid import StudyTask, expand_grid
+from stewartid.studies.report import write_study_report
 from stewartid.studies.results import RESULTS_NAME, finished_tasks, read_results, write_part
 from stewartid.studies.spec import StudySpec
 from stewartid.studies.task import run_task
@@ -125,14 +129,6 @@ def _check_folder(spec: StudySpec, directory: Path, resume: bool) -> None:
                           "they belong to this study. Use another folder.")
 
 
-def _worker_environment() -> dict[str, str]:
-    # the same one-thread limits as the process pool of ``reproduce``: parallelism is across
-    # processes, and multithreaded BLAS in every worker only oversubscribes the cores
-    from stewartid.reports.reproduction.run import _WORKER_THREADS
-
-    return dict(_WORKER_THREADS)
-
-
 @contextmanager
 def connect(scheduler: str | None = None, workers: int | None = None) -> Iterator[Any]:
     """A :class:`distributed.Client`: of the cluster at ``scheduler``, or of a new
@@ -163,11 +159,12 @@ def connect(scheduler: str | None = None, workers: int | None = None) -> Iterato
     count = (os.cpu_count() or 1) if workers is None else workers
     if count < 1:
         raise ConfigError(f"--workers must be >= 1; got {workers!r}.")
+    # one BLAS thread per worker, as in every process pool of the package (stewartid.parallel);
     # quiet workers: at shutdown their heartbeats to the closing scheduler log errors, and a
     # task's own failure reaches the client through its future anyway
     with LocalCluster(n_workers=count, threads_per_worker=1, processes=True,
                       dashboard_address=None, silence_logs=logging.CRITICAL,
-                      env=_worker_environment()) as cluster, Client(cluster) as client:
+                      env=dict(WORKER_THREADS)) as cluster, Client(cluster) as client:
         yield client
 
 
@@ -177,8 +174,6 @@ def _progress_display(enabled: bool, total: int) -> Iterator[ProgressCallback | 
     if not enabled:
         yield None
         return
-    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
-
     counts = TextColumn("{task.fields[done]} done, {task.fields[failed]} failed, "
                         "{task.fields[remaining]} remaining")
     with Progress(TextColumn("study"), BarColumn(), counts, TimeElapsedColumn()) as bar:
@@ -286,8 +281,6 @@ def run_study(spec: StudySpec, out: str | Path, *, scheduler: str | None = None,
     rows = read_results(directory, {task.key for task in tasks})
     files: list[Path] = []
     if report:
-        from stewartid.studies.report import write_study_report
-
         files = write_study_report(rows, spec, directory, total_tasks=len(tasks),
                                    failed_tasks=len(failures))
     return StudyRun(directory, spec, rows, computed, skipped, tuple(failures), files,

@@ -15,8 +15,11 @@ from typing import Any
 import numpy as np
 
 from stewartid.errors import StewartidError
+from stewartid.identification.registry import create_identifier
 from stewartid.platform import Platform
 from stewartid.reference.published import PAPER_ENTRIES, entry_label, relative_error_percent
+from stewartid.simulation import simulate_experiments
+from stewartid.simulation.sensors import reference_noise
 from stewartid.studies.grid import StudyTask
 from stewartid.studies.results import ENTRY_COLUMNS
 
@@ -92,10 +95,6 @@ def run_task(task: StudyTask, platform: Platform, methods: Sequence[str],
     list of dict
         One row per method, with the columns of :func:`stewartid.studies.results.columns`.
     """
-    from stewartid.identification.registry import create_identifier
-    from stewartid.simulation import simulate_experiments
-    from stewartid.simulation.sensors import reference_noise
-
     point = task.parameters
     common = {"task": task.key, **point, "seed": int(task.seed), "worker": _worker_address()}
     cpu_start = time.thread_time()

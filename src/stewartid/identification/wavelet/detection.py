@@ -16,8 +16,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from stewartid.datasets.dataset import DataWarning
-from stewartid.errors import IdentificationError
+from stewartid.errors import DataWarning, IdentificationError
 from stewartid.identification.preparation import Experiment
 from stewartid.identification.wavelet.intervals import constant_direction_intervals, joint_rates
 from stewartid.identification.wavelet.noise import joint_rate_noise, white_noise_covariance

@@ -53,7 +53,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stewartid.datasets.dataset import DataWarning
+from stewartid.errors import DataWarning
 from stewartid.identification.solvers import _check_rank, regressor_names
 from stewartid.platform import COORDINATES
 

@@ -22,15 +22,15 @@ Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
 
 from __future__ import annotations
 
-import os
 import time
-from collections.abc import Callable, Iterator, Sequence
-from concurrent.futures import Executor, Future, ProcessPoolExecutor
+from collections.abc import Iterator, Sequence
+from concurrent.futures import Future
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 from stewartid.files import check_output_folder, to_jsonable, write_json_atomic
+from stewartid.parallel import process_pool
 from stewartid.platform import Platform, load_platform
 from stewartid.reference.published import load_published
 from stewartid.reporting.comparison import ComparisonResults, MethodRun
@@ -106,54 +106,6 @@ def identify(method: str, coulomb: float, datasets: Sequence[Any], platform: Pla
 
 
 # ---------------------------------------------------------------------------- orchestration
-
-class _InlineExecutor(Executor):
-    """Runs submitted calls at once in this process (``jobs=1``)."""
-
-    def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> Future:
-        future: Future = Future()
-        try:
-            future.set_result(fn(*args, **kwargs))
-        except BaseException as exc:  # handed to the caller through the future
-            future.set_exception(exc)
-        return future
-
-
-#: Thread counts of the numerical libraries inside worker processes: one each, since the
-#: parallelism is across processes (two-thread BLAS in two workers on two cores doubles the
-#: identification time).
-_WORKER_THREADS = {name: "1" for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS",
-                                          "MKL_NUM_THREADS", "NUMBA_NUM_THREADS")}
-
-
-def _ready() -> bool:
-    return True
-
-
-@contextmanager
-def _executor(jobs: int) -> Iterator[Executor]:
-    """A pool of ``jobs`` fresh worker processes ("spawn": they read the thread limits from
-    the environment at start), or in-process execution for ``jobs=1``."""
-    if jobs <= 1:
-        yield _InlineExecutor()
-        return
-    import multiprocessing
-
-    saved = {name: os.environ.get(name) for name in _WORKER_THREADS}
-    os.environ.update(_WORKER_THREADS)
-    try:
-        pool = ProcessPoolExecutor(max_workers=jobs,
-                                   mp_context=multiprocessing.get_context("spawn"))
-        pool.submit(_ready).result()  # starts every worker while the limits are set
-    finally:
-        for name, value in saved.items():
-            if value is None:
-                os.environ.pop(name, None)
-            else:
-                os.environ[name] = value
-    with pool:
-        yield pool
-
 
 class _Silent:
     """Stand-in for a rich progress display when progress is off."""
@@ -247,7 +199,7 @@ def run_reproduce(out: str | Path = "results/reproduce", quick: bool = False,
     nominal_M, nominal_B = nominal_matrices(platform)
     # the signal figures show the highest Coulomb level, where friction shows most
     trace_level = max(levels)
-    with _progress(progress) as bar, _executor(settings.jobs) as pool:
+    with _progress(progress) as bar, process_pool(settings.jobs) as pool:
         task = bar.add_task("simulating experiments", total=6 * len(levels))
         keys = [(level, k) for level in levels for k in range(6)]
         futures = [pool.submit(simulate_one, plants[level], k, settings.frequency_hz,
