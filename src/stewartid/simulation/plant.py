@@ -34,6 +34,8 @@ import numpy as np
 from numba import njit
 
 from stewartid.model import compiled
+from stewartid.model import parameters as layout
+from stewartid.model.joints import N_GIMBAL_AXES, N_JOINTS
 from stewartid.simulation.controller import pid_force, valve_command
 from stewartid.simulation.hydraulics import H_MID, H_STROKE, actuator_force, pressure_rates
 
@@ -128,17 +130,17 @@ def rhs(y, dy, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, hyd
         for i in range(6):
             s += J[i, c] * force[i]
         work[c] = s
-    viscous = params[compiled.P_VISCOUS]
-    coulomb = params[compiled.P_COULOMB]
+    viscous = params[layout.VISCOUS]
+    coulomb = params[layout.COULOMB]
     for i in range(6):
-        for j in range(compiled.N_JOINTS):
+        for j in range(N_JOINTS):
             w = 0.0
             for c in range(6):
                 w += Jj[i, j, c] * qd[c]
             tau = 0.0
             if coulomb > 0.0:
                 tau = coulomb * w / math.sqrt(w * w + smoothing * smoothing)
-            if j < 4:
+            if j < N_GIMBAL_AXES:
                 tau += viscous * w
             for c in range(6):
                 work[c] -= tau * Jj[i, j, c]

@@ -57,7 +57,6 @@ import numpy as np
 
 from stewartid.datasets.dataset import Dataset
 from stewartid.identification.base import BaseIdentifier, check_parameter
-from stewartid.identification.least_squares import JOINT_TYPES
 from stewartid.identification.preparation import Experiment, prepare
 from stewartid.identification.registry import Preset, register_method
 from stewartid.identification.result import IdentificationResult
@@ -77,6 +76,7 @@ from stewartid.identification.wavelet.gls import solve_weak_form
 from stewartid.identification.wavelet.noise import generalized_force_sensitivity
 from stewartid.identification.wavelet.point_equations import EXACT_DEGREE, point_equations
 from stewartid.identification.wavelet.weak_form import interval_equations
+from stewartid.model.joints import JOINT_TYPES
 from stewartid.model.kinematics import joint_rate_jacobians
 from stewartid.platform import COORDINATES, Platform
 from stewartid.signals.wavelets import MotherWavelet, PolynomialWavelet, make_wavelet

@@ -28,7 +28,6 @@ import numpy as np
 
 from stewartid.assessment.validation import (
     DEFAULT_FOLDS,
-    FRICTION_TYPES,
     Segment,
     ValidationResult,
     coulomb_levels,
@@ -44,6 +43,7 @@ from stewartid.identification.consistency import (
     require_cvxpy,
 )
 from stewartid.identification.result import IdentificationResult
+from stewartid.model.joints import FRICTION_TYPES
 from stewartid.platform import Platform
 from stewartid.reporting.exports import ExportedModel, write_exports
 

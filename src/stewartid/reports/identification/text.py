@@ -12,10 +12,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from stewartid.assessment.validation import FRICTION_TYPES, friction_signature
+from stewartid.assessment.validation import friction_signature
 from stewartid.datasets.dataset import Dataset
 from stewartid.identification.consistency import consistency_metrics, is_consistent
 from stewartid.identification.result import IdentificationResult
+from stewartid.model.joints import FRICTION_TYPES
 from stewartid.platform import COORDINATES, Platform
 from stewartid.reporting.tables import ResultTable, to_markdown
 
