@@ -337,21 +337,27 @@ def _to_pose_coordinates(q, qd, E, Mn, hn, Gn, M, h, G, J_leg, J_joint):
                 J_joint[i, j, 3], J_joint[i, j, 4], J_joint[i, j, 5], E)
 
 
-def joint_friction(params, J_joint, qd, smoothing):
-    """Generalized joint friction forces (N, N m) at one sample, regularised Coulomb.
+def joint_friction_torque(rate, gimbal, viscous, coulomb, smoothing):
+    """Friction torque (N m) of one joint axis turning at ``rate`` (rad/s): viscous on a
+    ``gimbal`` axis, Coulomb on every axis, regularised as
+    coulomb * rate / sqrt(rate^2 + smoothing^2)."""
+    tau = 0.0
+    if coulomb > 0.0:
+        tau = coulomb * rate / math.sqrt(rate * rate + smoothing * smoothing)
+    if gimbal:
+        tau += viscous * rate
+    return tau
 
-    Viscous on the gimbal axes, Coulomb Fc * rate / sqrt(rate^2 + smoothing^2) on all five.
-    """
-    c = params[layout.VISCOUS]
-    fc = params[layout.COULOMB]
+
+def joint_friction(params, J_joint, qd, smoothing):
+    """Generalized joint friction forces (N, N m) at one sample (:func:`joint_friction_torque`
+    on every axis of every leg)."""
     F = np.zeros(6)
     for i in range(6):
         for j in range(N_JOINTS):
             rate = J_joint[i, j] @ qd
-            tau = fc * rate / math.sqrt(rate * rate + smoothing * smoothing)
-            if j < N_GIMBAL_AXES:
-                tau += c * rate
-            F += tau * J_joint[i, j]
+            F += joint_friction_torque(rate, j < N_GIMBAL_AXES, params[layout.VISCOUS],
+                                       params[layout.COULOMB], smoothing) * J_joint[i, j]
     return F
 
 

@@ -20,7 +20,7 @@ N m s/rad at Fc = 5 N m, about ten times the viscous gimbal friction), which the
 include (they are taken at rest, where that damping is largest).
 
 Friction: viscous on the four gimbal axes of each leg, Coulomb on all five rotational axes,
-regularised as Fc w / sqrt(w^2 + s^2) (:func:`stewartid.model.compiled.joint_friction`). Within
+regularised as Fc w / sqrt(w^2 + s^2) (:func:`stewartid.model.kernels.joint_friction_torque`). Within
 |w| < s a joint behaves as a very stiff viscous damper: it sticks (creeps at a rate below
 s, 1e-4 rad/s) until the applied torque exceeds Fc, then slips with the full Coulomb torque
 opposing the motion, so the stick-slip transitions are resolved without event detection.
@@ -137,11 +137,7 @@ def rhs(y, dy, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, hyd
             w = 0.0
             for c in range(6):
                 w += Jj[i, j, c] * qd[c]
-            tau = 0.0
-            if coulomb > 0.0:
-                tau = coulomb * w / math.sqrt(w * w + smoothing * smoothing)
-            if j < N_GIMBAL_AXES:
-                tau += viscous * w
+            tau = compiled.joint_friction_torque(w, j < N_GIMBAL_AXES, viscous, coulomb, smoothing)
             for c in range(6):
                 work[c] -= tau * Jj[i, j, c]
     _solve_spd(M, work, chol, qdd)
