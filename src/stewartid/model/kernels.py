@@ -75,15 +75,15 @@ def leg_vector(R, x, y, z, a0, a1, a2, b0, b1, b2):
     return r0, r1, r2, s0 / length, s1 / length, s2 / length, length
 
 
-def twist_column(c, r0, r1, r2, zero):
+def twist_column(c, r0, r1, r2, zero, one):
     """Column c of J_A = [I, -[r]x]: the upper joint's velocity per unit of twist component c,
-    with ``zero`` at the structural zeros."""
+    with ``zero`` and ``one`` at the structural zeros and ones."""
     if c == 0:
-        return 1.0, zero, zero
+        return one, zero, zero
     if c == 1:
-        return zero, 1.0, zero
+        return zero, one, zero
     if c == 2:
-        return zero, zero, 1.0
+        return zero, zero, one
     if c == 3:
         return zero, -r2, r1
     if c == 4:
@@ -278,7 +278,7 @@ def _leg_kinematics(params, R, q, qd, omega, a, b, J_leg_row, J_joint_leg, Jcl, 
     wd[0], wd[1], wd[2] = wd0, wd1, wd2
     frame = leg_frame(u0, u1, u2)
     for c in range(6):
-        b0, b1, b2 = twist_column(c, r0, r1, r2, 0.0)
+        b0, b1, b2 = twist_column(c, r0, r1, r2, 0.0, 1.0)
         rate = leg_rate(u0, u1, u2, b0, b1, b2)
         J_leg_row[c] = rate
         w0, w1, w2 = leg_angular_rate(u0, u1, u2, b0, b1, b2, l)

@@ -10,8 +10,9 @@ Numpy, not numba: in a fresh process, starting numba and loading its cached kern
 terms are the kernels' own per-sample geometry functions (:func:`~stewartid.model.kernels.leg_vector`,
 :func:`~stewartid.model.kernels.joint_rate_column`, ...) applied to arrays of samples: one
 definition, the same numbers to the last bit (``tests/test_dynamics.py``). Where the kernel
-passes 0.0 for a structural zero of J_A = [I, -[r]x], this module passes :data:`ZERO`, which
-drops out of sums and products without a whole-array operation.
+passes 0.0 and 1.0 for the structural zeros and ones of J_A = [I, -[r]x], this module passes
+:data:`ZERO` and :data:`ONE`, which drop out of sums and products without a whole-array
+operation.
 
 Coordinates and joint axes as in :mod:`stewartid.model.kernels`: q = [x, y, z, rx, ry, rz] (m, rad),
 R = Rz Ry Rx, twist nu = [v, omega] mapped to q rates by E(q); leg frame e1 = unit(z x u),
@@ -95,8 +96,31 @@ class _StructuralZero:
         return -other
 
 
-#: The structural zero of J_A passed to the kernels' geometry functions.
+class _StructuralOne:
+    """An exact one in the kernels' arithmetic on arrays: x * ONE is x itself."""
+
+    __array_ufunc__ = None
+
+    def __mul__(self, other: Any) -> Any:
+        return other
+
+    __rmul__ = __mul__
+
+    def __sub__(self, other: Any) -> Any:
+        return 1.0 - other
+
+    def __rsub__(self, other: Any) -> Any:
+        return other - 1.0
+
+    def __add__(self, other: Any) -> Any:
+        return other + 1.0
+
+    __radd__ = __add__
+
+
+#: The structural zero and one of J_A passed to the kernels' geometry functions.
 ZERO = _StructuralZero()
+ONE = _StructuralOne()
 
 
 def leg_terms(params: np.ndarray, upper: np.ndarray, base: np.ndarray, q: np.ndarray,
@@ -168,7 +192,7 @@ def _leg_terms_block(params, upper, base, q, G, J_leg, lengths, J_joint):
     if not None). Every leg quantity has shape (n, 6): samples by legs."""
     E, (r0, r1, r2), u, length = leg_vectors(upper, base, q)
     lengths[:] = length
-    columns = [twist_column(c, r0, r1, r2, ZERO) for c in range(6)]
+    columns = [twist_column(c, r0, r1, r2, ZERO, ONE) for c in range(6)]
     if G is not None:
         rates = [leg_rate(*u, *b) for b in columns]
         _gravity(params, u[2], columns, rates, length, tuple(e[:, 0] for e in E), G)
