@@ -8,11 +8,11 @@ import pytest
 from linear_model_data import AMPLITUDES, make_experiment, random_matrices
 from stewartid.errors import IdentificationError
 from stewartid.identification.least_squares import (
-    JOINT_TYPES,
     LeastSquaresIdentifier,
     coulomb_regressors,
 )
 from stewartid.identification.solvers import integrated_autocorrelation, solve_least_squares
+from stewartid.model.joints import JOINT_TYPES
 
 
 def _coulomb(levels):

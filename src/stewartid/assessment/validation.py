@@ -39,12 +39,11 @@ import numpy as np
 from stewartid.datasets.dataset import Dataset
 from stewartid.errors import DataError, StewartidError
 from stewartid.identification.result import IdentificationResult
+from stewartid.model.joints import FRICTION_TYPES
 from stewartid.platform import Platform
 
 #: Default number of time-segment folds.
 DEFAULT_FOLDS = 3
-#: Joint types of the Coulomb levels, in the order of the regressors.
-FRICTION_TYPES = ("lower_gimbal", "upper_gimbal", "revolute")
 
 
 @dataclass(frozen=True)
@@ -351,7 +350,7 @@ def in_sample(segments: Sequence[Segment], result: IdentificationResult) -> Vali
     return score(segments, [predict(s, result) for s in segments], folds=1)
 
 
-__all__ = ["DEFAULT_FOLDS", "FRICTION_TYPES", "CrossValidation", "Segment", "ValidationResult",
+__all__ = ["DEFAULT_FOLDS", "CrossValidation", "Segment", "ValidationResult",
            "coulomb_estimate", "coulomb_levels", "cross_validate", "excitation_window", "fold_bounds",
            "friction_signature", "held_out_segments", "in_sample", "predict", "prepare_segment",
            "score"]

@@ -53,7 +53,6 @@ UNITS: dict[str, dict[str, float]] = {
 _QUANTITY = {**dict.fromkeys(_TIME, "time"), **dict.fromkeys(_POSITIONS + _LENGTHS, "length"),
              **dict.fromkeys(_ANGLES, "angle"), **dict.fromkeys(_FORCES, "force"),
              **dict.fromkeys(PRESSURE_COLUMNS, "pressure")}
-_SI = {"time": "s", "length": "m", "angle": "rad", "force": "N", "pressure": "Pa"}
 
 #: Keys of the ``[log]`` section (inline: the same names).
 LOG_KEYS = ("delimiter", "encoding", "decimal", "skip_rows")

@@ -24,7 +24,7 @@ import numpy as np
 
 from stewartid.datasets.arrays import median
 from stewartid.errors import DataError, DataWarning
-from stewartid.model.kinematics import _leg_terms, leg_lengths
+from stewartid.model.kinematics import compute_leg_terms, leg_lengths
 from stewartid.model.linearization import nominal_matrices
 from stewartid.platform import Platform
 
@@ -255,7 +255,7 @@ def check_static_balance(pose: np.ndarray, forces: np.ndarray, platform: Platfor
     """
     pose, forces = _subsample(pose, forces)
     # the pose-only leg terms that preparation uses too: no mass matrix, no compiled kernel
-    gravity, leg_jacobian, _, _ = _leg_terms(platform, np.ascontiguousarray(pose))
+    gravity, leg_jacobian, _, _ = compute_leg_terms(platform, np.ascontiguousarray(pose))
     generalized = np.einsum("nij,ni->nj", leg_jacobian, forces)
     weight = -float(np.mean(gravity[:, 2]))
     ratio = round(-float(np.mean(generalized[:, 2])) / weight, 6) + 0.0  # no "-0"

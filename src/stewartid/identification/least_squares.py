@@ -42,6 +42,7 @@ from stewartid.identification.preparation import prepare
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.solvers import regressor_names, solve_least_squares
+from stewartid.model.joints import JOINT_TYPES
 from stewartid.platform import Platform
 from stewartid.signals.differentiation import (
     DEFAULT_ORDER,
@@ -51,9 +52,6 @@ from stewartid.signals.differentiation import (
     kernel_filter,
     trim,
 )
-
-#: Joint types and their axes in the order of the joint-rate Jacobians.
-JOINT_TYPES = {"lower_gimbal": (0, 1), "upper_gimbal": (2, 3), "revolute": (4,)}
 
 
 def coulomb_regressors(joint_jacobians: np.ndarray, q_dot: np.ndarray, smoothing: float
@@ -205,4 +203,4 @@ class LeastSquaresIdentifier(BaseIdentifier):
             "offsets_": offsets, "coulomb_": levels, "coulomb_std_": levels_std}
 
 
-__all__ = ["JOINT_TYPES", "LeastSquaresIdentifier", "coulomb_regressors"]
+__all__ = ["LeastSquaresIdentifier", "coulomb_regressors"]

@@ -27,7 +27,7 @@ import numpy as np
 
 from stewartid.datasets.dataset import Dataset, read_datasets
 from stewartid.errors import ConfigError, DataError
-from stewartid.model.kinematics import _leg_terms, joint_rate_jacobians
+from stewartid.model.kinematics import compute_leg_terms, joint_rate_jacobians
 from stewartid.platform import Platform, load_platform
 
 
@@ -134,7 +134,7 @@ def prepare(datasets: Sequence[Dataset], platform: Platform, gravity: bool = Tru
     """
     out = []
     for d in datasets:
-        G, J, _, joint_jacobians = _leg_terms(platform, np.ascontiguousarray(d.pose), joints)
+        G, J, _, joint_jacobians = compute_leg_terms(platform, np.ascontiguousarray(d.pose), joints)
         y = np.einsum("nji,nj->ni", J, d.forces)
         if gravity:
             y = y - G

@@ -1,8 +1,7 @@
 """The kernels of :mod:`stewartid.model.kernels`, compiled with numba (cached on disk).
 
 Every function of that module is compiled here under the same name; within the compiled
-copies, a kernel's calls to the others go to their compiled copies. The constants the
-plant's compiled code reads are re-exported.
+copies, a kernel's calls to the others go to their compiled copies.
 """
 
 from __future__ import annotations
@@ -14,7 +13,6 @@ from typing import Any
 from numba import njit
 
 from stewartid.model import kernels as _kernel_code
-from stewartid.model.kernels import N_JOINTS, P_COULOMB, P_VISCOUS
 
 
 def _compile_all() -> dict[str, Callable[..., Any]]:
@@ -31,7 +29,5 @@ def _compile_all() -> dict[str, Callable[..., Any]]:
     return {name: namespace[name] for name in kernels}
 
 
-# rotation, model_terms, batch_terms, forward_dynamics_sample, ...: each kernel by its name
+# leg_vector, model_terms, batch_terms, forward_dynamics_sample, ...: each kernel by its name
 globals().update(_compile_all())
-
-__all__ = ["N_JOINTS", "P_COULOMB", "P_VISCOUS"]

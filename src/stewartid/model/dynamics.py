@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewartid.model.kinematics import _batch, _terms
-from stewartid.platform import Platform
+from stewartid.model.kinematics import as_batch, inverse_kinematics
+from stewartid.platform import GRAVITY, Platform
 
 #: Default Coulomb regularisation rate (rad/s).
 COULOMB_SMOOTHING = 1e-4
@@ -43,8 +43,15 @@ class ModelTerms:
     """
 
     def __init__(self, platform: Platform, q: np.ndarray, q_dot: np.ndarray | None = None):
+        from stewartid.model import compiled  # numba: only the full model terms need it
+
+        q2, self.single = as_batch(q)
+        qd2 = np.zeros_like(q2) if q_dot is None else as_batch(q_dot, "q_dot")[0]
+        if qd2.shape != q2.shape:
+            raise ValueError(f"q_dot must have the shape of q {q2.shape}; got {qd2.shape}.")
         (self.mass_matrix, self.velocity_product, self.gravity, self.leg_jacobian,
-         self.joint_jacobians, self.leg_lengths), self.single = _terms(platform, q, q_dot)
+         self.joint_jacobians, self.leg_lengths) = compiled.batch_terms(
+            platform.parameters(), platform.upper_joints, platform.base_joints, q2, qd2)
 
 
 def _out(x: np.ndarray, single: bool) -> np.ndarray:
@@ -88,7 +95,7 @@ def _joint_friction(platform: Platform, terms: ModelTerms, q_dot: np.ndarray,
     """Generalized joint friction (N, 6) at the samples of ``terms``."""
     from stewartid.model import compiled  # numba, started only when a model term is computed
 
-    qd2, _ = _batch(q_dot, "q_dot")
+    qd2, _ = as_batch(q_dot, "q_dot")
     return compiled.batch_friction(platform.parameters(), terms.joint_jacobians, qd2,
                                    float(coulomb_smoothing))
 
@@ -104,7 +111,7 @@ def inverse_dynamics(platform: Platform, q: np.ndarray, q_dot: np.ndarray, q_ddo
         Force along each leg, positive extending.
     """
     t = ModelTerms(platform, q, q_dot)
-    qdd2, _ = _batch(q_ddot, "q_ddot")
+    qdd2, _ = as_batch(q_ddot, "q_ddot")
     rhs = np.einsum("nij,nj->ni", t.mass_matrix, qdd2) + t.velocity_product + t.gravity
     if friction:
         rhs += _joint_friction(platform, t, q_dot, coulomb_smoothing)
@@ -122,7 +129,7 @@ def forward_dynamics(platform: Platform, q: np.ndarray, q_dot: np.ndarray, force
     ndarray, shape (6,) or (N, 6)
     """
     t = ModelTerms(platform, q, q_dot)
-    f2, _ = _batch(forces, "forces")
+    f2, _ = as_batch(forces, "forces")
     rhs = np.einsum("nji,nj->ni", t.leg_jacobian, f2) - t.velocity_product - t.gravity
     if friction:
         rhs -= _joint_friction(platform, t, q_dot, coulomb_smoothing)
@@ -133,7 +140,7 @@ def forward_dynamics(platform: Platform, q: np.ndarray, q_dot: np.ndarray, force
 def kinetic_energy(platform: Platform, q: np.ndarray, q_dot: np.ndarray) -> np.ndarray:
     """Kinetic energy 1/2 q_dot^T M(q) q_dot (J); shape () or (N,)."""
     t = ModelTerms(platform, q)
-    qd2, _ = _batch(q_dot, "q_dot")
+    qd2, _ = as_batch(q_dot, "q_dot")
     T = 0.5 * np.einsum("ni,nij,nj->n", qd2, t.mass_matrix, qd2)
     return T[0] if t.single else T
 
@@ -143,10 +150,7 @@ def potential_energy(platform: Platform, q: np.ndarray) -> np.ndarray:
 
     z points down, so V = -g * sum(m z_com). Shape () or (N,).
     """
-    from stewartid.model.kinematics import inverse_kinematics
-    from stewartid.platform import GRAVITY
-
-    q2, single = _batch(q)
+    q2, single = as_batch(q)
     legs = inverse_kinematics(platform, q2)
     i = platform.inertia
     z_lower = platform.base_joints[None, :, 2] + i.lower_leg_com * legs.directions[..., 2]

@@ -10,8 +10,12 @@ One kernel, :func:`model_terms`, evaluates every pose-dependent term of the mode
 sample, so the simulator pays for the leg geometry once per right-hand-side call. The batched
 functions of :mod:`stewartid.model.dynamics` loop over samples in compiled code around it; the
 pose-only terms (leg lengths, J_lq, G, joint Jacobians) that kinematics, command tables and
-identification need are computed by :mod:`stewartid.model.leg_terms` in numpy, equal to these to
-the last bit.
+identification need are computed by :mod:`stewartid.model.leg_terms` in numpy from the same
+per-sample geometry functions below (:func:`leg_vector`, :func:`twist_column`,
+:func:`leg_rate`, :func:`leg_angular_rate`, :func:`joint_rate_column`,
+:func:`centre_of_mass_rates`, :func:`leg_gravity`, :func:`euler_columns`): pure arithmetic
+on their arguments, which are floats here and arrays of samples there, so both give the
+same numbers to the last bit.
 
 Coordinates: q = [x, y, z, rx, ry, rz] (m, rad; R = Rz(rz) Ry(ry) Rx(rx)), q_dot its time
 derivative (Euler-angle rates). Internally the body equations are written in the twist
@@ -34,46 +38,127 @@ import math
 
 import numpy as np
 
-#: Indices into the packed parameter vector built by Platform.parameters().
-P_MASS, P_IXX, P_IYY, P_IZZ = 0, 1, 2, 3
-P_M_UPPER, P_M_LOWER, P_D_UPPER, P_D_LOWER, P_I_UPPER, P_I_LOWER = 4, 5, 6, 7, 8, 9
-P_VISCOUS, P_COULOMB, P_GRAVITY = 10, 11, 12
+from stewartid.model import parameters as layout
+from stewartid.model.joints import N_GIMBAL_AXES, N_JOINTS
 
-#: Joint axes per leg and which of them carry viscous friction (the gimbal axes).
-N_JOINTS = 5
-GIMBAL_AXES = (0, 1, 2, 3)
+# -- per-sample geometry: arithmetic only, on floats (kernels) or arrays (numpy leg terms) ----
 
 
-def rotation(rx: float, ry: float, rz: float) -> np.ndarray:
-    """R = Rz(rz) Ry(ry) Rx(rx), shape (3, 3)."""
-    cx, sx = math.cos(rx), math.sin(rx)
-    cy, sy = math.cos(ry), math.sin(ry)
-    cz, sz = math.cos(rz), math.sin(rz)
-    R = np.empty((3, 3))
-    R[0, 0] = cz * cy
-    R[0, 1] = cz * sy * sx - sz * cx
-    R[0, 2] = cz * sy * cx + sz * sx
-    R[1, 0] = sz * cy
-    R[1, 1] = sz * sy * sx + cz * cx
-    R[1, 2] = sz * sy * cx - cz * sx
-    R[2, 0] = -sy
-    R[2, 1] = cy * sx
-    R[2, 2] = cy * cx
-    return R
+def rotation_entries(cx, sx, cy, sy, cz, sz):
+    """Entries of R = Rz(rz) Ry(ry) Rx(rx) row by row, (R00, R01, ..., R22), from the cosines
+    and sines of rx, ry, rz."""
+    return (cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx,
+            sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx,
+            -sy, cy * sx, cy * cx)
 
 
-def euler_rate_map(ry: float, rz: float) -> np.ndarray:
-    """E with omega_world = E [rx_dot, ry_dot, rz_dot] for R = Rz Ry Rx, shape (3, 3)."""
-    cy, sy = math.cos(ry), math.sin(ry)
-    cz, sz = math.cos(rz), math.sin(rz)
-    E = np.zeros((3, 3))
-    E[0, 0] = cz * cy
-    E[1, 0] = sz * cy
-    E[2, 0] = -sy
-    E[0, 1] = -sz
-    E[1, 1] = cz
-    E[2, 2] = 1.0
-    return E
+def euler_rate_entries(cy, sy, cz, sz):
+    """Entries (E00, E10, E20, E01, E11) of E with omega_world = E [rx_dot, ry_dot, rz_dot]
+    for R = Rz Ry Rx; the others are E02 = E12 = E21 = 0, E22 = 1."""
+    return cz * cy, sz * cy, -sy, -sz, cz
+
+
+def leg_vector(R, x, y, z, a0, a1, a2, b0, b1, b2):
+    """One leg at pose position (x, y, z) (m) and rotation entries ``R``, upper joint a
+    (platform frame, from the reference point) and base joint b (fixed frame), all in m.
+
+    Returns (r0, r1, r2, u0, u1, u2, length): r = R a, the unit leg vector u from b to the
+    upper joint, and the leg length (m).
+    """
+    r0 = R[0] * a0 + R[1] * a1 + R[2] * a2
+    r1 = R[3] * a0 + R[4] * a1 + R[5] * a2
+    r2 = R[6] * a0 + R[7] * a1 + R[8] * a2
+    s0 = x + r0 - b0
+    s1 = y + r1 - b1
+    s2 = z + r2 - b2
+    length = np.sqrt(s0 * s0 + s1 * s1 + s2 * s2)
+    return r0, r1, r2, s0 / length, s1 / length, s2 / length, length
+
+
+def twist_column(c, r0, r1, r2, zero, one):
+    """Column c of J_A = [I, -[r]x]: the upper joint's velocity per unit of twist component c,
+    with ``zero`` and ``one`` at the structural zeros and ones."""
+    if c == 0:
+        return one, zero, zero
+    if c == 1:
+        return zero, one, zero
+    if c == 2:
+        return zero, zero, one
+    if c == 3:
+        return zero, -r2, r1
+    if c == 4:
+        return r2, zero, -r0
+    return -r1, r0, zero
+
+
+def leg_rate(u0, u1, u2, b0, b1, b2):
+    """Leg-length rate u . b for the joint velocity b (a column of J_A)."""
+    return u0 * b0 + u1 * b1 + u2 * b2
+
+
+def leg_angular_rate(u0, u1, u2, b0, b1, b2, length):
+    """The leg's angular velocity u x b / l for the joint velocity b (a column of J_A)."""
+    return ((u1 * b2 - u2 * b1) / length, (u2 * b0 - u0 * b2) / length,
+            (u0 * b1 - u1 * b0) / length)
+
+
+def centre_of_mass_rates(b, u, rate, length, d_upper, d_lower):
+    """One component of the rates of u, of the lower part's centre of mass (d_lower u) and of
+    the upper part's (joint point - d_upper u), for joint velocity component ``b``, unit leg
+    vector component ``u`` and leg-length rate ``rate``."""
+    u_rate = (b - u * rate) / length
+    return u_rate, d_lower * u_rate, b - d_upper * u_rate
+
+
+def leg_gravity(g, m_upper, m_lower, lower_z, upper_z):
+    """One leg's share of the gravity force on a twist component, from the vertical rates of
+    its two centres of mass (subtracted from G: z points down)."""
+    return g * (m_lower * lower_z + m_upper * upper_z)
+
+
+def leg_frame(u0, u1, u2):
+    """Leg frame e1 = unit(z x u), e2 = u x e1 as (e10, e11, e20, e21, e22); e12 = 0."""
+    nx, ny = -u1, u0
+    nn = np.sqrt(nx * nx + ny * ny)
+    e10, e11 = nx / nn, ny / nn
+    return e10, e11, -u2 * e11, u2 * e10, u0 * e11 - u1 * e10
+
+
+def joint_rate_column(c, frame, u0, u1, u2, w0, w1, w2):
+    """Rates of the five joint axes per unit of twist component c, from the leg frame, the
+    unit leg vector and the leg's angular velocity w for that component.
+
+    Gimbal rates are the components on e1 and e2 of the leg's angular velocity (lower) and
+    of the platform's relative to the leg (upper); the revolute rate is the relative rate
+    about u. A translation moves the platform's angular velocity by nothing, so its relative
+    rates are the leg's negated.
+    """
+    e10, e11, e20, e21, e22 = frame
+    lower_1 = e10 * w0 + e11 * w1
+    lower_2 = e20 * w0 + e21 * w1 + e22 * w2
+    if c < 3:
+        return lower_1, lower_2, -lower_1, -lower_2, -(u0 * w0 + u1 * w1 + u2 * w2)
+    v0 = 1.0 - w0 if c == 3 else -w0
+    v1 = 1.0 - w1 if c == 4 else -w1
+    v2 = 1.0 - w2 if c == 5 else -w2
+    return (lower_1, lower_2, e10 * v0 + e11 * v1, e20 * v0 + e21 * v1 + e22 * v2,
+            u0 * v0 + u1 * v1 + u2 * v2)
+
+
+def euler_columns(x0, x1, x2, E):
+    """The angular part [x0, x1, x2] of a twist row in Euler-angle rates: [x0, x1, x2] E, with
+    E the entries of :func:`euler_rate_entries`."""
+    E00, E10, E20, E01, E11 = E
+    return x0 * E00 + x1 * E10 + x2 * E20, x0 * E01 + x1 * E11, x2
+
+
+# -- the full model at one sample ---------------------------------------------------------
+
+
+def trigonometry(q):
+    """Cosines and sines (cx, sx, cy, sy, cz, sz) of the angles of pose ``q`` (6,)."""
+    return (math.cos(q[3]), math.sin(q[3]), math.cos(q[4]), math.sin(q[4]),
+            math.cos(q[5]), math.sin(q[5]))
 
 
 def euler_rate_map_derivative_product(ry: float, rz: float, rates: np.ndarray) -> np.ndarray:
@@ -88,20 +173,12 @@ def euler_rate_map_derivative_product(ry: float, rz: float, rates: np.ndarray) -
     return out
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    out = np.empty(3)
-    out[0] = a[1] * b[2] - a[2] * b[1]
-    out[1] = a[2] * b[0] - a[0] * b[2]
-    out[2] = a[0] * b[1] - a[1] * b[0]
-    return out
-
-
 def model_terms(params, upper, base, q, qd, M, h, G, J_leg, J_joint, lengths):
     """Evaluate every model term at one sample, in q coordinates (written into the outputs).
 
     Parameters
     ----------
-    params : (13,) packed parameters (Platform.parameters()).
+    params : (N_PARAMETERS,) packed parameters (:mod:`stewartid.model.parameters`).
     upper : (6, 3) upper joints, platform frame, relative to the reference point (m).
     base : (6, 3) base joints, fixed frame (m).
     q, qd : (6,) pose (m, rad) and its rate (m/s, rad/s).
@@ -118,204 +195,169 @@ def model_terms(params, upper, base, q, qd, M, h, G, J_leg, J_joint, lengths):
     times per integration step, and small-matrix products (BLAS calls) and temporaries
     would dominate its cost.
     """
-    m = params[P_MASS]
-    m_u, m_l = params[P_M_UPPER], params[P_M_LOWER]
-    d_u, d_l = params[P_D_UPPER], params[P_D_LOWER]
-    I_leg = params[P_I_UPPER] + params[P_I_LOWER]
-    g = params[P_GRAVITY]
-
-    R = rotation(q[3], q[4], q[5])
-    E = euler_rate_map(q[4], q[5])
-    omega = np.empty(3)
-    for k in range(3):
-        omega[k] = E[k, 0] * qd[3] + E[k, 1] * qd[4] + E[k, 2] * qd[5]
-
+    cx, sx, cy, sy, cz, sz = trigonometry(q)
+    R = rotation_entries(cx, sx, cy, sy, cz, sz)
+    E = euler_rate_entries(cy, sy, cz, sz)
+    omega = np.empty(3)  # E qd[3:]
+    omega[0] = E[0] * qd[3] + E[3] * qd[4]
+    omega[1] = E[1] * qd[3] + E[4] * qd[4]
+    omega[2] = E[2] * qd[3] + qd[5]
     Mn = np.zeros((6, 6))
     hn = np.zeros(6)
     Gn = np.zeros(6)
-    # per-leg scratch
-    r = np.empty(3)
-    ui = np.empty(3)
-    JA = np.empty((3, 6))
-    Judot = np.empty((3, 6))
-    Jw = np.empty((3, 6))
+    _platform_terms(params, R, omega, Mn, hn, Gn)
+    # per-leg scratch: velocities of the two centres of mass and the leg's angular velocity
+    # per twist component, their velocity-product accelerations
     Jcl = np.empty((3, 6))
     Jcu = np.empty((3, 6))
-    vA = np.empty(3)
-    udot = np.empty(3)
-    aA = np.empty(3)
-    udd = np.empty(3)
+    Jw = np.empty((3, 6))
     acl = np.empty(3)
     acu = np.empty(3)
     wd = np.empty(3)
-    w_rel = np.empty(3)
+    for i in range(6):
+        lengths[i] = _leg_kinematics(params, R, q, qd, omega, upper[i], base[i], J_leg[i],
+                                     J_joint[i], Jcl, Jcu, Jw, acl, acu, wd)
+        _add_leg_inertia(params, Jcl, Jcu, Jw, acl, acu, wd, Mn, hn, Gn)
+    _to_pose_coordinates(q, qd, E, Mn, hn, Gn, M, h, G, J_leg, J_joint)
 
-    # platform: M = diag(m, m, m, R Ib R^T), h = [0, omega x (Iw omega)]
+
+def _platform_terms(params, R, omega, Mn, hn, Gn):
+    """The platform body's share, into the twist-coordinate ``Mn``, ``hn``, ``Gn``:
+    M = diag(m, m, m, R Ib R^T), h = [0, omega x (Iw omega)], G = [0, 0, -m g, 0, 0, 0]."""
+    m = params[layout.MASS]
     for k in range(3):
         Mn[k, k] = m
     for a in range(3):
         for b in range(3):
-            Mn[3 + a, 3 + b] = (R[a, 0] * params[P_IXX] * R[b, 0]
-                                + R[a, 1] * params[P_IYY] * R[b, 1]
-                                + R[a, 2] * params[P_IZZ] * R[b, 2])
+            Mn[3 + a, 3 + b] = (R[3 * a] * params[layout.IXX] * R[3 * b]
+                                + R[3 * a + 1] * params[layout.IYY] * R[3 * b + 1]
+                                + R[3 * a + 2] * params[layout.IZZ] * R[3 * b + 2])
     Iwo0 = Mn[3, 3] * omega[0] + Mn[3, 4] * omega[1] + Mn[3, 5] * omega[2]
     Iwo1 = Mn[4, 3] * omega[0] + Mn[4, 4] * omega[1] + Mn[4, 5] * omega[2]
     Iwo2 = Mn[5, 3] * omega[0] + Mn[5, 4] * omega[1] + Mn[5, 5] * omega[2]
     hn[3] = omega[1] * Iwo2 - omega[2] * Iwo1
     hn[4] = omega[2] * Iwo0 - omega[0] * Iwo2
     hn[5] = omega[0] * Iwo1 - omega[1] * Iwo0
-    Gn[2] = -m * g
+    Gn[2] = -m * params[layout.GRAVITY]
 
-    for i in range(6):
-        l = _leg_geometry(R, upper, base, q, i, r, ui, JA)
-        lengths[i] = l
-        vA[0] = qd[0] + (omega[1] * r[2] - omega[2] * r[1])
-        vA[1] = qd[1] + (omega[2] * r[0] - omega[0] * r[2])
-        vA[2] = qd[2] + (omega[0] * r[1] - omega[1] * r[0])
-        ld = ui[0] * vA[0] + ui[1] * vA[1] + ui[2] * vA[2]
-        for k in range(3):
-            udot[k] = (vA[k] - ld * ui[k]) / l
-        # aA = omega x (omega x r)
-        wr0 = omega[1] * r[2] - omega[2] * r[1]
-        wr1 = omega[2] * r[0] - omega[0] * r[2]
-        wr2 = omega[0] * r[1] - omega[1] * r[0]
-        aA[0] = omega[1] * wr2 - omega[2] * wr1
-        aA[1] = omega[2] * wr0 - omega[0] * wr2
-        aA[2] = omega[0] * wr1 - omega[1] * wr0
-        uu = udot[0] * udot[0] + udot[1] * udot[1] + udot[2] * udot[2]
-        ua = ui[0] * aA[0] + ui[1] * aA[1] + ui[2] * aA[2]
-        for k in range(3):
-            # P aA with P = I - u u^T
-            udd[k] = ((aA[k] - ui[k] * ua) - l * uu * ui[k] - 2.0 * ld * udot[k]) / l
-        for c in range(6):
-            uJ = ui[0] * JA[0, c] + ui[1] * JA[1, c] + ui[2] * JA[2, c]
-            J_leg[i, c] = uJ
-            for k in range(3):
-                Judot[k, c] = (JA[k, c] - ui[k] * uJ) / l
-            Jw[0, c] = (ui[1] * JA[2, c] - ui[2] * JA[1, c]) / l
-            Jw[1, c] = (ui[2] * JA[0, c] - ui[0] * JA[2, c]) / l
-            Jw[2, c] = (ui[0] * JA[1, c] - ui[1] * JA[0, c]) / l
-            for k in range(3):
-                Jcl[k, c] = d_l * Judot[k, c]
-                Jcu[k, c] = JA[k, c] - d_u * Judot[k, c]
-        for k in range(3):
-            acl[k] = d_l * udd[k]
-            acu[k] = aA[k] - d_u * udd[k]
-        wd[0] = ui[1] * udd[2] - ui[2] * udd[1]
-        wd[1] = ui[2] * udd[0] - ui[0] * udd[2]
-        wd[2] = ui[0] * udd[1] - ui[1] * udd[0]
-        for a in range(6):
-            for b in range(6):
-                s = 0.0
-                for k in range(3):
-                    s += (m_l * Jcl[k, a] * Jcl[k, b] + m_u * Jcu[k, a] * Jcu[k, b]
-                          + I_leg * Jw[k, a] * Jw[k, b])
-                Mn[a, b] += s
+
+def _leg_kinematics(params, R, q, qd, omega, a, b, J_leg_row, J_joint_leg, Jcl, Jcu, Jw,
+                    acl, acu, wd):
+    """One leg's geometry at one sample: its row of J_leg and joint-rate Jacobian (twist
+    coordinates), the velocity Jacobians of its centres of mass ``Jcl``, ``Jcu`` and of its
+    angular velocity ``Jw`` (3, 6), and their velocity-product accelerations ``acl``, ``acu``,
+    ``wd`` (3,), all written into the arguments; returns the leg length (m)."""
+    d_u, d_l = params[layout.D_UPPER], params[layout.D_LOWER]
+    r0, r1, r2, u0, u1, u2, l = leg_vector(R, q[0], q[1], q[2], a[0], a[1], a[2],
+                                           b[0], b[1], b[2])
+    # velocity of the upper joint (qd[:3] + omega x r), the leg-length rate and u's rate
+    v0 = qd[0] + (omega[1] * r2 - omega[2] * r1)
+    v1 = qd[1] + (omega[2] * r0 - omega[0] * r2)
+    v2 = qd[2] + (omega[0] * r1 - omega[1] * r0)
+    ld = u0 * v0 + u1 * v1 + u2 * v2
+    ud0, ud1, ud2 = (v0 - ld * u0) / l, (v1 - ld * u1) / l, (v2 - ld * u2) / l
+    # acceleration of the upper joint at zero twist rate: omega x (omega x r)
+    wr0 = omega[1] * r2 - omega[2] * r1
+    wr1 = omega[2] * r0 - omega[0] * r2
+    wr2 = omega[0] * r1 - omega[1] * r0
+    aA = (omega[1] * wr2 - omega[2] * wr1, omega[2] * wr0 - omega[0] * wr2,
+          omega[0] * wr1 - omega[1] * wr0)
+    u = (u0, u1, u2)
+    udot = (ud0, ud1, ud2)
+    uu = ud0 * ud0 + ud1 * ud1 + ud2 * ud2
+    ua = u0 * aA[0] + u1 * aA[1] + u2 * aA[2]
+    for k in range(3):
+        # P aA with P = I - u u^T
+        udd = ((aA[k] - u[k] * ua) - l * uu * u[k] - 2.0 * ld * udot[k]) / l
+        acl[k] = d_l * udd
+        acu[k] = aA[k] - d_u * udd
+        wd[k] = udd  # crossed with u below
+    wd0 = u1 * wd[2] - u2 * wd[1]
+    wd1 = u2 * wd[0] - u0 * wd[2]
+    wd2 = u0 * wd[1] - u1 * wd[0]
+    wd[0], wd[1], wd[2] = wd0, wd1, wd2
+    frame = leg_frame(u0, u1, u2)
+    for c in range(6):
+        b0, b1, b2 = twist_column(c, r0, r1, r2, 0.0, 1.0)
+        rate = leg_rate(u0, u1, u2, b0, b1, b2)
+        J_leg_row[c] = rate
+        w0, w1, w2 = leg_angular_rate(u0, u1, u2, b0, b1, b2, l)
+        Jw[0, c], Jw[1, c], Jw[2, c] = w0, w1, w2
+        _, Jcl[0, c], Jcu[0, c] = centre_of_mass_rates(b0, u0, rate, l, d_u, d_l)
+        _, Jcl[1, c], Jcu[1, c] = centre_of_mass_rates(b1, u1, rate, l, d_u, d_l)
+        _, Jcl[2, c], Jcu[2, c] = centre_of_mass_rates(b2, u2, rate, l, d_u, d_l)
+        rows = joint_rate_column(c, frame, u0, u1, u2, w0, w1, w2)
+        for j in range(N_JOINTS):
+            J_joint_leg[j, c] = rows[j]
+    return l
+
+
+def _add_leg_inertia(params, Jcl, Jcu, Jw, acl, acu, wd, Mn, hn, Gn):
+    """Add one leg's two parts to the twist-coordinate ``Mn``, ``hn``, ``Gn`` (Kane's method:
+    each body's velocity Jacobian transposed times its inertial and gravity forces)."""
+    m_u, m_l = params[layout.M_UPPER], params[layout.M_LOWER]
+    I_leg = params[layout.I_UPPER] + params[layout.I_LOWER]
+    g = params[layout.GRAVITY]
+    for a in range(6):
+        for b in range(6):
             s = 0.0
             for k in range(3):
-                s += m_l * Jcl[k, a] * acl[k] + m_u * Jcu[k, a] * acu[k] + I_leg * Jw[k, a] * wd[k]
-            hn[a] += s
-            Gn[a] -= g * (m_l * Jcl[2, a] + m_u * Jcu[2, a])
-        _joint_axes(ui, Jw, w_rel, J_joint[i])
+                s += (m_l * Jcl[k, a] * Jcl[k, b] + m_u * Jcu[k, a] * Jcu[k, b]
+                      + I_leg * Jw[k, a] * Jw[k, b])
+            Mn[a, b] += s
+        s = 0.0
+        for k in range(3):
+            s += m_l * Jcl[k, a] * acl[k] + m_u * Jcu[k, a] * acu[k] + I_leg * Jw[k, a] * wd[k]
+        hn[a] += s
+        Gn[a] -= leg_gravity(g, m_u, m_l, Jcl[2, a], Jcu[2, a])
 
-    # map the twist equations to q coordinates: nu = T qd, nu_dot = T qdd + [0, Edot rates],
-    # T = blockdiag(I, E); M = T^T Mn T, h = T^T (hn + Mn bias), G = T^T Gn, J = J T
+
+def _to_pose_coordinates(q, qd, E, Mn, hn, Gn, M, h, G, J_leg, J_joint):
+    """Map the twist equations to q coordinates (into M, h, G, J_leg, J_joint), E the entries
+    of :func:`euler_rate_entries`: nu = T qd, nu_dot = T qdd + [0, Edot rates],
+    T = blockdiag(I, E); M = T^T Mn T, h = T^T (hn + Mn bias), G = T^T Gn, J = J T."""
     bias = euler_rate_map_derivative_product(q[4], q[5], qd[3:])
     for a in range(6):
         hn[a] += Mn[a, 3] * bias[0] + Mn[a, 4] * bias[1] + Mn[a, 5] * bias[2]
-    MT = np.empty((6, 6))  # Mn T
-    for a in range(6):
-        for b in range(3):
-            MT[a, b] = Mn[a, b]
-            MT[a, 3 + b] = Mn[a, 3] * E[0, b] + Mn[a, 4] * E[1, b] + Mn[a, 5] * E[2, b]
+    for a in range(6):  # Mn T, in place
+        Mn[a, 3], Mn[a, 4], Mn[a, 5] = euler_columns(Mn[a, 3], Mn[a, 4], Mn[a, 5], E)
     for b in range(6):
-        for a in range(3):
-            M[a, b] = MT[a, b]
-            M[3 + a, b] = E[0, a] * MT[3, b] + E[1, a] * MT[4, b] + E[2, a] * MT[5, b]
+        M[0, b], M[1, b], M[2, b] = Mn[0, b], Mn[1, b], Mn[2, b]
+        M[3, b], M[4, b], M[5, b] = euler_columns(Mn[3, b], Mn[4, b], Mn[5, b], E)
     for a in range(3):
         h[a] = hn[a]
         G[a] = Gn[a]
-        h[3 + a] = E[0, a] * hn[3] + E[1, a] * hn[4] + E[2, a] * hn[5]
-        G[3 + a] = E[0, a] * Gn[3] + E[1, a] * Gn[4] + E[2, a] * Gn[5]
+    h[3], h[4], h[5] = euler_columns(hn[3], hn[4], hn[5], E)
+    G[3], G[4], G[5] = euler_columns(Gn[3], Gn[4], Gn[5], E)
     for i in range(6):
-        _rotation_columns(J_leg[i], E)
+        J_leg[i, 3], J_leg[i, 4], J_leg[i, 5] = euler_columns(
+            J_leg[i, 3], J_leg[i, 4], J_leg[i, 5], E)
         for j in range(N_JOINTS):
-            _rotation_columns(J_joint[i, j], E)
+            J_joint[i, j, 3], J_joint[i, j, 4], J_joint[i, j, 5] = euler_columns(
+                J_joint[i, j, 3], J_joint[i, j, 4], J_joint[i, j, 5], E)
 
 
-def _leg_geometry(R, upper, base, q, i, r, u, JA):
-    """Leg i: r = R upper_i, unit leg vector u (into ``r``, ``u``, (3,)), J_A = [I, -[r]x]
-    (velocity of the upper joint point from the twist, into ``JA`` (3, 6)); returns the leg
-    length (m)."""
-    s = 0.0
-    for k in range(3):
-        r[k] = R[k, 0] * upper[i, 0] + R[k, 1] * upper[i, 1] + R[k, 2] * upper[i, 2]
-        u[k] = q[k] + r[k] - base[i, k]
-        s += u[k] * u[k]
-    length = math.sqrt(s)
-    for k in range(3):
-        u[k] /= length
-    for k in range(3):
-        for c in range(6):
-            JA[k, c] = 0.0
-    JA[0, 0] = 1.0
-    JA[1, 1] = 1.0
-    JA[2, 2] = 1.0
-    JA[0, 4] = r[2]
-    JA[0, 5] = -r[1]
-    JA[1, 3] = -r[2]
-    JA[1, 5] = r[0]
-    JA[2, 3] = r[1]
-    JA[2, 4] = -r[0]
-    return length
-
-
-def _joint_axes(u, Jw, w_rel, J_joint_leg):
-    """Rates of a leg's five joint axes per twist component (into ``J_joint_leg`` (5, 6)),
-    from its unit vector ``u`` and angular-velocity Jacobian ``Jw`` (3, 6); ``w_rel`` (3,) is
-    scratch. Leg frame e1 = unit(z x u), e2 = u x e1."""
-    nx, ny = -u[1], u[0]
-    nn = math.sqrt(nx * nx + ny * ny)
-    e10, e11 = nx / nn, ny / nn
-    e20 = -u[2] * e11
-    e21 = u[2] * e10
-    e22 = u[0] * e11 - u[1] * e10
-    for c in range(6):
-        for k in range(3):
-            w_rel[k] = -Jw[k, c]
-        if c >= 3:
-            w_rel[c - 3] += 1.0
-        J_joint_leg[0, c] = e10 * Jw[0, c] + e11 * Jw[1, c]
-        J_joint_leg[1, c] = e20 * Jw[0, c] + e21 * Jw[1, c] + e22 * Jw[2, c]
-        J_joint_leg[2, c] = e10 * w_rel[0] + e11 * w_rel[1]
-        J_joint_leg[3, c] = e20 * w_rel[0] + e21 * w_rel[1] + e22 * w_rel[2]
-        J_joint_leg[4, c] = u[0] * w_rel[0] + u[1] * w_rel[1] + u[2] * w_rel[2]
-
-
-def _rotation_columns(row, E):
-    """Map the angular part of a twist row (6,) to Euler-angle rates in place: row[3:] E."""
-    x0 = row[3]
-    x1 = row[4]
-    x2 = row[5]
-    for b in range(3):
-        row[3 + b] = x0 * E[0, b] + x1 * E[1, b] + x2 * E[2, b]
+def joint_friction_torque(rate, gimbal, viscous, coulomb, smoothing):
+    """Friction torque (N m) of one joint axis turning at ``rate`` (rad/s): viscous on a
+    ``gimbal`` axis, Coulomb on every axis, regularised as
+    coulomb * rate / sqrt(rate^2 + smoothing^2)."""
+    tau = 0.0
+    if coulomb > 0.0:
+        tau = coulomb * rate / math.sqrt(rate * rate + smoothing * smoothing)
+    if gimbal:
+        tau += viscous * rate
+    return tau
 
 
 def joint_friction(params, J_joint, qd, smoothing):
-    """Generalized joint friction forces (N, N m) at one sample, regularised Coulomb.
-
-    Viscous on the gimbal axes, Coulomb Fc * rate / sqrt(rate^2 + smoothing^2) on all five.
-    """
-    c = params[P_VISCOUS]
-    fc = params[P_COULOMB]
+    """Generalized joint friction forces (N, N m) at one sample (:func:`joint_friction_torque`
+    on every axis of every leg)."""
     F = np.zeros(6)
     for i in range(6):
         for j in range(N_JOINTS):
             rate = J_joint[i, j] @ qd
-            tau = fc * rate / math.sqrt(rate * rate + smoothing * smoothing)
-            if j < 4:
-                tau += c * rate
-            F += tau * J_joint[i, j]
+            F += joint_friction_torque(rate, j < N_GIMBAL_AXES, params[layout.VISCOUS],
+                                       params[layout.COULOMB], smoothing) * J_joint[i, j]
     return F
 
 

@@ -15,14 +15,32 @@ from typing import NamedTuple
 import numpy as np
 
 from stewartid.errors import KinematicsError
-from stewartid.model.leg_terms import LegTerms, leg_terms
+from stewartid.model.kernels import rotation_entries
+from stewartid.model.leg_terms import LegTerms, leg_terms, leg_vectors
 from stewartid.platform import Platform
 
-#: Names of the five rotational joint axes of a leg, in the order of joint_rate_jacobians.
-JOINT_AXES = ("lower_1", "lower_2", "upper_1", "upper_2", "revolute")
 
+def as_batch(q: np.ndarray, name: str = "q") -> tuple[np.ndarray, bool]:
+    """A pose-like array (6,) or (N, 6) as a contiguous float batch (N, 6).
 
-def _batch(q: np.ndarray, name: str = "q") -> tuple[np.ndarray, bool]:
+    Parameters
+    ----------
+    q : array_like, shape (6,) or (N, 6)
+    name : str
+        Its name in the error message.
+
+    Returns
+    -------
+    batch : ndarray, shape (N, 6)
+        N = 1 for a single row.
+    single : bool
+        Whether ``q`` was a single row (callers return ``result[0]`` then).
+
+    Raises
+    ------
+    ValueError
+        If ``q`` has another shape.
+    """
     q = np.asarray(q, dtype=float)
     single = q.ndim == 1
     q2 = np.ascontiguousarray(q[None] if single else q)
@@ -44,15 +62,8 @@ def rotation_matrix(angles: np.ndarray) -> np.ndarray:
     ndarray, shape (3, 3) or (N, 3, 3)
     """
     a = np.asarray(angles, dtype=float)
-    cx, sx = np.cos(a[..., 0]), np.sin(a[..., 0])
-    cy, sy = np.cos(a[..., 1]), np.sin(a[..., 1])
-    cz, sz = np.cos(a[..., 2]), np.sin(a[..., 2])
-    R = np.stack([
-        np.stack([cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx], -1),
-        np.stack([sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx], -1),
-        np.stack([-sy, cy * sx, cy * cx], -1),
-    ], -2)
-    return R
+    entries = rotation_entries(*(f(a[..., k]) for k in range(3) for f in (np.cos, np.sin)))
+    return np.stack(entries, -1).reshape(*a.shape[:-1], 3, 3)
 
 
 class LegState(NamedTuple):
@@ -87,36 +98,38 @@ def inverse_kinematics(platform: Platform, q: np.ndarray) -> LegState:
     LegState
         With a leading sample axis of length N (1 for a single pose).
     """
-    q2, _ = _batch(q)
-    R = rotation_matrix(q2[:, 3:])
-    upper = q2[:, None, :3] + np.einsum("nij,kj->nki", R, platform.upper_joints)
-    legs = upper - platform.base_joints[None]
-    lengths = np.linalg.norm(legs, axis=-1)
-    return LegState(lengths, legs / lengths[..., None], upper)
+    q2, _ = as_batch(q)
+    _, r, u, lengths = leg_vectors(platform.upper_joints, platform.base_joints, q2)
+    upper = np.stack([q2[:, k:k + 1] + r[k] for k in range(3)], -1)
+    return LegState(lengths, np.stack(u, -1), upper)
 
 
 def leg_lengths(platform: Platform, q: np.ndarray) -> np.ndarray:
     """Leg lengths (m) for poses ``q``: shape (6,) for one pose, (N, 6) for a batch."""
-    q2, single = _batch(q)
+    q2, single = as_batch(q)
     lengths = inverse_kinematics(platform, q2).lengths
     return lengths[0] if single else lengths
 
 
-def _terms(platform: Platform, q: np.ndarray, qd: np.ndarray | None = None):
-    from stewartid.model import compiled  # numba: only the full model terms need it
+def compute_leg_terms(platform: Platform, q: np.ndarray, joints: bool = False,
+                      pose_terms: bool = True) -> LegTerms:
+    """G(q), J_lq, leg lengths and joint-rate Jacobians at poses ``q``, without the inertia
+    terms: :func:`stewartid.model.leg_terms.leg_terms` for ``platform``.
 
-    q2, single = _batch(q)
-    qd2 = np.zeros_like(q2) if qd is None else _batch(qd, "q_dot")[0]
-    if qd2.shape != q2.shape:
-        raise ValueError(f"q_dot must have the shape of q {q2.shape}; got {qd2.shape}.")
-    return compiled.batch_terms(platform.parameters(), platform.upper_joints,
-                                platform.base_joints, q2, qd2), single
+    Parameters
+    ----------
+    platform : Platform
+    q : ndarray, shape (N, 6)
+        Poses (m, rad).
+    joints : bool
+        Also compute the joint-rate Jacobians (else ``joint_jacobians`` is empty).
+    pose_terms : bool
+        False: leave ``gravity`` and ``leg_jacobian`` empty.
 
-
-def _leg_terms(platform: Platform, q: np.ndarray, joints: bool = False,
-               pose_terms: bool = True) -> LegTerms:
-    """(G, J_leg, lengths, J_joint) at poses q (N, 6), without the inertia terms; J_joint is
-    empty unless ``joints``, G and J_leg unless ``pose_terms``."""
+    Returns
+    -------
+    LegTerms
+    """
     return leg_terms(platform.parameters(), platform.upper_joints, platform.base_joints, q,
                      joints, pose_terms)
 
@@ -135,25 +148,25 @@ def leg_jacobian(platform: Platform, q: np.ndarray) -> np.ndarray:
         Row k: d l_k / d q (m/m, m/rad). J_lq^T f maps actuator forces (N) to generalized
         forces (N, N m).
     """
-    q2, single = _batch(q)
-    J_leg = _leg_terms(platform, q2)[1]
+    q2, single = as_batch(q)
+    J_leg = compute_leg_terms(platform, q2)[1]
     return J_leg[0] if single else J_leg
 
 
 def joint_rate_jacobians(platform: Platform, q: np.ndarray) -> np.ndarray:
     """Jacobians of the five rotational joint axes of every leg.
 
-    Joint rates (rad/s) = J[..., leg, axis, :] @ q_dot, axes ordered as :data:`JOINT_AXES`:
-    two lower gimbal axes, two upper gimbal axes, the revolute about the leg. The gimbal
-    axes are an orthonormal leg frame e1 = unit(z x u) (horizontal), e2 = u x e1; see
-    ``docs/conventions.md``.
+    Joint rates (rad/s) = J[..., leg, axis, :] @ q_dot, axes ordered as
+    :data:`stewartid.model.joints.JOINT_AXES`: two lower gimbal axes, two upper gimbal axes,
+    the revolute about the leg. The gimbal axes are an orthonormal leg frame
+    e1 = unit(z x u) (horizontal), e2 = u x e1; see ``docs/conventions.md``.
 
     Returns
     -------
     ndarray, shape (6, 5, 6) or (N, 6, 5, 6)
     """
-    q2, single = _batch(q)
-    J_joint = _leg_terms(platform, q2, joints=True, pose_terms=False)[3]
+    q2, single = as_batch(q)
+    J_joint = compute_leg_terms(platform, q2, joints=True, pose_terms=False)[3]
     return J_joint[0] if single else J_joint
 
 
@@ -183,15 +196,15 @@ def forward_kinematics(platform: Platform, lengths: np.ndarray, initial: np.ndar
     KinematicsError
         If some sample does not converge or meets a singular Jacobian.
     """
-    l2, single = _batch(lengths, "lengths")
+    l2, single = as_batch(lengths, "lengths")
     if not np.all(np.isfinite(l2)) or np.any(l2 <= 0):
         raise KinematicsError("leg lengths must be finite and positive for forward kinematics.")
     q = np.tile(platform.neutral_pose, (len(l2), 1)) if initial is None else \
-        np.array(np.broadcast_to(_batch(initial, "initial")[0], l2.shape))
+        np.array(np.broadcast_to(as_batch(initial, "initial")[0], l2.shape))
     residual = np.inf
     active = np.arange(len(q))  # samples not yet converged: only they are iterated
     for _ in range(max_iterations):
-        _, J, current, _ = _leg_terms(platform, q[active])
+        _, J, current, _ = compute_leg_terms(platform, q[active])
         error = current - l2[active]
         residual_active = np.max(np.abs(error), axis=1)
         keep = residual_active >= tolerance

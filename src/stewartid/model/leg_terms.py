@@ -6,10 +6,13 @@ the mass matrix and velocity products of :func:`stewartid.model.kernels.model_te
 simulator's compiled kernel, which evaluates the same leg geometry at one state).
 
 Numpy, not numba: in a fresh process, starting numba and loading its cached kernels costs
-0.5-1 s, more than these terms take for the 6 x 20 s at 1 kHz of an identification. Each
-leg's twist Jacobian J_A = [I, -[r]x] is written out by column so that its structural zeros
-are never multiplied; the other products and sums are in the kernel's order, and the results
-equal the kernel's to the last bit (``tests/test_dynamics.py``).
+0.5-1 s, more than these terms take for the 6 x 20 s at 1 kHz of an identification. The
+terms are the kernels' own per-sample geometry functions (:func:`~stewartid.model.kernels.leg_vector`,
+:func:`~stewartid.model.kernels.joint_rate_column`, ...) applied to arrays of samples: one
+definition, the same numbers to the last bit (``tests/test_dynamics.py``). Where the kernel
+passes 0.0 and 1.0 for the structural zeros and ones of J_A = [I, -[r]x], this module passes
+:data:`ZERO` and :data:`ONE`, which drop out of sums and products without a whole-array
+operation.
 
 Coordinates and joint axes as in :mod:`stewartid.model.kernels`: q = [x, y, z, rx, ry, rz] (m, rad),
 R = Rz Ry Rx, twist nu = [v, omega] mapped to q rates by E(q); leg frame e1 = unit(z x u),
@@ -18,12 +21,25 @@ e2 = u x e1; joint axes [lower 1, lower 2, upper 1, upper 2, revolute].
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
-#: Indices into Platform.parameters() (the kernels' packed vector) used here.
-_MASS, _M_UPPER, _M_LOWER, _D_UPPER, _D_LOWER, _GRAVITY = 0, 4, 5, 6, 7, 12
+from stewartid.model import parameters as layout
+from stewartid.model.joints import N_JOINTS
+from stewartid.model.kernels import (
+    centre_of_mass_rates,
+    euler_columns,
+    euler_rate_entries,
+    joint_rate_column,
+    leg_angular_rate,
+    leg_frame,
+    leg_gravity,
+    leg_rate,
+    leg_vector,
+    rotation_entries,
+    twist_column,
+)
 
 
 class LegTerms(NamedTuple):
@@ -52,23 +68,59 @@ class LegTerms(NamedTuple):
 BLOCK = 2048
 
 
-def _dot(*pairs):
-    """Sum of the products a * b of ``pairs`` in order, None standing for an exact zero factor
-    (skipped, as adding a zero product leaves the kernel's sum unchanged); None if all are."""
-    total = None
-    for a, b in pairs:
-        if a is None or b is None:
-            continue
-        product = a * b
-        total = product if total is None else total + product
-    return total
+class _StructuralZero:
+    """An exact zero in the kernels' arithmetic on arrays: x + ZERO is x, x * ZERO is ZERO.
+
+    IEEE arithmetic gives the same values (up to the sign of a zero) for the kernel's 0.0, so
+    skipping these whole-array operations changes no number.
+    """
+
+    __array_ufunc__ = None  # arrays defer their operators to this class's reflected ones
+
+    def __mul__(self, other: Any) -> _StructuralZero:
+        return self
+
+    __rmul__ = __mul__
+    __truediv__ = __mul__
+
+    def __neg__(self) -> _StructuralZero:
+        return self
+
+    def __add__(self, other: Any) -> Any:
+        return other
+
+    __radd__ = __add__
+    __rsub__ = __add__
+
+    def __sub__(self, other: Any) -> Any:
+        return -other
 
 
-def _euler_columns(x0, x1, x2, E):
-    """Twist rows' angular part [x0, x1, x2] times E = (E00, E10, E20, E01, E11): the same rows
-    in Euler-angle rates (E21 = E02 = E12 = 0, E22 = 1)."""
-    E00, E10, E20, E01, E11 = E
-    return _dot((x0, E00), (x1, E10), (x2, E20)), _dot((x0, E01), (x1, E11)), x2
+class _StructuralOne:
+    """An exact one in the kernels' arithmetic on arrays: x * ONE is x itself."""
+
+    __array_ufunc__ = None
+
+    def __mul__(self, other: Any) -> Any:
+        return other
+
+    __rmul__ = __mul__
+
+    def __sub__(self, other: Any) -> Any:
+        return 1.0 - other
+
+    def __rsub__(self, other: Any) -> Any:
+        return other - 1.0
+
+    def __add__(self, other: Any) -> Any:
+        return other + 1.0
+
+    __radd__ = __add__
+
+
+#: The structural zero and one of J_A passed to the kernels' geometry functions.
+ZERO = _StructuralZero()
+ONE = _StructuralOne()
 
 
 def leg_terms(params: np.ndarray, upper: np.ndarray, base: np.ndarray, q: np.ndarray,
@@ -77,8 +129,9 @@ def leg_terms(params: np.ndarray, upper: np.ndarray, base: np.ndarray, q: np.nda
 
     Parameters
     ----------
-    params : ndarray, shape (13,)
-        Packed mass and friction parameters (``Platform.parameters()``).
+    params : ndarray, shape (N_PARAMETERS,)
+        Packed mass and friction parameters (``Platform.parameters()``,
+        :mod:`stewartid.model.parameters`).
     upper : ndarray, shape (6, 3)
         Upper joints in the platform frame, relative to the reference point (m).
     base : ndarray, shape (6, 3)
@@ -108,88 +161,76 @@ def leg_terms(params: np.ndarray, upper: np.ndarray, base: np.ndarray, q: np.nda
     return out
 
 
+def leg_vectors(upper: np.ndarray, base: np.ndarray, q: np.ndarray
+                ) -> tuple[tuple[np.ndarray, ...], list[np.ndarray], list[np.ndarray], np.ndarray]:
+    """Leg vectors at poses ``q`` by :func:`~stewartid.model.kernels.leg_vector`.
+
+    Parameters
+    ----------
+    upper, base : ndarray, shape (6, 3)
+        Upper joints (platform frame, from the reference point) and base joints (m).
+    q : ndarray, shape (N, 6)
+        Poses (m, rad).
+
+    Returns
+    -------
+    E : tuple of 5 ndarrays, shape (N, 1)
+        Entries of the Euler-rate map (:func:`~stewartid.model.kernels.euler_rate_entries`).
+    r, u : lists of 3 ndarrays, shape (N, 6)
+        Components of R upper_i (m) and of the unit leg vectors, per sample and leg.
+    lengths : ndarray, shape (N, 6)
+        Leg lengths (m).
+    """
+    trig = [f(q[:, k:k + 1]) for k in (3, 4, 5) for f in (np.cos, np.sin)]  # (N, 1) each
+    r0, r1, r2, u0, u1, u2, lengths = leg_vector(rotation_entries(*trig), q[:, 0:1], q[:, 1:2],
+                                                 q[:, 2:3], *upper.T, *base.T)
+    return euler_rate_entries(*trig[2:]), [r0, r1, r2], [u0, u1, u2], lengths
+
+
 def _leg_terms_block(params, upper, base, q, G, J_leg, lengths, J_joint):
     """:func:`leg_terms` for one block of samples, into the outputs (G and J_leg, J_joint
-    if not None)."""
-    sx, cx = np.sin(q[:, 3:4]), np.cos(q[:, 3:4])  # (n, 1): broadcast over the legs
-    sy, cy = np.sin(q[:, 4:5]), np.cos(q[:, 4:5])
-    sz, cz = np.sin(q[:, 5:6]), np.cos(q[:, 5:6])
-    R = ((cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx),
-         (sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx),
-         (-sy, cy * sx, cy * cx))
-    E = (cz * cy, sz * cy, -sy, -sz, cz)
-    # r = R upper_i and the unit leg vector u, each component of shape (n, 6)
-    r = [R[k][0] * upper[:, 0] + R[k][1] * upper[:, 1] + R[k][2] * upper[:, 2]
-         for k in range(3)]
-    s = [q[:, k:k + 1] + r[k] - base[:, k] for k in range(3)]
-    length = np.sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2])
+    if not None). Every leg quantity has shape (n, 6): samples by legs."""
+    E, (r0, r1, r2), u, length = leg_vectors(upper, base, q)
     lengths[:] = length
-    u = [s[k] / length for k in range(3)]
-    r0, r1, r2 = r
+    columns = [twist_column(c, r0, r1, r2, ZERO, ONE) for c in range(6)]
+    if G is not None:
+        rates = [leg_rate(*u, *b) for b in columns]
+        _gravity(params, u[2], columns, rates, length, tuple(e[:, 0] for e in E), G)
+        for c, column in enumerate([*rates[:3], *euler_columns(*rates[3:], E)]):
+            J_leg[:, :, c] = column
+    if J_joint is not None:
+        _joint_jacobians(u, columns, length, E, J_joint)
 
-    # columns of J_A = [I, -[r]x] (None: structural zero) and u . J_A[:, c]
-    JA = [(1.0, None, None), (None, 1.0, None), (None, None, 1.0),
-          (None, -r2, r1), (r2, None, -r0), (-r1, r0, None)]
-    if G is None:  # joint Jacobians only
-        _joint_jacobians(u, JA, length, E, J_joint)
-        return
-    uJ = [_dot(*zip(u, column, strict=True)) for column in JA]
 
-    m_u, m_l = params[_M_UPPER], params[_M_LOWER]
-    d_u, d_l = params[_D_UPPER], params[_D_LOWER]
-    g = params[_GRAVITY]
-    Gn = [0.0, 0.0, -params[_MASS] * g, 0.0, 0.0, 0.0]
-    for c in range(6):
-        # vertical velocity of the two centres of mass (gravity is along z), summed leg by
-        # leg in the kernel's order
-        JA2 = 0.0 if JA[c][2] is None else JA[c][2]
-        Judot2 = (JA2 - u[2] * uJ[c]) / length
-        vertical = JA2 - d_u * Judot2
-        term = g * (m_l * (d_l * Judot2) + m_u * vertical)
+def _gravity(params, u2, columns, rates, length, E, G):
+    """G (into ``G``, (n, 6)) from the vertical component of the unit leg vectors, the columns
+    of J_A, the leg-length rates per column, the leg lengths and the entries of E (n,),
+    summed leg by leg in the kernel's order."""
+    m_u, m_l = params[layout.M_UPPER], params[layout.M_LOWER]
+    d_u, d_l = params[layout.D_UPPER], params[layout.D_LOWER]
+    g = params[layout.GRAVITY]
+    Gn = [0.0, 0.0, -params[layout.MASS] * g, 0.0, 0.0, 0.0]
+    for c, b in enumerate(columns):
+        _, lower_z, upper_z = centre_of_mass_rates(b[2], u2, rates[c], length, d_u, d_l)
+        term = leg_gravity(g, m_u, m_l, lower_z, upper_z)
         for i in range(6):
             Gn[c] = Gn[c] - term[:, i]
-    E = tuple(e[:, 0] for e in E)
     G[:, :3] = np.stack(Gn[:3], -1)
-    G[:, 3:] = np.stack(_euler_columns(*Gn[3:], E), -1)
-    E = tuple(e[:, None] for e in E)
-    for c, column in enumerate([*uJ[:3], *_euler_columns(*uJ[3:], E)]):
-        J_leg[:, :, c] = column
-    if J_joint is not None:
-        _joint_jacobians(u, JA, length, E, J_joint)
+    G[:, 3:] = np.stack(euler_columns(*Gn[3:], E), -1)
 
 
-def _joint_jacobians(u, JA, length, E, out):
+def _joint_jacobians(u, columns, length, E, out):
     """Joint-axis Jacobians (into ``out``, (n, 6, 5, 6)) from the unit leg vectors ``u``
     (components (n, 6)), the columns of J_A, the leg lengths (n, 6) and the entries of E."""
-    u0, u1, u2 = u
-    nx, ny = -u1, u0
-    nn = np.sqrt(nx * nx + ny * ny)
-    e1 = (nx / nn, ny / nn)
-    e2 = (-u2 * e1[1], u2 * e1[0], u0 * e1[1] - u1 * e1[0])
-    rows = [[None] * 6 for _ in range(5)]
-    for c, b in enumerate(JA):
-        # angular velocity of the leg, u x J_A[:, c] / l, and of the platform relative to it
-        cross = [_dot((u[1], b[2]), (u[2], None if b[1] is None else -b[1])),
-                 _dot((u[2], b[0]), (u[0], None if b[2] is None else -b[2])),
-                 _dot((u[0], b[1]), (u[1], None if b[0] is None else -b[0]))]
-        Jw = [None if w is None else w / length for w in cross]
-        rows[0][c] = _dot((e1[0], Jw[0]), (e1[1], Jw[1]))
-        rows[1][c] = _dot(*zip(e2, Jw, strict=True))
-        if c < 3:  # relative rate -Jw: the rows negated, exactly as the kernel's sums
-            along_leg = _dot(*zip(u, Jw, strict=True))
-            rows[2][c], rows[3][c], rows[4][c] = (
-                None if x is None else -x for x in (rows[0][c], rows[1][c], along_leg))
-            continue
-        w_rel = [None if w is None else -w for w in Jw]
-        w_rel[c - 3] = 1.0 if w_rel[c - 3] is None else w_rel[c - 3] + 1.0
-        rows[2][c] = _dot((e1[0], w_rel[0]), (e1[1], w_rel[1]))
-        rows[3][c] = _dot(*zip(e2, w_rel, strict=True))
-        rows[4][c] = _dot(*zip(u, w_rel, strict=True))
+    frame = leg_frame(*u)
+    by_column = [joint_rate_column(c, frame, *u, *leg_angular_rate(*u, *b, length))
+                 for c, b in enumerate(columns)]
     # gathered contiguously, then interleaved per sample in one copy (5x faster than
     # writing each (axis, column) entry across the samples)
-    gathered = np.empty((5, 6, *length.shape))
-    for j, row in enumerate(rows):
-        row[3:] = _euler_columns(*row[3:], E)
+    gathered = np.empty((N_JOINTS, 6, *length.shape))
+    for j in range(N_JOINTS):
+        row = [rates[j] for rates in by_column]
+        row[3:] = euler_columns(*row[3:], E)
         for c in range(6):
-            gathered[j, c] = 0.0 if row[c] is None else row[c]
+            gathered[j, c] = 0.0 if row[c] is ZERO else row[c]
     out[:] = gathered.transpose(2, 3, 0, 1)

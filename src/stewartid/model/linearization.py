@@ -15,7 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 from stewartid.model.dynamics import ModelTerms
-from stewartid.model.kernels import GIMBAL_AXES, model_terms
+from stewartid.model.joints import GIMBAL_AXES
+from stewartid.model.kernels import model_terms
 from stewartid.model.kinematics import joint_rate_jacobians
 from stewartid.platform import Platform
 

@@ -79,8 +79,6 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
 
 #: MuJoCo world coordinates = T @ paper coordinates (half a turn about x).
 T = np.diag([1.0, -1.0, -1.0])
-#: The same change of frame for 6-vectors of poses, rates and generalized forces.
-T6 = np.diag([1.0, -1.0, -1.0, 1.0, -1.0, -1.0])
 #: Share of the platform's mass carried by each leg's end body (see the module docstring).
 END_MASS_FRACTION = 1e-4
 #: Radius (m) of the sphere whose inertia the end bodies carry: large enough that the
@@ -204,25 +202,24 @@ def build_mjcf(platform: Platform, *, integrator: str = "RK4", timestep: float =
     tau = 2.0 * timestep if constraint_timeconst is None else float(constraint_timeconst)
     if not 0.0 < constraint_impedance < 1.0:
         raise ValueError(f"constraint_impedance must lie in (0, 1); got {constraint_impedance!r}.")
-    g = platform.geometry
-    i = platform.inertia
-    damping = platform.friction.gimbal_viscous
     friction = platform.friction.coulomb if coulomb else 0.0
     frictionloss = f' frictionloss="{friction:.17g}"' if friction > 0 else ""
-    l0 = platform.neutral_leg_length
-    frames = leg_frames(platform)
-    base = platform.base_joints
-    p0 = T @ platform.neutral_pose[:3]
     mass, com, full, end_mass, end_inertia = _platform_inertial(platform)
-    # MuJoCo refuses a zero principal inertia; our leg parts have none about the leg axis,
-    # about which the Cardan joints let them turn only at second order in the deflection,
-    # so a token value changes nothing measurable (1e-9 of the transverse inertia).
-    axial = f"{max(1e-9 * max(i.lower_leg_inertia, i.upper_leg_inertia), 1e-10):.3g}"
-    lower_t = max(i.lower_leg_inertia, 1e-10)
-    upper_t = max(i.upper_leg_inertia, 1e-10)
-    imp = f"{constraint_impedance:.17g}"
+    lines = _world_lines(platform, integrator, timestep, mass, com, full)
+    frames = leg_frames(platform)
+    for k in range(6):
+        lines += _leg_lines(platform, k, frames[k], frictionloss, end_mass, end_inertia)
+    lines += ["  </worldbody>", *_closure_lines(tau, constraint_impedance), "</mujoco>", ""]
+    return "\n".join(lines)
 
-    lines = [
+
+def _world_lines(platform: Platform, integrator: str, timestep: float, mass: float,
+                 com: np.ndarray, full: np.ndarray) -> list[str]:
+    """MJCF from the model's opening tag to the platform body: options, base and platform
+    (``mass``, ``com``, ``full`` from :func:`_platform_inertial`)."""
+    g = platform.geometry
+    p0 = T @ platform.neutral_pose[:3]
+    return [
         f'<mujoco model="stewartid-{platform.name}">',
         '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
         f'  <option timestep="{timestep:.17g}" integrator="{integrator}" '
@@ -244,40 +241,60 @@ def build_mjcf(platform: Platform, *, integrator: str = "RK4", timestep: float =
         f'pos="0 0 {-g.reference_height:.17g}" rgba="0.2 0.4 0.8 0.6"/>',
         "    </body>",
     ]
-    for k in range(6):
-        n = k + 1
-        R0 = T @ frames[k]  # leg frame in MuJoCo world coordinates, columns e1, e2, u
-        lines += [
-            f'    <body name="leg{n}_cylinder" pos="{_vec(T @ base[k])}" '
-            f'xyaxes="{_vec(R0[:, 0])} {_vec(R0[:, 1])}">',
-            f'      <joint name="leg{n}_lower1" type="hinge" axis="1 0 0" '
-            f'damping="{damping:.17g}"{frictionloss}/>',
-            f'      <joint name="leg{n}_lower2" type="hinge" axis="0 1 0" '
-            f'damping="{damping:.17g}"{frictionloss}/>',
-            f'      <inertial pos="0 0 {i.lower_leg_com:.17g}" mass="{i.lower_leg_mass:.17g}" '
-            f'diaginertia="{lower_t:.17g} {lower_t:.17g} {axial}"/>',
-            f'      <geom type="capsule" size="0.06" fromto="0 0 0 0 0 {0.55 * l0:.6g}" '
-            'rgba="0.6 0.6 0.6 1"/>',
-            f'      <body name="leg{n}_rod" pos="0 0 {l0:.17g}">',
-            f'        <joint name="leg{n}_slide" type="slide" axis="0 0 1"/>',
-            f'        <inertial pos="0 0 {-i.upper_leg_com:.17g}" '
-            f'mass="{i.upper_leg_mass:.17g}" diaginertia="{upper_t:.17g} {upper_t:.17g} '
-            f'{axial}"/>',
-            f'        <geom type="capsule" size="0.035" fromto="0 0 {-0.55 * l0:.6g} 0 0 0" '
-            'rgba="0.8 0.8 0.8 1"/>',
-            f'        <body name="leg{n}_end">',
-            f'          <joint name="leg{n}_upper1" type="hinge" axis="1 0 0" '
-            f'damping="{damping:.17g}"{frictionloss}/>',
-            f'          <joint name="leg{n}_upper2" type="hinge" axis="0 1 0" '
-            f'damping="{damping:.17g}"{frictionloss}/>',
-            f'          <joint name="leg{n}_revolute" type="hinge" axis="0 0 1"{frictionloss}/>',
-            f'          <inertial pos="0 0 0" mass="{end_mass:.17g}" '
-            f'diaginertia="{end_inertia:.17g} {end_inertia:.17g} {end_inertia:.17g}"/>',
-            "        </body>",
-            "      </body>",
-            "    </body>",
-        ]
-    lines += ["  </worldbody>", "  <equality>"]
+
+
+def _leg_lines(platform: Platform, k: int, frame: np.ndarray, frictionloss: str,
+               end_mass: float, end_inertia: float) -> list[str]:
+    """MJCF of leg ``k``'s chain: cylinder on the lower gimbal, rod on the slide, end body on
+    the upper gimbal and revolute; ``frame`` (3, 3) its leg frame (:func:`leg_frames`)."""
+    i = platform.inertia
+    damping = platform.friction.gimbal_viscous
+    l0 = platform.neutral_leg_length
+    # MuJoCo refuses a zero principal inertia; our leg parts have none about the leg axis,
+    # about which the Cardan joints let them turn only at second order in the deflection,
+    # so a token value changes nothing measurable (1e-9 of the transverse inertia).
+    axial = f"{max(1e-9 * max(i.lower_leg_inertia, i.upper_leg_inertia), 1e-10):.3g}"
+    lower_t = max(i.lower_leg_inertia, 1e-10)
+    upper_t = max(i.upper_leg_inertia, 1e-10)
+    n = k + 1
+    R0 = T @ frame  # leg frame in MuJoCo world coordinates, columns e1, e2, u
+    return [
+        f'    <body name="leg{n}_cylinder" pos="{_vec(T @ platform.base_joints[k])}" '
+        f'xyaxes="{_vec(R0[:, 0])} {_vec(R0[:, 1])}">',
+        f'      <joint name="leg{n}_lower1" type="hinge" axis="1 0 0" '
+        f'damping="{damping:.17g}"{frictionloss}/>',
+        f'      <joint name="leg{n}_lower2" type="hinge" axis="0 1 0" '
+        f'damping="{damping:.17g}"{frictionloss}/>',
+        f'      <inertial pos="0 0 {i.lower_leg_com:.17g}" mass="{i.lower_leg_mass:.17g}" '
+        f'diaginertia="{lower_t:.17g} {lower_t:.17g} {axial}"/>',
+        f'      <geom type="capsule" size="0.06" fromto="0 0 0 0 0 {0.55 * l0:.6g}" '
+        'rgba="0.6 0.6 0.6 1"/>',
+        f'      <body name="leg{n}_rod" pos="0 0 {l0:.17g}">',
+        f'        <joint name="leg{n}_slide" type="slide" axis="0 0 1"/>',
+        f'        <inertial pos="0 0 {-i.upper_leg_com:.17g}" '
+        f'mass="{i.upper_leg_mass:.17g}" diaginertia="{upper_t:.17g} {upper_t:.17g} '
+        f'{axial}"/>',
+        f'        <geom type="capsule" size="0.035" fromto="0 0 {-0.55 * l0:.6g} 0 0 0" '
+        'rgba="0.8 0.8 0.8 1"/>',
+        f'        <body name="leg{n}_end">',
+        f'          <joint name="leg{n}_upper1" type="hinge" axis="1 0 0" '
+        f'damping="{damping:.17g}"{frictionloss}/>',
+        f'          <joint name="leg{n}_upper2" type="hinge" axis="0 1 0" '
+        f'damping="{damping:.17g}"{frictionloss}/>',
+        f'          <joint name="leg{n}_revolute" type="hinge" axis="0 0 1"{frictionloss}/>',
+        f'          <inertial pos="0 0 0" mass="{end_mass:.17g}" '
+        f'diaginertia="{end_inertia:.17g} {end_inertia:.17g} {end_inertia:.17g}"/>',
+        "        </body>",
+        "      </body>",
+        "    </body>",
+    ]
+
+
+def _closure_lines(tau: float, impedance: float) -> list[str]:
+    """MJCF of the welds that close each leg on the platform (time constant ``tau`` s,
+    impedance d) and of the leg motors."""
+    imp = f"{impedance:.17g}"
+    lines = ["  <equality>"]
     for k in range(6):
         # relpose omitted: the relative pose of the neutral configuration (qpos0), where every
         # chain meets the platform exactly; anchor 0 puts the position rows at the joint A
@@ -286,8 +303,8 @@ def build_mjcf(platform: Platform, *, integrator: str = "RK4", timestep: float =
     lines += ["  </equality>", "  <actuator>"]
     for k in range(6):
         lines.append(f'    <motor name="leg{k + 1}" joint="leg{k + 1}_slide" gear="1"/>')
-    lines += ["  </actuator>", "</mujoco>", ""]
-    return "\n".join(lines)
+    lines.append("  </actuator>")
+    return lines
 
 
 def load_model(platform: Platform, **options: Any) -> mujoco.MjModel:

@@ -22,6 +22,7 @@ import numpy as np
 from stewartid.errors import ConfigError
 from stewartid.fields import section_from_mapping, section_to_mapping
 from stewartid.files import read_toml
+from stewartid.model import parameters as layout
 from stewartid.platform.sections import (
     Controller,
     Friction,
@@ -128,16 +129,19 @@ class Platform:
 
         Returns
         -------
-        ndarray, shape (13,)
-            [m, Ixx, Iyy, Izz, m_upper, m_lower, d_upper, d_lower, I_upper, I_lower,
-            gimbal_viscous, coulomb, gravity].
+        ndarray, shape (N_PARAMETERS,)
+            Laid out as :mod:`stewartid.model.parameters` defines.
         """
         i, f = self.inertia, self.friction
-        return np.array([
-            i.platform_mass, *i.platform_inertia, i.upper_leg_mass, i.lower_leg_mass,
-            i.upper_leg_com, i.lower_leg_com, i.upper_leg_inertia, i.lower_leg_inertia,
-            f.gimbal_viscous, f.coulomb, GRAVITY,
-        ])
+        packed = np.empty(layout.N_PARAMETERS)
+        packed[layout.MASS] = i.platform_mass
+        packed[[layout.IXX, layout.IYY, layout.IZZ]] = i.platform_inertia
+        packed[layout.M_UPPER], packed[layout.M_LOWER] = i.upper_leg_mass, i.lower_leg_mass
+        packed[layout.D_UPPER], packed[layout.D_LOWER] = i.upper_leg_com, i.lower_leg_com
+        packed[layout.I_UPPER], packed[layout.I_LOWER] = i.upper_leg_inertia, i.lower_leg_inertia
+        packed[layout.VISCOUS], packed[layout.COULOMB] = f.gimbal_viscous, f.coulomb
+        packed[layout.GRAVITY] = GRAVITY
+        return packed
 
     # -- construction and serialisation -----------------------------------------------------
     def replace(self, **sections_or_values: Any) -> Platform:

@@ -21,9 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from stewartid.assessment.validation import FRICTION_TYPES
 from stewartid.files import write_bytes_atomic, write_text_atomic
 from stewartid.identification.result import IdentificationResult
+from stewartid.model.joints import FRICTION_TYPES
 from stewartid.platform import COORDINATES
 
 

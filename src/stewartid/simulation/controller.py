@@ -34,7 +34,6 @@ from stewartid.simulation.hydraulics import force_limits
 
 # indices into the packed controller parameter vector
 C_KP, C_KI, C_KD, C_KF, C_FMIN, C_FMAX = range(6)
-N_CONTROLLER_PARAMETERS = 6
 
 
 def controller_parameters(platform: Platform) -> np.ndarray:

@@ -39,7 +39,6 @@ from stewartid.platform import Hydraulics
 # indices into the packed hydraulic parameter vector
 H_AREA_A, H_AREA_B, H_SUPPLY, H_RETURN, H_BULK, H_DEAD, H_STROKE, H_MID = range(8)
 H_GAIN, H_TRANSITION, H_VALVE_OMEGA, H_VALVE_ZETA, H_LEAK = range(8, 13)
-N_HYDRAULIC_PARAMETERS = 13
 
 
 def hydraulic_parameters(hydraulics: Hydraulics, mid_stroke_length: float) -> np.ndarray:

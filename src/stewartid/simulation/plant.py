@@ -20,7 +20,7 @@ N m s/rad at Fc = 5 N m, about ten times the viscous gimbal friction), which the
 include (they are taken at rest, where that damping is largest).
 
 Friction: viscous on the four gimbal axes of each leg, Coulomb on all five rotational axes,
-regularised as Fc w / sqrt(w^2 + s^2) (:func:`stewartid.model.compiled.joint_friction`). Within
+regularised as Fc w / sqrt(w^2 + s^2) (:func:`stewartid.model.kernels.joint_friction_torque`). Within
 |w| < s a joint behaves as a very stiff viscous damper: it sticks (creeps at a rate below
 s, 1e-4 rad/s) until the applied torque exceeds Fc, then slips with the full Coulomb torque
 opposing the motion, so the stick-slip transitions are resolved without event detection.
@@ -34,6 +34,8 @@ import numpy as np
 from numba import njit
 
 from stewartid.model import compiled
+from stewartid.model import parameters as layout
+from stewartid.model.joints import N_GIMBAL_AXES, N_JOINTS
 from stewartid.simulation.controller import pid_force, valve_command
 from stewartid.simulation.hydraulics import H_MID, H_STROKE, actuator_force, pressure_rates
 
@@ -128,18 +130,14 @@ def rhs(y, dy, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, hyd
         for i in range(6):
             s += J[i, c] * force[i]
         work[c] = s
-    viscous = params[compiled.P_VISCOUS]
-    coulomb = params[compiled.P_COULOMB]
+    viscous = params[layout.VISCOUS]
+    coulomb = params[layout.COULOMB]
     for i in range(6):
-        for j in range(compiled.N_JOINTS):
+        for j in range(N_JOINTS):
             w = 0.0
             for c in range(6):
                 w += Jj[i, j, c] * qd[c]
-            tau = 0.0
-            if coulomb > 0.0:
-                tau = coulomb * w / math.sqrt(w * w + smoothing * smoothing)
-            if j < 4:
-                tau += viscous * w
+            tau = compiled.joint_friction_torque(w, j < N_GIMBAL_AXES, viscous, coulomb, smoothing)
             for c in range(6):
                 work[c] -= tau * Jj[i, j, c]
     _solve_spd(M, work, chol, qdd)

@@ -60,7 +60,6 @@ import numpy as np
 from stewartid.datasets.dataset import Dataset
 from stewartid.fields import Interval, ListOf, Options, nonnegative, positive, validate_parameters
 from stewartid.identification.base import BaseIdentifier
-from stewartid.identification.least_squares import JOINT_TYPES
 from stewartid.identification.preparation import Experiment, prepare
 from stewartid.identification.registry import Preset, register_method
 from stewartid.identification.result import IdentificationResult
@@ -80,6 +79,7 @@ from stewartid.identification.wavelet.gls import solve_weak_form
 from stewartid.identification.wavelet.noise import generalized_force_sensitivity
 from stewartid.identification.wavelet.point_equations import EXACT_DEGREE, point_equations
 from stewartid.identification.wavelet.weak_form import interval_equations
+from stewartid.model.joints import JOINT_TYPES
 from stewartid.model.kinematics import joint_rate_jacobians
 from stewartid.platform import COORDINATES, Platform
 from stewartid.signals.wavelets import MotherWavelet, PolynomialWavelet, make_wavelet

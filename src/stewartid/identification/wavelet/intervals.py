@@ -7,7 +7,7 @@ moments of order 0 and 1 removes it together with gravity.
 
 The joints of a 6-6 platform with two-part legs are, per leg, five rotational axes (two at the
 lower gimbal, two at the upper gimbal, the revolute about the leg; order of
-:data:`stewartid.model.kinematics.JOINT_AXES`) and the actuator. :func:`joint_rates` returns their
+:data:`stewartid.model.joints.JOINT_AXES`) and the actuator. :func:`joint_rates` returns their
 rates from a pose/velocity history, :func:`constant_direction_intervals` the intervals, and
 :func:`check_intervals` tells whether a trajectory design yields enough of them, and
 :func:`wavelet_points` places the wavelets' (a, b) points inside them.
@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 from stewartid.errors import ConfigError, DataError
-from stewartid.model.kinematics import JOINT_AXES
+from stewartid.model.joints import JOINT_AXES
 from stewartid.platform import Platform
 
 if TYPE_CHECKING:

@@ -89,7 +89,7 @@ def generalized_force_sensitivity(platform: Platform, q: np.ndarray, forces: np.
     errors-in-variables correction can account for noise shared by regressors and targets.
     Central differences of ``step`` (m, rad).
     """
-    from stewartid.model.kinematics import _leg_terms
+    from stewartid.model.kinematics import compute_leg_terms
 
     q0, f0 = q.mean(axis=0), forces.mean(axis=0)
     poses = np.repeat(q0[None], 12, axis=0)
@@ -97,7 +97,7 @@ def generalized_force_sensitivity(platform: Platform, q: np.ndarray, forces: np.
         poses[2 * j, j] += step
         poses[2 * j + 1, j] -= step
     # the numpy pose-only terms: equal to the compiled model terms, without numba's start
-    terms = _leg_terms(platform, poses)
+    terms = compute_leg_terms(platform, poses)
     y = np.einsum("nji,j->ni", terms.leg_jacobian, f0)
     if gravity:
         y = y - terms.gravity

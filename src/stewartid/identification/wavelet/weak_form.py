@@ -56,7 +56,7 @@ from functools import lru_cache
 import numpy as np
 from numpy.polynomial import polynomial
 
-from stewartid.identification.least_squares import JOINT_TYPES
+from stewartid.model.joints import JOINT_TYPES
 
 
 @lru_cache(maxsize=32)

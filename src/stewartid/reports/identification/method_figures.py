@@ -14,7 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from stewartid.assessment.validation import FRICTION_TYPES, ValidationResult
+from stewartid.assessment.validation import ValidationResult
+from stewartid.model.joints import FRICTION_TYPES
 from stewartid.platform import COORDINATES
 from stewartid.reporting.figures import new_figure, save_figure, styled, thinning_step
 

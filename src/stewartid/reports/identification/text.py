@@ -12,11 +12,12 @@ from typing import Any
 
 import numpy as np
 
-from stewartid.assessment.validation import FRICTION_TYPES, friction_signature
+from stewartid.assessment.validation import friction_signature
 from stewartid.assessment.verdict import Verdict, relative_std, worst_dof
 from stewartid.datasets.dataset import Dataset
 from stewartid.identification.consistency import consistency_metrics, is_consistent
 from stewartid.identification.wavelet.noise import white_noise_covariance
+from stewartid.model.joints import FRICTION_TYPES
 from stewartid.platform import COORDINATES, Platform
 from stewartid.reporting.tables import ResultTable, to_markdown
 from stewartid.reports.identification.records import IdentificationReport, MethodReport
