@@ -283,7 +283,7 @@ class WaveletIdentifier(BaseIdentifier):
         return {"truncation": self.truncation}
 
     # ------------------------------------------------------------------ steps
-    def _intervals(self, experiment: Experiment, smallest: float) -> Detection:
+    def _noise_and_intervals(self, experiment: Experiment, smallest: float) -> Detection:
         """The noise model, then the usable intervals, of one prepared experiment."""
         window, margin = excitation_scales(experiment, self.differentiation_window,
                                            self.margin, MARGIN_PERIODS)
@@ -296,12 +296,13 @@ class WaveletIdentifier(BaseIdentifier):
     def _fit_weak_form(self, datasets: list[Dataset], platform: Platform,
                        wavelet: MotherWavelet) -> tuple[IdentificationResult, dict]:
         """The default path: orthonormal test-function families per interval
-        (:mod:`~stewartid.identification.wavelet.weak_form`). One experiment at a time, its arrays
+        (:mod:`~stewartid.identification.wavelet.weak_form`), the steps of the data path in
+        :mod:`stewartid.identification.wavelet`. One experiment at a time, its arrays
         dropped once its equations are formed, so that long logs fit in memory."""
         infos, equations, sensitivities, motion = [], [], [], []
         for k, dataset in enumerate(datasets):
             experiment = prepare_experiment(dataset, platform, self.gravity, joints=True)
-            found = self._intervals(experiment, 1.0)
+            found = self._noise_and_intervals(experiment, 1.0)
             equations += experiment_equations(experiment, found, int(self.wavelet_order),
                                               int(self.test_functions), k, self.friction)
             infos.append(found.info)
@@ -351,7 +352,7 @@ class WaveletIdentifier(BaseIdentifier):
         """Wavelet equations of one prepared experiment at (a, b) points
         (``test_functions=None``), with the covariances of the pose noise they carry: per
         row E[e_x e_x^T] (12, 12) and E[e_x e_y^T] (12, 6), zero without noise correction."""
-        found = self._intervals(experiment, min(self.scale_fractions))
+        found = self._noise_and_intervals(experiment, min(self.scale_fractions))
         wavelets = [wavelet]
         if self.odd_companion and isinstance(wavelet, PolynomialWavelet):
             wavelets.append(PolynomialWavelet(wavelet.order, odd=True))

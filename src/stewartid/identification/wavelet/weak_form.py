@@ -280,15 +280,21 @@ def stack_equations(equations: Sequence[IntervalEquations],
                     pose_covariance: np.ndarray | None = None,
                     force_sensitivity: np.ndarray | None = None,
                     force_variance: np.ndarray | None = None) -> StackedEquations:
-    """Every interval's equations as arrays, and its experiment's noise levels
-    (the arguments as in
-    :func:`~stewartid.identification.wavelet.gls.solve_weak_form`)."""
-    n = len(equations)
+    """Every interval's equations as arrays, with its experiment's noise levels.
+
+    Parameters
+    ----------
+    equations : sequence of IntervalEquations
+        n intervals, all with the same number K of invariant rows.
+    pose_covariance, force_sensitivity, force_variance : ndarray, optional
+        Per experiment, as in :func:`~stewartid.identification.wavelet.gls.solve_weak_form`;
+        None: zero.
+
+    Returns
+    -------
+    StackedEquations
+    """
     owner = np.array([e.experiment for e in equations])
-
-    def per_interval(value, shape):
-        return np.zeros((n, *shape)) if value is None else np.asarray(value, dtype=float)[owner]
-
     return StackedEquations(
         regressors=np.stack([e.regressors for e in equations]),
         targets=np.stack([e.targets for e in equations]),
@@ -297,9 +303,18 @@ def stack_equations(equations: Sequence[IntervalEquations],
         weights=np.array([e.weight for e in equations]),
         coulomb=np.stack([e.coulomb for e in equations]), owner=owner,
         gram=np.stack([e.noise_gram for e in equations]),
-        sigma=per_interval(pose_covariance, (6, 6)),
-        sensitivity=per_interval(force_sensitivity, (6, 6)),
-        white=per_interval(force_variance, (6,)))
+        sigma=_per_interval(pose_covariance, owner, (6, 6)),
+        sensitivity=_per_interval(force_sensitivity, owner, (6, 6)),
+        white=_per_interval(force_variance, owner, (6,)))
+
+
+def _per_interval(values: np.ndarray | None, owner: np.ndarray, shape: tuple[int, ...]
+                  ) -> np.ndarray:
+    """Per-experiment ``values`` (n_experiments, *shape) at every interval (n, *shape), from
+    the intervals' experiments ``owner``; zeros for None."""
+    if values is None:
+        return np.zeros((len(owner), *shape))
+    return np.asarray(values, dtype=float)[owner]
 
 
 __all__ = ["IntervalEquations", "StackedEquations", "experiment_equations", "interval_equations",
