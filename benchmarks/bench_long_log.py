@@ -99,7 +99,6 @@ def stages(base: Path, minutes: float) -> list[tuple[str, float, float]]:
     """
     import threading
 
-    from stewartid.identification import preparation
     from stewartid.identification.wavelet import estimator as wavelet
     from stewartid.platform import load_platform
 
@@ -126,12 +125,9 @@ def stages(base: Path, minutes: float) -> list[tuple[str, float, float]]:
             return result
         return wrapper
 
-    for name in ("prepare", "detect_intervals", "interval_equations", "solve_weak_form"):
+    for name in ("prepare_experiment", "estimate_noise", "detect_intervals",
+                 "experiment_equations", "solve_weak_form"):
         setattr(wavelet, name, traced(name, getattr(wavelet, name)))
-    joint = functools.cached_property(
-        traced("joint_jacobians", preparation.Experiment.joint_jacobians.func))
-    joint.__set_name__(preparation.Experiment, "joint_jacobians")
-    preparation.Experiment.joint_jacobians = joint
     estimator = wavelet.WaveletIdentifier()
     estimator.fit(long_datasets(base, 10.0), load_platform("paper"))  # warm-up
     rows.clear()

@@ -134,8 +134,9 @@ def information_bound(platform: Platform, motions: Sequence[tuple[np.ndarray, ..
         precision = np.einsum("nal,l,nbl->nab", inverse, sigma ** -2.0, inverse)
         labels = np.zeros(len(t), dtype=int)
         if friction == "immune":
-            found = constant_direction_intervals(t, joint_rates(platform, q, q_dot),
-                                                 margin=margin, ignore_below=ignore_below)
+            rates = joint_rates(platform, q, q_dot, leg_jacobian=jacobian)
+            found = constant_direction_intervals(t, rates, margin=margin,
+                                                 ignore_below=ignore_below)
             labels[:] = -1
             for k, (start, stop) in enumerate(found):
                 labels[(t > start) & (t < stop)] = k

@@ -1,5 +1,6 @@
-"""Data preparation shared by every identifier: experiments with Jacobians and gravity at
-every measured pose.
+"""Data preparation shared by every identifier: experiments with every model term the
+identifiers need (leg and joint-axis Jacobians, gravity, the generalized force and its
+sensitivity to the pose), computed once at every measured pose.
 
 The identified model is the paper's linearised equation of motion (Zhang 2020, Eq. 5),
 
@@ -49,6 +50,9 @@ class Experiment:
         J_lq at every measured pose.
     gravity : ndarray, shape (N, 6)
         G(q) of the platform description (N, N m), whether or not it was subtracted.
+    force_sensitivity : ndarray, shape (6, 6)
+        K = d y / d q at the mean pose and mean leg forces (N/m, N m/rad ...): how pose
+        noise enters the generalized force (:func:`generalized_force_sensitivity`).
     sample_rate : float
         Hz.
     platform : Platform
@@ -65,6 +69,7 @@ class Experiment:
     generalized_force: np.ndarray
     leg_jacobian: np.ndarray
     gravity: np.ndarray
+    force_sensitivity: np.ndarray
     sample_rate: float
     platform: Platform = field(repr=False)
 
@@ -111,13 +116,50 @@ def resolve_datasets(datasets: Any, platform: Platform) -> list[Dataset]:
     return out
 
 
-def prepare(datasets: Sequence[Dataset], platform: Platform, gravity: bool = True,
-            joints: bool = False) -> list[Experiment]:
-    """Jacobians, gravity and generalized forces at every measured pose.
+def generalized_force_sensitivity(platform: Platform, q: np.ndarray, forces: np.ndarray,
+                                  gravity: bool = True, step: float = 1e-6) -> np.ndarray:
+    """K = d(J_lq(q)^T f - G(q)) / dq at the mean pose and mean leg forces.
+
+    Pose noise enters the generalized force through the Jacobian (the static leg load times
+    the change of the leg directions) and through G(q); K maps it there, so that an
+    errors-in-variables correction can account for noise shared by regressors and targets.
 
     Parameters
     ----------
-    datasets : sequence of Dataset
+    platform : Platform
+    q : ndarray, shape (N, 6)
+        Measured poses (m, rad).
+    forces : ndarray, shape (N, 6)
+        Measured leg forces (N).
+    gravity : bool
+        Whether G(q) is part of the generalized force (as :func:`prepare`'s ``gravity``).
+    step : float
+        Central-difference step (m, rad).
+
+    Returns
+    -------
+    ndarray, shape (6, 6)
+        K[i, j] = d y_i / d q_j (N/m, N/rad, N m/m, N m/rad).
+    """
+    q0, f0 = q.mean(axis=0), forces.mean(axis=0)
+    poses = np.repeat(q0[None], 12, axis=0)
+    for j in range(6):
+        poses[2 * j, j] += step
+        poses[2 * j + 1, j] -= step
+    terms = compute_leg_terms(platform, poses)
+    y = np.einsum("nji,j->ni", terms.leg_jacobian, f0)
+    if gravity:
+        y = y - terms.gravity
+    return ((y[0::2] - y[1::2]) / (2 * step)).T
+
+
+def prepare_experiment(dataset: Dataset, platform: Platform, gravity: bool = True,
+                       joints: bool = False) -> Experiment:
+    """Every model term of one experiment, each computed once, at every measured pose.
+
+    Parameters
+    ----------
+    dataset : Dataset
     platform : Platform
         Platform description (geometry for J_lq; leg masses for G(q)).
     gravity : bool
@@ -125,26 +167,45 @@ def prepare(datasets: Sequence[Dataset], platform: Platform, gravity: bool = Tru
         legs' gravity stiffness biases Mt by about -K_G / omega^2 (about -3 % on Mt(4,4) of
         the paper's platform at 0.5 Hz).
     joints : bool
-        Compute the joint-axis Jacobians now, with the other leg terms, rather than on first
-        use: a method that needs them then evaluates the leg geometry once, not twice.
+        Compute the joint-axis Jacobians now, in the same pass over the leg geometry as
+        J_lq and G(q), rather than on first use (1.4 kB a sample, and not every method needs
+        them).
+
+    Returns
+    -------
+    Experiment
+    """
+    G, J, _, joint_jacobians = compute_leg_terms(platform, np.ascontiguousarray(dataset.pose), joints)
+    y = np.einsum("nji,nj->ni", J, dataset.forces)
+    if gravity:
+        y = y - G
+    experiment = Experiment(
+        name=dataset.name, t=dataset.t, q=dataset.pose, generalized_force=y, leg_jacobian=J,
+        gravity=G, force_sensitivity=generalized_force_sensitivity(
+            platform, dataset.pose, dataset.forces, gravity),
+        sample_rate=dataset.sample_rate, platform=platform)
+    if joints:  # the cached property's slot, as its first use would fill it
+        experiment.__dict__["joint_jacobians"] = joint_jacobians
+    return experiment
+
+
+def prepare(datasets: Sequence[Dataset], platform: Platform, gravity: bool = True,
+            joints: bool = False) -> list[Experiment]:
+    """:func:`prepare_experiment` of every data set.
+
+    Parameters
+    ----------
+    datasets : sequence of Dataset
+    platform : Platform
+    gravity, joints : bool
+        As in :func:`prepare_experiment`.
 
     Returns
     -------
     list of Experiment
     """
-    out = []
-    for d in datasets:
-        G, J, _, joint_jacobians = compute_leg_terms(platform, np.ascontiguousarray(d.pose), joints)
-        y = np.einsum("nji,nj->ni", J, d.forces)
-        if gravity:
-            y = y - G
-        experiment = Experiment(name=d.name, t=d.t, q=d.pose, generalized_force=y,
-                                leg_jacobian=J, gravity=G, sample_rate=d.sample_rate,
-                                platform=platform)
-        if joints:  # the cached property's slot, as its first use would fill it
-            experiment.__dict__["joint_jacobians"] = joint_jacobians
-        out.append(experiment)
-    return out
+    return [prepare_experiment(d, platform, gravity, joints) for d in datasets]
 
 
-__all__ = ["Experiment", "prepare", "resolve_datasets", "resolve_platform"]
+__all__ = ["Experiment", "generalized_force_sensitivity", "prepare", "prepare_experiment",
+           "resolve_datasets", "resolve_platform"]

@@ -56,9 +56,30 @@ def _regressor_dof(name: str) -> str | None:
     return None
 
 
-def _check_rank(normal: np.ndarray, names: Sequence[str], max_condition: float) -> float:
-    """Condition number of the equilibrated regression (square root of the normal matrix's);
-    raise IdentificationError on rank loss."""
+def check_rank(normal: np.ndarray, names: Sequence[str], max_condition: float) -> float:
+    """Condition number of the equilibrated regression; raise on rank loss.
+
+    Parameters
+    ----------
+    normal : ndarray, shape (p, p)
+        Normal matrix X^T X (or a weighted one) of the p regressors.
+    names : sequence of str
+        The regressors' names (:func:`regressor_names`), for the error message.
+    max_condition : float
+        Largest acceptable condition number of the column-equilibrated regression.
+
+    Returns
+    -------
+    float
+        The condition number of the equilibrated regression (square root of that of the
+        equilibrated normal matrix).
+
+    Raises
+    ------
+    IdentificationError
+        When a regressor is identically zero or the condition number exceeds
+        ``max_condition``; the message names the DOF never excited.
+    """
     diag = np.diag(normal).copy()
     scale = np.sqrt(np.abs(diag))
     top = float(np.max(scale)) if len(scale) else 0.0
@@ -211,7 +232,7 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
 
     def solve(weights):
         N, b, Tf = assemble(weights)
-        condition = _check_rank(N, z_names, max_condition)
+        condition = check_rank(N, z_names, max_condition)
         scale = np.sqrt(np.diag(N))
         Ns = N / np.outer(scale, scale)
         z = np.linalg.solve(Ns, b / scale) / scale
@@ -395,6 +416,7 @@ def select_symmetric_pairs(matrix: np.ndarray, std: np.ndarray,
 __all__ = [
     "LeastSquaresSolution",
     "bias_compensated_least_squares",
+    "check_rank",
     "integrated_autocorrelation",
     "regressor_names",
     "select_symmetric_pairs",

@@ -1,11 +1,10 @@
-"""Constant-direction intervals of one measured experiment, with the noise levels that
-decide them: the first step of Method B.
+"""Constant-direction intervals of one measured experiment: the interval step of Method B.
 
-The pose is smoothed and differentiated (Savitzky-Golay, window from the excitation
-frequency estimated from the data), mapped to the rates of the 30 joint axes and the 6
-actuators, and cut where any active joint reverses (:mod:`.intervals`). The noise of each
-rate is estimated from the data (:mod:`.noise`), so that a reversal inside the noise band
-stays outside every interval.
+The smoothed pose rates of the noise model (:mod:`.noise`) are mapped to the rates of the 30
+joint axes and the 6 actuators with the Jacobians the prepared experiment holds, and cut
+where any active joint reverses (:mod:`.intervals`); a reversal inside a rate's noise band
+stays outside every interval. :func:`excitation_scales` sets the smoothing window and the
+interval margin from the excitation frequency estimated from the data.
 """
 
 from __future__ import annotations
@@ -19,10 +18,9 @@ import numpy as np
 from stewartid.errors import DataWarning, IdentificationError
 from stewartid.identification.preparation import Experiment
 from stewartid.identification.wavelet.intervals import constant_direction_intervals, joint_rates
-from stewartid.identification.wavelet.noise import joint_rate_noise, white_noise_covariance
-from stewartid.model.kinematics import joint_rate_jacobians
-from stewartid.platform import COORDINATES, Platform
-from stewartid.signals.differentiation import default_window, differentiate, estimate_frequency
+from stewartid.identification.wavelet.noise import NoiseModel
+from stewartid.platform import COORDINATES
+from stewartid.signals.differentiation import default_window, estimate_frequency
 
 
 class Detection(NamedTuple):
@@ -49,10 +47,6 @@ class Detection(NamedTuple):
     rate_noise: np.ndarray
     q_dot: np.ndarray
     q_ddot: np.ndarray
-
-
-#: Samples per block when joint Jacobians are formed on the fly (1.4 kB a sample).
-BLOCK_SAMPLES = 65536
 
 
 #: Joints whose rate RMS is below this multiple of its noise level count as idle.
@@ -106,45 +100,45 @@ def check_coverage(names: Sequence[str], motion: np.ndarray, counts: Sequence[in
             f"diagnostics, or lower hysteresis / margin")
 
 
-def _joint_rates_in_blocks(experiment: Experiment, platform: Platform, q_dot: np.ndarray
-                           ) -> tuple[np.ndarray, np.ndarray]:
-    """Joint rates (N, 36) and the mean joint-axis Jacobian (1, 6, 5, 6) of an experiment.
+def excitation_scales(experiment: Experiment, window: float | None, margin: float | None,
+                      margin_periods: float) -> tuple[float, float]:
+    """The Savitzky-Golay window and the interval margin of one experiment (s).
 
-    The joint Jacobians (N, 6, 5, 6) of a long record would take 1.4 kB a sample; unless the
-    experiment already holds them they are formed block by block and dropped.
+    Parameters
+    ----------
+    experiment : Experiment
+    window : float or None
+        Savitzky-Golay window (s); None: from the excitation frequency estimated from the
+        pose (:func:`~stewartid.signals.differentiation.default_window`).
+    margin : float or None
+        Time cut from both ends of every interval (s); None: ``margin_periods`` periods of
+        the estimated excitation frequency.
+    margin_periods : float
+
+    Returns
+    -------
+    window, margin : float
     """
-    if "joint_jacobians" in vars(experiment):
-        jacobians = experiment.joint_jacobians
-        return (joint_rates(platform, experiment.q, q_dot, jacobians, experiment.leg_jacobian),
-                jacobians.mean(axis=0, keepdims=True))
-    n = len(experiment.q)
-    rates = np.empty((n, 36))
-    total = np.zeros((6, 5, 6))
-    for start in range(0, n, BLOCK_SAMPLES):
-        block = slice(start, min(start + BLOCK_SAMPLES, n))
-        jacobians = joint_rate_jacobians(platform, experiment.q[block])
-        rates[block] = joint_rates(platform, experiment.q[block], q_dot[block], jacobians,
-                                   experiment.leg_jacobian[block])
-        total += jacobians.sum(axis=0)
-    return rates, (total / max(n, 1))[None]
+    if window is None or margin is None:
+        frequency = estimate_frequency(experiment.q, 1.0 / experiment.period)
+        window = default_window(frequency) if window is None else window
+        margin = margin_periods / frequency if margin is None else margin
+    return window, margin
 
 
-def detect_intervals(experiment: Experiment, platform: Platform, *, window: float | None,
-                     margin: float | None, margin_periods: float, hysteresis: float,
-                     ignore_below: float, min_interval: float | None,
+def detect_intervals(experiment: Experiment, noise: NoiseModel, *, margin: float,
+                     hysteresis: float, ignore_below: float, min_interval: float | None,
                      min_support_samples: int, smallest: float) -> Detection:
     """Usable constant-direction intervals of one experiment.
 
     Parameters
     ----------
     experiment : Experiment
-    platform : Platform
-    window : float or None
-        Savitzky-Golay window (s); None: from the estimated excitation frequency.
-    margin : float or None
-        Time cut from both ends of every interval (s); None: ``margin_periods`` periods of
-        the estimated excitation frequency.
-    margin_periods : float
+        Prepared with its joint-axis Jacobians.
+    noise : NoiseModel
+        Its smoothed motion and noise levels (:func:`.noise.estimate_noise`).
+    margin : float
+        Time cut from both ends of every interval (s).
     hysteresis : float
         Multiple of each rate's noise level inside which its direction counts as unknown.
     ignore_below : float
@@ -160,19 +154,9 @@ def detect_intervals(experiment: Experiment, platform: Platform, *, window: floa
     -------
     Detection
     """
-    t, q, period = experiment.t, experiment.q, experiment.period
-    rate = 1.0 / period
-    if window is None or margin is None:
-        frequency = estimate_frequency(q, rate)
-        window = default_window(frequency) if window is None else window
-        margin = margin_periods / frequency if margin is None else margin
-    q_smooth, q_dot, q_ddot = differentiate(q, rate, window)
-    rates, mean_jacobian = _joint_rates_in_blocks(experiment, platform, q_dot)
-    noise = white_noise_covariance(q, q_smooth)
-    y = experiment.generalized_force
-    force_noise = np.diag(white_noise_covariance(y, differentiate(y, rate, window)[0]))
-    rate_noise = joint_rate_noise(noise, rate, window, mean_jacobian,
-                                  experiment.leg_jacobian)
+    t, period, rate_noise = experiment.t, experiment.period, noise.rate_noise
+    rates = joint_rates(experiment.platform, experiment.q, noise.q_dot,
+                        experiment.joint_jacobians, experiment.leg_jacobian)
     # a joint whose rate is no larger than its noise has no direction to keep, whatever its
     # share of the largest rate (pure heave with 20 um pose noise leaves three axes per leg at
     # 1.0x their noise and 1 % of the largest rate; on some seeds they broke every interval)
@@ -190,13 +174,15 @@ def detect_intervals(experiment: Experiment, platform: Platform, *, window: floa
     info = {"name": experiment.name, "intervals_found": int(len(found)),
             "longest_interval": float(lengths.max()) if len(lengths) else 0.0,
             "shortest_usable": float(max(shortest, needed)),
-            "intervals": intervals, "differentiation_window": float(window),
-            "noise_covariance": noise, "force_noise_variance": force_noise}
+            "intervals": intervals, "differentiation_window": float(noise.window),
+            "noise_covariance": noise.pose_covariance,
+            "force_noise_variance": noise.force_variance}
     # a floor keeps the direction weights of noise-free data finite
     return Detection(intervals=intervals, info=info,
                      joint_rates=rates[:, :30].reshape(len(t), 6, 5),
                      rate_noise=np.maximum(rate_noise[:30].reshape(6, 5), 1e-12),
-                     q_dot=q_dot, q_ddot=q_ddot)
+                     q_dot=noise.q_dot, q_ddot=noise.q_ddot)
 
 
-__all__ = ["Detection", "detect_intervals"]
+__all__ = ["Detection", "check_coverage", "detect_intervals", "excitation_scales",
+           "raise_no_interval"]

@@ -33,7 +33,7 @@ idea); ``"mexican_hat"``, the paper's Gaussian wavelet, truncated at +-``truncat
 Default (``test_functions=8``): per interval a family of orthonormalised zero-mean test
 functions spanning the whole interval, the weak form of :mod:`.weak_form`, solved by
 generalized least squares with the force and pose noise estimated from the data and the pose
-noise's bias removed (:mod:`.weak_form_solver`); ``test_functions=None`` uses (a, b) points
+noise's bias removed (:mod:`.gls`); ``test_functions=None`` uses (a, b) points
 (:mod:`.point_equations`), as the paper does.
 
 Couplings (the paper's Mt(2,4) case): an entry and its transpose come from different
@@ -60,7 +60,7 @@ import numpy as np
 from stewartid.datasets.dataset import Dataset
 from stewartid.fields import Interval, ListOf, Options, nonnegative, positive, validate_parameters
 from stewartid.identification.base import BaseIdentifier
-from stewartid.identification.preparation import Experiment, prepare
+from stewartid.identification.preparation import Experiment, prepare_experiment
 from stewartid.identification.registry import Preset, register_method
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.solvers import (
@@ -73,14 +73,14 @@ from stewartid.identification.wavelet.detection import (
     Detection,
     check_coverage,
     detect_intervals,
+    excitation_scales,
     raise_no_interval,
 )
-from stewartid.identification.wavelet.gls import solve_weak_form
-from stewartid.identification.wavelet.noise import generalized_force_sensitivity
+from stewartid.identification.wavelet.gls import WeakFormSolution, solve_weak_form
+from stewartid.identification.wavelet.noise import estimate_noise
 from stewartid.identification.wavelet.point_equations import EXACT_DEGREE, point_equations
-from stewartid.identification.wavelet.weak_form import interval_equations
+from stewartid.identification.wavelet.weak_form import experiment_equations
 from stewartid.model.joints import JOINT_TYPES
-from stewartid.model.kinematics import joint_rate_jacobians
 from stewartid.platform import COORDINATES, Platform
 from stewartid.signals.wavelets import MotherWavelet, PolynomialWavelet, make_wavelet
 
@@ -166,7 +166,7 @@ class WaveletIdentifier(BaseIdentifier):
         (:class:`~stewartid.signals.wavelets.PolynomialWavelet`; ``wavelet_order`` >= 8).
     noise_correction : bool
         Position variant: weight by and remove the pose noise's contribution to the normal
-        equations (errors in variables, noise estimated from the data; :mod:`.weak_form_solver`,
+        equations (errors in variables, noise estimated from the data; :mod:`.gls`,
         :func:`~stewartid.identification.solvers.bias_compensated_least_squares`).
     symmetric : bool
         Impose Mt = Mt^T and Bt = Bt^T in the solve.
@@ -257,62 +257,49 @@ class WaveletIdentifier(BaseIdentifier):
             return {"order": self.wavelet_order}
         return {"truncation": self.truncation}
 
-    # ------------------------------------------------------------------ equations
-    def _intervals(self, experiment: Experiment, platform: Platform, smallest: float
-                   ) -> Detection:
-        """Usable intervals of one experiment with this estimator's settings."""
+    # ------------------------------------------------------------------ steps
+    def _noise_and_intervals(self, experiment: Experiment, smallest: float) -> Detection:
+        """The noise model, then the usable intervals, of one prepared experiment."""
+        window, margin = excitation_scales(experiment, self.differentiation_window,
+                                           self.margin, MARGIN_PERIODS)
+        noise = estimate_noise(experiment, window)
         return detect_intervals(
-            experiment, platform, window=self.differentiation_window, margin=self.margin,
-            margin_periods=MARGIN_PERIODS, hysteresis=self.hysteresis,
+            experiment, noise, margin=margin, hysteresis=self.hysteresis,
             ignore_below=self.ignore_below, min_interval=self.min_interval,
             min_support_samples=self.min_support_samples, smallest=smallest)
-
-    def _experiment_equations(self, experiment: Experiment, wavelet: MotherWavelet,
-                              platform: Platform):
-        """Wavelet equations of one experiment at (a, b) points (``test_functions=None``)."""
-        found = self._intervals(experiment, platform, min(self.scale_fractions))
-        wavelets = [wavelet]
-        if self.odd_companion and isinstance(wavelet, PolynomialWavelet):
-            wavelets.append(PolynomialWavelet(wavelet.order, odd=True))
-        return point_equations(experiment, found, wavelets, tuple(self.scale_fractions),
-                               int(self.shifts_per_scale), self.variant)
 
     def _fit_weak_form(self, datasets: list[Dataset], platform: Platform,
                        wavelet: MotherWavelet) -> tuple[IdentificationResult, dict]:
         """The default path: orthonormal test-function families per interval
-        (:mod:`~stewartid.identification.wavelet.weak_form`). One experiment at a time, its arrays
+        (:mod:`~stewartid.identification.wavelet.weak_form`), the steps of the data path in
+        :mod:`stewartid.identification.wavelet`. One experiment at a time, its arrays
         dropped once its equations are formed, so that long logs fit in memory."""
         infos, equations, sensitivities, motion = [], [], [], []
         for k, dataset in enumerate(datasets):
-            (experiment,) = prepare([dataset], platform, gravity=self.gravity)
-            if self.noise_correction:
-                sensitivities.append(generalized_force_sensitivity(
-                    platform, dataset.pose, dataset.forces, self.gravity))
-            found = self._intervals(experiment, platform, 1.0)
-
-            def jacobians(indices: np.ndarray, q: np.ndarray = experiment.q) -> np.ndarray:
-                return joint_rate_jacobians(platform, q[indices])
-
-            for interval in found.intervals:
-                rows = interval_equations(
-                    experiment.t, experiment.q, experiment.generalized_force,
-                    jacobians if self.friction != "free" else None,
-                    found.joint_rates, found.rate_noise, interval,
-                    int(self.wavelet_order), int(self.test_functions), k,
-                    uniform=self.friction == "uniform")
-                if rows is not None:
-                    equations.append(rows)
+            experiment = prepare_experiment(dataset, platform, self.gravity, joints=True)
+            found = self._noise_and_intervals(experiment, 1.0)
+            equations += experiment_equations(experiment, found, int(self.wavelet_order),
+                                              int(self.test_functions), k, self.friction)
             infos.append(found.info)
+            sensitivities.append(experiment.force_sensitivity)
             motion.append(np.std(experiment.q, axis=0))
             del experiment, found
         if not equations:
             raise_no_interval(infos)
         check_coverage([i["name"] for i in infos], np.array(motion),
                        [sum(e.experiment == k for e in equations) for k in range(len(infos))])
-        pose, white = ([[i[key] for i in infos] for key in ("noise_covariance",
-                        "force_noise_variance")] if self.noise_correction else (None, None))
-        solution = solve_weak_form(equations, len(datasets), self.friction != "free", pose_covariance=pose,
-                                   force_sensitivity=sensitivities or None, force_variance=white)
+        noise = {}
+        if self.noise_correction:
+            noise = {"pose_covariance": [i["noise_covariance"] for i in infos],
+                     "force_variance": [i["force_noise_variance"] for i in infos],
+                     "force_sensitivity": sensitivities}
+        solution = solve_weak_form(equations, len(datasets), self.friction != "free", **noise)
+        return self._weak_form_result(solution, infos, len(equations), wavelet)
+
+    def _weak_form_result(self, solution: WeakFormSolution, infos: list[dict],
+                          n_intervals: int, wavelet: MotherWavelet
+                          ) -> tuple[IdentificationResult, dict]:
+        """The result and the learned Coulomb levels of :meth:`_fit_weak_form`."""
         M, B = solution.theta[:, :6].copy(), solution.theta[:, 6:12].copy()
         std_M, std_B = solution.theta_std[:, :6].copy(), solution.theta_std[:, 6:12].copy()
         chosen = self._combine_pairs(M, B, std_M, std_B)
@@ -322,7 +309,7 @@ class WaveletIdentifier(BaseIdentifier):
             "position_noise_std": [np.sqrt(np.diag(i["noise_covariance"])).tolist()
                                    for i in infos],
             "wavelet": wavelet.to_dict(), "test_functions": int(self.test_functions),
-            "n_equations": solution.n_equations, "n_intervals": len(equations),
+            "n_equations": solution.n_equations, "n_intervals": n_intervals,
             "experiments": [{"name": i["name"], "intervals_found": i["intervals_found"],
                              "intervals": i["intervals"].tolist()} for i in infos],
             "pair_choice": chosen, "coordinates": list(COORDINATES),
@@ -335,6 +322,27 @@ class WaveletIdentifier(BaseIdentifier):
             condition_number=solution.condition_number, residual_rms=solution.noise_std,
             method=self.method, settings=self._settings(), diagnostics=diagnostics)
         return result, {"coulomb_": levels, "coulomb_std_": levels_std}
+
+    def _point_equations(self, experiment: Experiment, wavelet: MotherWavelet):
+        """Wavelet equations of one prepared experiment at (a, b) points
+        (``test_functions=None``), with the covariances of the pose noise they carry: per
+        row E[e_x e_x^T] (12, 12) and E[e_x e_y^T] (12, 6), zero without noise correction."""
+        found = self._noise_and_intervals(experiment, min(self.scale_fractions))
+        wavelets = [wavelet]
+        if self.odd_companion and isinstance(wavelet, PolynomialWavelet):
+            wavelets.append(PolynomialWavelet(wavelet.order, odd=True))
+        x, y, owner, products, info = point_equations(
+            experiment, found, wavelets, tuple(self.scale_fractions),
+            int(self.shifts_per_scale), self.variant)
+        if len(x) and self.noise_correction and self.variant == "position":
+            sigma, sens = info["noise_covariance"], experiment.force_sensitivity
+            noise_xx = np.einsum("kuv,ij->kuivj", products[:, :2, :2], sigma
+                                 ).reshape(len(x), 12, 12)
+            noise_xy = np.einsum("ku,ij->kuij", products[:, :2, 2],
+                                 sigma @ sens.T).reshape(len(x), 12, 6)
+        else:
+            noise_xx, noise_xy = np.zeros((len(x), 12, 12)), np.zeros((len(x), 12, 6))
+        return x, y, owner, noise_xx, noise_xy, info
 
     def _combine_pairs(self, M: np.ndarray, B: np.ndarray, std_M: np.ndarray,
                        std_B: np.ndarray) -> dict:
@@ -360,35 +368,26 @@ class WaveletIdentifier(BaseIdentifier):
         wavelet = make_wavelet(self.wavelet, **self._wavelet_options())
         if self.test_functions is not None:
             return self._fit_weak_form(datasets, platform, wavelet)
-        experiments = prepare(datasets, platform, gravity=self.gravity)
-        phi, target, cluster, infos, noise_xx, noise_xy = [], [], [], [], [], []
+        phi, target, cluster, infos, noise_xx, noise_xy, motion = [], [], [], [], [], [], []
         offset = 0
-        for dataset, experiment in zip(datasets, experiments, strict=True):
-            x, y, owner, products, info = self._experiment_equations(experiment, wavelet,
-                                                                     platform)
+        for dataset in datasets:
+            experiment = prepare_experiment(dataset, platform, self.gravity, joints=True)
+            x, y, owner, xx, xy, info = self._point_equations(experiment, wavelet)
             phi.append(x)
             target.append(y)
             cluster.append(owner + offset)
-            offset += len(info["intervals"])
+            noise_xx.append(xx)
+            noise_xy.append(xy)
             infos.append(info)
-            if len(x) and self.noise_correction and self.variant == "position":
-                sigma = info["noise_covariance"]
-                sens = generalized_force_sensitivity(platform, dataset.pose, dataset.forces,
-                                                     self.gravity)
-                # per row: E[e_x e_x^T] (12, 12) and E[e_x e_y^T] (12, 6)
-                noise_xx.append(np.einsum("kuv,ij->kuivj", products[:, :2, :2], sigma
-                                          ).reshape(len(x), 12, 12))
-                noise_xy.append(np.einsum("ku,ij->kuij", products[:, :2, 2],
-                                          sigma @ sens.T).reshape(len(x), 12, 6))
-            else:
-                noise_xx.append(np.zeros((len(x), 12, 12)))
-                noise_xy.append(np.zeros((len(x), 12, 6)))
+            motion.append(np.std(experiment.q, axis=0))
+            offset += len(info["intervals"])
+            del experiment
         phi, target, cluster = np.vstack(phi), np.vstack(target), np.concatenate(cluster)
         noise_xx, noise_xy = np.concatenate(noise_xx), np.concatenate(noise_xy)
         if len(phi) == 0:
             raise_no_interval(infos)
-        check_coverage([i["name"] for i in infos], np.array([np.std(e.q, axis=0) for e in
-                       experiments]), [len(i["intervals"]) for i in infos])
+        check_coverage([i["name"] for i in infos], np.array(motion),
+                       [len(i["intervals"]) for i in infos])
         names = regressor_names("q_ddot", "q_dot")
         solution = solve_least_squares(phi, target, symmetric=bool(self.symmetric),
                                        regressor_names=names)
@@ -400,11 +399,10 @@ class WaveletIdentifier(BaseIdentifier):
         std_M, std_B = std[:, :6].copy(), std[:, 6:12].copy()
         chosen = {} if self.symmetric else self._combine_pairs(M, B, std_M, std_B)
         residual = target - phi @ theta.T
-        noise = [info["noise_covariance"] for info in infos]
         diagnostics = {
-            "position_noise_std": [np.sqrt(np.diag(c)).tolist() for c in noise],
-            "wavelet": wavelet.to_dict(),
-            "n_equations": int(len(phi)),
+            "position_noise_std": [np.sqrt(np.diag(i["noise_covariance"])).tolist()
+                                   for i in infos],
+            "wavelet": wavelet.to_dict(), "n_equations": int(len(phi)),
             "n_intervals": int(offset),
             "experiments": [
                 {"name": info["name"], "intervals_found": info["intervals_found"],

@@ -50,11 +50,24 @@ from __future__ import annotations
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from stewartid.errors import DataWarning
-from stewartid.identification.solvers import _check_rank, regressor_names
+from stewartid.identification.solvers import check_rank, regressor_names
+from stewartid.identification.wavelet.variance_components import (
+    chi2_excess,
+    compensate,
+    excess_variance,
+    pose_coefficients,
+    pose_covariance,
+)
+from stewartid.identification.wavelet.weak_form import (
+    IntervalEquations,
+    StackedEquations,
+    stack_equations,
+)
 from stewartid.platform import COORDINATES
 
 #: Unknowns of [Mt Bt].
@@ -97,66 +110,6 @@ class WeakFormSolution:
     n_equations: int
 
 
-def _pose_covariance(gram: np.ndarray, sigma: np.ndarray, coefficients: np.ndarray
-                     ) -> np.ndarray:
-    """Q per interval, (n, R, R): the row covariance the pose noise causes in one channel.
-
-    gram (n, 3, 3, R, R) of the test functions and their derivatives, sigma (n, 6, 6), and
-    coefficients (n, 3, 6): what multiplies <phi^(a), n> in the channel's residual, a = 0
-    (the target's sensitivity k_i), 1 (b_i) and 2 (-m_i).
-    """
-    c = np.einsum("naj,njk,nbk->nab", coefficients, sigma, coefficients)
-    return np.einsum("nab,nabrs->nrs", c, gram)
-
-
-def _noise_bias(weights: np.ndarray, gram: np.ndarray, sigma: np.ndarray,
-                sensitivity: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Expected noise parts of sum X^T W X (12, 12) and of sum X^T W y (12,) over intervals
-    for one channel, the regressors' noise being [<phi'', n>, -<phi', n>] and the target's
-    <phi, k_i n> (sensitivity (n, 6) = k_i per interval)."""
-    t = np.einsum("nrs,nabrs->nab", weights, gram)                     # sum_rs W_rs G_ab,rs
-    mm = np.einsum("n,njk->jk", t[:, 2, 2], sigma)
-    mb = -np.einsum("n,njk->jk", t[:, 2, 1], sigma)
-    bb = np.einsum("n,njk->jk", t[:, 1, 1], sigma)
-    sk = np.einsum("njk,nk->nj", sigma, sensitivity)
-    target = np.r_[np.einsum("n,nj->j", t[:, 2, 0], sk), -np.einsum("n,nj->j", t[:, 1, 0], sk)]
-    return np.block([[mm, mb], [mb.T, bb]]), target
-
-
-def _coefficients(sensitivity: np.ndarray, theta_i: np.ndarray) -> np.ndarray:
-    """(n, 3, 6) coefficients of :func:`_pose_covariance` for channel row theta_i = [m, b]."""
-    n = len(sensitivity)
-    return np.stack([sensitivity, np.broadcast_to(theta_i[6:], (n, 6)),
-                     np.broadcast_to(-theta_i[:6], (n, 6))], axis=1)
-
-
-def _chi2_excess(variances: np.ndarray, squares: np.ndarray, dof: float) -> float:
-    """e >= 0 with sum_k squares_k / (variances_k + e) = dof (0 when the left side is already
-    at most dof at e = 0): the variance that residuals of expected variances ``variances``
-    hold beyond them, matched in weighted chi-square (the Paule-Mandel estimator of
-    random-effects meta-analysis). Both arrays of any one shape, variances >= 0."""
-    lam = np.maximum(variances, 0.0)
-    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):  # noise-free rows
-        if np.sum(np.where(squares > 0, squares / lam, 0.0)) <= dof:
-            return 0.0
-    low, high = 0.0, float(np.sum(squares)) / max(dof, 1)   # chi2(high) <= dof
-    for _ in range(60):  # bisection on the monotone chi2(e), to 1e-18 of the bracket
-        mid = 0.5 * (low + high)
-        low, high = (mid, high) if np.sum(squares / (lam + mid)) > dof else (low, mid)
-    return high
-
-
-def _excess_variance(covariance: np.ndarray, residual: np.ndarray, dof: int) -> float:
-    """e >= 0 with sum_n r_n^T (V_n + e I)^-1 r_n = dof: the white variance per row the
-    residuals (n, R) hold beyond their expected covariance V (n, R, R), model error.
-
-    Weighted, because the pose part of V is orders of magnitude larger on the narrow test
-    functions than on the wide ones: the plain moment (sum |r|^2 - tr V) / (n R) is then the
-    difference of two numbers whose randomness alone exceeds the force noise."""
-    lam, vectors = np.linalg.eigh(covariance)
-    return _chi2_excess(lam, np.einsum("nrk,nr->nk", vectors, residual) ** 2, dof)
-
-
 def _weighted_normal(design: np.ndarray, weights: np.ndarray, target: np.ndarray
                      ) -> tuple[np.ndarray, np.ndarray]:
     """sum_n D_n^T W_n D_n and sum_n D_n^T W_n t_n for designs (n, R, u), weights (n, R, R)
@@ -167,8 +120,204 @@ def _weighted_normal(design: np.ndarray, weights: np.ndarray, target: np.ndarray
             weighted.reshape(flat.shape).T @ target.ravel())
 
 
-def solve_weak_form(equations: Sequence, n_experiments: int, shared_friction: bool = True,
-                    iterations: int = 5, max_condition: float = 1e8,
+def channel_systems(stacked: StackedEquations, n_experiments: int, shared_friction: bool
+                    ) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """Design (n, R, u) and targets (n, R) of each of the 6 channels over all u unknowns:
+    [Mt Bt] row-major, then (shared friction) an offset per experiment and channel and the
+    Coulomb levels; R = K invariant rows, plus the mean row with shared friction."""
+    x, y, owner = stacked.regressors, stacked.targets, stacked.owner
+    n, k_rows = x.shape[:2]
+    n_unknowns = N_THETA + (6 * n_experiments + stacked.coulomb.shape[1]
+                            if shared_friction else 0)
+    rows = k_rows + 1 if shared_friction else k_rows
+    designs, targets = [], []
+    for i in range(6):
+        design = np.zeros((n, rows, n_unknowns))
+        design[:, :k_rows, 12 * i:12 * i + 12] = x
+        target = y[:, :, i]
+        if shared_friction:
+            design[:, k_rows, 12 * i:12 * i + 12] = stacked.mean_regressors
+            design[np.arange(n), k_rows, N_THETA + 6 * owner + i] = stacked.weights
+            design[:, k_rows, N_THETA + 6 * n_experiments:] = stacked.coulomb[:, :, i]
+            target = np.concatenate([target, stacked.mean_targets[:, i:i + 1]], axis=1)
+        designs.append(design)
+        targets.append(target)
+    return designs, targets
+
+
+def channel_covariance(stacked: StackedEquations, gram: np.ndarray, noise: np.ndarray,
+                       i: int, theta_i: np.ndarray, scatter: float | None) -> np.ndarray:
+    """Covariance (n, R, R) of channel i's rows: the force-side noise ``noise`` (n,) per
+    row, the pose noise at the estimate theta_i (12,) and, with shared friction
+    (``scatter`` not None), the interval constants' scatter tau on the mean row."""
+    rows = gram.shape[-1]
+    v = noise[:, None, None] * np.eye(rows) + pose_covariance(
+        gram, stacked.sigma, pose_coefficients(stacked.sensitivity[:, i], theta_i))
+    if scatter is not None:
+        v[:, -1, -1] += (scatter * stacked.weights) ** 2
+    return v
+
+
+class InvariantFit(NamedTuple):
+    """Result of :func:`fit_invariant_rows`: theta (6, 12), the force-side noise s (n, 6)
+    per interval and channel, and the share of each channel's residual power the pose
+    noise explains (6,)."""
+
+    theta: np.ndarray
+    noise: np.ndarray
+    pose_share: np.ndarray
+
+
+def fit_invariant_rows(stacked: StackedEquations, iterations: int) -> InvariantFit:
+    """Each channel from the invariant rows alone (the estimate the scatter of the interval
+    constants is measured with), reweighted ``iterations`` times with the row covariance
+    s_i I + Q, s_i the white force noise plus the chi-square excess of the residuals."""
+    x, y = stacked.regressors, stacked.targets
+    n, k_rows = x.shape[:2]
+    sigma, sensitivity, white = stacked.sigma, stacked.sensitivity, stacked.white
+    gram = stacked.gram[..., :k_rows, :k_rows]
+    # start: each channel's invariant rows, force-side weights only
+    theta = np.linalg.lstsq(x.reshape(-1, 12), y.reshape(-1, 6), rcond=None)[0].T
+    # floor: noise-free data must not give infinite weights
+    floor = 1e-24 * np.maximum(np.mean(y.reshape(-1, 6) ** 2, axis=0), 1e-300)
+    noise = np.zeros((n, 6))
+    pose_share = np.zeros(6)
+    for i in range(6):
+        for _ in range(max(1, iterations)):
+            q_inv = pose_covariance(gram, sigma, pose_coefficients(sensitivity[:, i], theta[i]))
+            residual = y[:, :, i] - x @ theta[i]
+            power, pose = float(np.sum(residual ** 2)), float(np.trace(q_inv, 0, 1, 2).sum())
+            excess = excess_variance(white[:, i, None, None] * np.eye(k_rows) + q_inv,
+                                     residual, residual.size - 12)
+            noise[:, i] = np.maximum(white[:, i] + excess, floor[i])
+            pose_share[i] = min(pose / max(power, 1e-300), 1.0)
+            w = np.linalg.inv(noise[:, i, None, None] * np.eye(k_rows) + q_inv)
+            normal, rhs, _ = compensate(*_weighted_normal(x, w, y[:, :, i]), w, gram, sigma,
+                                        sensitivity[:, i])
+            theta[i] = np.linalg.solve(normal, rhs)
+    return InvariantFit(theta=theta, noise=noise, pose_share=pose_share)
+
+
+def constant_scatter(stacked: StackedEquations, designs: Sequence[np.ndarray],
+                     invariant: InvariantFit) -> np.ndarray:
+    """tau (6,): the scatter of the interval constants around the friction structure, per
+    channel (N, N m).
+
+    Measured with the invariant estimate: a joint fit would bend Bt to hide a structure that
+    does not hold, and so report a scatter too small to notice it.
+    """
+    theta, n = invariant.theta, len(stacked.owner)
+    gram = stacked.gram
+    variance = np.stack([channel_covariance(stacked, gram, invariant.noise[:, i], i, theta[i],
+                                            0.0)[:, -1, -1]
+                         for i in range(6)], axis=1)                  # (n, 6), tau = 0
+    base = stacked.mean_targets - stacked.mean_regressors @ theta.T
+    nuisance_design = np.stack([d[:, -1, N_THETA:] for d in designs], axis=1)  # (n,6,u)
+    n_nuisance = nuisance_design.shape[-1]
+    scaled = nuisance_design / np.sqrt(variance)[:, :, None]
+    fitted = np.linalg.lstsq(scaled.reshape(-1, n_nuisance),
+                             (base / np.sqrt(variance)).ravel(), rcond=None)[0]
+    mean_residual = base - nuisance_design @ fitted
+    # tau^2 per channel with sum_k r_k^2 / (v_k + tau^2 w_k^2) = dof, i.e. the chi-square
+    # excess of r_k / w_k over v_k / w_k. Not the plain moment sum(r^2 - v) / sum(w^2):
+    # the intervals' noise variances v differ 100-fold, the moment was ruled by the
+    # noisiest, came out zero on half the seeds and 20x the typical value on others,
+    # and the estimates of Bt followed it (kurtosis 4-9 over seeds, twice the spread)
+    dof = n - n_nuisance / 6
+    weight = stacked.weights
+    return np.sqrt([chi2_excess(variance[:, i] / weight ** 2,
+                                (mean_residual[:, i] / weight) ** 2, dof)
+                    for i in range(6)])
+
+
+class JointFit(NamedTuple):
+    """Result of :func:`fit_jointly`.
+
+    Attributes
+    ----------
+    z : ndarray, shape (u,)
+        All unknowns.
+    normal : ndarray, shape (u, u)
+        The compensated normal matrix of the last pass.
+    scale : ndarray, shape (u,)
+        Its column equilibration.
+    weights : list of ndarray, shape (n, R, R)
+        Row weights of each channel in the last pass.
+    uncorrected : ndarray of bool, shape (6,)
+        Channels the errors-in-variables correction was left out of in the last pass.
+    """
+
+    z: np.ndarray
+    normal: np.ndarray
+    scale: np.ndarray
+    weights: list[np.ndarray]
+    uncorrected: np.ndarray
+
+
+def fit_jointly(stacked: StackedEquations, designs: Sequence[np.ndarray],
+                targets: Sequence[np.ndarray], invariant: InvariantFit,
+                scatter: np.ndarray | None, iterations: int) -> JointFit:
+    """All channels at once (the Coulomb levels are shared by the channels), each interval's
+    rows weighted by the inverse of their covariance, the noise bias of every channel's
+    [Mt Bt] block removed; reweighted ``iterations`` times with shared friction
+    (``scatter`` not None), once without."""
+    n_unknowns = designs[0].shape[-1]
+    rows = designs[0].shape[1]
+    gram = stacked.gram[..., :rows, :rows]
+    z = np.zeros(n_unknowns)
+    z[:N_THETA] = invariant.theta.ravel()
+    uncorrected = np.zeros(6, dtype=bool)
+    for _ in range(max(1, iterations) if scatter is not None else 1):
+        normal = np.zeros((n_unknowns, n_unknowns))
+        rhs = np.zeros(n_unknowns)
+        weights = []
+        for i in range(6):
+            block = slice(12 * i, 12 * i + 12)
+            w = np.linalg.inv(channel_covariance(stacked, gram, invariant.noise[:, i], i,
+                                                 z[block], None if scatter is None
+                                                 else scatter[i]))
+            weights.append(w)
+            part, part_rhs = _weighted_normal(designs[i], w, targets[i])
+            normal += part
+            rhs += part_rhs
+            normal[block, block], rhs[block], corrected = compensate(
+                normal[block, block], rhs[block], w, gram, stacked.sigma,
+                stacked.sensitivity[:, i])
+            uncorrected[i] = not corrected
+        scale = np.sqrt(np.abs(np.diag(normal)))
+        scale = np.where(scale > 0, scale, 1.0)
+        z = np.linalg.solve(normal / np.outer(scale, scale), rhs / scale) / scale
+    return JointFit(z=z, normal=normal, scale=scale, weights=weights, uncorrected=uncorrected)
+
+
+def standard_errors(designs: Sequence[np.ndarray], targets: Sequence[np.ndarray],
+                    fit: JointFit) -> np.ndarray:
+    """Standard errors (u,) of all unknowns: the larger of the model's (GLS with the
+    compensated normal matrix) and a cluster-robust sandwich over intervals (model errors
+    such as a friction reversal inside an interval show in the spread between intervals,
+    not in the noise level)."""
+    n, n_unknowns = len(designs[0]), len(fit.z)
+    scores = np.zeros((n, n_unknowns))
+    squares, n_rows = 0.0, 0
+    for i in range(6):
+        residual = targets[i] - designs[i] @ fit.z
+        weighted = (fit.weights[i] @ residual[:, :, None])[:, :, 0]
+        scores += (weighted[:, None, :] @ designs[i])[:, 0, :]
+        squares += float(np.sum(residual * weighted))
+        n_rows += residual.size
+    # the equilibrated normal matrix is well conditioned (checked above): an inverse, not
+    # pinv's SVD of the 111 x 111 shared-friction system
+    outer = np.outer(fit.scale, fit.scale)
+    bread = np.linalg.inv(fit.normal / outer) / outer
+    model_cov = bread * max(squares / max(n_rows - n_unknowns, 1), 1e-300)
+    g = n
+    robust_cov = (g / max(g - 1, 1) * (n_rows - 1) / max(n_rows - n_unknowns, 1)
+                  * bread @ (scores.T @ scores) @ bread)
+    return np.sqrt(np.maximum(np.diag(model_cov), np.diag(robust_cov)))
+
+
+def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
+                    shared_friction: bool = True, iterations: int = 5, max_condition: float = 1e8,
                     pose_covariance: np.ndarray | None = None,
                     force_sensitivity: np.ndarray | None = None,
                     force_variance: np.ndarray | None = None) -> WeakFormSolution:
@@ -182,8 +331,8 @@ def solve_weak_form(equations: Sequence, n_experiments: int, shared_friction: bo
     n_experiments : int
     shared_friction : bool
         Use the mean rows with the friction structure of
-        :mod:`~stewartid.identification.wavelet.weak_form`; False: the invariant rows alone (every
-        interval constant free).
+        :mod:`~stewartid.identification.wavelet.weak_form`; False: the invariant rows alone
+        (every interval constant free).
     iterations : int
         Reweighting passes.
     max_condition : float
@@ -193,8 +342,8 @@ def solve_weak_form(equations: Sequence, n_experiments: int, shared_friction: bo
         None: noise-free poses (weights from the force side only).
     force_sensitivity : ndarray, shape (n_experiments, 6, 6), optional
         K = d(J^T f - G) / dq of each experiment
-        (:func:`~stewartid.identification.wavelet.noise.generalized_force_sensitivity`): the pose
-        noise the targets share with the regressors. None: zero.
+        (:attr:`~stewartid.identification.preparation.Experiment.force_sensitivity`): the
+        pose noise the targets share with the regressors. None: zero.
     force_variance : ndarray, shape (n_experiments, 6), optional
         White noise variance per sample of each experiment's generalized force (N^2,
         N^2 m^2), e.g. :func:`~stewartid.identification.wavelet.noise.white_noise_covariance`
@@ -203,157 +352,32 @@ def solve_weak_form(equations: Sequence, n_experiments: int, shared_friction: bo
     Returns
     -------
     WeakFormSolution
+
+    Notes
+    -----
+    The steps, each a function of this module: :func:`stack_equations` (the intervals'
+    equations and noise levels as arrays), :func:`channel_systems` (each channel's design),
+    :func:`fit_invariant_rows` (the invariant rows alone, reweighted, with the force-side
+    noise), :func:`constant_scatter` (shared friction: the interval constants' scatter),
+    :func:`fit_jointly` (all rows and channels) and :func:`standard_errors`.
     """
-    x = np.stack([e.regressors for e in equations])                    # (n, K, 12)
-    y = np.stack([e.targets for e in equations])                       # (n, K, 6)
-    n, k_rows = x.shape[:2]
-    owner = np.array([e.experiment for e in equations])
-    gram_all = np.stack([e.noise_gram for e in equations])          # (n, 3, 3, K+1, K+1)
-    sigma = (np.zeros((n, 6, 6)) if pose_covariance is None
-             else np.asarray(pose_covariance, dtype=float)[owner])
-    sensitivity = (np.zeros((n, 6, 6)) if force_sensitivity is None
-                   else np.asarray(force_sensitivity, dtype=float)[owner])      # (n, 6, 6)
-    white = (np.zeros((n, 6)) if force_variance is None
-             else np.asarray(force_variance, dtype=float)[owner])             # (n, 6)
-    flat = x.reshape(-1, 12)
-    condition = _check_rank(flat.T @ flat, regressor_names("q_ddot", "q_dot"), max_condition)
-    n_types = equations[0].coulomb.shape[0]
-    n_nuisance = 6 * n_experiments + n_types if shared_friction else 0
-    n_unknowns = N_THETA + n_nuisance
-    rows = k_rows + 1 if shared_friction else k_rows
-
-    # per channel: design (n, rows, n_unknowns), target (n, rows), gram (n, 3, rows, rows)
-    designs, targets = [], []
-    if shared_friction:
-        xm = np.stack([e.mean_regressors for e in equations])
-        ym = np.stack([e.mean_target for e in equations])
-        weight = np.array([e.weight for e in equations])
-        wm = np.stack([e.coulomb for e in equations])                   # (n, types, 6)
-    for i in range(6):
-        design = np.zeros((n, rows, n_unknowns))
-        design[:, :k_rows, 12 * i:12 * i + 12] = x
-        target = y[:, :, i]
-        if shared_friction:
-            design[:, k_rows, 12 * i:12 * i + 12] = xm
-            design[np.arange(n), k_rows, N_THETA + 6 * owner + i] = weight
-            design[:, k_rows, N_THETA + 6 * n_experiments:] = wm[:, :, i]
-            target = np.concatenate([target, ym[:, i:i + 1]], axis=1)
-        designs.append(design)
-        targets.append(target)
-    gram = gram_all[..., :rows, :rows]
-    gram_inv = gram_all[..., :k_rows, :k_rows]
-
-    # start: each channel's invariant rows, force-side weights only
-    theta = np.linalg.lstsq(flat, y.reshape(-1, 6), rcond=None)[0].T
-    # floor: noise-free data must not give infinite weights
-    floor = 1e-24 * np.maximum(np.mean(y.reshape(-1, 6) ** 2, axis=0), 1e-300)
-    noise = np.zeros((n, 6))  # s per interval and channel
-    pose_share = np.zeros(6)
-
-    uncorrected = np.zeros(6, dtype=bool)  # channels of the last pass left uncorrected
-
-    def compensated(normal: np.ndarray, rhs: np.ndarray, w: np.ndarray, g: np.ndarray,
-                    i: int) -> tuple[np.ndarray, np.ndarray]:
-        bias, bias_rhs = _noise_bias(w, g, sigma, sensitivity[:, i])
-        try:  # noise so large that the correction leaves no information: no correction
-            np.linalg.cholesky(normal - bias)
-        except np.linalg.LinAlgError:
-            uncorrected[i] = True
-            return normal, rhs
-        uncorrected[i] = False
-        return normal - bias, rhs - bias_rhs
-
-    # invariant rows alone (the estimate the scatter is measured with)
-    for i in range(6):
-        for _ in range(max(1, iterations)):
-            q_inv = _pose_covariance(gram_inv, sigma, _coefficients(sensitivity[:, i], theta[i]))
-            residual = y[:, :, i] - x @ theta[i]
-            power, pose = float(np.sum(residual ** 2)), float(np.trace(q_inv, 0, 1, 2).sum())
-            excess = _excess_variance(white[:, i, None, None] * np.eye(k_rows) + q_inv,
-                                      residual, residual.size - 12)
-            noise[:, i] = np.maximum(white[:, i] + excess, floor[i])
-            pose_share[i] = min(pose / max(power, 1e-300), 1.0)
-            w = np.linalg.inv(noise[:, i, None, None] * np.eye(k_rows) + q_inv)
-            normal, rhs = compensated(*_weighted_normal(x, w, y[:, :, i]), w, gram_inv, i)
-            theta[i] = np.linalg.solve(normal, rhs)
-
-    def channel_covariance(i: int, theta_i: np.ndarray) -> np.ndarray:
-        v = noise[:, i, None, None] * np.eye(rows) + _pose_covariance(gram, sigma,
-                                                       _coefficients(sensitivity[:, i], theta_i))
-        if shared_friction:
-            v[:, -1, -1] += (scatter[i] * weight) ** 2
-        return v
-
-    scatter = np.zeros(6)
-    if shared_friction:
-        # the scatter of the interval constants around the friction structure, measured with
-        # the invariant estimate: a joint fit would bend Bt to hide a structure that does
-        # not hold, and so report a scatter too small to notice it
-        variance = np.stack([channel_covariance(i, theta[i])[:, -1, -1]
-                             for i in range(6)], axis=1)                  # (n, 6), tau = 0
-        base = ym - xm @ theta.T
-        nuisance_design = np.stack([d[:, -1, N_THETA:] for d in designs], axis=1)  # (n,6,u)
-        scaled = nuisance_design / np.sqrt(variance)[:, :, None]
-        fitted = np.linalg.lstsq(scaled.reshape(-1, n_nuisance),
-                                 (base / np.sqrt(variance)).ravel(), rcond=None)[0]
-        mean_residual = base - nuisance_design @ fitted
-        # tau^2 per channel with sum_k r_k^2 / (v_k + tau^2 w_k^2) = dof, i.e. the chi-square
-        # excess of r_k / w_k over v_k / w_k. Not the plain moment sum(r^2 - v) / sum(w^2):
-        # the intervals' noise variances v differ 100-fold, the moment was ruled by the
-        # noisiest, came out zero on half the seeds and 20x the typical value on others,
-        # and the estimates of Bt followed it (kurtosis 4-9 over seeds, twice the spread)
-        dof = n - n_nuisance / 6
-        scatter = np.sqrt([_chi2_excess(variance[:, i] / weight ** 2,
-                                        (mean_residual[:, i] / weight) ** 2, dof)
-                           for i in range(6)])
-
-    z = np.zeros(n_unknowns)
-    z[:N_THETA] = theta.ravel()
-    for _ in range(max(1, iterations) if shared_friction else 1):
-        normal = np.zeros((n_unknowns, n_unknowns))
-        rhs = np.zeros(n_unknowns)
-        weights = []
-        for i in range(6):
-            block = slice(12 * i, 12 * i + 12)
-            w = np.linalg.inv(channel_covariance(i, z[block]))
-            weights.append(w)
-            part, part_rhs = _weighted_normal(designs[i], w, targets[i])
-            normal += part
-            rhs += part_rhs
-            normal[block, block], rhs[block] = compensated(normal[block, block], rhs[block], w,
-                                                           gram, i)
-        scale = np.sqrt(np.abs(np.diag(normal)))
-        scale = np.where(scale > 0, scale, 1.0)
-        z = np.linalg.solve(normal / np.outer(scale, scale), rhs / scale) / scale
-
-    if uncorrected.any():
-        names = ", ".join(c for c, u in zip(COORDINATES, uncorrected, strict=True) if u)
+    stacked = stack_equations(equations, pose_covariance, force_sensitivity, force_variance)
+    n, k_rows = stacked.regressors.shape[:2]
+    flat = stacked.regressors.reshape(-1, 12)
+    condition = check_rank(flat.T @ flat, regressor_names("q_ddot", "q_dot"), max_condition)
+    designs, targets = channel_systems(stacked, n_experiments, shared_friction)
+    invariant = fit_invariant_rows(stacked, iterations)
+    scatter = constant_scatter(stacked, designs, invariant) if shared_friction else None
+    fit = fit_jointly(stacked, designs, targets, invariant, scatter, iterations)
+    if fit.uncorrected.any():
+        names = ", ".join(c for c, u in zip(COORDINATES, fit.uncorrected, strict=True) if u)
         warnings.warn(f"pose noise too large for the errors-in-variables correction of the "
                       f"{names} equations: their rows of Mt and Bt keep the attenuation the "
                       f"noise causes (biased towards zero by its share of the regressors' "
                       f"power); longer intervals or less pose noise remove it", DataWarning,
                       stacklevel=3)
-
-    # standard errors: the model's (GLS with the compensated normal matrix) and a
-    # cluster-robust sandwich over intervals (model errors such as a friction reversal
-    # inside an interval show in the spread between intervals, not in the noise level)
-    scores = np.zeros((n, n_unknowns))
-    squares, n_rows = 0.0, 0
-    for i in range(6):
-        residual = targets[i] - designs[i] @ z
-        weighted = (weights[i] @ residual[:, :, None])[:, :, 0]
-        scores += (weighted[:, None, :] @ designs[i])[:, 0, :]
-        squares += float(np.sum(residual * weighted))
-        n_rows += residual.size
-    # the equilibrated normal matrix is well conditioned (checked above): an inverse, not
-    # pinv's SVD of the 111 x 111 shared-friction system
-    bread = np.linalg.inv(normal / np.outer(scale, scale)) / np.outer(scale, scale)
-    model_cov = bread * max(squares / max(n_rows - n_unknowns, 1), 1e-300)
-    g = n
-    robust_cov = (g / max(g - 1, 1) * (n_rows - 1) / max(n_rows - n_unknowns, 1)
-                  * bread @ (scores.T @ scores) @ bread)
-    std = np.sqrt(np.maximum(np.diag(model_cov), np.diag(robust_cov)))
-    theta = z[:N_THETA].reshape(6, 12)
+    std = standard_errors(designs, targets, fit)
+    z, n_types = fit.z, stacked.coulomb.shape[1]
     if shared_friction:
         offsets = z[N_THETA:N_THETA + 6 * n_experiments].reshape(n_experiments, 6)
         coulomb, coulomb_std = z[N_THETA + 6 * n_experiments:], std[N_THETA + 6 * n_experiments:]
@@ -361,10 +385,13 @@ def solve_weak_form(equations: Sequence, n_experiments: int, shared_friction: bo
         offsets = np.full((n_experiments, 6), np.nan)
         coulomb = coulomb_std = np.full(n_types, np.nan)
     return WeakFormSolution(
-        theta=theta, theta_std=std[:N_THETA].reshape(6, 12), coulomb=coulomb,
-        coulomb_std=coulomb_std, offsets=offsets, noise_std=np.sqrt(noise.mean(axis=0)),
-        pose_noise_share=pose_share, constant_scatter=scatter, condition_number=condition,
-        n_equations=int(n * k_rows))
+        theta=z[:N_THETA].reshape(6, 12), theta_std=std[:N_THETA].reshape(6, 12),
+        coulomb=coulomb, coulomb_std=coulomb_std, offsets=offsets,
+        noise_std=np.sqrt(invariant.noise.mean(axis=0)), pose_noise_share=invariant.pose_share,
+        constant_scatter=np.zeros(6) if scatter is None else scatter,
+        condition_number=condition, n_equations=int(n * k_rows))
 
 
-__all__ = ["WeakFormSolution", "solve_weak_form"]
+__all__ = ["InvariantFit", "JointFit", "WeakFormSolution",
+           "channel_covariance", "channel_systems", "constant_scatter",
+           "fit_invariant_rows", "fit_jointly", "solve_weak_form", "standard_errors"]

@@ -32,6 +32,8 @@ import numpy as np
 
 from stewartid.errors import ConfigError, DataError
 from stewartid.model.joints import JOINT_AXES
+from stewartid.model.kinematics import joint_rate_jacobians
+from stewartid.model.kinematics import leg_jacobian as leg_jacobian_at
 from stewartid.platform import Platform
 
 if TYPE_CHECKING:
@@ -58,10 +60,11 @@ def joint_rates(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
     q_dot : ndarray, shape (N, 6)
         Pose rates (m/s, rad/s).
     joint_jacobians : ndarray, shape (N, 6, 5, 6), optional
-        Joint-axis Jacobians at ``q`` if already computed
-        (:func:`stewartid.model.kinematics.joint_rate_jacobians`).
+        Joint-axis Jacobians at ``q`` if already computed (a prepared experiment holds
+        them); None: :func:`stewartid.model.kinematics.joint_rate_jacobians`.
     leg_jacobian : ndarray, shape (N, 6, 6), optional
-        Leg Jacobians J_lq at ``q`` if already computed.
+        Leg Jacobians J_lq at ``q`` if already computed; None:
+        :func:`stewartid.model.kinematics.leg_jacobian`.
 
     Returns
     -------
@@ -74,11 +77,10 @@ def joint_rates(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
     if q.shape != q_dot.shape or q.shape[1:] != (6,):
         raise DataError(f"q and q_dot must both have shape (N, 6); got {q.shape} and "
                         f"{q_dot.shape}.")
-    if joint_jacobians is None or leg_jacobian is None:
-        from stewartid.model.dynamics import ModelTerms
-
-        terms = ModelTerms(platform, q)
-        joint_jacobians, leg_jacobian = terms.joint_jacobians, terms.leg_jacobian
+    if joint_jacobians is None:
+        joint_jacobians = joint_rate_jacobians(platform, q)
+    if leg_jacobian is None:
+        leg_jacobian = leg_jacobian_at(platform, q)
     axes = np.einsum("nlaj,nj->nla", joint_jacobians, q_dot).reshape(len(q), 30)
     legs = np.einsum("nlj,nj->nl", leg_jacobian, q_dot)
     return np.concatenate([axes, legs], axis=1)

@@ -4,17 +4,23 @@ equations of Method B.
 - :func:`white_noise_covariance`: covariance of white noise per sample (pose, forces);
 - :func:`joint_rate_noise`: the noise it causes on the Savitzky-Golay joint rates (for the
   hysteresis thresholds of the interval detection);
-- :func:`generalized_force_sensitivity`: how pose noise enters the generalized force (for
-  the errors-in-variables correction).
+- :func:`estimate_noise`: both, for one prepared experiment (the noise-model step of
+  Method B).
+
+How pose noise enters the generalized force, for the errors-in-variables correction, is a
+model term: :func:`~stewartid.identification.preparation.generalized_force_sensitivity`.
 """
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
-from stewartid.platform import Platform
+from stewartid.identification.preparation import Experiment
 from stewartid.signals.differentiation import (
     DEFAULT_ORDER,
+    differentiate,
     savgol_coefficients,
     window_samples,
 )
@@ -80,28 +86,58 @@ def joint_rate_noise(covariance: np.ndarray, sample_rate: float, window: float,
     return gain * np.sqrt(np.clip(variance, 0.0, None))
 
 
-def generalized_force_sensitivity(platform: Platform, q: np.ndarray, forces: np.ndarray,
-                                  gravity: bool = True, step: float = 1e-6) -> np.ndarray:
-    """K = d(J_lq(q)^T f - G(q)) / dq at the mean pose and mean leg forces, shape (6, 6).
+class NoiseModel(NamedTuple):
+    """The smoothed motion of one experiment and the measurement noise around it.
 
-    Pose noise enters the generalized force through the Jacobian (the static leg load times
-    the change of the leg directions) and through G(q); K maps it there, so the
-    errors-in-variables correction can account for noise shared by regressors and targets.
-    Central differences of ``step`` (m, rad).
+    Attributes
+    ----------
+    window : float
+        Savitzky-Golay window (s).
+    q_dot, q_ddot : ndarray, shape (N, 6)
+        Savitzky-Golay derivatives of the pose (m/s, rad/s; m/s^2, rad/s^2).
+    pose_covariance : ndarray, shape (6, 6)
+        White pose noise per sample (m^2, m rad, rad^2), :func:`white_noise_covariance`.
+    force_variance : ndarray, shape (6,)
+        White noise variance per sample of the generalized force (N^2, N^2 m^2).
+    rate_noise : ndarray, shape (36,)
+        Standard deviation the pose noise causes on each joint rate (:func:`joint_rate_noise`;
+        columns as :data:`~stewartid.identification.wavelet.intervals.JOINT_RATE_NAMES`).
     """
-    from stewartid.model.kinematics import compute_leg_terms
 
-    q0, f0 = q.mean(axis=0), forces.mean(axis=0)
-    poses = np.repeat(q0[None], 12, axis=0)
-    for j in range(6):
-        poses[2 * j, j] += step
-        poses[2 * j + 1, j] -= step
-    # the numpy pose-only terms: equal to the compiled model terms, without numba's start
-    terms = compute_leg_terms(platform, poses)
-    y = np.einsum("nji,j->ni", terms.leg_jacobian, f0)
-    if gravity:
-        y = y - terms.gravity
-    return ((y[0::2] - y[1::2]) / (2 * step)).T
+    window: float
+    q_dot: np.ndarray
+    q_ddot: np.ndarray
+    pose_covariance: np.ndarray
+    force_variance: np.ndarray
+    rate_noise: np.ndarray
 
 
-__all__ = ["generalized_force_sensitivity", "joint_rate_noise", "white_noise_covariance"]
+def estimate_noise(experiment: Experiment, window: float) -> NoiseModel:
+    """The noise model of one prepared experiment: pose and generalized force smoothed with
+    a Savitzky-Golay window, the white noise each holds around its smoothed copy, and what
+    the pose noise puts on the joint rates (from the Jacobians the experiment holds).
+
+    Parameters
+    ----------
+    experiment : Experiment
+        Prepared with its joint-axis Jacobians
+        (:func:`~stewartid.identification.preparation.prepare_experiment`).
+    window : float
+        Savitzky-Golay window (s).
+
+    Returns
+    -------
+    NoiseModel
+    """
+    q, rate = experiment.q, 1.0 / experiment.period
+    q_smooth, q_dot, q_ddot = differentiate(q, rate, window)
+    covariance = white_noise_covariance(q, q_smooth)
+    y = experiment.generalized_force
+    force_variance = np.diag(white_noise_covariance(y, differentiate(y, rate, window)[0]))
+    rate_noise = joint_rate_noise(covariance, rate, window, experiment.joint_jacobians,
+                                  experiment.leg_jacobian)
+    return NoiseModel(window=window, q_dot=q_dot, q_ddot=q_ddot, pose_covariance=covariance,
+                      force_variance=force_variance, rate_noise=rate_noise)
+
+
+__all__ = ["NoiseModel", "estimate_noise", "joint_rate_noise", "white_noise_covariance"]

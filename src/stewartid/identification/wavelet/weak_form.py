@@ -49,13 +49,16 @@ Shinbrot, M. "On the analysis of linear and nonlinear systems." Trans. ASME 79, 
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 from numpy.polynomial import polynomial
 
+from stewartid.identification.preparation import Experiment
+from stewartid.identification.wavelet.detection import Detection
 from stewartid.model.joints import JOINT_TYPES
 
 
@@ -118,7 +121,7 @@ class IntervalEquations:
 
 
 def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
-                       joint_jacobians: np.ndarray | Callable[[np.ndarray], np.ndarray] | None,
+                       joint_jacobians: np.ndarray | None,
                        joint_rates: np.ndarray,
                        rate_noise: np.ndarray, interval: Sequence[float], order: int, size: int,
                        experiment: int = 0, uniform: bool = False) -> IntervalEquations | None:
@@ -132,10 +135,9 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
         Measured pose (m, rad).
     y : ndarray, shape (N, 6)
         Generalized force J^T f - G(q) (N, N m).
-    joint_jacobians : ndarray, shape (N, 6, 5, 6), or callable
-        Joint-axis rate Jacobians (rad/s per unit q_dot), or a function returning them
-        (n, 6, 5, 6) at the sample indices it is given (long records need not hold them).
-        None: no friction structure (``coulomb`` zero; the mean row is then unused).
+    joint_jacobians : ndarray, shape (N, 6, 5, 6), or None
+        Joint-axis rate Jacobians (rad/s per unit q_dot). None: no friction structure
+        (``coulomb`` zero; the mean row is then unused).
     joint_rates : ndarray, shape (N, 6, 5)
         Smoothed joint-axis rates (rad/s); only their mean over the interval is used, for the
         joint directions.
@@ -188,9 +190,7 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
     if joint_jacobians is None:
         coulomb = np.zeros((len(JOINT_TYPES), 6))
     else:
-        jacobians = (joint_jacobians(sel) if callable(joint_jacobians)
-                     else joint_jacobians[sel])
-        pattern = np.einsum("la,nlac->nac", direction, jacobians)              # (n, 5, 6)
+        pattern = np.einsum("la,nlac->nac", direction, joint_jacobians[sel])   # (n, 5, 6)
         coulomb = np.array([bump0 @ pattern[:, list(axes)].sum(axis=1)
                             for axes in JOINT_TYPES.values()])
         if uniform:
@@ -205,4 +205,117 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
         noise_gram=gram)
 
 
-__all__ = ["IntervalEquations", "interval_equations"]
+def experiment_equations(experiment: Experiment, found: Detection, order: int, size: int,
+                         index: int, friction: str) -> list[IntervalEquations]:
+    """The equations step of Method B: the weak-form equations of every usable interval of
+    one experiment.
+
+    Parameters
+    ----------
+    experiment : Experiment
+        Prepared with its joint-axis Jacobians.
+    found : Detection
+        Its intervals and joint rates (:func:`.detection.detect_intervals`).
+    order, size : int
+        As in :func:`interval_equations`.
+    index : int
+        Index of the experiment, stored in every interval's equations.
+    friction : {"free", "shared", "uniform"}
+        "free": no friction structure; "uniform": one Coulomb level for every joint axis.
+
+    Returns
+    -------
+    list of IntervalEquations
+        One per interval long enough for the test functions.
+    """
+    jacobians = None if friction == "free" else experiment.joint_jacobians
+    equations = (interval_equations(experiment.t, experiment.q, experiment.generalized_force,
+                                    jacobians, found.joint_rates, found.rate_noise, interval,
+                                    order, size, index, uniform=friction == "uniform")
+                 for interval in found.intervals)
+    return [rows for rows in equations if rows is not None]
+
+
+class StackedEquations(NamedTuple):
+    """The equations of n intervals as arrays, with the noise levels of their experiments.
+
+    Attributes
+    ----------
+    regressors : ndarray, shape (n, K, 12)
+        Invariant rows [<phi'', q>, -<phi', q>].
+    targets : ndarray, shape (n, K, 6)
+        <phi, y>.
+    mean_regressors : ndarray, shape (n, 12)
+    mean_targets : ndarray, shape (n, 6)
+    weights : ndarray, shape (n,)
+        <g, 1> of every mean row (s^(1/2)).
+    coulomb : ndarray, shape (n, n_types, 6)
+        Generalized Coulomb force per unit level of each joint type.
+    owner : ndarray of int, shape (n,)
+        Experiment of every interval.
+    gram : ndarray, shape (n, 3, 3, K + 1, K + 1)
+        Gram matrices of the rows' test functions and their derivatives.
+    sigma : ndarray, shape (n, 6, 6)
+        Pose noise per sample of every interval's experiment (zero when not given).
+    sensitivity : ndarray, shape (n, 6, 6)
+        K = dy/dq of every interval's experiment (zero when not given).
+    white : ndarray, shape (n, 6)
+        White noise variance of the generalized force (zero when not given).
+    """
+
+    regressors: np.ndarray
+    targets: np.ndarray
+    mean_regressors: np.ndarray
+    mean_targets: np.ndarray
+    weights: np.ndarray
+    coulomb: np.ndarray
+    owner: np.ndarray
+    gram: np.ndarray
+    sigma: np.ndarray
+    sensitivity: np.ndarray
+    white: np.ndarray
+
+
+def stack_equations(equations: Sequence[IntervalEquations],
+                    pose_covariance: np.ndarray | None = None,
+                    force_sensitivity: np.ndarray | None = None,
+                    force_variance: np.ndarray | None = None) -> StackedEquations:
+    """Every interval's equations as arrays, with its experiment's noise levels.
+
+    Parameters
+    ----------
+    equations : sequence of IntervalEquations
+        n intervals, all with the same number K of invariant rows.
+    pose_covariance, force_sensitivity, force_variance : ndarray, optional
+        Per experiment, as in :func:`~stewartid.identification.wavelet.gls.solve_weak_form`;
+        None: zero.
+
+    Returns
+    -------
+    StackedEquations
+    """
+    owner = np.array([e.experiment for e in equations])
+    return StackedEquations(
+        regressors=np.stack([e.regressors for e in equations]),
+        targets=np.stack([e.targets for e in equations]),
+        mean_regressors=np.stack([e.mean_regressors for e in equations]),
+        mean_targets=np.stack([e.mean_target for e in equations]),
+        weights=np.array([e.weight for e in equations]),
+        coulomb=np.stack([e.coulomb for e in equations]), owner=owner,
+        gram=np.stack([e.noise_gram for e in equations]),
+        sigma=_per_interval(pose_covariance, owner, (6, 6)),
+        sensitivity=_per_interval(force_sensitivity, owner, (6, 6)),
+        white=_per_interval(force_variance, owner, (6,)))
+
+
+def _per_interval(values: np.ndarray | None, owner: np.ndarray, shape: tuple[int, ...]
+                  ) -> np.ndarray:
+    """Per-experiment ``values`` (n_experiments, *shape) at every interval (n, *shape), from
+    the intervals' experiments ``owner``; zeros for None."""
+    if values is None:
+        return np.zeros((len(owner), *shape))
+    return np.asarray(values, dtype=float)[owner]
+
+
+__all__ = ["IntervalEquations", "StackedEquations", "experiment_equations", "interval_equations",
+           "stack_equations"]

@@ -1,0 +1,126 @@
+"""Variance components of the weak-form rows of Method B.
+
+- :func:`pose_covariance`: the covariance the white pose noise puts into each interval's
+  rows of one channel, Q_rs = sum_ab (c_a Sigma c_b) <phi_r^(a), phi_s^(b)> (see
+  :mod:`~stewartid.identification.wavelet.gls`), with :func:`pose_coefficients` the c_a;
+- :func:`noise_bias`: the expected noise parts of the weighted normal equations, which
+  :func:`compensate` subtracts (the errors-in-variables solve);
+- :func:`chi2_excess` and :func:`excess_variance`: the variance residuals hold beyond what
+  the noise explains (model error, the scatter of the interval constants), matched in
+  weighted chi-square.
+
+References
+----------
+Paule, R. C., Mandel, J. "Consensus values and weighting factors." J. Res. Natl. Bur. Stand.
+87(5), 377-385 (1982). doi:10.6028/jres.087.022
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def pose_covariance(gram: np.ndarray, sigma: np.ndarray, coefficients: np.ndarray
+                    ) -> np.ndarray:
+    """The row covariance the pose noise causes in one channel, per interval.
+
+    Parameters
+    ----------
+    gram : ndarray, shape (n, 3, 3, R, R)
+        Gram matrices of the test functions and their first and second derivatives.
+    sigma : ndarray, shape (n, 6, 6)
+        Pose noise per sample of each interval's experiment (m^2, m rad, rad^2).
+    coefficients : ndarray, shape (n, 3, 6)
+        What multiplies <phi^(a), n> in the channel's residual, a = 0 (the target's
+        sensitivity k_i), 1 (b_i) and 2 (-m_i) (:func:`pose_coefficients`).
+
+    Returns
+    -------
+    ndarray, shape (n, R, R)
+        Q per interval (units of the targets squared).
+    """
+    c = np.einsum("naj,njk,nbk->nab", coefficients, sigma, coefficients)
+    return np.einsum("nab,nabrs->nrs", c, gram)
+
+
+def noise_bias(weights: np.ndarray, gram: np.ndarray, sigma: np.ndarray,
+               sensitivity: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Expected noise parts of sum X^T W X (12, 12) and of sum X^T W y (12,) over intervals
+    for one channel, the regressors' noise being [<phi'', n>, -<phi', n>] and the target's
+    <phi, k_i n>.
+
+    Parameters
+    ----------
+    weights : ndarray, shape (n, R, R)
+        Row weights W of every interval.
+    gram : ndarray, shape (n, 3, 3, R, R)
+    sigma : ndarray, shape (n, 6, 6)
+    sensitivity : ndarray, shape (n, 6)
+        k_i of every interval's experiment: row i of dy/dq.
+
+    Returns
+    -------
+    normal : ndarray, shape (12, 12)
+    rhs : ndarray, shape (12,)
+    """
+    t = np.einsum("nrs,nabrs->nab", weights, gram)                     # sum_rs W_rs G_ab,rs
+    mm = np.einsum("n,njk->jk", t[:, 2, 2], sigma)
+    mb = -np.einsum("n,njk->jk", t[:, 2, 1], sigma)
+    bb = np.einsum("n,njk->jk", t[:, 1, 1], sigma)
+    sk = np.einsum("njk,nk->nj", sigma, sensitivity)
+    target = np.r_[np.einsum("n,nj->j", t[:, 2, 0], sk), -np.einsum("n,nj->j", t[:, 1, 0], sk)]
+    return np.block([[mm, mb], [mb.T, bb]]), target
+
+
+def compensate(normal: np.ndarray, rhs: np.ndarray, weights: np.ndarray, gram: np.ndarray,
+               sigma: np.ndarray, sensitivity: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray, bool]:
+    """One channel's [Mt Bt] block of the normal equations less its expected noise part
+    (:func:`noise_bias`), and whether it was; the block unchanged when
+    the noise is so large that the correction leaves no information (not positive
+    definite)."""
+    bias, bias_rhs = noise_bias(weights, gram, sigma, sensitivity)
+    try:
+        np.linalg.cholesky(normal - bias)
+    except np.linalg.LinAlgError:
+        return normal, rhs, False
+    return normal - bias, rhs - bias_rhs, True
+
+
+def pose_coefficients(sensitivity: np.ndarray, theta_i: np.ndarray) -> np.ndarray:
+    """(n, 3, 6) coefficients of :func:`pose_covariance` for channel row theta_i = [m, b]
+    (12,), sensitivity (n, 6) the channel's k_i per interval."""
+    n = len(sensitivity)
+    return np.stack([sensitivity, np.broadcast_to(theta_i[6:], (n, 6)),
+                     np.broadcast_to(-theta_i[:6], (n, 6))], axis=1)
+
+
+def chi2_excess(variances: np.ndarray, squares: np.ndarray, dof: float) -> float:
+    """e >= 0 with sum_k squares_k / (variances_k + e) = dof (0 when the left side is already
+    at most dof at e = 0): the variance that residuals of expected variances ``variances``
+    hold beyond them, matched in weighted chi-square (the Paule-Mandel estimator of
+    random-effects meta-analysis). Both arrays of any one shape, variances >= 0."""
+    lam = np.maximum(variances, 0.0)
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):  # noise-free rows
+        if np.sum(np.where(squares > 0, squares / lam, 0.0)) <= dof:
+            return 0.0
+    low, high = 0.0, float(np.sum(squares)) / max(dof, 1)   # chi2(high) <= dof
+    for _ in range(60):  # bisection on the monotone chi2(e), to 1e-18 of the bracket
+        mid = 0.5 * (low + high)
+        low, high = (mid, high) if np.sum(squares / (lam + mid)) > dof else (low, mid)
+    return high
+
+
+def excess_variance(covariance: np.ndarray, residual: np.ndarray, dof: int) -> float:
+    """e >= 0 with sum_n r_n^T (V_n + e I)^-1 r_n = dof: the white variance per row the
+    residuals (n, R) hold beyond their expected covariance V (n, R, R), model error.
+
+    Weighted, because the pose part of V is orders of magnitude larger on the narrow test
+    functions than on the wide ones: the plain moment (sum |r|^2 - tr V) / (n R) is then the
+    difference of two numbers whose randomness alone exceeds the force noise."""
+    lam, vectors = np.linalg.eigh(covariance)
+    return chi2_excess(lam, np.einsum("nrk,nr->nk", vectors, residual) ** 2, dof)
+
+
+__all__ = ["chi2_excess", "compensate", "excess_variance", "noise_bias", "pose_coefficients",
+           "pose_covariance"]
