@@ -34,7 +34,7 @@ import numpy as np
 from numba import njit
 
 from stewartid.errors import ConfigError
-from stewartid.platform import Hydraulics
+from stewartid.platform.sections import Hydraulics
 
 # indices into the packed hydraulic parameter vector
 H_AREA_A, H_AREA_B, H_SUPPLY, H_RETURN, H_BULK, H_DEAD, H_STROKE, H_MID = range(8)

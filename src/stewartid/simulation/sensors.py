@@ -16,7 +16,8 @@ import numpy as np
 from stewartid.errors import ConfigError
 from stewartid.model.dynamics import inverse_dynamics
 from stewartid.model.kinematics import forward_kinematics
-from stewartid.platform import Platform, Sensors
+from stewartid.platform import Platform
+from stewartid.platform.sections import Sensors
 
 
 @dataclasses.dataclass(frozen=True)
