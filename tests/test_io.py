@@ -67,3 +67,24 @@ def test_figures_leave_matplotlib_global_state_alone(tmp_path):
     assert dict(matplotlib.rcParams) == before
     if "matplotlib.pyplot" in sys.modules:  # no figure registered with pyplot
         assert not sys.modules["matplotlib.pyplot"].get_fignums()
+
+
+def test_csv_columns_keep_missing_values_and_integer_columns():
+    from stewartid.datasets.columns import read_csv_columns
+
+    columns = read_csv_columns("a,b,c\n1,2.5,\n-3,,4\n5,1e3,6\n", "log.csv")
+    assert columns["a"].tolist() == [1.0, -3.0, 5.0]
+    assert columns["b"][0] == 2.5 and math.isnan(columns["b"][1]) and columns["b"][2] == 1e3
+    assert math.isnan(columns["c"][0]) and columns["c"][1:].tolist() == [4.0, 6.0]
+
+
+def test_reading_a_log_loads_neither_pandas_nor_pyarrow_compute(tmp_path):
+    # each costs 0.1-0.4 s of every command line that reads a log
+    import subprocess
+
+    (tmp_path / "log.csv").write_text("t,x\n0,1\n0.001,\n")
+    code = ("import sys; from stewartid.datasets.log_format import read_table; "
+            f"from pathlib import Path; read_table(Path({str(tmp_path / 'log.csv')!r}), 'csv'); "
+            "print(sorted(m for m in ('pandas', 'pyarrow.compute') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"

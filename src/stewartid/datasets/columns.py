@@ -93,13 +93,22 @@ def _values(column: pa.ChunkedArray) -> np.ndarray:
     kind = column.type
     if not (pa.types.is_floating(kind) or pa.types.is_integer(kind)):
         return np.array(column.to_pylist(), dtype=object)
-    column = column.cast(pa.float64())
-    if column.null_count:
-        column = column.fill_null(np.nan)
-    # the values buffer as is: Array.to_numpy would import pandas
-    return np.concatenate([np.frombuffer(chunk.buffers()[1], dtype=np.float64, count=len(chunk),
-                                         offset=chunk.offset * 8)
-                           for chunk in column.chunks] or [np.empty(0)])
+    # read from the buffers: Array.to_numpy would import pandas, and cast or fill_null
+    # pyarrow.compute (0.1 s of every command line that reads a log)
+    code = "f" if pa.types.is_floating(kind) else "i" if pa.types.is_signed_integer(kind) else "u"
+    dtype = np.dtype(f"<{code}{kind.bit_width // 8}")
+    return np.concatenate([_chunk_values(chunk, dtype) for chunk in column.chunks]
+                          or [np.empty(0)])
+
+
+def _chunk_values(chunk: pa.Array, dtype: np.dtype) -> np.ndarray:
+    validity, data = chunk.buffers()[:2]
+    values = np.frombuffer(data, dtype=dtype, count=len(chunk),
+                           offset=chunk.offset * dtype.itemsize).astype(float)
+    if chunk.null_count:
+        bits = np.unpackbits(np.frombuffer(validity, dtype=np.uint8), bitorder="little")
+        values[bits[chunk.offset:chunk.offset + len(chunk)] == 0] = np.nan
+    return values
 
 
 def to_numbers(values: np.ndarray) -> np.ndarray:
