@@ -74,7 +74,7 @@ def test_stiffness_needs_two_frequencies(paper, truth):
     # fitted at one frequency, the 3 Hz line (half the amplitude, the third harmonic) is a
     # second sine, and Method A says so instead of returning the biased Mt - K / w^2
     with pytest.raises(IdentificationError, match=r"exp1: Method A needs motion at the given "
-                                                  r"1 Hz only; .* 2 spectral lines .*\(1, 3 Hz\)"):
+                                                  r"1 Hz only; .* 2 spectral lines .*\(1.0, 3.0 Hz\)"):
         FourierIdentifier(frequency_hz=1.0).fit(data, paper)
     with pytest.raises(ConfigError, match="single excitation frequency"):
         FourierIdentifier(frequency_hz=1.0, stiffness=True).fit(data, paper)
