@@ -24,10 +24,8 @@ from stewartid.errors import DataError, IdentificationError
 from stewartid.identification.fourier import FourierIdentifier
 from stewartid.model.kinematics import leg_lengths
 
-
-@pytest.fixture(scope="module")
-def truth():
-    return random_matrices(np.random.default_rng(3))
+#: Mt, Bt of the model data (symmetric positive definite, realistic magnitudes).
+TRUTH = random_matrices(np.random.default_rng(3))
 
 
 def _one_line(result) -> str:
@@ -65,8 +63,8 @@ def test_a_pure_sine_is_one_line_whatever_its_phase_to_the_bins():
 
 # -- Method A ----------------------------------------------------------------------------------
 
-def test_method_a_refuses_several_sines_per_experiment(paper, truth):
-    M, B = truth
+def test_method_a_refuses_several_sines_per_experiment(paper):
+    M, B = TRUTH
     # each DOF driven by three sines, as a user's multi-sine test would
     data = [make_experiment(paper, M, B, k, periods=8, extra=[
         (k, 0.5 * AMPLITUDES[k], 2 * np.pi * 2.3, 1.0),
@@ -77,8 +75,8 @@ def test_method_a_refuses_several_sines_per_experiment(paper, truth):
         FourierIdentifier().fit(data, paper)
 
 
-def test_method_a_refuses_all_dofs_moving_at_once(paper, truth):
-    M, B = truth
+def test_method_a_refuses_all_dofs_moving_at_once(paper):
+    M, B = TRUTH
     frequencies = [1.0, 1.5, 2.0, 2.5, 3.0, 3.5]
     data = [make_experiment(paper, M, B, k, periods=8, extra=[
         (d, 0.7 * AMPLITUDES[d], 2 * np.pi * frequencies[(d + k) % 6], 0.5 * d)
@@ -88,10 +86,10 @@ def test_method_a_refuses_all_dofs_moving_at_once(paper, truth):
         FourierIdentifier().fit(data, paper)
 
 
-def test_method_a_accepts_a_sine_with_a_small_harmonic_distortion(paper, truth):
+def test_method_a_accepts_a_sine_with_a_small_harmonic_distortion(paper):
     """A 3rd harmonic of 10 % (a servo's distortion) is orthogonal to the first harmonic
     over whole periods: accepted, and the linear model is still recovered exactly."""
-    M, B = truth
+    M, B = TRUTH
     data = [make_experiment(paper, M, B, k, periods=8, extra=[
         (k, 0.1 * AMPLITUDES[k], 2 * np.pi * 3.0, 0.4)]) for k in range(6)]
     estimator = FourierIdentifier().fit(data, paper)
@@ -116,9 +114,9 @@ def test_method_a_accepts_the_paper_sines_on_the_plant(paper, noise):
 # -- the same experiment twice -----------------------------------------------------------------
 
 @pytest.fixture(scope="module")
-def files(tmp_path_factory, paper, truth):
+def files(tmp_path_factory, paper):
     folder = tmp_path_factory.mktemp("refusals")
-    M, B = truth
+    M, B = TRUTH
     return [write_dataset(make_experiment(paper, M, B, k), folder / f"exp{k + 1}.csv")
             for k in range(6)]
 
@@ -148,8 +146,8 @@ def test_a_copy_of_an_experiment_is_refused(files, tmp_path):
     assert f"{names[2]} and {copy} hold the same experiment (identical pose and forces)" in line
 
 
-def test_the_set_check_sees_repeated_datasets_by_content(paper, truth):
-    M, B = truth
+def test_the_set_check_sees_repeated_datasets_by_content(paper):
+    M, B = TRUTH
     data = [make_experiment(paper, M, B, k) for k in range(6)]
     renamed = Dataset(t=data[0].t + 5.0, pose=data[0].pose, lengths=data[0].lengths,
                       forces=data[0].forces, name="again")

@@ -233,7 +233,11 @@ class FourierIdentifier(BaseIdentifier):
         experiments = prepare(datasets, platform, gravity=self.gravity)
         rows_motion, rows_force, used = [], [], []
         for exp in experiments:
-            freqs = self._given_frequencies() or [estimate_frequency(exp.q, exp.sample_rate)]
+            # detected on the leg-length motion, where every DOF counts in one unit: on the
+            # pose, a DOF that the excited one drags along at twice the frequency can have
+            # the sharper peak relative to its own spread
+            freqs = self._given_frequencies() or [
+                estimate_frequency(leg_space_motion(exp.q, platform), exp.sample_rate)]
             check_single_sine(exp.name, exp.q, exp.sample_rate, platform, freqs,
                               given=self.frequency_hz is not None)
             window = self.window or default_window(max(freqs))
