@@ -37,6 +37,7 @@ import pyarrow.csv
 from stewartid.datasets import plausibility as checks
 from stewartid.datasets.arrays import median
 from stewartid.datasets.columns import shown_value, to_numbers
+from stewartid.datasets.distinct import check_distinct_experiments, check_distinct_paths
 from stewartid.datasets.log_format import LogFormat, read_table
 from stewartid.errors import DataError, DataWarning, KinematicsError
 from stewartid.files import write_bytes_atomic
@@ -351,7 +352,10 @@ def read_datasets(paths: str | Path | Sequence[str | Path],
     files = expand_paths(paths)
     if not files:
         raise DataError("no data files given; pass one or more .csv/.parquet files.")
-    return [read_dataset(f, platform, log_format=log_format) for f in files]
+    check_distinct_paths(files)
+    datasets = [read_dataset(f, platform, log_format=log_format) for f in files]
+    check_distinct_experiments(datasets, [str(f) for f in files])
+    return datasets
 
 
 def write_dataset(dataset: Dataset, path: str | Path, format: str | None = None) -> Path:

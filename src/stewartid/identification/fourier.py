@@ -40,7 +40,8 @@ from numbers import Integral
 import numpy as np
 
 from stewartid.datasets.dataset import Dataset
-from stewartid.errors import ConfigError, DataError
+from stewartid.datasets.excitation import LINE_FRACTION, leg_space_motion, spectral_lines
+from stewartid.errors import ConfigError, DataError, IdentificationError
 from stewartid.fields import Interval, ListOf, positive
 from stewartid.identification.base import DIFFERENTIATION_CONSTRAINTS, BaseIdentifier
 from stewartid.identification.preparation import prepare
@@ -86,6 +87,65 @@ def harmonic_coefficients(x: np.ndarray, t: np.ndarray, frequencies_hz: Sequence
     # normal equations: the columns are nearly orthogonal over whole periods
     coefficients = np.linalg.solve(design.T @ design, design.T @ x)
     return coefficients[1:]
+
+
+#: A harmonic of a fitted frequency passes below this amplitude relative to the largest line:
+#: a servo tracking a sine distorts it by a few per cent, and harmonics do not disturb the
+#: first-harmonic equations over whole periods (they are orthogonal to it); a line this large
+#: is a second sine of the excitation.
+HARMONIC_FRACTION = 0.2
+
+
+def check_single_sine(name: str, pose: np.ndarray, sample_rate: float, platform: Platform,
+                      frequencies_hz: Sequence[float], given: bool = False) -> None:
+    """Refuse an experiment whose motion is not one sine at the fitted frequency (or at the
+    given ones).
+
+    The spectral lines of the motion (:func:`~stewartid.datasets.excitation.spectral_lines`
+    of its leg-length change) reaching :data:`~stewartid.datasets.excitation.LINE_FRACTION`
+    of the largest must sit at ``frequencies_hz``, or at their harmonics below
+    :data:`HARMONIC_FRACTION`.
+
+    Parameters
+    ----------
+    name : str
+        Experiment named in the message.
+    pose : ndarray, shape (N, 6)
+        m, rad.
+    sample_rate : float
+        Hz.
+    platform : Platform
+    frequencies_hz : sequence of float
+        The frequencies Method A fits (Hz).
+    given : bool
+        They were given by the user (else detected as the dominant sine).
+
+    Raises
+    ------
+    IdentificationError
+        Naming the experiment and the lines found.
+    """
+    lines = spectral_lines(leg_space_motion(pose, platform), sample_rate)
+    tolerance = lines.resolution_hz
+
+    def order(f: float) -> int:
+        """1 at a fitted frequency, n >= 2 at its n-th harmonic, 0 elsewhere."""
+        if any(abs(f - g) <= tolerance for g in frequencies_hz):
+            return 1
+        return next((round(f / g) for g in frequencies_hz
+                     if round(f / g) >= 2 and abs(f - round(f / g) * g) <= tolerance), 0)
+
+    orders = [order(f) for f in lines.frequencies_hz]
+    foreign = [n == 0 or (n >= 2 and a >= HARMONIC_FRACTION)
+               for n, a in zip(orders, lines.amplitudes, strict=True)]
+    if not any(foreign):
+        return
+    listed = ", ".join(f"{g:.3g}" for g in frequencies_hz)
+    needs = f"motion at the given {listed} Hz only" if given else "one sine per experiment"
+    raise IdentificationError(
+        f"{name}: Method A needs {needs}; the pose of {name} has {len(lines)} spectral lines "
+        f"above {100 * LINE_FRACTION:.3g} % of the largest ({lines.describe()}); use Method B "
+        "or least squares (--method wavelet or ls).")
 
 
 @register_method(
@@ -173,7 +233,13 @@ class FourierIdentifier(BaseIdentifier):
         experiments = prepare(datasets, platform, gravity=self.gravity)
         rows_motion, rows_force, used = [], [], []
         for exp in experiments:
-            freqs = self._given_frequencies() or [estimate_frequency(exp.q, exp.sample_rate)]
+            # detected on the leg-length motion, where every DOF counts in one unit: on the
+            # pose, a DOF that the excited one drags along at twice the frequency can have
+            # the sharper peak relative to its own spread
+            freqs = self._given_frequencies() or [
+                estimate_frequency(leg_space_motion(exp.q, platform), exp.sample_rate)]
+            check_single_sine(exp.name, exp.q, exp.sample_rate, platform, freqs,
+                              given=self.frequency_hz is not None)
             window = self.window or default_window(max(freqs))
             q0 = exp.q.mean(axis=0)
             q, qd, qdd = differentiate(exp.q - q0, exp.sample_rate, window, self.order)
@@ -227,4 +293,4 @@ class FourierIdentifier(BaseIdentifier):
             "stiffness_": stiffness, "frequencies_": [u["frequencies_hz"] for u in used]}
 
 
-__all__ = ["FourierIdentifier", "harmonic_coefficients"]
+__all__ = ["HARMONIC_FRACTION", "FourierIdentifier", "check_single_sine", "harmonic_coefficients"]

@@ -17,6 +17,7 @@ import numpy as np
 
 from stewartid.assessment.validation import DEFAULT_FOLDS
 from stewartid.datasets.dataset import expand_paths, read_datasets
+from stewartid.datasets.excitation import check_experiment_set
 from stewartid.datasets.log_format import load_log_format
 from stewartid.datasets.meta import nominal_from_meta, platform_for_data
 from stewartid.datasets.plausibility import check_identified
@@ -194,7 +195,9 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     Raises
     ------
     StewartidError
-        Bad options or outputs (before any computation), unreadable data, a method that
+        Bad options or outputs (before any computation), unreadable data, an experiment given
+        twice or a DOF left unexcited
+        (:func:`~stewartid.datasets.excitation.check_experiment_set`), a method that
         cannot be applied, or an implausible result
         (:func:`~stewartid.datasets.plausibility.check_identified`).
     """
@@ -206,6 +209,7 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
                    folds)
     log_format = load_log_format(columns) if columns is not None else None
     datasets = read_datasets(paths, description, log_format)
+    check_experiment_set(datasets, description)
     meta = nominal_from_meta(paths)
 
     def check(found: IdentificationResult) -> None:

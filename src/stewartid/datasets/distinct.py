@@ -1,0 +1,85 @@
+"""An experiment given twice: the same file under two spellings, or two files with the same
+numbers.
+
+Counted twice, an experiment weighs its DOF double, and the one it displaced is often
+missing: with the paper's protocol (experiment k excites DOF k) that DOF is then moved only
+by coupling and its column of Mt and Bt comes out wrong by orders of magnitude, without any
+rank warning. Both checks run before anything is fitted.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from stewartid.errors import DataError
+
+if TYPE_CHECKING:
+    from stewartid.datasets.dataset import Dataset
+
+
+def _give_once(what: str) -> DataError:
+    return DataError(f"{what}: each experiment must be given once (one counted twice weighs "
+                     "its DOF double and may hide another left out); drop the repeat and check "
+                     "that no experiment is missing.")
+
+
+def check_distinct_paths(files: Sequence[Path]) -> None:
+    """Refuse a file given twice, however spelled (relative, absolute, through a link).
+
+    Parameters
+    ----------
+    files : sequence of Path
+
+    Raises
+    ------
+    DataError
+        Naming both spellings.
+    """
+    seen: dict[Path, Path] = {}
+    for f in files:
+        key = f.resolve()
+        if key in seen:
+            raise _give_once(f"{f} is given twice" if str(seen[key]) == str(f) else
+                             f"{seen[key]} and {f} are the same file ({key})")
+        seen[key] = f
+
+
+def experiment_digest(dataset: Dataset) -> str:
+    """SHA-256 of the pose and forces of an experiment (the numbers every method uses).
+
+    Two files with equal digests hold the same experiment, whatever their time stamps,
+    names or formats.
+    """
+    numbers = np.ascontiguousarray(np.concatenate([dataset.pose, dataset.forces], axis=1))
+    return hashlib.sha256(numbers.tobytes()).hexdigest()
+
+
+def check_distinct_experiments(datasets: Sequence[Dataset], labels: Sequence[str]) -> None:
+    """Refuse two experiments with identical pose and forces (a file copied or given twice).
+
+    Parameters
+    ----------
+    datasets : sequence of Dataset
+    labels : sequence of str
+        Their names in the message (file paths or experiment names).
+
+    Raises
+    ------
+    DataError
+        Naming both.
+    """
+    seen: dict[str, str] = {}
+    for dataset, label in zip(datasets, labels, strict=True):
+        digest = experiment_digest(dataset)
+        if digest in seen:
+            raise _give_once(f"{seen[digest]} and {label} hold the same experiment "
+                             "(identical pose and forces)")
+        seen[digest] = label
+
+
+__all__ = ["check_distinct_experiments", "check_distinct_paths", "experiment_digest"]

@@ -1,0 +1,278 @@
+"""What the motion of a set of experiments allows an identification to see.
+
+Two questions about the logged pose, asked before anything is fitted:
+
+- which sines a record holds (:func:`spectral_lines`): Method A assumes one per experiment;
+- whether every DOF moves on its own somewhere in the set (:func:`excitation_per_dof`,
+  :func:`check_excitation`): column k of Mt and Bt is seen only through the part of the
+  velocity and acceleration of DOF k that the other DOFs' do not explain.
+
+Both look at the motion in one unit for all six DOFs: the leg-length change it causes at the
+neutral pose, dl = J_lq(q0) (q - mean q) (m), so that a rotation counts as much as the
+translation that moves the legs as far.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from stewartid.datasets.dataset import Dataset
+from stewartid.datasets.distinct import check_distinct_experiments
+from stewartid.errors import DataError
+from stewartid.model.kinematics import compute_leg_terms
+from stewartid.platform import COORDINATES, Platform
+from stewartid.signals.differentiation import default_window, differentiate, trim
+
+#: A spectral line counts when its amplitude reaches this fraction of the largest line's. The
+#: Hann window's highest sidelobe is 2.7 % of its line (-31.5 dB), and the single sines of our
+#: plant and of an independent simulator show nothing else above 2.8 %; 5 % of the amplitude
+#: is 0.25 % of the power, small against the Coulomb bias Method A carries anyway.
+LINE_FRACTION = 0.05
+#: Within this many frequency bins (1 / record length) of a larger peak, a peak below
+#: SIDELOBE_FRACTION of it is taken for a sidelobe: the Hann window's first sidelobes peak 2.3
+#: to 2.4 bins from their line at 2.7 % of it (SIDELOBE_FRACTION allows three times that, for
+#: a line whose amplitude varies); its main lobe spans 2 bins either side.
+SIDELOBE_BINS = 2.6
+SIDELOBE_FRACTION = 0.08
+#: A line needs this many periods in the record; slower content is drift or a fade-in.
+MIN_LINE_PERIODS = 2.0
+#: Smallest share of a DOF's velocity and acceleration left unexplained by the other DOFs',
+#: relative to the best-excited DOF's. The standard errors of column k of Mt and Bt scale with
+#: its inverse: at 1 % they are a hundred times those of the best column. A DOF moved only by
+#: coupling from the others' experiments measures 0.005 % to 0.15 % on our plant and an
+#: independent simulator; a single experiment moving all six DOFs at once 7 % or more.
+MIN_RELATIVE_EXCITATION = 0.01
+#: Rows per experiment used by the excitation measure (an evenly strided subset).
+CHECK_SAMPLES = 4000
+
+
+@dataclass(frozen=True)
+class SpectralLines:
+    """The sines of a record, largest first.
+
+    Attributes
+    ----------
+    frequencies_hz : ndarray, shape (L,)
+    amplitudes : ndarray, shape (L,)
+        Relative to the largest line (the first is 1).
+    resolution_hz : float
+        1 / record length: lines closer than a few of these are one line.
+    """
+
+    frequencies_hz: np.ndarray
+    amplitudes: np.ndarray
+    resolution_hz: float
+
+    def __len__(self) -> int:
+        return len(self.frequencies_hz)
+
+    def describe(self) -> str:
+        """The frequencies in ascending order, to the decimal the resolution allows:
+        ``"0.30, 0.70, 1.50 Hz"`` for a 20 s record."""
+        decimals = max(0, int(np.ceil(-np.log10(self.resolution_hz))))
+        return ", ".join(f"{f:.{decimals}f}" for f in np.sort(self.frequencies_hz)) + " Hz"
+
+
+def dof_scales(platform: Platform) -> np.ndarray:
+    """Leg-length change per unit motion of each DOF at the neutral pose.
+
+    Returns
+    -------
+    ndarray, shape (6,)
+        Column norms of J_lq(q0): m/m for x, y, z and m/rad for rx, ry, rz.
+    """
+    _, jacobian, _, _ = compute_leg_terms(platform, platform.neutral_pose[None].copy())
+    return np.linalg.norm(jacobian[0], axis=0)
+
+
+def leg_space_motion(pose: np.ndarray, platform: Platform) -> np.ndarray:
+    """The motion of the pose as the leg-length change it causes, linearised at neutral.
+
+    Parameters
+    ----------
+    pose : ndarray, shape (N, 6)
+        m, rad.
+    platform : Platform
+
+    Returns
+    -------
+    ndarray, shape (N, 6)
+        J_lq(q0) (q - mean q) (m): a pure sine of the pose stays a pure sine.
+    """
+    _, jacobian, _, _ = compute_leg_terms(platform, platform.neutral_pose[None].copy())
+    return (pose - pose.mean(axis=0)) @ jacobian[0].T
+
+
+def spectral_lines(motion: np.ndarray, sample_rate: float,
+                   fraction: float = LINE_FRACTION) -> SpectralLines:
+    """The sines in a multichannel record: peaks of its Hann-windowed amplitude spectrum.
+
+    The channels' power spectra are summed (so the channels must share a unit), after the
+    mean and a linear drift are removed. A line is a local maximum at least
+    :data:`MIN_LINE_PERIODS` periods long, at least ``fraction`` of the largest line's
+    amplitude, and not a sidelobe of a larger one (:data:`SIDELOBE_BINS`,
+    :data:`SIDELOBE_FRACTION`). Lines closer than about 2 bins merge into one.
+
+    Parameters
+    ----------
+    motion : ndarray, shape (N,) or (N, m)
+        Uniformly sampled channels, time on axis 0.
+    sample_rate : float
+        Hz.
+    fraction : float
+        Smallest relative amplitude of a line.
+
+    Returns
+    -------
+    SpectralLines
+        Empty when nothing moves.
+    """
+    x = np.asarray(motion, dtype=float)
+    x = x[:, None] if x.ndim == 1 else x
+    n = len(x)
+    ramp = np.linspace(-1.0, 1.0, n)
+    basis = np.column_stack([np.ones(n), ramp])
+    x = x - basis @ np.linalg.lstsq(basis, x, rcond=None)[0]
+    padding = 4  # peak frequencies to an eighth of a bin
+    nfft = 1 << int(np.ceil(np.log2(padding * n)))
+    amplitude = np.sqrt(np.sum(np.abs(np.fft.rfft(x * np.hanning(n)[:, None], nfft, axis=0))
+                               ** 2, axis=1))
+    resolution = sample_rate / n
+    empty = SpectralLines(np.empty(0), np.empty(0), resolution)
+    frequencies = np.arange(len(amplitude)) * sample_rate / nfft
+    amplitude[frequencies < MIN_LINE_PERIODS * resolution] = 0.0
+    if not np.any(amplitude > 0):
+        return empty
+    peaks = np.flatnonzero((amplitude[1:-1] > amplitude[:-2])
+                           & (amplitude[1:-1] >= amplitude[2:])) + 1
+    if not len(peaks):
+        return empty
+    largest = amplitude[peaks].max()
+    peaks = peaks[amplitude[peaks] >= fraction * largest]
+    reach = SIDELOBE_BINS * resolution
+    sidelobe = [np.any((np.abs(frequencies[peaks] - frequencies[p]) <= reach)
+                       & (SIDELOBE_FRACTION * amplitude[peaks] > amplitude[p])) for p in peaks]
+    peaks = peaks[~np.asarray(sidelobe, dtype=bool)]
+    peaks = peaks[np.argsort(amplitude[peaks])[::-1]]
+    # a parabola through the log amplitudes of the peak and its neighbours: the Hann main
+    # lobe is nearly Gaussian, so this places the line well inside the padded grid step
+    below, at, above = (np.log(np.maximum(amplitude[peaks + k], np.finfo(float).tiny))
+                        for k in (-1, 0, 1))
+    curvature = below - 2 * at + above
+    # at a local maximum the curvature is negative, or zero on a plateau (then no shift)
+    shift = 0.5 * (below - above) / np.minimum(curvature, -np.finfo(float).tiny)
+    heights = np.exp(at - 0.25 * (below - above) * shift)
+    return SpectralLines((peaks + shift) * sample_rate / nfft, heights / heights.max(),
+                         resolution)
+
+
+def _regressors(dataset: Dataset, scales: np.ndarray, platform: Platform) -> np.ndarray:
+    """Strided, scaled [q_dot, q_ddot] of one experiment, shape (n, 12) (m/s, m/s^2)."""
+    lines = spectral_lines(leg_space_motion(dataset.pose, platform), dataset.sample_rate)
+    if not len(lines):
+        return np.zeros((0, 12))
+    window = min(default_window(float(np.max(lines.frequencies_hz))), dataset.duration / 4)
+    _, velocity, acceleration = differentiate(dataset.pose - dataset.pose.mean(axis=0),
+                                              dataset.sample_rate, window)
+    cut = trim(window, dataset.sample_rate)
+    stride = max(1, int(np.ceil((len(dataset) - 2 * cut) / CHECK_SAMPLES)))
+    rows = slice(cut, len(dataset) - cut, stride)
+    return np.concatenate([velocity[rows] * scales, acceleration[rows] * scales], axis=1)
+
+
+def excitation_per_dof(datasets: Sequence[Dataset], platform: Platform) -> np.ndarray:
+    """How well each DOF is excited on its own over a set of experiments.
+
+    The twelve regressors (velocity and acceleration of each DOF: Savitzky-Golay derivatives
+    of the pose in the leg-length unit of :func:`dof_scales`, stacked over the experiments),
+    each divided by the largest norm among the regressors of its kind, are orthogonalised
+    greedily, the largest remaining part first (Gram-Schmidt with column pivoting): a
+    regressor's measure is the norm of the part the ones taken before it do not explain. A
+    DOF moved only by coupling thus comes last with the sliver of its own motion, and does
+    not discredit the DOF it follows. Per DOF the smaller of its two. The standard error of
+    an entry of column k of Mt or Bt is the noise divided by that part, so the measure is the
+    inverse of how much worse column k is determined than the best-excited one.
+
+    Parameters
+    ----------
+    datasets : sequence of Dataset
+    platform : Platform
+
+    Returns
+    -------
+    ndarray, shape (6,)
+        In [0, 1], order x, y, z, rx, ry, rz.
+    """
+    scales = dof_scales(platform)
+    phi = np.concatenate([_regressors(d, scales, platform) for d in datasets])
+    independent = np.zeros(12)
+    norms = np.linalg.norm(phi, axis=0)
+    for kind in (slice(0, 6), slice(6, 12)):
+        if np.max(norms[kind], initial=0.0) > 0:
+            phi[:, kind] /= np.max(norms[kind])
+    remaining = list(range(12))
+    while remaining:
+        sizes = np.linalg.norm(phi[:, remaining], axis=0)
+        pick = remaining.pop(int(np.argmax(sizes)))
+        independent[pick] = np.max(sizes)
+        if not remaining or independent[pick] == 0:
+            break
+        direction = phi[:, pick] / independent[pick]
+        for _ in range(2):  # twice: orthogonal to round-off even after large cancellations
+            phi[:, remaining] -= np.outer(direction, direction @ phi[:, remaining])
+    return np.minimum(independent[:6], independent[6:])
+
+
+def check_excitation(datasets: Sequence[Dataset], platform: Platform) -> None:
+    """Refuse a set of experiments that leaves a DOF (nearly) unexcited.
+
+    Parameters
+    ----------
+    datasets : sequence of Dataset
+    platform : Platform
+
+    Raises
+    ------
+    DataError
+        Naming the DOF, its largest motion, the measure of :func:`excitation_per_dof` against
+        :data:`MIN_RELATIVE_EXCITATION`, and the fix.
+    """
+    measure = excitation_per_dof(datasets, platform)
+    weak = [k for k in range(6) if measure[k] < MIN_RELATIVE_EXCITATION]
+    if not weak:
+        return
+    worst = min(weak, key=lambda k: measure[k])
+    names = ", ".join(COORDINATES[k] for k in weak)
+    name = COORDINATES[worst]
+    motion = max(float(np.max(np.abs(d.pose[:, worst] - d.pose[:, worst].mean())))
+                 for d in datasets)
+    detail = f"{name} never moves" if motion == 0 else (
+        f"largest {name} motion {motion * 1e3:.3g} {'mm' if worst < 3 else 'mrad'}; the part of "
+        f"its velocity and acceleration the other DOFs do not explain is "
+        f"{100 * measure[worst]:.2g} % of the best-excited DOF's, below "
+        f"{100 * MIN_RELATIVE_EXCITATION:.3g} %")
+    verb, columns = ("moves", "its column") if len(weak) == 1 else ("move", "their columns")
+    raise DataError(f"no experiment {verb} {names} enough to identify {columns} of Mt and Bt "
+                    f"({detail}); add an experiment exciting {names}, e.g. from "
+                    "`stewartid design`.")
+
+
+def check_experiment_set(datasets: Sequence[Dataset], platform: Platform) -> None:
+    """The checks a set of experiments must pass before any method fits it: no experiment
+    given twice (:func:`~stewartid.datasets.distinct.check_distinct_experiments`) and every
+    DOF excited (:func:`check_excitation`).
+
+    Raises
+    ------
+    DataError
+    """
+    check_distinct_experiments(datasets, [d.name for d in datasets])
+    check_excitation(datasets, platform)
+
+
+__all__ = ["LINE_FRACTION", "MIN_RELATIVE_EXCITATION", "SpectralLines", "check_excitation",
+           "check_experiment_set", "dof_scales", "excitation_per_dof", "leg_space_motion",
+           "spectral_lines"]
