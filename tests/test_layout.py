@@ -172,3 +172,14 @@ def test_functions_and_modules_are_short(module):
             if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef)
             and _body_lines(node) > MAX_FUNCTION_BODY]
     assert long == []
+
+
+def test_the_shared_reporting_parts_import_no_report():
+    def inside(dotted: str, package: str) -> bool:
+        return dotted == package or dotted.startswith(package + ".")
+
+    reversed_imports = [f"{module}:{line} imports {target}.{name}"
+                        for module in MODULES if inside(module, "stewartid.reporting")
+                        for target, name, line in _imports(module)
+                        if inside(f"{target}.{name}", "stewartid.reports")]
+    assert reversed_imports == []

@@ -1,5 +1,5 @@
-"""Tables, summary sentences, HTML and figures of the reporting package, on constructed results
-whose errors are known exactly."""
+"""Tables, summary sentences, HTML and figures of the reproduction report and the shared reporting
+parts, on constructed results whose errors are known exactly."""
 
 from __future__ import annotations
 
@@ -14,21 +14,18 @@ from stewartid.files import write_text_atomic
 from stewartid.identification.result import IdentificationResult
 from stewartid.model.linearization import nominal_matrices
 from stewartid.reference.published import load_published
-from stewartid.reporting.comparison import ComparisonResults, MethodRun
-from stewartid.reporting.document import (
+from stewartid.reporting.figures import ExperimentTrace, plot_joint_rates
+from stewartid.reporting.html import render_html
+from stewartid.reporting.tables import to_csv, to_markdown
+from stewartid.reports.reproduction.comparison import ComparisonResults, MethodRun
+from stewartid.reports.reproduction.figures import plot_errors, plot_force_budget
+from stewartid.reports.reproduction.report import (
     FigureEntry,
     fourier_summary,
-    render_html,
     render_markdown,
     wavelet_summary,
 )
-from stewartid.reporting.figures import (
-    ExperimentTrace,
-    plot_errors,
-    plot_force_budget,
-    plot_joint_rates,
-)
-from stewartid.reporting.tables import build_tables, paper_table, to_csv, to_markdown
+from stewartid.reports.reproduction.tables import build_tables, paper_table
 
 
 @pytest.fixture(scope="module")

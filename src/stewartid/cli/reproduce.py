@@ -32,7 +32,7 @@ def reproduce(
                            progress=True)
     typer.echo(f"wrote {len(output.files)} files to {output.directory} in "
                f"{output.runtime_s:.1f} s; report: {output.directory / 'report.md'}")
-    from stewartid.reporting.document import summary_lines
+    from stewartid.reports.reproduction.report import summary_lines
 
     for line in summary_lines(output.results):
         typer.echo("  " + line.replace("**", ""))

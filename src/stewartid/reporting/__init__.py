@@ -1,16 +1,16 @@
-"""Reports: what a comparison run found, as tables, figures and a Markdown/HTML report, and
-terminal tables for the command line.
+"""What every report of the package is built from: tables, figures, the HTML page, method
+labels, terminal tables and the matrix files.
 
-Modules: :mod:`~stewartid.reporting.comparison` (the data a report is built from, method
-labels and colours from the registry), :mod:`~stewartid.reporting.tables` (Markdown/CSV
-tables beside the paper's published values), :mod:`~stewartid.reporting.figures`
-(matplotlib figures, PNG and SVG), :mod:`~stewartid.reporting.document` (``report.md`` and a
-self-contained ``report.html``) and :mod:`~stewartid.reporting.terminal` (rich tables).
+Modules: :mod:`~stewartid.reporting.methods` (display names, colours, the paper's letters and
+report order, from the registry), :mod:`~stewartid.reporting.tables` (titled tables written as
+Markdown and CSV), :mod:`~stewartid.reporting.figures` (the figures' style and saving as PNG and
+SVG, and the signal figures of an experiment), :mod:`~stewartid.reporting.html` (Markdown to a
+self-contained HTML page), :mod:`~stewartid.reporting.terminal` (rich tables) and
+:mod:`~stewartid.reporting.exports` (identified matrices as CSV and MATLAB files).
 
-The two products built on these parts are :mod:`stewartid.reports.identification`
-(``identify --report``: the run in :mod:`~stewartid.reports.identification.run`, the report in
-:mod:`~stewartid.reports.identification.report`, its text and figures, and
-:mod:`~stewartid.reporting.exports` for the CSV and MATLAB files) and
-:mod:`stewartid.reports.reproduction` (``reproduce``). Held-out validation and the choice of
-the method to trust are in :mod:`stewartid.assessment`.
+The products built on these parts import from here, never the reverse:
+:mod:`stewartid.reports.identification` (``identify --report``),
+:mod:`stewartid.reports.reproduction` (``reproduce``), :mod:`stewartid.studies` (``study``) and
+:mod:`stewartid.design` (``design``). Held-out validation and the choice of the method to trust
+are in :mod:`stewartid.assessment`.
 """

@@ -20,9 +20,9 @@ import numpy as np
 import pandas as pd
 
 from stewartid.files import write_text_atomic
-from stewartid.reporting.comparison import method_color, method_name, report_order
-from stewartid.reporting.document import render_html
 from stewartid.reporting.figures import STYLE, save_figure
+from stewartid.reporting.html import render_html
+from stewartid.reporting.methods import method_color, method_name, report_order
 from stewartid.reporting.tables import ResultTable, to_markdown, write_tables
 from stewartid.studies.spec import PARAMETERS, StudySpec
 

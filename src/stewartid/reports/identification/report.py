@@ -43,8 +43,8 @@ from stewartid.identification.consistency import ConsistentEstimate, project_con
 from stewartid.identification.result import IdentificationResult
 from stewartid.model.linearization import nominal_matrices
 from stewartid.platform import Platform
-from stewartid.reporting.document import render_html
 from stewartid.reporting.exports import ExportedModel, write_exports
+from stewartid.reporting.html import render_html
 from stewartid.reports.identification.figures import FigureDrawer, data_figures, result_figures
 from stewartid.reports.identification.records import IdentificationReport, MethodReport
 from stewartid.reports.identification.text import data_rows, render_report

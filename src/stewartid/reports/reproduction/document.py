@@ -1,7 +1,7 @@
 """``results.json`` of a reproduction: everything of a run as one JSON document, and back.
 
 Written through :func:`stewartid.files.write_json_atomic` (non-finite numbers as ``null``);
-:func:`load_results` rebuilds the :class:`~stewartid.reporting.comparison.ComparisonResults`
+:func:`load_results` rebuilds the :class:`~stewartid.reports.reproduction.comparison.ComparisonResults`
 the tables, figures and report are made from.
 """
 
@@ -24,7 +24,8 @@ from stewartid.reference.published import (
     load_published,
     relative_error_percent,
 )
-from stewartid.reporting.comparison import ComparisonResults, MethodRun
+from stewartid.reports.reproduction.comparison import ComparisonResults, MethodRun
+from stewartid.reports.reproduction.report import summary_lines
 
 #: Method names of files written before the registry (read as the registry's names).
 LEGACY_METHOD_NAMES = {"least_squares": "ls", "wavelet_paper": "wavelet-paper"}
@@ -59,7 +60,6 @@ def results_document(results: ComparisonResults, runtime_s: float,
                      files: Sequence[str] = ()) -> dict[str, Any]:
     """Everything of a run as a JSON-ready dict (see the module docstring)."""
     from stewartid import __version__
-    from stewartid.reporting.document import summary_lines
 
     runs = [run_record(results, run) for run in results.runs]
     return to_jsonable({

@@ -16,9 +16,11 @@ import dataclasses
 from collections.abc import Sequence
 
 from stewartid.reference.published import PAPER_ENTRIES, entry_label
-from stewartid.reporting.comparison import ComparisonResults, MethodRun, method_name
-from stewartid.reporting.tables import ResultTable, comparison_table
+from stewartid.reporting.methods import method_name
+from stewartid.reporting.tables import ResultTable
+from stewartid.reports.reproduction.comparison import ComparisonResults, MethodRun
 from stewartid.reports.reproduction.document import run_record
+from stewartid.reports.reproduction.tables import comparison_table
 
 #: Multiple of the reference sensor noise in the noisy case.
 NOISE_SCALE = 1.0

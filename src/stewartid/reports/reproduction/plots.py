@@ -1,5 +1,6 @@
 """The figures of a reproduction, submitted to the worker pool in report order with their
-captions (drawn by :mod:`stewartid.reporting.figures`)."""
+captions (drawn by :mod:`stewartid.reporting.figures` and
+:mod:`stewartid.reports.reproduction.figures`)."""
 
 from __future__ import annotations
 
@@ -11,7 +12,15 @@ from typing import Any
 import numpy as np
 
 from stewartid.platform import COORDINATES, Platform
-from stewartid.reporting.comparison import ComparisonResults
+from stewartid.reporting.figures import ExperimentTrace, plot_excitation, plot_joint_rates
+from stewartid.reports.reproduction.comparison import ComparisonResults
+from stewartid.reports.reproduction.figures import (
+    plot_errors,
+    plot_force_budget,
+    plot_identified_vs_nominal,
+    plot_scalogram,
+)
+from stewartid.reports.reproduction.report import FigureEntry
 from stewartid.reports.reproduction.settings import TRACE_EXPERIMENT
 from stewartid.reports.reproduction.traces import experiment_trace, reference_poses
 
@@ -21,17 +30,15 @@ class FigureQueue:
 
     def __init__(self, pool: Executor, folder: Path, bar: Any, task: Any):
         self.pool, self.folder, self.bar, self.task = pool, folder, bar, task
-        self.submitted: list[tuple[Future, Any]] = []
+        self.submitted: list[tuple[Future, FigureEntry]] = []
 
     def submit(self, function: Callable[..., Any], stem: str, caption: str, *args: Any,
                **kwargs: Any) -> None:
-        from stewartid.reporting.document import FigureEntry
-
         future = self.pool.submit(function, *args, directory=self.folder, stem=stem, **kwargs)
         future.add_done_callback(lambda _: self.bar.advance(self.task))
         self.submitted.append((future, FigureEntry(f"figures/{stem}.png", caption)))
 
-    def finish(self) -> tuple[list[Any], list[Path]]:
+    def finish(self) -> tuple[list[FigureEntry], list[Path]]:
         files: list[Path] = []
         for future, _ in self.submitted:
             files += future.result()
@@ -41,9 +48,6 @@ class FigureQueue:
 def submit_signal_figures(figures: FigureQueue, plant: Platform, datasets: Sequence[Any],
                     record: Any, level: float, frequency_hz: float) -> list[Any]:
     """Submit the excitation, joint-velocity and force-budget figures; return the traces."""
-    from stewartid.reporting import figures as plots
-    from stewartid.reporting.figures import ExperimentTrace
-
     references = reference_poses(plant, frequency_hz, [d.t for d in datasets])
     traces = []
     for k, dataset in enumerate(datasets):
@@ -57,14 +61,14 @@ def submit_signal_figures(figures: FigureQueue, plant: Platform, datasets: Seque
                                           neutral=np.asarray(plant.neutral_pose),
                                           reference=references[k]))
     trace = traces[TRACE_EXPERIMENT]
-    figures.submit(plots.plot_excitation, "excitation",
+    figures.submit(plot_excitation, "excitation",
                    f"Excitation at Coulomb {level:g} N·m: each experiment drives one "
                    f"coordinate with a {frequency_hz:g} Hz sine; commanded, measured and "
                    "tracking error.", traces)
-    figures.submit(plots.plot_joint_rates, "joint_velocities",
+    figures.submit(plot_joint_rates, "joint_velocities",
                    f"Joint velocities of {trace.name} at Coulomb {level:g} N·m; shaded: the "
                    "constant-direction intervals in which no joint reverses.", trace)
-    figures.submit(plots.plot_force_budget, "force_budget",
+    figures.submit(plot_force_budget, "force_budget",
                    f"Force budget of {trace.name} at Coulomb {level:g} N·m: the model's "
                    "inertial, viscous, Coulomb and gravity terms along the simulated motion, "
                    "and the measured actuators' generalized force.", trace)
@@ -74,19 +78,17 @@ def submit_signal_figures(figures: FigureQueue, plant: Platform, datasets: Seque
 def submit_comparison_figures(figures: FigureQueue, results: ComparisonResults, level: float,
                         traces: Sequence[Any]) -> None:
     """Submit the scalogram and the figures that compare methods."""
-    from stewartid.reporting import figures as plots
-
     trace = traces[TRACE_EXPERIMENT]
     scalogram = _scalogram_arguments(results, level, trace)
     if scalogram is not None:
-        figures.submit(plots.plot_scalogram, "scalogram",
+        figures.submit(plot_scalogram, "scalogram",
                        f"Scalogram of the excited equation of {trace.name} at Coulomb "
                        f"{level:g} N·m, with the (a, b) points Method B used.", **scalogram)
-    figures.submit(plots.plot_errors, "errors",
+    figures.submit(plot_errors, "errors",
                    "ε per entry at each Coulomb level: every method, and the paper's "
                    "published ε (hatched) where it reports one.", results)
     for value in results.coulomb_levels:
-        figures.submit(plots.plot_identified_vs_nominal,
+        figures.submit(plot_identified_vs_nominal,
                        f"identified_vs_nominal_coulomb{value:g}",
                        f"Identified / nominal per entry at Coulomb {value:g} N·m.", results,
                        value)

@@ -33,7 +33,8 @@ from stewartid.files import check_output_folder, to_jsonable, write_json_atomic
 from stewartid.parallel import process_pool
 from stewartid.platform import Platform, load_platform
 from stewartid.reference.published import load_published
-from stewartid.reporting.comparison import ComparisonResults, MethodRun
+from stewartid.reporting.tables import write_tables
+from stewartid.reports.reproduction.comparison import ComparisonResults, MethodRun
 from stewartid.reports.reproduction.document import results_document
 from stewartid.reports.reproduction.noisy import (
     NOISE_SCALE,
@@ -185,9 +186,9 @@ def run_reproduce(out: str | Path = "results/reproduce", quick: bool = False,
     """
     from stewartid import __version__
     from stewartid.model.linearization import nominal_matrices
-    from stewartid.reporting.document import write_report
-    from stewartid.reporting.figures import plot_identified_vs_nominal
-    from stewartid.reporting.tables import build_tables, write_tables
+    from stewartid.reports.reproduction.figures import plot_identified_vs_nominal
+    from stewartid.reports.reproduction.report import write_report
+    from stewartid.reports.reproduction.tables import build_tables
 
     start = time.perf_counter()
     settings = settings or make_settings(quick=quick, jobs=jobs, seed=seed)

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from stewartid.errors import ConfigError
-from stewartid.reporting.comparison import ComparisonResults
+from stewartid.reports.reproduction.comparison import ComparisonResults
 
 #: Coulomb friction levels of the paper's experiments (N·m per joint axis).
 COULOMB_LEVELS = (0.0, 5.0, 30.0)

@@ -1,4 +1,4 @@
-"""Identification results of a comparison run, in the form the tables, figures and report use.
+"""Identification results of a reproduction, in the form its tables, figures and report use.
 
 A :class:`ComparisonResults` holds one :class:`MethodRun` per (method, Coulomb level), the
 nominal matrices of the simulated plant and the paper's published values; everything the
@@ -8,14 +8,12 @@ report says is computed from it, so the same object can be rebuilt from ``result
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from stewartid.files import to_jsonable
-from stewartid.identification.registry import MethodSpec, registered_methods
 from stewartid.identification.result import IdentificationResult
 from stewartid.reference.published import (
     PAPER_ENTRIES,
@@ -24,47 +22,7 @@ from stewartid.reference.published import (
     PublishedResults,
     relative_error_percent,
 )
-
-
-def _spec(method: str) -> MethodSpec | None:
-    return next((spec for spec in registered_methods() if spec.name == method), None)
-
-
-def method_name(method: str) -> str:
-    """Display name of a method (the registry's; the name itself when not registered)."""
-    spec = _spec(method)
-    return method if spec is None else spec.display_name
-
-
-def method_color(method: str) -> str:
-    """Colour of a method in every figure (the registry's; grey when not registered)."""
-    spec = _spec(method)
-    return "grey" if spec is None else spec.color
-
-
-def paper_letter(method: str) -> str | None:
-    """The paper's letter for a method ("A", "B"), None if the paper does not report it."""
-    spec = _spec(method)
-    return None if spec is None else spec.letter
-
-
-def paper_methods() -> dict[str, str]:
-    """Registered methods the paper reports, name -> letter, in the letters' order."""
-    found = {spec.name: spec.letter for spec in registered_methods() if spec.letter}
-    return dict(sorted(found.items(), key=lambda item: item[1]))
-
-
-def report_order(methods: Iterable[str]) -> tuple[str, ...]:
-    """``methods`` in report order: those the paper reports by their letter (A, B), then the
-    others in registry order, then unregistered names alphabetically."""
-    registry = [spec.name for spec in registered_methods()]
-
-    def key(method: str) -> tuple[int, str, int, str]:
-        letter = paper_letter(method)
-        rank = registry.index(method) if method in registry else len(registry)
-        return (0 if letter else 1, letter or "", rank, method)
-
-    return tuple(sorted(set(methods), key=key))
+from stewartid.reporting.methods import paper_letter, report_order
 
 
 @dataclass(frozen=True)
@@ -194,5 +152,4 @@ class ComparisonResults:
         return key, found[key]
 
 
-__all__ = ["ComparisonResults", "MethodRun", "method_color", "method_name", "paper_letter",
-           "paper_methods", "report_order"]
+__all__ = ["ComparisonResults", "MethodRun"]

@@ -1,4 +1,4 @@
-"""The run report: ``report.md`` and a self-contained ``report.html`` (figures inlined).
+"""The report of a reproduction: ``report.md`` and a self-contained ``report.html``.
 
 The report states what was run, an automatic summary computed from the results (largest
 error per method and case, set against the paper's), every table and every figure. The
@@ -8,17 +8,16 @@ so does the sentence about it.
 
 from __future__ import annotations
 
-import base64
-import html
-import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 from stewartid.files import write_text_atomic
 from stewartid.reference.published import PAPER_ENTRIES, EntryKey, entry_label
-from stewartid.reporting.comparison import ComparisonResults, MethodRun, method_name
+from stewartid.reporting.html import render_html
+from stewartid.reporting.methods import method_name
 from stewartid.reporting.tables import ResultTable, to_markdown
+from stewartid.reports.reproduction.comparison import ComparisonResults, MethodRun
 
 #: The 1 % target of the wavelet method over the 20 entries.
 TARGET_PERCENT = 1.0
@@ -218,48 +217,6 @@ def render_markdown(results: ComparisonResults, tables: Sequence[ResultTable],
     return "\n".join(lines).rstrip() + "\n"
 
 
-_STYLE = """
-body { font-family: system-ui, sans-serif; max-width: 1200px; margin: 2em auto;
-       padding: 0 1em; line-height: 1.45; color: #222; }
-table { border-collapse: collapse; margin: 0.5em 0 1.5em; font-size: 0.86em; }
-th, td { border: 1px solid #ccc; padding: 0.25em 0.5em; }
-th { background: #f3f3f3; }
-tr:nth-child(even) td { background: #fafafa; }
-img { max-width: 100%; height: auto; border: 1px solid #eee; }
-em { color: #555; }
-"""
-
-
-def render_html(markdown_text: str, base: str | Path, title: str = "stewartid report") -> str:
-    """A self-contained HTML page from the report's Markdown; PNG figures are inlined as
-    base64 data so the file can be moved or mailed alone.
-
-    Parameters
-    ----------
-    markdown_text : str
-    base : str or Path
-        Folder the Markdown's relative image paths refer to.
-    """
-    from markdown_it import MarkdownIt
-
-    base = Path(base)
-    body = MarkdownIt("commonmark", {"html": False}).enable("table").render(markdown_text)
-
-    def inline(match: re.Match[str]) -> str:
-        source = html.unescape(match.group(1))
-        path = base / source
-        if source.startswith(("data:", "http:", "https:")) or not path.is_file():
-            return match.group(0)
-        data = base64.b64encode(path.read_bytes()).decode("ascii")
-        mime = "image/svg+xml" if path.suffix == ".svg" else "image/png"
-        return f'src="data:{mime};base64,{data}"'
-
-    body = re.sub(r'src="([^"]+)"', inline, body)
-    return (f"<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-            f"<title>{html.escape(title)}</title>\n<style>{_STYLE}</style>\n</head>\n"
-            f"<body>\n{body}</body>\n</html>\n")
-
-
 def write_report(results: ComparisonResults, tables: Sequence[ResultTable],
                  figures: Sequence[FigureEntry], directory: str | Path
                  ) -> tuple[Path, Path]:
@@ -276,7 +233,6 @@ __all__ = [
     "TARGET_PERCENT",
     "fourier_summary",
     "others_summary",
-    "render_html",
     "render_markdown",
     "summary_lines",
     "wavelet_summary",
