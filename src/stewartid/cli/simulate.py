@@ -2,14 +2,29 @@
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
 from stewartid.files import check_output_folder
 from stewartid.platform import load_platform
+
+if TYPE_CHECKING:
+    from stewartid.simulation.sensors import SensorNoise
+
+#: The sensor imperfections set on the command line: flag -> SensorNoise field.
+IMPERFECTION_FLAGS = {
+    "--force-delay": "force_delay", "--length-delay": "length_delay",
+    "--force-lowpass": "force_lowpass", "--force-lowpass-order": "force_lowpass_order",
+    "--hum": "hum_amplitude", "--hum-frequency": "hum_frequency",
+    "--force-drift": "force_drift", "--length-drift": "length_drift",
+    "--force-resolution": "force_resolution", "--length-resolution": "length_resolution"}
+#: A flag that only shapes the error another flag switches on: flag -> (that flag, field).
+SHAPING_FLAGS = {"--force-lowpass-order": ("--force-lowpass", "force_lowpass"),
+                 "--hum-frequency": ("--hum", "hum_amplitude")}
 
 
 def simulate(
@@ -49,6 +64,34 @@ def simulate(
     jobs: Annotated[int | None, typer.Option(
         "--jobs", help="Worker processes for the paper's experiments (default: every core); "
         "the data do not depend on it.")] = None,
+    force_delay: Annotated[float | None, typer.Option(
+        "--force-delay", help="Log the forces this long after the motion (s, e.g. 0.002): "
+        "f(t) = true f(t - delay), interpolated between samples.")] = None,
+    length_delay: Annotated[float | None, typer.Option(
+        "--length-delay", help="Log the leg lengths (and so the pose) this long after the "
+        "motion (s).")] = None,
+    force_lowpass: Annotated[float | None, typer.Option(
+        "--force-lowpass", help="Colour the force noise: pass it through a causal Butterworth "
+        "low-pass filter with this cut-off (Hz), its standard deviation kept.")] = None,
+    force_lowpass_order: Annotated[int | None, typer.Option(
+        "--force-lowpass-order", help="Order of that filter (default 4).")] = None,
+    hum: Annotated[float | None, typer.Option(
+        "--hum", help="Mains hum on every force channel: amplitude (N), a random phase per "
+        "leg.")] = None,
+    hum_frequency: Annotated[float | None, typer.Option(
+        "--hum-frequency", help="Mains frequency of the hum (Hz, default 50).")] = None,
+    force_drift: Annotated[float | None, typer.Option(
+        "--force-drift", help="Random-walk drift of each force channel from zero: its "
+        "standard deviation at the end of the record (N).")] = None,
+    length_drift: Annotated[float | None, typer.Option(
+        "--length-drift", help="Random-walk drift of each leg-length channel: standard "
+        "deviation at the end of the record (m).")] = None,
+    force_resolution: Annotated[float | None, typer.Option(
+        "--force-resolution", help="Quantisation step of the forces (N); default: [sensors] "
+        "force_resolution.")] = None,
+    length_resolution: Annotated[float | None, typer.Option(
+        "--length-resolution", help="Quantisation step of the leg lengths (m, e.g. 1e-6); "
+        "default: [sensors] length_resolution.")] = None,
 ) -> None:
     """Simulate the six experiments (experiment k excites DOF k) on the hydraulic plant."""
     # simulation, design and rich.progress load in 0.4-0.5 s; every command's module is
@@ -72,8 +115,14 @@ def simulate(
             ("--duration", duration, positive(), "s")):
         if value is not None:  # an optional flag not given
             check(flag, value, [constraint], unit)
-    noise = sensor_noise(description, "always" if noise_on else "never", length_noise,
-                         force_noise)
+    noise = with_imperfections(
+        sensor_noise(description, "always" if noise_on else "never", length_noise, force_noise),
+        description.sensors.sample_rate,
+        {"--force-delay": force_delay, "--length-delay": length_delay,
+         "--force-lowpass": force_lowpass, "--force-lowpass-order": force_lowpass_order,
+         "--hum": hum, "--hum-frequency": hum_frequency, "--force-drift": force_drift,
+         "--length-drift": length_drift, "--force-resolution": force_resolution,
+         "--length-resolution": length_resolution})
     with Progress(transient=True) as bar:
         task = bar.add_task("simulating", total=len(excitation) if excitation else 6)
 
@@ -98,3 +147,53 @@ def simulate(
                                           jobs=(os.cpu_count() or 1) if jobs is None else jobs)
     paths = write_experiments(result, out, format=format, force=force)
     typer.echo(f"wrote {len(paths) - 1} experiments and meta.json to {out}")
+
+
+def with_imperfections(noise: SensorNoise, sample_rate: float,
+                       given: dict[str, Any]) -> SensorNoise:
+    """``noise`` with the sensor imperfections given on the command line.
+
+    Parameters
+    ----------
+    noise : SensorNoise
+        The errors of ``[sensors]`` and the noise flags.
+    sample_rate : float
+        Sample rate of the records (Hz): filter and hum frequencies must lie below half of it.
+    given : dict
+        Flag of :data:`IMPERFECTION_FLAGS` -> value, None when not given.
+
+    Raises
+    ------
+    ConfigError
+        One line naming the flag: a value outside its range, a frequency at or above the
+        Nyquist frequency, a flag that shapes an error nobody switched on.
+    """
+    from numbers import Real
+
+    import numpy as np
+
+    from stewartid.errors import ConfigError
+    from stewartid.fields import Interval, check, field_spec
+    from stewartid.simulation.sensors import SensorNoise
+
+    fields = {f.name: f for f in dataclasses.fields(SensorNoise)}
+    changes = {}
+    for flag, value in given.items():
+        if value is not None:  # an optional flag not given
+            declared = field_spec(fields[IMPERFECTION_FLAGS[flag]])
+            check(flag, value, [declared.constraint], declared.unit)
+            changes[IMPERFECTION_FLAGS[flag]] = value
+    noise = dataclasses.replace(noise, **changes)
+    for flag, (switch, field) in SHAPING_FLAGS.items():
+        if given.get(flag) is not None and not getattr(noise, field):
+            raise ConfigError(f"{flag} has no effect without {switch}; add {switch} or leave "
+                              f"{flag} out.")
+    if noise.force_lowpass and not any(np.atleast_1d(noise.force_noise)):
+        raise ConfigError("--force-lowpass colours the force noise, which is zero here; add "
+                          "--noise or --force-noise N.")
+    for flag, field, used in (("--force-lowpass", "force_lowpass", noise.force_lowpass > 0),
+                              ("--hum-frequency", "hum_frequency", noise.hum_amplitude > 0)):
+        if used:
+            check(flag, getattr(noise, field), [Interval(Real, 0.0, sample_rate / 2, "neither")],
+                  "Hz", f"sampling at {sample_rate:g} Hz")
+    return noise
