@@ -15,16 +15,36 @@ from stewartid.platform import load_platform
 if TYPE_CHECKING:
     from stewartid.simulation.sensors import SensorNoise
 
-#: The sensor imperfections set on the command line: flag -> SensorNoise field.
+#: The sensor imperfections set on the command line: flag -> (SensorNoise field, help).
 IMPERFECTION_FLAGS = {
-    "--force-delay": "force_delay", "--length-delay": "length_delay",
-    "--force-lowpass": "force_lowpass", "--force-lowpass-order": "force_lowpass_order",
-    "--hum": "hum_amplitude", "--hum-frequency": "hum_frequency",
-    "--force-drift": "force_drift", "--length-drift": "length_drift",
-    "--force-resolution": "force_resolution", "--length-resolution": "length_resolution"}
+    "--force-delay": ("force_delay", "Log the forces this long after the motion (s, e.g. "
+                      "0.002): f(t) = true f(t - delay), interpolated between samples."),
+    "--length-delay": ("length_delay", "Log the leg lengths (and so the pose) this long "
+                       "after the motion (s)."),
+    "--force-lowpass": ("force_lowpass", "Colour the force noise: pass it through a causal "
+                        "Butterworth low-pass filter with this cut-off (Hz), its standard "
+                        "deviation kept."),
+    "--force-lowpass-order": ("force_lowpass_order", "Order of that filter (default 4)."),
+    "--hum": ("hum_amplitude", "Mains hum on every force channel: amplitude (N), a random "
+              "phase per leg."),
+    "--hum-frequency": ("hum_frequency", "Mains frequency of the hum (Hz, default 50)."),
+    "--force-drift": ("force_drift", "Random-walk drift of each force channel from zero: its "
+                      "standard deviation at the end of the record (N)."),
+    "--length-drift": ("length_drift", "Random-walk drift of each leg-length channel: its "
+                       "standard deviation at the end of the record (m)."),
+    "--force-resolution": ("force_resolution", "Quantisation step of the forces (N); "
+                           "default: \\[sensors] force_resolution."),
+    "--length-resolution": ("length_resolution", "Quantisation step of the leg lengths (m, "
+                            "e.g. 1e-6); default: \\[sensors] length_resolution."),
+}
 #: A flag that only shapes the error another flag switches on: flag -> (that flag, field).
 SHAPING_FLAGS = {"--force-lowpass-order": ("--force-lowpass", "force_lowpass"),
                  "--hum-frequency": ("--hum", "hum_amplitude")}
+
+
+def imperfection_option(flag: str) -> Any:
+    """The typer option of a sensor-imperfection flag, with its help."""
+    return typer.Option(flag, help=IMPERFECTION_FLAGS[flag][1])
 
 
 def simulate(
@@ -47,12 +67,12 @@ def simulate(
         "either).")] = False,
     length_noise: Annotated[float | None, typer.Option(
         "--length-noise", help="Leg-length sensor noise, standard deviation (m); default: "
-        "[sensors] length_noise.")] = None,
+        "\\[sensors] length_noise.")] = None,
     force_noise: Annotated[float | None, typer.Option(
         "--force-noise", help="Force sensor noise, standard deviation (N); default: "
-        "[sensors] force_noise.")] = None,
+        "\\[sensors] force_noise.")] = None,
     actuator: Annotated[str | None, typer.Option(
-        "--actuator", help="'hydraulic' or 'ideal'; default: [hydraulics] mode.")] = None,
+        "--actuator", help="'hydraulic' or 'ideal'; default: \\[hydraulics] mode.")] = None,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the sensor noise.")] = 0,
     format: Annotated[str, typer.Option("--format", help="'csv' or 'parquet'.")] = "csv",
     force: Annotated[bool, typer.Option("--force", help="Overwrite results already in "
@@ -64,34 +84,18 @@ def simulate(
     jobs: Annotated[int | None, typer.Option(
         "--jobs", help="Worker processes for the paper's experiments (default: every core); "
         "the data do not depend on it.")] = None,
-    force_delay: Annotated[float | None, typer.Option(
-        "--force-delay", help="Log the forces this long after the motion (s, e.g. 0.002): "
-        "f(t) = true f(t - delay), interpolated between samples.")] = None,
-    length_delay: Annotated[float | None, typer.Option(
-        "--length-delay", help="Log the leg lengths (and so the pose) this long after the "
-        "motion (s).")] = None,
-    force_lowpass: Annotated[float | None, typer.Option(
-        "--force-lowpass", help="Colour the force noise: pass it through a causal Butterworth "
-        "low-pass filter with this cut-off (Hz), its standard deviation kept.")] = None,
-    force_lowpass_order: Annotated[int | None, typer.Option(
-        "--force-lowpass-order", help="Order of that filter (default 4).")] = None,
-    hum: Annotated[float | None, typer.Option(
-        "--hum", help="Mains hum on every force channel: amplitude (N), a random phase per "
-        "leg.")] = None,
-    hum_frequency: Annotated[float | None, typer.Option(
-        "--hum-frequency", help="Mains frequency of the hum (Hz, default 50).")] = None,
-    force_drift: Annotated[float | None, typer.Option(
-        "--force-drift", help="Random-walk drift of each force channel from zero: its "
-        "standard deviation at the end of the record (N).")] = None,
-    length_drift: Annotated[float | None, typer.Option(
-        "--length-drift", help="Random-walk drift of each leg-length channel: standard "
-        "deviation at the end of the record (m).")] = None,
-    force_resolution: Annotated[float | None, typer.Option(
-        "--force-resolution", help="Quantisation step of the forces (N); default: [sensors] "
-        "force_resolution.")] = None,
-    length_resolution: Annotated[float | None, typer.Option(
-        "--length-resolution", help="Quantisation step of the leg lengths (m, e.g. 1e-6); "
-        "default: [sensors] length_resolution.")] = None,
+    force_delay: Annotated[float | None, imperfection_option("--force-delay")] = None,
+    length_delay: Annotated[float | None, imperfection_option("--length-delay")] = None,
+    force_lowpass: Annotated[float | None, imperfection_option("--force-lowpass")] = None,
+    force_lowpass_order: Annotated[int | None,
+                                   imperfection_option("--force-lowpass-order")] = None,
+    hum: Annotated[float | None, imperfection_option("--hum")] = None,
+    hum_frequency: Annotated[float | None, imperfection_option("--hum-frequency")] = None,
+    force_drift: Annotated[float | None, imperfection_option("--force-drift")] = None,
+    length_drift: Annotated[float | None, imperfection_option("--length-drift")] = None,
+    force_resolution: Annotated[float | None, imperfection_option("--force-resolution")] = None,
+    length_resolution: Annotated[float | None,
+                                 imperfection_option("--length-resolution")] = None,
 ) -> None:
     """Simulate the six experiments (experiment k excites DOF k) on the hydraulic plant."""
     # simulation, design and rich.progress load in 0.4-0.5 s; every command's module is
@@ -180,9 +184,10 @@ def with_imperfections(noise: SensorNoise, sample_rate: float,
     changes = {}
     for flag, value in given.items():
         if value is not None:  # an optional flag not given
-            declared = field_spec(fields[IMPERFECTION_FLAGS[flag]])
+            name = IMPERFECTION_FLAGS[flag][0]
+            declared = field_spec(fields[name])
             check(flag, value, [declared.constraint], declared.unit)
-            changes[IMPERFECTION_FLAGS[flag]] = value
+            changes[name] = value
     noise = dataclasses.replace(noise, **changes)
     for flag, (switch, field) in SHAPING_FLAGS.items():
         if given.get(flag) is not None and not getattr(noise, field):
