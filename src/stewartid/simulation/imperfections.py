@@ -6,10 +6,10 @@ simulator and of :func:`stewartid.simulation.sensors.degrade`:
 
 - :func:`delay_signal`: a channel logged ``delay`` seconds after the motion, by cubic-spline
   interpolation of the sampled true signal (the plant records its states at the samples
-  only);
-  on the paper platform at 1 kHz, Coulomb 30 N m, a half-sample delay of the leg forces
-  differs from the forces the integrator gives at those instants by 1e-3 N RMS and 0.07 N at
-  worst (friction reversals), of the order of the integration error itself;
+  only); on the paper platform at 1 kHz, Coulomb 30 N m, three sines on each DOF, a
+  half-sample delay of the leg forces differs from the forces the integrator gives at those
+  instants by 8e-4 N RMS and 0.074 N at worst (friction reversals), against leg forces of
+  about 30 kN and 9e-3 N for halving the integration step (``docs/benchmarks.md``);
 - :func:`lowpass_noise`: white noise through a causal Butterworth low-pass filter, as an
   anti-aliasing filter colours a transducer's noise, scaled to the requested standard
   deviation;

@@ -123,8 +123,8 @@ class SensorNoise:
     @classmethod
     def from_sensors(cls, sensors: Sensors) -> SensorNoise:
         """The errors declared in a platform's ``[sensors]`` section."""
-        return cls(**{name: getattr(sensors, name) for name in _SENSORS_FIELDS
-                      if name in {f.name for f in dataclasses.fields(cls)}})
+        names = {f.name for f in dataclasses.fields(cls)} & set(_SENSORS_FIELDS)
+        return cls(**{name: getattr(sensors, name) for name in names})
 
     @property
     def is_ideal(self) -> bool:
@@ -268,7 +268,7 @@ def measure_legs(lengths: np.ndarray, forces: np.ndarray, noise: SensorNoise,
     noise : SensorNoise
     rng : numpy.random.Generator
         Draws, in this order and only for the errors that are nonzero: the length noise, the
-        force noise, the length drift, the hum phases, the force drift.
+        force noise, the hum phases, the length drift, the force drift.
     t : ndarray, shape (N,), optional
         Sample times (s), uniform; required for delays, filtered noise and hum.
 
@@ -298,11 +298,11 @@ def measure_legs(lengths: np.ndarray, forces: np.ndarray, noise: SensorNoise,
     elif np.any(noise.force_noise):
         measured_forces = measured_forces + rng.normal(0.0, np.asarray(noise.force_noise),
                                                        size=measured_forces.shape)
-    if noise.length_drift:
-        measured_lengths = measured_lengths + random_walk(n, noise.length_drift, rng)
     if noise.hum_amplitude:
         measured_forces = measured_forces + mains_hum(t, noise.hum_amplitude,
                                                       noise.hum_frequency, rng)
+    if noise.length_drift:
+        measured_lengths = measured_lengths + random_walk(n, noise.length_drift, rng)
     if noise.force_drift:
         measured_forces = measured_forces + random_walk(n, noise.force_drift, rng)
     return (quantise(measured_lengths, noise.length_resolution),
