@@ -26,9 +26,9 @@ import numpy as np
 
 from stewartid.datasets.dataset import Dataset, read_datasets
 from stewartid.identification.registry import create_identifier
-from stewartid.model.kinematics import forward_kinematics
 from stewartid.platform import load_platform
 from stewartid.reference.published import PAPER_ENTRIES, relative_error_percent
+from stewartid.simulation import SensorNoise, degrade
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "tests" / "data" / "example_c10"
 #: Method B (default: every interval constant free), with the shared-friction interval
@@ -93,17 +93,13 @@ def load_example(folder: Path = EXAMPLE):
 
 
 def add_noise(platform, datasets, length_noise: float, force_noise: float, seed: int):
-    """Copies of ``datasets`` with noisy lengths (m), their forward-kinematics pose, and
-    force noise of ``force_noise`` times each leg's mean |force| (N)."""
+    """Copies of ``datasets`` measured by noisy sensors (:func:`stewartid.simulation.degrade`):
+    white noise of ``length_noise`` (m) on the leg lengths, the pose their forward kinematics,
+    and of ``force_noise`` times each leg's mean |force| (N) on the forces."""
     rng = np.random.default_rng(seed)
-    out = []
-    for d in datasets:
-        lengths = d.lengths + length_noise * rng.standard_normal(d.lengths.shape)
-        level = force_noise * np.abs(d.forces).mean(axis=0)
-        forces = d.forces + level * rng.standard_normal(d.forces.shape)
-        pose = forward_kinematics(platform, lengths, initial=d.pose) if length_noise else d.pose
-        out.append(Dataset(t=d.t, pose=pose, lengths=lengths, forces=forces, name=d.name))
-    return out
+    return [degrade(d, platform, SensorNoise(
+        length_noise=length_noise, force_noise=tuple(force_noise * np.abs(d.forces).mean(axis=0))),
+        rng) for d in datasets]
 
 
 def entry_ratios(estimator, M, B, reference=None) -> tuple[np.ndarray, np.ndarray]:

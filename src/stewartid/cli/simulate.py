@@ -2,14 +2,49 @@
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
 from stewartid.files import check_output_folder
 from stewartid.platform import load_platform
+
+if TYPE_CHECKING:
+    from stewartid.simulation.sensors import SensorNoise
+
+#: The sensor imperfections set on the command line: flag -> (SensorNoise field, help).
+IMPERFECTION_FLAGS = {
+    "--force-delay": ("force_delay", "Log the forces this long after the motion (s, e.g. "
+                      "0.002): f(t) = true f(t - delay), interpolated between samples."),
+    "--length-delay": ("length_delay", "Log the leg lengths (and so the pose) this long "
+                       "after the motion (s)."),
+    "--force-lowpass": ("force_lowpass", "Colour the force noise: pass it through a causal "
+                        "Butterworth low-pass filter with this cut-off (Hz), its standard "
+                        "deviation kept."),
+    "--force-lowpass-order": ("force_lowpass_order", "Order of that filter (default 4)."),
+    "--hum": ("hum_amplitude", "Mains hum on every force channel: amplitude (N), a random "
+              "phase per leg."),
+    "--hum-frequency": ("hum_frequency", "Mains frequency of the hum (Hz, default 50)."),
+    "--force-drift": ("force_drift", "Random-walk drift of each force channel from zero: its "
+                      "standard deviation at the end of the record (N)."),
+    "--length-drift": ("length_drift", "Random-walk drift of each leg-length channel: its "
+                       "standard deviation at the end of the record (m)."),
+    "--force-resolution": ("force_resolution", "Quantisation step of the forces (N); "
+                           "default: \\[sensors] force_resolution."),
+    "--length-resolution": ("length_resolution", "Quantisation step of the leg lengths (m, "
+                            "e.g. 1e-6); default: \\[sensors] length_resolution."),
+}
+#: A flag that only shapes the error another flag switches on: flag -> (that flag, field).
+SHAPING_FLAGS = {"--force-lowpass-order": ("--force-lowpass", "force_lowpass"),
+                 "--hum-frequency": ("--hum", "hum_amplitude")}
+
+
+def imperfection_option(flag: str) -> Any:
+    """The typer option of a sensor-imperfection flag, with its help."""
+    return typer.Option(flag, help=IMPERFECTION_FLAGS[flag][1])
 
 
 def simulate(
@@ -32,12 +67,12 @@ def simulate(
         "either).")] = False,
     length_noise: Annotated[float | None, typer.Option(
         "--length-noise", help="Leg-length sensor noise, standard deviation (m); default: "
-        "[sensors] length_noise.")] = None,
+        "\\[sensors] length_noise.")] = None,
     force_noise: Annotated[float | None, typer.Option(
         "--force-noise", help="Force sensor noise, standard deviation (N); default: "
-        "[sensors] force_noise.")] = None,
+        "\\[sensors] force_noise.")] = None,
     actuator: Annotated[str | None, typer.Option(
-        "--actuator", help="'hydraulic' or 'ideal'; default: [hydraulics] mode.")] = None,
+        "--actuator", help="'hydraulic' or 'ideal'; default: \\[hydraulics] mode.")] = None,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the sensor noise.")] = 0,
     format: Annotated[str, typer.Option("--format", help="'csv' or 'parquet'.")] = "csv",
     force: Annotated[bool, typer.Option("--force", help="Overwrite results already in "
@@ -49,6 +84,18 @@ def simulate(
     jobs: Annotated[int | None, typer.Option(
         "--jobs", help="Worker processes for the paper's experiments (default: every core); "
         "the data do not depend on it.")] = None,
+    force_delay: Annotated[float | None, imperfection_option("--force-delay")] = None,
+    length_delay: Annotated[float | None, imperfection_option("--length-delay")] = None,
+    force_lowpass: Annotated[float | None, imperfection_option("--force-lowpass")] = None,
+    force_lowpass_order: Annotated[int | None,
+                                   imperfection_option("--force-lowpass-order")] = None,
+    hum: Annotated[float | None, imperfection_option("--hum")] = None,
+    hum_frequency: Annotated[float | None, imperfection_option("--hum-frequency")] = None,
+    force_drift: Annotated[float | None, imperfection_option("--force-drift")] = None,
+    length_drift: Annotated[float | None, imperfection_option("--length-drift")] = None,
+    force_resolution: Annotated[float | None, imperfection_option("--force-resolution")] = None,
+    length_resolution: Annotated[float | None,
+                                 imperfection_option("--length-resolution")] = None,
 ) -> None:
     """Simulate the six experiments (experiment k excites DOF k) on the hydraulic plant."""
     # simulation, design and rich.progress load in 0.4-0.5 s; every command's module is
@@ -72,8 +119,14 @@ def simulate(
             ("--duration", duration, positive(), "s")):
         if value is not None:  # an optional flag not given
             check(flag, value, [constraint], unit)
-    noise = sensor_noise(description, "always" if noise_on else "never", length_noise,
-                         force_noise)
+    noise = with_imperfections(
+        sensor_noise(description, "always" if noise_on else "never", length_noise, force_noise),
+        description.sensors.sample_rate,
+        {"--force-delay": force_delay, "--length-delay": length_delay,
+         "--force-lowpass": force_lowpass, "--force-lowpass-order": force_lowpass_order,
+         "--hum": hum, "--hum-frequency": hum_frequency, "--force-drift": force_drift,
+         "--length-drift": length_drift, "--force-resolution": force_resolution,
+         "--length-resolution": length_resolution})
     with Progress(transient=True) as bar:
         task = bar.add_task("simulating", total=len(excitation) if excitation else 6)
 
@@ -98,3 +151,54 @@ def simulate(
                                           jobs=(os.cpu_count() or 1) if jobs is None else jobs)
     paths = write_experiments(result, out, format=format, force=force)
     typer.echo(f"wrote {len(paths) - 1} experiments and meta.json to {out}")
+
+
+def with_imperfections(noise: SensorNoise, sample_rate: float,
+                       given: dict[str, Any]) -> SensorNoise:
+    """``noise`` with the sensor imperfections given on the command line.
+
+    Parameters
+    ----------
+    noise : SensorNoise
+        The errors of ``[sensors]`` and the noise flags.
+    sample_rate : float
+        Sample rate of the records (Hz): filter and hum frequencies must lie below half of it.
+    given : dict
+        Flag of :data:`IMPERFECTION_FLAGS` -> value, None when not given.
+
+    Raises
+    ------
+    ConfigError
+        One line naming the flag: a value outside its range, a frequency at or above the
+        Nyquist frequency, a flag that shapes an error nobody switched on.
+    """
+    from numbers import Real
+
+    import numpy as np
+
+    from stewartid.errors import ConfigError
+    from stewartid.fields import Interval, check, field_spec
+    from stewartid.simulation.sensors import SensorNoise
+
+    fields = {f.name: f for f in dataclasses.fields(SensorNoise)}
+    changes = {}
+    for flag, value in given.items():
+        if value is not None:  # an optional flag not given
+            name = IMPERFECTION_FLAGS[flag][0]
+            declared = field_spec(fields[name])
+            check(flag, value, [declared.constraint], declared.unit)
+            changes[name] = value
+    noise = dataclasses.replace(noise, **changes)
+    for flag, (switch, field) in SHAPING_FLAGS.items():
+        if given.get(flag) is not None and not getattr(noise, field):
+            raise ConfigError(f"{flag} has no effect without {switch}; add {switch} or leave "
+                              f"{flag} out.")
+    if noise.force_lowpass and not any(np.atleast_1d(noise.force_noise)):
+        raise ConfigError("--force-lowpass colours the force noise, which is zero here; add "
+                          "--noise or --force-noise N.")
+    for flag, field, used in (("--force-lowpass", "force_lowpass", noise.force_lowpass > 0),
+                              ("--hum-frequency", "hum_frequency", noise.hum_amplitude > 0)):
+        if used:
+            check(flag, getattr(noise, field), [Interval(Real, 0.0, sample_rate / 2, "neither")],
+                  "Hz", f"sampling at {sample_rate:g} Hz")
+    return noise

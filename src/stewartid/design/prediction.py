@@ -251,7 +251,7 @@ def measured_plant_datasets(platform: Platform, records: list, noise: SensorNois
     """
     out = []
     for k, (record, rng) in enumerate(zip(records, generators, strict=True)):
-        lengths, forces = measure_legs(record.lengths, record.forces, noise, rng)
+        lengths, forces = measure_legs(record.lengths, record.forces, noise, rng, record.t)
         if inverse_jacobians is None:
             pose = measured_pose(platform, lengths, record.q)
         else:

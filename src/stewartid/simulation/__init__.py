@@ -4,6 +4,9 @@ The five blocks of the paper's Simulink model (Zhang 2020, Fig. 3): signal gener
 (:mod:`.excitation`), inverse motion and PID (:mod:`.controller`), hydraulic actuators
 (:mod:`.hydraulics`), plant dynamics (:mod:`.plant`, compiled closed loop) and forward
 solution (:mod:`.sensors`). :func:`simulate_experiments` runs the paper's six experiments.
+A real rig's sensor imperfections (channel delays, filtered noise, mains hum, drift:
+:mod:`.imperfections`) are part of :class:`SensorNoise`; :func:`degrade` applies them to any
+data set.
 """
 
 from stewartid.simulation.excitation import (
@@ -21,7 +24,7 @@ from stewartid.simulation.experiments import (
     simulate_experiments,
     write_experiments,
 )
-from stewartid.simulation.sensors import SensorNoise
+from stewartid.simulation.sensors import SensorNoise, degrade
 
 __all__ = [
     "DEFAULT_AMPLITUDES",
@@ -30,6 +33,7 @@ __all__ = [
     "SensorNoise",
     "SimulationResult",
     "Sine",
+    "degrade",
     "multisine_excitation",
     "paper_experiments",
     "simulate_experiment",

@@ -130,7 +130,8 @@ def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: 
     duration_s : float
         Record length (s); samples at ``platform.sensors.sample_rate``.
     noise : SensorNoise, optional
-        Sensor errors; those of ``[sensors]`` by default.
+        Sensor errors (delays, noise, hum, drift, quantisation:
+        :func:`stewartid.simulation.sensors.measure_legs`); those of ``[sensors]`` by default.
     rng : numpy.random.Generator, optional
         Noise source; a fresh ``default_rng(0)`` by default.
     step : float
@@ -148,9 +149,9 @@ def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: 
     Raises
     ------
     ConfigError
-        On a non-positive duration, a frequency at or above the Nyquist limit, an
-        actuator that cannot hold the platform, or a servo loop that is unstable at the
-        start pose (:func:`stewartid.simulation.stability.require_stable`).
+        On a non-positive duration, an excitation, filter or hum frequency at or above the
+        Nyquist limit, an actuator that cannot hold the platform, or a servo loop that is
+        unstable at the start pose (:func:`stewartid.simulation.stability.require_stable`).
     StewartidError
         If a leg leaves its stroke or the integration diverges.
     """
@@ -160,6 +161,7 @@ def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: 
         raise ConfigError(f"integration step must be > 0 s; got {step!r}.")
     noise = SensorNoise.from_sensors(platform.sensors) if noise is None else noise
     rng = np.random.default_rng(0) if rng is None else rng
+    noise.check_sampling(fs)
     n_out = int(math.floor(duration_s * fs + 1e-9)) + 1
     substeps = max(1, math.ceil(1.0 / (fs * step) - 1e-9))
     h = 1.0 / (fs * substeps)
@@ -198,7 +200,7 @@ def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: 
         pressures=np.stack([states[:, plant.S_PA:plant.S_PA + 6],
                             states[:, plant.S_PB:plant.S_PB + 6]], axis=-1),
         spools=states[:, plant.S_XV:plant.S_XV + 6])
-    measured_lengths, measured_forces = measure_legs(lengths, forces, noise, rng)
+    measured_lengths, measured_forces = measure_legs(lengths, forces, noise, rng, t)
     # Newton started at the true pose: the same solution as from the commanded one (tracking
     # errors of millimetres), in one or two iterations instead of four
     pose = measured_pose(platform, measured_lengths, record.q)
@@ -272,6 +274,7 @@ def simulate_experiments(platform: Platform, coulomb: float | None = None,
         platform = platform.replace(**updates)
     noise = SensorNoise.from_sensors(platform.sensors) if noise is None else noise
     _check_timing(duration_s, platform.sensors.sample_rate, frequency_hz)
+    noise.check_sampling(platform.sensors.sample_rate)
     if not (isinstance(seed, int | np.integer) and seed >= 0):
         raise ConfigError(f"seed must be an integer >= 0; got {seed!r}.")
     if isinstance(jobs, bool) or not isinstance(jobs, int | np.integer) or jobs < 1:

@@ -1,60 +1,165 @@
 """Sensors: sampling, leg-length and actuator-force measurement errors, forward kinematics.
 
-A measurement is quantise(true + bias + noise): Gaussian noise of standard deviation
-``*_noise`` drawn from a seeded generator, a constant ``*_bias`` and rounding to a multiple
-of ``*_resolution`` (none when 0). The force sensor stands for the two pressure transducers
-of a leg (f = p_A A_A - p_B A_B); its errors are given in newtons. The measured pose is the
-forward kinematics of the measured leg lengths, as on a real hexapod without pose sensors.
+A measurement is quantise(true(t - delay) + bias + noise + hum + drift): the true signal
+logged ``*_delay`` seconds after the motion, a constant ``*_bias``, Gaussian noise of
+standard deviation ``*_noise`` (white, or low-pass filtered for the forces), a mains hum on
+the forces, a random-walk drift, and rounding to a multiple of ``*_resolution`` (none when
+0); every error is drawn from a seeded generator (:mod:`.imperfections`). The force sensor
+stands for the two pressure transducers of a leg (f = p_A A_A - p_B A_B); its errors are
+given in newtons. The measured pose is the forward kinematics of the measured leg lengths,
+as on a real hexapod without pose sensors. :func:`degrade` applies the same errors to an
+existing data set, simulated or logged.
 """
 
 from __future__ import annotations
 
 import dataclasses
+from numbers import Integral
+from typing import Any
 
 import numpy as np
 
+from stewartid.datasets.dataset import Dataset
 from stewartid.errors import ConfigError
+from stewartid.fields import FieldSpec, Interval, ListOf, check, field_spec, nonnegative, positive, spec
 from stewartid.model.dynamics import inverse_dynamics
 from stewartid.model.kinematics import forward_kinematics
 from stewartid.platform import Platform
 from stewartid.platform.sections import Sensors
+from stewartid.simulation.imperfections import (
+    delay_signal,
+    lowpass_noise,
+    mains_hum,
+    random_walk,
+)
+
+_SENSORS_FIELDS = {f.name: f for f in dataclasses.fields(Sensors)}
+
+
+def _as_in_sensors(name: str) -> Any:
+    """A field declared as the platform's ``[sensors] name`` (unit, description, values), 0."""
+    return dataclasses.field(default=0.0, metadata=_SENSORS_FIELDS[name].metadata)
+
+
+#: Errors given either once for the six legs or as six values, one per leg.
+PER_LEG = ("length_noise", "force_noise")
+#: Settings that shape an error without being one (ideal sensors whatever their value).
+SHAPES = ("force_lowpass_order", "hum_frequency")
+#: The errors of the leg-length channels (any of them nonzero: the pose is recomputed).
+LENGTH_ERRORS = ("length_noise", "length_bias", "length_resolution", "length_delay",
+                 "length_drift")
 
 
 @dataclasses.dataclass(frozen=True)
 class SensorNoise:
-    """Measurement errors of the leg-length and force sensors (all zero: ideal sensors).
+    """Measurement errors of the leg-length and force sensors (defaults: ideal sensors).
+
+    Declared with the constraints of :mod:`stewartid.fields` (the first six as the
+    platform's ``[sensors]`` section); every error is drawn from the generator given to
+    :func:`measure_legs`, in the order of the attributes below, so that switching on a hum
+    or a drift leaves the noise of the same seed unchanged.
 
     Attributes
     ----------
-    length_noise, length_bias, length_resolution : float
-        m (standard deviation, offset, quantisation step).
-    force_noise, force_bias, force_resolution : float
-        N.
+    length_noise : float or tuple of 6 float
+        Standard deviation of the white leg-length noise (m), one per leg when six.
+    length_bias, length_resolution : float
+        Offset and quantisation step of the leg lengths (m).
+    force_noise : float or tuple of 6 float
+        Standard deviation of the force noise (N), one per leg when six; white, or coloured
+        by ``force_lowpass`` (the standard deviation after filtering).
+    force_bias, force_resolution : float
+        Offset and quantisation step of the forces (N).
+    length_delay, force_delay : float
+        Delay of the channel behind the motion (s): measured(t) = true(t - delay).
+    force_lowpass : float
+        Cut-off (-3 dB) of the Butterworth low-pass filter colouring the force noise (Hz);
+        0: white noise.
+    force_lowpass_order : int
+        Order of that filter.
+    hum_amplitude : float
+        Amplitude of the mains hum on every force channel (N), a random phase per leg.
+    hum_frequency : float
+        Mains frequency (Hz).
+    length_drift, force_drift : float
+        Standard deviation at the end of the record of a random walk from zero per channel
+        (m, N).
     """
 
-    length_noise: float = 0.0
-    length_bias: float = 0.0
-    length_resolution: float = 0.0
-    force_noise: float = 0.0
-    force_bias: float = 0.0
-    force_resolution: float = 0.0
+    length_noise: float | tuple[float, ...] = _as_in_sensors("length_noise")
+    length_bias: float = _as_in_sensors("length_bias")
+    length_resolution: float = _as_in_sensors("length_resolution")
+    force_noise: float | tuple[float, ...] = _as_in_sensors("force_noise")
+    force_bias: float = _as_in_sensors("force_bias")
+    force_resolution: float = _as_in_sensors("force_resolution")
+    length_delay: float = spec("s", "delay of the leg-length channels behind the motion",
+                               nonnegative(0.0, 1.0), 0.0)
+    force_delay: float = spec("s", "delay of the force channels behind the motion",
+                              nonnegative(0.0, 1.0), 0.0)
+    force_lowpass: float = spec("Hz", "cut-off of the low-pass filter colouring the force "
+                                "noise (0: white noise)", nonnegative(0.0, 1e6), 0.0)
+    force_lowpass_order: int = spec("-", "order of the Butterworth filter colouring the force "
+                                    "noise", Interval(Integral, 1, 12, "both"), 4)
+    hum_amplitude: float = spec("N", "amplitude of the mains hum on the forces",
+                                nonnegative(0.0, 1e7), 0.0)
+    hum_frequency: float = spec("Hz", "mains frequency", positive(1.0, 1e5), 50.0)
+    length_drift: float = spec("m", "standard deviation of the leg-length drift at the end "
+                               "of the record", nonnegative(0.0, 0.1), 0.0)
+    force_drift: float = spec("N", "standard deviation of the force drift at the end of the "
+                              "record", nonnegative(0.0, 1e7), 0.0)
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):
-            value = float(getattr(self, f.name))
-            if not np.isfinite(value) or ("bias" not in f.name and value < 0):
-                raise ConfigError(f"sensor {f.name} must be a finite value >= 0; got {value!r}.")
+            declared = field_spec(f)
+            allowed = [declared.constraint]
+            value = declared.normalise(getattr(self, f.name))
+            if f.name in PER_LEG:
+                allowed.append(ListOf(declared.constraint, length=6))
+                value = FieldSpec(declared.unit, declared.doc, allowed[-1]).normalise(value)
+            check(f"The {f.name!r} parameter of SensorNoise", value, allowed, declared.unit)
+            if isinstance(declared.constraint, Interval) and declared.constraint.kind is Integral:
+                value = int(value)
             object.__setattr__(self, f.name, value)
 
     @classmethod
     def from_sensors(cls, sensors: Sensors) -> SensorNoise:
         """The errors declared in a platform's ``[sensors]`` section."""
-        return cls(**{f.name: getattr(sensors, f.name) for f in dataclasses.fields(cls)})
+        names = {f.name for f in dataclasses.fields(cls)} & set(_SENSORS_FIELDS)
+        return cls(**{name: getattr(sensors, name) for name in names})
 
     @property
     def is_ideal(self) -> bool:
         """True when every error is zero."""
-        return all(getattr(self, f.name) == 0.0 for f in dataclasses.fields(self))
+        return not any(np.any(getattr(self, f.name)) for f in dataclasses.fields(self)
+                       if f.name not in SHAPES)
+
+    @property
+    def changes_lengths(self) -> bool:
+        """True when the measured leg lengths differ from the true ones."""
+        return any(np.any(getattr(self, name)) for name in LENGTH_ERRORS)
+
+    @property
+    def needs_sampling(self) -> bool:
+        """True when an error depends on the sample times (a delay, filter or hum)."""
+        return bool(self.length_delay or self.force_delay or self.hum_amplitude
+                    or (self.force_lowpass and np.any(self.force_noise)))
+
+    def check_sampling(self, sample_rate: float) -> None:
+        """Refuse a filter cut-off or hum frequency at or above the Nyquist frequency.
+
+        Raises
+        ------
+        ConfigError
+            Naming the setting, the Nyquist frequency and the sample rate (Hz).
+        """
+        nyquist = sample_rate / 2
+        for name, used in (("force_lowpass", self.force_lowpass > 0),
+                           ("hum_frequency", self.hum_amplitude > 0)):
+            if used and not getattr(self, name) < nyquist:
+                raise ConfigError(
+                    f"SensorNoise {name} = {getattr(self, name):g} Hz is not below the Nyquist "
+                    f"frequency {nyquist:g} Hz of the {sample_rate:g} Hz sampling; lower it or "
+                    "sample faster.")
 
 
 #: The reference sensor noise (``stewartid simulate --noise``, ``noise_scale = 1`` in a
@@ -138,23 +243,71 @@ def sensor_noise(platform: Platform, reference: str = "never", length_noise: flo
     return dataclasses.replace(noise, **changes) if changes else noise
 
 
+def quantise(values: np.ndarray, resolution: float) -> np.ndarray:
+    """``values`` rounded to the nearest multiple of ``resolution`` (unchanged when 0)."""
+    return resolution * np.round(values / resolution) if resolution > 0 else values
+
+
 def measure(true: np.ndarray, noise: float, bias: float, resolution: float,
             rng: np.random.Generator) -> np.ndarray:
     """quantise(true + bias + N(0, noise^2)) element-wise; same shape as ``true``."""
     out = np.asarray(true, dtype=float) + bias
     if noise > 0:
         out = out + rng.normal(0.0, noise, size=out.shape)
-    if resolution > 0:
-        out = resolution * np.round(out / resolution)
-    return out
+    return quantise(out, resolution)
 
 
 def measure_legs(lengths: np.ndarray, forces: np.ndarray, noise: SensorNoise,
-                 rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-    """Measured leg lengths (m) and forces (N), both (N, 6), from the true ones."""
-    return (measure(lengths, noise.length_noise, noise.length_bias, noise.length_resolution,
-                    rng),
-            measure(forces, noise.force_noise, noise.force_bias, noise.force_resolution, rng))
+                 rng: np.random.Generator, t: np.ndarray | None = None,
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """Measured leg lengths (m) and forces (N), both (N, 6), from the true ones.
+
+    Parameters
+    ----------
+    lengths, forces : ndarray, shape (N, 6)
+        True leg lengths (m) and actuator forces (N).
+    noise : SensorNoise
+    rng : numpy.random.Generator
+        Draws, in this order and only for the errors that are nonzero: the length noise, the
+        force noise, the hum phases, the length drift, the force drift.
+    t : ndarray, shape (N,), optional
+        Sample times (s), uniform; required for delays, filtered noise and hum.
+
+    Raises
+    ------
+    ConfigError
+        If ``t`` is missing where it is required, or a filter or hum frequency is not below
+        the Nyquist frequency.
+    """
+    n = len(lengths)
+    rate = None
+    if noise.needs_sampling:
+        if t is None:
+            raise ConfigError("sensor delays, filtered noise and hum need the sample times; "
+                              "pass t to measure_legs.")
+        rate = (n - 1) / (t[-1] - t[0])
+        noise.check_sampling(rate)
+    measured_lengths = delay_signal(t, lengths, noise.length_delay) + noise.length_bias
+    measured_forces = delay_signal(t, forces, noise.force_delay) + noise.force_bias
+    if np.any(noise.length_noise):
+        measured_lengths = measured_lengths + rng.normal(0.0, np.asarray(noise.length_noise),
+                                                         size=measured_lengths.shape)
+    if np.any(noise.force_noise) and noise.force_lowpass:
+        measured_forces = measured_forces + lowpass_noise(
+            rng, n, np.asarray(noise.force_noise), noise.force_lowpass,
+            noise.force_lowpass_order, rate)
+    elif np.any(noise.force_noise):
+        measured_forces = measured_forces + rng.normal(0.0, np.asarray(noise.force_noise),
+                                                       size=measured_forces.shape)
+    if noise.hum_amplitude:
+        measured_forces = measured_forces + mains_hum(t, noise.hum_amplitude,
+                                                      noise.hum_frequency, rng)
+    if noise.length_drift:
+        measured_lengths = measured_lengths + random_walk(n, noise.length_drift, rng)
+    if noise.force_drift:
+        measured_forces = measured_forces + random_walk(n, noise.force_drift, rng)
+    return (quantise(measured_lengths, noise.length_resolution),
+            quantise(measured_forces, noise.force_resolution))
 
 
 def measured_pose(platform: Platform, lengths: np.ndarray,
@@ -165,3 +318,47 @@ def measured_pose(platform: Platform, lengths: np.ndarray,
     (N, 6), e.g. the commanded poses that the controller knows, or from the neutral pose.
     """
     return forward_kinematics(platform, lengths, initial=initial, tolerance=1e-12)
+
+
+def degrade(dataset: Dataset, platform: Platform, noise: SensorNoise,
+            rng: np.random.Generator | int | None = None) -> Dataset:
+    """A copy of a data set measured by imperfect sensors: a rig's errors on a clean log.
+
+    The leg lengths and forces go through the sensor model of the simulator
+    (:func:`measure_legs`: delay, bias, white or filtered noise, hum, drift, quantisation);
+    the pose is then the forward kinematics of the measured lengths, started from the
+    data set's pose (unchanged when the lengths are: no length error in ``noise``).
+
+    Parameters
+    ----------
+    dataset : Dataset
+        A clean log, simulated or a rig's own (then its errors add to those it has). Its
+        first sample is held before it for the delays (the rig at rest before the record).
+    platform : Platform
+        Geometry for the forward kinematics.
+    noise : SensorNoise
+        The errors to apply.
+    rng : numpy.random.Generator or int, optional
+        Generator or seed of the random errors (seed 0 when None).
+
+    Returns
+    -------
+    Dataset
+        Same times and name.
+
+    Raises
+    ------
+    ConfigError
+        If a filter or hum frequency is not below the data set's Nyquist frequency.
+
+    Examples
+    --------
+    >>> from stewartid.simulation import SensorNoise, degrade  # doctest: +SKIP
+    >>> late = degrade(clean, platform, SensorNoise(force_delay=2e-3, hum_amplitude=20.0), 1)
+    """
+    rng = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng or 0)
+    lengths, forces = measure_legs(dataset.lengths, dataset.forces, noise, rng, t=dataset.t)
+    pose = (measured_pose(platform, lengths, dataset.pose) if noise.changes_lengths
+            else dataset.pose.copy())
+    return Dataset(t=dataset.t.copy(), pose=pose, lengths=lengths, forces=forces,
+                   name=dataset.name)

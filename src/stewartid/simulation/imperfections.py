@@ -1,0 +1,195 @@
+"""Imperfections of a real rig's sensor channels: delay, coloured noise, mains hum, drift.
+
+Pure functions on sampled signals (time on axis 0, one column per channel) that
+:func:`stewartid.simulation.sensors.measure_legs` combines into the sensor model of the
+simulator and of :func:`stewartid.simulation.sensors.degrade`:
+
+- :func:`delay_signal`: a channel logged ``delay`` seconds after the motion, by cubic-spline
+  interpolation of the sampled true signal (the plant records its states at the samples
+  only); on the paper platform at 1 kHz, Coulomb 30 N m, three sines on each DOF, a
+  half-sample delay of the leg forces differs from the forces the integrator gives at those
+  instants by 8e-4 N RMS and 0.074 N at worst (friction reversals), against leg forces of
+  about 30 kN and 9e-3 N for halving the integration step (``docs/benchmarks.md``);
+- :func:`lowpass_noise`: white noise through a causal Butterworth low-pass filter, as an
+  anti-aliasing filter colours a transducer's noise, scaled to the requested standard
+  deviation;
+- :func:`mains_hum`: a sinusoid at the mains frequency with a random phase per channel;
+- :func:`random_walk`: a slow drift of each channel from zero at the start of the record.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from scipy import signal
+from scipy.interpolate import CubicSpline
+
+#: Decay (relative amplitude) of the filter's impulse response after its warm-up: the filter
+#: runs that many samples before the record so that the noise is stationary from its start.
+SETTLED = 1e-10
+#: First derivative at the first of five equally spaced samples, times the spacing
+#: (error h^4 x^(5) / 5).
+ONE_SIDED_SLOPE = np.array([-25.0, 48.0, -36.0, 16.0, -3.0]) / 12.0
+
+
+def delay_signal(t: np.ndarray, values: np.ndarray, delay_s: float) -> np.ndarray:
+    """The signal ``delay_s`` seconds later: out(t) = values(t - delay_s).
+
+    The sampled signal is interpolated by a cubic spline whose end slopes are the five-point
+    one-sided differences of the samples (error h^4 |x^(5)| / 5). That keeps the classical
+    error bound of the complete spline, (5/384) h^4 max|x''''| for a period h, up to the
+    ends of the record (plus h^5 max|x^(5)| / 5 from the end slopes): for a sine of
+    frequency f and amplitude A, 5/384 A (2 pi f h)^4, 1e-10 A at 1.5 Hz and 1 kHz. A delay
+    of a whole number of samples returns the samples shifted (to round-off). Before the
+    first sample the signal is its first value (the rig at rest before the record started).
+
+    Parameters
+    ----------
+    t : ndarray, shape (N,)
+        Sample times (s), strictly increasing, uniform over the first and last five.
+    values : ndarray, shape (N,) or (N, C)
+        Sampled signal, any unit.
+    delay_s : float
+        Delay (s), >= 0.
+
+    Returns
+    -------
+    ndarray
+        Same shape and unit as ``values``.
+
+    References
+    ----------
+    C. A. Hall, W. W. Meyer, Optimal error bounds for cubic spline interpolation, J. Approx.
+    Theory 16 (1976) 105-122, doi:10.1016/0021-9045(76)90040-X.
+    """
+    values = np.asarray(values, dtype=float)
+    if delay_s == 0:
+        return values.copy()
+    t = np.asarray(t, dtype=float)
+    ends: Any = "not-a-knot"
+    if len(t) >= 5:
+        first = np.tensordot(ONE_SIDED_SLOPE, values[:5], axes=1) / (t[1] - t[0])
+        last = -np.tensordot(ONE_SIDED_SLOPE, values[::-1][:5], axes=1) / (t[-1] - t[-2])
+        ends = ((1, first), (1, last))
+    return CubicSpline(t, values, axis=0, bc_type=ends)(np.maximum(t - delay_s, t[0]))
+
+
+def lowpass_sections(cutoff_hz: float, order: int, sample_rate_hz: float) -> np.ndarray:
+    """Second-order sections of a digital Butterworth low-pass filter.
+
+    Parameters
+    ----------
+    cutoff_hz : float
+        -3 dB frequency (Hz), below the Nyquist frequency ``sample_rate_hz / 2``.
+    order : int
+        Filter order (roll-off 20 ``order`` dB per decade).
+    sample_rate_hz : float
+        Sample rate (Hz).
+
+    Returns
+    -------
+    ndarray, shape (ceil(order / 2), 6)
+        For :func:`scipy.signal.sosfilt`.
+    """
+    return signal.butter(int(order), cutoff_hz, btype="low", fs=sample_rate_hz, output="sos")
+
+
+def warm_up_length(sections: np.ndarray) -> int:
+    """Samples after which the filter's impulse response has decayed to :data:`SETTLED`."""
+    _, poles, _ = signal.sos2zpk(sections)
+    radius = float(np.max(np.abs(poles))) if len(poles) else 0.0
+    if radius <= 0.0:
+        return 1
+    return int(math.ceil(math.log(SETTLED) / math.log(radius))) + 1
+
+
+def lowpass_noise(rng: np.random.Generator, n_samples: int, std: float | np.ndarray,
+                  cutoff_hz: float, order: int, sample_rate_hz: float,
+                  channels: int = 6) -> np.ndarray:
+    """Stationary low-pass (coloured) Gaussian noise of a given standard deviation.
+
+    White noise runs through the causal filter of :func:`lowpass_sections` (as a transducer's
+    noise through an anti-aliasing filter), started :func:`warm_up_length` samples before the
+    record so that it is stationary from the first sample, and is divided by the filter's
+    noise gain sqrt(sum h[k]^2) (h: impulse response), so that its standard deviation is
+    ``std`` and its power spectrum is ``std^2 |H(f)|^2 / sum h[k]^2``: flat below the cutoff,
+    half (-3 dB) at it.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Draws ``(warm-up + n_samples) * channels`` standard normal values.
+    n_samples : int
+    std : float or ndarray, shape (channels,)
+        Standard deviation after filtering, per channel when an array (unit of the signal).
+    cutoff_hz, order, sample_rate_hz
+        As :func:`lowpass_sections`.
+    channels : int
+
+    Returns
+    -------
+    ndarray, shape (n_samples, channels)
+    """
+    sections = lowpass_sections(cutoff_hz, order, sample_rate_hz)
+    warm_up = warm_up_length(sections)
+    impulse = np.zeros(warm_up)
+    impulse[0] = 1.0
+    gain = math.sqrt(float(np.sum(signal.sosfilt(sections, impulse) ** 2)))
+    white = rng.standard_normal((warm_up + n_samples, channels))
+    return np.asarray(std) / gain * signal.sosfilt(sections, white, axis=0)[warm_up:]
+
+
+def mains_hum(t: np.ndarray, amplitude: float, frequency_hz: float, rng: np.random.Generator,
+              channels: int = 6) -> np.ndarray:
+    """A sinusoid of the mains frequency on every channel, each with its own random phase.
+
+    Parameters
+    ----------
+    t : ndarray, shape (N,)
+        Sample times (s).
+    amplitude : float
+        Peak amplitude (unit of the signal).
+    frequency_hz : float
+        Mains frequency (Hz), 50 or 60; below the Nyquist frequency of ``t``.
+    rng : numpy.random.Generator
+        Draws ``channels`` phases, uniform in [0, 2 pi).
+    channels : int
+
+    Returns
+    -------
+    ndarray, shape (N, channels)
+        amplitude * sin(2 pi frequency_hz t + phase_c).
+    """
+    phases = rng.uniform(0.0, 2.0 * np.pi, size=channels)
+    return amplitude * np.sin(2.0 * np.pi * frequency_hz * np.asarray(t, dtype=float)[:, None]
+                              + phases)
+
+
+def random_walk(n_samples: int, std: float, rng: np.random.Generator,
+                channels: int = 6) -> np.ndarray:
+    """A slow drift per channel: a Gaussian random walk from zero at the first sample.
+
+    The sampled Brownian motion of standard deviation ``std`` at the last sample, so
+    ``std * sqrt(k / (n_samples - 1))`` at sample k: a sensor zeroed when the record starts
+    that wanders off over it.
+
+    Parameters
+    ----------
+    n_samples : int
+    std : float
+        Standard deviation at the end of the record (unit of the signal).
+    rng : numpy.random.Generator
+        Draws ``(n_samples - 1) * channels`` standard normal values.
+    channels : int
+
+    Returns
+    -------
+    ndarray, shape (n_samples, channels)
+    """
+    out = np.zeros((n_samples, channels))
+    if n_samples > 1:
+        steps = rng.standard_normal((n_samples - 1, channels)) * (std / math.sqrt(n_samples - 1))
+        out[1:] = np.cumsum(steps, axis=0)
+    return out
