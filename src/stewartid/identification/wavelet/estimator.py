@@ -252,7 +252,7 @@ class WaveletIdentifier(BaseIdentifier):
         super()._validate_params()
         owner, params = type(self).__name__, self.get_params()
         if self.test_functions is None:  # the point equations have no interval constants
-            validate_parameters({"friction": [Options(("free",))]}, params, owner,
+            validate_parameters({"friction": [Options(("auto", "free"))]}, params, owner,
                                 condition="test_functions is None")
         else:
             validate_parameters({"wavelet": [Options(("polynomial",))],
