@@ -36,12 +36,16 @@ def linear_model_datasets(platform, M, B, offset, coulomb, dofs=range(6), freque
             dq, q_dot, q_ddot = motion(t)
             q += dq
         y = q_ddot @ M.T + q_dot @ B.T + offset + np.outer(np.sign(q_dot[:, k]), coulomb)
-        terms = ModelTerms(platform, q)
-        forces = np.linalg.solve(np.swapaxes(terms.leg_jacobian, 1, 2),
-                                 (y + terms.gravity)[..., None])[..., 0]
-        out.append(Dataset(t=t, pose=q, lengths=leg_lengths(platform, q), forces=forces,
-                           name=f"dof{k + 1}"))
+        out.append(dataset_of(platform, t, q, y, f"dof{k + 1}"))
     return out
+
+
+def dataset_of(platform, t, q, y, name):
+    """The record whose leg forces give the generalized force y: J^T f = y + G(q)."""
+    terms = ModelTerms(platform, q)
+    forces = np.linalg.solve(np.swapaxes(terms.leg_jacobian, 1, 2),
+                             (y + terms.gravity)[..., None])[..., 0]
+    return Dataset(t=t, pose=q, lengths=leg_lengths(platform, q), forces=forces, name=name)
 
 
 @pytest.fixture(scope="module")
@@ -303,12 +307,8 @@ def coulomb_structured_datasets(platform, M, B, levels, kind, duration=6.0, peri
         friction = sum(level * np.einsum("nla,nlac->nc", signs[:, :, list(axes)],
                                          jac[:, :, list(axes)])
                        for level, axes in zip(levels, JOINT_TYPES.values(), strict=True))
-        y = q_ddot @ M.T + q_dot @ B.T + friction
-        terms = ModelTerms(platform, q)
-        forces = np.linalg.solve(np.swapaxes(terms.leg_jacobian, 1, 2),
-                                 (y + terms.gravity)[..., None])[..., 0]
-        out.append(Dataset(t=t, pose=q, lengths=leg_lengths(platform, q), forces=forces,
-                           name=f"exp{k + 1}"))
+        out.append(dataset_of(platform, t, q, q_ddot @ M.T + q_dot @ B.T + friction,
+                              f"exp{k + 1}"))
     return out
 
 
