@@ -37,8 +37,10 @@ def identify(
         "--stiffness", help="fourier: identify a stiffness matrix too (needs >= 2 "
                             "frequencies).")] = False,
     friction: Annotated[str | None, typer.Option(
-        "--friction", help="wavelet: the interval constants: 'free' (default; immune to the "
-                           "friction law), 'shared' (Coulomb level per joint type), 'uniform' "
+        "--friction", help="wavelet: the interval constants: 'auto' (default: 'free' for one "
+                           "sine per experiment, else 'coulomb'), 'free' (immune to the "
+                           "friction law), 'coulomb' (windows across reversals, Coulomb level "
+                           "per joint type), 'shared' (Coulomb level per joint type), 'uniform' "
                            "(one level for every joint axis; what 'stewartid design' "
                            "predicts for).")] = None,
     report: Annotated[Path | None, typer.Option(

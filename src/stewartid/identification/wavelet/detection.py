@@ -64,9 +64,9 @@ def raise_no_interval(infos: Sequence[dict]) -> None:
     raise IdentificationError(
         f"no constant-direction interval long enough for the smallest wavelet scale "
         f"in any experiment (longest {longest:.3g} s, at least {needed:.3g} s needed); "
-        "excite with a slower single-frequency sine, lower 'margin' or "
-        "'min_support_samples', raise 'ignore_below' to leave idle joints out, or "
-        "record at a higher sample rate.")
+        "use friction='coulomb' (windows across reversals) or '--method ls', excite with "
+        "a slower single-frequency sine ('stewartid design'), or lower 'margin' or "
+        "'min_support_samples'.")
 
 
 def check_coverage(names: Sequence[str], motion: np.ndarray, counts: Sequence[int]) -> None:
@@ -98,6 +98,42 @@ def check_coverage(names: Sequence[str], motion: np.ndarray, counts: Sequence[in
             f"({', '.join(n for n, c in zip(names, counts, strict=True) if c == 0)}) gave no "
             f"usable constant-direction interval; check their joint-rate noise in the "
             f"diagnostics, or lower hysteresis / margin")
+
+
+#: Share of every moving pose channel's variance one sine must explain for an experiment to
+#: count as the paper's protocol (one sine per experiment).
+SINGLE_SINE_SHARE = 0.9
+
+
+def sine_share(lengths: np.ndarray, sample_rate: float) -> float:
+    """Share of the leg-length variance a single sine at the dominant frequency (with an
+    offset and a drift per leg) explains, over the legs that move.
+
+    Leg lengths, not the pose: they share one unit, and a single sine of the pose is a single
+    sine of every leg length (to first order in the amplitude).
+
+    Parameters
+    ----------
+    lengths : ndarray, shape (N, 6)
+        Leg lengths (m).
+    sample_rate : float
+        Hz.
+
+    Returns
+    -------
+    float
+        In [0, 1]: near 1 for one sine per experiment (the paper's protocol), well below
+        for several frequencies or DOFs moving at different frequencies.
+    """
+    frequency = estimate_frequency(lengths, sample_rate)
+    t = np.arange(len(lengths)) / sample_rate
+    basis = np.column_stack([np.sin(2 * np.pi * frequency * t),
+                             np.cos(2 * np.pi * frequency * t), np.ones_like(t), t - t.mean()])
+    centered = lengths - lengths.mean(axis=0)
+    residual = centered - basis @ np.linalg.lstsq(basis, centered, rcond=None)[0]
+    power = np.mean(centered ** 2, axis=0)
+    moving = power > 1e-2 * power.max()
+    return float(1.0 - np.sum(np.mean(residual ** 2, axis=0)[moving]) / np.sum(power[moving]))
 
 
 def excitation_scales(experiment: Experiment, window: float | None, margin: float | None,
@@ -184,5 +220,5 @@ def detect_intervals(experiment: Experiment, noise: NoiseModel, *, margin: float
                      q_dot=noise.q_dot, q_ddot=noise.q_ddot)
 
 
-__all__ = ["Detection", "check_coverage", "detect_intervals", "excitation_scales",
-           "raise_no_interval"]
+__all__ = ["SINGLE_SINE_SHARE", "Detection", "check_coverage", "detect_intervals",
+           "excitation_scales", "raise_no_interval", "sine_share"]

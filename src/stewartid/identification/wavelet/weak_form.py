@@ -82,6 +82,48 @@ def _family_coefficients(order: int, size: int) -> tuple[np.ndarray, ...]:
     return tuple(out)
 
 
+def test_family(t: np.ndarray, start: float, stop: float, order: int, size: int, h: float
+                ) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
+    """The test functions of one span, sampled and scaled for quadrature.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n,)
+        Sample times inside (start, stop) (s).
+    start, stop : float
+        The span (s).
+    order, size : int
+        As in :func:`interval_equations`.
+    h : float
+        Sample period (s): the quadrature weight.
+
+    Returns
+    -------
+    (phi, phi', phi'') : tuple of ndarray, shape (size, n)
+        The zero-mean family, orthonormal on the samples, and its first two derivatives
+        (times h: rows give <phi, x> as plain dot products).
+    (g, g', g'') : tuple of ndarray, shape (n,)
+        The mean row: the bump orthogonalised against the family, unit norm, and its
+        derivatives.
+    """
+    half, centre = 0.5 * (stop - start), 0.5 * (start + stop)
+    x = (t - centre) / half
+    vander = polynomial.polyvander(x, _family_coefficients(order, size)[0].shape[0] - 1)
+    # rows: test functions and their time derivatives, times the quadrature step
+    g0, g1, g2, g3 = (vander @ c * (h / half ** d)
+                      for d, c in enumerate(_family_coefficients(order, size)))
+    phi0, phi1, phi2 = g1[:, 1:].T, g2[:, 1:].T, g3[:, 1:].T
+    u, s, _ = np.linalg.svd(phi0, full_matrices=False)
+    transform = (u / s).T  # orthonormal rows
+    phi0, phi1, phi2 = transform @ phi0, transform @ phi1, transform @ phi2
+    bump0, bump1, bump2 = g0[:, 0], g1[:, 0], g2[:, 0]
+    projection = phi0 @ bump0
+    bump0, bump1, bump2 = bump0 - projection @ phi0, bump1 - projection @ phi1, \
+        bump2 - projection @ phi2
+    norm = np.linalg.norm(bump0)
+    return (phi0, phi1, phi2), (bump0 / norm, bump1 / norm, bump2 / norm)
+
+
 @dataclass(frozen=True)
 class IntervalEquations:
     """Weak-form equations of one constant-direction interval.
@@ -164,23 +206,8 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
     sel = np.flatnonzero((t > start) & (t < stop))
     if len(sel) < 4 * (size + 1):
         return None
-    h = float(t[1] - t[0])
-    half, centre = 0.5 * (stop - start), 0.5 * (start + stop)
-    x = (t[sel] - centre) / half
-    vander = polynomial.polyvander(x, _family_coefficients(order, size)[0].shape[0] - 1)
-    # rows: test functions and their time derivatives, times the quadrature step
-    g0, g1, g2, g3 = (vander @ c * (h / half ** d)
-                      for d, c in enumerate(_family_coefficients(order, size)))
-    phi0, phi1, phi2 = g1[:, 1:].T, g2[:, 1:].T, g3[:, 1:].T
-    u, s, _ = np.linalg.svd(phi0, full_matrices=False)
-    transform = (u / s).T  # orthonormal rows
-    phi0, phi1, phi2 = transform @ phi0, transform @ phi1, transform @ phi2
-    bump0, bump1, bump2 = g0[:, 0], g1[:, 0], g2[:, 0]
-    projection = phi0 @ bump0
-    bump0, bump1, bump2 = bump0 - projection @ phi0, bump1 - projection @ phi1, \
-        bump2 - projection @ phi2
-    norm = np.linalg.norm(bump0)
-    bump0, bump1, bump2 = bump0 / norm, bump1 / norm, bump2 / norm
+    (phi0, phi1, phi2), (bump0, bump1, bump2) = test_family(t[sel], start, stop, order, size,
+                                                            float(t[1] - t[0]))
     # constants and straight lines vanish against phi'' and phi', so the offset only costs
     # rounding; removing the mean keeps it from being amplified
     qc = q[sel] - q[sel].mean(axis=0)
@@ -318,4 +345,4 @@ def _per_interval(values: np.ndarray | None, owner: np.ndarray, shape: tuple[int
 
 
 __all__ = ["IntervalEquations", "StackedEquations", "experiment_equations", "interval_equations",
-           "stack_equations"]
+           "stack_equations", "test_family"]

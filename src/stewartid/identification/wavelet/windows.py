@@ -1,0 +1,200 @@
+"""Method B on windows that span joint reversals: the Coulomb structure integrated.
+
+When joints reverse every few tens of milliseconds (several frequencies per DOF, all DOFs
+moving at once) the constant-direction intervals are too short to hold the test functions,
+or so short that a free constant per interval takes what Bt does (on a short interval
+Bt q_dot is nearly constant). With the friction's Coulomb structure,
+
+    c(t) = sum_types F_type W_type(t),   W_type(t) = sum_{legs, axes of the type}
+           sign(w_axis(t)) J_axis(q(t))    (6,),
+
+the interval is no longer needed: the record is cut into windows of any length, and every
+test function's row gains the Coulomb regressors <phi, W_type>,
+
+    Mt <phi'', q> - Bt <phi', q> + sum_types F_type <phi, W_type> = <phi, y>,
+
+the zero-mean test functions still removing each window's constant (what the gravity model
+leaves). The joint directions come from the smoothed joint rates, w / sqrt(w^2 + s^2) with s
+the rate's noise level, so a reversal inside the noise band is weighed as uncertain. The
+solve is :func:`~stewartid.identification.wavelet.gls.fit_jointly`'s generalized least
+squares, pose noise weighted and its bias removed, the Coulomb levels shared by the channels.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import NamedTuple
+
+import numpy as np
+
+from stewartid.identification.preparation import Experiment
+from stewartid.identification.solvers import check_rank, regressor_names
+from stewartid.identification.wavelet.detection import Detection
+from stewartid.identification.wavelet.gls import (
+    N_THETA,
+    InvariantFit,
+    WeakFormSolution,
+    fit_jointly,
+    standard_errors,
+)
+from stewartid.identification.wavelet.variance_components import (
+    excess_variance,
+    pose_coefficients,
+    pose_covariance,
+)
+from stewartid.identification.wavelet.weak_form import (
+    IntervalEquations,
+    stack_equations,
+    test_family,
+)
+from stewartid.model.joints import JOINT_TYPES
+
+
+class WindowEquations(NamedTuple):
+    """Weak-form equations of one window: the interval equations (mean row unused) and
+    ``coulomb`` (K, n_types, 6), <phi_k, W_type> of every row (s^(1/2) per N m of level)."""
+
+    rows: IntervalEquations
+    coulomb: np.ndarray
+
+
+def window_bounds(t: np.ndarray, length: float) -> np.ndarray:
+    """[start, stop] (s) of consecutive windows about ``length`` s long covering ``t``."""
+    span = float(t[-1] - t[0])
+    count = max(1, int(round(span / length)))
+    edges = t[0] + span * np.arange(count + 1) / count
+    return np.column_stack([edges[:-1], edges[1:]])
+
+
+def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: bool
+                     ) -> np.ndarray:
+    """W_type(t) at every sample, shape (N, n_types, 6) (or (N, 1, 6) with ``uniform``):
+    the generalized force of a unit Coulomb torque on every axis of a joint type, opposing
+    the axis's smoothed rate (soft sign over its noise level)."""
+    rates, noise = found.joint_rates, found.rate_noise
+    direction = rates / np.sqrt(rates ** 2 + noise ** 2)                     # (N, 6, 5)
+    patterns = np.stack([np.einsum("nla,nlac->nc", direction[:, :, list(axes)],
+                                   joint_jacobians[:, :, list(axes)])
+                         for axes in JOINT_TYPES.values()], axis=1)        # (N, 3, 6)
+    return patterns.sum(axis=1, keepdims=True) if uniform else patterns
+
+
+def window_equations(experiment: Experiment, found: Detection, order: int, size: int,
+                     index: int, uniform: bool, length: float) -> list[WindowEquations]:
+    """The equations of every window of one experiment (module docstring).
+
+    Parameters
+    ----------
+    experiment : Experiment
+        Prepared with its joint-axis Jacobians.
+    found : Detection
+        Its smoothed joint rates and their noise (:func:`.detection.detect_intervals`).
+    order, size : int
+        Exponent of the bump and number K of zero-mean test functions per window.
+    index : int
+        Index of the experiment.
+    uniform : bool
+        One Coulomb level for every joint axis.
+    length : float
+        Window length (s).
+
+    Returns
+    -------
+    list of WindowEquations
+    """
+    t, q, y = experiment.t, experiment.q, experiment.generalized_force
+    patterns = coulomb_patterns(found, experiment.joint_jacobians, uniform)
+    h = float(t[1] - t[0])
+    out = []
+    for start, stop in window_bounds(t, length):
+        sel = np.flatnonzero((t > start) & (t < stop))
+        if len(sel) < 4 * (size + 1):
+            continue
+        (phi0, phi1, phi2), bump = test_family(t[sel], start, stop, order, size, h)
+        qc = q[sel] - q[sel].mean(axis=0)
+        family = np.stack([np.vstack([phi0, bump[0]]), np.vstack([phi1, bump[1]]),
+                           np.vstack([phi2, bump[2]])])
+        rows = IntervalEquations(
+            regressors=np.hstack([phi2 @ qc, -(phi1 @ qc)]), targets=phi0 @ y[sel],
+            mean_regressors=np.zeros(12), mean_target=np.zeros(6), weight=0.0,
+            coulomb=np.zeros((patterns.shape[1], 6)), experiment=int(index),
+            noise_gram=np.einsum("arn,bsn->abrs", family, family))
+        out.append(WindowEquations(rows, np.einsum("kn,ntc->ktc", phi0, patterns[sel])))
+    return out
+
+
+def _designs(regressors: np.ndarray, coulomb: np.ndarray) -> list[np.ndarray]:
+    """Design (n, K, 72 + n_types) of each channel: its [Mt Bt] row, then the levels."""
+    n, k_rows = regressors.shape[:2]
+    designs = []
+    for i in range(6):
+        design = np.zeros((n, k_rows, N_THETA + coulomb.shape[2]))
+        design[:, :, 12 * i:12 * i + 12] = regressors
+        design[:, :, N_THETA:] = coulomb[:, :, :, i]
+        designs.append(design)
+    return designs
+
+
+def _row_noise(stacked, designs, targets, z: np.ndarray) -> np.ndarray:
+    """Force-side noise s (n, 6) per window and channel: the white part measured from the
+    data plus the chi-square excess of the residuals at z over what the noise explains."""
+    n, k_rows = stacked.regressors.shape[:2]
+    gram = stacked.gram[..., :k_rows, :k_rows]
+    floor = 1e-24 * np.maximum(np.mean(stacked.targets.reshape(-1, 6) ** 2, axis=0), 1e-300)
+    noise = np.zeros((n, 6))
+    for i in range(6):
+        q_inv = pose_covariance(gram, stacked.sigma,
+                                pose_coefficients(stacked.sensitivity[:, i],
+                                                  z[12 * i:12 * i + 12]))
+        residual = targets[i] - designs[i] @ z
+        excess = excess_variance(stacked.white[:, i, None, None] * np.eye(k_rows) + q_inv,
+                                 residual, residual.size - 12)
+        noise[:, i] = np.maximum(stacked.white[:, i] + excess, floor[i])
+    return noise
+
+
+def solve_windows(equations: Sequence[WindowEquations], iterations: int = 3,
+                  max_condition: float = 1e8, pose_covariance: np.ndarray | None = None,
+                  force_sensitivity: np.ndarray | None = None,
+                  force_variance: np.ndarray | None = None) -> WeakFormSolution:
+    """[Mt Bt] and the Coulomb levels from window equations: generalized least squares over
+    all channels (the levels are shared), reweighted ``iterations`` times with the
+    force-side noise re-estimated from the residuals, the pose-noise bias removed.
+
+    Parameters as :func:`~stewartid.identification.wavelet.gls.solve_weak_form`.
+
+    Returns
+    -------
+    WeakFormSolution
+        ``offsets`` NaN (each window's constant is removed), ``constant_scatter`` zero.
+    """
+    stacked = stack_equations([e.rows for e in equations], pose_covariance, force_sensitivity,
+                              force_variance)
+    coulomb = np.stack([e.coulomb for e in equations])                 # (n, K, types, 6)
+    n, k_rows = stacked.regressors.shape[:2]
+    flat = stacked.regressors.reshape(-1, 12)
+    condition = check_rank(flat.T @ flat, regressor_names("q_ddot", "q_dot"), max_condition)
+    designs = _designs(stacked.regressors, coulomb)
+    targets = [stacked.targets[:, :, i] for i in range(6)]
+    # start: ordinary least squares over all channels at once
+    stacked_design = np.concatenate([d.reshape(-1, d.shape[-1]) for d in designs])
+    z = np.linalg.lstsq(stacked_design, np.concatenate([t.ravel() for t in targets]),
+                        rcond=None)[0]
+    for _ in range(max(1, iterations)):
+        noise = _row_noise(stacked, designs, targets, z)
+        start = InvariantFit(theta=z[:N_THETA].reshape(6, 12), noise=noise,
+                             pose_share=np.zeros(6))
+        fit = fit_jointly(stacked, designs, targets, start, None, 1)
+        z = fit.z
+    std = standard_errors(designs, targets, fit)
+    return WeakFormSolution(
+        theta=z[:N_THETA].reshape(6, 12), theta_std=std[:N_THETA].reshape(6, 12),
+        coulomb=z[N_THETA:], coulomb_std=std[N_THETA:],
+        offsets=np.full((int(stacked.owner.max()) + 1, 6), np.nan),
+        noise_std=np.sqrt(noise.mean(axis=0)), pose_noise_share=np.zeros(6),
+        constant_scatter=np.zeros(6), condition_number=condition,
+        n_equations=int(n * k_rows))
+
+
+__all__ = ["WindowEquations", "coulomb_patterns", "solve_windows", "window_bounds",
+           "window_equations"]
