@@ -19,7 +19,8 @@ from stewartid.cli import app
 from stewartid.datasets.alignment import align_forces, shift_forces
 from stewartid.datasets.dataset import Dataset, write_dataset
 from stewartid.errors import ConfigError, IdentificationError
-from stewartid.identification.delay import apply_delay, estimate_delay, excitation_lines
+from stewartid.identification.delay import apply_delay, estimate_delay
+from stewartid.identification.excitation import excitation_lines
 from stewartid.identification.least_squares import LeastSquaresIdentifier
 from stewartid.model.dynamics import ModelTerms
 from stewartid.model.kinematics import leg_lengths

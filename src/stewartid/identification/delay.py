@@ -41,6 +41,7 @@ import numpy as np
 from stewartid.datasets.alignment import align_forces
 from stewartid.datasets.dataset import Dataset
 from stewartid.errors import ConfigError, IdentificationError
+from stewartid.identification.excitation import excitation_lines
 from stewartid.identification.least_squares import coulomb_regressors
 from stewartid.identification.preparation import generalized_force_sensitivity, prepare_experiment
 from stewartid.model.linearization import nominal_matrices
@@ -51,13 +52,6 @@ from stewartid.signals.differentiation import (
     estimate_frequency,
     kernel_filter,
 )
-
-#: A spectral line of a DOF's motion counts when it is at least this fraction of the DOF's
-#: largest line (over all experiments).
-LINE_THRESHOLD = 0.1
-
-#: Lines closer than this many frequency resolutions (1 / record length) are one line.
-LINE_MERGE_BINS = 3.0
 
 #: Kernel support of the weak form, in periods of the highest excitation line.
 WINDOW_PERIODS = 0.45
@@ -103,71 +97,6 @@ class DelayEstimate:
         return (f"force delay {self.seconds * 1e3:.3f} ms (standard error "
                 f"{self.std_error * 1e3:.3f} ms), estimated from "
                 f"{min(len(f) for f in self.lines_hz)} or more lines per DOF")
-
-
-def spectral_lines(x: np.ndarray, sample_rate: float) -> tuple[np.ndarray, np.ndarray]:
-    """Local maxima of the Hann-windowed amplitude spectrum of one signal.
-
-    Parameters
-    ----------
-    x : ndarray, shape (N,)
-        A position signal (m or rad), uniformly sampled.
-    sample_rate : float
-        Hz.
-
-    Returns
-    -------
-    frequencies : ndarray, shape (L,)
-        Hz, above two frequency resolutions (drift apart).
-    amplitudes : ndarray, shape (L,)
-        Amplitude of each peak (units of x, up to the window's gain).
-    """
-    n = len(x)
-    t = np.arange(n)
-    centered = x - np.polyval(np.polyfit(t, x, 1), t)
-    nfft = 1 << int(np.ceil(np.log2(4 * n)))
-    frequencies = np.fft.rfftfreq(nfft, 1.0 / sample_rate)
-    spectrum = np.abs(np.fft.rfft(centered * np.hanning(n), nfft))
-    peak = (spectrum[1:-1] > spectrum[:-2]) & (spectrum[1:-1] >= spectrum[2:])
-    index = np.flatnonzero(peak) + 1
-    index = index[frequencies[index] > 2.0 * sample_rate / n]
-    return frequencies[index], spectrum[index]
-
-
-def excitation_lines(datasets: Sequence[Dataset], threshold: float = LINE_THRESHOLD
-                     ) -> tuple[tuple[float, ...], ...]:
-    """The distinct excitation frequencies of each DOF over all experiments.
-
-    A line counts when its amplitude is at least ``threshold`` times the DOF's largest line
-    over the experiments (a position spectrum: sensor noise, white in the pose, stays far
-    below it, where a velocity spectrum would raise it with frequency); lines within
-    :data:`LINE_MERGE_BINS` frequency resolutions of each other are one.
-
-    Parameters
-    ----------
-    datasets : sequence of Dataset
-    threshold : float
-        Fraction of the DOF's largest line.
-
-    Returns
-    -------
-    tuple of 6 tuples of float
-        Hz, ascending, per DOF of :data:`~stewartid.platform.COORDINATES`.
-    """
-    found = []
-    for dof in range(6):
-        peaks = [spectral_lines(d.pose[:, dof], d.sample_rate) + (d.duration,) for d in datasets]
-        largest = max((float(a.max()) if len(a) else 0.0) for _, a, _ in peaks)
-        if largest <= 0:
-            found.append(())
-            continue
-        lines: list[float] = []
-        for f, a, duration in peaks:
-            for frequency in np.sort(f[a >= threshold * largest]):
-                if all(abs(frequency - g) > LINE_MERGE_BINS / duration for g in lines):
-                    lines.append(float(frequency))
-        found.append(tuple(sorted(lines)))
-    return tuple(found)
 
 
 def delay_bias_per_ms(platform: Platform | np.ndarray, frequencies_hz: Sequence[float],
@@ -472,5 +401,4 @@ def apply_delay(datasets: Sequence[Dataset], platform: Platform, delay: str | fl
 
 
 __all__ = ["AUTO", "DelayEstimate", "apply_delay", "check_delay_identifiable", "delay_bias_per_ms",
-           "estimate_delay", "excitation_lines", "fit_delay", "parse_delay", "shared_least_squares",
-           "spectral_lines"]
+           "estimate_delay", "fit_delay", "parse_delay", "shared_least_squares"]
