@@ -54,6 +54,12 @@ def identify(
     folds: Annotated[int | None, typer.Option(
         "--folds", help="--report: time segments per experiment for the validation "
                         "(default 3).")] = None,
+    delay: Annotated[str | None, typer.Option(
+        "--delay", help="Delay of the force channels behind the motion, in seconds (0.002 for "
+                        "2 ms; negative when the forces lead): every method works on the forces "
+                        "aligned by it. 'auto' estimates it first (needs two or more "
+                        "frequencies per DOF) and prints it with its standard error "
+                        "(docs/logs.md).")] = None,
 ) -> None:
     """Identify Mt and Bt from experiments; print the paper-style table when nominal values are
     known (platform description, or meta.json/truth.json beside the data) and write JSON."""
@@ -68,7 +74,15 @@ def identify(
              "--stiffness": FlagSetting("stiffness", stiffness, stiffness),
              "--friction": FlagSetting("friction", friction, friction is not None)}
     found = identify_files(files, method, platform, flags=flags, columns=columns, out=out,
-                           force=force, report=report, consistent=consistent, folds=folds)
+                           force=force, report=report, consistent=consistent, folds=folds,
+                           delay=delay)
+    if found.delay is not None:
+        entry = found.delay
+        if entry["source"] == "estimated":
+            typer.echo(f"force delay {entry['seconds'] * 1e3:.3f} ms (standard error "
+                       f"{entry['std_error'] * 1e3:.3f} ms), estimated; forces aligned")
+        else:
+            typer.echo(f"force delay {entry['seconds'] * 1e3:.3f} ms, given; forces aligned")
     if found.report is not None:
         typer.echo(f"wrote the report to {report}/report.html; trusted: {found.report.trusted}")
     rows = found.comparison()

@@ -40,6 +40,10 @@ class IdentificationResult:
     validation : dict, optional
         Held-out prediction scores, ``{"vaf_percent": [6], "nrmse": [6], "folds": N}``
         (:mod:`stewartid.assessment.validation`); None when not validated.
+    delay : dict, optional
+        The delay of the force channels relative to the motion the data were aligned by,
+        ``{"seconds", "std_error", "applied", "source": "given" | "estimated", ...}``
+        (:mod:`stewartid.identification.delay`); None when the data were used as logged.
 
     ``to_dict`` also writes ``consistency``, the symmetry and definiteness of M and B
     (:func:`~stewartid.identification.consistency.consistency_metrics`).
@@ -55,6 +59,7 @@ class IdentificationResult:
     settings: dict[str, Any] = field(default_factory=dict)
     diagnostics: dict[str, Any] = field(default_factory=dict)
     validation: dict[str, Any] | None = None
+    delay: dict[str, Any] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict; ``M`` and ``B`` at the top level; non-finite numbers are None
@@ -71,6 +76,8 @@ class IdentificationResult:
         }
         if self.validation is not None:
             document["validation"] = self.validation
+        if self.delay is not None:
+            document["delay"] = self.delay
         return to_jsonable(document)
 
     def to_json(self, path: str | Path) -> Path:
@@ -95,7 +102,7 @@ class IdentificationResult:
                    method=str(document.get("method", "unknown")),
                    settings=dict(document.get("settings", {})),
                    diagnostics=dict(document.get("diagnostics", {})),
-                   validation=document.get("validation"))
+                   validation=document.get("validation"), delay=document.get("delay"))
 
     @classmethod
     def from_json(cls, path: str | Path) -> IdentificationResult:

@@ -7,6 +7,7 @@ what it returns. Every output location is checked before anything is computed.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -24,6 +25,7 @@ from stewartid.datasets.plausibility import check_identified
 from stewartid.errors import ConfigError
 from stewartid.files import check_output_file, check_output_folder
 from stewartid.identification import registry
+from stewartid.identification.delay import apply_delay, parse_delay
 from stewartid.identification.result import IdentificationResult, comparison_rows
 from stewartid.model.linearization import nominal_matrices
 from stewartid.platform import Platform
@@ -71,6 +73,9 @@ class IdentifyRun:
         platform description's at the neutral pose.
     nominal_source : str
         Where they come from.
+    delay : dict or None
+        The force delay the data were aligned by (the ``"delay"`` entry of the result), or
+        None when they were used as logged.
     """
 
     result: IdentificationResult
@@ -80,6 +85,7 @@ class IdentifyRun:
     nominal_M: np.ndarray
     nominal_B: np.ndarray
     nominal_source: str
+    delay: dict[str, Any] | None = None
 
     def comparison(self) -> list[dict[str, Any]]:
         """The paper's 20 entries, identified against nominal
@@ -160,7 +166,7 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
                    platform: str | None = None, *, flags: Mapping[str, FlagSetting] | None = None,
                    columns: str | None = None, out: Path | None = None, force: bool = False,
                    report: Path | None = None, consistent: bool = False,
-                   folds: int | None = None) -> IdentifyRun:
+                   folds: int | None = None, delay: str | float | None = None) -> IdentifyRun:
     """Identify Mt and Bt from experiment files, as ``stewartid identify`` does.
 
     Parameters
@@ -187,6 +193,10 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
         Replace Mt, Bt by the nearest consistent pair (needs the ``convex`` extra).
     folds : int, optional
         Validation folds of the report (default 3).
+    delay : float or 'auto', optional
+        Delay of the force channels relative to the motion (s, positive when the forces are
+        logged late): every method works on the forces aligned by it; ``"auto"`` estimates
+        it first (:func:`~stewartid.identification.delay.apply_delay`). None: as logged.
 
     Returns
     -------
@@ -201,6 +211,7 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
         cannot be applied, or an implausible result
         (:func:`~stewartid.datasets.plausibility.check_identified`).
     """
+    delay = parse_delay(delay)
     names = methods_for(method)
     settings = settings_for(names, method, flags or {})
     paths = expand_paths(files)
@@ -210,6 +221,7 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     log_format = load_log_format(columns) if columns is not None else None
     datasets = read_datasets(paths, description, log_format)
     check_experiment_set(datasets, description)
+    datasets, delay_entry = apply_delay(datasets, description, delay)
     meta = nominal_from_meta(paths)
 
     def check(found: IdentificationResult) -> None:
@@ -237,12 +249,16 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
             check(result)
             result = consistent_result(result)[0]
     check(result)
+    if delay_entry is not None:
+        result = dataclasses.replace(result, delay=delay_entry)
+        if written is not None:
+            result.to_json(Path(report) / "result.json")
     M_nominal, B_nominal = meta[:2] if meta is not None else nominal_matrices(description)
     source = meta[2] if meta is not None else f"platform '{description.name}' at neutral"
     if out is not None:
         result.to_json(out)
     return IdentifyRun(result, written, description, len(datasets), M_nominal, B_nominal,
-                       source)
+                       source, delay_entry)
 
 
 __all__ = ["ALL_METHODS", "INPUT_SUFFIXES", "FlagSetting", "IdentifyRun", "identify_files",

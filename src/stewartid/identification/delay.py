@@ -1,0 +1,404 @@
+"""Delay of the force channels relative to the motion, estimated from the logged experiments.
+
+With the forces logged tau seconds late, f_logged(t) = f(t - tau), the generalized force the
+identifiers see is y_logged(t) ~ y(t) - tau y_dot(t), and the equation of motion becomes
+
+    y_logged = Mt q_ddot + Bt q_dot + Fc(t) + c - tau y_dot_logged          (first order).
+
+Under a sine of angular frequency w the delay term is tau w^2 Mt q_dot: the apparent Bt is
+Bt + tau w^2 Mt (plus tau K from the static load, :func:`delay_bias_per_ms`), which no fit
+can tell from damping at one frequency. Across several
+frequencies per DOF the two separate (viscous force grows with w, the delay term with w^2),
+and tau, shared by every channel and experiment, is fitted jointly with Mt, Bt, the Coulomb
+levels per joint type and an offset per channel and experiment.
+
+The fit is in weak form: every signal is filtered with one smooth compact kernel h
+(:func:`~stewartid.signals.differentiation.kernel_filter`), so q_dot = q * h', q_ddot = q * h''
+and y_dot = y * h' come without differentiating any measured signal; for a symmetric kernel
+the noise of y * h' is uncorrelated with that of y * h at the same instant (sum h h' = 0), so
+the force noise in the delay regressor does not correlate with the target's. A second pass on
+the experiments aligned by the first estimate (exact shift,
+:func:`~stewartid.datasets.alignment.align_forces`) removes the bias of the first-order
+expansion (of order tau^2 w) and the attenuation the noise of y * h' gives the first
+estimate; the standard error is that of the last pass, from a sandwich covariance robust to
+residuals correlated in time and across channels (:func:`shared_least_squares`).
+
+References
+----------
+Shinbrot, M. "On the analysis of linear and nonlinear systems." Trans. ASME 79, 547-552
+(1957): the modulating-function (weak-form) method.
+Khalil, W., Dombre, E. Modeling, Identification and Control of Robots, ch. 12 (2002).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from stewartid.datasets.alignment import align_forces
+from stewartid.datasets.dataset import Dataset
+from stewartid.errors import ConfigError, IdentificationError
+from stewartid.identification.excitation import excitation_lines
+from stewartid.identification.least_squares import coulomb_regressors
+from stewartid.identification.preparation import generalized_force_sensitivity, prepare_experiment
+from stewartid.model.linearization import nominal_matrices
+from stewartid.platform import COORDINATES, Platform
+from stewartid.signals.differentiation import (
+    DEFAULT_ORDER,
+    differentiate,
+    estimate_frequency,
+    kernel_filter,
+)
+
+#: Kernel support of the weak form, in periods of the highest excitation line.
+WINDOW_PERIODS = 0.45
+
+#: Rate (rad/s) below which a joint's Coulomb sign is attenuated (as the least squares).
+COULOMB_SMOOTHING = 1e-4
+
+
+@dataclass(frozen=True)
+class DelayEstimate:
+    """The estimated delay of the force channels relative to the motion.
+
+    Attributes
+    ----------
+    seconds : float
+        Delay (s), positive when the forces are logged after the motion.
+    std_error : float
+        Its standard error (s), for autocorrelated residuals.
+    first_pass : float
+        The estimate of the first pass, before alignment (s).
+    lines_hz : tuple of tuple of float
+        The excitation lines found in each DOF's motion (Hz), in the order of
+        :data:`~stewartid.platform.COORDINATES`.
+    window_s : float
+        Kernel support of the weak form (s).
+    """
+
+    seconds: float
+    std_error: float
+    first_pass: float
+    lines_hz: tuple[tuple[float, ...], ...]
+    window_s: float
+
+    def to_dict(self, applied: bool = True) -> dict[str, Any]:
+        """The ``"delay"`` entry of ``result.json``."""
+        return {"seconds": self.seconds, "std_error": self.std_error, "applied": applied,
+                "source": "estimated", "first_pass_seconds": self.first_pass,
+                "window_s": self.window_s,
+                "lines_hz": {c: list(f) for c, f in zip(COORDINATES, self.lines_hz, strict=True)}}
+
+    def describe(self) -> str:
+        """One line for the terminal: the delay in ms with its standard error."""
+        return (f"force delay {self.seconds * 1e3:.3f} ms (standard error "
+                f"{self.std_error * 1e3:.3f} ms), estimated from "
+                f"{min(len(f) for f in self.lines_hz)} or more lines per DOF")
+
+
+def delay_bias_per_ms(platform: Platform | np.ndarray, frequencies_hz: Sequence[float],
+                      stiffness: np.ndarray | None = None) -> np.ndarray:
+    """The bias a delay of 1 ms puts on the Bt diagonal under single sines:
+    Delta Bt(i, i) = tau (w_i^2 Mt(i, i) + K(i, i)).
+
+    With the forces logged tau late, y_logged(t) = J(q(t))^T f(t - tau) - G(q(t)) ~
+    y(t) - tau y_dot(t) + tau K q_dot(t): under a sine of angular frequency w, -tau Mt q_dddot
+    = tau w^2 Mt q_dot, and the static leg load turned by the pose change over tau adds
+    tau K q_dot, with K = d y / d q (the geometric and gravity stiffness).
+
+    Parameters
+    ----------
+    platform : Platform or ndarray, shape (6, 6)
+        The nominal Mt is the platform's at the neutral pose; or an (identified) Mt.
+    frequencies_hz : sequence of 6 float
+        Each DOF's excitation frequency (Hz).
+    stiffness : ndarray, shape (6, 6), optional
+        K = d y / d q at the mean pose and leg forces
+        (:func:`~stewartid.identification.preparation.generalized_force_sensitivity`);
+        without it the inertial term alone.
+
+    Returns
+    -------
+    ndarray, shape (6,)
+        N s/m (translations) and N m s/rad (rotations) per millisecond of delay.
+    """
+    M = nominal_matrices(platform)[0] if isinstance(platform, Platform) else np.asarray(platform)
+    w = 2 * np.pi * np.asarray(frequencies_hz, dtype=float)
+    K = np.zeros((6, 6)) if stiffness is None else np.asarray(stiffness)
+    return 1e-3 * (w ** 2 * np.diag(M) + np.diag(K))
+
+
+def check_delay_identifiable(datasets: Sequence[Dataset], platform: Platform
+                             ) -> tuple[tuple[float, ...], ...]:
+    """The excitation lines per DOF, when every DOF holds two or more.
+
+    Raises
+    ------
+    IdentificationError
+        One line: the DOFs with a single frequency, that delay and damping cannot be told
+        apart there, and the bias on the Bt diagonal per millisecond of delay
+        (:func:`delay_bias_per_ms`, at each DOF's frequency refined in the experiment that
+        moves it most).
+    """
+    lines = excitation_lines(datasets)
+    single = [k for k, f in enumerate(lines) if len(f) < 2]
+    if not single:
+        return lines
+    frequencies = []
+    for k, found in enumerate(lines):
+        most = max(datasets, key=lambda d: float(np.ptp(d.pose[:, k])))
+        frequencies.append(estimate_frequency(most.pose[:, k], most.sample_rate) if found
+                           else np.nan)
+    reference = datasets[0]
+    bias = delay_bias_per_ms(platform, frequencies, generalized_force_sensitivity(
+        platform, reference.pose, reference.forces))
+    named = ", ".join(f"{COORDINATES[k]} ({frequencies[k]:.3g} Hz)" for k in single)
+    per_ms = ", ".join(f"Bt({k + 1},{k + 1}) {bias[k]:+.4g}" for k in range(6)
+                       if np.isfinite(bias[k]))
+    raise IdentificationError(
+        f"the force delay cannot be estimated: {named} moved at one frequency only, where a "
+        f"delay and damping cannot be told apart (each ms of delay the forces lag adds "
+        f"tau (w^2 Mt + K) to Bt: {per_ms} per ms); excite every DOF at two or more "
+        "frequencies (stewartid design), or give a known delay (--delay SECONDS).")
+
+
+def _filtered_rows(dataset: Dataset, platform: Platform, window: float
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Weak-form rows of one experiment: q_ddot, q_dot (N', 6), y (N', 6), Coulomb
+    regressors (N', 3, 6) and the delay regressor -y_dot (N', 6), all filtered with h."""
+    experiment = prepare_experiment(dataset, platform, gravity=True, joints=True)
+    rate = experiment.sample_rate
+    # the Coulomb signs need rates at every sample; they only decide signs
+    _, q_dot_sign, _ = differentiate(experiment.q, rate, window / 4, DEFAULT_ORDER)
+    coulomb = coulomb_regressors(experiment.joint_jacobians, q_dot_sign, COULOMB_SMOOTHING)
+    y = experiment.generalized_force
+    filtered = kernel_filter(np.concatenate([y, coulomb.reshape(len(y), -1)], axis=1), rate,
+                             window, derivatives=1)
+    _, q_dot, q_ddot = kernel_filter(experiment.q, rate, window, derivatives=2)
+    shared = np.concatenate([filtered[0][:, 6:].reshape(len(q_dot), -1, 6),
+                             -filtered[1][:, None, :6]], axis=1)
+    return q_ddot, q_dot, filtered[0][:, :6], shared
+
+
+def shared_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray,
+                         groups: np.ndarray, lags: int) -> tuple[np.ndarray, np.ndarray]:
+    """The shared coefficients c of y(k) = theta phi(k) + sum_s c_s S_s(k), with standard
+    errors robust to residuals correlated in time and across channels.
+
+    The per-channel coefficients theta are partialled out (Frisch-Waugh); the channels are
+    weighted by their residual variance from a first, unweighted pass. The covariance is the
+    sandwich A^-1 Omega A^-1 with the Newey-West (Bartlett) long-run covariance Omega of the
+    scores g(k) = sum_i w_i S~_i(k) e_i(k), summed over the channels at each row (the six
+    generalized forces share the six leg-force noises) and over the experiments
+    (independent groups).
+
+    Parameters
+    ----------
+    phi : ndarray, shape (K, p)
+    y : ndarray, shape (K, 6)
+    shared : ndarray, shape (K, s, 6)
+    groups : ndarray, shape (K,)
+        Experiment of each row (rows of one experiment consecutive).
+    lags : int
+        Bartlett bandwidth (rows): beyond the residuals' correlation length.
+
+    Returns
+    -------
+    c, std : ndarray, shape (s,)
+
+    Raises
+    ------
+    IdentificationError
+        When the shared terms are not independent of the per-channel regressors.
+    """
+    basis, _ = np.linalg.qr(phi)
+    y_partial = y - basis @ (basis.T @ y)
+    s_partial = shared - np.einsum("kp,psi->ksi", basis, np.einsum("kp,ksi->psi", basis, shared))
+    gram = np.einsum("ksi,kti->ist", s_partial, s_partial)
+    rhs = np.einsum("ksi,ki->is", s_partial, y_partial)
+    weights = 1.0 / np.maximum(np.mean(y_partial ** 2, axis=0), np.finfo(float).tiny)
+    for _ in range(2):
+        A = np.einsum("i,ist->st", weights, gram)
+        scale = np.sqrt(np.diag(A))
+        if not np.all(scale > 0) or np.linalg.cond(A / np.outer(scale, scale)) > 1e10:
+            raise IdentificationError("the delay and Coulomb terms are not independent of "
+                                      "the inertial and viscous ones in these experiments; "
+                                      "excite every DOF at two or more frequencies.")
+        c = np.linalg.solve(A, np.einsum("i,is->s", weights, rhs))
+        residual = y_partial - np.einsum("ksi,s->ki", s_partial, c)
+        weights = 1.0 / np.maximum(np.mean(residual ** 2, axis=0), np.finfo(float).tiny)
+    scores = np.einsum("i,ksi,ki->ks", weights, s_partial, residual)
+    omega = np.zeros((len(c), len(c)))
+    for group in np.unique(groups):
+        g = scores[groups == group]
+        omega += g.T @ g
+        for lag in range(1, min(lags, len(g) - 1) + 1):
+            cross = g[lag:].T @ g[:-lag]
+            omega += (1.0 - lag / (lags + 1.0)) * (cross + cross.T)
+    A_inv = np.linalg.inv(A)
+    covariance = A_inv @ omega @ A_inv
+    return c, np.sqrt(np.clip(np.diag(covariance), 0.0, None))
+
+
+def fit_delay(datasets: Sequence[Dataset], platform: Platform, window: float,
+              decimate: int = 1) -> tuple[float, float]:
+    """One weak-form least-squares fit of the delay (first order in tau).
+
+    Parameters
+    ----------
+    datasets : sequence of Dataset
+    platform : Platform
+    window : float
+        Kernel support (s).
+    decimate : int
+        Keep every ``decimate``-th filtered row (the filtered signals are smooth over the
+        window).
+
+    Returns
+    -------
+    delay, std_error : float
+        s.
+    """
+    n_exp = len(datasets)
+    phis, ys, shared, groups = [], [], [], []
+    for e, dataset in enumerate(datasets):
+        q_ddot, q_dot, y, terms = (a[::decimate] for a in _filtered_rows(dataset, platform,
+                                                                          window))
+        offsets = np.zeros((len(y), n_exp))
+        offsets[:, e] = 1.0
+        phis.append(np.concatenate([q_ddot, q_dot, offsets], axis=1))
+        ys.append(y)
+        shared.append(terms)
+        groups.append(np.full(len(y), e))
+    # the filtered noise is correlated over 2 windows (the kernel's autocorrelation support)
+    lags = int(np.ceil(2 * window * min(d.sample_rate for d in datasets) / decimate))
+    c, std = shared_least_squares(np.concatenate(phis), np.concatenate(ys),
+                                  np.concatenate(shared), np.concatenate(groups), lags)
+    return float(c[-1]), float(std[-1])
+
+
+def estimate_delay(datasets: Sequence[Dataset], platform: Platform, window: float | None = None,
+                   iterations: int = 1) -> DelayEstimate:
+    """Estimate the delay of the force channels relative to the motion, with its standard
+    error.
+
+    Parameters
+    ----------
+    datasets : sequence of Dataset
+        The experiments, logged with one acquisition chain (one delay for all).
+    platform : Platform
+        Description of the measured hexapod (Jacobians, gravity, joint axes).
+    window : float, optional
+        Kernel support of the weak form (s); by default :data:`WINDOW_PERIODS` periods of
+        the highest excitation line.
+    iterations : int
+        Refits on the experiments aligned by the estimate so far (1 removes the bias of the
+        first-order expansion at a few ms; 0 keeps the first pass).
+
+    Returns
+    -------
+    DelayEstimate
+
+    Raises
+    ------
+    IdentificationError
+        A DOF moved at a single frequency (:func:`check_delay_identifiable`), or the
+        regression is rank deficient.
+    ConfigError
+        A non-positive window or a negative number of iterations.
+    """
+    if iterations < 0 or int(iterations) != iterations:
+        raise ConfigError(f"The 'iterations' parameter of estimate_delay must be an int in "
+                          f"the range [0, inf). Got {iterations!r} instead.")
+    datasets = list(datasets)
+    lines = check_delay_identifiable(datasets, platform)
+    if window is None:
+        window = WINDOW_PERIODS / max(f[-1] for f in lines)
+    elif not (window > 0 and np.isfinite(window)):
+        raise ConfigError(f"The 'window' parameter of estimate_delay must be a positive "
+                          f"number of seconds. Got {window!r} instead.")
+    decimate = max(1, int(window * min(d.sample_rate for d in datasets) / 20))
+    delay, std = fit_delay(datasets, platform, window, decimate)
+    first = delay
+    for _ in range(int(iterations)):
+        step, std = fit_delay(align_forces(datasets, delay), platform, window, decimate)
+        delay += step
+    return DelayEstimate(seconds=delay, std_error=std, first_pass=first, lines_hz=lines,
+                         window_s=float(window))
+
+
+#: ``delay`` value of :func:`apply_delay` (and ``identify --delay``) that estimates it first.
+AUTO = "auto"
+
+
+def parse_delay(value: str | float | None) -> str | float | None:
+    """A delay setting: None, :data:`AUTO`, or a finite number of seconds (also as text).
+
+    Raises
+    ------
+    ConfigError
+        Anything else.
+    """
+    if value is None or value == AUTO:
+        return value
+    try:
+        seconds = float(value)
+    except (TypeError, ValueError):
+        seconds = float("nan")
+    if not np.isfinite(seconds):
+        raise ConfigError(f"--delay must be a number of seconds (0.002 for 2 ms, negative when "
+                          f"the forces lead the motion) or 'auto'; got {value!r}.")
+    return seconds
+
+
+def apply_delay(datasets: Sequence[Dataset], platform: Platform, delay: str | float | None
+                ) -> tuple[list[Dataset], dict[str, Any] | None]:
+    """The experiments with their forces aligned with the motion, before any identifier.
+
+    Parameters
+    ----------
+    datasets : sequence of Dataset
+    platform : Platform
+    delay : float, 'auto' or None
+        The delay of the force channels relative to the motion (s, positive when the forces
+        are logged late), :data:`AUTO` to estimate it first (:func:`estimate_delay`), or
+        None to use the data as logged.
+
+    Returns
+    -------
+    datasets : list of Dataset
+        Aligned (:func:`~stewartid.datasets.alignment.align_forces`); the input when
+        ``delay`` is None.
+    entry : dict or None
+        The ``"delay"`` entry of ``result.json``: ``seconds``, ``std_error`` (None for a
+        given delay), ``applied``, ``source`` (``"given"`` or ``"estimated"``).
+
+    Raises
+    ------
+    ConfigError
+        A delay that is neither a number nor 'auto', or one longer than the records.
+    IdentificationError
+        'auto' on experiments where the delay cannot be estimated
+        (:func:`check_delay_identifiable`).
+
+    Examples
+    --------
+    >>> aligned, entry = apply_delay(datasets, platform, "auto")  # doctest: +SKIP
+    >>> WaveletIdentifier().fit(aligned, platform)  # doctest: +SKIP
+    """
+    delay = parse_delay(delay)
+    datasets = list(datasets)
+    if delay is None:
+        return datasets, None
+    if delay == AUTO:
+        estimate = estimate_delay(datasets, platform)
+        return align_forces(datasets, estimate.seconds), estimate.to_dict(applied=True)
+    entry = {"seconds": float(delay), "std_error": None, "applied": True, "source": "given"}
+    return align_forces(datasets, float(delay)), entry
+
+
+__all__ = ["AUTO", "DelayEstimate", "apply_delay", "check_delay_identifiable", "delay_bias_per_ms",
+           "estimate_delay", "fit_delay", "parse_delay", "shared_least_squares"]

@@ -1,0 +1,188 @@
+"""The force-channel delay: exact alignment, estimation against injected delays, the refusal
+on single-frequency data, and ``identify --delay``.
+
+The data are the paper platform's nominal linear model along analytic multi-sines: the pose is
+logged at t_k, the forces at t_k - tau (the model evaluated at the earlier instant, pose and
+Jacobian included), so the injected delay is exact and independent of the alignment code.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from stewartid.cli import app
+from stewartid.datasets.alignment import align_forces, shift_forces
+from stewartid.datasets.dataset import Dataset, write_dataset
+from stewartid.errors import ConfigError, IdentificationError
+from stewartid.identification.delay import apply_delay, estimate_delay
+from stewartid.identification.excitation import excitation_lines
+from stewartid.identification.least_squares import LeastSquaresIdentifier
+from stewartid.model.dynamics import ModelTerms
+from stewartid.model.kinematics import leg_lengths
+from stewartid.model.linearization import nominal_matrices
+
+AMPLITUDES = np.array([0.01, 0.01, 0.01, 0.005, 0.005, 0.005])
+RATE = 500.0
+DURATION = 8.0
+#: Each DOF's excitation: (relative amplitude, Hz, phase).
+MULTISINE = ((1.0, 0.5, 0.0), (0.5, 1.1, 1.0), (0.25, 2.3, 2.0))
+
+
+def model_experiment(platform, M, B, dof, sines, delay=0.0, noise=0.0, seed=0):
+    """Experiment driving ``dof`` with ``sines``; forces logged ``delay`` s late, white noise of
+    ``noise`` N added to them."""
+    t = np.arange(int(DURATION * RATE)) / RATE
+
+    def state(times):
+        q = np.tile(platform.neutral_pose, (len(times), 1))
+        qd, qdd = np.zeros_like(q), np.zeros_like(q)
+        for relative, frequency, phase in sines:
+            a, w = relative * AMPLITUDES[dof], 2 * np.pi * frequency
+            q[:, dof] += a * np.sin(w * times + phase)
+            qd[:, dof] += a * w * np.cos(w * times + phase)
+            qdd[:, dof] -= a * w ** 2 * np.sin(w * times + phase)
+        return q, qd, qdd
+
+    q = state(t)[0]
+    q_late, qd_late, qdd_late = state(t - delay)
+    terms = ModelTerms(platform, q_late)
+    y = qdd_late @ M.T + qd_late @ B.T + 50.0
+    forces = np.linalg.solve(np.transpose(terms.leg_jacobian, (0, 2, 1)),
+                             (y + terms.gravity)[..., None])[..., 0]
+    forces = forces + noise * np.random.default_rng(seed).standard_normal(forces.shape)
+    return Dataset(t=t, pose=q, lengths=leg_lengths(platform, q), forces=forces,
+                   name=f"exp{dof + 1}")
+
+
+def experiments(platform, sines=MULTISINE, delay=0.0, noise=0.0):
+    M, B = nominal_matrices(platform)
+    return [model_experiment(platform, M, B, k, sines, delay, noise, seed=k) for k in range(6)]
+
+
+# --- alignment ---------------------------------------------------------------------------
+
+def test_whole_sample_shift_returns_the_logged_samples(paper):
+    data = experiments(paper, delay=0.0)[0]
+    shifted = shift_forces(data, 3 / RATE)
+    assert len(shifted) == len(data) - 3
+    assert np.array_equal(shifted.forces, data.forces[3:])
+    assert np.array_equal(shifted.pose, data.pose[:-3])
+
+
+def test_fractional_shift_recovers_the_undelayed_forces(paper):
+    # the cubic spline's error on a 2.3 Hz sine at 500 Hz is (2 pi 2.3 / 500)^4 / 384 ~ 2e-9
+    # of its amplitude; the forces' dynamic part is ~1e3 N, the static ~3e4 N
+    late = experiments(paper, delay=1.3e-3)[2]
+    on_time = experiments(paper, delay=0.0)[2]
+    aligned = shift_forces(late, 1.3e-3)
+    assert len(aligned) == len(late) - 1  # t + 1.3 ms falls beyond the last sample once
+    assert np.abs(aligned.forces - on_time.forces[:-1]).max() < 1e-4
+    early = shift_forces(late, -1.3e-3)
+    assert early.t[0] == late.t[1] and len(early) == len(late) - 1
+
+
+def test_a_delay_longer_than_the_record_is_refused(paper):
+    with pytest.raises(ConfigError, match="leaves .* samples .* in seconds"):
+        align_forces(experiments(paper)[:1], 7.99)
+
+
+# --- estimation ----------------------------------------------------------------------------
+
+def test_every_dof_shows_its_three_lines(paper):
+    lines = excitation_lines(experiments(paper))
+    for found in lines:  # resolution of the Hann-windowed 8 s record: 0.125 Hz
+        assert np.allclose(found, [f for _, f, _ in MULTISINE], atol=0.07)
+
+
+@pytest.mark.parametrize("delay", [0.5e-3, 1e-3, 2e-3, 3e-3])
+def test_injected_delay_is_recovered_on_noise_free_data(paper, delay):
+    # noise-free: the error left is that of the first-order expansion after one alignment,
+    # of order (tau - tau_1)^2 w with tau - tau_1 ~ tau^2 w / 2 < 0.1 ms, and the 0.02 %
+    # geometric stiffness term tau K q_dot, both far below 1 microsecond
+    estimate = estimate_delay(experiments(paper, delay=delay), paper)
+    assert estimate.seconds == pytest.approx(delay, abs=1e-6)
+    assert estimate.std_error < 1e-6
+
+
+def test_noisy_estimate_is_within_its_standard_errors(paper):
+    # 20 N of white noise per leg force (about the reference noise's share of the dynamics)
+    estimate = estimate_delay(experiments(paper, delay=2e-3, noise=20.0), paper)
+    assert abs(estimate.seconds - 2e-3) < 4 * estimate.std_error
+    assert estimate.std_error < 1e-4
+
+
+def test_single_sine_is_refused_with_the_bias_a_delay_puts_on_bt(paper):
+    single = ((1.0, 0.5, 0.0),)
+    with pytest.raises(IdentificationError, match="one frequency only") as refused:
+        estimate_delay(experiments(paper, sines=single, delay=1e-3), paper)
+    stated = float(re.search(r"Bt\(1,1\) ([-+0-9.e]+)", str(refused.value)).group(1))
+    # the bias itself, measured: least squares on the same motion with forces 1 ms late
+    fitted = [LeastSquaresIdentifier(coulomb=False).fit(experiments(paper, sines=single,
+                                                                    delay=delay), paper)
+              for delay in (0.0, 1e-3)]
+    measured = fitted[1].B_[0, 0] - fitted[0].B_[0, 0]
+    assert stated == pytest.approx(measured, rel=0.02)
+
+
+def test_alignment_removes_the_delay_bias_from_the_matrices(paper):
+    M, B = nominal_matrices(paper)
+    aligned, entry = apply_delay(experiments(paper, delay=2e-3), paper, "auto")
+    fitted = LeastSquaresIdentifier(coulomb=False).fit(aligned, paper)
+    assert entry["source"] == "estimated" and entry["applied"]
+    assert np.abs(np.diag(fitted.B_) / np.diag(B) - 1).max() < 1e-3
+    assert np.abs(np.diag(fitted.M_) / np.diag(M) - 1).max() < 1e-3
+
+
+# --- command line --------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def late_files(tmp_path_factory, paper):
+    folder = tmp_path_factory.mktemp("late")
+    return [write_dataset(d, folder / f"{d.name}.csv")
+            for d in experiments(paper, delay=1e-3)]
+
+
+def test_identify_applies_a_given_delay(tmp_path, late_files):
+    out = tmp_path / "result.json"
+    result = CliRunner().invoke(app, ["identify", "--method", "ls", "--platform", "paper",
+                                      "--delay", "0.001", "--out", str(out),
+                                      *map(str, late_files)])
+    assert result.exit_code == 0, result.output
+    assert "force delay 1.000 ms, given" in result.output
+    document = json.loads(out.read_text())
+    assert document["delay"] == {"seconds": 0.001, "std_error": None, "applied": True,
+                                 "source": "given"}
+
+
+def test_identify_estimates_the_delay(tmp_path, late_files):
+    out = tmp_path / "result.json"
+    result = CliRunner().invoke(app, ["identify", "--method", "ls", "--platform", "paper",
+                                      "--delay", "auto", "--out", str(out),
+                                      *map(str, late_files)])
+    assert result.exit_code == 0, result.output
+    assert re.search(r"force delay 1\.00\d ms \(standard error", result.output)
+    delay = json.loads(out.read_text())["delay"]
+    assert delay["source"] == "estimated"
+    assert delay["seconds"] == pytest.approx(1e-3, abs=1e-6)
+
+
+def test_identify_without_the_flag_writes_no_delay(tmp_path, late_files):
+    out = tmp_path / "result.json"
+    result = CliRunner().invoke(app, ["identify", "--method", "ls", "--platform", "paper",
+                                      "--out", str(out), *map(str, late_files)])
+    assert result.exit_code == 0, result.output
+    assert "delay" not in json.loads(out.read_text())
+
+
+@pytest.mark.parametrize("value, message", [("2ms", "--delay must be a number of seconds"),
+                                            ("nan", "--delay must be a number of seconds")])
+def test_identify_refuses_a_bad_delay(tmp_path, late_files, value, message):
+    result = CliRunner().invoke(app, ["identify", "--method", "ls", "--platform", "paper",
+                                      "--delay", value, *map(str, late_files)])
+    assert result.exit_code == 2
+    assert message in result.output
