@@ -18,9 +18,9 @@ from typer.testing import CliRunner
 from stewartid.cli import app
 from stewartid.datasets.alignment import align_forces, shift_forces
 from stewartid.datasets.dataset import Dataset, write_dataset
+from stewartid.datasets.excitation import excitation_lines
 from stewartid.errors import ConfigError, IdentificationError
 from stewartid.identification.delay import apply_delay, estimate_delay
-from stewartid.identification.excitation import excitation_lines
 from stewartid.identification.least_squares import LeastSquaresIdentifier
 from stewartid.model.dynamics import ModelTerms
 from stewartid.model.kinematics import leg_lengths

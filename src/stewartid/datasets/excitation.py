@@ -60,11 +60,15 @@ class SpectralLines:
         Relative to the largest line (the first is 1).
     resolution_hz : float
         1 / record length: lines closer than a few of these are one line.
+    largest : float
+        Amplitude of the largest line in the Hann-windowed spectrum (units of the motion
+        times the window's gain), to compare lines across records; 0 when empty.
     """
 
     frequencies_hz: np.ndarray
     amplitudes: np.ndarray
     resolution_hz: float
+    largest: float = 0.0
 
     def __len__(self) -> int:
         return len(self.frequencies_hz)
@@ -166,7 +170,7 @@ def spectral_lines(motion: np.ndarray, sample_rate: float,
     shift = 0.5 * (below - above) / np.minimum(curvature, -np.finfo(float).tiny)
     heights = np.exp(at - 0.25 * (below - above) * shift)
     return SpectralLines((peaks + shift) * sample_rate / nfft, heights / heights.max(),
-                         resolution)
+                         resolution, float(heights.max()))
 
 
 def _regressors(dataset: Dataset, scales: np.ndarray, platform: Platform) -> np.ndarray:
@@ -273,6 +277,51 @@ def check_experiment_set(datasets: Sequence[Dataset], platform: Platform) -> Non
     check_excitation(datasets, platform)
 
 
-__all__ = ["LINE_FRACTION", "MIN_RELATIVE_EXCITATION", "SpectralLines", "check_excitation",
-           "check_experiment_set", "dof_scales", "excitation_per_dof", "leg_space_motion",
-           "spectral_lines"]
+#: In :func:`excitation_lines`, a spectral line of a DOF's motion counts when it is at least
+#: this fraction of the DOF's largest line (over all experiments).
+LINE_THRESHOLD = 0.1
+
+#: Lines closer than this many frequency resolutions (1 / record length) are one line.
+LINE_MERGE_BINS = 3.0
+
+
+def excitation_lines(datasets: Sequence[Dataset], threshold: float = LINE_THRESHOLD
+                     ) -> tuple[tuple[float, ...], ...]:
+    """The distinct excitation frequencies of each DOF over all experiments.
+
+    A line counts when its amplitude is at least ``threshold`` times the DOF's largest line
+    over the experiments (a position spectrum: sensor noise, white in the pose, stays far
+    below it, where a velocity spectrum would raise it with frequency); lines within
+    :data:`LINE_MERGE_BINS` frequency resolutions of each other are one.
+
+    Parameters
+    ----------
+    datasets : sequence of Dataset
+    threshold : float
+        Fraction of the DOF's largest line.
+
+    Returns
+    -------
+    tuple of 6 tuples of float
+        Hz, ascending, per DOF of :data:`~stewartid.platform.COORDINATES`.
+    """
+    found = []
+    for dof in range(6):
+        records = [spectral_lines(d.pose[:, dof], d.sample_rate, fraction=0.0) for d in datasets]
+        largest = max((r.largest for r in records), default=0.0)
+        lines: list[float] = []
+        for record in records:
+            if largest <= 0 or not len(record):
+                continue
+            strong = record.amplitudes * record.largest >= threshold * largest
+            for frequency in np.sort(record.frequencies_hz[strong]):
+                if all(abs(frequency - g) > LINE_MERGE_BINS * record.resolution_hz
+                       for g in lines):
+                    lines.append(float(frequency))
+        found.append(tuple(sorted(lines)))
+    return tuple(found)
+
+
+__all__ = ["LINE_FRACTION", "LINE_MERGE_BINS", "LINE_THRESHOLD", "MIN_RELATIVE_EXCITATION",
+           "SpectralLines", "check_excitation", "check_experiment_set", "dof_scales",
+           "excitation_lines", "excitation_per_dof", "leg_space_motion", "spectral_lines"]

@@ -40,8 +40,8 @@ import numpy as np
 
 from stewartid.datasets.alignment import align_forces
 from stewartid.datasets.dataset import Dataset
+from stewartid.datasets.excitation import excitation_lines
 from stewartid.errors import ConfigError, IdentificationError
-from stewartid.identification.excitation import excitation_lines
 from stewartid.identification.least_squares import coulomb_regressors
 from stewartid.identification.preparation import generalized_force_sensitivity, prepare_experiment
 from stewartid.model.linearization import nominal_matrices
