@@ -19,9 +19,10 @@ sys.path.insert(0, str(ROOT / "src"))
 sys.path.insert(0, str(DOCS))
 os.environ.setdefault("MPLBACKEND", "Agg")
 
-import stewartid  # noqa: E402
 from method_pages import write_method_pages  # noqa: E402
 from plain_bars import process_docstring  # noqa: E402
+
+import stewartid  # noqa: E402
 
 project = "stewartid"
 author = "stewartid developers"
