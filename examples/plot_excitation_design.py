@@ -32,12 +32,9 @@ print("largest amplitudes (m, rad):", np.round(amplitudes, 4))
 
 
 def motions_of(design, rate_hz=200.0):
-    """(t, q, q_dot, q_ddot) of every record, played exactly."""
-    out = []
-    for record in design.playable(paper):
-        t = np.arange(0.0, record.record.duration, 1 / rate_hz)
-        out.append((t, *record.evaluate(t)))  # the design's motion itself, no plant
-    return out
+    """(t, q, q_dot, q_ddot) of every record, played exactly (the motion itself, no plant)."""
+    return [(t, *record.evaluate(t)) for record in design.playable(paper)
+            for t in [np.arange(0.0, record.record.duration, 1 / rate_hz)]]
 
 
 # %%

@@ -14,6 +14,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from stewartid import load_platform
+from stewartid.design.candidates import paper_design
 from stewartid.identification.bounds import information_bound
 from stewartid.model.linearization import nominal_matrices
 from stewartid.simulation.sensors import static_leg_force
@@ -25,26 +26,18 @@ _, nominal_B = nominal_matrices(paper)
 AT_1KHZ = 1 / np.sqrt(5)
 
 
-def sine_motions(duration_s, amplitude=(0.02, 0.02, 0.02, 0.01, 0.01, 0.01), frequency_hz=0.5,
-                 rate_hz=200.0):
-    """The paper's excitation, exactly: record k a sine on DOF k, as (t, q, q_dot, q_ddot)."""
-    t = np.arange(0.0, duration_s, 1 / rate_hz)
-    w = 2 * np.pi * frequency_hz
-    motions = []
-    for k in range(6):
-        q = np.tile(paper.neutral_pose, (len(t), 1))
-        q_dot, q_ddot = np.zeros_like(q), np.zeros_like(q)
-        q[:, k] += amplitude[k] * np.sin(w * t)
-        q_dot[:, k] = amplitude[k] * w * np.cos(w * t)
-        q_ddot[:, k] = -amplitude[k] * w ** 2 * np.sin(w * t)
-        motions.append((t, q, q_dot, q_ddot))
-    return motions
+def sine_motions(duration_s, rate_hz=200.0):
+    """The paper's excitation played exactly (record k a 0.5 Hz sine on DOF k, with a
+    one-period fade-in and fade-out), as (t, q, q_dot, q_ddot) per record."""
+    records = paper_design(duration_s=duration_s).playable(paper)
+    return [(t, *record.evaluate(t)) for record in records
+            for t in [np.arange(0.0, record.record.duration, 1 / rate_hz)]]
 
 
 # %%
 # The reference noise: 0.5 % of the static leg force. On the paper's 6 x 20 s of sines the
 # Bt diagonal cannot be known better than this, whatever the estimator (the table of
-# ``docs/accuracy-bounds.md`` gives the same numbers).
+# ``docs/accuracy-bounds.md`` gives nearly the same numbers for the plant's records).
 sigma = 0.005 * static_leg_force(paper)
 print(f"reference force noise {sigma:.1f} N per leg")
 motions = sine_motions(20.0)

@@ -2,9 +2,11 @@
 README.md and docs/*.md names a command and options that exist, the getting-started page's
 commands run as written, and the Python blocks of README.md and the getting-started page run.
 
-Commands of other tools (``dask scheduler``) are not checked. Commands that are templates (``paper|FILE.toml``, ``[--seeds 120]``, ``exp*.csv``) or long
-(``stewartid reproduce``, ``design --budget 120``, a study, the install commands) are checked
-against the command's options only; the commands of ``docs/getting-started.md`` run in full.
+Commands of other tools (``dask scheduler``) are not checked. Commands that are templates
+(``paper|FILE.toml``, ``[--seeds 120]``, ``exp*.csv``) or long (``stewartid reproduce``,
+``design --budget 120``, a study, the install commands) are checked against the command's
+options only (install commands: the extras they name exist); the commands of
+``docs/getting-started.md`` run in full.
 """
 
 from __future__ import annotations
