@@ -185,7 +185,10 @@ def finite(low: float | None = None, high: float | None = None) -> Interval:
 
 
 def constraint_error(subject: str, expected: str, value: Any) -> ConfigError:
-    """The one refusal: ``"{subject} must be {expected}. Got {value!r} instead."``."""
+    """The one refusal of a bad setting, as a ConfigError.
+
+    Its message reads ``"{subject} must be {expected}. Got {value!r} instead."``.
+    """
     return ConfigError(f"{subject} must be {expected}. Got {value!r} instead.")
 
 

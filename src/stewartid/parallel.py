@@ -72,6 +72,7 @@ class InlineExecutor(Executor):
     """Runs submitted calls at once in this process (one worker, no pool)."""
 
     def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> Future:
+        """Call ``fn(*args, **kwargs)`` now and return a Future holding its result or error."""
         future: Future = Future()
         try:
             future.set_result(fn(*args, **kwargs))

@@ -18,7 +18,7 @@ from contextvars import ContextVar
 from typing import Annotated, Any
 
 import typer
-from typer.core import TyperGroup
+from typer.core import TyperCommand, TyperGroup
 
 from stewartid.errors import StewartidError
 
@@ -57,8 +57,45 @@ class OneLineUsageErrors(TyperGroup):
         sys.exit(code if isinstance(code, int) else 0)
 
 
+class PlainHelpCommand(TyperCommand):
+    """A command whose ``--help`` reads like the ecosystem's (git, pip, click): an argument
+    shows as its metavar (``FILE...``, never ``{files}...`` or ``<list[Path]>``), an option
+    as its flag and metavar (``--out DIR``), a flag alone; the text is reflowed to the
+    terminal, so a line break in the source never breaks a sentence."""
+
+    def collect_usage_pieces(self, ctx: Any) -> list[str]:
+        pieces = [self.options_metavar] if self.options_metavar else []
+        for parameter in self.get_params(ctx):
+            if parameter.param_type_name == "argument":
+                pieces.append(_argument_label(parameter, usage=True))
+        return pieces
+
+    def format_options(self, ctx: Any, formatter: Any) -> None:
+        arguments = [(_argument_label(parameter, usage=False), parameter.help or "")
+                     for parameter in self.get_params(ctx)
+                     if parameter.param_type_name == "argument"]
+        options = [record for parameter in self.get_params(ctx)
+                   if parameter.param_type_name == "option"
+                   and (record := parameter.get_help_record(ctx)) is not None]
+        if arguments:
+            with formatter.section("Arguments"):
+                formatter.write_dl(arguments)
+        if options:
+            with formatter.section("Options"):
+                formatter.write_dl(options)
+
+
+def _argument_label(parameter: Any, usage: bool) -> str:
+    """``FILE...`` for a required argument of several values, ``[FILE]`` for an optional one."""
+    label = parameter.metavar or parameter.name.upper()
+    if parameter.nargs != 1:
+        label += "..."
+    return f"[{label}]" if usage and not parameter.required else label
+
+
 app = typer.Typer(
     cls=OneLineUsageErrors,
+    rich_markup_mode=None,
     name="stewartid",
     help="Dynamic parameter identification of Stewart platforms (Zhang 2020, wavelet method).",
     no_args_is_help=True,
@@ -124,13 +161,13 @@ def _register() -> None:
 
     for command in (nominal.nominal, simulate.simulate, identify.identify,
                     reproduce.reproduce, methods.methods):
-        app.command()(clean_errors(command))
+        app.command(cls=PlainHelpCommand)(clean_errors(command))
     from stewartid.cli import study
 
-    app.command()(clean_errors(study.study))
+    app.command(cls=PlainHelpCommand)(clean_errors(study.study))
     from stewartid.cli import design
 
-    app.command()(clean_errors(design.design))
+    app.command(cls=PlainHelpCommand)(clean_errors(design.design))
 
 
 _register()

@@ -13,33 +13,37 @@ from stewartid.platform import load_platform
 
 
 def design(
-    out: Annotated[Path, typer.Option("--out", help="Output folder: design.json, commands/, "
+    out: Annotated[Path, typer.Option("--out", metavar="DIR", help="Output folder: design.json, commands/, "
                                       "figures/, report.md, report.html.")],
-    budget: Annotated[float, typer.Option("--budget", help="Total motion time (s).")] = 120.0,
-    platform: Annotated[str, typer.Option("--platform", help="'paper' for the preset, or a "
+    budget: Annotated[float, typer.Option("--budget", metavar="SECONDS",
+                                          help="Total motion time (s).")] = 120.0,
+    platform: Annotated[str, typer.Option("--platform", metavar="NAME|FILE",
+                                          help="'paper' for the preset, or a "
                                           "platform TOML file (with its [limits]).")] = "paper",
-    method: Annotated[str, typer.Option("--method", help="Identification method the design "
+    method: Annotated[str, typer.Option("--method", metavar="NAME", help="Identification method the design "
                                         "is for.")] = "wavelet",
     coulomb: Annotated[float | None, typer.Option(
-        "--coulomb", help="Coulomb friction per joint axis the machine is expected to have "
+        "--coulomb", metavar="TORQUE", help="Coulomb friction per joint axis the machine is expected to have "
         "(N m); default: the platform's.")] = None,
     length_noise: Annotated[float | None, typer.Option(
-        "--length-noise", help="Leg-length noise, standard deviation (m); default: [sensors] "
+        "--length-noise", metavar="METRES",
+        help="Leg-length noise, standard deviation (m); default: [sensors] "
         "length_noise, or the reference 20 um when that is 0.")] = None,
     force_noise: Annotated[float | None, typer.Option(
-        "--force-noise", help="Force noise, standard deviation (N); default: [sensors] "
+        "--force-noise", metavar="NEWTONS", help="Force noise, standard deviation (N); default: [sensors] "
         "force_noise, or the reference 0.5 % of the static leg force when that is 0.")] = None,
-    rate: Annotated[float, typer.Option("--rate", help="Controller rate of the command files "
+    rate: Annotated[float, typer.Option("--rate", metavar="HZ", help="Controller rate of the command files "
                                         "(Hz).")] = 500.0,
-    max_use: Annotated[float, typer.Option("--max-use", help="Largest fraction of every limit "
+    max_use: Annotated[float, typer.Option("--max-use", metavar="FRACTION",
+                                           help="Largest fraction of every limit "
                                            "the design may use on the plant's simulated "
                                            "states.")] = 0.7,
-    seeds: Annotated[int, typer.Option("--seeds", help="Noise realisations of the predicted "
+    seeds: Annotated[int, typer.Option("--seeds", metavar="N", help="Noise realisations of the predicted "
                                        "accuracy, >= 2 (a predicted standard error is "
                                        "uncertain by about 1/sqrt(2 seeds): 6.5 % at "
                                        "120).")] = 120,
     workers: Annotated[int | None, typer.Option(
-        "--workers", help="Processes the predictions are spread over (default: every "
+        "--workers", metavar="N", help="Processes the predictions are spread over (default: every "
         "available core).")] = None,
     model_data: Annotated[bool, typer.Option(
         "--model-data", help="Predict on rigid-body model data with perfect tracking (fast, "

@@ -10,41 +10,45 @@ import typer
 
 def identify(
     files: Annotated[list[Path], typer.Argument(
-        help="Data files (CSV/Parquet, one experiment each) or folders of them.")],
-    method: Annotated[str, typer.Option("--method",
-                                        help="wavelet (Zhang 2020), fourier (Tian), ls, or "
-                                             "another name that 'stewartid methods' lists.")]
+        metavar="FILE", help="Data files (CSV/Parquet, one experiment each) or folders of them.")],
+    method: Annotated[str, typer.Option("--method", metavar="NAME",
+                                        help="wavelet (Zhang 2020), fourier (Tian), ls, "
+                                             "another name that 'stewartid methods' lists, or "
+                                             "'all': every registered method (with --report, "
+                                             "which to trust).")]
     = "wavelet",
     platform: Annotated[str | None, typer.Option(
-        "--platform", help="'paper' for the preset, or a platform TOML file; required unless "
+        "--platform", metavar="NAME|FILE",
+        help="'paper' for the preset, or a platform TOML file; required unless "
                            "a meta.json beside the data names the platform.")] = None,
-    out: Annotated[Path | None, typer.Option("--out", help="Write the result as JSON.")]
+    out: Annotated[Path | None, typer.Option("--out", metavar="FILE", help="Write the result as JSON.")]
     = None,
     force: Annotated[bool, typer.Option(
         "--force", help="Overwrite an existing --out file that is not an earlier result.")]
     = False,
     columns: Annotated[str | None, typer.Option(
-        "--columns", help="Column mapping of the logs with units: a TOML file or entries "
+        "--columns", metavar="MAPPING", help="Column mapping of the logs with units: a TOML file or entries "
                           "such as 't=Time:ms,l1..l6=Leg{k}:mm' (docs/logs.md).")] = None,
     no_gravity: Annotated[bool, typer.Option(
         "--no-gravity", help="Do not subtract the model's gravity term G(q).")] = False,
     symmetric: Annotated[bool, typer.Option(
         "--symmetric", help="Impose symmetric Mt and Bt.")] = False,
     frequency: Annotated[list[float] | None, typer.Option(
-        "--frequency", help="Excitation frequency (Hz) for --method fourier; repeat for "
+        "--frequency", metavar="HZ", help="Excitation frequency (Hz) for --method fourier; repeat for "
                             "several. Detected from the data by default.")] = None,
     stiffness: Annotated[bool, typer.Option(
         "--stiffness", help="fourier: identify a stiffness matrix too (needs >= 2 "
                             "frequencies).")] = False,
     friction: Annotated[str | None, typer.Option(
-        "--friction", help="wavelet: the interval constants: 'auto' (default: 'free' for one "
+        "--friction", metavar="NAME",
+        help="wavelet: the interval constants: 'auto' (default: 'free' for one "
                            "sine per experiment, else 'coulomb'), 'free' (immune to the "
                            "friction law), 'coulomb' (windows across reversals, Coulomb level "
                            "per joint type), 'shared' (Coulomb level per joint type), 'uniform' "
                            "(one level for every joint axis; what 'stewartid design' "
                            "predicts for).")] = None,
     report: Annotated[Path | None, typer.Option(
-        "--report", help="Write a report into this folder: data, intervals, matrices with "
+        "--report", metavar="DIR", help="Write a report into this folder: data, intervals, matrices with "
                          "standard errors, residuals, validation on held-out data, "
                          "consistency, friction, CSV and MATLAB exports, result.json.")] = None,
     consistent: Annotated[bool, typer.Option(
@@ -52,14 +56,14 @@ def identify(
                              "definite and Bt positive semidefinite (needs the 'convex' "
                              "extra).")] = False,
     folds: Annotated[int | None, typer.Option(
-        "--folds", help="--report: time segments per experiment for the validation "
+        "--folds", metavar="N", help="--report: time segments per experiment for the validation "
                         "(default 3).")] = None,
     delay: Annotated[str | None, typer.Option(
-        "--delay", help="Delay of the force channels behind the motion, in seconds (0.002 for "
-                        "2 ms; negative when the forces lead): every method works on the forces "
-                        "aligned by it. 'auto' estimates it first (needs two or more "
-                        "frequencies per DOF) and prints it with its standard error "
-                        "(docs/logs.md).")] = None,
+        "--delay", metavar="SECONDS|auto",
+        help="Delay of the force channels behind the motion, in seconds (0.002 for 2 ms; "
+             "negative when the forces lead): every method works on the forces aligned by it. "
+             "'auto' estimates it first (needs two or more frequencies per DOF) and prints it "
+             "with its standard error (docs/logs.md).")] = None,
 ) -> None:
     """Identify Mt and Bt from experiments; print the paper-style table when nominal values are
     known (platform description, or meta.json/truth.json beside the data) and write JSON."""

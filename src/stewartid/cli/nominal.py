@@ -11,7 +11,8 @@ import typer
 
 def nominal(
     platform: Annotated[str, typer.Option(
-        "--platform", help="'paper' for the preset, or a platform TOML file.")] = "paper",
+        "--platform", metavar="NAME|FILE",
+        help="'paper' for the preset, or a platform TOML file.")] = "paper",
     as_json: Annotated[bool, typer.Option("--json", help="Print {\"M\": ..., \"B\": ...}.")] = False,
     gravity: Annotated[bool, typer.Option("--gravity-stiffness",
                                           help="Also print K_G = dG/dq.")] = False,

@@ -9,18 +9,18 @@ import typer
 
 
 def reproduce(
-    out: Annotated[Path, typer.Option("--out", help="Output folder (created if missing).")]
+    out: Annotated[Path, typer.Option("--out", metavar="DIR", help="Output folder (created if missing).")]
     = Path("results/reproduce"),
     quick: Annotated[bool, typer.Option("--quick",
                                         help="Shortened records (6 s per experiment) for CI "
                                              "and tests.")] = False,
-    jobs: Annotated[int | None, typer.Option("--jobs", min=1,
+    jobs: Annotated[int | None, typer.Option("--jobs", metavar="N", min=1,
                                              help="Worker processes (default: all cores).")]
     = None,
     force: Annotated[bool, typer.Option("--force",
                                         help="Overwrite the results of an earlier run in "
                                              "--out.")] = False,
-    seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the simulated noise.")]
+    seed: Annotated[int, typer.Option("--seed", metavar="N", min=0, help="Seed of the simulated noise.")]
     = 0,
 ) -> None:
     """Regenerate the paper's Tables 3-6 on the simulated plant, beside the published values:

@@ -33,10 +33,15 @@ IMPERFECTION_FLAGS = {
     "--length-drift": ("length_drift", "Random-walk drift of each leg-length channel: its "
                        "standard deviation at the end of the record (m)."),
     "--force-resolution": ("force_resolution", "Quantisation step of the forces (N); "
-                           "default: \\[sensors] force_resolution."),
+                           "default: [sensors] force_resolution."),
     "--length-resolution": ("length_resolution", "Quantisation step of the leg lengths (m, "
-                            "e.g. 1e-6); default: \\[sensors] length_resolution."),
+                            "e.g. 1e-6); default: [sensors] length_resolution."),
 }
+#: The metavar of each sensor-imperfection flag in ``--help``: what its value is.
+IMPERFECTION_METAVARS = {"--force-delay": "SECONDS", "--length-delay": "SECONDS", "--force-lowpass": "HZ",
+                         "--force-lowpass-order": "N", "--hum": "NEWTONS", "--hum-frequency": "HZ",
+                         "--force-drift": "NEWTONS", "--length-drift": "METRES",
+                         "--force-resolution": "NEWTONS", "--length-resolution": "METRES"}
 #: A flag that only shapes the error another flag switches on: flag -> (that flag, field).
 SHAPING_FLAGS = {"--force-lowpass-order": ("--force-lowpass", "force_lowpass"),
                  "--hum-frequency": ("--hum", "hum_amplitude")}
@@ -44,45 +49,48 @@ SHAPING_FLAGS = {"--force-lowpass-order": ("--force-lowpass", "force_lowpass"),
 
 def imperfection_option(flag: str) -> Any:
     """The typer option of a sensor-imperfection flag, with its help."""
-    return typer.Option(flag, help=IMPERFECTION_FLAGS[flag][1])
+    return typer.Option(flag, metavar=IMPERFECTION_METAVARS[flag], help=IMPERFECTION_FLAGS[flag][1])
 
 
 def simulate(
-    out: Annotated[Path, typer.Option("--out", help="Output folder for exp1..exp6 and "
+    out: Annotated[Path, typer.Option("--out", metavar="DIR", help="Output folder for exp1..exp6 and "
                                       "meta.json.")],
-    platform: Annotated[str, typer.Option("--platform", help="'paper' for the preset, or a "
+    platform: Annotated[str, typer.Option("--platform", metavar="NAME|FILE",
+                                          help="'paper' for the preset, or a "
                                           "platform TOML file.")] = "paper",
-    coulomb: Annotated[float | None, typer.Option("--coulomb", help="Coulomb friction per "
+    coulomb: Annotated[float | None, typer.Option("--coulomb", metavar="TORQUE", help="Coulomb friction per "
                                                   "joint axis (N m); default: the platform's.")
                        ] = None,
-    viscous: Annotated[float | None, typer.Option("--viscous", help="Viscous friction per "
+    viscous: Annotated[float | None, typer.Option("--viscous", metavar="DAMPING", help="Viscous friction per "
                                                   "gimbal axis (N m s/rad).")] = None,
-    frequency: Annotated[float, typer.Option("--frequency", help="Excitation sine frequency "
+    frequency: Annotated[float, typer.Option("--frequency", metavar="HZ", help="Excitation sine frequency "
                                              "(Hz).")] = 0.5,
-    duration: Annotated[float, typer.Option("--duration", help="Record length of each "
+    duration: Annotated[float, typer.Option("--duration", metavar="SECONDS", help="Record length of each "
                                             "experiment (s).")] = 20.0,
     noise_on: Annotated[bool, typer.Option(
         "--noise", help="Switch on the reference sensor noise: 20 um on the leg lengths and "
         "0.5 % of the static leg force on the forces (--length-noise/--force-noise override "
         "either).")] = False,
     length_noise: Annotated[float | None, typer.Option(
-        "--length-noise", help="Leg-length sensor noise, standard deviation (m); default: "
-        "\\[sensors] length_noise.")] = None,
+        "--length-noise", metavar="METRES", help="Leg-length sensor noise, standard deviation (m); default: "
+        "[sensors] length_noise.")] = None,
     force_noise: Annotated[float | None, typer.Option(
-        "--force-noise", help="Force sensor noise, standard deviation (N); default: "
-        "\\[sensors] force_noise.")] = None,
+        "--force-noise", metavar="NEWTONS", help="Force sensor noise, standard deviation (N); default: "
+        "[sensors] force_noise.")] = None,
     actuator: Annotated[str | None, typer.Option(
-        "--actuator", help="'hydraulic' or 'ideal'; default: \\[hydraulics] mode.")] = None,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the sensor noise.")] = 0,
-    format: Annotated[str, typer.Option("--format", help="'csv' or 'parquet'.")] = "csv",
+        "--actuator", metavar="hydraulic|ideal",
+        help="'hydraulic' or 'ideal'; default: [hydraulics] mode.")] = None,
+    seed: Annotated[int, typer.Option("--seed", metavar="N", help="Seed of the sensor noise.")] = 0,
+    format: Annotated[str, typer.Option("--format", metavar="csv|parquet",
+                                        help="'csv' or 'parquet'.")] = "csv",
     force: Annotated[bool, typer.Option("--force", help="Overwrite results already in "
                                         "--out.")] = False,
     excitation: Annotated[list[Path] | None, typer.Option(
-        "--excitation", help="Play this excitation file instead of the paper's sines: CSV "
+        "--excitation", metavar="FILE", help="Play this excitation file instead of the paper's sines: CSV "
         "with t and the pose x..rz (m, rad) or t and l1..l6 (m), e.g. a command file of "
         "`stewartid design`; repeat for more experiments (exp1, exp2, ...).")] = None,
     jobs: Annotated[int | None, typer.Option(
-        "--jobs", help="Worker processes for the paper's experiments (default: every core); "
+        "--jobs", metavar="N", help="Worker processes for the paper's experiments (default: every core); "
         "the data do not depend on it.")] = None,
     force_delay: Annotated[float | None, imperfection_option("--force-delay")] = None,
     length_delay: Annotated[float | None, imperfection_option("--length-delay")] = None,

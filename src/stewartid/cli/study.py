@@ -11,21 +11,21 @@ from stewartid.errors import StewartidError
 
 
 def study(
-    file: Annotated[Path, typer.Argument(help="Study file (TOML): [study] fixed settings, "
+    file: Annotated[Path, typer.Argument(metavar="FILE", help="Study file (TOML): [study] fixed settings, "
                                          "[grid] swept values; see docs/studies.md.")],
-    out: Annotated[Path, typer.Option("--out", help="Output folder: results.parquet/, "
+    out: Annotated[Path, typer.Option("--out", metavar="DIR", help="Output folder: results.parquet/, "
                                       "report.md/.html, figures/, tables/.")],
     scheduler: Annotated[str | None, typer.Option(
-        "--scheduler", help="Address of an existing dask scheduler (tcp://host:8786); "
+        "--scheduler", metavar="ADDRESS", help="Address of an existing dask scheduler (tcp://host:8786); "
         "default: a local cluster.")] = None,
     workers: Annotated[int | None, typer.Option(
-        "--workers", min=1, help="Worker processes of the local cluster (default: one per "
+        "--workers", metavar="N", min=1, help="Worker processes of the local cluster (default: one per "
         "core).")] = None,
     resume: Annotated[bool, typer.Option(
         "--resume", help="Continue the study in --out: compute only its missing rows.")]
     = False,
     retries: Annotated[int, typer.Option(
-        "--retries", min=0, help="Extra attempts of a task that raises.")] = 2,
+        "--retries", metavar="N", min=0, help="Extra attempts of a task that raises.")] = 2,
 ) -> None:
     """Run every (grid point, seed) of a study: simulate the six experiments, identify them
     with every method, store one row per method in OUT/results.parquet and write a report

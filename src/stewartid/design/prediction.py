@@ -377,7 +377,7 @@ class NoiseRuns:
 
     def fit(self, ks: Sequence[int], progress: Callable[[int, int], None] | None = None
             ) -> np.ndarray:
-        """[M_, B_] of the estimator on realisations ``ks``; shape (len(ks), 2, 6, 6).
+        """``[M_, B_]`` of the estimator on realisations ``ks``; shape (len(ks), 2, 6, 6).
         ``progress(done, total)`` after each."""
         estimator = default_estimator(self.method)
         out = np.empty((len(ks), 2, 6, 6))

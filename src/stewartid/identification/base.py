@@ -35,7 +35,9 @@ class BaseIdentifier:
     ``std_errors_`` : dict with ``"M"`` and ``"B"`` : ndarray (6, 6)
         Standard errors from the residuals.
     ``condition_number_`` : float
+        Condition number of the (equilibrated) regression.
     ``result_`` : IdentificationResult
+        Everything the fit found, as one object.
 
     plus the method-specific ones a subclass's ``_fit`` returns.
     """

@@ -291,7 +291,7 @@ def _unknown_names(names: list[str], snames: list[str], T: np.ndarray, p: int) -
 
 
 def regressor_names(*groups: str) -> list[str]:
-    """Names like ``q_ddot[x] ... q_dot[rz]`` for regressor groups given by prefix."""
+    """Names like ``q_ddot[x]``, ``q_dot[rz]`` for regressor groups given by prefix."""
     return [f"{g}[{c}]" for g in groups for c in COORDINATES]
 
 

@@ -1,7 +1,9 @@
-"""The figures of the identification report (:mod:`.report`), in report order.
+"""The figures of the identification report (:mod:`~stewartid.reports.identification.report`),
+in report order.
 
-The drawing itself is :mod:`.method_figures` and :mod:`stewartid.reporting.figures`; this
-module decides what is drawn, with which data and caption.
+The drawing itself is :mod:`~stewartid.reports.identification.method_figures` and
+:mod:`stewartid.reporting.figures`; this module decides what is drawn, with which data and
+caption.
 """
 
 from __future__ import annotations

@@ -10,8 +10,8 @@ consistent pair (:mod:`stewartid.identification.consistency`), chooses the metho
 - ``report.md`` and a self-contained ``report.html`` (:mod:`.text`): the data, the
   constant-direction intervals, Mt and Bt with standard errors beside the nominal values,
   residuals, validation, consistency, friction and, for several methods, which one to trust;
-- ``figures/``: every figure as PNG and SVG (:mod:`.figures` chooses them,
-  :mod:`.method_figures` draws them);
+- ``figures/``: every figure as PNG and SVG (:mod:`~stewartid.reports.identification.figures` chooses them,
+  :mod:`~stewartid.reports.identification.method_figures` draws them);
 - ``result.json``: the trusted method's result with its ``validation`` and ``consistency``
   objects, and the CSV and MATLAB exports of every method
   (:mod:`stewartid.reporting.exports`).

@@ -1,5 +1,6 @@
-"""The text of the identification report (:mod:`.report`): data summary, which method to
-trust and why (the :class:`~stewartid.assessment.verdict.Verdict` in words), and ``report.md``.
+"""The text of the identification report (:mod:`~stewartid.reports.identification.report`):
+data summary, which method to trust and why (the
+:class:`~stewartid.assessment.verdict.Verdict` in words), and ``report.md``.
 
 Every statement is computed from the numbers of the run (no fixed verdicts): if a result
 changes, so does the sentence about it.

@@ -1,0 +1,77 @@
+"""``--help`` of every command reads like the ecosystem's: metavars say what a value is, flags
+take none, and the text is reflowed so that no sentence is broken by a line break of the source."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+import typer.main
+
+from stewartid.cli.application import app
+
+COMMAND = typer.main.get_command(app)
+COMMANDS = sorted(COMMAND.commands)
+#: The metavars typer derives from type annotations, which say nothing about the value.
+TYPE_METAVAR = re.compile(r"<(?:bool|str|path|Path|int|float|list\[[^\]]*\])>|\{\w+\}\.\.\.")
+
+
+def render_help(capsys: pytest.CaptureFixture[str], command: str | None, width: int) -> str:
+    """The help text of ``stewartid [command] --help`` formatted for a terminal of ``width``."""
+    arguments = [command, "--help"] if command else ["--help"]
+    COMMAND.main(arguments, prog_name="stewartid", standalone_mode=False, terminal_width=width,
+                 max_content_width=width)
+    return capsys.readouterr().out
+
+
+def test_the_commands_are_all_checked() -> None:
+    assert COMMANDS == ["design", "identify", "methods", "nominal", "reproduce", "simulate", "study"]
+
+
+@pytest.mark.parametrize("command", [None, *COMMANDS])
+def test_help_has_no_type_metavars(capsys: pytest.CaptureFixture[str], command: str | None) -> None:
+    text = render_help(capsys, command, 100)
+    assert text.startswith("Usage: stewartid")
+    assert TYPE_METAVAR.findall(text) == []
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_every_value_option_names_its_value_and_flags_take_none(command: str) -> None:
+    for parameter in COMMAND.commands[command].params:
+        if getattr(parameter, "is_flag", False):
+            assert not parameter.metavar, f"{command} {parameter.opts[0]} is a flag"
+        else:
+            metavar = parameter.metavar or ""
+            assert re.fullmatch(r"[A-Z][A-Z_|]*(\|[a-z]+)*|[a-z]+(\|[a-z]+)+", metavar), (
+                f"{command} {parameter.opts[0]}: metavar {metavar!r}")
+
+
+@pytest.mark.parametrize("command", [None, *COMMANDS])
+def test_no_sentence_is_broken_by_a_line_break_of_the_source(
+        capsys: pytest.CaptureFixture[str], command: str | None) -> None:
+    """On a terminal wide enough for every paragraph, the description and each option's help
+    are one line each: a line break that survives is one the source put in by hand. (The check
+    is concrete: every paragraph of the description, and every option entry, is one line.)"""
+    text = render_help(capsys, command, 2000)
+    sections = text.split("\n\n")
+    description = [paragraph for paragraph in sections[1:]
+                   if not paragraph.lstrip().startswith(("Arguments:", "Options:", "Commands:"))]
+    for paragraph in description:
+        assert "\n" not in paragraph.strip(), f"broken description: {paragraph!r}"
+    entries = [line for section in sections
+               if section.startswith(("Arguments:", "Options:", "Commands:"))
+               for line in section.splitlines()[1:]]
+    assert entries
+    for line in entries:
+        assert re.match(r"  (-|[A-Z]|[a-z])", line), f"an entry broken over lines: {line!r}"
+
+
+def test_method_help_names_all() -> None:
+    option = next(parameter for parameter in COMMAND.commands["identify"].params
+                  if parameter.name == "method")
+    assert "'all'" in option.help
+
+
+def test_a_description_keeps_its_square_brackets(capsys: pytest.CaptureFixture[str]) -> None:
+    # rich markup read "[limits]" as a style tag and dropped it from the design's description
+    assert "within the platform's [limits]" in render_help(capsys, "design", 2000)
