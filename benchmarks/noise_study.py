@@ -321,14 +321,15 @@ def fit_method(method: str, data, clean, platform):
 
 
 def kind_study(kind: str, platform_name: str = "paper", folder: Path | None = None,
-               methods=None, seeds=(0, 1, 2, 3)):
+               methods=None, seeds=(0, 1, 2, 3), tag: str | None = None):
     """Rows (kind, method, seed, largest error %, err/SE ratios) on one log kind: every
     method on the clean logs (seed None) and on ``seeds`` copies with the reference sensor
     noise; the truth is the platform's nominal (Mt, Bt). A method that refuses the data
-    gives a row with ``refused`` set to its message."""
+    gives a row with ``refused`` set to its message. The clean logs live in
+    ``folder/TAG_KIND_clean`` (``tag``: default "paper", or the platform file's stem)."""
     platform = kind_platform(platform_name)
     M, B = nominal_matrices(platform)
-    tag = "paper" if platform_name == "paper" else Path(platform_name).parent.name
+    tag = tag or ("paper" if platform_name == "paper" else Path(platform_name).stem)
     folder = Path(folder) if folder is not None else Path("noise_study_logs")
     clean = kind_logs(kind, platform, folder / f"{tag}_{kind}_clean")
     methods = methods or [*(spec.name for spec in registered_methods()), "oracle"]
@@ -396,12 +397,16 @@ def main() -> None:
     parser.add_argument("--clean", type=Path, default=Path("noise_study_logs"),
                         help="with --kind: folder of the clean logs, TAG_KIND_clean/exp1..6.csv "
                              "(simulated and written there when missing)")
+    parser.add_argument("--tag", default=None,
+                        help="with --kind: TAG of the clean-log folders (default: paper, or the "
+                             "platform file's stem)")
     args = parser.parse_args()
     if args.kind:
         methods = args.methods.split(",") if args.methods else None
         rows = []
         for kind in args.kind.split(","):
-            rows += kind_study(kind, args.platform, args.clean, methods, tuple(range(args.seeds)))
+            rows += kind_study(kind, args.platform, args.clean, methods, tuple(range(args.seeds)),
+                               args.tag)
         print(f"platform {args.platform}, Coulomb {KIND_COULOMB:g} N m, reference sensor noise, "
               f"{args.seeds} seeds")
         print("\n".join(kind_summary(rows)))
