@@ -53,7 +53,7 @@ from stewartid.identification.wavelet.weak_form import (
 from stewartid.model.joints import JOINT_TYPES
 
 #: Candidate transition rates r (rad/s) of the Coulomb soft sign (module docstring). No rate
-#: between 0 and 1e-4: on records of an exact sign sampled at 1 kHz, 3e-5 fitted the
+#: between 0 and 1e-4: on records of an exact sign sampled at 500 Hz, 3e-5 fitted the
 #: sampling error of the switches better than 0 and moved the rotational Bt diagonal by 3 %.
 SOFT_SIGN_RATES = (0.0, 1e-4, 3e-4, 1e-3, 3e-3)
 
