@@ -1,5 +1,13 @@
 """Sensor-noise study: each method's errors against the standard errors it predicts.
 
+Two data sources. By default the independent simulator's example data set (below). With
+``--kind paper|three|alldof|tenx`` (several separated by commas), noise-free logs of our own
+plant (``--platform paper|FILE``, Coulomb 30 N m, 6 x 20 s; :func:`kind_logs`): the paper's
+0.5 Hz sine per DOF, three sines per DOF (0.3, 0.7, 1.5 Hz), all six DOFs at once (one
+frequency each) and the paper's sine at ten times its amplitude, with the reference sensor
+noise (:func:`stewartid.simulation.sensors.reference_noise`) added per seed; the truth is the
+nominal (Mt, Bt). Every registered method and the oracle run on each kind (:func:`kind_study`).
+
 Data: the independent simulator's example data set (``tests/data/example_c10``, truth in
 ``truth.json``) with sensor noise added as on a real hexapod: white noise on the measured
 leg lengths (the pose is then the forward kinematics of the noisy lengths) and on the leg
@@ -12,6 +20,8 @@ Usage::
 
     python benchmarks/noise_study.py [--seeds 4] [--scales 0.5,1,2] [--length-noise 20e-6]
         [--force-noise 0.005] [--methods wavelet,fourier,...]
+    python benchmarks/noise_study.py --kind three,alldof,tenx [--platform paper|FILE]
+        [--clean DIR] [--tag NAME] [--seeds 4] [--methods ...]
 """
 
 from __future__ import annotations
@@ -24,11 +34,21 @@ from pathlib import Path
 
 import numpy as np
 
-from stewartid.datasets.dataset import Dataset, read_datasets
-from stewartid.identification.registry import create_identifier
+from stewartid.datasets.dataset import Dataset, read_datasets, write_dataset
+from stewartid.identification.registry import create_identifier, registered_methods
+from stewartid.model.linearization import nominal_matrices
 from stewartid.platform import load_platform
 from stewartid.reference.published import PAPER_ENTRIES, relative_error_percent
-from stewartid.simulation import SensorNoise, degrade
+from stewartid.signals.differentiation import savgol_gain, window_samples
+from stewartid.simulation import (
+    DEFAULT_AMPLITUDES,
+    SensorNoise,
+    Sine,
+    degrade,
+    multisine_excitation,
+    simulate_experiment,
+)
+from stewartid.simulation.sensors import reference_noise
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "tests" / "data" / "example_c10"
 #: Method B (default: every interval constant free), with the shared-friction interval
@@ -46,7 +66,8 @@ class OracleIdentifier:
     """Least squares given the Coulomb force of the noise-free motion (the efficiency bound a
     friction-immune method is measured against): y - F_coulomb = Mt q_ddot + Bt q_dot + offset
     per experiment, Savitzky-Golay derivatives of the measured pose, standard errors for
-    autocorrelated residuals."""
+    autocorrelated residuals. The window is the longest that passes every excitation line of
+    the clean pose with a gain within 1e-3 of 1 (:func:`oracle_window`)."""
 
     def __init__(self, clean):
         self.clean = clean
@@ -55,19 +76,14 @@ class OracleIdentifier:
         from stewartid.identification.preparation import prepare
         from stewartid.identification.solvers import solve_least_squares
         from stewartid.model.dynamics import friction_forces
-        from stewartid.signals.differentiation import (
-            default_window,
-            differentiate,
-            estimate_frequency,
-            trim,
-        )
+        from stewartid.signals.differentiation import differentiate, trim
 
         viscous_only = platform.replace(friction__coulomb=0.0)
         phis, ys = [], []
         for k, (experiment, clean) in enumerate(zip(prepare(datasets, platform), self.clean,
                                                     strict=True)):
             rate = experiment.sample_rate
-            window = default_window(estimate_frequency(clean.pose, rate))
+            window = oracle_window(clean.lengths, rate)
             _, qd_true, _ = differentiate(clean.pose, rate, window)
             coulomb = (friction_forces(platform, clean.pose, qd_true)
                        - friction_forces(viscous_only, clean.pose, qd_true))
@@ -83,6 +99,68 @@ class OracleIdentifier:
         self.std_errors_ = {"M": solution.theta_std[:, :6], "B": solution.theta_std[:, 6:12]}
         return self
 
+
+#: Lines of the clean pose's spectrum counted as excitation: local maxima of amplitude above
+#: this share of the channel's largest line.
+LINE_FLOOR = 1e-2
+
+
+def excitation_lines(lengths: np.ndarray, sample_rate: float, floor: float = LINE_FLOOR
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """The spectral lines of a clean record with real power, found in the leg lengths (one
+    unit for every channel; a pose line is a line of the legs that move).
+
+    Parameters
+    ----------
+    lengths : ndarray, shape (N, 6)
+        Noise-free leg lengths (m).
+    sample_rate : float
+        Hz.
+    floor : float
+        A bin counts when its Hann-windowed amplitude on some leg is a local maximum above
+        ``floor`` times the largest of any leg.
+
+    Returns
+    -------
+    frequencies : ndarray, shape (n_lines,)
+        Sorted (Hz), zero excluded.
+    shares : ndarray, shape (n_lines,)
+        Each line's largest amplitude over the largest of any leg.
+    """
+    centered = lengths - lengths.mean(axis=0)
+    amplitude = np.abs(np.fft.rfft(centered * np.hanning(len(lengths))[:, None], axis=0))
+    amplitude[0] = 0.0
+    # one unit for every channel: shares of the largest line of any leg
+    share = amplitude / amplitude.max()
+    # local maxima only: the fade-in's leakage around a line is not a line of its own
+    local = np.zeros_like(share, dtype=bool)
+    local[1:-1] = (share[1:-1] >= share[:-2]) & (share[1:-1] >= share[2:])
+    share = np.where(local & (share > floor), share, 0.0).max(axis=1)
+    strong = share > 0
+    return np.fft.rfftfreq(len(lengths), 1.0 / sample_rate)[strong], share[strong]
+
+
+def oracle_window(lengths: np.ndarray, sample_rate: float, tolerance: float = 1e-3) -> float:
+    """The longest Savitzky-Golay window (s) whose error on the position, velocity and
+    acceleration of every excitation line (:func:`excitation_lines`), |gain - 1| times the
+    line's share of that derivative's largest line, stays within ``tolerance`` (longer
+    windows average more noise; shorter ones bias less)."""
+    frequencies, shares = excitation_lines(lengths, sample_rate)
+    # each derivative's amplitude relative to its largest line
+    weights = [shares * frequencies ** d / np.max(shares * frequencies ** d) for d in (0, 1, 2)]
+
+    def worst(window: float) -> float:
+        return max(abs(savgol_gain(f, sample_rate, window, deriv=d) - 1.0) * weights[d][i]
+                   for i, f in enumerate(frequencies) for d in (0, 1, 2))
+
+    low = window_samples(0.0, sample_rate) / sample_rate
+    high = 1.0 / float(frequencies.min())
+    if worst(low) > tolerance:
+        return low
+    while high - low > 1.0 / sample_rate:
+        middle = 0.5 * (low + high)
+        low, high = (middle, high) if worst(middle) <= tolerance else (low, middle)
+    return low
 
 def load_example(folder: Path = EXAMPLE):
     """Platform, datasets and true (Mt, Bt) of the example data set."""
@@ -180,6 +258,126 @@ def summary(rows) -> list[str]:
     return lines
 
 
+#: Log kinds of our own plant (:func:`kind_sines`).
+KINDS = ("paper", "three", "alldof", "tenx")
+#: Coulomb level (N m), record length (s) and sample count of the kinds' logs.
+KIND_COULOMB = 30.0
+KIND_DURATION = 20.0
+#: Frequencies (Hz) of the all-DOFs kind: DOF d of experiment k at ALLDOF_HZ[(d + k) % 6].
+ALLDOF_HZ = (0.3, 0.45, 0.6, 0.75, 0.9, 1.05)
+
+
+def kind_sines(kind: str, k: int) -> list[Sine]:
+    """The sines of experiment ``k`` (0..5) of a log kind.
+
+    "paper": DOF k at 0.5 Hz, the paper's amplitude; "three": DOF k at 0.3, 0.7 and 1.5 Hz
+    (0.6, 0.3, 0.15 of that amplitude); "alldof": every DOF at 0.7 of its amplitude, each at
+    its own frequency (:data:`ALLDOF_HZ`); "tenx": the paper's sine at ten times its amplitude.
+    """
+    a = DEFAULT_AMPLITUDES[k]
+    if kind == "paper":
+        return [Sine(k, a, 0.5)]
+    if kind == "three":
+        return [Sine(k, a * w, f, ph) for w, f, ph in ((0.6, 0.3, 0.0), (0.3, 0.7, 1.0),
+                                                        (0.15, 1.5, 2.0))]
+    if kind == "alldof":
+        return [Sine(d, DEFAULT_AMPLITUDES[d] * 0.7, ALLDOF_HZ[(d + k) % 6], 0.5 * d + k)
+                for d in range(6)]
+    if kind == "tenx":
+        return [Sine(k, 10 * a, 0.5)]
+    raise ValueError(f"log kind must be one of {', '.join(KINDS)}; got {kind!r}.")
+
+
+def kind_platform(name: str):
+    """The platform ``name`` ("paper" or a TOML file) with the kinds' Coulomb level."""
+    return load_platform(name).replace(friction__coulomb=KIND_COULOMB)
+
+
+def kind_logs(kind: str, platform, folder: Path) -> list[Dataset]:
+    """Noise-free logs exp1..exp6 of a kind on our plant, read from ``folder`` when there,
+    else simulated (ideal sensors, 1 kHz) and written there first."""
+    paths = [folder / f"exp{k + 1}.csv" for k in range(6)]
+    if not all(path.exists() for path in paths):
+        folder.mkdir(parents=True, exist_ok=True)
+        for k, path in enumerate(paths):
+            dataset, _ = simulate_experiment(
+                platform, multisine_excitation(platform, kind_sines(kind, k), name=f"exp{k + 1}"),
+                KIND_DURATION, noise=SensorNoise(), rng=np.random.default_rng(0))
+            write_dataset(dataset, path)
+    return read_datasets(paths, platform)
+
+
+def fit_method(method: str, data, clean, platform):
+    """Fit one method (a registered name, a :data:`METHODS` variant or "oracle"); the
+    estimator, or the first line of the error that refused the data."""
+    if method == "oracle":
+        factory = functools.partial(OracleIdentifier, clean)
+    else:
+        factory = METHODS.get(method, functools.partial(create_identifier, method))
+    try:
+        return factory().fit(data, platform)
+    except Exception as error:  # noqa: BLE001 - a refusal is a result of the study
+        return str(error).splitlines()[0]
+
+
+def kind_study(kind: str, platform_name: str = "paper", folder: Path | None = None,
+               methods=None, seeds=(0, 1, 2, 3), tag: str | None = None):
+    """Rows (kind, method, seed, largest error %, err/SE ratios) on one log kind: every
+    method on the clean logs (seed None) and on ``seeds`` copies with the reference sensor
+    noise; the truth is the platform's nominal (Mt, Bt). A method that refuses the data
+    gives a row with ``refused`` set to its message. The clean logs live in
+    ``folder/TAG_KIND_clean`` (``tag``: default "paper", or the platform file's stem)."""
+    platform = kind_platform(platform_name)
+    M, B = nominal_matrices(platform)
+    tag = tag or ("paper" if platform_name == "paper" else Path(platform_name).stem)
+    folder = Path(folder) if folder is not None else Path("noise_study_logs")
+    clean = kind_logs(kind, platform, folder / f"{tag}_{kind}_clean")
+    methods = methods or [*(spec.name for spec in registered_methods()), "oracle"]
+    rows = []
+    for seed in [None, *seeds]:
+        data = clean if seed is None else [
+            degrade(d, platform, reference_noise(platform), np.random.default_rng(seed + 101 * k))
+            for k, d in enumerate(clean)]
+        for method in methods:
+            start = time.perf_counter()
+            estimator = fit_method(method, data, clean, platform)
+            row = {"kind": kind, "method": method, "seed": seed,
+                   "seconds": time.perf_counter() - start, "refused": None}
+            if isinstance(estimator, str):
+                row["refused"] = estimator
+            else:
+                errors, ratios = entry_ratios(estimator, M, B)
+                row.update(max_error_percent=float(errors.max()), errors=errors, ratios=ratios)
+            rows.append(row)
+    return rows
+
+
+def kind_summary(rows) -> list[str]:
+    """Markdown table per kind and method: the largest error over the 20 entries on the clean
+    logs, its median over the noisy seeds, the share of (entry, seed) pairs within 3
+    standard errors and the largest |error| / SE over them."""
+    lines = ["| log | method | clean: largest error (%) | noisy: median largest error (%) | "
+             "within 3 SE (%) | largest error/SE | time (s) |", "|---|---|---|---|---|---|---|"]
+    for kind in dict.fromkeys(r["kind"] for r in rows):
+        for method in dict.fromkeys(r["method"] for r in rows if r["kind"] == kind):
+            group = [r for r in rows if r["kind"] == kind and r["method"] == method]
+            clean = [r for r in group if r["seed"] is None]
+            noisy = [r for r in group if r["seed"] is not None and r["refused"] is None]
+            refused = [r for r in group if r["refused"] is not None]
+            clean_text = (f"{clean[0]['max_error_percent']:.3g}" if clean and not
+                          clean[0]["refused"] else "refused")
+            if noisy:
+                ratios = np.concatenate([r["ratios"] for r in noisy])
+                largest = np.median([r["max_error_percent"] for r in noisy])
+                cells = f"{largest:.3g} | {100 * np.mean(ratios <= 3):.0f} | {ratios.max():.3g}"
+            else:
+                cells = "refused | - | -"
+            note = f" (refused: {refused[0]['refused'][:90]})" if refused else ""
+            lines.append(f"| {kind} | {method}{note} | {clean_text} | {cells} | "
+                         f"{np.mean([r['seconds'] for r in group]):.1f} |")
+    return lines
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=4)
@@ -188,8 +386,32 @@ def main() -> None:
                         help="fraction of each leg's mean force")
     parser.add_argument("--scales", default="0.5,1,2",
                         help="comma-separated multiples of the noise levels (0 is always run)")
-    parser.add_argument("--methods", default=",".join([*METHODS, "oracle"]))
+    parser.add_argument("--methods", default=None,
+                        help="comma-separated; default: the variants of METHODS and the oracle "
+                             "on the example data, every registered method and the oracle "
+                             "with --kind")
+    parser.add_argument("--kind", default=None,
+                        help=f"comma-separated log kinds of our plant ({', '.join(KINDS)}) "
+                             "instead of the example data set")
+    parser.add_argument("--platform", default="paper", help="with --kind: paper or a TOML file")
+    parser.add_argument("--clean", type=Path, default=Path("noise_study_logs"),
+                        help="with --kind: folder of the clean logs, TAG_KIND_clean/exp1..6.csv "
+                             "(simulated and written there when missing)")
+    parser.add_argument("--tag", default=None,
+                        help="with --kind: TAG of the clean-log folders (default: paper, or the "
+                             "platform file's stem)")
     args = parser.parse_args()
+    if args.kind:
+        methods = args.methods.split(",") if args.methods else None
+        rows = []
+        for kind in args.kind.split(","):
+            rows += kind_study(kind, args.platform, args.clean, methods, tuple(range(args.seeds)),
+                               args.tag)
+        print(f"platform {args.platform}, Coulomb {KIND_COULOMB:g} N m, reference sensor noise, "
+              f"{args.seeds} seeds")
+        print("\n".join(kind_summary(rows)))
+        return
+    args.methods = args.methods or ",".join([*METHODS, "oracle"])
     scales = tuple(float(v) for v in args.scales.split(","))
     rows = study(tuple(args.methods.split(",")), tuple(range(args.seeds)), args.length_noise,
                  args.force_noise, scales=scales)

@@ -82,7 +82,7 @@ from stewartid.identification.wavelet.gls import WeakFormSolution, solve_weak_fo
 from stewartid.identification.wavelet.noise import estimate_noise
 from stewartid.identification.wavelet.point_equations import EXACT_DEGREE, point_equations
 from stewartid.identification.wavelet.weak_form import experiment_equations
-from stewartid.identification.wavelet.windows import solve_windows, window_equations
+from stewartid.identification.wavelet.windows import solve_windows_over_rates, window_equations
 from stewartid.model.joints import JOINT_TYPES
 from stewartid.platform import COORDINATES, Platform
 from stewartid.signals.wavelets import MotherWavelet, PolynomialWavelet, make_wavelet
@@ -307,7 +307,7 @@ class WaveletIdentifier(BaseIdentifier):
                      "force_variance": [i["force_noise_variance"] for i in infos],
                      "force_sensitivity": sensitivities}
         if friction == "coulomb":
-            solution = solve_windows(equations, **noise)
+            solution, _ = solve_windows_over_rates(equations, **noise)
         else:
             check_coverage([i["name"] for i in infos], np.array(motion),
                            [sum(e.experiment == k for e in equations) for k in range(len(infos))])
