@@ -105,7 +105,7 @@ class OracleIdentifier:
 LINE_FLOOR = 1e-2
 
 
-def excitation_lines(lengths: np.ndarray, sample_rate: float, floor: float = LINE_FLOOR
+def leg_length_lines(lengths: np.ndarray, sample_rate: float, floor: float = LINE_FLOOR
                      ) -> tuple[np.ndarray, np.ndarray]:
     """The spectral lines of a clean record with real power, found in the leg lengths (one
     unit for every channel; a pose line is a line of the legs that move).
@@ -142,10 +142,10 @@ def excitation_lines(lengths: np.ndarray, sample_rate: float, floor: float = LIN
 
 def oracle_window(lengths: np.ndarray, sample_rate: float, tolerance: float = 1e-3) -> float:
     """The longest Savitzky-Golay window (s) whose error on the position, velocity and
-    acceleration of every excitation line (:func:`excitation_lines`), |gain - 1| times the
+    acceleration of every excitation line (:func:`leg_length_lines`), |gain - 1| times the
     line's share of that derivative's largest line, stays within ``tolerance`` (longer
     windows average more noise; shorter ones bias less)."""
-    frequencies, shares = excitation_lines(lengths, sample_rate)
+    frequencies, shares = leg_length_lines(lengths, sample_rate)
     # each derivative's amplitude relative to its largest line
     weights = [shares * frequencies ** d / np.max(shares * frequencies ** d) for d in (0, 1, 2)]
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
-from noise_study import excitation_lines, kind_sines, oracle_window  # noqa: E402
+from noise_study import leg_length_lines, kind_sines, oracle_window  # noqa: E402
 
 from stewartid.signals.differentiation import differentiate, trim  # noqa: E402
 
@@ -32,7 +32,7 @@ def test_excitation_lines_are_the_injected_sines():
     """Three sines with whole periods in the record: exactly their frequencies, with their
     amplitude shares (Hann window: leakage only into the neighbouring bins)."""
     lengths, _ = three_sine_lengths()
-    frequencies, shares = excitation_lines(lengths, RATE)
+    frequencies, shares = leg_length_lines(lengths, RATE)
     np.testing.assert_allclose(frequencies, [0.3, 0.7, 1.5], atol=1e-9)
     np.testing.assert_allclose(shares, [1.0, 0.5, 0.25], rtol=1e-6)
 
