@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
-from noise_study import leg_length_lines, kind_sines, oracle_window  # noqa: E402
+from noise_study import kind_sines, leg_length_lines, oracle_window  # noqa: E402
 
 from stewartid.signals.differentiation import differentiate, trim  # noqa: E402
 
