@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from roundoff import EPS
 from stewartid.errors import ConfigError
 from stewartid.platform import load_platform
 
@@ -70,8 +71,9 @@ def test_leg_numbering_follows_model_md(paper):
                                deg(240) + a_u]) % (2 * math.pi)
     expected_lower = np.array([deg(300) + a_b, deg(60) - a_b, deg(60) + a_b, deg(180) - a_b,
                                deg(180) + a_b, deg(300) - a_b])
-    np.testing.assert_allclose(upper, expected_upper, atol=1e-12)
-    np.testing.assert_allclose(lower, expected_lower, atol=1e-12)
+    # joints placed by radius x (cos, sin), read back by atan2: a few ulps of angles up to 2 pi
+    np.testing.assert_allclose(upper, expected_upper, atol=8 * EPS * 2 * math.pi)
+    np.testing.assert_allclose(lower, expected_lower, atol=8 * EPS * 2 * math.pi)
     # each upper joint connects to the nearest lower joint
     world_upper = paper.upper_joints + paper.neutral_pose[:3]
     for k in range(6):

@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from roundoff import EPS
 from stewartid.datasets.dataset import dataset_from_frame, read_dataset
 from stewartid.datasets.log_format import load_log_format, log_format_from_mapping
 from stewartid.errors import ConfigError, DataError, DataWarning
@@ -53,8 +54,11 @@ def test_worked_mapping_lengths_in_mm_time_in_ms(tmp_path, frame, reference, exa
     path = _log(tmp_path, log, sep=";", decimal=",")
     assert "2706,908423" in path.read_text().splitlines()[1]
     back = read_dataset(path, example_platform, log_format=mapping)
-    assert back.t == pytest.approx(reference.t, abs=1e-12)
-    assert back.lengths == pytest.approx(reference.lengths, abs=1e-12)
+    # the log has <= 10 significant digits, so %.12g writes them exactly: only the x1e3 and
+    # /1e3 conversions round (2 eps each), whatever the decimal separator
+    assert back.t == pytest.approx(reference.t, abs=4 * EPS * np.abs(reference.t).max())
+    assert back.lengths == pytest.approx(reference.lengths,
+                                         abs=4 * EPS * np.abs(reference.lengths).max())
     assert back.forces == pytest.approx(reference.forces, rel=1e-12)
     assert back.pose == pytest.approx(reference.pose, abs=1e-6)  # forward kinematics
 
@@ -72,7 +76,9 @@ def test_worked_mapping_chamber_pressures(tmp_path, frame, reference, example_pl
         log[f"pA{k}"] = (frame[f"f{k}"] + rod_side * annulus) / piston / 1e5
         log[f"pB{k}"] = rod_side / 1e5
     back = read_dataset(_log(tmp_path, log), example_platform, log_format=mapping)
-    assert back.lengths == pytest.approx(reference.lengths, abs=1e-9)
+    # l - 2.2 and x1e3 round, %.12g restores the log's 10 digits, /1e3 + offset round again
+    assert back.lengths == pytest.approx(reference.lengths,
+                                         abs=8 * EPS * np.abs(reference.lengths).max())
     assert back.forces == pytest.approx(reference.forces, rel=1e-5)
 
 
