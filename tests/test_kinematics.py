@@ -29,8 +29,9 @@ def random_poses(platform, rng, n):
 def test_rotation_is_rz_ry_rx(rng):
     angles = rng.uniform(-0.5, 0.5, (20, 3))
     expected = Rotation.from_euler("xyz", angles).as_matrix()  # extrinsic x, y, z = Rz Ry Rx
-    # entries <= 1, sums of two products of three rounded sines/cosines: 8 eps per implementation
-    np.testing.assert_allclose(rotation_matrix(angles), expected, atol=16 * EPS)
+    # entries <= 1, sums of two products of three sines/cosines, each within 4 ulps where
+    # numpy vectorises them (some CPUs), against scipy's own construction: 32 eps each side
+    np.testing.assert_allclose(rotation_matrix(angles), expected, atol=64 * EPS)
 
 
 def test_neutral_legs_are_equal(paper):

@@ -71,9 +71,10 @@ def test_leg_numbering_follows_model_md(paper):
                                deg(240) + a_u]) % (2 * math.pi)
     expected_lower = np.array([deg(300) + a_b, deg(60) - a_b, deg(60) + a_b, deg(180) - a_b,
                                deg(180) + a_b, deg(300) - a_b])
-    # joints placed by radius x (cos, sin), read back by atan2: a few ulps of angles up to 2 pi
-    np.testing.assert_allclose(upper, expected_upper, atol=8 * EPS * 2 * math.pi)
-    np.testing.assert_allclose(lower, expected_lower, atol=8 * EPS * 2 * math.pi)
+    # joints placed by radius x (cos, sin), read back by atan2: three library calls, each
+    # within 4 ulps where numpy vectorises them (some CPUs), on angles up to 2 pi
+    np.testing.assert_allclose(upper, expected_upper, atol=64 * EPS * 2 * math.pi)
+    np.testing.assert_allclose(lower, expected_lower, atol=64 * EPS * 2 * math.pi)
     # each upper joint connects to the nearest lower joint
     world_upper = paper.upper_joints + paper.neutral_pose[:3]
     for k in range(6):
