@@ -25,6 +25,7 @@ import numpy as np
 
 from stewartid.datasets.dataset import MIN_SAMPLES, Dataset
 from stewartid.errors import ConfigError, DataError
+from stewartid.signals.interpolation import spline_at
 
 
 def shift_forces(dataset: Dataset, delay: float) -> Dataset:
@@ -42,7 +43,7 @@ def shift_forces(dataset: Dataset, delay: float) -> Dataset:
     -------
     Dataset
         The samples k with t_k + delay inside [t_0, t_end], pose and lengths unchanged there,
-        forces f_logged(t_k + delay) (cubic spline through the logged forces; a delay that
+        forces f_logged(t_k + delay) (:func:`~stewartid.signals.interpolation.spline_at`; a delay that
         is a whole number of sample periods gives the logged samples themselves).
 
     Raises
@@ -51,8 +52,6 @@ def shift_forces(dataset: Dataset, delay: float) -> Dataset:
         A non-finite delay, or one so long that fewer than
         :data:`~stewartid.datasets.dataset.MIN_SAMPLES` samples would remain.
     """
-    from scipy.interpolate import CubicSpline
-
     delay = float(delay)
     if not np.isfinite(delay):
         raise ConfigError(f"the force delay must be a finite number of seconds; got {delay}.")
@@ -74,7 +73,7 @@ def shift_forces(dataset: Dataset, delay: float) -> Dataset:
         whole = int(round(shifts))
         forces = dataset.forces[np.flatnonzero(keep) + whole]
     else:
-        forces = CubicSpline(t, dataset.forces, axis=0)(target)
+        forces = spline_at(t, dataset.forces, target)
     return Dataset(t=t[keep], pose=dataset.pose[keep], lengths=dataset.lengths[keep],
                    forces=forces, name=dataset.name)
 

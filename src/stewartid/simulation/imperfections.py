@@ -20,30 +20,23 @@ simulator and of :func:`stewartid.simulation.sensors.degrade`:
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 from scipy import signal
-from scipy.interpolate import CubicSpline
+
+from stewartid.signals.interpolation import spline_at
 
 #: Decay (relative amplitude) of the filter's impulse response after its warm-up: the filter
 #: runs that many samples before the record so that the noise is stationary from its start.
 SETTLED = 1e-10
-#: First derivative at the first of five equally spaced samples, times the spacing
-#: (error h^4 x^(5) / 5).
-ONE_SIDED_SLOPE = np.array([-25.0, 48.0, -36.0, 16.0, -3.0]) / 12.0
-
-
 def delay_signal(t: np.ndarray, values: np.ndarray, delay_s: float) -> np.ndarray:
     """The signal ``delay_s`` seconds later: out(t) = values(t - delay_s).
 
-    The sampled signal is interpolated by a cubic spline whose end slopes are the five-point
-    one-sided differences of the samples (error h^4 |x^(5)| / 5). That keeps the classical
-    error bound of the complete spline, (5/384) h^4 max|x''''| for a period h, up to the
-    ends of the record (plus h^5 max|x^(5)| / 5 from the end slopes): for a sine of
-    frequency f and amplitude A, 5/384 A (2 pi f h)^4, 1e-10 A at 1.5 Hz and 1 kHz. A delay
-    of a whole number of samples returns the samples shifted (to round-off). Before the
-    first sample the signal is its first value (the rig at rest before the record started).
+    The sampled signal is interpolated by :func:`~stewartid.signals.interpolation.spline_at`
+    (within its error bound up to the ends of the record): for a sine of frequency f and
+    amplitude A, 5/384 A (2 pi f h)^4, 1e-10 A at 1.5 Hz and 1 kHz. A delay of a whole number
+    of samples returns the samples shifted (to round-off). Before the first sample the
+    signal is its first value (the rig at rest before the record started).
 
     Parameters
     ----------
@@ -58,22 +51,12 @@ def delay_signal(t: np.ndarray, values: np.ndarray, delay_s: float) -> np.ndarra
     -------
     ndarray
         Same shape and unit as ``values``.
-
-    References
-    ----------
-    C. A. Hall, W. W. Meyer, Optimal error bounds for cubic spline interpolation, J. Approx.
-    Theory 16 (1976) 105-122, doi:10.1016/0021-9045(76)90040-X.
     """
     values = np.asarray(values, dtype=float)
     if delay_s == 0:
         return values.copy()
     t = np.asarray(t, dtype=float)
-    ends: Any = "not-a-knot"
-    if len(t) >= 5:
-        first = np.tensordot(ONE_SIDED_SLOPE, values[:5], axes=1) / (t[1] - t[0])
-        last = -np.tensordot(ONE_SIDED_SLOPE, values[::-1][:5], axes=1) / (t[-1] - t[-2])
-        ends = ((1, first), (1, last))
-    return CubicSpline(t, values, axis=0, bc_type=ends)(np.maximum(t - delay_s, t[0]))
+    return spline_at(t, values, np.maximum(t - delay_s, t[0]))
 
 
 def lowpass_sections(cutoff_hz: float, order: int, sample_rate_hz: float) -> np.ndarray:
