@@ -52,6 +52,34 @@ def test_coulomb_square_wave_biases_bt_by_four_over_pi(paper, truth):
     assert est.M_ == pytest.approx(M, rel=1e-3, abs=1e-3 * np.abs(M).max())
 
 
+def test_standard_errors_carry_the_coulomb_bias_the_third_harmonic_shows(paper, truth):
+    """The bias (4/pi) F / (w A) of a square wave is what its third harmonic, (4/3pi) F,
+    implies: the reported standard error of Bt[:, k] covers the bias; without friction the
+    bound vanishes (no third harmonic in a linear system's force)."""
+    M, B = truth
+    w = 2 * np.pi * 1.0
+    level = np.array([50.0, -20.0, 35.0, 80.0, 15.0, -60.0])
+
+    def fit(with_friction: bool) -> FourierIdentifier:
+        data = []
+        for k in range(6):
+            def square(t, q, qd, J, k=k):
+                return np.sign(qd[:, k])[:, None] * level
+            data.append(make_experiment(paper, M, B, k, sample_rate=400.0,
+                                        coulomb=square if with_friction else None))
+        return FourierIdentifier(frequency_hz=1.0).fit(data, paper)
+
+    biased = fit(True)
+    bias = (4 / np.pi) * np.abs(level)[:, None] / (w * AMPLITUDES[None, :])
+    bound = np.asarray(biased.result_.diagnostics["friction_bias"]["bound_B"])
+    # the sampled square wave's third harmonic is exact to the switching-time resolution
+    assert bound == pytest.approx(bias, rel=2e-2)
+    assert np.all(np.abs(biased.B_ - B) <= 1.05 * biased.std_errors_["B"])
+    clean = fit(False)
+    clean_bound = np.asarray(clean.result_.diagnostics["friction_bias"]["bound_B"])
+    assert np.all(clean_bound <= 1e-6 * bias)
+
+
 def test_stiffness_needs_two_frequencies(paper, truth):
     M, B = truth
     K = np.diag([2e4, 2e4, 5e4, 1e4, 1e4, 3e3])

@@ -24,6 +24,7 @@ from stewartid.identification.consistency import (
     consistency_metrics,
     project_consistent,
 )
+from stewartid.reference.published import PAPER_ENTRIES, relative_error_percent
 from stewartid.reporting.exports import read_matrix_csv
 from stewartid.reports.identification.report import write_identification_report
 
@@ -292,6 +293,25 @@ def test_report_on_the_independent_example(tmp_path, example_dir, example_platfo
     assert all(r.result is not None for r in compared.runs)
     trusted = next(r for r in compared.runs if r.name == compared.trusted)
     assert f"**Trust {trusted.display_name} on these data.**" in text
+    # the verdict against the independent simulator's truth: the trusted method's largest
+    # error over the paper's 20 entries is within 1.5x (+0.1 point) of the best method's
+    truth = json.loads((example_dir / "truth.json").read_text())
+    worst = {}
+    for run in compared.runs:
+        worst[run.name] = max(relative_error_percent(
+            (run.result.M if m == "M" else run.result.B)[i, j],
+            np.array(truth["Mt" if m == "M" else "Bt"])[i, j]) for m, i, j in PAPER_ENTRIES)
+    assert worst[compared.trusted] <= 1.5 * min(worst.values()) + 0.1, worst
+    document = json.loads((tmp_path / "all" / "result.json").read_text())
+    verdict = document["verdict"]
+    assert verdict["trusted"] == compared.trusted == document["method"]
+    assert sorted(verdict["ranking"]) == ["fourier", "ls", "wavelet"]
+    assert isinstance(verdict["uncertain_entries"], list) and verdict["reasons"]
+    for name in ("wavelet", "fourier", "ls"):
+        assert (tmp_path / "all" / f"{name}_std_errors_B.csv").is_file()
+    # Method B predicts held-out data with the Coulomb levels of its companion fit
+    wavelet = next(r for r in compared.runs if r.name == "wavelet")
+    assert np.all(wavelet.validation.vaf_percent >= 99.0)
     # Coulomb friction of 10 N m: the Fourier method's Bt is pulled up, and the report says so
     assert "Coulomb friction is present" in text and "pulls Bt up" in text
 

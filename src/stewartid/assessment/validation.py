@@ -30,6 +30,7 @@ per segment):
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -155,6 +156,44 @@ def coulomb_levels(result: IdentificationResult) -> np.ndarray | None:
     return values if np.all(np.isfinite(values)) else None
 
 
+def prediction_levels(result: IdentificationResult) -> np.ndarray | None:
+    """Coulomb levels per joint type (N m) a result predicts with: its own
+    (:func:`coulomb_levels`), else those of the friction fit run alongside it for the
+    validation (``diagnostics["validation_coulomb"]``, see :func:`with_companion_friction`),
+    else None."""
+    levels = coulomb_levels(result)
+    if levels is not None:
+        return levels
+    companion = result.diagnostics.get("validation_coulomb")
+    if not isinstance(companion, dict):
+        return None
+    values = np.array([companion.get(name, np.nan) for name in FRICTION_TYPES], dtype=float)
+    return values if np.all(np.isfinite(values)) else None
+
+
+def with_companion_friction(result: IdentificationResult, companion: Callable[[], Any] | None,
+                            datasets: Sequence[Dataset], platform: Platform
+                            ) -> IdentificationResult:
+    """``result`` with the Coulomb levels of a friction-estimating fit of the same data
+    (``diagnostics["validation_coulomb"]``), when it has none of its own.
+
+    A method that leaves friction free (Method B's interval constants) is immune to it but
+    cannot predict it; without it, its held-out residual would be the friction it never
+    claimed to model. The companion (Method B with ``friction="uniform"``) estimates the
+    levels; Mt and Bt stay the method's own.
+    """
+    if companion is None or coulomb_levels(result) is not None:
+        return result
+    try:
+        levels = companion().fit(list(datasets), platform).result_.diagnostics.get("coulomb")
+    except StewartidError:
+        return result
+    if not isinstance(levels, dict):
+        return result
+    return dataclasses.replace(result, diagnostics={**result.diagnostics,
+                                                    "validation_coulomb": dict(levels)})
+
+
 def coulomb_estimate(result: IdentificationResult) -> tuple[np.ndarray, np.ndarray]:
     """Coulomb level and standard error per joint type (N m), NaN where not estimated.
 
@@ -212,9 +251,10 @@ def prepare_segment(dataset: Dataset, platform: Platform, window: float, *, grav
 
 def predict(segment: Segment, result: IdentificationResult) -> np.ndarray:
     """Generalized force predicted by ``result`` on ``segment``, shape (n, 6) (N, N m),
-    before centring: Mt q_ddot + Bt q_dot (+ the Coulomb friction it identified)."""
+    before centring: Mt q_ddot + Bt q_dot (+ the Coulomb friction it identified, or that its
+    companion fit found, :func:`prediction_levels`)."""
     out = segment.q_ddot @ np.asarray(result.M).T + segment.q_dot @ np.asarray(result.B).T
-    levels = coulomb_levels(result)
+    levels = prediction_levels(result)
     if levels is not None:
         out = out + np.einsum("k,nkc->nc", levels, segment.coulomb)
     return out
@@ -271,7 +311,8 @@ def held_out_segments(datasets: Sequence[Dataset], platform: Platform,
 
 def cross_validate(create: Callable[[], Any], datasets: Sequence[Dataset], platform: Platform,
                    folds: int = DEFAULT_FOLDS, gravity: bool = True,
-                   segments: list[Segment] | None = None) -> CrossValidation:
+                   segments: list[Segment] | None = None,
+                   companion: Callable[[], Any] | None = None) -> CrossValidation:
     """Refit a method without each time segment and prepare the held-out segments.
 
     Parameters
@@ -288,6 +329,9 @@ def cross_validate(create: Callable[[], Any], datasets: Sequence[Dataset], platf
     segments : list of Segment, optional
         The held-out segments if already prepared (:func:`held_out_segments` with the same
         ``folds`` and ``gravity``).
+    companion : callable, optional
+        Returns a new friction-estimating identifier whose Coulomb levels each fold model
+        predicts with when it has none (:func:`with_companion_friction`).
 
     Returns
     -------
@@ -310,7 +354,8 @@ def cross_validate(create: Callable[[], Any], datasets: Sequence[Dataset], platf
                 if stop - start > 1:
                     training.append(_piece(dataset, start, stop))
         try:
-            fold_results.append(create().fit(training, platform).result_)
+            fold_results.append(with_companion_friction(
+                create().fit(training, platform).result_, companion, training, platform))
         except StewartidError as exc:
             raise DataError(f"validation fold {k + 1} of {folds} (segment {k + 1} of every "
                             f"experiment held out) cannot be fitted: {exc} Record longer "
@@ -352,5 +397,5 @@ def in_sample(segments: Sequence[Segment], result: IdentificationResult) -> Vali
 
 __all__ = ["DEFAULT_FOLDS", "CrossValidation", "Segment", "ValidationResult",
            "coulomb_estimate", "coulomb_levels", "cross_validate", "excitation_window", "fold_bounds",
-           "friction_signature", "held_out_segments", "in_sample", "predict", "prepare_segment",
-           "score"]
+           "friction_signature", "held_out_segments", "in_sample", "predict", "prediction_levels",
+           "prepare_segment", "score", "with_companion_friction"]

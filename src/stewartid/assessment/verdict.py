@@ -1,19 +1,35 @@
 """Which of several identified models to trust on the same data, and why.
 
-:func:`choose_trusted` compares the methods by what their held-out validation
-(:mod:`stewartid.assessment.validation`) and their matrices show and returns the finding as
-data (:class:`Verdict`); the identification report puts it into words.
+:func:`choose_trusted` weighs what each method's result and held-out validation
+(:mod:`stewartid.assessment.validation`) show and returns the finding as data
+(:class:`Verdict`); the identification report puts it into words and ``result.json`` holds
+it (:meth:`Verdict.to_dict`).
 
-Rule: among the methods whose matrices are physically plausible (symmetric parts of Mt
-positive definite and of Bt positive semidefinite; all methods, if none is), the one whose
-worst DOF leaves the least force unexplained on held-out data; methods within
-:data:`TIE_FACTOR` of that are tied and the one with the smaller median relative standard
-error wins. What set the others back is recorded per method: more unexplained force,
-inconsistency, friction pulled into Bt or left in the residuals.
+Rule, in order:
+
+1. **Applicable**: methods that refused the data (their assumptions fail: several sines for
+   Method A, no constant-direction interval for Method B) are out.
+2. **Physically plausible**: symmetric parts of Mt positive definite and of Bt positive
+   semidefinite (all methods, if none is).
+3. **Held-out prediction**: a method whose worst DOF leaves more than :data:`MISFIT_FACTOR`
+   times the least unexplained force, and more than :data:`MISFIT_FLOOR` %, misses something
+   the others model; it is ranked after the others. Held-out segments of the same excitation
+   cannot show a wrong parameter that a friction term compensates, so this is a gate, not the
+   ranking.
+4. **Honest uncertainty**: among the rest, the method with the smallest worst relative
+   standard error over the paper's 20 entries wins. Every method's standard errors carry its
+   model error where the data show it (symmetric pairs that disagree beyond their errors,
+   :func:`~stewartid.identification.solvers.pair_calibration`; for Method A the friction its
+   third harmonic reveals), so a method biased by friction it does not model reports it.
+
+Entries are *uncertain* when the trusted method's relative standard error exceeds
+:data:`UNCERTAIN_RELATIVE`, or when another plausible method's estimate differs from the
+trusted one's by more than :data:`DISAGREEMENT` combined standard errors.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Literal
@@ -28,9 +44,19 @@ from stewartid.assessment.validation import (
 from stewartid.identification.consistency import consistency_metrics
 from stewartid.identification.result import IdentificationResult
 from stewartid.platform import COORDINATES
+from stewartid.reference.published import PAPER_ENTRIES, entry_label
 
-#: Methods whose unexplained force is within this factor of the least are tied.
+#: Methods whose worst relative standard error is within this factor of the least are tied
+#: (the held-out prediction decides between them).
 TIE_FACTOR = 1.25
+#: A method leaving more than this factor times the least held-out unexplained force ...
+MISFIT_FACTOR = 4.0
+#: ... and more than this share (%) of the force in its worst DOF misses part of the physics.
+MISFIT_FLOOR = 1.0
+#: An entry's relative standard error above which the verdict names it uncertain.
+UNCERTAIN_RELATIVE = 0.10
+#: Two methods' estimates of an entry disagree beyond this many combined standard errors.
+DISAGREEMENT = 3.0
 #: A Coulomb level counts as present above this many standard errors.
 SIGNIFICANT = 3.0
 #: Mean relative excess of the Bt diagonal over the trusted method's above which a method
@@ -50,6 +76,63 @@ def relative_std(result: IdentificationResult) -> float:
     values = np.concatenate([np.diag(result.std_errors_M) / np.abs(np.diag(result.M)),
                              np.diag(result.std_errors_B) / np.abs(np.diag(result.B))])
     return float(np.nanmedian(values))
+
+
+def entry_relative_std(result: IdentificationResult) -> np.ndarray:
+    """Relative standard error of each of the paper's 20 entries (fractions), in the order
+    of :data:`~stewartid.reference.published.PAPER_ENTRIES`; infinite for a zero estimate."""
+    out = []
+    for matrix, i, j in PAPER_ENTRIES:
+        value = (result.M if matrix == "M" else result.B)[i, j]
+        std = (result.std_errors_M if matrix == "M" else result.std_errors_B)[i, j]
+        out.append(std / abs(value) if value != 0 else np.inf)
+    return np.nan_to_num(np.array(out, dtype=float), nan=np.inf)
+
+
+def worst_relative_std(result: IdentificationResult) -> tuple[float, str]:
+    """The largest relative standard error over the paper's 20 entries and the entry's label
+    (``"Bt(5,1)"``)."""
+    values = entry_relative_std(result)
+    k = int(np.argmax(values))
+    return float(values[k]), entry_label(PAPER_ENTRIES[k])
+
+
+def _entry(result: IdentificationResult, matrix: str, i: int, j: int) -> tuple[float, float]:
+    if matrix == "M":
+        return float(result.M[i, j]), float(result.std_errors_M[i, j])
+    return float(result.B[i, j]), float(result.std_errors_B[i, j])
+
+
+def uncertain_entries(trusted: IdentificationResult,
+                      others: Mapping[str, IdentificationResult]) -> list[dict]:
+    """The paper's entries the trusted result is unsure of, and why.
+
+    Parameters
+    ----------
+    trusted : IdentificationResult
+    others : mapping of str to IdentificationResult
+        The other plausible methods' results, by name.
+
+    Returns
+    -------
+    list of dict
+        ``{"entry": "Bt(5,1)", "relative_std": r, "disagrees_with": [names]}`` for every
+        entry whose relative standard error exceeds :data:`UNCERTAIN_RELATIVE` or whose
+        estimate another method contradicts beyond :data:`DISAGREEMENT` combined errors.
+    """
+    found = []
+    for k, (matrix, i, j) in enumerate(PAPER_ENTRIES):
+        value, std = _entry(trusted, matrix, i, j)
+        relative = std / abs(value) if value != 0 else np.inf
+        against = []
+        for name, other in others.items():
+            v, s = _entry(other, matrix, i, j)
+            if abs(v - value) > DISAGREEMENT * np.hypot(s, std):
+                against.append(name)
+        if relative > UNCERTAIN_RELATIVE or against:
+            found.append({"entry": entry_label(PAPER_ENTRIES[k]),
+                          "relative_std": float(relative), "disagrees_with": against})
+    return found
 
 
 def is_definite(result: IdentificationResult) -> bool:
@@ -96,6 +179,13 @@ class Standing:
     friction_share : float
         Share of its held-out residual that has the shape of Coulomb friction
         (:func:`~stewartid.assessment.validation.friction_signature`).
+    worst_relative_std : float
+        Its largest relative standard error over the paper's 20 entries (a fraction).
+    worst_entry : str
+        That entry (``"Bt(5,1)"``).
+    misfit : bool
+        Its held-out prediction leaves more than :data:`MISFIT_FACTOR` times the least
+        unexplained force (and over :data:`MISFIT_FLOOR` %).
     """
 
     name: str
@@ -107,6 +197,9 @@ class Standing:
     friction_effect: Literal["damping", "residuals"] | None
     damping_excess: float
     friction_share: float
+    worst_relative_std: float = float("nan")
+    worst_entry: str = ""
+    misfit: bool = False
 
     @property
     def unexplained_percent(self) -> float:
@@ -126,14 +219,18 @@ class Verdict:
         The applicable methods, trusted first, then the compared ones before the others,
         each group by unexplained force.
     tied : tuple of str
-        The compared methods within :data:`TIE_FACTOR` of the least unexplained force (the
-        standard errors decided between them).
+        The compared methods within :data:`TIE_FACTOR` of the least worst relative standard
+        error (the held-out prediction decided between them).
     standings : dict of str to Standing
         Per applicable method, in the order given.
     friction_source : str or None
         The first method that finds Coulomb friction, if any.
     not_applicable : tuple of str
         Methods that could not be applied to the data.
+    uncertain : list of dict
+        The entries the trusted method is unsure of (:func:`uncertain_entries`).
+    reasons : list of str
+        Why the trusted method was chosen and the others not, one sentence each.
     """
 
     trusted: str
@@ -142,6 +239,25 @@ class Verdict:
     standings: dict[str, Standing]
     friction_source: str | None
     not_applicable: tuple[str, ...]
+    uncertain: list[dict] = dataclasses.field(default_factory=list)
+    reasons: list[str] = dataclasses.field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        """The ``verdict`` object of ``result.json``: ``trusted``, ``ranking`` (registry
+        names), ``uncertain_entries`` (entry labels), ``reasons``, and the evidence per
+        method under ``evidence``."""
+        return {
+            "trusted": self.trusted, "ranking": list(self.ranking),
+            "uncertain_entries": [u["entry"] for u in self.uncertain],
+            "reasons": list(self.reasons),
+            "not_applicable": list(self.not_applicable),
+            "evidence": {name: {
+                "worst_relative_std": st.worst_relative_std, "worst_entry": st.worst_entry,
+                "heldout_worst_vaf_percent": st.worst_vaf_percent,
+                "heldout_worst_dof": st.worst_dof, "plausible": st.compared,
+                "misfit": st.misfit, "models_friction": st.models_friction}
+                for name, st in self.standings.items()},
+            "uncertain_detail": self.uncertain}
 
 
 def choose_trusted(assessed: Mapping[str, tuple[IdentificationResult, ValidationResult] | None]
@@ -161,10 +277,15 @@ def choose_trusted(assessed: Mapping[str, tuple[IdentificationResult, Validation
     ok = {name: pair for name, pair in assessed.items() if pair is not None}
     worst = {name: worst_dof(validation) for name, (_, validation) in ok.items()}
     unexplained = {name: 100.0 - vaf for name, (vaf, _) in worst.items()}
+    spread = {name: worst_relative_std(result) for name, (result, _) in ok.items()}
     compared = [name for name, (result, _) in ok.items() if is_definite(result)] or list(ok)
     floor = min(unexplained[name] for name in compared)
-    tied = [name for name in compared if unexplained[name] <= TIE_FACTOR * floor + 1e-12]
-    trusted = min(tied, key=lambda name: relative_std(ok[name][0]))
+    misfit = {name: bool(unexplained[name] > max(MISFIT_FACTOR * floor, MISFIT_FLOOR))
+              for name in ok}
+    candidates = [name for name in compared if not misfit[name]] or compared
+    least = min(spread[name][0] for name in candidates)
+    tied = [name for name in candidates if spread[name][0] <= TIE_FACTOR * least]
+    trusted = min(tied, key=lambda name: unexplained[name])
     friction_source = next((name for name, (result, _) in ok.items()
                             if finds_friction(result)), None)
     reference_B = np.diag(ok[trusted][0].B)
@@ -178,12 +299,53 @@ def choose_trusted(assessed: Mapping[str, tuple[IdentificationResult, Validation
         standings[name] = Standing(
             name, worst[name][0], worst[name][1],
             (100 - worst[name][0]) / max(100 - worst[trusted][0], 1e-12), name in compared,
-            models_friction, effect, excess, friction_signature(validation))
+            models_friction, effect, excess, friction_signature(validation),
+            spread[name][0], spread[name][1], misfit[name])
     others = sorted((name for name in ok if name != trusted),
-                    key=lambda name: (name not in compared, unexplained[name]))
+                    key=lambda name: (name not in compared, misfit[name], spread[name][0]))
+    uncertain = uncertain_entries(ok[trusted][0], {name: ok[name][0] for name in compared
+                                                   if name != trusted})
+    not_applicable = tuple(name for name, pair in assessed.items() if pair is None)
     return Verdict(trusted, (trusted, *others), tuple(tied), standings, friction_source,
-                   tuple(name for name, pair in assessed.items() if pair is None))
+                   not_applicable, uncertain,
+                   _reasons(trusted, standings, tied, not_applicable, uncertain))
 
 
-__all__ = ["DAMPING_EXCESS", "SIGNIFICANT", "TIE_FACTOR", "Standing", "Verdict",
-           "choose_trusted", "finds_friction", "is_definite", "relative_std", "worst_dof"]
+def _reasons(trusted: str, standings: Mapping[str, Standing], tied: list[str],
+             not_applicable: tuple[str, ...], uncertain: list[dict]) -> list[str]:
+    """One sentence per finding, for ``result.json`` (registry names, numbers)."""
+    best = standings[trusted]
+    reasons = [f"{trusted}: largest relative standard error {100 * best.worst_relative_std:.3g} % "
+               f"({best.worst_entry}), the smallest of the plausible methods that predict "
+               f"held-out data; held-out VAF {best.worst_vaf_percent:.4g} % in its worst DOF "
+               f"({best.worst_dof})."]
+    if len(tied) > 1:
+        reasons.append(f"{', '.join(tied)} are within {TIE_FACTOR}x in uncertainty; the "
+                       "held-out prediction decided.")
+    for name, standing in standings.items():
+        if name == trusted:
+            continue
+        if not standing.compared:
+            reasons.append(f"{name}: Mt or Bt has a negative eigenvalue, which no physical "
+                           "platform has.")
+        elif standing.misfit:
+            reasons.append(f"{name}: leaves {standing.unexplained_percent:.3g} % of the held-out "
+                           f"force unexplained in {standing.worst_dof}, over {MISFIT_FACTOR:g}x "
+                           "the least.")
+        else:
+            reasons.append(f"{name}: largest relative standard error "
+                           f"{100 * standing.worst_relative_std:.3g} % ({standing.worst_entry}).")
+    reasons += [f"{name}: not applicable to these data." for name in not_applicable]
+    if uncertain:
+        reasons.append("uncertain entries: " + ", ".join(
+            u["entry"] + (f" (disagrees with {', '.join(u['disagrees_with'])})"
+                          if u["disagrees_with"] else
+                          f" ({100 * u['relative_std']:.3g} % standard error)")
+            for u in uncertain) + ".")
+    return reasons
+
+
+__all__ = ["DAMPING_EXCESS", "DISAGREEMENT", "MISFIT_FACTOR", "MISFIT_FLOOR", "SIGNIFICANT",
+           "TIE_FACTOR", "UNCERTAIN_RELATIVE", "Standing", "Verdict", "choose_trusted",
+           "entry_relative_std", "finds_friction", "is_definite", "relative_std",
+           "uncertain_entries", "worst_dof", "worst_relative_std"]

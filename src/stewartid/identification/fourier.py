@@ -17,7 +17,10 @@ the 72 unknowns whose period-to-period scatter yields the standard errors.
 
 Coulomb friction is the method's weakness: a square wave of level Fc in phase with the
 velocity has the first harmonic (4/pi) Fc sin(w t + phase of velocity), which is
-indistinguishable from viscous friction and lands in Bt as (4/pi) Fc / (w A).
+indistinguishable from viscous friction and lands in Bt as (4/pi) Fc / (w A). The same
+square wave has a third harmonic of a third of that amplitude, which no linear term explains:
+the standard errors carry it (:func:`friction_bias_bound`), so that the entries friction
+biases are reported with the uncertainty the data show, not the noise's alone.
 
 With two or more excitation frequencies a stiffness matrix K can be identified alongside
 (``stiffness=True``): y = Mt q_ddot + Bt q_dot + K (q - q0), with the harmonic coefficients
@@ -47,7 +50,11 @@ from stewartid.identification.base import DIFFERENTIATION_CONSTRAINTS, BaseIdent
 from stewartid.identification.preparation import prepare
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
-from stewartid.identification.solvers import regressor_names, solve_least_squares
+from stewartid.identification.solvers import (
+    calibrate_by_pairs,
+    regressor_names,
+    solve_least_squares,
+)
 from stewartid.platform import Platform
 from stewartid.signals.differentiation import (
     DEFAULT_ORDER,
@@ -94,6 +101,72 @@ def harmonic_coefficients(x: np.ndarray, t: np.ndarray, frequencies_hz: Sequence
 #: first-harmonic equations over whole periods (they are orthogonal to it); a line this large
 #: is a second sine of the excitation.
 HARMONIC_FRACTION = 0.2
+
+
+#: The first harmonic of a square wave over its third: the friction force at the excitation
+#: frequency that a third harmonic of the force implies.
+SQUARE_WAVE_RATIO = 3.0
+
+
+def friction_bias_bound(pinv: np.ndarray, rows: Sequence[np.ndarray],
+                        third: Sequence[np.ndarray]) -> np.ndarray:
+    """Bias of the first-harmonic estimates that the force's third harmonic implies.
+
+    A Coulomb force switching with the velocity of a sine is a square wave whose first
+    harmonic is :data:`SQUARE_WAVE_RATIO` times its third; of unknown phase relative to the
+    motion, it enters an experiment's first-harmonic equations as an error of that amplitude
+    in each channel. Propagated through the least-squares solution (the same error in every
+    block of the experiment) and summed in quadrature over experiments (their switching
+    phases are independent).
+
+    Parameters
+    ----------
+    pinv : ndarray, shape (p, n_equations)
+        Pseudo-inverse of the first-harmonic regressor.
+    rows : sequence of ndarray of int
+        Per experiment, the (cos, sin) equation rows of each of its blocks, shape (blocks, 2).
+    third : sequence of ndarray, shape (6,)
+        Per experiment, the third-harmonic amplitude of each force channel (N, N m).
+
+    Returns
+    -------
+    ndarray, shape (6, p)
+        Bias bound of every parameter of every channel's equation.
+    """
+    bound = np.zeros((len(third[0]) if len(third) else 6, pinv.shape[0]))
+    for experiment_rows, amplitude in zip(rows, third, strict=True):
+        gain = np.hypot(pinv[:, experiment_rows[:, 0]].sum(axis=1),
+                        pinv[:, experiment_rows[:, 1]].sum(axis=1))
+        bound += (SQUARE_WAVE_RATIO * np.outer(amplitude, gain)) ** 2
+    return np.sqrt(bound)
+
+
+def third_harmonic(force: np.ndarray, t: np.ndarray, frequency_hz: float,
+                   blocks: Sequence[slice]) -> np.ndarray:
+    """Third-harmonic amplitude of each force channel, the median over whole-period blocks.
+
+    The median (of the cos and sin coefficients) keeps a start-up transient in one block out.
+    Noise is not subtracted: its share of the amplitude is friction the data cannot rule out.
+
+    Parameters
+    ----------
+    force : ndarray, shape (N, 6)
+    t : ndarray, shape (N,)
+        Time (s).
+    frequency_hz : float
+        Excitation frequency f.
+    blocks : sequence of slice
+        Whole-period blocks.
+
+    Returns
+    -------
+    ndarray, shape (6,)
+        (N, N m).
+    """
+    coefficients = np.array([harmonic_coefficients(force[b], t[b], [3 * frequency_hz])
+                             for b in blocks])
+    middle = np.median(coefficients, axis=0)
+    return np.hypot(middle[0], middle[1])
 
 
 def check_single_sine(name: str, pose: np.ndarray, sample_rate: float, platform: Platform,
@@ -231,7 +304,7 @@ class FourierIdentifier(BaseIdentifier):
     def _fit(self, datasets: list[Dataset], platform: Platform
              ) -> tuple[IdentificationResult, dict]:
         experiments = prepare(datasets, platform, gravity=self.gravity)
-        rows_motion, rows_force, used = [], [], []
+        rows_motion, rows_force, used, rows, third = [], [], [], [], []
         for exp in experiments:
             # detected on the leg-length motion, where every DOF counts in one unit: on the
             # pose, a DOF that the excited one drags along at twice the frequency can have
@@ -259,7 +332,7 @@ class FourierIdentifier(BaseIdentifier):
                 for d, columns in ((2, slice(0, 6)), (1, slice(6, 12)), (0, slice(12, 18))):
                     gains[2 * k:2 * k + 2, columns] = savgol_gain(f, exp.sample_rate, window,
                                                                   self.order, d)
-            blocks = []
+            blocks, slices, first = [], [], sum(len(r) for r in rows_motion)
             for s in range(n_segments):
                 start = cut + int(round(s * segment))
                 stop = cut + int(round((s + 1) * segment))
@@ -272,6 +345,11 @@ class FourierIdentifier(BaseIdentifier):
                 rows_motion.append(coefficients[:, :18])
                 rows_force.append(coefficients[:, 18:])
                 blocks.append([float(t[0]), float(t[-1] + 1.0 / exp.sample_rate)])
+                slices.append(sl)
+            rows.append(first + 2 * len(freqs) * np.arange(n_segments)[:, None]
+                        + np.arange(2)[None, :])
+            third.append(third_harmonic(exp.generalized_force, exp.t, freqs[0], slices)
+                         if len(freqs) == 1 else np.zeros(6))
             used.append({"name": exp.name, "frequencies_hz": freqs, "window_s": window,
                          "segments": blocks})
         motion = np.concatenate(rows_motion)
@@ -280,9 +358,18 @@ class FourierIdentifier(BaseIdentifier):
         phi = motion[:, :6 * len(groups)]
         solution = solve_least_squares(phi, force, symmetric=self.symmetric,
                                        regressor_names=regressor_names(*groups))
-        theta, std = solution.theta, solution.theta_std
+        theta, noise_std = solution.theta, solution.theta_std
+        bias = friction_bias_bound(np.linalg.pinv(phi), rows, third)
+        std = np.hypot(noise_std, bias)
+        calibration = {} if self.symmetric else calibrate_by_pairs(
+            theta[:, :6], theta[:, 6:12], std[:, :6], std[:, 6:12])
         stiffness = theta[:, 12:18] if self.stiffness else None
-        diagnostics = {"experiments": used, "n_equations": int(solution.n_equations)}
+        diagnostics = {"experiments": used, "n_equations": int(solution.n_equations),
+                       "friction_bias": {"third_harmonic": np.array(third),
+                                         "bound_M": bias[:, :6], "bound_B": bias[:, 6:12],
+                                         "noise_std_M": noise_std[:, :6],
+                                         "noise_std_B": noise_std[:, 6:12]},
+                       "pair_calibration": calibration}
         if stiffness is not None:
             diagnostics["K"] = stiffness
             diagnostics["std_errors_K"] = std[:, 12:18]
@@ -293,4 +380,5 @@ class FourierIdentifier(BaseIdentifier):
             "stiffness_": stiffness, "frequencies_": [u["frequencies_hz"] for u in used]}
 
 
-__all__ = ["HARMONIC_FRACTION", "FourierIdentifier", "check_single_sine", "harmonic_coefficients"]
+__all__ = ["HARMONIC_FRACTION", "SQUARE_WAVE_RATIO", "FourierIdentifier", "check_single_sine",
+           "friction_bias_bound", "harmonic_coefficients", "third_harmonic"]

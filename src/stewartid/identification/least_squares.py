@@ -41,7 +41,11 @@ from stewartid.identification.base import DIFFERENTIATION_CONSTRAINTS, BaseIdent
 from stewartid.identification.preparation import prepare
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
-from stewartid.identification.solvers import regressor_names, solve_least_squares
+from stewartid.identification.solvers import (
+    calibrate_by_pairs,
+    regressor_names,
+    solve_least_squares,
+)
 from stewartid.model.joints import JOINT_TYPES
 from stewartid.platform import Platform
 from stewartid.signals.differentiation import (
@@ -189,13 +193,18 @@ class LeastSquaresIdentifier(BaseIdentifier):
             regressor_names=names,
             shared_names=[f"coulomb[{t}]" for t in JOINT_TYPES] if self.coulomb else None,
             autocorrelated=True)
-        theta, std = solution.theta, solution.theta_std
+        theta, std = solution.theta, solution.theta_std.copy()
+        # residual autocorrelation is in theta_std; model error (friction the joint model
+        # lacks) shows as symmetric pairs that disagree beyond it
+        calibration = {} if self.symmetric else calibrate_by_pairs(
+            theta[:, :6], theta[:, 6:12], std[:, :6], std[:, 6:12])
         offsets = theta[:, 12:].T.copy()
         levels = dict(zip(JOINT_TYPES, solution.shared.tolist(), strict=False))
         levels_std = dict(zip(JOINT_TYPES, solution.shared_std.tolist(), strict=False))
         diagnostics = {"experiments": used, "offsets": offsets,
                        "coulomb": levels, "coulomb_std": levels_std,
-                       "n_equations": int(solution.n_equations)}
+                       "n_equations": int(solution.n_equations),
+                       "pair_calibration": calibration}
         return IdentificationResult(
             M=theta[:, :6], B=theta[:, 6:12], std_errors_M=std[:, :6], std_errors_B=std[:, 6:12],
             condition_number=solution.condition_number, residual_rms=solution.residual_rms,

@@ -44,6 +44,10 @@ class IdentificationResult:
         The delay of the force channels relative to the motion the data were aligned by,
         ``{"seconds", "std_error", "applied", "source": "given" | "estimated", ...}``
         (:mod:`stewartid.identification.delay`); None when the data were used as logged.
+    verdict : dict, optional
+        With several methods compared, which to trust and why,
+        ``{"trusted", "ranking", "uncertain_entries", "reasons", ...}``
+        (:meth:`stewartid.assessment.verdict.Verdict.to_dict`); None otherwise.
 
     ``to_dict`` also writes ``consistency``, the symmetry and definiteness of M and B
     (:func:`~stewartid.identification.consistency.consistency_metrics`).
@@ -60,6 +64,7 @@ class IdentificationResult:
     diagnostics: dict[str, Any] = field(default_factory=dict)
     validation: dict[str, Any] | None = None
     delay: dict[str, Any] | None = None
+    verdict: dict[str, Any] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict; ``M`` and ``B`` at the top level; non-finite numbers are None
@@ -78,6 +83,8 @@ class IdentificationResult:
             document["validation"] = self.validation
         if self.delay is not None:
             document["delay"] = self.delay
+        if self.verdict is not None:
+            document["verdict"] = self.verdict
         return to_jsonable(document)
 
     def to_json(self, path: str | Path) -> Path:
@@ -102,7 +109,8 @@ class IdentificationResult:
                    method=str(document.get("method", "unknown")),
                    settings=dict(document.get("settings", {})),
                    diagnostics=dict(document.get("diagnostics", {})),
-                   validation=document.get("validation"), delay=document.get("delay"))
+                   validation=document.get("validation"), delay=document.get("delay"),
+                   verdict=document.get("verdict"))
 
     @classmethod
     def from_json(cls, path: str | Path) -> IdentificationResult:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -355,6 +356,75 @@ def bias_compensated_least_squares(phi: np.ndarray, target: np.ndarray, cluster:
     return theta_s / scale, std / scale
 
 
+def symmetric_pair_scores(matrix: np.ndarray, std: np.ndarray) -> np.ndarray:
+    """|a_ij - a_ji| / sqrt(s_ij^2 + s_ji^2) of every off-diagonal pair (i < j), row-major.
+
+    The two members of a pair come from different equations and, in the usual protocol,
+    different experiments; as estimates of one entry of a symmetric matrix their difference
+    tests the standard errors.
+
+    Returns
+    -------
+    ndarray, shape (n (n - 1) / 2,)
+    """
+    upper = np.triu_indices(matrix.shape[0], 1)
+    spread = np.hypot(std[upper], std.T[upper])
+    return np.abs(matrix[upper] - matrix.T[upper]) / np.maximum(spread, 1e-300)
+
+
+def pair_calibration(scores: np.ndarray) -> dict[str, Any]:
+    """How far the symmetric pairs' disagreement exceeds their standard errors.
+
+    The Birge ratio sqrt(mean z^2) of the pair scores z (:func:`symmetric_pair_scores`) is
+    about 1 when the standard errors are honest; above 1, model error (friction a model
+    lacks, a delay, unmodelled dynamics) that the residual-based errors do not show. The
+    factor by which every standard error is multiplied is the ratio, at least 1 (the scatter
+    of 30 pairs cannot show that errors are too large).
+
+    Parameters
+    ----------
+    scores : ndarray
+        Pair scores of Mt and Bt together.
+
+    Returns
+    -------
+    dict
+        ``{"pairs": n, "birge_ratio": r, "largest": max z, "factor": max(r, 1)}``.
+    """
+    scores = np.asarray(scores, dtype=float)
+    scores = scores[np.isfinite(scores)]
+    if scores.size == 0:
+        return {"pairs": 0, "birge_ratio": float("nan"), "largest": float("nan"), "factor": 1.0}
+    ratio = float(np.sqrt(np.mean(scores ** 2)))
+    return {"pairs": int(scores.size), "birge_ratio": ratio, "largest": float(scores.max()),
+            "factor": max(ratio, 1.0)}
+
+
+def calibrate_by_pairs(M: np.ndarray, B: np.ndarray, std_M: np.ndarray,
+                       std_B: np.ndarray) -> dict[str, dict[str, Any]]:
+    """Multiply the standard errors of Mt and of Bt, in place, each by its pairs' factor
+    (:func:`pair_calibration` of :func:`symmetric_pair_scores`).
+
+    Parameters
+    ----------
+    M, B : ndarray, shape (6, 6)
+        Unsymmetrized estimates.
+    std_M, std_B : ndarray, shape (6, 6)
+        Their standard errors; modified in place.
+
+    Returns
+    -------
+    dict
+        ``{"M": pair_calibration(...), "B": ...}``, the ``pair_calibration`` entry of a
+        result's diagnostics.
+    """
+    found = {}
+    for name, matrix, std in (("M", M, std_M), ("B", B, std_B)):
+        found[name] = pair_calibration(symmetric_pair_scores(matrix, std))
+        std *= found[name]["factor"]
+    return found
+
+
 def select_symmetric_pairs(matrix: np.ndarray, std: np.ndarray,
                            preferred_rows: tuple[int, ...] = (0, 1, 2),
                            disagreement: float = 3.0, pool: bool = False) -> list[dict]:
@@ -415,6 +485,9 @@ def select_symmetric_pairs(matrix: np.ndarray, std: np.ndarray,
 
 __all__ = [
     "LeastSquaresSolution",
+    "calibrate_by_pairs",
+    "pair_calibration",
+    "symmetric_pair_scores",
     "bias_compensated_least_squares",
     "check_rank",
     "integrated_autocorrelation",

@@ -65,9 +65,11 @@ from stewartid.identification.registry import Preset, register_method
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.solvers import (
     bias_compensated_least_squares,
+    pair_calibration,
     regressor_names,
     select_symmetric_pairs,
     solve_least_squares,
+    symmetric_pair_scores,
 )
 from stewartid.identification.wavelet.detection import (
     SINGLE_SINE_SHARE,
@@ -339,8 +341,9 @@ class WaveletIdentifier(BaseIdentifier):
             "n_equations": solution.n_equations, "n_intervals": n_intervals,
             "experiments": [{"name": i["name"], "intervals_found": i["intervals_found"],
                              "intervals": i["intervals"].tolist()} for i in infos],
-            "pair_choice": chosen, "coordinates": list(COORDINATES),
-            "friction_model": friction, "coulomb": levels, "coulomb_std": levels_std,
+            "pair_choice": chosen, "pair_calibration": self.pair_calibration_,
+            "coordinates": list(COORDINATES), "friction_model": friction,
+            "coulomb": levels, "coulomb_std": levels_std,
             "offsets": solution.offsets, "noise_std": solution.noise_std,
             "constant_scatter": solution.constant_scatter,
             "pose_noise_share": solution.pose_noise_share}
@@ -373,19 +376,32 @@ class WaveletIdentifier(BaseIdentifier):
 
     def _combine_pairs(self, M: np.ndarray, B: np.ndarray, std_M: np.ndarray,
                        std_B: np.ndarray) -> dict:
-        """Symmetric pairs, in place: the better-determined member (``pair_selection``), or
-        with ``symmetric`` the inverse-variance weighted mean of both."""
+        """Symmetric pairs, in place: the better-determined member (``pair_selection``), the
+        standard errors then multiplied by the pairs' calibration factor
+        (:func:`~stewartid.identification.solvers.pair_calibration`); or with ``symmetric``
+        the inverse-variance weighted mean of both."""
+        self.pair_calibration_ = {}
         if self.symmetric:
             for matrix, std in ((M, std_M), (B, std_B)):
                 w = 1.0 / np.maximum(std, 1e-300) ** 2
                 matrix[:] = (w * matrix + w.T * matrix.T) / (w + w.T)
                 std[:] = 1.0 / np.sqrt(w + w.T)
             return {}
+        # the pairs are judged on the residual-based errors (an inflated error would pool a
+        # biased member); the calibration applies to what is reported
+        factors = {"M": pair_calibration(symmetric_pair_scores(M, std_M)),
+                   "B": pair_calibration(symmetric_pair_scores(B, std_B))}
+        raw = {"M": np.minimum(std_M, std_M.T), "B": np.minimum(std_B, std_B.T)}
+        chosen = {}
         if self.pair_selection in ("std_error", "pooled"):
             pool = self.pair_selection == "pooled"
-            return {"M": select_symmetric_pairs(M, std_M, pool=pool),
-                    "B": select_symmetric_pairs(B, std_B, pool=pool)}
-        return {}
+            chosen = {"M": select_symmetric_pairs(M, std_M, pool=pool),
+                      "B": select_symmetric_pairs(B, std_B, pool=pool)}
+        # a pair's error raised to its disagreement already holds its model error
+        for name, std in (("M", std_M), ("B", std_B)):
+            std[:] = np.maximum(std, factors[name]["factor"] * np.minimum(std, raw[name]))
+        self.pair_calibration_ = factors
+        return chosen
 
     def _settings(self) -> dict:
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.get_params().items()}
@@ -424,6 +440,7 @@ class WaveletIdentifier(BaseIdentifier):
                                                         noise_xy)
         M, B = theta[:, :6].copy(), theta[:, 6:12].copy()
         std_M, std_B = std[:, :6].copy(), std[:, 6:12].copy()
+        self.pair_calibration_ = {}
         chosen = {} if self.symmetric else self._combine_pairs(M, B, std_M, std_B)
         residual = target - phi @ theta.T
         diagnostics = {
@@ -436,7 +453,8 @@ class WaveletIdentifier(BaseIdentifier):
                  "intervals": info["intervals"].tolist(),
                  "scales": info["scales"].tolist(), "shifts": info["shifts"].tolist()}
                 for info in infos],
-            "pair_choice": chosen, "coordinates": list(COORDINATES)}
+            "pair_choice": chosen, "pair_calibration": self.pair_calibration_,
+            "coordinates": list(COORDINATES)}
         return IdentificationResult(
             M=M, B=B, std_errors_M=std_M, std_errors_B=std_B,
             condition_number=solution.condition_number,

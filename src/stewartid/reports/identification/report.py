@@ -33,6 +33,7 @@ from stewartid.assessment.validation import (
     cross_validate,
     held_out_segments,
     in_sample,
+    with_companion_friction,
 )
 from stewartid.assessment.verdict import choose_trusted
 from stewartid.datasets.dataset import Dataset
@@ -100,12 +101,16 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
         gravity = bool(estimator.get_params().get("gravity", True))
         if gravity not in segments:
             segments[gravity] = held_out_segments(datasets, platform, folds, gravity)
-        folds_fit = cross_validate(lambda: registry.create_identifier(name, **own), datasets, platform,
-                                   folds, gravity, segments[gravity])
+        companion = None
+        if "friction" in accepted:
+            def companion():
+                return registry.create_identifier(name, **{**own, "friction": "uniform"})
+        folds_fit = cross_validate(lambda: registry.create_identifier(name, **own), datasets,
+                                   platform, folds, gravity, segments[gravity], companion)
     except StewartidError as exc:
         return MethodReport(name, spec.display_name, spec.color, error=str(exc),
                             exception=exc, seconds=time.perf_counter() - start)
-    unconstrained = estimator.result_
+    unconstrained = with_companion_friction(estimator.result_, companion, datasets, platform)
     validation = folds_fit.scores()
     result, projection, before = unconstrained, None, None
     if consistent:
@@ -191,6 +196,10 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
     result_figures(drawer, runs, datasets, platform, nominal, trusted, rows)
     models = [ExportedModel(run.name, run.result, *run.coulomb) for run in usable]
     files = drawer.files + write_exports(models, directory, trusted)
+    if len(runs) > 1:
+        runs = [dataclasses.replace(run, result=dataclasses.replace(
+            run.result, verdict=verdict.to_dict())) if run.name == trusted else run
+            for run in runs]
     report = IdentificationReport(runs, verdict, directory)
     files.append(report.result.to_json(directory / "result.json"))
     text = render_report(report, datasets, platform, nominal, nominal_source or "", rows,

@@ -146,11 +146,21 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
         return method_lines(ok[0])
     best = next(run for run in ok if run.name == verdict.trusted)
     trusted = verdict.standings[best.name]
-    lines = [f"**Trust {best.display_name} on these data.** On held-out segments it leaves "
+    lines = [f"**Trust {best.display_name} on these data.** Of the physically plausible "
+             "methods that predict held-out data, it has the smallest largest relative "
+             f"standard error over the paper's 20 entries: {100 * trusted.worst_relative_std:.3g} "
+             f"% ({trusted.worst_entry}); its standard errors include the model error its "
+             "symmetric pairs reveal. On held-out segments it leaves "
              f"{trusted.unexplained_percent:.3g} % of the force unexplained in its worst DOF "
-             f"({trusted.worst_dof}), the least of the physically plausible methods"
-             + (" (tied methods: the smaller standard errors decide)." if len(verdict.tied) > 1
-                else ".")]
+             f"({trusted.worst_dof})"
+             + (" (methods tied in uncertainty: the held-out prediction decides)."
+                if len(verdict.tied) > 1 else ".")]
+    if verdict.uncertain:
+        lines.append("Entries to treat with care: " + ", ".join(
+            u["entry"] + (f" (other methods disagree: {', '.join(u['disagrees_with'])})"
+                          if u["disagrees_with"] else
+                          f" ({100 * u['relative_std']:.3g} % standard error)")
+            for u in verdict.uncertain) + ".")
     if verdict.friction_source is not None:
         source = next(run for run in ok if run.name == verdict.friction_source)
         lines.append(f"Coulomb friction is present: {source.display_name} finds "
@@ -159,8 +169,12 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
         if run is best:
             continue
         standing = verdict.standings[run.name]
-        text = (f"{run.display_name} leaves {standing.unexplained_percent:.3g} % unexplained in "
-                f"its worst DOF ({standing.worst_dof}), {standing.unexplained_ratio:.3g}× as much")
+        text = (f"{run.display_name}: largest relative standard error "
+                f"{100 * standing.worst_relative_std:.3g} % ({standing.worst_entry}); it leaves "
+                f"{standing.unexplained_percent:.3g} % unexplained in its worst held-out DOF "
+                f"({standing.worst_dof}), {standing.unexplained_ratio:.3g}× as much")
+        if standing.misfit:
+            text += ", more than the held-out prediction allows for a trusted method"
         if not standing.compared:
             text += ("; its Mt or Bt has a negative eigenvalue, which no physical "
                      "platform has")
