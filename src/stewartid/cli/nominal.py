@@ -45,11 +45,12 @@ def nominal(
     gravity: Annotated[bool, typer.Option("--gravity-stiffness",
                                           help="Also print K_G = dG/dq.")] = False,
     pose: Annotated[str | None, typer.Option(
-        "--pose", metavar="X,Y,Z,RX,RY,RZ",
+        "--pose", metavar="POSE",
         help=f"Evaluate at this pose instead of neutral, and print G(q) too; {POSE_FORM}, "
              "within the stroke and gimbal limits.")] = None,
 ) -> None:
-    """Nominal Mt and Bt of the linearised model at the neutral pose (paper frame)."""
+    """Nominal Mt and Bt of the linearised model at the neutral pose (paper frame), or Mt, Bt
+    and the gravity force G at the pose given with --pose."""
     from stewartid.model.linearization import gravity_stiffness, nominal_matrices, nominal_terms
     from stewartid.platform import load_platform
 
