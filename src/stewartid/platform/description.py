@@ -3,7 +3,8 @@
 A :class:`Platform` is a frozen dataclass built from a TOML file (format in
 ``docs/platform-format.md``) or from the shipped ``paper`` preset (Zhang 2020, Tables 1-2).
 It checks itself when built: unknown keys, missing keys, wrong types, negative masses and
-geometries whose legs cannot be built are refused with one message naming the key.
+geometries whose legs cannot be built are refused with one message naming the key. An
+optional ``[payload]`` moves with the platform as one body (:attr:`Platform.moving_body`).
 
 Frame (the paper's): x forward, y right, z down; origin at the centre of the base joint
 plane. Leg numbering follows ``docs/conventions.md`` and is part of the data format.
@@ -201,7 +202,8 @@ class Platform:
             if "__" in key:
                 section, field = key.split("__", 1)
                 if section not in tables:
-                    current = getattr(self, section)  # None: an absent [payload]
+                    current = sections_or_values.get(section, getattr(self, section))
+                    # None: an absent [payload], built from the keys given here alone
                     tables[section] = {} if current is None else section_to_mapping(current)
                 tables[section][field] = value
             else:
