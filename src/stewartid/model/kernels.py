@@ -13,9 +13,9 @@ pose-only terms (leg lengths, J_lq, G, joint Jacobians) that kinematics, command
 identification need are computed by :mod:`stewartid.model.leg_terms` in numpy from the same
 per-sample geometry functions below (:func:`leg_vector`, :func:`twist_column`,
 :func:`leg_rate`, :func:`leg_angular_rate`, :func:`joint_rate_column`,
-:func:`centre_of_mass_rates`, :func:`leg_gravity`, :func:`euler_columns`): pure arithmetic
-on their arguments, which are floats here and arrays of samples there, so both give the
-same numbers to the last bit.
+:func:`centre_of_mass_rates`, :func:`leg_gravity`, :func:`body_gravity`,
+:func:`euler_columns`): pure arithmetic on their arguments, which are floats here and arrays
+of samples there, so both give the same numbers to the last bit.
 
 Coordinates: q = [x, y, z, rx, ry, rz] (m, rad; R = Rz(rz) Ry(ry) Rx(rx)), q_dot its time
 derivative (Euler-angle rates). Internally the body equations are written in the twist
