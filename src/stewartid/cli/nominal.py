@@ -1,37 +1,83 @@
-"""``stewartid nominal``: the nominal Mt and Bt of a platform description."""
+"""``stewartid nominal``: the nominal Mt and Bt of a platform description, at the neutral
+pose or at a pose given with ``--pose`` (then with the gravity force G there)."""
 
 from __future__ import annotations
 
 import json
+import math
 import sys
 from typing import Annotated
 
+import numpy as np
 import typer
+
+from stewartid.errors import ConfigError
+
+#: What ``--pose`` takes, as its help and its refusals say it.
+POSE_FORM = ("X,Y,Z,RX,RY,RZ: the absolute pose of the reference point in the paper frame "
+             "(m, rad; z down), as the x..rz columns of a log in the interchange format")
+
+
+def parse_pose(text: str) -> np.ndarray:
+    """The six numbers of ``--pose`` (m, rad), shape (6,).
+
+    Raises
+    ------
+    ConfigError
+        Unless ``text`` is six finite numbers separated by commas.
+    """
+    parts = [part.strip() for part in text.split(",")]
+    try:
+        values = [float(part) for part in parts]
+    except ValueError:
+        values = []
+    if len(values) != 6 or not all(math.isfinite(v) for v in values):
+        raise ConfigError(f"--pose must be six numbers {POSE_FORM}. Got {text!r} instead.")
+    return np.array(values)
 
 
 def nominal(
     platform: Annotated[str, typer.Option(
         "--platform", metavar="NAME|FILE",
         help="'paper' for the preset, or a platform TOML file.")] = "paper",
-    as_json: Annotated[bool, typer.Option("--json", help="Print {\"M\": ..., \"B\": ...}.")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Print {\"M\": ..., \"B\": ...} "
+                                          "(and \"G\" with --pose).")] = False,
     gravity: Annotated[bool, typer.Option("--gravity-stiffness",
                                           help="Also print K_G = dG/dq.")] = False,
+    pose: Annotated[str | None, typer.Option(
+        "--pose", metavar="POSE",
+        help=f"Evaluate at this pose instead of neutral, and print G(q) too; {POSE_FORM}, "
+             "within the stroke and gimbal limits.")] = None,
 ) -> None:
-    """Nominal Mt and Bt of the linearised model at the neutral pose (paper frame)."""
-    from stewartid.model.linearization import gravity_stiffness, nominal_matrices
+    """Nominal Mt and Bt of the linearised model at the neutral pose (paper frame), or Mt, Bt
+    and the gravity force G at the pose given with --pose."""
+    from stewartid.model.linearization import gravity_stiffness, nominal_matrices, nominal_terms
     from stewartid.platform import load_platform
 
     description = load_platform(platform)
-    M, B = nominal_matrices(description)
+    if pose is None:
+        M, B = nominal_matrices(description)
+        G = q = None
+    else:
+        from stewartid.design.limits import require_within_limits
+
+        q = parse_pose(pose)
+        require_within_limits(description, q, f"--pose {pose}")
+        M, B, G = nominal_terms(description, q)
     if as_json:
         out = {"M": M.tolist(), "B": B.tolist()}
+        if G is not None:
+            out["G"] = G.tolist()
         if gravity:
-            out["K_G"] = gravity_stiffness(description).tolist()
+            out["K_G"] = gravity_stiffness(description, q).tolist()
         sys.stdout.write(json.dumps(out) + "\n")
         return
-    from stewartid.reporting.terminal import print_matrix
+    from stewartid.reporting.terminal import print_matrix, print_vector
 
-    print_matrix(M, f"Mt ({description.name}, neutral pose)")
-    print_matrix(B, f"Bt ({description.name}, neutral pose)")
+    where = "neutral pose" if q is None else f"pose {','.join(f'{v:g}' for v in q)}"
+    print_matrix(M, f"Mt ({description.name}, {where})")
+    print_matrix(B, f"Bt ({description.name}, {where})")
+    if G is not None:
+        print_vector(G, f"G ({description.name}, {where}; N, N m)")
     if gravity:
-        print_matrix(gravity_stiffness(description), "K_G = dG/dq")
+        print_matrix(gravity_stiffness(description, q), "K_G = dG/dq")

@@ -278,7 +278,7 @@ def check_static_balance(pose: np.ndarray, forces: np.ndarray, platform: Platfor
                         "load, the other legs about their share; check that channel "
                         "(unplugged, unit, sign).")
     if abs(ratio - 1.0) > BALANCE_WARNING:
-        _warn(f"{what}: a payload missing from [inertia] platform_mass?")
+        _warn(f"{what}: a payload missing from the platform file (its [payload] section)?")
 
 
 def check_dataset(pose: np.ndarray, lengths: np.ndarray, forces: np.ndarray,

@@ -140,6 +140,43 @@ def gimbal_angles(platform: Platform, q: np.ndarray) -> np.ndarray:
     return np.stack([lower, upper], axis=-1)
 
 
+def require_within_limits(platform: Platform, pose: np.ndarray, subject: str) -> None:
+    """Refuse a pose outside the workspace: a leg outside its stroke or a gimbal deflected
+    beyond ``[limits] gimbal_angle``.
+
+    Parameters
+    ----------
+    platform : Platform
+    pose : ndarray, shape (6,)
+        Absolute pose (m, rad), paper frame.
+    subject : str
+        What the pose is, as the message names it (``"--pose"``).
+
+    Raises
+    ------
+    ConfigError
+        Naming the leg and limit at fault and the neutral pose.
+    """
+    limits = resolve_limits(platform)
+    q = np.asarray(pose, dtype=float).reshape(1, 6)
+    lengths = inverse_kinematics(platform, q).lengths[0]
+    neutral = ",".join(f"{v:g}" for v in platform.neutral_pose)
+    hint = (f"give an absolute pose in the paper frame (m, rad, z down; neutral is {neutral})")
+    leg = int(np.argmax(np.maximum(limits.stroke_min - lengths, lengths - limits.stroke_max)))
+    if not limits.stroke_min <= lengths[leg] <= limits.stroke_max:
+        raise ConfigError(
+            f"{subject} is outside the workspace: leg {leg + 1} would be {lengths[leg]:.4g} m "
+            f"long, outside its stroke {limits.stroke_min:.4g} to {limits.stroke_max:.4g} m; "
+            f"{hint}.")
+    angles = gimbal_angles(platform, q)[0]
+    leg, end = np.unravel_index(np.argmax(angles), angles.shape)
+    if not angles[leg, end] <= limits.gimbal_angle:
+        raise ConfigError(
+            f"{subject} is outside the workspace: the {('lower', 'upper')[end]} gimbal of leg "
+            f"{leg + 1} would turn {angles[leg, end]:.3g} rad, beyond [limits] gimbal_angle = "
+            f"{limits.gimbal_angle:g} rad; {hint}.")
+
+
 def limit_use(platform: Platform, limits: OperatingLimits, t: np.ndarray, q: np.ndarray,
               lengths: np.ndarray, length_rates: np.ndarray,
               length_accelerations: np.ndarray, forces: np.ndarray) -> LimitUse:

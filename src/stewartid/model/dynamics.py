@@ -4,8 +4,9 @@ Equation of motion in the paper's frame and coordinates (z down, q = [x y z rx r
 
     M(q) q_ddot + h(q, q_dot) + G(q) + F(q, q_dot) = J_lq(q)^T f_a
 
-M is the mass matrix of platform and legs, h the velocity-product (Coriolis and
-centrifugal) forces, G gravity (g = 9.81 m/s^2 along +z), F joint friction (viscous on the
+M is the mass matrix of the moving body (platform and payload as one rigid body, its centre
+of mass anywhere and its inertia matrix full) and the legs, h the velocity-product (Coriolis
+and centrifugal) forces, G gravity (g = 9.81 m/s^2 along +z), F joint friction (viscous on the
 four gimbal axes, Coulomb on all five rotational axes of each leg), f_a the actuator forces
 (N, positive extends the leg). Body equations are Newton-Euler per body, projected with the
 velocity Jacobians (Kane's method), compiled with numba in :mod:`stewartid.model.compiled`.
@@ -22,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewartid.model.kinematics import as_batch, inverse_kinematics
+from stewartid.model.kinematics import as_batch, inverse_kinematics, rotation_matrix
 from stewartid.platform import GRAVITY, Platform
 
 #: Default Coulomb regularisation rate (rad/s).
@@ -146,15 +147,16 @@ def kinetic_energy(platform: Platform, q: np.ndarray, q_dot: np.ndarray) -> np.n
 
 
 def potential_energy(platform: Platform, q: np.ndarray) -> np.ndarray:
-    """Gravitational potential energy of platform and leg parts (J), zero at z = 0.
+    """Gravitational potential energy of platform, payload and leg parts (J), zero at z = 0.
 
     z points down, so V = -g * sum(m z_com). Shape () or (N,).
     """
     q2, single = as_batch(q)
     legs = inverse_kinematics(platform, q2)
-    i = platform.inertia
+    i, body = platform.inertia, platform.moving_body
+    z_body = q2[:, 2] + rotation_matrix(q2[:, 3:])[:, 2, :] @ body.com
     z_lower = platform.base_joints[None, :, 2] + i.lower_leg_com * legs.directions[..., 2]
     z_upper = legs.upper_joints[..., 2] - i.upper_leg_com * legs.directions[..., 2]
-    V = -GRAVITY * (i.platform_mass * q2[:, 2] + i.lower_leg_mass * z_lower.sum(1)
+    V = -GRAVITY * (body.mass * z_body + i.lower_leg_mass * z_lower.sum(1)
                     + i.upper_leg_mass * z_upper.sum(1))
     return V[0] if single else V

@@ -13,14 +13,19 @@ pose-only terms (leg lengths, J_lq, G, joint Jacobians) that kinematics, command
 identification need are computed by :mod:`stewartid.model.leg_terms` in numpy from the same
 per-sample geometry functions below (:func:`leg_vector`, :func:`twist_column`,
 :func:`leg_rate`, :func:`leg_angular_rate`, :func:`joint_rate_column`,
-:func:`centre_of_mass_rates`, :func:`leg_gravity`, :func:`euler_columns`): pure arithmetic
-on their arguments, which are floats here and arrays of samples there, so both give the
-same numbers to the last bit.
+:func:`centre_of_mass_rates`, :func:`leg_gravity`, :func:`body_gravity`,
+:func:`euler_columns`): pure arithmetic on their arguments, which are floats here and arrays
+of samples there, so both give the same numbers to the last bit.
 
 Coordinates: q = [x, y, z, rx, ry, rz] (m, rad; R = Rz(rz) Ry(ry) Rx(rx)), q_dot its time
 derivative (Euler-angle rates). Internally the body equations are written in the twist
 nu = [v, omega] (world frame, at the reference point) and mapped to q with
 nu = T(q) q_dot, T = blockdiag(I, E(q)).
+
+Moving body: the platform with its payload, one rigid body of mass m, centre of mass c_body
+(platform frame, from the reference point) and inertia matrix I_body about the reference
+point, packed by :meth:`stewartid.platform.Platform.parameters`; without a payload c_body = 0
+and I_body is diagonal.
 
 Leg bodies (per leg, zero inertia about the leg's own axis):
 lower part turns about the lower gimbal point B with the leg, centre of mass at B + d_l u;
@@ -116,6 +121,14 @@ def leg_gravity(g, m_upper, m_lower, lower_z, upper_z):
     return g * (m_lower * lower_z + m_upper * upper_z)
 
 
+def body_gravity(R, g, m, c0, c1, c2):
+    """The moving body's gravity force on the twist components z, rx, ry (the others are
+    zero) for rotation entries ``R``, gravity ``g`` along +z, mass ``m`` and centre of mass
+    (c0, c1, c2) in the platform frame: -m g, and the moment -(R c) x (0, 0, m g)."""
+    w = m * g
+    return -w, -w * (R[3] * c0 + R[4] * c1 + R[5] * c2), w * (R[0] * c0 + R[1] * c1 + R[2] * c2)
+
+
 def leg_frame(u0, u1, u2):
     """Leg frame e1 = unit(z x u), e2 = u x e1 as (e10, e11, e20, e21, e22); e12 = 0."""
     nx, ny = -u1, u0
@@ -205,7 +218,7 @@ def model_terms(params, upper, base, q, qd, M, h, G, J_leg, J_joint, lengths):
     Mn = np.zeros((6, 6))
     hn = np.zeros(6)
     Gn = np.zeros(6)
-    _platform_terms(params, R, omega, Mn, hn, Gn)
+    _body_terms(params, R, omega, Mn, hn, Gn)
     # per-leg scratch: velocities of the two centres of mass and the leg's angular velocity
     # per twist component, their velocity-product accelerations
     Jcl = np.empty((3, 6))
@@ -221,24 +234,45 @@ def model_terms(params, upper, base, q, qd, M, h, G, J_leg, J_joint, lengths):
     _to_pose_coordinates(q, qd, E, Mn, hn, Gn, M, h, G, J_leg, J_joint)
 
 
-def _platform_terms(params, R, omega, Mn, hn, Gn):
-    """The platform body's share, into the twist-coordinate ``Mn``, ``hn``, ``Gn``:
-    M = diag(m, m, m, R Ib R^T), h = [0, omega x (Iw omega)], G = [0, 0, -m g, 0, 0, 0]."""
+def _body_terms(params, R, omega, Mn, hn, Gn):
+    """The moving body's share (platform and payload), into the twist-coordinate ``Mn``,
+    ``hn``, ``Gn``. With c = R c_body its centre of mass from the reference point and I the
+    inertia about the reference point in the world frame (R I_body R^T), Newton-Euler about
+    the reference point gives M = [[m 1, -m [c]x], [m [c]x, I]],
+    h = [m omega x (omega x c), omega x (I omega)] and G = -[m g e_z, c x m g e_z]."""
     m = params[layout.MASS]
+    ixx, iyy, izz = params[layout.IXX], params[layout.IYY], params[layout.IZZ]
+    ixy, ixz, iyz = params[layout.IXY], params[layout.IXZ], params[layout.IYZ]
+    cb0, cb1, cb2 = params[layout.COM_X], params[layout.COM_Y], params[layout.COM_Z]
     for k in range(3):
         Mn[k, k] = m
     for a in range(3):
+        Ra0, Ra1, Ra2 = R[3 * a], R[3 * a + 1], R[3 * a + 2]
         for b in range(3):
-            Mn[3 + a, 3 + b] = (R[3 * a] * params[layout.IXX] * R[3 * b]
-                                + R[3 * a + 1] * params[layout.IYY] * R[3 * b + 1]
-                                + R[3 * a + 2] * params[layout.IZZ] * R[3 * b + 2])
+            Rb0, Rb1, Rb2 = R[3 * b], R[3 * b + 1], R[3 * b + 2]
+            # the diagonal part first, summed as for a platform alone
+            Mn[3 + a, 3 + b] = ((Ra0 * ixx * Rb0 + Ra1 * iyy * Rb1 + Ra2 * izz * Rb2)
+                                + (ixy * (Ra0 * Rb1 + Ra1 * Rb0) + ixz * (Ra0 * Rb2 + Ra2 * Rb0)
+                                   + iyz * (Ra1 * Rb2 + Ra2 * Rb1)))
+    # first moment m c in the world frame, and the coupling blocks -m [c]x and m [c]x
+    s0 = m * (R[0] * cb0 + R[1] * cb1 + R[2] * cb2)
+    s1 = m * (R[3] * cb0 + R[4] * cb1 + R[5] * cb2)
+    s2 = m * (R[6] * cb0 + R[7] * cb1 + R[8] * cb2)
+    Mn[0, 4], Mn[0, 5], Mn[1, 3], Mn[1, 5], Mn[2, 3], Mn[2, 4] = s2, -s1, -s2, s0, s1, -s0
+    Mn[4, 0], Mn[5, 0], Mn[3, 1], Mn[5, 1], Mn[3, 2], Mn[4, 2] = s2, -s1, -s2, s0, s1, -s0
+    ws0 = omega[1] * s2 - omega[2] * s1
+    ws1 = omega[2] * s0 - omega[0] * s2
+    ws2 = omega[0] * s1 - omega[1] * s0
+    hn[0] = omega[1] * ws2 - omega[2] * ws1
+    hn[1] = omega[2] * ws0 - omega[0] * ws2
+    hn[2] = omega[0] * ws1 - omega[1] * ws0
     Iwo0 = Mn[3, 3] * omega[0] + Mn[3, 4] * omega[1] + Mn[3, 5] * omega[2]
     Iwo1 = Mn[4, 3] * omega[0] + Mn[4, 4] * omega[1] + Mn[4, 5] * omega[2]
     Iwo2 = Mn[5, 3] * omega[0] + Mn[5, 4] * omega[1] + Mn[5, 5] * omega[2]
     hn[3] = omega[1] * Iwo2 - omega[2] * Iwo1
     hn[4] = omega[2] * Iwo0 - omega[0] * Iwo2
     hn[5] = omega[0] * Iwo1 - omega[1] * Iwo0
-    Gn[2] = -m * params[layout.GRAVITY]
+    Gn[2], Gn[3], Gn[4] = body_gravity(R, params[layout.GRAVITY], m, cb0, cb1, cb2)
 
 
 def _leg_kinematics(params, R, q, qd, omega, a, b, J_leg_row, J_joint_leg, Jcl, Jcu, Jw,

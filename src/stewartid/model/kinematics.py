@@ -99,7 +99,7 @@ def inverse_kinematics(platform: Platform, q: np.ndarray) -> LegState:
         With a leading sample axis of length N (1 for a single pose).
     """
     q2, _ = as_batch(q)
-    _, r, u, lengths = leg_vectors(platform.upper_joints, platform.base_joints, q2)
+    _, _, r, u, lengths = leg_vectors(platform.upper_joints, platform.base_joints, q2)
     upper = np.stack([q2[:, k:k + 1] + r[k] for k in range(3)], -1)
     return LegState(lengths, np.stack(u, -1), upper)
 

@@ -28,6 +28,7 @@ import numpy as np
 from stewartid.model import parameters as layout
 from stewartid.model.joints import N_JOINTS
 from stewartid.model.kernels import (
+    body_gravity,
     centre_of_mass_rates,
     euler_columns,
     euler_rate_entries,
@@ -162,7 +163,8 @@ def leg_terms(params: np.ndarray, upper: np.ndarray, base: np.ndarray, q: np.nda
 
 
 def leg_vectors(upper: np.ndarray, base: np.ndarray, q: np.ndarray
-                ) -> tuple[tuple[np.ndarray, ...], list[np.ndarray], list[np.ndarray], np.ndarray]:
+                ) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...], list[np.ndarray],
+                           list[np.ndarray], np.ndarray]:
     """Leg vectors at poses ``q`` by :func:`~stewartid.model.kernels.leg_vector`.
 
     Parameters
@@ -176,40 +178,45 @@ def leg_vectors(upper: np.ndarray, base: np.ndarray, q: np.ndarray
     -------
     E : tuple of 5 ndarrays, shape (N, 1)
         Entries of the Euler-rate map (:func:`~stewartid.model.kernels.euler_rate_entries`).
+    R : tuple of 9 ndarrays, shape (N, 1)
+        Entries of the rotation matrix (:func:`~stewartid.model.kernels.rotation_entries`).
     r, u : lists of 3 ndarrays, shape (N, 6)
         Components of R upper_i (m) and of the unit leg vectors, per sample and leg.
     lengths : ndarray, shape (N, 6)
         Leg lengths (m).
     """
     trig = [f(q[:, k:k + 1]) for k in (3, 4, 5) for f in (np.cos, np.sin)]  # (N, 1) each
-    r0, r1, r2, u0, u1, u2, lengths = leg_vector(rotation_entries(*trig), q[:, 0:1], q[:, 1:2],
-                                                 q[:, 2:3], *upper.T, *base.T)
-    return euler_rate_entries(*trig[2:]), [r0, r1, r2], [u0, u1, u2], lengths
+    R = rotation_entries(*trig)
+    r0, r1, r2, u0, u1, u2, lengths = leg_vector(R, q[:, 0:1], q[:, 1:2], q[:, 2:3], *upper.T,
+                                                 *base.T)
+    return euler_rate_entries(*trig[2:]), R, [r0, r1, r2], [u0, u1, u2], lengths
 
 
 def _leg_terms_block(params, upper, base, q, G, J_leg, lengths, J_joint):
     """:func:`leg_terms` for one block of samples, into the outputs (G and J_leg, J_joint
     if not None). Every leg quantity has shape (n, 6): samples by legs."""
-    E, (r0, r1, r2), u, length = leg_vectors(upper, base, q)
+    E, R, (r0, r1, r2), u, length = leg_vectors(upper, base, q)
     lengths[:] = length
     columns = [twist_column(c, r0, r1, r2, ZERO, ONE) for c in range(6)]
     if G is not None:
         rates = [leg_rate(*u, *b) for b in columns]
-        _gravity(params, u[2], columns, rates, length, tuple(e[:, 0] for e in E), G)
+        _gravity(params, tuple(e[:, 0] for e in R), u[2], columns, rates, length,
+                 tuple(e[:, 0] for e in E), G)
         for c, column in enumerate([*rates[:3], *euler_columns(*rates[3:], E)]):
             J_leg[:, :, c] = column
     if J_joint is not None:
         _joint_jacobians(u, columns, length, E, J_joint)
 
 
-def _gravity(params, u2, columns, rates, length, E, G):
-    """G (into ``G``, (n, 6)) from the vertical component of the unit leg vectors, the columns
-    of J_A, the leg-length rates per column, the leg lengths and the entries of E (n,),
-    summed leg by leg in the kernel's order."""
+def _gravity(params, R, u2, columns, rates, length, E, G):
+    """G (into ``G``, (n, 6)) from the rotation entries R (n,), the vertical component of the
+    unit leg vectors, the columns of J_A, the leg-length rates per column, the leg lengths
+    and the entries of E (n,), summed leg by leg in the kernel's order."""
     m_u, m_l = params[layout.M_UPPER], params[layout.M_LOWER]
     d_u, d_l = params[layout.D_UPPER], params[layout.D_LOWER]
     g = params[layout.GRAVITY]
-    Gn = [0.0, 0.0, -params[layout.MASS] * g, 0.0, 0.0, 0.0]
+    Gn = [0.0, 0.0, *body_gravity(R, g, params[layout.MASS], params[layout.COM_X],
+                                  params[layout.COM_Y], params[layout.COM_Z]), 0.0]
     for c, b in enumerate(columns):
         _, lower_z, upper_z = centre_of_mass_rates(b[2], u2, rates[c], length, d_u, d_l)
         term = leg_gravity(g, m_u, m_l, lower_z, upper_z)

@@ -49,13 +49,34 @@ def nominal_matrices(platform: Platform, pose: np.ndarray | None = None
     Bt : ndarray, shape (6, 6)
         N s/m, N s/rad, N m s/rad blocks.
     """
+    return nominal_terms(platform, pose)[:2]
+
+
+def nominal_terms(platform: Platform, pose: np.ndarray | None = None
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Mt, Bt and the gravity force G at a pose, from one evaluation of the model.
+
+    Parameters
+    ----------
+    platform : Platform
+    pose : ndarray, shape (6,), optional
+        Absolute pose (m, rad; paper frame, z down); the neutral pose by default.
+
+    Returns
+    -------
+    Mt, Bt : ndarray, shape (6, 6)
+        As :func:`nominal_matrices`.
+    G : ndarray, shape (6,)
+        Gravity generalized force G(q) (N, N m; on the left-hand side of the equation of
+        motion, so G_z < 0 with z down).
+    """
     q0 = platform.neutral_pose if pose is None else np.asarray(pose, dtype=float)
     M, h, G, J_leg, J_joint, lengths = (np.empty(shape) for shape in
                                         ((6, 6), 6, 6, (6, 6), (6, 5, 6), 6))
     # one pose: the kernel interpreted, which spares the command line numba's start
     model_terms(platform.parameters(), platform.upper_joints, platform.base_joints, q0,
                 np.zeros(6), M, h, G, J_leg, J_joint, lengths)
-    return M, _viscous(platform, J_joint)
+    return M, _viscous(platform, J_joint), G
 
 
 def gravity_stiffness(platform: Platform, pose: np.ndarray | None = None,

@@ -33,7 +33,9 @@ Each leg is an open chain from the base, closed on the platform by a weld:
   (e2), a second Cardan joint, then ``leg<k>_revolute`` about the leg; welded to the
   platform (6 constraint rows).
 
-The platform is a free body at the reference point (its centre of mass). The axes are the
+The platform is a free body at the reference point (its centre of mass). A ``[payload]`` is
+a body ``payload`` fixed in it (no joint), with its own mass, centre of mass and full inertia:
+MuJoCo composes the two bodies itself. The axes are the
 orthonormal leg frame of ``docs/conventions.md`` (e1 = unit(z x u), e2 = u x e1, u) at the
 neutral pose, which is every joint's zero. Away from it the Cardan axes move with the
 bodies that carry them while our model re-evaluates e1, e2 from the current leg direction:
@@ -239,7 +241,25 @@ def _world_lines(platform: Platform, integrator: str, timestep: float, mass: flo
         f'      <inertial pos="{_vec(com)}" mass="{mass:.17g}" fullinertia="{_vec(full)}"/>',
         f'      <geom type="cylinder" size="{g.upper_radius:.6g} 0.05" '
         f'pos="0 0 {-g.reference_height:.17g}" rgba="0.2 0.4 0.8 0.6"/>',
+        *_payload_lines(platform),
         "    </body>",
+    ]
+
+
+def _payload_lines(platform: Platform) -> list[str]:
+    """MJCF of the payload: a body fixed in the platform's, with the description's mass,
+    centre of mass (``pos``) and inertia matrix (``fullinertia``) turned into the platform
+    body's MuJoCo frame; none without a payload or for one of zero mass."""
+    payload = platform.payload
+    if payload is None or payload.mass == 0.0:
+        return []
+    I = T @ payload.inertia_matrix @ T
+    full = I[[0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]]
+    return [
+        '      <body name="payload">',
+        f'        <inertial pos="{_vec(T @ np.asarray(payload.com))}" '
+        f'mass="{payload.mass:.17g}" fullinertia="{_vec(full)}"/>',
+        "      </body>",
     ]
 
 

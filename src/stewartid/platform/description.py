@@ -3,7 +3,8 @@
 A :class:`Platform` is a frozen dataclass built from a TOML file (format in
 ``docs/platform-format.md``) or from the shipped ``paper`` preset (Zhang 2020, Tables 1-2).
 It checks itself when built: unknown keys, missing keys, wrong types, negative masses and
-geometries whose legs cannot be built are refused with one message naming the key.
+geometries whose legs cannot be built are refused with one message naming the key. An
+optional ``[payload]`` moves with the platform as one body (:attr:`Platform.moving_body`).
 
 Frame (the paper's): x forward, y right, z down; origin at the centre of the base joint
 plane. Leg numbering follows ``docs/conventions.md`` and is part of the data format.
@@ -15,7 +16,7 @@ import dataclasses
 import math
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -30,6 +31,7 @@ from stewartid.platform.sections import (
     Hydraulics,
     Inertia,
     Limits,
+    Payload,
     Sensors,
 )
 
@@ -42,10 +44,29 @@ COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
 
 
 #: TOML sections of a platform description, in file order, with their dataclass.
-SECTIONS: dict[str, type] = {cls.section: cls for cls in (Geometry, Inertia, Friction, Hydraulics,
-                                                          Controller, Sensors, Limits)}
+SECTIONS: dict[str, type] = {cls.section: cls for cls in (Geometry, Inertia, Payload, Friction,
+                                                          Hydraulics, Controller, Sensors, Limits)}
 #: Sections that must be present in every file; the others take their documented defaults.
 REQUIRED_SECTIONS = ("geometry", "inertia", "friction")
+# [payload] alone has no defaults: its absence means no payload (Platform.payload None).
+
+
+class MovingBody(NamedTuple):
+    """The moving body, platform and payload, as one rigid body.
+
+    Attributes
+    ----------
+    mass : float
+        kg.
+    com : ndarray, shape (3,)
+        Centre of mass (m), platform frame, from the reference point.
+    inertia : ndarray, shape (3, 3)
+        Inertia matrix about the reference point (kg m^2), platform frame.
+    """
+
+    mass: float
+    com: np.ndarray
+    inertia: np.ndarray
 
 
 @dataclasses.dataclass(frozen=True)
@@ -60,6 +81,8 @@ class Platform:
         Plant simulator settings; documented defaults when absent from the file.
     limits : Limits
         Operating limits of excitation design; derived defaults when absent.
+    payload : Payload or None
+        A rigid payload on the platform; None (the section absent) for none.
     name : str
         Label used in reports ("paper" for the preset, the file stem otherwise).
     """
@@ -71,6 +94,7 @@ class Platform:
     controller: Controller = dataclasses.field(default_factory=Controller)
     sensors: Sensors = dataclasses.field(default_factory=Sensors)
     limits: Limits = dataclasses.field(default_factory=Limits)
+    payload: Payload | None = None
     name: str = "platform"
 
     def __post_init__(self) -> None:
@@ -124,6 +148,23 @@ class Platform:
         return float(np.linalg.norm(self.upper_joints[0] + self.neutral_pose[:3]
                                     - self.base_joints[0]))
 
+    @property
+    def moving_body(self) -> MovingBody:
+        """Platform and payload as one rigid body: its mass, centre of mass and inertia about
+        the reference point (the platform's own centre of mass), by the parallel-axis theorem.
+
+        Without a payload: the platform alone, its centre of mass at the reference point and
+        its inertia the diagonal of ``platform_inertia``, exactly.
+        """
+        i, p = self.inertia, self.payload
+        inertia = np.diag(np.asarray(i.platform_inertia, dtype=float))
+        if p is None:
+            return MovingBody(i.platform_mass, np.zeros(3), inertia)
+        c = np.asarray(p.com, dtype=float)
+        mass = i.platform_mass + p.mass
+        shifted = p.inertia_matrix + p.mass * (c @ c * np.eye(3) - np.outer(c, c))
+        return MovingBody(mass, p.mass * c / mass, inertia + shifted)
+
     def parameters(self) -> np.ndarray:
         """Mass and friction parameters packed for the compiled kernels.
 
@@ -132,10 +173,12 @@ class Platform:
         ndarray, shape (N_PARAMETERS,)
             Laid out as :mod:`stewartid.model.parameters` defines.
         """
-        i, f = self.inertia, self.friction
+        i, f, body = self.inertia, self.friction, self.moving_body
         packed = np.empty(layout.N_PARAMETERS)
-        packed[layout.MASS] = i.platform_mass
-        packed[[layout.IXX, layout.IYY, layout.IZZ]] = i.platform_inertia
+        packed[layout.MASS] = body.mass
+        packed[[layout.IXX, layout.IYY, layout.IZZ]] = np.diag(body.inertia)
+        packed[[layout.IXY, layout.IXZ, layout.IYZ]] = body.inertia[[0, 0, 1], [1, 2, 2]]
+        packed[[layout.COM_X, layout.COM_Y, layout.COM_Z]] = body.com
         packed[layout.M_UPPER], packed[layout.M_LOWER] = i.upper_leg_mass, i.lower_leg_mass
         packed[layout.D_UPPER], packed[layout.D_LOWER] = i.upper_leg_com, i.lower_leg_com
         packed[layout.I_UPPER], packed[layout.I_LOWER] = i.upper_leg_inertia, i.lower_leg_inertia
@@ -154,19 +197,27 @@ class Platform:
         30.0
         """
         updates: dict[str, Any] = {}
+        tables: dict[str, dict[str, Any]] = {}
         for key, value in sections_or_values.items():
             if "__" in key:
                 section, field = key.split("__", 1)
-                table = section_to_mapping(updates.get(section, getattr(self, section)))
-                table[field] = value
-                updates[section] = section_from_mapping(SECTIONS[section], table, section)
+                if section not in tables:
+                    current = sections_or_values.get(section, getattr(self, section))
+                    # None: an absent [payload], built from the keys given here alone
+                    tables[section] = {} if current is None else section_to_mapping(current)
+                tables[section][field] = value
             else:
                 updates[key] = value
+        # each section built once, with all its new values (a new [payload] needs every key)
+        for section, table in tables.items():
+            updates[section] = section_from_mapping(SECTIONS[section], table, section)
         return dataclasses.replace(self, **updates)
 
     def to_dict(self) -> dict[str, Any]:
-        """All sections as plain dictionaries (JSON/TOML ready)."""
-        return {name: section_to_mapping(getattr(self, name)) for name in SECTIONS}
+        """All sections as plain dictionaries (JSON/TOML ready); an absent optional section
+        (no payload) is left out."""
+        return {name: section_to_mapping(getattr(self, name)) for name in SECTIONS
+                if getattr(self, name) is not None}
 
     def to_toml(self) -> str:
         """The description as TOML text that :func:`load_platform` reads back identically."""

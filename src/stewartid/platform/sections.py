@@ -13,6 +13,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Sequence
+
+import numpy as np
 
 from stewartid.errors import ConfigError
 from stewartid.fields import (
@@ -73,6 +76,79 @@ class Inertia(Section):
     lower_leg_inertia: float = spec(
         "kg m^2", "transverse inertia of the lower part about its centre of mass",
         nonnegative(0.0, 1e7))
+
+
+@dataclasses.dataclass(frozen=True)
+class Payload(Section):
+    """A rigid payload fixed to the platform: it moves with the platform as one body.
+
+    The products of inertia are entries of the inertia matrix (Ixy = -integral of x y dm),
+    in the order of MuJoCo's ``fullinertia``. A payload of zero mass has no inertia either.
+    """
+
+    section = "payload"
+
+    mass: float = spec("kg", "mass of the payload", nonnegative(0.0, 1e6))
+    com: tuple[float, float, float] = spec(
+        "m", "[x, y, z] of the payload's centre of mass in the platform frame, from the "
+        "reference point", ListOf(finite(-50.0, 50.0), length=3))
+    inertia: tuple[float, float, float, float, float, float] = spec(
+        "kg m^2", "[Ixx, Iyy, Izz, Ixy, Ixz, Iyz] about the payload's centre of mass, platform "
+        "frame; the products are entries of the inertia matrix (Ixy = -sum x y dm)",
+        ListOf(finite(-1e9, 1e9), length=6))
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_payload_inertia(self.mass, self.inertia_matrix)
+
+    @property
+    def inertia_matrix(self) -> np.ndarray:
+        """The inertia matrix about the payload's centre of mass (kg m^2), shape (3, 3)."""
+        return inertia_matrix(self.inertia)
+
+
+def inertia_matrix(entries: Sequence[float]) -> np.ndarray:
+    """The symmetric 3x3 inertia matrix of [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] (kg m^2), the
+    products being its off-diagonal entries (MuJoCo's ``fullinertia`` order)."""
+    xx, yy, zz, xy, xz, yz = (float(v) for v in entries)
+    return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+
+
+#: Relative slack of the triangle inequality of principal moments (of their sum): an
+#: inertia rounded to a few digits from an exact flat body may cross the bound by as much.
+TRIANGLE_SLACK = 1e-6
+
+
+def check_payload_inertia(mass: float, inertia: np.ndarray) -> None:
+    """Refuse an inertia matrix no mass distribution has.
+
+    A body's inertia about its centre of mass is positive definite and its principal moments
+    satisfy the triangle inequalities (each at most the sum of the other two); a body without
+    mass has no inertia.
+
+    Raises
+    ------
+    ConfigError
+        Naming ``[payload] inertia`` and what to check.
+    """
+    entries = f"{[float(v) for v in inertia[[0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]]]}"
+    if mass == 0.0:
+        if np.any(inertia != 0.0):
+            raise ConfigError(f"[payload] inertia = {entries} kg m^2 for a payload of zero "
+                              "mass: a body without mass has no inertia; give its mass or "
+                              "set inertia = [0, 0, 0, 0, 0, 0].")
+        return
+    moments = np.linalg.eigvalsh(inertia)
+    if not moments[0] > 0.0:
+        raise ConfigError(
+            f"[payload] inertia = {entries} kg m^2 is not positive definite (principal moments "
+            f"{', '.join(f'{m:.6g}' for m in moments)}); check the signs of the products, "
+            "which are entries of the matrix (Ixy = -sum x y dm, MuJoCo's fullinertia).")
+    if moments[2] > moments[0] + moments[1] + TRIANGLE_SLACK * moments.sum():
+        raise ConfigError(
+            f"[payload] inertia = {entries} kg m^2 has principal moments "
+            f"{', '.join(f'{m:.6g}' for m in moments)}, the largest above the sum of the "
+            "other two, which no mass distribution gives; check the inertias and their axes.")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -234,5 +310,5 @@ class Limits(Section):
                               f"stroke_max = {self.stroke_max} m.")
 
 
-__all__ = ["ACTUATOR_MODES", "Controller", "Friction", "Geometry", "Hydraulics", "Inertia",
-           "Limits", "Sensors"]
+__all__ = ["ACTUATOR_MODES", "TRIANGLE_SLACK", "Controller", "Friction", "Geometry", "Hydraulics",
+           "Inertia", "Limits", "Payload", "Sensors", "check_payload_inertia", "inertia_matrix"]

@@ -1,4 +1,5 @@
-"""Readable terminal tables (rich): a 6x6 matrix, and identified versus nominal values."""
+"""Readable terminal tables (rich): a 6x6 matrix, a six-vector, and identified versus nominal
+values."""
 
 from __future__ import annotations
 
@@ -32,6 +33,18 @@ def print_matrix(matrix: np.ndarray, title: str, digits: int = 1,
     (console or Console()).print(matrix_table(matrix, title, digits))
 
 
+def print_vector(vector: np.ndarray, title: str, digits: int = 1,
+                 console: Console | None = None) -> None:
+    """Print a vector of the six coordinates as a one-row labelled table; entries below 1e-9
+    of the largest are shown as 0, as in :func:`matrix_table`."""
+    table = Table(title=title, title_justify="left")
+    for name in COORDINATES:
+        table.add_column(name, justify="right")
+    scale = float(np.max(np.abs(vector))) or 1.0
+    table.add_row(*(f"{0.0 if abs(v) < 1e-9 * scale else v:,.{digits}f}" for v in vector))
+    (console or Console()).print(table)
+
+
 def print_comparison(rows: Iterable[Mapping[str, Any]], title: str,
                      console: Console | None = None) -> None:
     """Print identified versus nominal values of the paper's 20 entries.
@@ -53,4 +66,4 @@ def print_comparison(rows: Iterable[Mapping[str, Any]], title: str,
     (console or Console()).print(view)
 
 
-__all__ = ["matrix_table", "print_comparison", "print_matrix"]
+__all__ = ["matrix_table", "print_comparison", "print_matrix", "print_vector"]
