@@ -2,19 +2,22 @@
 README.md and docs/*.md names a command and options that exist, and the commands and Python
 blocks of every page run.
 
-Each page's shell commands and Python blocks run in page order in one folder of their own
-(in this process, but for Python blocks that start a dask cluster),
-prepared with what the page assumes the reader has (``PREPARED``: a platform file, logged
-experiments). A command runs as written unless:
+Each page's shell commands and Python blocks run in page order, in a folder of their own
+holding what the page assumes the reader has (``prepare``: a platform file, logged
+experiments, the page's own mapping or study file), in this process (Python blocks that start
+a dask cluster: in a fresh interpreter). A command runs as written unless:
 
-- it is slower than a test may be: it runs with the argument substitutions of ``SCALED``,
-  each stated there (a shorter record, a smaller budget, a smaller study);
-- it cannot run here at all: ``PARSED_ONLY`` names it with the reason, and it is only checked
-  against the command's options (install commands: the extras they name exist).
+- it would take minutes: it runs with the argument substitutions ``SCALED`` states (a shorter
+  record, a smaller budget, a smaller study);
+- it cannot run here (an install, the test suite itself, the site build, dask's own servers)
+  or runs end to end elsewhere in the suite (``reproduce``): ``PARSED_ONLY`` names it with
+  the reason, and it is only checked against the command's options (install commands: the
+  extras they name exist).
 
-A page's command that is neither run nor listed fails ``test_every_documented_command_runs_or_is_listed``.
-Synopses (``text`` blocks of ``stewartid ...`` with ``[--option]`` and ``a|b``) are checked
-against the options only: they are not commands.
+README's quick start is the getting-started page's commands, which run there. A command
+neither run nor listed fails ``test_every_documented_command_runs_or_is_listed``. Synopses
+(``text`` blocks of ``stewartid ...`` with ``[--option]`` and ``a|b``) are not commands: they
+are checked against the options only.
 """
 
 from __future__ import annotations
