@@ -317,12 +317,13 @@ def logged(tmp_path_factory: pytest.TempPathFactory) -> Path:
     file) and six logged experiments ``exp1.csv .. exp6.csv`` (2 s each, simulated)."""
     folder = tmp_path_factory.mktemp("logged")
     shutil.copy(ROOT / "src" / "stewartid" / "data" / "paper.toml", folder / "my_hexapod.toml")
+    here = Path.cwd()
     os.chdir(folder)
     try:
         run_command("fixture", "stewartid simulate --platform my_hexapod.toml --coulomb 5 "
                     "--duration 2 --noise --seed 3 --out sim")
     finally:
-        os.chdir(ROOT)
+        os.chdir(here)
     for path in (folder / "sim").glob("exp*.csv"):
         shutil.copy(path, folder / path.name)
     return folder
