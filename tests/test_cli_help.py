@@ -5,27 +5,54 @@ from __future__ import annotations
 
 import re
 
+import click
 import pytest
 import typer.main
 
 from stewartid.cli.application import app
 
 COMMAND = typer.main.get_command(app)
-COMMANDS = sorted(COMMAND.commands)
+
+
+def command_paths(group: click.Group, prefix: tuple[str, ...] = ()) -> list[str]:
+    """Every command and subcommand under ``group``, as the words that name it
+    (``"study"``, or ``"group sub"`` for a subcommand)."""
+    paths = []
+    for name, command in sorted(group.commands.items()):
+        paths.append(" ".join((*prefix, name)))
+        if isinstance(command, click.Group):
+            paths.extend(command_paths(command, (*prefix, name)))
+    return paths
+
+
+def command_of(path: str | None) -> click.Command:
+    command = COMMAND
+    for name in (path or "").split():
+        command = command.commands[name]
+    return command
+
+
+COMMANDS = command_paths(COMMAND)
 #: The metavars typer derives from type annotations, which say nothing about the value.
 TYPE_METAVAR = re.compile(r"<(?:bool|str|path|Path|int|float|list\[[^\]]*\])>|\{\w+\}\.\.\.")
 
 
 def render_help(capsys: pytest.CaptureFixture[str], command: str | None, width: int) -> str:
     """The help text of ``stewartid [command] --help`` formatted for a terminal of ``width``."""
-    arguments = [command, "--help"] if command else ["--help"]
+    arguments = [*(command or "").split(), "--help"]
     COMMAND.main(arguments, prog_name="stewartid", standalone_mode=False, terminal_width=width,
                  max_content_width=width)
     return capsys.readouterr().out
 
 
 def test_the_commands_are_all_checked() -> None:
-    assert COMMANDS == ["design", "identify", "methods", "nominal", "reproduce", "simulate", "study"]
+    # every command and subcommand the application registers is walked, whatever its depth
+    assert set(COMMANDS) >= {"design", "identify", "methods", "nominal", "reproduce", "simulate",
+                             "study"}
+    registered = {group.name for group in app.registered_groups} | {
+        command.name or command.callback.__name__.replace("_", "-")
+        for command in app.registered_commands}
+    assert registered <= set(COMMANDS)
 
 
 @pytest.mark.parametrize("command", [None, *COMMANDS])
@@ -35,9 +62,9 @@ def test_help_has_no_type_metavars(capsys: pytest.CaptureFixture[str], command: 
     assert TYPE_METAVAR.findall(text) == []
 
 
-@pytest.mark.parametrize("command", COMMANDS)
-def test_every_value_option_names_its_value_and_flags_take_none(command: str) -> None:
-    for parameter in COMMAND.commands[command].params:
+@pytest.mark.parametrize("command", [None, *COMMANDS])
+def test_every_value_option_names_its_value_and_flags_take_none(command: str | None) -> None:
+    for parameter in command_of(command).params:
         if getattr(parameter, "is_flag", False):
             assert not parameter.metavar, f"{command} {parameter.opts[0]} is a flag"
         else:

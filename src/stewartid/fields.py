@@ -63,6 +63,7 @@ class Interval:
     physical: tuple[float, float] | None = None
 
     def is_satisfied_by(self, value: Any) -> bool:
+        """Whether ``value`` meets the constraint."""
         if not _is_number(value, self.kind) or not math.isfinite(value):
             return False
         if self.low is not None and (value < self.low
@@ -85,6 +86,7 @@ class Interval:
         return ""
 
     def describe(self, value: Any) -> str:
+        """What the constraint asks for, in the words of an error message about ``value``."""
         # integers are always named; real numbers only when the value given is not one
         if self.kind is Integral:
             noun = "an integer"
@@ -118,14 +120,17 @@ class ListOf:
     length: int | None = None
 
     def has_shape(self, value: Any) -> bool:
+        """Whether ``value`` is one-dimensional with the required number of elements."""
         if not isinstance(value, list | tuple | np.ndarray) or np.ndim(value) != 1:
             return False
         return len(value) == self.length if self.length is not None else len(value) > 0
 
     def is_satisfied_by(self, value: Any) -> bool:
+        """Whether ``value`` meets the constraint."""
         return self.has_shape(value) and all(self.item.is_satisfied_by(v) for v in value)
 
     def describe(self, value: Any) -> str:
+        """What the constraint asks for, in the words of an error message about ``value``."""
         count = f"{self.length} " if self.length is not None else "non-empty list of "
         nouns = "integers" if self.item.kind is Integral else "numbers"
         text = f"a list of {count}{nouns}" if self.length is not None else f"a {count}{nouns}"
@@ -139,9 +144,11 @@ class Options:
     values: tuple
 
     def is_satisfied_by(self, value: Any) -> bool:
+        """Whether ``value`` meets the constraint."""
         return isinstance(value, Real | str) and value in self.values
 
     def describe(self, value: Any) -> str:
+        """What the constraint asks for, in the words of an error message about ``value``."""
         if len(self.values) == 1:
             return repr(self.values[0])
         return "one of " + ", ".join(repr(v) for v in self.values)
@@ -155,9 +162,11 @@ class InstanceOf:
     noun: str
 
     def is_satisfied_by(self, value: Any) -> bool:
+        """Whether ``value`` meets the constraint."""
         return isinstance(value, self.kind)
 
     def describe(self, value: Any) -> str:
+        """What the constraint asks for, in the words of an error message about ``value``."""
         return self.noun
 
 

@@ -33,6 +33,8 @@ class OneLineUsageErrors(TyperGroup):
     as one line ``error: ...`` and exit code 2 instead of a usage box."""
 
     def main(self, *args: Any, standalone_mode: bool = True, **kwargs: Any) -> Any:
+        """Run the application; in standalone mode, a usage error is one line on stderr and exit
+        code 2, and the process exits with the command's code."""
         if not standalone_mode:
             return super().main(*args, standalone_mode=False, **kwargs)
         try:
@@ -71,6 +73,7 @@ class PlainHelpCommand(TyperCommand):
         return pieces
 
     def format_options(self, ctx: Any, formatter: Any) -> None:
+        """Write the "Arguments:" and "Options:" sections, each entry its label and help."""
         arguments = [(_argument_label(parameter, usage=False), parameter.help or "")
                      for parameter in self.get_params(ctx)
                      if parameter.param_type_name == "argument"]

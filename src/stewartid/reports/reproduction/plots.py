@@ -34,11 +34,15 @@ class FigureQueue:
 
     def submit(self, function: Callable[..., Any], stem: str, caption: str, *args: Any,
                **kwargs: Any) -> None:
+        """Draw ``function(*args, directory=folder, stem=stem, **kwargs)`` on the pool, as
+        ``figures/{stem}.png`` of the report with ``caption``."""
         future = self.pool.submit(function, *args, directory=self.folder, stem=stem, **kwargs)
         future.add_done_callback(lambda _: self.bar.advance(self.task))
         self.submitted.append((future, FigureEntry(f"figures/{stem}.png", caption)))
 
     def finish(self) -> tuple[list[FigureEntry], list[Path]]:
+        """Wait for every figure: their report entries in submission order, and the files
+        written."""
         files: list[Path] = []
         for future, _ in self.submitted:
             files += future.result()
