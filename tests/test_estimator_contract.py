@@ -3,6 +3,8 @@ preset (modelled on scikit-learn's own estimator checks)."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from sklearn.base import clone
@@ -99,3 +101,33 @@ def test_a_bad_setting_is_refused_in_one_message_form(spec, paper):
     with pytest.raises(ConfigError, match=rf"^The '{name}' parameter of {owner} must be .+\. "
                                           r"Got <object object at \w+> instead\.$"):
         estimator.fit([], paper)
+
+
+@pytest.fixture(scope="module")
+def noisy_truth(paper):
+    """Six experiments of the linear model, 8 periods, the forces measured with white noise
+    of 0.5 % of each leg's mean force, in 6 realisations; and the true (Mt, Bt)."""
+    M, B = random_matrices(np.random.default_rng(11))
+    clean = [make_experiment(paper, M, B, k, frequency_hz=1.0, periods=8) for k in range(6)]
+    rng = np.random.default_rng(12)
+    sets = []
+    for _ in range(6):
+        sets.append([dataclasses.replace(d, forces=d.forces + 0.005 * np.abs(d.forces).mean(axis=0)
+                                         * rng.normal(size=d.forces.shape)) for d in clean])
+    return sets, M, B
+
+
+def test_standard_errors_are_calibrated_on_a_small_noisy_case(spec, noisy_truth, paper):
+    """Against the generating model: most of the 72 entries x 6 realisations within 3
+    reported standard errors, and the errors not so pessimistic that the check is vacuous.
+    With 432 draws of honest Gaussian errors, the share within 3 SE is 0.997 (binomial
+    standard deviation 0.003), the RMS ratio 1 +- 0.03."""
+    sets, M, B = noisy_truth
+    ratios = []
+    for data in sets:
+        estimator = spec.create().fit(data, paper)
+        for estimate, truth, matrix in ((estimator.M_, M, "M"), (estimator.B_, B, "B")):
+            ratios.append(np.abs(estimate - truth) / estimator.std_errors_[matrix])
+    ratios = np.concatenate([r.ravel() for r in ratios])
+    assert np.mean(ratios <= 3.0) >= 0.95, f"{spec.name}: {np.mean(ratios <= 3.0):.2%} within 3 SE"
+    assert np.sqrt(np.mean(ratios ** 2)) >= 0.2, spec.name

@@ -331,3 +331,49 @@ def test_report_on_own_noisy_plant(tmp_path, paper):
     # sensor noise shows in the data table, and the model still predicts held-out force
     assert np.all(report.runs[0].validation.vaf_percent >= 98.0)
     assert Path(tmp_path / "identification.mat").is_file()
+
+
+def _validation_record(paper, M, B, name):
+    """All six DOFs at once at frequencies the fitted experiments lack."""
+    extra = [(k, AMPLITUDES[k] * 0.5, 2 * np.pi * (0.6 + 0.15 * k), 0.4 * k) for k in range(1, 6)]
+    return make_experiment(paper, M, B, 0, frequency_hz=0.45, periods=6,
+                           sample_rate=SAMPLE_RATE, extra=extra, name=name)
+
+
+def test_validation_records_see_a_wrong_parameter(tmp_path, linear_data, paper):
+    """A record of the fitted model's own dynamics is predicted to round-off of the filters;
+    one whose Mt(1,5) coupling differs by 30 % of the diagonal scale is not: records of another
+    excitation see what held-out segments of the same sines cannot."""
+    data, M, B = linear_data
+    wrong = M.copy()
+    wrong[0, 4] = wrong[4, 0] = M[0, 4] + 0.3 * np.sqrt(M[0, 0] * M[4, 4])
+    records = [_validation_record(paper, M, B, "same"), _validation_record(paper, wrong, B, "wrong")]
+    report = write_identification_report(data, paper, tmp_path / "r", methods=("ls",),
+                                         settings={"coulomb": False}, folds=3,
+                                         records=records[:1])
+    run = report.runs[0]
+    assert np.all(run.records.vaf_percent > 99.0), run.records.vaf_percent
+    text = (tmp_path / "r" / "report.md").read_text()
+    assert "## Validation on other records" in text
+    document = json.loads((tmp_path / "r" / "result.json").read_text())
+    assert len(document["validation"]["records"]["vaf_percent"]) == 6
+    other = write_identification_report(data, paper, tmp_path / "w", methods=("ls",),
+                                        settings={"coulomb": False}, folds=3,
+                                        records=records[1:])
+    worse = other.runs[0].records.vaf_percent
+    assert min(worse[0], worse[4]) < 99.0 and min(worse[0], worse[4]) < min(
+        run.records.vaf_percent[0], run.records.vaf_percent[4]) - 1.0
+
+
+def test_validate_needs_a_report_and_other_files(tmp_path, files):
+    runner = CliRunner()
+    alone = runner.invoke(app, ["identify", "--platform", "paper", "--validate", str(files[0]),
+                                *map(str, files[1:])])
+    assert alone.exit_code == 2 and "--report" in alone.output
+    assert len(alone.output.strip().splitlines()) == 1
+    same = runner.invoke(app, ["identify", "--platform", "paper", "--method", "ls",
+                               "--report", str(tmp_path / "r"), "--validate", str(files[0]),
+                               *map(str, files)])
+    assert same.exit_code == 2 and "also an experiment" in same.output
+    assert len(same.output.strip().splitlines()) == 1
+    assert not (tmp_path / "r").exists()

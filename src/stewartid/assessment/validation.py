@@ -365,6 +365,28 @@ def cross_validate(create: Callable[[], Any], datasets: Sequence[Dataset], platf
     return CrossValidation(folds=int(folds), fold_results=fold_results, segments=segments)
 
 
+def record_segments(datasets: Sequence[Dataset], platform: Platform, gravity: bool = True
+                    ) -> list[Segment]:
+    """Validation records (motion the fit did not see), filtered as the held-out segments
+    are, each whole (:func:`prepare_segment`, labelled with fold 0)."""
+    return [prepare_segment(dataset, platform, excitation_window(dataset), gravity=gravity,
+                            experiment=k) for k, dataset in enumerate(datasets)]
+
+
+def validate_on_records(result: IdentificationResult, segments: Sequence[Segment]
+                        ) -> ValidationResult:
+    """Scores of a model fitted on all experiments on validation records of another
+    excitation (:func:`record_segments`). Unlike held-out segments of the same sines, other
+    motion shows a wrong parameter that a friction term compensated on the fitted one.
+
+    Returns
+    -------
+    ValidationResult
+        With ``folds`` = 0 (no refit).
+    """
+    return score(segments, [predict(s, result) for s in segments], folds=0)
+
+
 def friction_signature(validation: ValidationResult) -> float:
     """Share of the held-out residual that has the shape of Coulomb joint friction.
 
@@ -398,4 +420,5 @@ def in_sample(segments: Sequence[Segment], result: IdentificationResult) -> Vali
 __all__ = ["DEFAULT_FOLDS", "CrossValidation", "Segment", "ValidationResult",
            "coulomb_estimate", "coulomb_levels", "cross_validate", "excitation_window", "fold_bounds",
            "friction_signature", "held_out_segments", "in_sample", "predict", "prediction_levels",
-           "prepare_segment", "score", "with_companion_friction"]
+           "prepare_segment", "record_segments", "score", "validate_on_records",
+           "with_companion_friction"]

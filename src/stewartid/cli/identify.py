@@ -64,6 +64,11 @@ def identify(
              "negative when the forces lead): every method works on the forces aligned by it. "
              "'auto' estimates it first (needs two or more frequencies per DOF) and prints it "
              "with its standard error (docs/logs.md).")] = None,
+    validate: Annotated[list[Path] | None, typer.Option(
+        "--validate", metavar="FILE",
+        help="--report: a record of another excitation (e.g. the validation record of "
+             "'stewartid design'), not fitted: every method predicts it and the verdict "
+             "judges the methods by it. Repeat for several.")] = None,
 ) -> None:
     """Identify Mt and Bt from experiments; print the paper-style table when nominal values are
     known (platform description, or meta.json/truth.json beside the data) and write JSON."""
@@ -79,7 +84,7 @@ def identify(
              "--friction": FlagSetting("friction", friction, friction is not None)}
     found = identify_files(files, method, platform, flags=flags, columns=columns, out=out,
                            force=force, report=report, consistent=consistent, folds=folds,
-                           delay=delay)
+                           delay=delay, validate=validate or ())
     if found.delay is not None:
         entry = found.delay
         if entry["source"] == "estimated":

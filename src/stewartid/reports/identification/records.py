@@ -35,6 +35,8 @@ class MethodReport:
     in_sample : ValidationResult or None
         The full fit on the same segments (residuals over time).
     projection : ConsistentEstimate or None
+    records : ValidationResult or None
+        The full fit's prediction of the validation records (``identify --validate``).
     seconds : float
         Fit and validation time.
     error : str or None
@@ -50,6 +52,7 @@ class MethodReport:
     validation_unconstrained: ValidationResult | None = None
     in_sample: ValidationResult | None = None
     projection: ConsistentEstimate | None = None
+    records: ValidationResult | None = None
     seconds: float = 0.0
     error: str | None = None
     exception: StewartidError | None = field(default=None, repr=False, compare=False)
@@ -62,6 +65,12 @@ class MethodReport:
             nan = np.full(len(FRICTION_TYPES), np.nan)
             return nan, nan
         return coulomb_estimate(self.result)
+
+    @property
+    def evidence(self) -> ValidationResult | None:
+        """What the verdict judges the prediction by: the validation records when given,
+        else the held-out segments."""
+        return self.records if self.records is not None else self.validation
 
 
 @dataclass(frozen=True)

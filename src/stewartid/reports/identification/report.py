@@ -33,6 +33,8 @@ from stewartid.assessment.validation import (
     cross_validate,
     held_out_segments,
     in_sample,
+    record_segments,
+    validate_on_records,
     with_companion_friction,
 )
 from stewartid.assessment.verdict import choose_trusted
@@ -71,7 +73,9 @@ def _project(result: IdentificationResult) -> IdentificationResult:
 def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Dataset],
                platform: Platform, folds: int, consistent: bool,
                segments: dict[bool, list[Segment]],
-               check: Callable[[IdentificationResult], None] | None = None) -> MethodReport:
+               check: Callable[[IdentificationResult], None] | None = None,
+               records: Sequence[Dataset] = (),
+               record_cache: dict[bool, list[Segment]] | None = None) -> MethodReport:
     """Fit, validate and check one method; a method that cannot be applied to these data
     (a :class:`~stewartid.errors.StewartidError`) is reported with its message.
 
@@ -89,6 +93,11 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
     check : callable, optional
         Raises a StewartidError for an implausible result (the method is then reported as
         not applicable).
+    records : sequence of Dataset
+        Validation records of another excitation (``identify --validate``), predicted by the
+        full fit.
+    record_cache : dict, optional
+        Their filtered segments by ``gravity`` setting, filled on first use.
     """
     spec = registry.method_spec(name)
     accepted = spec.estimator_class.param_names()
@@ -116,12 +125,25 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
     if consistent:
         result, projection = consistent_result(unconstrained)
         before, validation = validation, folds_fit.scores(_project)
-    result = dataclasses.replace(result, validation=validation.to_dict())
+    external = None
+    if records:
+        cache = {} if record_cache is None else record_cache
+        if gravity not in cache:
+            cache[gravity] = record_segments(records, platform, gravity)
+        external = validate_on_records(
+            with_companion_friction(result, companion, datasets, platform)
+            if result is not unconstrained else unconstrained, cache[gravity])
+    entry = validation.to_dict()
+    if external is not None:
+        entry["records"] = {"vaf_percent": external.vaf_percent.tolist(),
+                            "nrmse": external.nrmse.tolist(),
+                            "names": [s.name for s in external.segments]}
+    result = dataclasses.replace(result, validation=entry)
     return MethodReport(name, spec.display_name, spec.color, result=result,
                         unconstrained=unconstrained, validation=validation,
                         validation_unconstrained=before,
                         in_sample=in_sample(segments[gravity], result), projection=projection,
-                        seconds=time.perf_counter() - start)
+                        records=external, seconds=time.perf_counter() - start)
 
 
 def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
@@ -131,8 +153,8 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
                                 nominal: tuple[np.ndarray, np.ndarray] | None = None,
                                 nominal_source: str | None = None,
                                 sources: Sequence[str] = (),
-                                check: Callable[[IdentificationResult], None] | None = None
-                                ) -> IdentificationReport:
+                                check: Callable[[IdentificationResult], None] | None = None,
+                                records: Sequence[Dataset] = ()) -> IdentificationReport:
     """Identify, validate and report on measured experiments.
 
     Parameters
@@ -162,6 +184,9 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
         The data files, listed in the report.
     check : callable, optional
         See :func:`run_method`.
+    records : sequence of Dataset
+        Validation records of another excitation: every method predicts them, and the
+        verdict judges the prediction on them instead of on held-out segments.
 
     Returns
     -------
@@ -183,13 +208,14 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
                                             "neutral pose")
     rows = data_rows(datasets, platform)
     segments: dict[bool, list[Segment]] = {}
+    record_cache: dict[bool, list[Segment]] = {}
     runs = [run_method(name, settings or {}, datasets, platform, folds, consistent, segments,
-                       check) for name in dict.fromkeys(methods)]
+                       check, records, record_cache) for name in dict.fromkeys(methods)]
     usable = [run for run in runs if run.result is not None]
     if not usable:
         raise runs[0].exception
     verdict = choose_trusted({run.name: None if run.result is None else
-                              (run.result, run.validation) for run in runs})
+                              (run.result, run.evidence) for run in runs})
     trusted = verdict.trusted
     drawer = FigureDrawer(directory / "figures")
     data_figures(drawer, datasets, platform, rows)
@@ -203,7 +229,8 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
     report = IdentificationReport(runs, verdict, directory)
     files.append(report.result.to_json(directory / "result.json"))
     text = render_report(report, datasets, platform, nominal, nominal_source or "", rows,
-                         drawer.entries, sources, folds, time.perf_counter() - started)
+                         drawer.entries, sources, folds, time.perf_counter() - started,
+                         [d.name for d in records])
     files.append(write_text_atomic(directory / "report.md", text))
     files.append(write_text_atomic(directory / "report.html", render_html(
         text, directory, title=f"stewartid identification report: {platform.name}")))

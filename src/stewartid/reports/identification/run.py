@@ -166,7 +166,8 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
                    platform: str | None = None, *, flags: Mapping[str, FlagSetting] | None = None,
                    columns: str | None = None, out: Path | None = None, force: bool = False,
                    report: Path | None = None, consistent: bool = False,
-                   folds: int | None = None, delay: str | float | None = None) -> IdentifyRun:
+                   folds: int | None = None, delay: str | float | None = None,
+                   validate: Sequence[str | Path] = ()) -> IdentifyRun:
     """Identify Mt and Bt from experiment files, as ``stewartid identify`` does.
 
     Parameters
@@ -197,6 +198,9 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
         Delay of the force channels relative to the motion (s, positive when the forces are
         logged late): every method works on the forces aligned by it; ``"auto"`` estimates
         it first (:func:`~stewartid.identification.delay.apply_delay`). None: as logged.
+    validate : sequence of str or Path
+        Validation records of another excitation (files or folders; needs ``report``): every
+        method predicts them, and the verdict judges the prediction on them.
 
     Returns
     -------
@@ -218,10 +222,21 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     description = platform_for_data(paths, platform)
     _check_outputs(paths, (platform, columns), out, report, force, method, len(names) > 1,
                    folds)
+    if validate and report is None:
+        raise ConfigError("--validate compares the methods' predictions in a report; add "
+                          "--report DIR.")
+    records_paths = expand_paths(validate) if validate else []
+    shared = sorted({str(p.resolve()) for p in records_paths} & {str(p.resolve()) for p in paths})
+    if shared:
+        raise ConfigError(f"--validate {shared[0]!r} is also an experiment to fit; validation "
+                          "records must be motion the fit does not see.")
     log_format = load_log_format(columns) if columns is not None else None
     datasets = read_datasets(paths, description, log_format)
     check_experiment_set(datasets, description)
     datasets, delay_entry = apply_delay(datasets, description, delay)
+    records = read_datasets(records_paths, description, log_format) if records_paths else []
+    if records and delay_entry is not None:
+        records, _ = apply_delay(records, description, delay_entry["seconds"])
     meta = nominal_from_meta(paths)
 
     def check(found: IdentificationResult) -> None:
@@ -241,7 +256,7 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
         written = write_identification_report(
             datasets, description, report, names, settings, consistent,
             DEFAULT_FOLDS if folds is None else folds, None if meta is None else meta[:2],
-            None if meta is None else meta[2], [str(p) for p in paths], check)
+            None if meta is None else meta[2], [str(p) for p in paths], check, records)
         result = written.result
     else:
         result = registry.create_identifier(method, **settings).fit(datasets, description).result_

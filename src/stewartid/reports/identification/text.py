@@ -241,8 +241,9 @@ def render_report(report: IdentificationReport, datasets: Sequence[Dataset],
                   platform: Platform, nominal: tuple[np.ndarray, np.ndarray],
                   nominal_source: str, rows: Sequence[dict[str, Any]],
                   figures: Mapping[str, tuple[str, str]], sources: Sequence[str], folds: int,
-                  seconds: float) -> str:
-    """``report.md``: every section, figures referenced by relative path."""
+                  seconds: float, records: Sequence[str] = ()) -> str:
+    """``report.md``: every section, figures referenced by relative path; ``records`` names
+    the validation records (``identify --validate``)."""
     from stewartid import __version__
 
     best = next(run for run in report.runs if run.name == report.trusted)
@@ -287,7 +288,8 @@ def render_report(report: IdentificationReport, datasets: Sequence[Dataset],
               "odd harmonics of the excitation are the signature of unmodelled Coulomb "
               "friction.", ""]
     lines += _figure(figures, "residuals")
-    lines += _validation_section(report, folds) + _figure(figures, "validation")
+    lines += (_validation_section(report, folds) + _figure(figures, "validation")
+              + _records_section(report, records))
     lines += _consistency_section(ok)
     lines += ["## Friction", ""]
     for run in ok:
@@ -334,6 +336,24 @@ def _validation_section(report: IdentificationReport, folds: int) -> list[str]:
                                 kinds, tuple(vaf_rows))),
         to_markdown(ResultTable("nrmse", "Held-out NRMSE per DOF", ("method", *COORDINATES),
                                 kinds, tuple(nrmse_rows)))]
+
+
+def _records_section(report: IdentificationReport, records: Sequence[str]) -> list[str]:
+    """Validation on records of another excitation, or what the segments cannot show."""
+    if not records:
+        return ["The held-out segments come from the same excitation as the fit: a model "
+                "whose friction term compensates a wrong coupling predicts them as well as the "
+                "right one. Records of another excitation (`identify --validate FILE`, e.g. "
+                "the validation record `stewartid design` writes) would show it.", ""]
+    rows = tuple((run.display_name, *(f"{v:.3f}" for v in run.records.vaf_percent))
+                 for run in report.runs if run.records is not None)
+    lines = ["## Validation on other records", "",
+             f"Each method's model, fitted on all experiments, predicts {len(records)} "
+             f"record(s) of another excitation ({', '.join(records)}), filtered as the held-out "
+             "segments are; the verdict judges the prediction on these.", ""]
+    return lines + [to_markdown(ResultTable(
+        "records", "VAF per DOF on the validation records (%)", ("method", *COORDINATES),
+        ("text",) + ("value",) * 6, rows)), ""]
 
 
 def _consistency_section(runs: Sequence[MethodReport]) -> list[str]:
