@@ -39,3 +39,18 @@ def test_bad_sine_is_refused():
         Sine(6, 0.01, 0.5)
     with pytest.raises(ConfigError, match="frequency_hz must be > 0"):
         Sine(0, 0.01, -1.0)
+
+
+def test_spectral_lines_ignore_the_edge_of_the_blanked_low_band():
+    """A faded sine over a slow swell: the largest value just above the blanked band is that
+    band's edge, not a line; the line is the sine's, its height that of a Hann-windowed sine
+    (A n / 4 for amplitude A over n samples), not an overflow of the peak interpolation."""
+    from stewartid.datasets.excitation import spectral_lines
+
+    rate, n = 1000.0, 12001
+    t = np.arange(n) / rate
+    fade = np.clip(t / 2, 0, 1) * np.clip((12 - t) / 2, 0, 1)
+    x = 0.0126 * fade * np.sin(2 * np.pi * 0.53 * t) + 0.01 * np.exp(-((t - 6) / 3) ** 2)
+    lines = spectral_lines(x, rate, fraction=0.0)
+    assert lines.frequencies_hz[0] == pytest.approx(0.53, abs=0.01)
+    assert lines.largest <= 0.0126 * n / 4 * 1.01

@@ -150,8 +150,10 @@ def spectral_lines(motion: np.ndarray, sample_rate: float,
     amplitude[frequencies < MIN_LINE_PERIODS * resolution] = 0.0
     if not np.any(amplitude > 0):
         return empty
+    # a maximum beside the blanked low band is that band's edge, not a line (and its log
+    # parabola through a zero neighbour would place an absurd height)
     peaks = np.flatnonzero((amplitude[1:-1] > amplitude[:-2])
-                           & (amplitude[1:-1] >= amplitude[2:])) + 1
+                           & (amplitude[1:-1] >= amplitude[2:]) & (amplitude[:-2] > 0)) + 1
     if not len(peaks):
         return empty
     largest = amplitude[peaks].max()
@@ -167,7 +169,9 @@ def spectral_lines(motion: np.ndarray, sample_rate: float,
                         for k in (-1, 0, 1))
     curvature = below - 2 * at + above
     # at a local maximum the curvature is negative, or zero on a plateau (then no shift)
-    shift = 0.5 * (below - above) / np.minimum(curvature, -np.finfo(float).tiny)
+    # the vertex of a parabola through a maximum and its neighbours lies within half a step
+    shift = np.clip(0.5 * (below - above) / np.minimum(curvature, -np.finfo(float).tiny),
+                    -0.5, 0.5)
     heights = np.exp(at - 0.25 * (below - above) * shift)
     return SpectralLines((peaks + shift) * sample_rate / nfft, heights / heights.max(),
                          resolution, float(heights.max()))

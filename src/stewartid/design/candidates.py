@@ -31,7 +31,7 @@ from stewartid.platform import COORDINATES, Platform
 from stewartid.simulation.excitation import DEFAULT_AMPLITUDES
 
 
-def _ramp(s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def quintic_ramp(s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Quintic smoothstep on s in [0, 1] and its first two derivatives in s."""
     s = np.clip(s, 0.0, 1.0)
     return (s ** 3 * (10 - 15 * s + 6 * s ** 2), 30 * s ** 2 * (1 - s) ** 2,
@@ -106,7 +106,7 @@ class DesignedRecord:
         fade, hold = self.fade_periods * self.period, self.hold_periods * self.period
         start, previous = 0.0, 0.0
         for level in (*self.levels, 0.0):
-            w, dw, ddw = _ramp((t - start) / fade)
+            w, dw, ddw = quintic_ramp((t - start) / fade)
             a += (level - previous) * w
             da += (level - previous) * dw / fade
             dda += (level - previous) * ddw / fade ** 2
@@ -278,5 +278,5 @@ def schedule_label(schedules: Sequence, unit: str = "") -> str:
 
 
 __all__ = ["COORDINATES", "Design", "DesignedRecord", "PlayableRecord", "design_from_dict",
-           "paper_design", "record_from_dict", "schedule_label", "scheduled_design",
+           "paper_design", "quintic_ramp", "record_from_dict", "schedule_label", "scheduled_design",
            "unit_direction"]

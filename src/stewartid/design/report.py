@@ -122,7 +122,11 @@ def render_markdown(design: Design, prediction: Prediction, baseline: Prediction
               "The prediction holds for the estimator it was made with. On the plant first "
               "(with the sensor noise; `--seed` for another realisation), then on the "
               "machine's logs (PLATFORM: the platform file of the design):", "", "```bash",
-              play_command(design, coulomb, folder), identify_command(method), "```", ""]
+              play_command(design, coulomb, folder), identify_command(method), "```", "",
+              "`validation/validation.csv` moves every DOF at once at frequencies of its own, "
+              "within half the limits: motion the fit does not see. Identified with it held "
+              "out, the report judges each model by its prediction of it:", "", "```bash",
+              *validation_commands(method, coulomb, folder), "```", ""]
     return "\n".join(lines)
 
 
@@ -139,6 +143,18 @@ def play_command(design: Design, coulomb: float, folder: str = "DIR", run: str =
 def identify_command(method: str, run: str = "RUN") -> str:
     """The ``stewartid identify`` command of the estimator a design is made for."""
     return f"stewartid identify {run} --platform PLATFORM {' '.join(identify_options(method))}"
+
+
+def validation_commands(method: str, coulomb: float, folder: str = "DIR", run: str = "RUN"
+                        ) -> list[str]:
+    """The commands that play the design's validation record on the plant and identify with
+    it held out (``identify --validate``): the report then judges every model on motion it
+    did not see."""
+    record = shlex.quote(f"{folder}/validation/validation.csv")
+    return [f"stewartid simulate --platform PLATFORM --coulomb {coulomb:g} --excitation "
+            f"{record} --noise --seed 1 --out {run}_validation",
+            f"{identify_command(method, run)} --report {run}_report --validate "
+            f"{run}_validation/exp1.csv"]
 
 
 def write_design_report(directory: str | Path, markdown_text: str) -> list[Path]:

@@ -4,6 +4,7 @@ Output folder layout::
 
     design.json           the design, its prediction, the baseline's, the limits
     commands/exp*.csv     pose and leg-length commands at the controller rate
+    validation/validation.csv  a record of every DOF at once, for ``identify --validate``
     figures/*.png, *.svg  limit use over time, predicted accuracy vs the paper's set
     report.md, report.html
 """
@@ -29,8 +30,10 @@ from stewartid.design.report import (
     plot_accuracy,
     plot_limit_use,
     render_markdown,
+    validation_commands,
     write_design_report,
 )
+from stewartid.design.validation import write_validation_record
 from stewartid.files import check_output_folder, write_json_atomic
 from stewartid.platform import Platform
 from stewartid.simulation.sensors import SensorNoise
@@ -56,7 +59,8 @@ class DesignOutput:
 
 def is_design_file(path: Path) -> bool:
     """True for what :func:`run_design` writes."""
-    return path.name in ("design.json", "report.md", "report.html", "commands", "figures")
+    return path.name in ("design.json", "report.md", "report.html", "commands", "figures",
+                         "validation")
 
 
 def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str | Path,
@@ -123,6 +127,7 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
     use_source = ("the plant's true states" if source == "plant"
                   else "commanded motion, rigid-body model forces")
     files = write_commands(platform, design, out / "commands", rate_hz)
+    files.append(write_validation_record(platform, out / "validation", rate_hz))
     files += plot_limit_use(uses, [r.name for r in design.records], out / "figures")
     files += plot_accuracy(prediction, baseline, out / "figures")
     settings = {"platform": platform.name, "budget (s)": budget_s, "method": prediction.method,
@@ -150,6 +155,9 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
                 "settings": settings,
                 "identify": {"method": method, "settings": DESIGN_SETTINGS.get(method, {}),
                              "command": identify_command(method),
-                             "play": play_command(design, platform.friction.coulomb, str(out))}}
+                             "play": play_command(design, platform.friction.coulomb, str(out))},
+                "validation": {"record": "validation/validation.csv",
+                               "commands": validation_commands(
+                                   method, platform.friction.coulomb, str(out))}}
     files.append(write_json_atomic(out / "design.json", document))
     return DesignOutput(design, prediction, baseline, files)
