@@ -186,3 +186,29 @@ def test_identify_refuses_a_bad_delay(tmp_path, late_files, value, message):
                                       "--delay", value, *map(str, late_files)])
     assert result.exit_code == 2
     assert message in result.output
+
+
+def test_identify_on_single_sines_notes_the_bias_a_delay_would_put_on_bt(tmp_path, paper):
+    """Without --delay on single-frequency data: one note naming the bias per millisecond,
+    the bias measured by fitting the same motion with the forces 1 ms late; result.json
+    carries it; with a given delay, no note."""
+    single = ((1.0, 0.5, 0.0),)
+    folder = tmp_path / "single"
+    folder.mkdir()
+    files = [write_dataset(d, folder / f"{d.name}.csv")
+             for d in experiments(paper, sines=single)]
+    out = tmp_path / "result.json"
+    result = CliRunner().invoke(app, ["identify", "--method", "ls", "--platform", "paper",
+                                      "--out", str(out), *map(str, files)])
+    assert result.exit_code == 0, result.output
+    (note,) = [line for line in result.output.splitlines() if line.startswith("note:")]
+    stated = float(re.search(r"Bt\(4,4\) ([-+0-9.e]+)", note).group(1))
+    fitted = [LeastSquaresIdentifier(coulomb=False).fit(experiments(paper, sines=single,
+                                                                    delay=delay), paper)
+              for delay in (0.0, 1e-3)]
+    assert stated == pytest.approx(fitted[1].B_[3, 3] - fitted[0].B_[3, 3], rel=0.02)
+    sensitivity = json.loads(out.read_text())["diagnostics"]["delay_sensitivity"]
+    assert sensitivity["dofs"] == ["x", "y", "z", "rx", "ry", "rz"]
+    given = CliRunner().invoke(app, ["identify", "--method", "ls", "--platform", "paper",
+                                     "--delay", "0", *map(str, files)])
+    assert given.exit_code == 0 and "note:" not in given.output

@@ -92,6 +92,10 @@ def identify(
                        f"{entry['std_error'] * 1e3:.3f} ms), estimated; forces aligned")
         else:
             typer.echo(f"force delay {entry['seconds'] * 1e3:.3f} ms, given; forces aligned")
+    if found.delay_sensitivity is not None:
+        from stewartid.reports.identification.run import delay_note
+
+        typer.echo(f"note: {delay_note(found.delay_sensitivity)}")
     if found.report is not None:
         typer.echo(f"wrote the report to {report}/report.html; trusted: {found.report.trusted}")
     rows = found.comparison()

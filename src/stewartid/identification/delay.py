@@ -131,6 +131,50 @@ def delay_bias_per_ms(platform: Platform | np.ndarray, frequencies_hz: Sequence[
     return 1e-3 * (w ** 2 * np.diag(M) + np.diag(K))
 
 
+def single_frequency_bias(datasets: Sequence[Dataset], platform: Platform,
+                          lines: tuple[tuple[float, ...], ...] | None = None
+                          ) -> dict[str, Any] | None:
+    """Where a force delay cannot be told from damping, and what it would do to Bt.
+
+    Parameters
+    ----------
+    datasets : sequence of Dataset
+    platform : Platform
+    lines : tuple of 6 tuples of float, optional
+        The excitation lines per DOF (:func:`~stewartid.datasets.excitation.excitation_lines`)
+        if already found.
+
+    Returns
+    -------
+    dict or None
+        None when every DOF moves at two or more frequencies; else ``{"dofs": [names],
+        "frequencies_hz": [6], "bt_diagonal_per_ms": [6]}``, the bias on the Bt diagonal per
+        millisecond of delay (:func:`delay_bias_per_ms`, at each DOF's frequency refined in
+        the experiment that moves it most; NaN for a DOF that does not move).
+    """
+    lines = excitation_lines(datasets) if lines is None else lines
+    single = [k for k, f in enumerate(lines) if len(f) < 2]
+    if not single:
+        return None
+    frequencies = []
+    for k, found in enumerate(lines):
+        most = max(datasets, key=lambda d: float(np.ptp(d.pose[:, k])))
+        frequencies.append(estimate_frequency(most.pose[:, k], most.sample_rate) if found
+                           else np.nan)
+    reference = datasets[0]
+    bias = delay_bias_per_ms(platform, frequencies, generalized_force_sensitivity(
+        platform, reference.pose, reference.forces))
+    return {"dofs": [COORDINATES[k] for k in single], "frequencies_hz": frequencies,
+            "bt_diagonal_per_ms": bias.tolist()}
+
+
+def describe_bias(found: dict[str, Any]) -> str:
+    """The bias of :func:`single_frequency_bias` in words: "Bt(1,1) +123.4, ... per ms"."""
+    return ", ".join(f"Bt({k + 1},{k + 1}) {b:+.4g}"
+                     for k, b in enumerate(found["bt_diagonal_per_ms"]) if np.isfinite(b)) \
+        + " per ms"
+
+
 def check_delay_identifiable(datasets: Sequence[Dataset], platform: Platform
                              ) -> tuple[tuple[float, ...], ...]:
     """The excitation lines per DOF, when every DOF holds two or more.
@@ -140,28 +184,18 @@ def check_delay_identifiable(datasets: Sequence[Dataset], platform: Platform
     IdentificationError
         One line: the DOFs with a single frequency, that delay and damping cannot be told
         apart there, and the bias on the Bt diagonal per millisecond of delay
-        (:func:`delay_bias_per_ms`, at each DOF's frequency refined in the experiment that
-        moves it most).
+        (:func:`single_frequency_bias`).
     """
     lines = excitation_lines(datasets)
-    single = [k for k, f in enumerate(lines) if len(f) < 2]
-    if not single:
+    found = single_frequency_bias(datasets, platform, lines)
+    if found is None:
         return lines
-    frequencies = []
-    for k, found in enumerate(lines):
-        most = max(datasets, key=lambda d: float(np.ptp(d.pose[:, k])))
-        frequencies.append(estimate_frequency(most.pose[:, k], most.sample_rate) if found
-                           else np.nan)
-    reference = datasets[0]
-    bias = delay_bias_per_ms(platform, frequencies, generalized_force_sensitivity(
-        platform, reference.pose, reference.forces))
-    named = ", ".join(f"{COORDINATES[k]} ({frequencies[k]:.3g} Hz)" for k in single)
-    per_ms = ", ".join(f"Bt({k + 1},{k + 1}) {bias[k]:+.4g}" for k in range(6)
-                       if np.isfinite(bias[k]))
+    named = ", ".join(f"{name} ({found['frequencies_hz'][COORDINATES.index(name)]:.3g} Hz)"
+                      for name in found["dofs"])
     raise IdentificationError(
         f"the force delay cannot be estimated: {named} moved at one frequency only, where a "
         f"delay and damping cannot be told apart (each ms of delay the forces lag adds "
-        f"tau (w^2 Mt + K) to Bt: {per_ms} per ms); excite every DOF at two or more "
+        f"tau (w^2 Mt + K) to Bt: {describe_bias(found)}); excite every DOF at two or more "
         "frequencies (stewartid design), or give a known delay (--delay SECONDS).")
 
 
@@ -401,4 +435,5 @@ def apply_delay(datasets: Sequence[Dataset], platform: Platform, delay: str | fl
 
 
 __all__ = ["AUTO", "DelayEstimate", "apply_delay", "check_delay_identifiable", "delay_bias_per_ms",
+           "describe_bias", "single_frequency_bias",
            "estimate_delay", "fit_delay", "parse_delay", "shared_least_squares"]

@@ -154,7 +154,8 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
                                 nominal_source: str | None = None,
                                 sources: Sequence[str] = (),
                                 check: Callable[[IdentificationResult], None] | None = None,
-                                records: Sequence[Dataset] = ()) -> IdentificationReport:
+                                records: Sequence[Dataset] = (), notes: Sequence[str] = ()
+                                ) -> IdentificationReport:
     """Identify, validate and report on measured experiments.
 
     Parameters
@@ -187,6 +188,8 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
     records : sequence of Dataset
         Validation records of another excitation: every method predicts them, and the
         verdict judges the prediction on them instead of on held-out segments.
+    notes : sequence of str
+        Sentences added to the report's summary.
 
     Returns
     -------
@@ -230,7 +233,7 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
     files.append(report.result.to_json(directory / "result.json"))
     text = render_report(report, datasets, platform, nominal, nominal_source or "", rows,
                          drawer.entries, sources, folds, time.perf_counter() - started,
-                         [d.name for d in records])
+                         [d.name for d in records], notes)
     files.append(write_text_atomic(directory / "report.md", text))
     files.append(write_text_atomic(directory / "report.html", render_html(
         text, directory, title=f"stewartid identification report: {platform.name}")))

@@ -25,7 +25,12 @@ from stewartid.datasets.plausibility import check_identified
 from stewartid.errors import ConfigError
 from stewartid.files import check_output_file, check_output_folder
 from stewartid.identification import registry
-from stewartid.identification.delay import apply_delay, parse_delay
+from stewartid.identification.delay import (
+    apply_delay,
+    describe_bias,
+    parse_delay,
+    single_frequency_bias,
+)
 from stewartid.identification.result import IdentificationResult, comparison_rows
 from stewartid.model.linearization import nominal_matrices
 from stewartid.platform import Platform
@@ -76,6 +81,11 @@ class IdentifyRun:
     delay : dict or None
         The force delay the data were aligned by (the ``"delay"`` entry of the result), or
         None when they were used as logged.
+    delay_sensitivity : dict or None
+        With the data used as logged and a DOF moved at one frequency only, where a force
+        delay would pass for damping and its bias on the Bt diagonal per millisecond
+        (:func:`~stewartid.identification.delay.single_frequency_bias`; the result's
+        ``diagnostics["delay_sensitivity"]``); else None.
     """
 
     result: IdentificationResult
@@ -86,6 +96,7 @@ class IdentifyRun:
     nominal_B: np.ndarray
     nominal_source: str
     delay: dict[str, Any] | None = None
+    delay_sensitivity: dict[str, Any] | None = None
 
     def comparison(self) -> list[dict[str, Any]]:
         """The paper's 20 entries, identified against nominal
@@ -162,6 +173,15 @@ def _check_outputs(paths: Sequence[Path], inputs: Sequence[str | Path | None],
         raise ConfigError("--folds sets the report's validation; add --report DIR.")
 
 
+def delay_note(sensitivity: Mapping[str, Any]) -> str:
+    """One sentence: where a force delay passes for damping and its bias on Bt per
+    millisecond (:func:`~stewartid.identification.delay.single_frequency_bias`)."""
+    return (f"{', '.join(sensitivity['dofs'])} moved at one frequency only, where a delay of "
+            "the force channels behind the motion passes for damping: each ms of delay adds "
+            f"{describe_bias(sensitivity)} to Bt. Give a known delay (--delay SECONDS), or "
+            "excite two or more frequencies per DOF and estimate it (--delay auto).")
+
+
 def identify_files(files: Sequence[str | Path], method: str = "wavelet",
                    platform: str | None = None, *, flags: Mapping[str, FlagSetting] | None = None,
                    columns: str | None = None, out: Path | None = None, force: bool = False,
@@ -234,6 +254,7 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     datasets = read_datasets(paths, description, log_format)
     check_experiment_set(datasets, description)
     datasets, delay_entry = apply_delay(datasets, description, delay)
+    sensitivity = single_frequency_bias(datasets, description) if delay is None else None
     records = read_datasets(records_paths, description, log_format) if records_paths else []
     if records and delay_entry is not None:
         records, _ = apply_delay(records, description, delay_entry["seconds"])
@@ -256,7 +277,8 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
         written = write_identification_report(
             datasets, description, report, names, settings, consistent,
             DEFAULT_FOLDS if folds is None else folds, None if meta is None else meta[:2],
-            None if meta is None else meta[2], [str(p) for p in paths], check, records)
+            None if meta is None else meta[2], [str(p) for p in paths], check, records,
+            [] if sensitivity is None else [delay_note(sensitivity)])
         result = written.result
     else:
         result = registry.create_identifier(method, **settings).fit(datasets, description).result_
@@ -266,15 +288,18 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     check(result)
     if delay_entry is not None:
         result = dataclasses.replace(result, delay=delay_entry)
-        if written is not None:
-            result.to_json(Path(report) / "result.json")
+    if sensitivity is not None:
+        result = dataclasses.replace(result, diagnostics={**result.diagnostics,
+                                                          "delay_sensitivity": sensitivity})
+    if written is not None and (delay_entry is not None or sensitivity is not None):
+        result.to_json(Path(report) / "result.json")
     M_nominal, B_nominal = meta[:2] if meta is not None else nominal_matrices(description)
     source = meta[2] if meta is not None else f"platform '{description.name}' at neutral"
     if out is not None:
         result.to_json(out)
     return IdentifyRun(result, written, description, len(datasets), M_nominal, B_nominal,
-                       source, delay_entry)
+                       source, delay_entry, sensitivity)
 
 
-__all__ = ["ALL_METHODS", "INPUT_SUFFIXES", "FlagSetting", "IdentifyRun", "identify_files",
+__all__ = ["ALL_METHODS", "INPUT_SUFFIXES", "FlagSetting", "IdentifyRun", "delay_note", "identify_files",
            "methods_for", "settings_for"]

@@ -153,7 +153,9 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
              "symmetric pairs reveal. On held-out segments it leaves "
              f"{trusted.unexplained_percent:.3g} % of the force unexplained in its worst DOF "
              f"({trusted.worst_dof})"
-             + (" (methods tied in uncertainty: the held-out prediction decides)."
+             + ((" (methods tied in uncertainty: the friction-immune method is preferred)."
+                 if trusted.friction_immune else
+                 " (methods tied in uncertainty: the held-out prediction decides).")
                 if len(verdict.tied) > 1 else ".")]
     if verdict.uncertain:
         lines.append("Entries to treat with care: " + ", ".join(
@@ -241,9 +243,11 @@ def render_report(report: IdentificationReport, datasets: Sequence[Dataset],
                   platform: Platform, nominal: tuple[np.ndarray, np.ndarray],
                   nominal_source: str, rows: Sequence[dict[str, Any]],
                   figures: Mapping[str, tuple[str, str]], sources: Sequence[str], folds: int,
-                  seconds: float, records: Sequence[str] = ()) -> str:
+                  seconds: float, records: Sequence[str] = (), notes: Sequence[str] = ()
+                  ) -> str:
     """``report.md``: every section, figures referenced by relative path; ``records`` names
-    the validation records (``identify --validate``)."""
+    the validation records (``identify --validate``), ``notes`` are sentences for the
+    summary (e.g. what a force delay would do to Bt)."""
     from stewartid import __version__
 
     best = next(run for run in report.runs if run.name == report.trusted)
@@ -256,7 +260,7 @@ def render_report(report: IdentificationReport, datasets: Sequence[Dataset],
     if sources:
         lines += ["Data: " + ", ".join(f"`{s}`" for s in sources) + ".", ""]
     verdict = [f"- {line}" for line in verdict_lines(report.verdict, report.runs)]
-    lines += ["## Summary", "", *verdict, ""]
+    lines += ["## Summary", "", *verdict, *(f"- {note}" for note in notes), ""]
     lines += ["## Data", ""] + _data_section(rows)
     lines += _figure(figures, "excitation") + _figure(figures, "spectrum")
     lines += ["## Joint rates and constant-direction intervals", ""]
