@@ -147,10 +147,11 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
     best = next(run for run in ok if run.name == verdict.trusted)
     trusted = verdict.standings[best.name]
     lines = [f"**Trust {best.display_name} on these data.** Of the physically plausible "
-             "methods that predict held-out data, it has the smallest largest relative "
-             f"standard error over the paper's 20 entries: {100 * trusted.worst_relative_std:.3g} "
-             f"% ({trusted.worst_entry}); its standard errors include the model error its "
-             "symmetric pairs reveal. On held-out segments it leaves "
+             "methods that predict held-out data, its standard errors predict the smallest "
+             f"largest error over the paper's 20 entries: {100 * trusted.expected_worst:.3g} % "
+             f"(largest standard error {100 * trusted.worst_relative_std:.3g} %, "
+             f"{trusted.worst_entry}); they include the model error its symmetric pairs "
+             "reveal. On held-out segments it leaves "
              f"{trusted.unexplained_percent:.3g} % of the force unexplained in its worst DOF "
              f"({trusted.worst_dof})"
              + ((" (methods tied in uncertainty: the friction-immune method is preferred)."
@@ -171,8 +172,9 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
         if run is best:
             continue
         standing = verdict.standings[run.name]
-        text = (f"{run.display_name}: largest relative standard error "
-                f"{100 * standing.worst_relative_std:.3g} % ({standing.worst_entry}); it leaves "
+        text = (f"{run.display_name}: predicted largest error "
+                f"{100 * standing.expected_worst:.3g} % (largest standard error "
+                f"{100 * standing.worst_relative_std:.3g} %, {standing.worst_entry}); it leaves "
                 f"{standing.unexplained_percent:.3g} % unexplained in its worst held-out DOF "
                 f"({standing.worst_dof}), {standing.unexplained_ratio:.3g}× as much")
         if standing.misfit:
