@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from stewartid.assessment.validation import Segment, ValidationResult
-from stewartid.assessment.verdict import choose_trusted, expected_worst_error
+from stewartid.assessment.verdict import choose_trusted
+from stewartid.identification.accuracy import expected_worst_error
 from stewartid.identification.result import IdentificationResult
 
 

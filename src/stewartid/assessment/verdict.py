@@ -17,10 +17,11 @@ Rule, in order:
    cannot show a wrong parameter that a friction term compensates, so this is a gate, not the
    ranking.
 4. **Honest uncertainty**: among the rest, the method with the smallest expected largest
-   relative error over the paper's 20 entries wins (:func:`expected_worst_error`: what its
-   standard errors predict for the largest of 20 errors, so one conservative entry does not
-   outweigh nineteen). Every method's standard errors carry its
-   model error where the data show it (symmetric pairs that disagree beyond their errors,
+   relative error over the paper's 20 entries wins
+   (:func:`~stewartid.identification.accuracy.expected_worst_error`: what its standard errors
+   predict for the largest of 20 errors, so one conservative entry does not outweigh
+   nineteen). Every method's standard errors carry its model error where the data show it
+   (symmetric pairs that disagree beyond their errors,
    :func:`~stewartid.identification.solvers.pair_calibration`; for Method A the friction its
    third harmonic reveals), so a method biased by friction it does not model reports it.
 5. **Ties** (within :data:`TIE_FACTOR`): a method immune to the friction law (Method B with
@@ -46,6 +47,7 @@ from stewartid.assessment.validation import (
     coulomb_estimate,
     friction_signature,
 )
+from stewartid.identification.accuracy import entry_relative_std, expected_worst_error
 from stewartid.identification.consistency import consistency_metrics
 from stewartid.identification.result import IdentificationResult
 from stewartid.platform import COORDINATES
@@ -82,47 +84,6 @@ def relative_std(result: IdentificationResult) -> float:
     values = np.concatenate([np.diag(result.std_errors_M) / np.abs(np.diag(result.M)),
                              np.diag(result.std_errors_B) / np.abs(np.diag(result.B))])
     return float(np.nanmedian(values))
-
-
-def entry_relative_std(result: IdentificationResult) -> np.ndarray:
-    """Relative standard error of each of the paper's 20 entries (fractions), in the order
-    of :data:`~stewartid.reference.published.PAPER_ENTRIES`; infinite for a zero estimate."""
-    out = []
-    for matrix, i, j in PAPER_ENTRIES:
-        value = (result.M if matrix == "M" else result.B)[i, j]
-        std = (result.std_errors_M if matrix == "M" else result.std_errors_B)[i, j]
-        out.append(std / abs(value) if value != 0 else np.inf)
-    values = np.array(out, dtype=float)
-    return np.where(np.isnan(values), np.inf, values)
-
-
-def expected_worst_error(relative_std: np.ndarray) -> float:
-    """Expected largest |error| of independent Gaussian errors with these standard errors.
-
-    E[max_k |e_k|] = integral over x > 0 of 1 - prod_k (2 Phi(x / s_k) - 1), on a grid of
-    4000 steps up to 8 times the largest s_k (the tail beyond holds less than 1e-14 of it).
-
-    Parameters
-    ----------
-    relative_std : ndarray, shape (K,)
-        Standard errors (any unit; non-finite ones make the result infinite).
-
-    Returns
-    -------
-    float
-        In the unit of ``relative_std``.
-    """
-    from scipy.special import erf
-
-    s = np.asarray(relative_std, dtype=float)
-    if not np.all(np.isfinite(s)):
-        return float("inf")
-    s = s[s > 0]
-    if s.size == 0:
-        return 0.0
-    x = np.linspace(0.0, 8.0 * s.max(), 4001)
-    below = np.prod(erf(x[:, None] / (np.sqrt(2.0) * s[None, :])), axis=1)
-    return float(np.trapezoid(1.0 - below, x))
 
 
 def worst_relative_std(result: IdentificationResult) -> tuple[float, str]:
@@ -232,7 +193,7 @@ class Standing:
         Its Mt and Bt do not rest on a friction law (:func:`friction_immune`).
     expected_worst : float
         The largest relative error over the paper's 20 entries its standard errors predict
-        (:func:`expected_worst_error`, a fraction).
+        (:func:`~stewartid.identification.accuracy.expected_worst_error`, a fraction).
     """
 
     name: str
@@ -405,6 +366,6 @@ def _reasons(trusted: str, standings: Mapping[str, Standing], tied: list[str],
 
 __all__ = ["DAMPING_EXCESS", "DISAGREEMENT", "MISFIT_FACTOR", "MISFIT_FLOOR", "SIGNIFICANT",
            "TIE_FACTOR", "UNCERTAIN_RELATIVE", "Standing", "Verdict", "choose_trusted",
-           "entry_relative_std", "expected_worst_error", "finds_friction", "friction_immune",
+           "finds_friction", "friction_immune",
            "is_definite", "relative_std", "uncertain_entries", "worst_dof",
            "worst_relative_std"]

@@ -1,0 +1,62 @@
+"""What a result's standard errors predict about its accuracy over the paper's 20 entries.
+
+Used to choose between fits of the same data (Method B's friction model, the verdict between
+methods): the one whose calibrated standard errors predict the smaller largest error.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stewartid.identification.result import IdentificationResult
+from stewartid.reference.published import PAPER_ENTRIES
+
+
+def entry_relative_std(result: IdentificationResult) -> np.ndarray:
+    """Relative standard error of each of the paper's 20 entries (fractions), in the order
+    of :data:`~stewartid.reference.published.PAPER_ENTRIES`; infinite for a zero estimate."""
+    out = []
+    for matrix, i, j in PAPER_ENTRIES:
+        value = (result.M if matrix == "M" else result.B)[i, j]
+        std = (result.std_errors_M if matrix == "M" else result.std_errors_B)[i, j]
+        out.append(std / abs(value) if value != 0 else np.inf)
+    values = np.array(out, dtype=float)
+    return np.where(np.isnan(values), np.inf, values)
+
+
+def expected_worst_error(relative_std: np.ndarray) -> float:
+    """Expected largest |error| of independent Gaussian errors with these standard errors.
+
+    E[max_k |e_k|] = integral over x > 0 of 1 - prod_k (2 Phi(x / s_k) - 1), on a grid of
+    4000 steps up to 8 times the largest s_k (the tail beyond holds less than 1e-14 of it).
+
+    Parameters
+    ----------
+    relative_std : ndarray, shape (K,)
+        Standard errors (any unit; non-finite ones make the result infinite).
+
+    Returns
+    -------
+    float
+        In the unit of ``relative_std``.
+    """
+    from scipy.special import erf
+
+    s = np.asarray(relative_std, dtype=float)
+    if not np.all(np.isfinite(s)):
+        return float("inf")
+    s = s[s > 0]
+    if s.size == 0:
+        return 0.0
+    x = np.linspace(0.0, 8.0 * s.max(), 4001)
+    below = np.prod(erf(x[:, None] / (np.sqrt(2.0) * s[None, :])), axis=1)
+    return float(np.trapezoid(1.0 - below, x))
+
+
+def predicted_worst_error(result: IdentificationResult) -> float:
+    """The largest relative error over the paper's 20 entries that the result's standard
+    errors predict (:func:`expected_worst_error` of :func:`entry_relative_std`, a fraction)."""
+    return expected_worst_error(entry_relative_std(result))
+
+
+__all__ = ["entry_relative_std", "expected_worst_error", "predicted_worst_error"]
