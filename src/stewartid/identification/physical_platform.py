@@ -1,0 +1,148 @@
+"""The platform description of an identified physical model: the TOML every command accepts,
+and the ``identify --model physical`` run behind the command line.
+
+Payload mode writes the platform file with the identified ``[payload]``. Full mode writes the
+identified moving body as the file's platform plus a ``[payload]`` that carries the
+difference (the only form a body with its centre of mass off the reference point and a full
+inertia matrix takes in the format), the legs' centres of mass and inertias from their
+identified first moments and inertias (the leg masses kept from the file: no motion tells
+them), and one viscous and one Coulomb level for all joint types (the format's), the mean of
+the identified ones.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stewartid.datasets.dataset import Dataset
+from stewartid.errors import ConfigError
+from stewartid.files import write_text_atomic
+from stewartid.identification.physical import (
+    PhysicalIdentifier,
+    PhysicalResult,
+    known_platform,
+    payload_section,
+)
+from stewartid.model import regressor as reg
+from stewartid.platform import Platform
+
+#: Values of ``identify --model``.
+MODELS = ("physical",)
+
+
+def _standard_values(platform: Platform, result: PhysicalResult) -> np.ndarray:
+    """The standard parameters of a full-mode result: each base parameter less the
+    combinations it stands for, with the file's values for the parameters folded into it."""
+    base = reg.base_parameters(platform)
+    pi = reg.standard_parameters(platform)
+    values = pi.copy()
+    for name, column, row in zip(base.names, base.columns, base.combination, strict=True):
+        others = row.copy()
+        others[column] = 0.0
+        values[column] = result.parameters[name] - others @ pi
+    return values
+
+
+def _full_platform(platform: Platform, result: PhysicalResult) -> Platform:
+    """The description of a full-mode result (see the module docstring)."""
+    pi = _standard_values(platform, result)
+    value = dict(zip(reg.PARAMETERS, pi, strict=True))
+    own = reg.standard_parameters(known_platform(platform))
+    body = reg.parameter_index(reg.BODY_PARAMETERS)
+    difference = dict(zip((f"payload.{n}" for n in reg.BODY_PARAMETERS), pi[body] - own[body],
+                          strict=True))
+    i = platform.inertia
+    updates: dict[str, Any] = {f"payload__{k}": v for k, v in
+                               payload_section(difference).items()}
+    if i.upper_leg_mass > 0:
+        updates["inertia__upper_leg_com"] = value["md_u"] / i.upper_leg_mass
+    if i.lower_leg_mass > 0:
+        updates["inertia__lower_leg_com"] = value["md_l"] / i.lower_leg_mass
+    d_u = updates.get("inertia__upper_leg_com", i.upper_leg_com)
+    d_l = updates.get("inertia__lower_leg_com", i.lower_leg_com)
+    updates["inertia__upper_leg_inertia"] = (value["J_u"] + value["J_l"] - i.lower_leg_inertia
+                                             - i.upper_leg_mass * d_u ** 2
+                                             - i.lower_leg_mass * d_l ** 2)
+    gimbals = [value[f"viscous[{t}]"] for t in ("lower_gimbal", "upper_gimbal")]
+    updates["friction__gimbal_viscous"] = float(np.mean(gimbals))
+    updates["friction__coulomb"] = float(np.mean(
+        [value[f"coulomb[{t}]"] for t in reg.JOINT_TYPES]))
+    return platform.replace(payload=None).replace(**updates)
+
+
+def identified_platform(platform: Platform, result: PhysicalResult) -> Platform:
+    """The platform description with the identified parameters.
+
+    Raises
+    ------
+    ConfigError
+        When they are no valid description (a negative mass or inertia, an inertia no mass
+        distribution has); the message names the section and key.
+    """
+    try:
+        if result.diagnostics.get("mode") == "payload":
+            section = result.diagnostics["payload"]
+            return platform.replace(payload=None).replace(
+                **{f"payload__{key}": value for key, value in section.items()})
+        return _full_platform(platform, result)
+    except ConfigError as exc:
+        raise ConfigError(f"the identified parameters are no valid platform description: "
+                          f"{exc}") from None
+
+
+def check_model_options(model: str, platform_out: Path | None, forbidden: dict[str, bool]
+                        ) -> None:
+    """Refuse, before any computation, a model not known and options the physical model
+    does not take.
+
+    Parameters
+    ----------
+    model : str
+        The ``--model`` value.
+    platform_out : Path, optional
+        The ``--platform-out`` file.
+    forbidden : dict of str to bool
+        Options that do not apply, by flag, and whether each was given.
+    """
+    if model not in MODELS:
+        raise ConfigError(f"--model {model!r}: expected one of {', '.join(MODELS)}.")
+    given = [flag for flag, on in forbidden.items() if on]
+    if given:
+        raise ConfigError(f"{given[0]} does not apply to --model {model}; leave it out.")
+    if platform_out is not None and platform_out.suffix.lower() != ".toml":
+        raise ConfigError(f"--platform-out {str(platform_out)!r}: the platform description "
+                          "is TOML; give a .toml file name.")
+
+
+def identify_model(datasets: list[Dataset], platform: Platform, model: str = "physical",
+                   payload: bool = False, platform_out: Path | None = None
+                   ) -> PhysicalResult:
+    """``stewartid identify --model physical``: fit, and write ``platform_out``.
+
+    Parameters
+    ----------
+    datasets : list of Dataset
+    platform : Platform
+    model : str
+        ``"physical"``.
+    payload : bool
+        Payload mode (:class:`~stewartid.identification.physical.PhysicalIdentifier`).
+    platform_out : Path, optional
+        Write the identified platform description here (TOML).
+
+    Returns
+    -------
+    PhysicalResult
+    """
+    check_model_options(model, platform_out, {})
+    result = PhysicalIdentifier(payload=payload).fit(datasets, platform).result_
+    if platform_out is not None:
+        identified = identified_platform(platform, result)
+        write_text_atomic(platform_out, identified.to_toml())
+    return result
+
+
+__all__ = ["MODELS", "check_model_options", "identified_platform", "identify_model"]
