@@ -64,11 +64,23 @@ def identify(
              "negative when the forces lead): every method works on the forces aligned by it. "
              "'auto' estimates it first (needs two or more frequencies per DOF) and prints it "
              "with its standard error (docs/logs.md).")] = None,
+    model: Annotated[str | None, typer.Option(
+        "--model", metavar="NAME",
+        help="'physical': identify the physical parameters of the rigid-body model (masses, "
+             "first moments, inertias, friction per joint type, sensor offsets) and Mt, Bt "
+             "from them (docs/physical-model.md).")] = None,
+    payload: Annotated[bool, typer.Option(
+        "--payload", help="--model physical: identify only the payload on the platform "
+                          "file's known platform.")] = False,
+    platform_out: Annotated[Path | None, typer.Option(
+        "--platform-out", metavar="FILE",
+        help="--model physical: write the identified platform description (TOML).")] = None,
 ) -> None:
     """Identify Mt and Bt from experiments; print the paper-style table when nominal values are
     known (platform description, or meta.json/truth.json beside the data) and write JSON."""
     import numpy as np
 
+    from stewartid.errors import ConfigError
     from stewartid.reporting.terminal import print_comparison
     from stewartid.reports.identification.run import FlagSetting, identify_files
 
@@ -77,9 +89,12 @@ def identify(
              "--frequency": FlagSetting("frequency_hz", frequency or None, bool(frequency)),
              "--stiffness": FlagSetting("stiffness", stiffness, stiffness),
              "--friction": FlagSetting("friction", friction, friction is not None)}
+    if model is None and (payload or platform_out is not None):
+        raise ConfigError("--payload and --platform-out go with --model physical; add it.")
+    method = method if model is None else model
     found = identify_files(files, method, platform, flags=flags, columns=columns, out=out,
                            force=force, report=report, consistent=consistent, folds=folds,
-                           delay=delay)
+                           delay=delay, model=model, payload=payload, platform_out=platform_out)
     if found.delay is not None:
         entry = found.delay
         if entry["source"] == "estimated":

@@ -195,18 +195,24 @@ class Solution:
     n_equations: int
 
 
-def _weighted_fit(X, y, weights):
-    """Equilibrated weighted least squares: estimates, the scaled normal matrix's inverse
-    (in the original units) and the residual."""
-    Xw = X * np.sqrt(weights)[None, :, None]
-    A = Xw.reshape(-1, X.shape[2])
-    b = (y * np.sqrt(weights)).ravel()
-    scale = np.linalg.norm(A, axis=0)
+def _weighted_fit(gram, cross, weights, free, fixed_values):
+    """Equilibrated weighted least squares from the per-channel Gram matrices ``gram``
+    (6, p, p) and ``cross`` (6, p) = X_c^T y_c, the parameters outside ``free`` held at
+    ``fixed_values``: the estimates of the free ones, the inverse of their normal matrix (in
+    the original units), the singular values of the scaled regression relative to the
+    largest and its right singular vectors (rows)."""
+    N = np.einsum("c,cpq->pq", weights, gram)
+    b = np.einsum("c,cp->p", weights, cross) - N[:, ~free] @ fixed_values[~free]
+    N, b = N[np.ix_(free, free)], b[free]
+    scale = np.sqrt(np.diag(N))
     scale = np.where(scale > 0, scale, 1.0)
-    U, s, Vt = np.linalg.svd(A / scale, full_matrices=False)
-    theta = (Vt.T @ ((U.T @ b) / s)) / scale
-    inverse = (Vt.T / s ** 2) @ Vt / np.outer(scale, scale)
-    return theta, inverse, y - np.einsum("kcp,p->kc", X, theta), s / s[0], Vt
+    eigenvalues, vectors = np.linalg.eigh(N / np.outer(scale, scale))
+    eigenvalues = np.clip(eigenvalues[::-1], eigenvalues[-1] * 1e-300, None)
+    vectors = vectors[:, ::-1]
+    theta = (vectors @ ((vectors.T @ (b / scale)) / eigenvalues)) / scale
+    inverse = (vectors / eigenvalues) @ vectors.T / np.outer(scale, scale)
+    singular = np.sqrt(eigenvalues / eigenvalues[0])
+    return theta, inverse, singular, vectors.T
 
 
 def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np.ndarray,
@@ -236,13 +242,14 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
     p = X.shape[2]
     scale_y = np.sqrt(np.mean(y ** 2, axis=0))
     weights = 1.0 / np.where(scale_y > 0, scale_y, 1.0) ** 2
+    gram = np.einsum("kcp,kcq->cpq", X, X)
+    cross = np.einsum("kcp,kc->cp", X, y)
     free = np.ones(p, dtype=bool)
     fixed: dict[str, str] = {}
-    singular_all = _weighted_fit(X, y, weights)[3]
+    singular_all = _weighted_fit(gram, cross, weights, free, nominal)[2]
     for _ in range(2):  # the second pass with the residual's channel weights
         while True:
-            target = y - np.einsum("kcp,p->kc", X[:, :, ~free], nominal[~free])
-            theta, inverse, residual, s, Vt = _weighted_fit(X[:, :, free], target, weights)
+            theta, inverse, s, Vt = _weighted_fit(gram, cross, weights, free, nominal)
             condition = float(1.0 / s[-1])
             index = np.flatnonzero(free)
             if condition > max_condition:
@@ -251,6 +258,9 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
                                    f"{condition:.3g} of the scaled regression")
                 free[k] = False
                 continue
+            values = nominal.astype(float).copy()
+            values[free] = theta
+            residual = y - np.einsum("kcp,p->kc", X, values)
             sigma2 = np.sum(residual ** 2, axis=0) / max(len(y) - p / 6.0, 1.0)
             tau = np.array([integrated_autocorrelation(r) for r in residual.T])
             variance = float(np.mean(sigma2 * tau * weights))
@@ -265,8 +275,6 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
             free[index[j]] = False
         sigma = np.sqrt(np.sum(residual ** 2, axis=0) / len(y))
         weights = 1.0 / np.maximum(sigma, 1e-12 * scale_y) ** 2
-    values = nominal.astype(float).copy()
-    values[free] = theta
     covariance = np.zeros((p, p))
     covariance[np.ix_(free, free)] = inverse * variance
     return Solution(values, covariance, fixed, condition, singular_all,

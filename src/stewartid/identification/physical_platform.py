@@ -12,6 +12,7 @@ the identified ones.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -19,7 +20,7 @@ import numpy as np
 
 from stewartid.datasets.dataset import Dataset
 from stewartid.errors import ConfigError
-from stewartid.files import write_text_atomic
+from stewartid.files import check_output_file, write_text_atomic
 from stewartid.identification.physical import (
     PhysicalIdentifier,
     PhysicalResult,
@@ -31,6 +32,9 @@ from stewartid.platform import Platform
 
 #: Values of ``identify --model``.
 MODELS = ("physical",)
+#: First line of a platform file ``identify --platform-out`` wrote: such a file is
+#: overwritten by the next run, any other refused.
+IDENTIFIED_HEADER = "# identified by stewartid identify --model physical from"
 
 
 def _standard_values(platform: Platform, result: PhysicalResult) -> np.ndarray:
@@ -93,6 +97,14 @@ def identified_platform(platform: Platform, result: PhysicalResult) -> Platform:
                           f"{exc}") from None
 
 
+def _is_identified(path: Path) -> bool:
+    """True for a platform file that ``identify --platform-out`` wrote (overwritten)."""
+    try:
+        return path.read_text(encoding="utf-8").startswith(IDENTIFIED_HEADER)
+    except (OSError, UnicodeDecodeError):
+        return False
+
+
 def check_model_options(model: str, platform_out: Path | None, forbidden: dict[str, bool]
                         ) -> None:
     """Refuse, before any computation, a model not known and options the physical model
@@ -118,8 +130,9 @@ def check_model_options(model: str, platform_out: Path | None, forbidden: dict[s
 
 
 def identify_model(datasets: list[Dataset], platform: Platform, model: str = "physical",
-                   payload: bool = False, platform_out: Path | None = None
-                   ) -> PhysicalResult:
+                   payload: bool = False, platform_out: Path | None = None,
+                   refused: dict[str, bool] | None = None,
+                   inputs: Sequence[str | Path] = ()) -> PhysicalResult:
     """``stewartid identify --model physical``: fit, and write ``platform_out``.
 
     Parameters
@@ -132,17 +145,25 @@ def identify_model(datasets: list[Dataset], platform: Platform, model: str = "ph
         Payload mode (:class:`~stewartid.identification.physical.PhysicalIdentifier`).
     platform_out : Path, optional
         Write the identified platform description here (TOML).
+    refused : dict of str to bool, optional
+        Options of the command that do not apply, by flag, and whether each was given.
+    inputs : sequence of str or Path
+        Files the command reads, which ``platform_out`` must not be.
 
     Returns
     -------
     PhysicalResult
     """
-    check_model_options(model, platform_out, {})
+    check_model_options(model, platform_out, refused or {})
+    if platform_out is not None:
+        check_output_file(platform_out, False, inputs, is_result=_is_identified,
+                          option="--platform-out")
     result = PhysicalIdentifier(payload=payload).fit(datasets, platform).result_
     if platform_out is not None:
         identified = identified_platform(platform, result)
-        write_text_atomic(platform_out, identified.to_toml())
+        write_text_atomic(platform_out, f"{IDENTIFIED_HEADER} {len(datasets)} experiments\n"
+                          + identified.to_toml())
     return result
 
 
-__all__ = ["MODELS", "check_model_options", "identified_platform", "identify_model"]
+__all__ = ["IDENTIFIED_HEADER", "MODELS", "check_model_options", "identified_platform", "identify_model"]
