@@ -57,10 +57,9 @@ PAYLOAD_PARAMETERS = tuple(f"payload.{name}" for name in reg.BODY_PARAMETERS)
 #: The nuisance parameters of payload mode.
 NUISANCE_PARAMETERS = (reg.FRICTION_PARAMETERS + reg.ACTUATOR_PARAMETERS
                        + reg.OFFSET_PARAMETERS)
-#: Parameters whose physical value is positive: a relative standard error applies to them.
-_POSITIVE = {"m", "I_xx", "I_yy", "I_zz", "J_u", "m_u", "md_u", "md_l",
-             "viscous[lower_gimbal]", "viscous[upper_gimbal]",
-             *(f"payload.{name}" for name in ("m", "I_xx", "I_yy", "I_zz"))}
+#: Standard parameters positive by nature, whose standard error is judged against their size.
+POSITIVE_PARAMETERS = ("m", "I_xx", "I_yy", "I_zz", "m_u", "md_u", "md_l", "J_u", "J_l",
+                       "viscous[lower_gimbal]", "viscous[upper_gimbal]")
 
 
 @dataclass(frozen=True)
@@ -216,7 +215,8 @@ def _weighted_fit(gram, cross, weights, free, fixed_values):
 
 
 def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np.ndarray,
-                     max_condition: float = 1e5, max_relative_error: float = 0.3) -> Solution:
+                     scales: np.ndarray | None = None, max_condition: float = 1e5,
+                     max_relative_error: float = 0.3) -> Solution:
     """Weighted least squares for y = X theta with residual-autocorrelation-consistent
     standard errors, fixing at ``nominal`` what the data cannot tell.
 
@@ -224,7 +224,8 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
     (feasible generalized least squares). A parameter is fixed when the column-equilibrated
     regression's condition number exceeds ``max_condition`` (the one weighing most in the
     weakest direction, repeatedly) or, for a parameter whose value is positive by nature,
-    when its standard error exceeds ``max_relative_error`` of its magnitude.
+    when its standard error exceeds ``max_relative_error`` of its size (the larger of its
+    estimate and its scale).
 
     Parameters
     ----------
@@ -233,6 +234,9 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
     names : list of str
     nominal : ndarray, shape (p,)
         The values a fixed parameter keeps (the platform file's).
+    scales : ndarray, shape (p,), optional
+        The size of each parameter positive by nature (a mass, an inertia: the moving
+        body's, for a payload's), zero for the others, which no relative error applies to.
     max_condition, max_relative_error : float
 
     Returns
@@ -240,6 +244,7 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
     Solution
     """
     p = X.shape[2]
+    scales = np.zeros(p) if scales is None else np.asarray(scales, dtype=float)
     scale_y = np.sqrt(np.mean(y ** 2, axis=0))
     weights = 1.0 / np.where(scale_y > 0, scale_y, 1.0) ** 2
     gram = np.einsum("kcp,kcq->cpq", X, X)
@@ -265,11 +270,12 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
             tau = np.array([integrated_autocorrelation(r) for r in residual.T])
             variance = float(np.mean(sigma2 * tau * weights))
             std = np.sqrt(np.clip(np.diag(inverse) * variance, 0.0, None))
-            loose = [j for j, k in enumerate(index) if names[k] in _POSITIVE
-                     and std[j] > max_relative_error * max(abs(theta[j]), abs(nominal[k]))]
+            size = np.maximum(np.abs(theta), scales[index])
+            loose = [j for j, k in enumerate(index)
+                     if scales[k] > 0 and std[j] > max_relative_error * size[j]]
             if not loose:
                 break
-            j = max(loose, key=lambda j: std[j] / max(abs(theta[j]), abs(nominal[index[j]])))
+            j = max(loose, key=lambda j: std[j] / size[j])
             fixed[names[index[j]]] = (f"not identifiable from these data: standard error "
                                       f"{std[j]:.3g} against a value of {theta[j]:.4g}")
             free[index[j]] = False
@@ -365,7 +371,10 @@ class PhysicalIdentifier(BaseIdentifier):
         names, _, selection, nominal, offset = model
         X = np.einsum("kcs,ps->kcp", data.Y, selection)
         y = data.y - np.einsum("kcs,s->kc", data.Y, offset)
-        solution = solve_parameters(X, y, list(names), nominal, self.max_condition,
+        # the size of a positive parameter: the whole body's (of a payload's, too)
+        positive = np.isin(reg.PARAMETERS, POSITIVE_PARAMETERS)
+        scales = selection @ np.where(positive, np.abs(reg.standard_parameters(platform)), 0.0)
+        solution = solve_parameters(X, y, list(names), nominal, scales, self.max_condition,
                                     self.max_relative_error)
         result = _result(self, platform, model, solution, data)
         learned = {"parameters_": result.parameters,
@@ -441,3 +450,8 @@ def payload_section(parameters: dict[str, float]) -> dict[str, Any]:
     shift = m * (c @ c * np.eye(3) - np.outer(c, c))
     inertia = np.array(about_reference) - shift[[0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]]
     return {"mass": float(m), "com": c.tolist(), "inertia": inertia.tolist()}
+
+
+__all__ = ["NUISANCE_PARAMETERS", "PAYLOAD_PARAMETERS", "POSITIVE_PARAMETERS",
+           "PhysicalIdentifier", "PhysicalResult", "Regression", "Solution",
+           "filtered_regression", "known_platform", "payload_section", "solve_parameters"]
