@@ -4,7 +4,9 @@ and the ``identify --model physical`` run behind the command line.
 Payload mode writes the platform file with the identified ``[payload]``. Full mode writes the
 identified moving body as the file's platform plus a ``[payload]`` that carries the
 difference (the only form a body with its centre of mass off the reference point and a full
-inertia matrix takes in the format), the legs' centres of mass and inertias from their
+inertia matrix takes in the format), or, when the difference is no payload (a body lighter
+than the file's platform), as a platform carrying a light payload that holds the body's
+centre of mass offset and products of inertia; the legs' centres of mass and inertias from their
 identified first moments and inertias (the leg masses kept from the file: no motion tells
 them), and one viscous and one Coulomb level for all joint types (the format's), the mean of
 the identified ones.
@@ -29,6 +31,7 @@ from stewartid.identification.physical import (
 )
 from stewartid.model import regressor as reg
 from stewartid.platform import Platform
+from stewartid.platform.sections import inertia_matrix
 
 #: Values of ``identify --model``.
 MODELS = ("physical",)
@@ -59,8 +62,7 @@ def _full_platform(platform: Platform, result: PhysicalResult) -> Platform:
     difference = dict(zip((f"payload.{n}" for n in reg.BODY_PARAMETERS), pi[body] - own[body],
                           strict=True))
     i = platform.inertia
-    updates: dict[str, Any] = {f"payload__{k}": v for k, v in
-                               payload_section(difference).items()}
+    updates = _body_updates(platform, difference, pi[body])
     if i.upper_leg_mass > 0:
         updates["inertia__upper_leg_com"] = value["md_u"] / i.upper_leg_mass
     if i.lower_leg_mass > 0:
@@ -75,6 +77,38 @@ def _full_platform(platform: Platform, result: PhysicalResult) -> Platform:
     updates["friction__coulomb"] = float(np.mean(
         [value[f"coulomb[{t}]"] for t in reg.JOINT_TYPES]))
     return platform.replace(payload=None).replace(**updates)
+
+
+#: Share of the moving body's mass and principal inertias a carrier payload takes when the
+#: body is not the file's platform plus a payload (:func:`_body_updates`).
+CARRIER_SHARE = 0.01
+
+
+def _body_updates(platform: Platform, difference: dict[str, float], body: np.ndarray
+                  ) -> dict[str, Any]:
+    """The moving body (standard parameters ``body``, (10,)) as the file's platform plus a
+    ``[payload]`` of the difference; when that is no payload (a body lighter than the file's
+    platform, an inertia no mass has), as a platform that carries a light payload with the
+    body's centre of mass offset and products of inertia (CARRIER_SHARE of its mass and
+    principal inertias)."""
+    payload = {f"payload__{k}": v for k, v in payload_section(difference).items()}
+    try:
+        platform.replace(payload=None).replace(**payload)
+        return payload
+    except ConfigError:
+        pass
+    mass, first, inertia = body[0], body[1:4], inertia_matrix(body[[4, 5, 6, 7, 8, 9]])
+    carrier = CARRIER_SHARE * mass
+    c = first / carrier
+    spread = CARRIER_SHARE * np.diag(inertia)
+    shift = carrier * (c @ c * np.eye(3) - np.outer(c, c))
+    own = inertia - shift  # the body's inertia less the carrier's point mass
+    carried = own - np.diag(np.diag(own)) + np.diag(spread)
+    return {"inertia__platform_mass": float(mass - carrier),
+            "inertia__platform_inertia": [float(v) for v in np.diag(own) - spread],
+            "payload__mass": float(carrier), "payload__com": c.tolist(),
+            "payload__inertia": [float(carried[a, b]) for a, b in
+                                 ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))]}
 
 
 def identified_platform(platform: Platform, result: PhysicalResult) -> Platform:
