@@ -14,6 +14,7 @@ the identified ones.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -63,20 +64,29 @@ def _full_platform(platform: Platform, result: PhysicalResult) -> Platform:
                           strict=True))
     i = platform.inertia
     updates = _body_updates(platform, difference, pi[body])
+    legs: dict[str, Any] = {}
     if i.upper_leg_mass > 0:
-        updates["inertia__upper_leg_com"] = value["md_u"] / i.upper_leg_mass
+        legs["inertia__upper_leg_com"] = value["md_u"] / i.upper_leg_mass
     if i.lower_leg_mass > 0:
-        updates["inertia__lower_leg_com"] = value["md_l"] / i.lower_leg_mass
-    d_u = updates.get("inertia__upper_leg_com", i.upper_leg_com)
-    d_l = updates.get("inertia__lower_leg_com", i.lower_leg_com)
-    updates["inertia__upper_leg_inertia"] = (value["J_u"] + value["J_l"] - i.lower_leg_inertia
-                                             - i.upper_leg_mass * d_u ** 2
-                                             - i.lower_leg_mass * d_l ** 2)
+        legs["inertia__lower_leg_com"] = value["md_l"] / i.lower_leg_mass
+    d_u = legs.get("inertia__upper_leg_com", i.upper_leg_com)
+    d_l = legs.get("inertia__lower_leg_com", i.lower_leg_com)
+    legs["inertia__upper_leg_inertia"] = (value["J_u"] + value["J_l"] - i.lower_leg_inertia
+                                          - i.upper_leg_mass * d_u ** 2
+                                          - i.lower_leg_mass * d_l ** 2)
     gimbals = [value[f"viscous[{t}]"] for t in ("lower_gimbal", "upper_gimbal")]
     updates["friction__gimbal_viscous"] = float(np.mean(gimbals))
     updates["friction__coulomb"] = float(np.mean(
         [value[f"coulomb[{t}]"] for t in reg.JOINT_TYPES]))
-    return platform.replace(payload=None).replace(**updates)
+    base = platform.replace(payload=None)
+    try:
+        return base.replace(**updates, **legs)
+    except ConfigError as exc:
+        described = base.replace(**updates)  # the body's and friction's errors raise here
+        warnings.warn(f"--platform-out: the identified leg parameters are no leg ({exc}); "
+                      "the file's leg values are written instead, so the file's Mt differs "
+                      "from the identified one by the legs' share.", stacklevel=2)
+        return described
 
 
 #: Share of the moving body's mass and principal inertias a carrier payload takes when the
