@@ -266,14 +266,14 @@ def translation_records(platform, sample_rate=200.0):
 
 
 def test_unexcited_parameters_are_fixed_and_named(loaded):
-    """Without rotation the payload's inertias cannot be told: they are fixed at the file's
-    values (none: zero), named with the reason, their standard errors null; the mass is still
-    identified."""
+    """Without rotation the payload's inertias cannot be told (their columns vanish): they are
+    fixed at the file's values (none: zero), named with the reason, their standard errors
+    null; the mass is still identified."""
     bare = loaded.replace(payload=None)
     fitted = PhysicalIdentifier(payload=True).fit(translation_records(loaded), bare)
     inertias = {f"payload.{name}" for name in ENTRIES[:3]}
     assert inertias <= set(fitted.fixed_)
-    assert all("not identifiable" in fitted.fixed_[name] for name in inertias)
+    assert all("not excited" in fitted.fixed_[name] for name in inertias)
     for name in inertias:
         assert fitted.parameters_[name] == 0.0 and np.isnan(fitted.parameter_std_errors_[name])
     assert abs(fitted.parameters_["payload.m"] - PAYLOAD["mass"]) < 5e-3 * PAYLOAD["mass"]

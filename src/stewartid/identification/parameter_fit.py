@@ -15,6 +15,10 @@ import numpy as np
 
 from stewartid.identification.solvers import integrated_autocorrelation
 
+#: Weighted column norm, relative to the largest, below which a parameter counts as not
+#: excited (round-off of a column that is zero in exact arithmetic).
+DEAD_COLUMN = 1e-10
+
 
 @dataclass(frozen=True)
 class Solution:
@@ -100,8 +104,11 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
     weights = 1.0 / np.where(scale_y > 0, scale_y, 1.0) ** 2
     gram = np.einsum("kcp,kcq->cpq", X, X)
     cross = np.einsum("kcp,kc->cp", X, y)
-    free = np.ones(p, dtype=bool)
-    fixed: dict[str, str] = {}
+    # a column that is zero (relative to the forces it would explain) is not excited at all
+    column = np.sqrt(np.einsum("c,cpp->p", weights, gram))
+    free = column > DEAD_COLUMN * column.max()
+    fixed = {names[k]: "not excited by these data: its regressor column is zero"
+             for k in np.flatnonzero(~free)}
     singular_all = _weighted_fit(gram, cross, weights, free, nominal)[2]
     for _ in range(2):  # the second pass with the residual's channel weights
         while True:
@@ -138,4 +145,4 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
                     np.sqrt(np.mean(residual ** 2, axis=0)), len(y))
 
 
-__all__ = ["Solution", "solve_parameters"]
+__all__ = ["DEAD_COLUMN", "Solution", "solve_parameters"]
