@@ -80,7 +80,7 @@ def identify(
     known (platform description, or meta.json/truth.json beside the data) and write JSON."""
     import numpy as np
 
-    from stewartid.errors import ConfigError
+    from stewartid.identification.physical_platform import model_method
     from stewartid.reporting.terminal import print_comparison
     from stewartid.reports.identification.run import FlagSetting, identify_files
 
@@ -89,9 +89,7 @@ def identify(
              "--frequency": FlagSetting("frequency_hz", frequency or None, bool(frequency)),
              "--stiffness": FlagSetting("stiffness", stiffness, stiffness),
              "--friction": FlagSetting("friction", friction, friction is not None)}
-    if model is None and (payload or platform_out is not None):
-        raise ConfigError("--payload and --platform-out go with --model physical; add it.")
-    method = method if model is None else model
+    method = model_method(model, method, payload, platform_out)
     found = identify_files(files, method, platform, flags=flags, columns=columns, out=out,
                            force=force, report=report, consistent=consistent, folds=folds,
                            delay=delay, model=model, payload=payload, platform_out=platform_out)

@@ -173,6 +173,25 @@ def check_model_options(model: str, platform_out: Path | None, forbidden: dict[s
                           "is TOML; give a .toml file name.")
 
 
+def model_method(model: str | None, method: str, payload: bool,
+                 platform_out: Path | None) -> str:
+    """The method ``identify`` runs: ``method`` without ``--model``, else the model's
+    estimator (``"physical"``).
+
+    Raises
+    ------
+    ConfigError
+        An unknown model, or ``--payload``/``--platform-out`` without ``--model``.
+    """
+    if model is None:
+        if payload or platform_out is not None:
+            raise ConfigError("--payload and --platform-out go with --model physical; add it.")
+        return method
+    if model not in MODELS:
+        raise ConfigError(f"--model {model!r}: expected one of {', '.join(MODELS)}.")
+    return model
+
+
 def identify_model(datasets: list[Dataset], platform: Platform, model: str = "physical",
                    payload: bool = False, platform_out: Path | None = None,
                    refused: dict[str, bool] | None = None,
@@ -210,4 +229,5 @@ def identify_model(datasets: list[Dataset], platform: Platform, model: str = "ph
     return result
 
 
-__all__ = ["IDENTIFIED_HEADER", "MODELS", "check_model_options", "identified_platform", "identify_model"]
+__all__ = ["IDENTIFIED_HEADER", "MODELS", "check_model_options", "identified_platform",
+           "identify_model", "model_method"]
