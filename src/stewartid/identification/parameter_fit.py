@@ -102,8 +102,9 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
     scales = np.zeros(p) if scales is None else np.asarray(scales, dtype=float)
     scale_y = np.sqrt(np.mean(y ** 2, axis=0))
     weights = 1.0 / np.where(scale_y > 0, scale_y, 1.0) ** 2
-    gram = np.einsum("kcp,kcq->cpq", X, X)
-    cross = np.einsum("kcp,kc->cp", X, y)
+    by_channel = np.ascontiguousarray(X.transpose(1, 0, 2))  # (6, K, p): BLAS products
+    gram = np.swapaxes(by_channel, 1, 2) @ by_channel
+    cross = np.einsum("ckp,kc->cp", by_channel, y, optimize=True)
     # a column that is zero (relative to the forces it would explain) is not excited at all
     column = np.sqrt(np.einsum("c,cpp->p", weights, gram))
     free = column > DEAD_COLUMN * column.max()
@@ -123,7 +124,7 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
                 continue
             values = nominal.astype(float).copy()
             values[free] = theta
-            residual = y - np.einsum("kcp,p->kc", X, values)
+            residual = y - X @ values
             sigma2 = np.sum(residual ** 2, axis=0) / max(len(y) - p / 6.0, 1.0)
             tau = np.array([integrated_autocorrelation(r) for r in residual.T])
             variance = float(np.mean(sigma2 * tau * weights))

@@ -149,8 +149,9 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
         n = len(exp.q)
         _, q_sign, _ = differentiate(exp.q, exp.sample_rate, w / 4, order)
         rest = np.zeros_like(exp.q)
-        at_rest = reg.regressor(platform, exp.q, rest, rest, gravity)  # gravity and offsets
-        at_rest[:, :, coulomb] = reg.coulomb_columns(platform, exp.q, q_sign, coulomb_smoothing)
+        # gravity and offsets, with the Coulomb signs of the motion
+        at_rest = reg.regressor(platform, exp.q, rest, rest, gravity, coulomb_smoothing,
+                                coulomb_rates=q_sign)
         signals = np.concatenate([exp.generalized_force, at_rest.reshape(n, -1)], axis=1)
         filtered = kernel_filter(signals, exp.sample_rate, w)[0][::decimate]
         q_f, qd_f, qdd_f = (x[::decimate] for x in kernel_filter(exp.q, exp.sample_rate, w,
@@ -247,8 +248,8 @@ class PhysicalIdentifier(BaseIdentifier):
                                    self.decimate, self.gravity, self.coulomb_smoothing)
         model = _payload_model(platform) if self.payload else _full_model(platform)
         names, _, selection, nominal, offset = model
-        X = np.einsum("kcs,ps->kcp", data.Y, selection)
-        y = data.y - np.einsum("kcs,s->kc", data.Y, offset)
+        X = data.Y[:, :, np.argmax(selection, axis=1)]  # selection: rows of the identity
+        y = data.y - data.Y @ offset
         # the size of a positive parameter: the whole body's (of a payload's, too)
         positive = np.isin(reg.PARAMETERS, POSITIVE_PARAMETERS)
         scales = selection @ np.where(positive, np.abs(reg.standard_parameters(platform)), 0.0)

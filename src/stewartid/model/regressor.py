@@ -130,7 +130,8 @@ def _euler_maps(q: np.ndarray, q_dot: np.ndarray) -> tuple[np.ndarray, np.ndarra
 
 def regressor(platform: Platform, q: np.ndarray, q_dot: np.ndarray, q_ddot: np.ndarray,
               gravity: bool = True, coulomb_smoothing: float = COULOMB_SMOOTHING,
-              actuator_smoothing: float = ACTUATOR_SMOOTHING) -> np.ndarray:
+              actuator_smoothing: float = ACTUATOR_SMOOTHING,
+              coulomb_rates: np.ndarray | None = None) -> np.ndarray:
     """Y(q, q_dot, q_ddot): the measured generalized force J_lq^T f_meas = Y pi.
 
     Parameters
@@ -145,6 +146,9 @@ def regressor(platform: Platform, q: np.ndarray, q_dot: np.ndarray, q_ddot: np.n
         Regularisation rate (rad/s) of the joints' Coulomb sign, w / sqrt(w^2 + s^2).
     actuator_smoothing : float
         The same for the actuators' (m/s).
+    coulomb_rates : ndarray, shape of q, optional
+        Pose rates the Coulomb signs are taken from, when not ``q_dot`` (the columns at rest
+        with the signs of the motion, for filtering at every sample).
 
     Returns
     -------
@@ -178,7 +182,8 @@ def regressor(platform: Platform, q: np.ndarray, q_dot: np.ndarray, q_ddot: np.n
     _leg_columns(r, u, lengths, qd, qdd, omega, alpha, g, Yn)
     Y = Yn.copy()
     Y[:, 3:] = np.einsum("nji,njk->nik", E, Yn[:, 3:])
-    _friction_columns(platform, q2, qd, coulomb_smoothing, actuator_smoothing, Y)
+    signs = qd if coulomb_rates is None else as_batch(coulomb_rates, "coulomb_rates")[0]
+    _friction_columns(platform, q2, qd, signs, coulomb_smoothing, actuator_smoothing, Y)
     return Y[0] if single else Y
 
 
@@ -208,12 +213,14 @@ def _leg_columns(r, u, lengths, qd, qdd, omega, alpha, g, Yn):
         Yn[:, 3:, k] = _cross(r, x).sum(1)
 
 
-def _friction_columns(platform, q, qd, coulomb_smoothing, actuator_smoothing, Y):
-    """Joint friction per type, actuator friction and sensor offsets (q coordinates) into ``Y``."""
+def _friction_columns(platform, q, qd, qd_signs, coulomb_smoothing, actuator_smoothing, Y):
+    """Joint friction per type, actuator friction and sensor offsets (q coordinates) into
+    ``Y``, the Coulomb signs from the rates ``qd_signs``."""
     terms = compute_leg_terms(platform, q, joints=True)
     J, Jj = terms.leg_jacobian, terms.joint_jacobians
     rates = np.einsum("nlac,nc->nla", Jj, qd)
-    signs = _smooth_sign(rates, coulomb_smoothing)
+    signs = _smooth_sign(np.einsum("nlac,nc->nla", Jj, qd_signs) if qd_signs is not qd
+                         else rates, coulomb_smoothing)
     for t, axes in JOINT_TYPES.items():
         axes = list(axes)
         Y[:, :, _INDEX[f"viscous[{t}]"]] = np.einsum("nla,nlac->nc", rates[:, :, axes],
@@ -222,26 +229,14 @@ def _friction_columns(platform, q, qd, coulomb_smoothing, actuator_smoothing, Y)
                                                      Jj[:, :, axes])
     leg_rates = np.einsum("nlc,nc->nl", J, qd)
     Y[:, :, _INDEX["viscous[actuator]"]] = np.einsum("nl,nlc->nc", leg_rates, J)
+    sign_rates = leg_rates if qd_signs is qd else np.einsum("nlc,nc->nl", J, qd_signs)
     Y[:, :, _INDEX["coulomb[actuator]"]] = np.einsum(
-        "nl,nlc->nc", _smooth_sign(leg_rates, actuator_smoothing), J)
+        "nl,nlc->nc", _smooth_sign(sign_rates, actuator_smoothing), J)
     Y[:, :, parameter_index(OFFSET_PARAMETERS)] = np.swapaxes(J, 1, 2)
 
 
 def _smooth_sign(x: np.ndarray, smoothing: float) -> np.ndarray:
     return np.sign(x) if smoothing == 0 else x / np.sqrt(x * x + smoothing * smoothing)
-
-
-def coulomb_columns(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
-                    coulomb_smoothing: float = COULOMB_SMOOTHING,
-                    actuator_smoothing: float = ACTUATOR_SMOOTHING) -> np.ndarray:
-    """The Coulomb columns of :func:`regressor` alone (joint types, then the actuators'),
-    shape (N, 6, 4): what changes at a reversal, for filtering at every sample."""
-    names = [f"coulomb[{t}]" for t in JOINT_TYPES] + ["coulomb[actuator]"]
-    q2 = as_batch(q)[0]
-    Y = np.zeros((len(q2), 6, N_STANDARD))
-    _friction_columns(platform, q2, as_batch(q_dot, "q_dot")[0], coulomb_smoothing,
-                      actuator_smoothing, Y)
-    return Y[:, :, parameter_index(names)]
 
 
 class BaseParameters(NamedTuple):
@@ -399,6 +394,6 @@ def viscous_regressor(platform: Platform, pose: np.ndarray | None = None) -> np.
 __all__ = ["ACTUATOR_PARAMETERS", "ACTUATOR_SMOOTHING", "BODY_PARAMETERS", "BaseParameters",
            "FRICTION_PARAMETERS", "LEG_PARAMETERS", "N_STANDARD", "OFFSET_PARAMETERS",
            "PARAMETERS", "SAMPLE_ACCELERATIONS", "SAMPLE_RATES", "SAMPLE_SPAN",
-           "VISCOUS_PARAMETERS", "base_parameters", "coulomb_columns", "combination_text",
+           "VISCOUS_PARAMETERS", "base_parameters", "combination_text",
            "inertia_regressor", "parameter_index", "random_states", "regressor",
            "standard_parameters", "viscous_regressor"]
