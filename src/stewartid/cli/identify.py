@@ -69,11 +69,23 @@ def identify(
         help="--report: a record of another excitation (e.g. the validation record of "
              "'stewartid design'), not fitted: every method predicts it and the verdict "
              "judges the methods by it. Repeat for several.")] = None,
+    model: Annotated[str | None, typer.Option(
+        "--model", metavar="NAME",
+        help="'physical': identify the physical parameters of the rigid-body model (masses, "
+             "first moments, inertias, friction per joint type, sensor offsets) and Mt, Bt "
+             "from them (docs/physical-model.md).")] = None,
+    payload: Annotated[bool, typer.Option(
+        "--payload", help="--model physical: identify only the payload on the platform "
+                          "file's known platform.")] = False,
+    platform_out: Annotated[Path | None, typer.Option(
+        "--platform-out", metavar="FILE",
+        help="--model physical: write the identified platform description (TOML).")] = None,
 ) -> None:
     """Identify Mt and Bt from experiments; print the paper-style table when nominal values are
     known (platform description, or meta.json/truth.json beside the data) and write JSON."""
     import numpy as np
 
+    from stewartid.identification.physical_platform import model_method
     from stewartid.reporting.terminal import print_comparison
     from stewartid.reports.identification.run import FlagSetting, identify_files
 
@@ -82,9 +94,11 @@ def identify(
              "--frequency": FlagSetting("frequency_hz", frequency or None, bool(frequency)),
              "--stiffness": FlagSetting("stiffness", stiffness, stiffness),
              "--friction": FlagSetting("friction", friction, friction is not None)}
+    method = model_method(model, method, payload, platform_out)
     found = identify_files(files, method, platform, flags=flags, columns=columns, out=out,
                            force=force, report=report, consistent=consistent, folds=folds,
-                           delay=delay, validate=validate or ())
+                           delay=delay, validate=validate or (), model=model,
+                           payload=payload, platform_out=platform_out)
     if found.delay is not None:
         entry = found.delay
         if entry["source"] == "estimated":

@@ -187,7 +187,8 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
                    columns: str | None = None, out: Path | None = None, force: bool = False,
                    report: Path | None = None, consistent: bool = False,
                    folds: int | None = None, delay: str | float | None = None,
-                   validate: Sequence[str | Path] = ()) -> IdentifyRun:
+                   validate: Sequence[str | Path] = (), model: str | None = None,
+                   payload: bool = False, platform_out: Path | None = None) -> IdentifyRun:
     """Identify Mt and Bt from experiment files, as ``stewartid identify`` does.
 
     Parameters
@@ -221,6 +222,10 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     validate : sequence of str or Path
         Validation records of another excitation (files or folders; needs ``report``): every
         method predicts them, and the verdict judges the prediction on them.
+    model, payload, platform_out : optional
+        ``"physical"``: the physical model instead of ``method``, in payload mode with
+        ``payload``, its platform description written to ``platform_out``
+        (:func:`~stewartid.identification.physical_platform.identify_model`).
 
     Returns
     -------
@@ -273,7 +278,13 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
 
         if consistent:
             require_cvxpy()
-    if report is not None:
+    if model is not None:  # the physical model and its platform file
+        from stewartid.identification.physical_platform import identify_model
+
+        result = identify_model(datasets, description, model, payload, platform_out,
+                                {"--report": report is not None, "--consistent": consistent},
+                                [*paths, *([platform] if platform else [])])
+    elif report is not None:
         written = write_identification_report(
             datasets, description, report, names, settings, consistent,
             DEFAULT_FOLDS if folds is None else folds, None if meta is None else meta[:2],

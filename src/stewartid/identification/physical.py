@@ -1,0 +1,336 @@
+"""The physical model: weighted least squares on the base parameters of the regressor, and the
+paper's Mt, Bt at the neutral pose from the identified parameters.
+
+The measured generalized force is linear in the physical parameters
+(:mod:`stewartid.model.regressor`), J_lq^T f = Y(q, q_dot, q_ddot) pi. Both sides are filtered
+with the smooth kernel h of :func:`~stewartid.signals.differentiation.kernel_filter`, as the
+``ls`` method does: the columns that depend on the pose alone (gravity, sensor offsets) and the
+Coulomb columns (from a lightly smoothed velocity, their switches at every sample) are
+evaluated at every sample and filtered with h; the columns of the velocity and acceleration at
+the filtered pose, rate (q * h') and acceleration (q * h''), so that no numerical
+differentiation enters.
+
+Two modes:
+
+- full (default): every base parameter (:func:`~stewartid.model.regressor.base_parameters`);
+- payload (``payload=True``): the platform file is known but for its payload; the known
+  platform and legs are subtracted and the residual regressed on the moving body's ten columns
+  (the payload's mass, first moment and inertia about the reference point), with the joint
+  and actuator friction and the sensor offsets as nuisance parameters.
+
+Where the data cannot tell a parameter (the scaled regression's condition number, or a
+relative standard error above ``max_relative_error``), it is fixed at the platform file's
+value, named in ``diagnostics["fixed"]`` and the rest fitted. Mt and Bt are linear in the
+parameters (:func:`~stewartid.model.regressor.inertia_regressor`,
+:func:`~stewartid.model.regressor.viscous_regressor`), their standard errors by the delta
+method from the parameters' covariance (residual-autocorrelation consistent, as
+:func:`~stewartid.identification.solvers.solve_least_squares` with ``autocorrelated``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from numbers import Integral
+from typing import Any
+
+import numpy as np
+
+from stewartid.datasets.dataset import Dataset
+from stewartid.fields import BOOLEAN, Interval, nonnegative, positive
+from stewartid.identification.base import DIFFERENTIATION_CONSTRAINTS, BaseIdentifier
+from stewartid.identification.parameter_fit import Solution, solve_parameters
+from stewartid.identification.preparation import Experiment, prepare
+from stewartid.identification.registry import register_method
+from stewartid.identification.result import IdentificationResult
+from stewartid.model import regressor as reg
+from stewartid.platform import Platform
+from stewartid.signals.differentiation import (
+    DEFAULT_ORDER,
+    default_window,
+    differentiate,
+    estimate_frequency,
+    kernel_filter,
+)
+
+#: Names of the payload's parameters in payload mode (the moving body's columns).
+PAYLOAD_PARAMETERS = tuple(f"payload.{name}" for name in reg.BODY_PARAMETERS)
+#: The nuisance parameters of payload mode.
+NUISANCE_PARAMETERS = (reg.FRICTION_PARAMETERS + reg.ACTUATOR_PARAMETERS
+                       + reg.OFFSET_PARAMETERS)
+#: Standard parameters positive by nature, whose standard error is judged against their size.
+POSITIVE_PARAMETERS = ("m", "I_xx", "I_yy", "I_zz", "m_u", "md_u", "md_l", "J_u", "J_l",
+                       "viscous[lower_gimbal]", "viscous[upper_gimbal]")
+
+
+@dataclass(frozen=True)
+class PhysicalResult(IdentificationResult):
+    """An :class:`~stewartid.identification.result.IdentificationResult` of the physical
+    model, whose ``result.json`` adds the parameters.
+
+    Attributes
+    ----------
+    model : str
+        ``"physical"``.
+    parameters : dict of str to float
+        Identified (or fixed) value of each parameter, by name.
+    parameter_std_errors : dict of str to float
+        Standard errors; NaN (``null`` in JSON) for a parameter fixed at the file's value.
+    base_parameters : dict of str to str
+        The combination of standard parameters each parameter stands for.
+    """
+
+    model: str = "physical"
+    parameters: dict[str, float] = field(default_factory=dict)
+    parameter_std_errors: dict[str, float] = field(default_factory=dict)
+    base_parameters: dict[str, str] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        """:meth:`IdentificationResult.to_dict` with ``model``, ``parameters``,
+        ``parameter_std_errors`` and ``base_parameters``."""
+        from stewartid.files import to_jsonable
+
+        return {**super().to_dict(), **to_jsonable({
+            "model": self.model, "parameters": self.parameters,
+            "parameter_std_errors": self.parameter_std_errors,
+            "base_parameters": self.base_parameters})}
+
+
+@dataclass(frozen=True)
+class Regression:
+    """The filtered regression of one set of experiments.
+
+    Attributes
+    ----------
+    Y : ndarray, shape (K, 6, N_STANDARD)
+        Filtered standard regressor rows.
+    y : ndarray, shape (K, 6)
+        Filtered measured generalized force J_lq^T f (N, N m).
+    experiments : list of dict
+        Per experiment: name, window (s), rows used.
+    """
+
+    Y: np.ndarray
+    y: np.ndarray
+    experiments: list[dict[str, Any]]
+
+
+def filtered_regression(experiments: list[Experiment], platform: Platform,
+                        window: float | None = None, order: int = DEFAULT_ORDER,
+                        decimate: int = 1, gravity: bool = True,
+                        coulomb_smoothing: float = 1e-4) -> Regression:
+    """The regressor and the generalized force of every experiment, filtered with h.
+
+    Parameters
+    ----------
+    experiments : list of Experiment
+        Prepared without gravity subtraction (``generalized_force`` = J_lq^T f).
+    platform : Platform
+    window : float, optional
+        Kernel support (s); 0.2 periods of each experiment's dominant frequency by default.
+    order : int
+        Savitzky-Golay order of the light smoothing that decides the Coulomb signs.
+    decimate : int
+        Keep every ``decimate``-th filtered row.
+    gravity : bool
+        Include the gravity columns.
+    coulomb_smoothing : float
+        Regularisation rate of the Coulomb signs (rad/s).
+
+    Returns
+    -------
+    Regression
+    """
+    coulomb = reg.parameter_index([f"coulomb[{t}]" for t in reg.JOINT_TYPES]
+                                  + ["coulomb[actuator]"])
+    static = reg.parameter_index(reg.OFFSET_PARAMETERS)
+    Ys, ys, used = [], [], []
+    for exp in experiments:
+        w = window or default_window(estimate_frequency(exp.q, exp.sample_rate))
+        n = len(exp.q)
+        _, q_sign, _ = differentiate(exp.q, exp.sample_rate, w / 4, order)
+        rest = np.zeros_like(exp.q)
+        # gravity and offsets, with the Coulomb signs of the motion
+        at_rest = reg.regressor(platform, exp.q, rest, rest, gravity, coulomb_smoothing,
+                                coulomb_rates=q_sign)
+        signals = np.concatenate([exp.generalized_force, at_rest.reshape(n, -1)], axis=1)
+        filtered = kernel_filter(signals, exp.sample_rate, w)[0][::decimate]
+        q_f, qd_f, qdd_f = (x[::decimate] for x in kernel_filter(exp.q, exp.sample_rate, w,
+                                                                  derivatives=2))
+        Y = reg.regressor(platform, q_f, qd_f, qdd_f, gravity=False)
+        Y[:, :, coulomb] = 0.0
+        Y[:, :, static] = 0.0
+        Y += filtered[:, 6:].reshape(len(Y), 6, reg.N_STANDARD)
+        Ys.append(Y)
+        ys.append(filtered[:, :6])
+        used.append({"name": exp.name, "window_s": w, "samples": len(Y)})
+    return Regression(np.concatenate(Ys), np.concatenate(ys), used)
+
+
+def known_platform(platform: Platform) -> Platform:
+    """The part of a platform description payload mode takes as known: all but its payload."""
+    return platform.replace(payload=None)
+
+
+@register_method(
+    name="physical", color="#8c564b",
+    display_name="Physical model",
+    description="weighted least squares on the base parameters of the rigid-body model "
+                "(masses, first moments, inertias, friction per joint type, sensor offsets); "
+                "Mt, Bt from them",
+    reference="Khalil, W., Dombre, E. Modeling, Identification and Control of Robots, "
+              "ch. 12 (2002); Gautier, M. Numerical calculation of the base inertial "
+              "parameters of robots, J. Robotic Systems 8(4) (1991)")
+class PhysicalIdentifier(BaseIdentifier):
+    """The physical parameters of the rigid-body model by weighted least squares, and Mt, Bt
+    at the neutral pose from them.
+
+    Parameters
+    ----------
+    payload : bool
+        Identify the payload alone on top of the known platform (the file's description
+        without its ``[payload]``); friction and offsets as nuisance parameters.
+    window : float, optional
+        Kernel support (s); 0.2 periods of each experiment's dominant frequency by default.
+    order : int
+        Savitzky-Golay order of the light smoothing that decides the Coulomb signs.
+    gravity : bool
+        Model gravity (False only for records without it).
+    coulomb_smoothing : float
+        Rate (rad/s) below which a joint's Coulomb sign is attenuated.
+    decimate : int
+        Use every ``decimate``-th filtered row.
+    max_condition : float
+        Largest condition number of the scaled regression before a parameter is fixed.
+    max_relative_error : float
+        Largest relative standard error of a positive parameter before it is fixed.
+
+    Attributes
+    ----------
+    M_, B_ : ndarray, shape (6, 6)
+    std_errors_ : dict of ndarray (6, 6)
+    parameters_ : dict of str to float
+    parameter_std_errors_ : dict of str to float
+    covariance_ : ndarray, shape (p, p)
+        Of the parameters in the order of ``parameters_``.
+    fixed_ : dict of str to str
+        Parameters fixed at the file's value and why.
+    condition_number_ : float
+    result_ : PhysicalResult
+    """
+
+    def __init__(self, payload: bool = False, window: float | None = None,
+                 order: int = DEFAULT_ORDER, gravity: bool = True,
+                 coulomb_smoothing: float = 1e-4, decimate: int = 1,
+                 max_condition: float = 1e5, max_relative_error: float = 0.3):
+        self.payload = payload
+        self.window = window
+        self.order = order
+        self.gravity = gravity
+        self.coulomb_smoothing = coulomb_smoothing
+        self.decimate = decimate
+        self.max_condition = max_condition
+        self.max_relative_error = max_relative_error
+
+    _parameter_constraints = {
+        **DIFFERENTIATION_CONSTRAINTS,
+        "payload": [BOOLEAN],
+        "gravity": [BOOLEAN],
+        "coulomb_smoothing": [nonnegative()],
+        "decimate": [Interval(Integral, 1, None)],
+        "max_condition": [positive()],
+        "max_relative_error": [positive()],
+    }
+
+    def _fit(self, datasets: list[Dataset], platform: Platform
+             ) -> tuple[IdentificationResult, dict]:
+        experiments = prepare(datasets, platform, gravity=False)
+        data = filtered_regression(experiments, platform, self.window, self.order,
+                                   self.decimate, self.gravity, self.coulomb_smoothing)
+        model = _payload_model(platform) if self.payload else _full_model(platform)
+        names, _, selection, nominal, offset = model
+        X = data.Y[:, :, np.argmax(selection, axis=1)]  # selection: rows of the identity
+        y = data.y - data.Y @ offset
+        # the size of a positive parameter: the whole body's (of a payload's, too)
+        positive = np.isin(reg.PARAMETERS, POSITIVE_PARAMETERS)
+        scales = selection @ np.where(positive, np.abs(reg.standard_parameters(platform)), 0.0)
+        solution = solve_parameters(X, y, list(names), nominal, scales, self.max_condition,
+                                    self.max_relative_error)
+        result = _result(self, platform, model, solution, data)
+        learned = {"parameters_": result.parameters,
+                   "parameter_std_errors_": result.parameter_std_errors,
+                   "covariance_": solution.covariance, "fixed_": solution.fixed}
+        return result, learned
+
+
+def _full_model(platform: Platform):
+    """(names, combination strings, selection (p, N_STANDARD) of the columns regressed on,
+    nominal values (p,), known standard parameters (N_STANDARD,)) of the base parameters."""
+    base = reg.base_parameters(platform)
+    pi = reg.standard_parameters(platform)
+    return (base.names, dict(zip(base.names, base.combinations, strict=True)),
+            np.eye(reg.N_STANDARD)[base.columns], base.combination @ pi,
+            np.zeros(reg.N_STANDARD))
+
+
+def _payload_model(platform: Platform):
+    """The same for payload mode: the payload's ten parameters (the moving body's columns)
+    and the nuisance ones; the known platform and legs as the offset."""
+    known = reg.standard_parameters(known_platform(platform))
+    loaded = reg.standard_parameters(platform)
+    body = reg.parameter_index(reg.BODY_PARAMETERS)
+    nuisance = reg.parameter_index(NUISANCE_PARAMETERS)
+    columns = np.concatenate([body, nuisance])
+    selection = np.eye(reg.N_STANDARD)[columns]
+    offset = known.copy()
+    offset[columns] = 0.0
+    offset[body] = known[body]  # the platform's own body is known
+    nominal = np.concatenate([loaded[body] - known[body], known[nuisance]])
+    names = PAYLOAD_PARAMETERS + NUISANCE_PARAMETERS
+    what = {name: f"{standard} of the moving body minus the platform file's own"
+            for name, standard in zip(PAYLOAD_PARAMETERS, reg.BODY_PARAMETERS, strict=True)}
+    return (names, {**what, **{name: name for name in NUISANCE_PARAMETERS}}, selection,
+            nominal, offset)
+
+
+def _result(estimator: PhysicalIdentifier, platform: Platform, model, solution: Solution,
+            data: Regression) -> PhysicalResult:
+    """Mt, Bt at neutral with their delta-method standard errors, and the parameters."""
+    names, combinations, selection, _, offset = model
+    matrices, errors = [], []
+    for A in (reg.inertia_regressor(platform), reg.viscous_regressor(platform)):
+        rows = A @ selection.T  # (6, 6, p): the matrix's entries in the parameters
+        matrices.append(rows @ solution.values + A @ offset)
+        errors.append(np.sqrt(np.clip(np.einsum("ijp,pq,ijq->ij", rows, solution.covariance,
+                                                rows), 0.0, None)))
+    std = np.sqrt(np.diag(solution.covariance))
+    std[[names.index(name) for name in solution.fixed]] = np.nan
+    diagnostics = {"experiments": data.experiments, "fixed": solution.fixed,
+                   "mode": "payload" if estimator.payload else "full",
+                   "singular_values": solution.singular_values,
+                   "n_equations": solution.n_equations}
+    if estimator.payload:
+        diagnostics["payload"] = payload_section(dict(zip(names, solution.values, strict=True)))
+    return PhysicalResult(
+        M=matrices[0], B=matrices[1], std_errors_M=errors[0], std_errors_B=errors[1],
+        condition_number=solution.condition_number, residual_rms=solution.residual_rms,
+        method=estimator.method, settings=estimator.get_params(), diagnostics=diagnostics,
+        parameters=dict(zip(names, solution.values.tolist(), strict=True)),
+        parameter_std_errors=dict(zip(names, std.tolist(), strict=True)),
+        base_parameters=dict(combinations))
+
+
+def payload_section(parameters: dict[str, float]) -> dict[str, Any]:
+    """The ``[payload]`` keys (mass, com, inertia about the centre of mass) of the payload's
+    identified mass, first moment and inertia about the reference point."""
+    m = parameters["payload.m"]
+    first = np.array([parameters[f"payload.mc_{a}"] for a in "xyz"])
+    about_reference = [parameters[f"payload.I_{e}"] for e in ("xx", "yy", "zz", "xy", "xz", "yz")]
+    c = first / m if m > 0 else np.zeros(3)
+    shift = m * (c @ c * np.eye(3) - np.outer(c, c))
+    inertia = np.array(about_reference) - shift[[0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]]
+    return {"mass": float(m), "com": c.tolist(), "inertia": inertia.tolist()}
+
+
+__all__ = ["NUISANCE_PARAMETERS", "PAYLOAD_PARAMETERS", "POSITIVE_PARAMETERS",
+           "PhysicalIdentifier", "PhysicalResult", "Regression", "filtered_regression",
+           "known_platform", "payload_section"]
