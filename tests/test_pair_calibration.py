@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stewartid.identification.solvers import (
+from stewartid.identification.pairs import (
     calibrate_by_pairs,
     pair_calibration,
     symmetric_pair_scores,

@@ -8,8 +8,9 @@ import pytest
 
 from stewartid.datasets.dataset import Dataset
 from stewartid.errors import ConfigError, IdentificationError
+from stewartid.identification.pairs import select_symmetric_pairs
 from stewartid.identification.result import max_error_percent
-from stewartid.identification.wavelet.estimator import WaveletIdentifier, select_symmetric_pairs
+from stewartid.identification.wavelet.estimator import WaveletIdentifier
 from stewartid.model.dynamics import ModelTerms
 from stewartid.model.kinematics import leg_lengths
 from stewartid.model.linearization import nominal_matrices

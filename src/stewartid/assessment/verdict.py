@@ -22,7 +22,7 @@ Rule, in order:
    predict for the largest of 20 errors, so one conservative entry does not outweigh
    nineteen). Every method's standard errors carry its model error where the data show it
    (symmetric pairs that disagree beyond their errors,
-   :func:`~stewartid.identification.solvers.pair_calibration`; for Method A the friction its
+   :func:`~stewartid.identification.pairs.pair_calibration`; for Method A the friction its
    third harmonic reveals), so a method biased by friction it does not model reports it.
 5. **Ties** (within :data:`TIE_FACTOR`): a method immune to the friction law (Method B with
    free interval constants) before one whose errors rest on its friction model being right

@@ -47,14 +47,11 @@ from stewartid.datasets.excitation import LINE_FRACTION, leg_space_motion, spect
 from stewartid.errors import ConfigError, DataError, IdentificationError
 from stewartid.fields import Interval, ListOf, positive
 from stewartid.identification.base import DIFFERENTIATION_CONSTRAINTS, BaseIdentifier
+from stewartid.identification.pairs import calibrate_by_pairs
 from stewartid.identification.preparation import prepare
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
-from stewartid.identification.solvers import (
-    calibrate_by_pairs,
-    regressor_names,
-    solve_least_squares,
-)
+from stewartid.identification.solvers import regressor_names, solve_least_squares
 from stewartid.platform import Platform
 from stewartid.signals.differentiation import (
     DEFAULT_ORDER,

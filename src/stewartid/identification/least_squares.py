@@ -38,14 +38,11 @@ import numpy as np
 from stewartid.datasets.dataset import Dataset
 from stewartid.fields import Interval, Options, nonnegative
 from stewartid.identification.base import DIFFERENTIATION_CONSTRAINTS, BaseIdentifier
+from stewartid.identification.pairs import calibrate_by_pairs
 from stewartid.identification.preparation import prepare
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
-from stewartid.identification.solvers import (
-    calibrate_by_pairs,
-    regressor_names,
-    solve_least_squares,
-)
+from stewartid.identification.solvers import regressor_names, solve_least_squares
 from stewartid.model.joints import JOINT_TYPES
 from stewartid.platform import Platform
 from stewartid.signals.differentiation import (

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -356,167 +355,11 @@ def bias_compensated_least_squares(phi: np.ndarray, target: np.ndarray, cluster:
     return theta_s / scale, std / scale
 
 
-def symmetric_pair_scores(matrix: np.ndarray, std: np.ndarray) -> np.ndarray:
-    """|a_ij - a_ji| / sqrt(s_ij^2 + s_ji^2) of every off-diagonal pair (i < j), row-major.
-
-    The two members of a pair come from different equations and, in the usual protocol,
-    different experiments; as estimates of one entry of a symmetric matrix their difference
-    tests the standard errors.
-
-    Returns
-    -------
-    ndarray, shape (n (n - 1) / 2,)
-    """
-    upper = np.triu_indices(matrix.shape[0], 1)
-    spread = np.hypot(std[upper], std.T[upper])
-    return np.abs(matrix[upper] - matrix.T[upper]) / np.maximum(spread, 1e-300)
-
-
-#: A symmetric pair whose members still differ by more than this many combined standard
-#: errors after the common factor carries a model error of its own.
-PAIR_DISAGREEMENT = 3.0
-
-
-#: Median of |z| for a standard normal z: the robust scale of honest pair scores.
-HALF_NORMAL_MEDIAN = 0.6744897501960817
-
-
-def pair_calibration(scores: np.ndarray) -> dict[str, Any]:
-    """How far the symmetric pairs' scatter exceeds their standard errors.
-
-    The Birge ratio sqrt(mean z^2) of the pair scores z (:func:`symmetric_pair_scores`) is
-    about 1 when the standard errors are honest; above 1, model error (friction a model
-    lacks, unmodelled dynamics) that the residual-based errors do not show. The factor that
-    multiplies every standard error is the ratio, at least 1 (the scatter of 15 pairs cannot
-    show that errors are too large). The mean of z^2, not a robust scale (median |z| /
-    0.6745, also reported): measured on logs with friction the model lacks, the bias spreads
-    over many entries, and a robust scale left a third of them beyond 3 errors.
-
-    Parameters
-    ----------
-    scores : ndarray
-        Pair scores of one matrix.
-
-    Returns
-    -------
-    dict
-        ``{"pairs": n, "birge_ratio": r, "scale": median |z| / 0.6745, "largest": max z,
-        "factor": max(r, 1)}``.
-    """
-    scores = np.asarray(scores, dtype=float)
-    scores = scores[np.isfinite(scores)]
-    if scores.size == 0:
-        nan = float("nan")
-        return {"pairs": 0, "birge_ratio": nan, "scale": nan, "largest": nan, "factor": 1.0}
-    ratio = float(np.sqrt(np.mean(scores ** 2)))
-    return {"pairs": int(scores.size), "birge_ratio": ratio,
-            "scale": float(np.median(scores) / HALF_NORMAL_MEDIAN),
-            "largest": float(scores.max()), "factor": max(ratio, 1.0)}
-
-
-def calibrate_by_pairs(M: np.ndarray, B: np.ndarray, std_M: np.ndarray,
-                       std_B: np.ndarray) -> dict[str, dict[str, Any]]:
-    """Calibrate the standard errors of Mt and Bt, in place, by their symmetric pairs.
-
-    Each matrix's errors are multiplied by its pairs' factor (:func:`pair_calibration`);
-    then both members of a pair that still disagree beyond :data:`PAIR_DISAGREEMENT` get at
-    least half their difference (which of the two is biased the data cannot tell; if one is
-    right, the other is within two such errors).
-
-    Parameters
-    ----------
-    M, B : ndarray, shape (6, 6)
-        Unsymmetrized estimates.
-    std_M, std_B : ndarray, shape (6, 6)
-        Their standard errors; modified in place.
-
-    Returns
-    -------
-    dict
-        ``{"M": pair_calibration(...), "B": ...}``, the ``pair_calibration`` entry of a
-        result's diagnostics.
-    """
-    found = {}
-    upper = np.triu_indices(M.shape[0], 1)
-    for name, matrix, std in (("M", M, std_M), ("B", B, std_B)):
-        found[name] = pair_calibration(symmetric_pair_scores(matrix, std))
-        std *= found[name]["factor"]
-        half = np.abs(matrix[upper] - matrix.T[upper]) / 2
-        apart = half * 2 > PAIR_DISAGREEMENT * np.hypot(std[upper], std.T[upper])
-        for i, j, h in zip(upper[0][apart], upper[1][apart], half[apart], strict=True):
-            std[i, j], std[j, i] = max(std[i, j], h), max(std[j, i], h)
-    return found
-
-
-def select_symmetric_pairs(matrix: np.ndarray, std: np.ndarray,
-                           preferred_rows: tuple[int, ...] = (0, 1, 2),
-                           disagreement: float = 3.0, pool: bool = False) -> list[dict]:
-    """For every off-diagonal pair, copy the better estimate (or, with ``pool``, the
-    inverse-variance mean of two that agree) onto both entries.
-
-    Normally the estimate with the smaller standard error is kept. When the two estimates
-    differ by more than ``disagreement`` combined standard errors, at least one carries a
-    model error that its standard error does not show; then the member in one of
-    ``preferred_rows`` is kept if exactly one is (the translational equations: under
-    translational excitation the rotational equations see the lever-arm-amplified friction
-    of joints that barely move, measured as a 2.8 % bias of Mt(5,1) at 5 N m), and the kept
-    standard error is raised to |difference| / ``disagreement``, so that the reported
-    uncertainty covers the disagreement.
-
-    Parameters
-    ----------
-    matrix, std : ndarray, shape (n, n)
-        Estimates and their standard errors; modified in place.
-    preferred_rows : tuple of int
-        0-based rows whose equations are trusted first on a significant disagreement.
-    disagreement : float
-        Threshold of |a - b| / sqrt(s_a^2 + s_b^2).
-    pool : bool
-        Two members within ``disagreement`` are both estimates of the one entry of a
-        symmetric matrix: take their inverse-variance mean, standard error
-        (s_a^-2 + s_b^-2)^(-1/2), recorded as ``"pooled": True``.
-
-    Returns
-    -------
-    list of dict
-        Per pair {"pair": [[i, j], [j, i]], "kept": [i, j], "disagreement": z, "pooled": bool}
-        (1-based; "kept" is the better-determined member when pooled).
-    """
-    choice = []
-    n = matrix.shape[0]
-    for i in range(n):
-        for j in range(i + 1, n):
-            keep, drop = ((i, j), (j, i)) if std[i, j] <= std[j, i] else ((j, i), (i, j))
-            difference = abs(matrix[i, j] - matrix[j, i])
-            z = difference / max(float(np.hypot(std[i, j], std[j, i])), 1e-300)
-            if z > disagreement and (i in preferred_rows) != (j in preferred_rows):
-                keep, drop = ((i, j), (j, i)) if i in preferred_rows else ((j, i), (i, j))
-            pooled = pool and z <= disagreement
-            if pooled:
-                w_keep, w_drop = std[keep] ** -2.0, std[drop] ** -2.0
-                matrix[keep] = (w_keep * matrix[keep] + w_drop * matrix[drop]) / (w_keep + w_drop)
-                std[keep] = (w_keep + w_drop) ** -0.5
-            matrix[drop] = matrix[keep]
-            if z > disagreement:
-                std[keep] = max(std[keep], difference / disagreement)
-            std[drop] = std[keep]
-            choice.append({"pair": [[i + 1, j + 1], [j + 1, i + 1]],
-                           "kept": [keep[0] + 1, keep[1] + 1], "disagreement": float(z),
-                           "pooled": bool(pooled)})
-    return choice
-
-
 __all__ = [
     "LeastSquaresSolution",
-    "HALF_NORMAL_MEDIAN",
-    "PAIR_DISAGREEMENT",
-    "calibrate_by_pairs",
-    "pair_calibration",
-    "symmetric_pair_scores",
     "bias_compensated_least_squares",
     "check_rank",
     "integrated_autocorrelation",
     "regressor_names",
-    "select_symmetric_pairs",
     "solve_least_squares",
 ]

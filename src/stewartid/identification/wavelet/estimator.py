@@ -39,7 +39,7 @@ noise's bias removed (:mod:`.gls`); ``test_functions=None`` uses (a, b) points
 Couplings (the paper's Mt(2,4) case): an entry and its transpose come from different
 equations (Mt(5,1) from pitch under surge, Mt(1,5) from surge under pitch), the rotational
 ones the sensitive; ``pair_selection`` combines them
-(:func:`~stewartid.identification.solvers.select_symmetric_pairs`), ``symmetric=True``
+(:func:`~stewartid.identification.pairs.select_symmetric_pairs`), ``symmetric=True``
 imposes symmetry in the solve instead.
 
 Standard errors are cluster-robust over intervals (the equations of one interval share
@@ -60,16 +60,14 @@ import numpy as np
 from stewartid.datasets.dataset import Dataset
 from stewartid.fields import Interval, ListOf, Options, nonnegative, positive, validate_parameters
 from stewartid.identification.base import BaseIdentifier
+from stewartid.identification.pairs import combine_pairs
 from stewartid.identification.preparation import Experiment, prepare_experiment
 from stewartid.identification.registry import Preset, register_method
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.solvers import (
     bias_compensated_least_squares,
-    pair_calibration,
     regressor_names,
-    select_symmetric_pairs,
     solve_least_squares,
-    symmetric_pair_scores,
 )
 from stewartid.identification.wavelet.detection import (
     SINGLE_SINE_SHARE,
@@ -376,31 +374,10 @@ class WaveletIdentifier(BaseIdentifier):
 
     def _combine_pairs(self, M: np.ndarray, B: np.ndarray, std_M: np.ndarray,
                        std_B: np.ndarray) -> dict:
-        """Symmetric pairs, in place: the better-determined member (``pair_selection``), the
-        standard errors then multiplied by the pairs' calibration factor
-        (:func:`~stewartid.identification.solvers.pair_calibration`); or with ``symmetric``
-        the inverse-variance weighted mean of both."""
-        self.pair_calibration_ = {}
-        if self.symmetric:
-            for matrix, std in ((M, std_M), (B, std_B)):
-                w = 1.0 / np.maximum(std, 1e-300) ** 2
-                matrix[:] = (w * matrix + w.T * matrix.T) / (w + w.T)
-                std[:] = 1.0 / np.sqrt(w + w.T)
-            return {}
-        # the pairs are judged on the residual-based errors (an inflated error would pool a
-        # biased member); the calibration applies to what is reported
-        factors = {"M": pair_calibration(symmetric_pair_scores(M, std_M)),
-                   "B": pair_calibration(symmetric_pair_scores(B, std_B))}
-        raw = {"M": np.minimum(std_M, std_M.T), "B": np.minimum(std_B, std_B.T)}
-        chosen = {}
-        if self.pair_selection in ("std_error", "pooled"):
-            pool = self.pair_selection == "pooled"
-            chosen = {"M": select_symmetric_pairs(M, std_M, pool=pool),
-                      "B": select_symmetric_pairs(B, std_B, pool=pool)}
-        # a pair's error raised to its disagreement already holds its model error
-        for name, std in (("M", std_M), ("B", std_B)):
-            std[:] = np.maximum(std, factors[name]["factor"] * np.minimum(std, raw[name]))
-        self.pair_calibration_ = factors
+        """Symmetric pairs, in place (:func:`~stewartid.identification.pairs.combine_pairs`);
+        the calibration kept for the diagnostics."""
+        chosen, self.pair_calibration_ = combine_pairs(
+            M, B, std_M, std_B, bool(self.symmetric), self.pair_selection)
         return chosen
 
     def _settings(self) -> dict:
@@ -464,4 +441,4 @@ class WaveletIdentifier(BaseIdentifier):
 
 
 __all__ = ["EXACT_DEGREE", "FRICTION_MODELS", "MARGIN_PERIODS", "PAIR_SELECTIONS", "VARIANTS",
-           "WaveletIdentifier", "select_symmetric_pairs"]
+           "WaveletIdentifier"]
