@@ -183,3 +183,24 @@ def test_the_shared_reporting_parts_import_no_report():
                         for target, name, line in _imports(module)
                         if inside(f"{target}.{name}", "stewartid.reports")]
     assert reversed_imports == []
+
+
+def test_the_layout_page_lists_every_module_in_its_package():
+    """docs/layout.md's tree holds every module, indented under its package (so the page a
+    reader learns the package from stays true when a module is added)."""
+    page = (SOURCE.parent / "docs" / "layout.md").read_text()
+    tree = page.split("```text", 1)[1].split("```", 1)[0].splitlines()
+    listed, stack = set(), []
+    for row in tree[2:]:  # below "stewartid/"
+        depth = (len(row) - len(row.lstrip(" "))) // 4
+        name = row.split()[0] if row.strip() else ""
+        if not name:
+            continue
+        stack = stack[:depth - 1]
+        if name.endswith("/"):
+            stack.append(name[:-1])
+        else:
+            listed.add(".".join(["stewartid", *stack, name]))
+    modules = {m for m, (_, package) in MODULES.items() if not package
+               and m.rsplit(".", 1)[1] != "__main__"}
+    assert not sorted(modules - listed), "add them to docs/layout.md"
