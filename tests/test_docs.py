@@ -87,6 +87,8 @@ SCALED = {
     # the Python block's 6 x 6 s records: 2 s each (the commands keep 6 s: the report's
     # held-out validation needs more than 2 s, and figures, not the records, take its time)
     "getting-started.md": [("duration_s=6.0", "duration_s=2.0")],
+    # the paper's six 20 s sines and the physical model on them: 8 s records
+    "physical-model.md": [("--coulomb 30 --noise", "--coulomb 30 --noise --duration 8")],
 }
 
 #: A stand-in for dask-jobqueue (a batch system is not at hand): its cluster is a local one.
@@ -361,6 +363,13 @@ def prepare(page: str, folder: Path, logged: Path) -> tuple[Path, ...]:
     if page == "logs.md":
         shutil.copytree(logged / "sim", folder / "clean")
         write_controller_logs(folder, ROOT / "docs" / page)
+    if page == "physical-model.md":
+        # the shipped platform file, and the same with the page's [payload] section
+        shutil.copy(ROOT / "src" / "stewartid" / "data" / "paper.toml", folder / "paper.toml")
+        (payload,) = [block for block in blocks(ROOT / "docs" / page, ("text",))
+                      if block.startswith("[payload]")]
+        (folder / "loaded.toml").write_text((folder / "paper.toml").read_text() + "\n"
+                                            + payload)
     if page == "studies.md":
         (study,) = [block for block in blocks(ROOT / "docs" / page, ("toml",))
                     if block.startswith("[study]")]

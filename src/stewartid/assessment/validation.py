@@ -186,7 +186,7 @@ def with_companion_friction(result: IdentificationResult, companion: Callable[[]
         return result
     try:
         levels = companion().fit(list(datasets), platform).result_.diagnostics.get("coulomb")
-    except StewartidError:
+    except StewartidError:  # too little data for the companion: predict without friction
         return result
     if not isinstance(levels, dict):
         return result

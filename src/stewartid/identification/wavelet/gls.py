@@ -54,7 +54,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from stewartid.errors import DataWarning
+from stewartid.errors import DataWarning, IdentificationError
 from stewartid.identification.solvers import check_rank, regressor_names
 from stewartid.identification.wavelet.variance_components import (
     chi2_excess,
@@ -286,7 +286,14 @@ def fit_jointly(stacked: StackedEquations, designs: Sequence[np.ndarray],
             uncorrected[i] = not corrected
         scale = np.sqrt(np.abs(np.diag(normal)))
         scale = np.where(scale > 0, scale, 1.0)
-        z = np.linalg.solve(normal / np.outer(scale, scale), rhs / scale) / scale
+        try:
+            z = np.linalg.solve(normal / np.outer(scale, scale), rhs / scale) / scale
+        except np.linalg.LinAlgError as exc:
+            raise IdentificationError(
+                "the weak-form equations do not determine every unknown (the records hold too "
+                "few constant-direction intervals for the interval constants shared by "
+                "friction); record longer experiments or leave the constants free "
+                "(friction='free').") from exc
     return JointFit(z=z, normal=normal, scale=scale, weights=weights, uncorrected=uncorrected)
 
 
