@@ -114,9 +114,20 @@ class Regression:
     experiments: list[dict[str, Any]]
 
 
+#: Filtered rows kept per kernel window when the row step is automatic: the filtered signals
+#: vary on the scale of the window, so denser rows add round-off-level information only.
+ROWS_PER_WINDOW = 40
+
+
+def row_step(window: float, sample_rate: float) -> int:
+    """The automatic row step of :func:`filtered_regression`: ``ROWS_PER_WINDOW`` rows per
+    kernel window (``window`` s at ``sample_rate`` Hz), at least 1."""
+    return max(1, int(window * sample_rate) // ROWS_PER_WINDOW)
+
+
 def filtered_regression(experiments: list[Experiment], platform: Platform,
                         window: float | None = None, order: int = DEFAULT_ORDER,
-                        decimate: int = 1, gravity: bool = True,
+                        decimate: int | None = 1, gravity: bool = True,
                         coulomb_smoothing: float = 1e-4) -> Regression:
     """The regressor and the generalized force of every experiment, filtered with h.
 
@@ -129,8 +140,10 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
         Kernel support (s); 0.2 periods of each experiment's dominant frequency by default.
     order : int
         Savitzky-Golay order of the light smoothing that decides the Coulomb signs.
-    decimate : int
-        Keep every ``decimate``-th filtered row.
+    decimate : int, optional
+        Keep every ``decimate``-th filtered row; None: :func:`row_step` of each experiment's
+        window (the filtered signals are band-limited by the kernel, so the rows between add
+        little: the estimates move by a small fraction of their standard errors).
     gravity : bool
         Include the gravity columns.
     coulomb_smoothing : float
@@ -146,23 +159,26 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
     Ys, ys, used = [], [], []
     for exp in experiments:
         w = window or default_window(estimate_frequency(exp.q, exp.sample_rate))
+        step = decimate or row_step(w, exp.sample_rate)
         n = len(exp.q)
         _, q_sign, _ = differentiate(exp.q, exp.sample_rate, w / 4, order)
         rest = np.zeros_like(exp.q)
-        # gravity and offsets, with the Coulomb signs of the motion
+        # gravity and offsets, with the Coulomb signs of the motion; only the channels that
+        # are not identically zero at rest are filtered (most of the inertial ones are)
         at_rest = reg.regressor(platform, exp.q, rest, rest, gravity, coulomb_smoothing,
-                                coulomb_rates=q_sign)
-        signals = np.concatenate([exp.generalized_force, at_rest.reshape(n, -1)], axis=1)
-        filtered = kernel_filter(signals, exp.sample_rate, w)[0][::decimate]
-        q_f, qd_f, qdd_f = (x[::decimate] for x in kernel_filter(exp.q, exp.sample_rate, w,
-                                                                  derivatives=2))
+                                coulomb_rates=q_sign).reshape(n, -1)
+        live = np.flatnonzero(np.any(at_rest != 0.0, axis=0))
+        signals = np.concatenate([exp.generalized_force, at_rest[:, live]], axis=1)
+        filtered = kernel_filter(signals, exp.sample_rate, w)[0][::step]
+        q_f, qd_f, qdd_f = (x[::step] for x in kernel_filter(exp.q, exp.sample_rate, w,
+                                                              derivatives=2))
         Y = reg.regressor(platform, q_f, qd_f, qdd_f, gravity=False)
         Y[:, :, coulomb] = 0.0
         Y[:, :, static] = 0.0
-        Y += filtered[:, 6:].reshape(len(Y), 6, reg.N_STANDARD)
+        Y.reshape(len(Y), -1)[:, live] += filtered[:, 6:]
         Ys.append(Y)
         ys.append(filtered[:, :6])
-        used.append({"name": exp.name, "window_s": w, "samples": len(Y)})
+        used.append({"name": exp.name, "window_s": w, "samples": len(Y), "row_step": step})
     return Regression(np.concatenate(Ys), np.concatenate(ys), used)
 
 
@@ -197,8 +213,9 @@ class PhysicalIdentifier(BaseIdentifier):
         Model gravity (False only for records without it).
     coulomb_smoothing : float
         Rate (rad/s) below which a joint's Coulomb sign is attenuated.
-    decimate : int
-        Use every ``decimate``-th filtered row.
+    decimate : int, optional
+        Use every ``decimate``-th filtered row; None (default): ``ROWS_PER_WINDOW`` rows per
+        kernel window (:func:`row_step`).
     max_condition : float
         Largest condition number of the scaled regression before a parameter is fixed.
     max_relative_error : float
@@ -220,7 +237,7 @@ class PhysicalIdentifier(BaseIdentifier):
 
     def __init__(self, payload: bool = False, window: float | None = None,
                  order: int = DEFAULT_ORDER, gravity: bool = True,
-                 coulomb_smoothing: float = 1e-4, decimate: int = 1,
+                 coulomb_smoothing: float = 1e-4, decimate: int | None = None,
                  max_condition: float = 1e5, max_relative_error: float = 0.3):
         self.payload = payload
         self.window = window
@@ -236,7 +253,7 @@ class PhysicalIdentifier(BaseIdentifier):
         "payload": [BOOLEAN],
         "gravity": [BOOLEAN],
         "coulomb_smoothing": [nonnegative()],
-        "decimate": [Interval(Integral, 1, None)],
+        "decimate": [Interval(Integral, 1, None), None],
         "max_condition": [positive()],
         "max_relative_error": [positive()],
     }
@@ -332,5 +349,5 @@ def payload_section(parameters: dict[str, float]) -> dict[str, Any]:
 
 
 __all__ = ["NUISANCE_PARAMETERS", "PAYLOAD_PARAMETERS", "POSITIVE_PARAMETERS",
-           "PhysicalIdentifier", "PhysicalResult", "Regression", "filtered_regression",
-           "known_platform", "payload_section"]
+           "ROWS_PER_WINDOW", "PhysicalIdentifier", "PhysicalResult", "Regression",
+           "filtered_regression", "known_platform", "payload_section", "row_step"]
