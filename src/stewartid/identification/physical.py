@@ -116,7 +116,7 @@ class Regression:
 
 #: Filtered rows kept per kernel window when the row step is automatic: the filtered signals
 #: vary on the scale of the window, so denser rows add round-off-level information only.
-ROWS_PER_WINDOW = 40
+ROWS_PER_WINDOW = 20
 
 
 def row_step(window: float, sample_rate: float) -> int:
@@ -141,9 +141,10 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
     order : int
         Savitzky-Golay order of the light smoothing that decides the Coulomb signs.
     decimate : int, optional
-        Keep every ``decimate``-th filtered row; None: :func:`row_step` of each experiment's
-        window (the filtered signals are band-limited by the kernel, so the rows between add
-        little: the estimates move by a small fraction of their standard errors).
+        Keep every ``decimate``-th filtered row; None: the smallest :func:`row_step` of the
+        experiments' windows, the same for all so that each keeps its share of the rows (the
+        filtered signals are band-limited by the kernel: the rows between add little, and
+        the estimates move by a small fraction of their standard errors).
     gravity : bool
         Include the gravity columns.
     coulomb_smoothing : float
@@ -157,9 +158,12 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
                                   + ["coulomb[actuator]"])
     static = reg.parameter_index(reg.OFFSET_PARAMETERS)
     Ys, ys, used = [], [], []
-    for exp in experiments:
-        w = window or default_window(estimate_frequency(exp.q, exp.sample_rate))
-        step = decimate or row_step(w, exp.sample_rate)
+    windows = [window or default_window(estimate_frequency(exp.q, exp.sample_rate))
+               for exp in experiments]
+    # one step for every experiment: each keeps its share of the rows, as without decimation
+    step = decimate or min(row_step(w, exp.sample_rate)
+                           for w, exp in zip(windows, experiments, strict=True))
+    for exp, w in zip(experiments, windows, strict=True):
         n = len(exp.q)
         _, q_sign, _ = differentiate(exp.q, exp.sample_rate, w / 4, order)
         rest = np.zeros_like(exp.q)

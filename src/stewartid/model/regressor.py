@@ -224,6 +224,7 @@ def _leg_columns(r, u, lengths, qd, qdd, omega, alpha, g, Yn, moving=True):
 
 # joint axes of each friction type, as a mask over the five axes of a leg: (types, 5)
 _TYPE_MASK = np.array([[a in axes for a in range(5)] for axes in JOINT_TYPES.values()], float)
+_TYPE_MASK_LEGS = np.tile(_TYPE_MASK, (1, 6))  # (types, legs x axes), legs major
 
 
 def _friction_columns(platform, q, qd, qd_signs, coulomb_smoothing, actuator_smoothing, Y,
@@ -240,7 +241,7 @@ def _friction_columns(platform, q, qd, qd_signs, coulomb_smoothing, actuator_smo
         return (flat @ rates[:, :, None]).reshape(n, 6, -1)
 
     def by_type(weights):  # sum over legs and the axes of each type of weight x row
-        return np.swapaxes(_TYPE_MASK @ (weights[..., None] * Jj).sum(1), 1, 2)
+        return np.swapaxes((weights.reshape(n, 1, -1) * _TYPE_MASK_LEGS) @ flat, 1, 2)
 
     rates = axis_rates(qd) if moving or qd_signs is qd else None
     signs = _smooth_sign(rates if qd_signs is qd else axis_rates(qd_signs), coulomb_smoothing)
