@@ -36,9 +36,17 @@ from typing import Any
 import numpy as np
 
 from stewartid.datasets.dataset import Dataset
+from stewartid.errors import IdentificationError
 from stewartid.fields import BOOLEAN, Interval, nonnegative, positive
 from stewartid.identification.base import DIFFERENTIATION_CONSTRAINTS, BaseIdentifier
-from stewartid.identification.parameter_fit import Solution, solve_parameters
+from stewartid.identification.consistency import require_cvxpy
+from stewartid.identification.parameter_fit import (
+    Body,
+    ConsistentParameters,
+    Solution,
+    nearest_consistent,
+    solve_parameters,
+)
 from stewartid.identification.preparation import Experiment, prepare
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
@@ -224,6 +232,12 @@ class PhysicalIdentifier(BaseIdentifier):
         Largest condition number of the scaled regression before a parameter is fixed.
     max_relative_error : float
         Largest relative standard error of a positive parameter before it is fixed.
+    consistent : bool
+        Replace the estimate by the physically consistent parameters nearest to it in the
+        metric of its covariance (:func:`~stewartid.identification.parameter_fit.nearest_consistent`):
+        the moving body's (payload mode: the payload's) pseudo-inertia positive semidefinite,
+        its mass positive, friction coefficients nonnegative; how far each parameter moved,
+        in standard errors, in ``diagnostics["consistent"]``. Needs the ``convex`` extra.
 
     Attributes
     ----------
@@ -242,7 +256,8 @@ class PhysicalIdentifier(BaseIdentifier):
     def __init__(self, payload: bool = False, window: float | None = None,
                  order: int = DEFAULT_ORDER, gravity: bool = True,
                  coulomb_smoothing: float = 1e-4, decimate: int | None = None,
-                 max_condition: float = 1e5, max_relative_error: float = 0.3):
+                 max_condition: float = 1e5, max_relative_error: float = 0.3,
+                 consistent: bool = False):
         self.payload = payload
         self.window = window
         self.order = order
@@ -251,6 +266,7 @@ class PhysicalIdentifier(BaseIdentifier):
         self.decimate = decimate
         self.max_condition = max_condition
         self.max_relative_error = max_relative_error
+        self.consistent = consistent
 
     _parameter_constraints = {
         **DIFFERENTIATION_CONSTRAINTS,
@@ -260,10 +276,13 @@ class PhysicalIdentifier(BaseIdentifier):
         "decimate": [Interval(Integral, 1, None), None],
         "max_condition": [positive()],
         "max_relative_error": [positive()],
+        "consistent": [BOOLEAN],
     }
 
     def _fit(self, datasets: list[Dataset], platform: Platform
              ) -> tuple[IdentificationResult, dict]:
+        if self.consistent:
+            require_cvxpy()  # before the fit, not after it
         experiments = prepare(datasets, platform, gravity=False)
         data = filtered_regression(experiments, platform, self.window, self.order,
                                    self.decimate, self.gravity, self.coulomb_smoothing)
@@ -276,7 +295,12 @@ class PhysicalIdentifier(BaseIdentifier):
         scales = selection @ np.where(positive, np.abs(reg.standard_parameters(platform)), 0.0)
         solution = solve_parameters(X, y, list(names), nominal, scales, self.max_condition,
                                     self.max_relative_error)
-        result = _result(self, platform, model, solution, data)
+        projection = None
+        if self.consistent:
+            nonnegative = np.isin(names, reg.FRICTION_PARAMETERS + reg.ACTUATOR_PARAMETERS)
+            projection = nearest_consistent(solution.values, solution.covariance,
+                                            _bodies(platform, model, self.payload), nonnegative)
+        result = _result(self, platform, model, solution, data, projection)
         learned = {"parameters_": result.parameters,
                    "parameter_std_errors_": result.parameter_std_errors,
                    "covariance_": solution.covariance, "fixed_": solution.fixed}
@@ -313,14 +337,35 @@ def _payload_model(platform: Platform):
             nominal, offset)
 
 
+def _bodies(platform: Platform, model, payload: bool) -> list[Body]:
+    """The rigid body of the consistent fit: the payload (payload mode) or the moving body,
+    whose base parameters hold the legs' upper parts (six point masses) at the file's
+    values."""
+    names, _, selection, nominal, _ = model
+    body = reg.parameter_index(reg.BODY_PARAMETERS)
+    if not np.all(selection[:, body].any(axis=0)):
+        raise IdentificationError("the consistent fit needs the moving body's ten parameters "
+                                  "among the base parameters; they are not for this platform.")
+    rows = np.argmax(selection[:, body], axis=0)
+    mapping = np.zeros((len(body), len(names)))
+    mapping[np.arange(len(body)), rows] = 1.0
+    scale = platform.moving_body.mass
+    if payload:
+        return [Body("payload", mapping, np.zeros(len(body)), scale)]
+    return [Body("moving body", mapping, reg.standard_parameters(platform)[body] - nominal[rows],
+                 scale)]
+
+
 def _result(estimator: PhysicalIdentifier, platform: Platform, model, solution: Solution,
-            data: Regression) -> PhysicalResult:
-    """Mt, Bt at neutral with their delta-method standard errors, and the parameters."""
+            data: Regression, projection: ConsistentParameters | None = None) -> PhysicalResult:
+    """Mt, Bt at neutral with their delta-method standard errors (of the unconstrained
+    estimate), and the parameters (the consistent ones when ``projection`` is given)."""
     names, combinations, selection, _, offset = model
+    values = solution.values if projection is None else projection.values
     matrices, errors = [], []
     for A in (reg.inertia_regressor(platform), reg.viscous_regressor(platform)):
         rows = A @ selection.T  # (6, 6, p): the matrix's entries in the parameters
-        matrices.append(rows @ solution.values + A @ offset)
+        matrices.append(rows @ values + A @ offset)
         errors.append(np.sqrt(np.clip(np.einsum("ijp,pq,ijq->ij", rows, solution.covariance,
                                                 rows), 0.0, None)))
     std = np.sqrt(np.diag(solution.covariance))
@@ -329,13 +374,22 @@ def _result(estimator: PhysicalIdentifier, platform: Platform, model, solution: 
                    "mode": "payload" if estimator.payload else "full",
                    "singular_values": solution.singular_values,
                    "n_equations": solution.n_equations}
+    if projection is not None:
+        free = [k for k, name in enumerate(names) if name not in solution.fixed]
+        diagnostics["consistent"] = {
+            "solver": projection.solver, "status": projection.status,
+            "objective": projection.objective,
+            "max_change_std_errors": float(np.max(np.abs(projection.change), initial=0.0)),
+            "change_std_errors": {names[k]: float(projection.change[k]) for k in free},
+            "unconstrained": dict(zip(names, solution.values.tolist(), strict=True)),
+            "min_eigenvalue_pseudo_inertia": projection.min_eigenvalues}
     if estimator.payload:
-        diagnostics["payload"] = payload_section(dict(zip(names, solution.values, strict=True)))
+        diagnostics["payload"] = payload_section(dict(zip(names, values, strict=True)))
     return PhysicalResult(
         M=matrices[0], B=matrices[1], std_errors_M=errors[0], std_errors_B=errors[1],
         condition_number=solution.condition_number, residual_rms=solution.residual_rms,
         method=estimator.method, settings=estimator.get_params(), diagnostics=diagnostics,
-        parameters=dict(zip(names, solution.values.tolist(), strict=True)),
+        parameters=dict(zip(names, values.tolist(), strict=True)),
         parameter_std_errors=dict(zip(names, std.tolist(), strict=True)),
         base_parameters=dict(combinations))
 

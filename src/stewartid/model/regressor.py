@@ -107,6 +107,36 @@ def standard_parameters(platform: Platform) -> np.ndarray:
     return pi
 
 
+def pseudo_inertia(body: np.ndarray) -> np.ndarray:
+    """The pseudo-inertia matrix of a rigid body from its ten standard parameters.
+
+    J = [[Sigma, h], [h^T, m]] with Sigma = integral r r^T dm = tr(I) / 2 1 - I the second
+    moment about the reference point, h = m c the first moment and m the mass. The body is
+    physically realisable (a nonnegative mass density exists) exactly when J is positive
+    semidefinite (Wensing, Kim, Slotine, IEEE RA-L 3(1), 2017); J is linear in the parameters.
+
+    Parameters
+    ----------
+    body : ndarray, shape (..., 10)
+        m (kg), m c (kg m), I_xx, I_yy, I_zz, I_xy, I_xz, I_yz about the reference point
+        (kg m^2), in the order of :data:`BODY_PARAMETERS`.
+
+    Returns
+    -------
+    ndarray, shape (..., 4, 4)
+        kg, kg m, kg m^2.
+    """
+    body = np.asarray(body, dtype=float)
+    inertia = np.zeros(body.shape[:-1] + (3, 3))
+    for k, (a, b) in enumerate(_INERTIA_ENTRIES):
+        inertia[..., a, b] = inertia[..., b, a] = body[..., 4 + k]
+    J = np.zeros(body.shape[:-1] + (4, 4))
+    J[..., :3, :3] = np.trace(inertia, axis1=-2, axis2=-1)[..., None, None] / 2 * np.eye(3) - inertia
+    J[..., :3, 3] = J[..., 3, :3] = body[..., 1:4]
+    J[..., 3, 3] = body[..., 0]
+    return J
+
+
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.cross(a, b, axis=-1)
 
@@ -185,7 +215,7 @@ def regressor(platform: Platform, q: np.ndarray, q_dot: np.ndarray, q_ddot: np.n
         Yn[:, 3:, 4 + k] = np.einsum("nij,nj->ni", R, moment)
     _leg_columns(r, u, lengths, qd, qdd, omega, alpha, g, Yn, moving)
     Y = Yn  # the moment rows to q coordinates, E^T m, in place
-    Y[:, 3:] = np.swapaxes(E, 1, 2) @ Yn[:, 3:]
+    Y[:, 3:] = np.swapaxes(E, 1, 2) @ Y[:, 3:]
     signs = qd if coulomb_rates is None else as_batch(coulomb_rates, "coulomb_rates")[0]
     _friction_columns(platform, q2, qd, signs, coulomb_smoothing, actuator_smoothing, Y, moving)
     return Y[0] if single else Y
@@ -222,9 +252,9 @@ def _leg_columns(r, u, lengths, qd, qdd, omega, alpha, g, Yn, moving=True):
         Yn[:, 3:, k] = _cross(r, x).sum(1)
 
 
-# joint axes of each friction type, as a mask over the five axes of a leg: (types, 5)
-_TYPE_MASK = np.array([[a in axes for a in range(5)] for axes in JOINT_TYPES.values()], float)
-_TYPE_MASK_LEGS = np.tile(_TYPE_MASK, (1, 6))  # (types, legs x axes), legs major
+# the joint axes of each friction type, as a mask over the rows (legs x axes) of a sample
+_TYPE_MASK_LEGS = np.tile([[a in axes for a in range(5)] for axes in JOINT_TYPES.values()],
+                          (1, 6)).astype(float)
 
 
 def _friction_columns(platform, q, qd, qd_signs, coulomb_smoothing, actuator_smoothing, Y,
@@ -234,8 +264,7 @@ def _friction_columns(platform, q, qd, qd_signs, coulomb_smoothing, actuator_smo
     and so are the viscous columns (left as they are)."""
     n = len(q)
     terms = compute_leg_terms(platform, q, joints=True)
-    J, Jj = terms.leg_jacobian, terms.joint_jacobians  # (n, 6, 6), (n, legs, axes, 6)
-    flat = Jj.reshape(n, -1, 6)
+    J, flat = terms.leg_jacobian, terms.joint_jacobians.reshape(n, -1, 6)  # legs x axes rows
 
     def axis_rates(rates):  # (n, 6) -> (n, legs, axes)
         return (flat @ rates[:, :, None]).reshape(n, 6, -1)
@@ -245,11 +274,10 @@ def _friction_columns(platform, q, qd, qd_signs, coulomb_smoothing, actuator_smo
 
     rates = axis_rates(qd) if moving or qd_signs is qd else None
     signs = _smooth_sign(rates if qd_signs is qd else axis_rates(qd_signs), coulomb_smoothing)
-    types = len(JOINT_TYPES)
-    friction = parameter_index(FRICTION_PARAMETERS)
+    friction = parameter_index(FRICTION_PARAMETERS)  # the viscous types, then the Coulomb
     if moving:
-        Y[:, :, friction[:types]] = by_type(rates)
-    Y[:, :, friction[types:]] = by_type(signs)
+        Y[:, :, friction[:len(JOINT_TYPES)]] = by_type(rates)
+    Y[:, :, friction[len(JOINT_TYPES):]] = by_type(signs)
     leg_rates = (J @ qd[:, :, None])[..., 0]
     actuator = parameter_index(ACTUATOR_PARAMETERS)
     Y[:, :, actuator[0]] = (leg_rates[:, None] @ J)[:, 0]
@@ -418,5 +446,5 @@ __all__ = ["ACTUATOR_PARAMETERS", "ACTUATOR_SMOOTHING", "BODY_PARAMETERS", "Base
            "FRICTION_PARAMETERS", "LEG_PARAMETERS", "N_STANDARD", "OFFSET_PARAMETERS",
            "PARAMETERS", "SAMPLE_ACCELERATIONS", "SAMPLE_RATES", "SAMPLE_SPAN",
            "VISCOUS_PARAMETERS", "base_parameters", "combination_text",
-           "inertia_regressor", "parameter_index", "random_states", "regressor",
-           "standard_parameters", "viscous_regressor"]
+           "inertia_regressor", "parameter_index", "pseudo_inertia", "random_states",
+           "regressor", "standard_parameters", "viscous_regressor"]
