@@ -170,6 +170,18 @@ def test_mujoco_mass_matrix_and_gravity_through_the_regressor(loaded):
         assert np.abs(t["gravity"] - G).max() < 1e-6 * np.abs(G).max()
 
 
+def test_columns_at_rest_are_those_of_a_motion_too_slow_to_matter(loaded):
+    """At rest the regressor skips the velocity and acceleration terms; the full evaluation at
+    rates and accelerations of 1e-150 (their products far below round-off) must agree, the
+    Coulomb columns taking their signs from the same given rates."""
+    q, signs, _ = reg.random_states(loaded, 20, seed=5)
+    rest = np.zeros_like(q)
+    at_rest = reg.regressor(loaded, q, rest, rest, coulomb_rates=signs)
+    slow = reg.regressor(loaded, q, np.full_like(q, 1e-150), np.full_like(q, 1e-150),
+                         coulomb_rates=signs)
+    assert np.abs(at_rest - slow).max() <= 10 * EPS * np.abs(slow).max()
+
+
 def test_base_parameters_reproduce_the_regressor(loaded):
     """Y_base pi_base = Y pi for random pi on states the base was not found on; the upper
     parts are point masses at the upper joints (m_u folds into m six times, into the

@@ -1,19 +1,37 @@
 """Weighted least squares of physical parameters, the ones the data cannot tell fixed at known
-values: the solver of :mod:`stewartid.identification.physical`.
+values, and the physically consistent parameters nearest to them: the solvers of
+:mod:`stewartid.identification.physical`.
 
 Channels (forces and moments, in different units) are weighted by their residual variance
 (feasible generalized least squares); the standard errors allow for the residual's
 autocorrelation (filtered signals) as
 :func:`~stewartid.identification.solvers.solve_least_squares` with ``autocorrelated`` does.
+
+:func:`nearest_consistent` projects the estimate onto the physically consistent set in the
+metric of its covariance,
+
+    minimise (p - p^)^T Sigma^-1 (p - p^)  subject to  J(body) >= 0,  m(body) > 0,  f >= 0,
+
+over the estimated parameters (the fixed ones keep their values): every rigid body's
+pseudo-inertia matrix J (:func:`~stewartid.model.regressor.pseudo_inertia`, of its standard
+parameters, affine in p) positive semidefinite, its mass positive and the friction
+coefficients nonnegative (Wensing, Kim, Slotine, "Linear matrix inequalities for physically
+consistent inertial parameter identification", IEEE RA-L 3(1), 2017). Where the unconstrained
+estimate is consistent it is its own projection. A small semidefinite program, solved with
+cvxpy (the ``convex`` extra).
 """
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
+from stewartid.errors import IdentificationError
+from stewartid.identification.consistency import STRICT_FRACTION, require_cvxpy
 from stewartid.identification.solvers import integrated_autocorrelation
+from stewartid.model.regressor import BODY_PARAMETERS, pseudo_inertia
 
 #: Weighted column norm, relative to the largest, below which a parameter counts as not
 #: excited (round-off of a column that is zero in exact arithmetic).
@@ -146,4 +164,166 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
                     np.sqrt(np.mean(residual ** 2, axis=0)), len(y))
 
 
-__all__ = ["DEAD_COLUMN", "Solution", "solve_parameters"]
+@dataclass(frozen=True)
+class Body:
+    """A rigid body of the consistent fit: its ten standard parameters (m, m c, inertia about
+    the reference point, :data:`~stewartid.model.regressor.BODY_PARAMETERS`) are
+    ``mapping @ p + offset`` for the fitted parameters p.
+
+    Attributes
+    ----------
+    name : str
+    mapping : ndarray, shape (10, p)
+    offset : ndarray, shape (10,)
+    mass_scale : float
+        A mass (kg) of the body's order: its mass is kept above ``STRICT_FRACTION`` of it and
+        its pseudo-inertia scaled by it in the solver.
+    """
+
+    name: str
+    mapping: np.ndarray
+    offset: np.ndarray
+    mass_scale: float
+
+    def pseudo_inertia(self, p: np.ndarray) -> np.ndarray:
+        """Its pseudo-inertia matrix (4, 4) at the parameters ``p``."""
+        return pseudo_inertia(self.mapping @ p + self.offset)
+
+
+@dataclass(frozen=True)
+class ConsistentParameters:
+    """The physically consistent parameters nearest an estimate (:func:`nearest_consistent`).
+
+    Attributes
+    ----------
+    values : ndarray, shape (p,)
+    change : ndarray, shape (p,)
+        (consistent - unconstrained) / standard error; 0 for a fixed parameter.
+    objective : float
+        (p - p^)^T Sigma^-1 (p - p^) at the solution (squared standard errors).
+    min_eigenvalues : dict of str to float
+        Smallest eigenvalue of each body's pseudo-inertia at the solution (kg m^2).
+    solver : str
+        The cvxpy solver, or ``"none"`` when the estimate was consistent already.
+    status : str
+        The solver's status: ``"optimal"``, or ``"optimal_inaccurate"`` when it stopped
+        just short of its tolerances (a solution with several zero eigenvalues of a
+        pseudo-inertia, e.g. a point mass), or ``"consistent already"``.
+    """
+
+    values: np.ndarray
+    change: np.ndarray
+    objective: float
+    min_eigenvalues: dict[str, float]
+    solver: str
+    status: str
+
+
+def nearest_consistent(values: np.ndarray, covariance: np.ndarray, bodies: list[Body],
+                       nonnegative: np.ndarray, solver: str | None = None
+                       ) -> ConsistentParameters:
+    """The consistent parameters nearest ``values`` in the metric of ``covariance``.
+
+    Parameters
+    ----------
+    values : ndarray, shape (p,)
+        The unconstrained estimate.
+    covariance : ndarray, shape (p, p)
+        Its covariance; parameters with zero variance are fixed and stay as they are.
+    bodies : list of Body
+        Rigid bodies whose pseudo-inertia must be positive semidefinite and mass positive.
+    nonnegative : ndarray of bool, shape (p,)
+        Parameters that cannot be negative (friction coefficients).
+    solver : str, optional
+        A cvxpy solver; Clarabel when installed, else SCS.
+
+    Returns
+    -------
+    ConsistentParameters
+
+    Raises
+    ------
+    ConfigError
+        If cvxpy is not installed (the message names the extra).
+    IdentificationError
+        If the solver fails or no consistent parameters exist with the fixed ones.
+    """
+    require_cvxpy()  # needed whatever the estimate
+    values = np.asarray(values, dtype=float)
+    bounded = np.asarray(nonnegative, dtype=bool)
+    minima = {body.name: float(np.linalg.eigvalsh(body.pseudo_inertia(values))[0])
+              for body in bodies}
+    if (all(v >= 0 for v in minima.values()) and np.all(values[bounded] >= 0)
+            and all(body.mapping[0] @ values + body.offset[0]
+                    >= STRICT_FRACTION * body.mass_scale for body in bodies)):
+        # consistent already: the estimate is its own projection, exactly
+        return ConsistentParameters(values, np.zeros(len(values)), 0.0, minima, "none",
+                                    "consistent already")
+    # only the parameters in a constraint are solved for; the others follow them by their
+    # correlation (the minimum over them of the quadratic objective, in closed form)
+    variance = np.diag(covariance)
+    involved = bounded | np.any([np.any(body.mapping != 0, axis=0) for body in bodies], axis=0)
+    solved = np.flatnonzero((variance > 0) & involved)
+    follow = np.flatnonzero((variance > 0) & ~involved)
+    std = np.sqrt(np.maximum(variance, 0.0))
+    scaled = np.where(std > 0, std, 1.0)
+    correlation = covariance / np.outer(scaled, scaled)
+    block = correlation[np.ix_(solved, solved)]
+    z_solved, status = _projection(values, std, block, solved, bodies, bounded, solver)
+    change = np.zeros(len(values))
+    change[solved] = z_solved
+    change[follow] = correlation[np.ix_(follow, solved)] @ np.linalg.solve(block, z_solved)
+    consistent = values + std * change
+    return ConsistentParameters(
+        consistent, change, float(z_solved @ np.linalg.solve(block, z_solved)),
+        {body.name: float(np.linalg.eigvalsh(body.pseudo_inertia(consistent))[0])
+         for body in bodies}, solver or _default_solver(), status)
+
+
+def _default_solver() -> str:
+    cp = require_cvxpy()
+    return "CLARABEL" if "CLARABEL" in cp.installed_solvers() else "SCS"
+
+
+def _projection(values, std, correlation, solved, bodies, bounded, solver):
+    """The changes z (standard errors) of the parameters ``solved`` minimising z^T C^-1 z,
+    C their ``correlation``, subject to the constraints of :func:`nearest_consistent`; and
+    the solver's status."""
+    cp = require_cvxpy()
+    eigenvalues, vectors = np.linalg.eigh(correlation)
+    eigenvalues = np.maximum(eigenvalues, eigenvalues[-1] * 1e-15)
+    root = (vectors / np.sqrt(eigenvalues)) @ vectors.T  # C^(-1/2)
+    D = np.zeros((len(values), len(solved)))  # p = values + D z
+    D[solved, np.arange(len(solved))] = std[solved]
+    z = cp.Variable(len(solved))
+    units = pseudo_inertia(np.eye(len(BODY_PARAMETERS))).reshape(len(BODY_PARAMETERS), 16).T
+    constraints = []
+    for body in bodies:  # in units of the body's mass scale, so that tolerances are relative
+        linear = units @ body.mapping @ D / body.mass_scale
+        constant = units @ (body.mapping @ values + body.offset) / body.mass_scale
+        J = cp.reshape(linear @ z + constant, (4, 4), order="C")
+        mass = body.mapping[0] @ values + body.offset[0]
+        constraints += [(J + J.T) / 2 >> 0, body.mapping[0] @ D @ z / body.mass_scale
+                        >= STRICT_FRACTION - mass / body.mass_scale]
+    lower = bounded[solved]
+    if lower.any():
+        index = solved[lower]
+        constraints.append(z[np.flatnonzero(lower)] >= -values[index] / std[index])
+    problem = cp.Problem(cp.Minimize(cp.sum_squares(root @ z)), constraints)
+    solver = solver or _default_solver()
+    try:
+        with warnings.catch_warnings():  # "inaccurate" is reported in the status instead
+            warnings.filterwarnings("ignore", "Solution may be inaccurate", UserWarning)
+            problem.solve(solver=solver)
+    except cp.error.SolverError as exc:
+        raise IdentificationError(f"the consistent fit failed in solver {solver}: {exc}; "
+                                  "try another solver.") from None
+    if problem.status not in ("optimal", "optimal_inaccurate") or z.value is None:
+        raise IdentificationError(f"the consistent fit found no consistent parameters (solver "
+                                  f"{solver}, status {problem.status}); check the parameters "
+                                  "fixed at the platform file's values.")
+    return np.asarray(z.value, dtype=float), str(problem.status)
+
+
+__all__ = ["Body", "ConsistentParameters", "DEAD_COLUMN", "Solution", "nearest_consistent",
+           "solve_parameters"]

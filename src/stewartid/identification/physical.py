@@ -8,7 +8,9 @@ with the smooth kernel h of :func:`~stewartid.signals.differentiation.kernel_fil
 Coulomb columns (from a lightly smoothed velocity, their switches at every sample) are
 evaluated at every sample and filtered with h; the columns of the velocity and acceleration at
 the filtered pose, rate (q * h') and acceleration (q * h''), so that no numerical
-differentiation enters.
+differentiation enters. The filtered signals are band-limited by h: the regression keeps
+``ROWS_PER_WINDOW`` rows per kernel window (:func:`row_step`), which moves the estimates by a
+small fraction of their standard errors at a fraction of the cost.
 
 Two modes:
 
@@ -25,6 +27,9 @@ parameters (:func:`~stewartid.model.regressor.inertia_regressor`,
 :func:`~stewartid.model.regressor.viscous_regressor`), their standard errors by the delta
 method from the parameters' covariance (residual-autocorrelation consistent, as
 :func:`~stewartid.identification.solvers.solve_least_squares` with ``autocorrelated``).
+With ``consistent=True`` the estimate is replaced by the physically consistent parameters
+nearest to it in the metric of its covariance
+(:func:`~stewartid.identification.parameter_fit.nearest_consistent`).
 """
 
 from __future__ import annotations
@@ -36,9 +41,17 @@ from typing import Any
 import numpy as np
 
 from stewartid.datasets.dataset import Dataset
+from stewartid.errors import IdentificationError
 from stewartid.fields import BOOLEAN, Interval, nonnegative, positive
 from stewartid.identification.base import DIFFERENTIATION_CONSTRAINTS, BaseIdentifier
-from stewartid.identification.parameter_fit import Solution, solve_parameters
+from stewartid.identification.consistency import require_cvxpy
+from stewartid.identification.parameter_fit import (
+    Body,
+    ConsistentParameters,
+    Solution,
+    nearest_consistent,
+    solve_parameters,
+)
 from stewartid.identification.preparation import Experiment, prepare
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
@@ -114,9 +127,20 @@ class Regression:
     experiments: list[dict[str, Any]]
 
 
+#: Filtered rows kept per kernel window when the row step is automatic: the filtered signals
+#: vary on the scale of the window, so denser rows add round-off-level information only.
+ROWS_PER_WINDOW = 20
+
+
+def row_step(window: float, sample_rate: float) -> int:
+    """The automatic row step of :func:`filtered_regression`: ``ROWS_PER_WINDOW`` rows per
+    kernel window (``window`` s at ``sample_rate`` Hz), at least 1."""
+    return max(1, int(window * sample_rate) // ROWS_PER_WINDOW)
+
+
 def filtered_regression(experiments: list[Experiment], platform: Platform,
                         window: float | None = None, order: int = DEFAULT_ORDER,
-                        decimate: int = 1, gravity: bool = True,
+                        decimate: int | None = 1, gravity: bool = True,
                         coulomb_smoothing: float = 1e-4) -> Regression:
     """The regressor and the generalized force of every experiment, filtered with h.
 
@@ -129,8 +153,11 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
         Kernel support (s); 0.2 periods of each experiment's dominant frequency by default.
     order : int
         Savitzky-Golay order of the light smoothing that decides the Coulomb signs.
-    decimate : int
-        Keep every ``decimate``-th filtered row.
+    decimate : int, optional
+        Keep every ``decimate``-th filtered row; None: the smallest :func:`row_step` of the
+        experiments' windows, the same for all so that each keeps its share of the rows (the
+        filtered signals are band-limited by the kernel: the rows between add little, and
+        the estimates move by a small fraction of their standard errors).
     gravity : bool
         Include the gravity columns.
     coulomb_smoothing : float
@@ -144,25 +171,31 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
                                   + ["coulomb[actuator]"])
     static = reg.parameter_index(reg.OFFSET_PARAMETERS)
     Ys, ys, used = [], [], []
-    for exp in experiments:
-        w = window or default_window(estimate_frequency(exp.q, exp.sample_rate))
+    windows = [window or default_window(estimate_frequency(exp.q, exp.sample_rate))
+               for exp in experiments]
+    # one step for every experiment: each keeps its share of the rows, as without decimation
+    step = decimate or min(row_step(w, exp.sample_rate)
+                           for w, exp in zip(windows, experiments, strict=True))
+    for exp, w in zip(experiments, windows, strict=True):
         n = len(exp.q)
         _, q_sign, _ = differentiate(exp.q, exp.sample_rate, w / 4, order)
         rest = np.zeros_like(exp.q)
-        # gravity and offsets, with the Coulomb signs of the motion
+        # gravity and offsets, with the Coulomb signs of the motion; only the channels that
+        # are not identically zero at rest are filtered (most of the inertial ones are)
         at_rest = reg.regressor(platform, exp.q, rest, rest, gravity, coulomb_smoothing,
-                                coulomb_rates=q_sign)
-        signals = np.concatenate([exp.generalized_force, at_rest.reshape(n, -1)], axis=1)
-        filtered = kernel_filter(signals, exp.sample_rate, w)[0][::decimate]
-        q_f, qd_f, qdd_f = (x[::decimate] for x in kernel_filter(exp.q, exp.sample_rate, w,
-                                                                  derivatives=2))
+                                coulomb_rates=q_sign).reshape(n, -1)
+        live = np.flatnonzero(np.any(at_rest != 0.0, axis=0))
+        signals = np.concatenate([exp.generalized_force, at_rest[:, live]], axis=1)
+        filtered = kernel_filter(signals, exp.sample_rate, w)[0][::step]
+        q_f, qd_f, qdd_f = (x[::step] for x in kernel_filter(exp.q, exp.sample_rate, w,
+                                                              derivatives=2))
         Y = reg.regressor(platform, q_f, qd_f, qdd_f, gravity=False)
         Y[:, :, coulomb] = 0.0
         Y[:, :, static] = 0.0
-        Y += filtered[:, 6:].reshape(len(Y), 6, reg.N_STANDARD)
+        Y.reshape(len(Y), -1)[:, live] += filtered[:, 6:]
         Ys.append(Y)
         ys.append(filtered[:, :6])
-        used.append({"name": exp.name, "window_s": w, "samples": len(Y)})
+        used.append({"name": exp.name, "window_s": w, "samples": len(Y), "row_step": step})
     return Regression(np.concatenate(Ys), np.concatenate(ys), used)
 
 
@@ -197,12 +230,19 @@ class PhysicalIdentifier(BaseIdentifier):
         Model gravity (False only for records without it).
     coulomb_smoothing : float
         Rate (rad/s) below which a joint's Coulomb sign is attenuated.
-    decimate : int
-        Use every ``decimate``-th filtered row.
+    decimate : int, optional
+        Use every ``decimate``-th filtered row; None (default): ``ROWS_PER_WINDOW`` rows per
+        kernel window (:func:`row_step`).
     max_condition : float
         Largest condition number of the scaled regression before a parameter is fixed.
     max_relative_error : float
         Largest relative standard error of a positive parameter before it is fixed.
+    consistent : bool
+        Replace the estimate by the physically consistent parameters nearest to it in the
+        metric of its covariance (:func:`~stewartid.identification.parameter_fit.nearest_consistent`):
+        the moving body's (payload mode: the payload's) pseudo-inertia positive semidefinite,
+        its mass positive, friction coefficients nonnegative; how far each parameter moved,
+        in standard errors, in ``diagnostics["consistent"]``. Needs the ``convex`` extra.
 
     Attributes
     ----------
@@ -220,8 +260,9 @@ class PhysicalIdentifier(BaseIdentifier):
 
     def __init__(self, payload: bool = False, window: float | None = None,
                  order: int = DEFAULT_ORDER, gravity: bool = True,
-                 coulomb_smoothing: float = 1e-4, decimate: int = 1,
-                 max_condition: float = 1e5, max_relative_error: float = 0.3):
+                 coulomb_smoothing: float = 1e-4, decimate: int | None = None,
+                 max_condition: float = 1e5, max_relative_error: float = 0.3,
+                 consistent: bool = False):
         self.payload = payload
         self.window = window
         self.order = order
@@ -230,19 +271,23 @@ class PhysicalIdentifier(BaseIdentifier):
         self.decimate = decimate
         self.max_condition = max_condition
         self.max_relative_error = max_relative_error
+        self.consistent = consistent
 
     _parameter_constraints = {
         **DIFFERENTIATION_CONSTRAINTS,
         "payload": [BOOLEAN],
         "gravity": [BOOLEAN],
         "coulomb_smoothing": [nonnegative()],
-        "decimate": [Interval(Integral, 1, None)],
+        "decimate": [Interval(Integral, 1, None), None],
         "max_condition": [positive()],
         "max_relative_error": [positive()],
+        "consistent": [BOOLEAN],
     }
 
     def _fit(self, datasets: list[Dataset], platform: Platform
              ) -> tuple[IdentificationResult, dict]:
+        if self.consistent:
+            require_cvxpy()  # before the fit, not after it
         experiments = prepare(datasets, platform, gravity=False)
         data = filtered_regression(experiments, platform, self.window, self.order,
                                    self.decimate, self.gravity, self.coulomb_smoothing)
@@ -255,7 +300,12 @@ class PhysicalIdentifier(BaseIdentifier):
         scales = selection @ np.where(positive, np.abs(reg.standard_parameters(platform)), 0.0)
         solution = solve_parameters(X, y, list(names), nominal, scales, self.max_condition,
                                     self.max_relative_error)
-        result = _result(self, platform, model, solution, data)
+        projection = None
+        if self.consistent:
+            nonnegative = np.isin(names, reg.FRICTION_PARAMETERS + reg.ACTUATOR_PARAMETERS)
+            projection = nearest_consistent(solution.values, solution.covariance,
+                                            _bodies(platform, model, self.payload), nonnegative)
+        result = _result(self, platform, model, solution, data, projection)
         learned = {"parameters_": result.parameters,
                    "parameter_std_errors_": result.parameter_std_errors,
                    "covariance_": solution.covariance, "fixed_": solution.fixed}
@@ -292,14 +342,35 @@ def _payload_model(platform: Platform):
             nominal, offset)
 
 
+def _bodies(platform: Platform, model, payload: bool) -> list[Body]:
+    """The rigid body of the consistent fit: the payload (payload mode) or the moving body,
+    whose base parameters hold the legs' upper parts (six point masses) at the file's
+    values."""
+    names, _, selection, nominal, _ = model
+    body = reg.parameter_index(reg.BODY_PARAMETERS)
+    if not np.all(selection[:, body].any(axis=0)):
+        raise IdentificationError("the consistent fit needs the moving body's ten parameters "
+                                  "among the base parameters; they are not for this platform.")
+    rows = np.argmax(selection[:, body], axis=0)
+    mapping = np.zeros((len(body), len(names)))
+    mapping[np.arange(len(body)), rows] = 1.0
+    scale = platform.moving_body.mass
+    if payload:
+        return [Body("payload", mapping, np.zeros(len(body)), scale)]
+    return [Body("moving body", mapping, reg.standard_parameters(platform)[body] - nominal[rows],
+                 scale)]
+
+
 def _result(estimator: PhysicalIdentifier, platform: Platform, model, solution: Solution,
-            data: Regression) -> PhysicalResult:
-    """Mt, Bt at neutral with their delta-method standard errors, and the parameters."""
+            data: Regression, projection: ConsistentParameters | None = None) -> PhysicalResult:
+    """Mt, Bt at neutral with their delta-method standard errors (of the unconstrained
+    estimate), and the parameters (the consistent ones when ``projection`` is given)."""
     names, combinations, selection, _, offset = model
+    values = solution.values if projection is None else projection.values
     matrices, errors = [], []
     for A in (reg.inertia_regressor(platform), reg.viscous_regressor(platform)):
         rows = A @ selection.T  # (6, 6, p): the matrix's entries in the parameters
-        matrices.append(rows @ solution.values + A @ offset)
+        matrices.append(rows @ values + A @ offset)
         errors.append(np.sqrt(np.clip(np.einsum("ijp,pq,ijq->ij", rows, solution.covariance,
                                                 rows), 0.0, None)))
     std = np.sqrt(np.diag(solution.covariance))
@@ -308,13 +379,22 @@ def _result(estimator: PhysicalIdentifier, platform: Platform, model, solution: 
                    "mode": "payload" if estimator.payload else "full",
                    "singular_values": solution.singular_values,
                    "n_equations": solution.n_equations}
+    if projection is not None:
+        free = [k for k, name in enumerate(names) if name not in solution.fixed]
+        diagnostics["consistent"] = {
+            "solver": projection.solver, "status": projection.status,
+            "objective": projection.objective,
+            "max_change_std_errors": float(np.max(np.abs(projection.change), initial=0.0)),
+            "change_std_errors": {names[k]: float(projection.change[k]) for k in free},
+            "unconstrained": dict(zip(names, solution.values.tolist(), strict=True)),
+            "min_eigenvalue_pseudo_inertia": projection.min_eigenvalues}
     if estimator.payload:
-        diagnostics["payload"] = payload_section(dict(zip(names, solution.values, strict=True)))
+        diagnostics["payload"] = payload_section(dict(zip(names, values, strict=True)))
     return PhysicalResult(
         M=matrices[0], B=matrices[1], std_errors_M=errors[0], std_errors_B=errors[1],
         condition_number=solution.condition_number, residual_rms=solution.residual_rms,
         method=estimator.method, settings=estimator.get_params(), diagnostics=diagnostics,
-        parameters=dict(zip(names, solution.values.tolist(), strict=True)),
+        parameters=dict(zip(names, values.tolist(), strict=True)),
         parameter_std_errors=dict(zip(names, std.tolist(), strict=True)),
         base_parameters=dict(combinations))
 
@@ -332,5 +412,5 @@ def payload_section(parameters: dict[str, float]) -> dict[str, Any]:
 
 
 __all__ = ["NUISANCE_PARAMETERS", "PAYLOAD_PARAMETERS", "POSITIVE_PARAMETERS",
-           "PhysicalIdentifier", "PhysicalResult", "Regression", "filtered_regression",
-           "known_platform", "payload_section"]
+           "ROWS_PER_WINDOW", "PhysicalIdentifier", "PhysicalResult", "Regression",
+           "filtered_regression", "known_platform", "payload_section", "row_step"]

@@ -107,6 +107,36 @@ def standard_parameters(platform: Platform) -> np.ndarray:
     return pi
 
 
+def pseudo_inertia(body: np.ndarray) -> np.ndarray:
+    """The pseudo-inertia matrix of a rigid body from its ten standard parameters.
+
+    J = [[Sigma, h], [h^T, m]] with Sigma = integral r r^T dm = tr(I) / 2 1 - I the second
+    moment about the reference point, h = m c the first moment and m the mass. The body is
+    physically realisable (a nonnegative mass density exists) exactly when J is positive
+    semidefinite (Wensing, Kim, Slotine, IEEE RA-L 3(1), 2017); J is linear in the parameters.
+
+    Parameters
+    ----------
+    body : ndarray, shape (..., 10)
+        m (kg), m c (kg m), I_xx, I_yy, I_zz, I_xy, I_xz, I_yz about the reference point
+        (kg m^2), in the order of :data:`BODY_PARAMETERS`.
+
+    Returns
+    -------
+    ndarray, shape (..., 4, 4)
+        kg, kg m, kg m^2.
+    """
+    body = np.asarray(body, dtype=float)
+    inertia = np.zeros(body.shape[:-1] + (3, 3))
+    for k, (a, b) in enumerate(_INERTIA_ENTRIES):
+        inertia[..., a, b] = inertia[..., b, a] = body[..., 4 + k]
+    J = np.zeros(body.shape[:-1] + (4, 4))
+    J[..., :3, :3] = np.trace(inertia, axis1=-2, axis2=-1)[..., None, None] / 2 * np.eye(3) - inertia
+    J[..., :3, 3] = J[..., 3, :3] = body[..., 1:4]
+    J[..., 3, 3] = body[..., 0]
+    return J
+
+
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.cross(a, b, axis=-1)
 
@@ -167,71 +197,92 @@ def regressor(platform: Platform, q: np.ndarray, q_dot: np.ndarray, q_ddot: np.n
     alpha = np.einsum("nij,nj->ni", E, qdd[:, 3:]) + bias
     a_g = qdd[:, :3] - g * np.array([0.0, 0.0, 1.0])  # a - g e_z
     Yn = np.zeros((n, 6, N_STANDARD))  # twist coordinates
+    # at rest (the gravity, offset and Coulomb columns filtered at every sample) the
+    # velocity and acceleration terms vanish: skipped, not computed as zeros
+    moving = bool(qd.any() or qdd.any())
     Yn[:, :3, 0] = a_g
     for k in range(3):
         s = R[:, :, k]
-        Yn[:, :3, 1 + k] = _cross(alpha, s) + _cross(omega, _cross(omega, s))
+        if moving:
+            Yn[:, :3, 1 + k] = _cross(alpha, s) + _cross(omega, _cross(omega, s))
         Yn[:, 3:, 1 + k] = _cross(s, a_g)
     w_b = np.einsum("nji,nj->ni", R, omega)
     alpha_b = np.einsum("nji,nj->ni", R, alpha)
-    for k, (a, b) in enumerate(_INERTIA_ENTRIES):
+    for k, (a, b) in enumerate(_INERTIA_ENTRIES if moving else ()):
         unit = np.zeros((3, 3))
         unit[a, b] = unit[b, a] = 1.0
         moment = alpha_b @ unit + _cross(w_b, w_b @ unit)
         Yn[:, 3:, 4 + k] = np.einsum("nij,nj->ni", R, moment)
-    _leg_columns(r, u, lengths, qd, qdd, omega, alpha, g, Yn)
-    Y = Yn.copy()
-    Y[:, 3:] = np.einsum("nji,njk->nik", E, Yn[:, 3:])
+    _leg_columns(r, u, lengths, qd, qdd, omega, alpha, g, Yn, moving)
+    Y = Yn  # the moment rows to q coordinates, E^T m, in place
+    Y[:, 3:] = np.swapaxes(E, 1, 2) @ Y[:, 3:]
     signs = qd if coulomb_rates is None else as_batch(coulomb_rates, "coulomb_rates")[0]
-    _friction_columns(platform, q2, qd, signs, coulomb_smoothing, actuator_smoothing, Y)
+    _friction_columns(platform, q2, qd, signs, coulomb_smoothing, actuator_smoothing, Y, moving)
     return Y[0] if single else Y
 
 
-def _leg_columns(r, u, lengths, qd, qdd, omega, alpha, g, Yn):
+def _leg_columns(r, u, lengths, qd, qdd, omega, alpha, g, Yn, moving=True):
     """The legs' columns (twist coordinates) into ``Yn``: every leg term is J_A^T x for a
-    3-vector x at the upper joint, i.e. the wrench [x, r x x] at the reference point."""
-    v, a = qd[:, None, :3], qdd[:, None, :3]
-    w, al = omega[:, None], alpha[:, None]
-    v_A = v + _cross(w, r)
-    a_A = a + _cross(al, r) + _cross(w, _cross(w, r))
-    rate = _dot(u, v_A)
-    u_dot = (v_A - rate * u) / lengths
-    u_ddot = (a_A - u * _dot(u, a_A) - lengths * _dot(u_dot, u_dot) * u
-              - 2.0 * rate * u_dot) / lengths
+    3-vector x at the upper joint, i.e. the wrench [x, r x x] at the reference point.
+    ``moving`` False: the rates and accelerations are zero (gravity only)."""
     e_z = np.array([0.0, 0.0, 1.0])
-    a_g = a_A - g * e_z
 
     def project(x):  # (I - u u^T) x / l
         return (x - u * _dot(u, x)) / lengths
 
-    forces = {"m_u": a_g, "md_u": -(u_ddot + project(a_g)),
-              "md_l": -g * project(np.broadcast_to(e_z, u.shape)), "J_u": project(u_ddot)}
-    forces["J_l"] = forces["J_u"]
+    if moving:
+        v, a = qd[:, None, :3], qdd[:, None, :3]
+        w, al = omega[:, None], alpha[:, None]
+        v_A = v + _cross(w, r)
+        a_A = a + _cross(al, r) + _cross(w, _cross(w, r))
+        rate = _dot(u, v_A)
+        u_dot = (v_A - rate * u) / lengths
+        u_ddot = (a_A - u * _dot(u, a_A) - lengths * _dot(u_dot, u_dot) * u
+                  - 2.0 * rate * u_dot) / lengths
+        a_g = a_A - g * e_z
+        forces = {"m_u": a_g, "md_u": -(u_ddot + project(a_g)), "J_u": project(u_ddot)}
+        forces["J_l"] = forces["J_u"]
+    else:
+        a_g = np.broadcast_to(-g * e_z, u.shape)
+        forces = {"m_u": a_g, "md_u": -project(a_g)}
+    forces["md_l"] = -g * project(np.broadcast_to(e_z, u.shape))
     for name, x in forces.items():
         k = _INDEX[name]
         Yn[:, :3, k] = x.sum(1)
         Yn[:, 3:, k] = _cross(r, x).sum(1)
 
 
-def _friction_columns(platform, q, qd, qd_signs, coulomb_smoothing, actuator_smoothing, Y):
+# the joint axes of each friction type, as a mask over the rows (legs x axes) of a sample
+_TYPE_MASK_LEGS = np.tile([[a in axes for a in range(5)] for axes in JOINT_TYPES.values()],
+                          (1, 6)).astype(float)
+
+
+def _friction_columns(platform, q, qd, qd_signs, coulomb_smoothing, actuator_smoothing, Y,
+                      moving=True):
     """Joint friction per type, actuator friction and sensor offsets (q coordinates) into
-    ``Y``, the Coulomb signs from the rates ``qd_signs``."""
+    ``Y``, the Coulomb signs from the rates ``qd_signs``; ``moving`` False: ``qd`` is zero,
+    and so are the viscous columns (left as they are)."""
+    n = len(q)
     terms = compute_leg_terms(platform, q, joints=True)
-    J, Jj = terms.leg_jacobian, terms.joint_jacobians
-    rates = np.einsum("nlac,nc->nla", Jj, qd)
-    signs = _smooth_sign(np.einsum("nlac,nc->nla", Jj, qd_signs) if qd_signs is not qd
-                         else rates, coulomb_smoothing)
-    for t, axes in JOINT_TYPES.items():
-        axes = list(axes)
-        Y[:, :, _INDEX[f"viscous[{t}]"]] = np.einsum("nla,nlac->nc", rates[:, :, axes],
-                                                     Jj[:, :, axes])
-        Y[:, :, _INDEX[f"coulomb[{t}]"]] = np.einsum("nla,nlac->nc", signs[:, :, axes],
-                                                     Jj[:, :, axes])
-    leg_rates = np.einsum("nlc,nc->nl", J, qd)
-    Y[:, :, _INDEX["viscous[actuator]"]] = np.einsum("nl,nlc->nc", leg_rates, J)
-    sign_rates = leg_rates if qd_signs is qd else np.einsum("nlc,nc->nl", J, qd_signs)
-    Y[:, :, _INDEX["coulomb[actuator]"]] = np.einsum(
-        "nl,nlc->nc", _smooth_sign(sign_rates, actuator_smoothing), J)
+    J, flat = terms.leg_jacobian, terms.joint_jacobians.reshape(n, -1, 6)  # legs x axes rows
+
+    def axis_rates(rates):  # (n, 6) -> (n, legs, axes)
+        return (flat @ rates[:, :, None]).reshape(n, 6, -1)
+
+    def by_type(weights):  # sum over legs and the axes of each type of weight x row
+        return np.swapaxes((weights.reshape(n, 1, -1) * _TYPE_MASK_LEGS) @ flat, 1, 2)
+
+    rates = axis_rates(qd) if moving or qd_signs is qd else None
+    signs = _smooth_sign(rates if qd_signs is qd else axis_rates(qd_signs), coulomb_smoothing)
+    friction = parameter_index(FRICTION_PARAMETERS)  # the viscous types, then the Coulomb
+    if moving:
+        Y[:, :, friction[:len(JOINT_TYPES)]] = by_type(rates)
+    Y[:, :, friction[len(JOINT_TYPES):]] = by_type(signs)
+    leg_rates = (J @ qd[:, :, None])[..., 0]
+    actuator = parameter_index(ACTUATOR_PARAMETERS)
+    Y[:, :, actuator[0]] = (leg_rates[:, None] @ J)[:, 0]
+    sign_rates = leg_rates if qd_signs is qd else (J @ qd_signs[:, :, None])[..., 0]
+    Y[:, :, actuator[1]] = (_smooth_sign(sign_rates, actuator_smoothing)[:, None] @ J)[:, 0]
     Y[:, :, parameter_index(OFFSET_PARAMETERS)] = np.swapaxes(J, 1, 2)
 
 
@@ -395,5 +446,5 @@ __all__ = ["ACTUATOR_PARAMETERS", "ACTUATOR_SMOOTHING", "BODY_PARAMETERS", "Base
            "FRICTION_PARAMETERS", "LEG_PARAMETERS", "N_STANDARD", "OFFSET_PARAMETERS",
            "PARAMETERS", "SAMPLE_ACCELERATIONS", "SAMPLE_RATES", "SAMPLE_SPAN",
            "VISCOUS_PARAMETERS", "base_parameters", "combination_text",
-           "inertia_regressor", "parameter_index", "random_states", "regressor",
-           "standard_parameters", "viscous_regressor"]
+           "inertia_regressor", "parameter_index", "pseudo_inertia", "random_states",
+           "regressor", "standard_parameters", "viscous_regressor"]
