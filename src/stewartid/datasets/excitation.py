@@ -158,10 +158,15 @@ def spectral_lines(motion: np.ndarray, sample_rate: float,
         return empty
     largest = amplitude[peaks].max()
     peaks = peaks[amplitude[peaks] >= fraction * largest]
-    reach = SIDELOBE_BINS * resolution
-    sidelobe = [np.any((np.abs(frequencies[peaks] - frequencies[p]) <= reach)
-                       & (SIDELOBE_FRACTION * amplitude[peaks] > amplitude[p])) for p in peaks]
-    peaks = peaks[~np.asarray(sidelobe, dtype=bool)]
+    # a sidelobe: a larger peak within reach; the largest peak within reach of every grid
+    # point in one pass (a noisy spectrum has thousands of maxima)
+    from scipy.ndimage import maximum_filter1d
+
+    reach_bins = int(np.floor(SIDELOBE_BINS * resolution / (sample_rate / nfft) + 1e-9))
+    heights_at = np.zeros_like(amplitude)
+    heights_at[peaks] = amplitude[peaks]
+    nearby = maximum_filter1d(heights_at, size=2 * reach_bins + 1, mode="constant")
+    peaks = peaks[~(SIDELOBE_FRACTION * nearby[peaks] > amplitude[peaks])]
     peaks = peaks[np.argsort(amplitude[peaks])[::-1]]
     # a parabola through the log amplitudes of the peak and its neighbours: the Hann main
     # lobe is nearly Gaussian, so this places the line well inside the padded grid step
@@ -311,7 +316,11 @@ def excitation_lines(datasets: Sequence[Dataset], threshold: float = LINE_THRESH
     """
     found = []
     for dof in range(6):
-        records = [spectral_lines(d.pose[:, dof], d.sample_rate, fraction=0.0) for d in datasets]
+        # a line below the threshold of its own record's largest is below the threshold of
+        # the DOF's largest: the records need report no more (a noisy spectrum has thousands
+        # of maxima, each checked against the others as a sidelobe)
+        records = [spectral_lines(d.pose[:, dof], d.sample_rate, fraction=threshold)
+                   for d in datasets]
         largest = max((r.largest for r in records), default=0.0)
         lines: list[float] = []
         for record in records:
