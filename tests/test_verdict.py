@@ -86,20 +86,3 @@ def test_entries_another_method_contradicts_are_named_uncertain():
     # every Mt entry of the paper's 20 differs by 5 % at 0.14 % combined error: all ten named
     assert labels == [f"Mt({i},{j})" for i, j in ((1, 1), (2, 2), (3, 3), (4, 4), (5, 5),
                                                    (6, 6), (1, 5), (2, 4), (4, 2), (5, 1))]
-
-
-def test_a_method_every_other_contradicts_is_not_trusted_however_small_its_errors():
-    """Three methods agree within their errors; the fourth, with the smallest errors, is 5 %
-    off on every Mt entry: outvoted, ranked last."""
-    verdict = choose_trusted({"a": (_result(0.01), _validation(0.1)),
-                              "b": (_result(0.012), _validation(0.1)),
-                              "c": (_result(0.011), _validation(0.1)),
-                              "d": (_result(0.0005, shift=0.05), _validation(0.1))})
-    assert verdict.trusted == "a" and verdict.ranking[-1] == "d"
-    assert len(verdict.standings["d"].contradicted) == 10
-
-
-def test_two_methods_that_disagree_outvote_neither():
-    verdict = choose_trusted({"a": (_result(0.01), _validation(0.1)),
-                              "b": (_result(0.0005, shift=0.05), _validation(0.1))})
-    assert verdict.trusted == "b" and verdict.standings["b"].contradicted == ()

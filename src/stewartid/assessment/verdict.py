@@ -11,16 +11,12 @@ Rule, in order:
    Method A, no constant-direction interval for Method B) are out.
 2. **Physically plausible**: symmetric parts of Mt positive definite and of Bt positive
    semidefinite (all methods, if none is).
-3. **Outvoted**: a method that every other plausible method (two or more) contradicts, beyond
-   :data:`DISAGREEMENT` combined standard errors, on :data:`OUTVOTED` or more of the paper's
-   entries has an error its standard errors do not hold (a model class that misses this
-   plant, errors in variables); it is ranked after the others.
-4. **Held-out prediction**: a method whose worst DOF leaves more than :data:`MISFIT_FACTOR`
+3. **Held-out prediction**: a method whose worst DOF leaves more than :data:`MISFIT_FACTOR`
    times the least unexplained force, and more than :data:`MISFIT_FLOOR` %, misses something
    the others model; it is ranked after the others. Held-out segments of the same excitation
    cannot show a wrong parameter that a friction term compensates, so this is a gate, not the
    ranking.
-5. **Honest uncertainty**: among the rest, the method with the smallest expected largest
+4. **Honest uncertainty**: among the rest, the method with the smallest expected largest
    relative error over the paper's 20 entries wins
    (:func:`~stewartid.identification.accuracy.expected_worst_error`: what its standard errors
    predict for the largest of 20 errors, so one conservative entry does not outweigh
@@ -28,7 +24,7 @@ Rule, in order:
    (symmetric pairs that disagree beyond their errors,
    :func:`~stewartid.identification.pairs.pair_calibration`; for Method A the friction its
    third harmonic reveals), so a method biased by friction it does not model reports it.
-6. **Ties** (within :data:`TIE_FACTOR`): a method immune to the friction law (Method B with
+5. **Ties** (within :data:`TIE_FACTOR`): a method immune to the friction law (Method B with
    free interval constants) before one whose errors rest on its friction model being right
    (which the data can only partly check), then the better held-out prediction.
 
@@ -40,7 +36,7 @@ trusted one's by more than :data:`DISAGREEMENT` combined standard errors.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Literal
 
@@ -65,10 +61,6 @@ TIE_FACTOR = 2.0
 MISFIT_FACTOR = 4.0
 #: ... and more than this share (%) of the force in its worst DOF misses part of the physics.
 MISFIT_FLOOR = 1.0
-#: A method every other plausible method contradicts on this many of the paper's entries
-#: (:func:`contradicted_entries`) has an error its standard errors do not hold: it is ranked
-#: after the others.
-OUTVOTED = 2
 #: An entry's relative standard error above which the verdict names it uncertain.
 UNCERTAIN_RELATIVE = 0.10
 #: Two methods' estimates of an entry disagree beyond this many combined standard errors.
@@ -106,22 +98,6 @@ def _entry(result: IdentificationResult, matrix: str, i: int, j: int) -> tuple[f
     if matrix == "M":
         return float(result.M[i, j]), float(result.std_errors_M[i, j])
     return float(result.B[i, j]), float(result.std_errors_B[i, j])
-
-
-def contradicted_entries(result: IdentificationResult,
-                         others: Sequence[IdentificationResult]) -> list[str]:
-    """The paper's entries on which every other result contradicts this one: differs by more
-    than :data:`DISAGREEMENT` combined standard errors. Empty with fewer than two others (two
-    results that disagree cannot tell which is wrong)."""
-    if len(others) < 2:
-        return []
-    found = []
-    for matrix, i, j in PAPER_ENTRIES:
-        value, std = _entry(result, matrix, i, j)
-        if all(abs(v - value) > DISAGREEMENT * np.hypot(s, std)
-               for v, s in (_entry(other, matrix, i, j) for other in others)):
-            found.append(entry_label((matrix, i, j)))
-    return found
 
 
 def uncertain_entries(trusted: IdentificationResult,
@@ -218,8 +194,6 @@ class Standing:
     expected_worst : float
         The largest relative error over the paper's 20 entries its standard errors predict
         (:func:`~stewartid.identification.accuracy.expected_worst_error`, a fraction).
-    contradicted : tuple of str
-        The entries every other plausible method contradicts (:func:`contradicted_entries`).
     """
 
     name: str
@@ -236,7 +210,6 @@ class Standing:
     misfit: bool = False
     friction_immune: bool = False
     expected_worst: float = float("nan")
-    contradicted: tuple[str, ...] = ()
 
     @property
     def unexplained_percent(self) -> float:
@@ -294,8 +267,7 @@ class Verdict:
                 "heldout_worst_vaf_percent": st.worst_vaf_percent,
                 "heldout_worst_dof": st.worst_dof, "plausible": st.compared,
                 "misfit": st.misfit, "models_friction": st.models_friction,
-                "friction_immune": st.friction_immune,
-                "contradicted_entries": list(st.contradicted)}
+                "friction_immune": st.friction_immune}
                 for name, st in self.standings.items()},
             "uncertain_detail": self.uncertain}
 
@@ -324,12 +296,7 @@ def choose_trusted(assessed: Mapping[str, tuple[IdentificationResult, Validation
     floor = min(unexplained[name] for name in compared)
     misfit = {name: bool(unexplained[name] > max(MISFIT_FACTOR * floor, MISFIT_FLOOR))
               for name in ok}
-    contradicted = {name: contradicted_entries(ok[name][0], [ok[other][0] for other in compared
-                                                            if other != name])
-                    for name in ok}
-    outvoted = {name: len(contradicted[name]) >= OUTVOTED for name in ok}
-    candidates = ([name for name in compared if not misfit[name] and not outvoted[name]]
-                  or [name for name in compared if not misfit[name]] or compared)
+    candidates = [name for name in compared if not misfit[name]] or compared
     least = min(expected[name] for name in candidates)
     tied = [name for name in candidates if expected[name] <= TIE_FACTOR * least]
     trusted = min(tied, key=lambda name: (not friction_immune(ok[name][0]), unexplained[name]))
@@ -348,10 +315,9 @@ def choose_trusted(assessed: Mapping[str, tuple[IdentificationResult, Validation
             (100 - worst[name][0]) / max(100 - worst[trusted][0], 1e-12), name in compared,
             models_friction, effect, excess, friction_signature(validation),
             spread[name][0], spread[name][1], misfit[name], friction_immune(result),
-            expected[name], tuple(contradicted[name]))
+            expected[name])
     others = sorted((name for name in ok if name != trusted),
-                    key=lambda name: (name not in compared, misfit[name] or outvoted[name],
-                                      expected[name]))
+                    key=lambda name: (name not in compared, misfit[name], expected[name]))
     uncertain = uncertain_entries(ok[trusted][0], {name: ok[name][0] for name in compared
                                                    if name != trusted})
     not_applicable = tuple(name for name, pair in assessed.items() if pair is None)
@@ -380,9 +346,6 @@ def _reasons(trusted: str, standings: Mapping[str, Standing], tied: list[str],
         if not standing.compared:
             reasons.append(f"{name}: Mt or Bt has a negative eigenvalue, which no physical "
                            "platform has.")
-        elif len(standing.contradicted) >= OUTVOTED:
-            reasons.append(f"{name}: every other plausible method contradicts it on "
-                           f"{', '.join(standing.contradicted)}.")
         elif standing.misfit:
             reasons.append(f"{name}: leaves {standing.unexplained_percent:.3g} % of the held-out "
                            f"force unexplained in {standing.worst_dof}, over {MISFIT_FACTOR:g}x "
@@ -401,9 +364,8 @@ def _reasons(trusted: str, standings: Mapping[str, Standing], tied: list[str],
     return reasons
 
 
-__all__ = ["DAMPING_EXCESS", "DISAGREEMENT", "MISFIT_FACTOR", "MISFIT_FLOOR", "OUTVOTED",
-           "SIGNIFICANT",
+__all__ = ["DAMPING_EXCESS", "DISAGREEMENT", "MISFIT_FACTOR", "MISFIT_FLOOR", "SIGNIFICANT",
            "TIE_FACTOR", "UNCERTAIN_RELATIVE", "Standing", "Verdict", "choose_trusted",
-           "contradicted_entries", "finds_friction", "friction_immune",
+           "finds_friction", "friction_immune",
            "is_definite", "relative_std", "uncertain_entries", "worst_dof",
            "worst_relative_std"]

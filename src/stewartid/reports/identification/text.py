@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from stewartid.assessment.validation import friction_signature
-from stewartid.assessment.verdict import OUTVOTED, Verdict, relative_std, worst_dof
+from stewartid.assessment.verdict import Verdict, relative_std, worst_dof
 from stewartid.datasets.dataset import Dataset
 from stewartid.identification.consistency import consistency_metrics, is_consistent
 from stewartid.identification.wavelet.noise import white_noise_covariance
@@ -179,9 +179,6 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
                 f"({standing.worst_dof}), {standing.unexplained_ratio:.3g}× as much")
         if standing.misfit:
             text += ", more than the held-out prediction allows for a trusted method"
-        if len(standing.contradicted) >= OUTVOTED:
-            text += (f"; every other plausible method contradicts it on "
-                     f"{', '.join(standing.contradicted)}, beyond their standard errors")
         if not standing.compared:
             text += ("; its Mt or Bt has a negative eigenvalue, which no physical "
                      "platform has")
