@@ -78,7 +78,8 @@ def log_sets(platform_name: str, kinds, coulombs, clean_folder: Path, example: b
 
 def evaluate(label, platform, data, M, B, seed) -> dict:
     """Every registered method fitted and validated as the report does, and the verdict."""
-    names = [spec.name for spec in registry.registered_methods() if spec.preset_of is None]
+    names = [spec.name for spec in registry.registered_methods()
+             if spec.preset_of is None and spec.compared]
     runs = [run_method(name, {}, data, platform, 3, False, {}) for name in names]
     verdict = choose_trusted({run.name: None if run.result is None else
                               (run.result, run.validation) for run in runs})

@@ -14,8 +14,9 @@ def identify(
     method: Annotated[str, typer.Option("--method", metavar="NAME",
                                         help="wavelet (Zhang 2020), fourier (Tian), ls, "
                                              "another name that 'stewartid methods' lists, or "
-                                             "'all': every registered method (with --report, "
-                                             "which to trust).")]
+                                             "'all': every registered method of the comparison "
+                                             "(with --report, which to trust; the physical "
+                                             "model runs by name).")]
     = "wavelet",
     platform: Annotated[str | None, typer.Option(
         "--platform", metavar="NAME|FILE",

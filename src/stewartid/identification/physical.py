@@ -205,7 +205,7 @@ def known_platform(platform: Platform) -> Platform:
 
 
 @register_method(
-    name="physical", color="#8c564b",
+    name="physical", color="#8c564b", compared=False,
     display_name="Physical model",
     description="weighted least squares on the base parameters of the rigid-body model "
                 "(masses, first moments, inertias, friction per joint type, sensor offsets); "

@@ -63,6 +63,11 @@ class MethodSpec:
         Settings passed to ``estimator_class`` (a preset's; empty for a method).
     preset_of : str or None
         Name of the method this preset configures, None for a method.
+    compared : bool
+        Run by ``identify --method all`` (and so judged by its verdict) and by the
+        reproduction. False for a method whose standard errors are not yet calibrated on the
+        logs the verdict is measured on (the physical model: ``docs/benchmarks.md``, "Which
+        method to trust"); it runs by name.
     """
 
     name: str
@@ -74,6 +79,7 @@ class MethodSpec:
     estimator_class: type
     defaults: Mapping[str, Any] = field(default_factory=dict)
     preset_of: str | None = None
+    compared: bool = True
 
     def create(self, **settings: Any) -> Any:
         """A new estimator with this spec's defaults updated by ``settings``."""
@@ -120,15 +126,18 @@ def register(spec: MethodSpec) -> MethodSpec:
 
 def register_method(*, name: str, display_name: str, reference: str, description: str,
                     color: str, letter: str | None = None,
-                    presets: Mapping[str, Preset] | None = None) -> Callable[[type], type]:
+                    presets: Mapping[str, Preset] | None = None,
+                    compared: bool = True) -> Callable[[type], type]:
     """Class decorator registering an estimator class as method ``name`` (and its presets).
 
-    Sets the class's ``method`` attribute (the name stored in its results) to ``name``.
+    Sets the class's ``method`` attribute (the name stored in its results) to ``name``;
+    ``compared`` as :attr:`MethodSpec.compared`.
     """
 
     def decorate(cls: type) -> type:
         cls.method = name
-        register(MethodSpec(name, display_name, letter, reference, description, color, cls))
+        register(MethodSpec(name, display_name, letter, reference, description, color, cls,
+                            compared=compared))
         for preset_name, preset in (presets or {}).items():
             register(MethodSpec(preset_name, preset.display_name, preset.letter, reference,
                                 preset.description, preset.color, cls,

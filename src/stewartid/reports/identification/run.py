@@ -107,8 +107,10 @@ class IdentifyRun:
 
 
 def methods_for(name: str) -> tuple[str, ...]:
-    """The methods ``identify --method NAME`` runs: every registered method (presets aside)
-    for ``"all"``, else ``(NAME,)``.
+    """The methods ``identify --method NAME`` runs: every registered method compared by the
+    verdict (presets and the physical model aside,
+    :attr:`~stewartid.identification.registry.MethodSpec.compared`) for ``"all"``, else
+    ``(NAME,)``.
 
     Raises
     ------
@@ -116,7 +118,8 @@ def methods_for(name: str) -> tuple[str, ...]:
         For an unknown name (the message lists the registered ones).
     """
     if name == ALL_METHODS:
-        return tuple(spec.name for spec in registry.registered_methods() if spec.preset_of is None)
+        return tuple(spec.name for spec in registry.registered_methods()
+                     if spec.preset_of is None and spec.compared)
     return (registry.method_spec(name).name,)
 
 

@@ -39,10 +39,11 @@ QUICK_DURATION_S = 6.0
 
 
 def default_methods() -> tuple[str, ...]:
-    """Every registered method and preset, in registry order."""
+    """Every registered method and preset that the comparisons run
+    (:attr:`~stewartid.identification.registry.MethodSpec.compared`), in registry order."""
     from stewartid.identification.registry import registered_methods
 
-    return tuple(spec.name for spec in registered_methods())
+    return tuple(spec.name for spec in registered_methods() if spec.compared)
 
 
 #: Coulomb level (index into the levels run, from the top) whose experiment is plotted.
