@@ -155,6 +155,50 @@ def require_cvxpy() -> Any:
     return cvxpy
 
 
+def default_solver() -> str:
+    """Clarabel when installed (the ``convex`` extra's), else SCS."""
+    cp = require_cvxpy()
+    return "CLARABEL" if "CLARABEL" in cp.installed_solvers() else "SCS"
+
+
+def solve_convex(problem: Any, solver: str | None, hint: str) -> tuple[str, str]:
+    """Solve a cvxpy problem of a consistent fit; "optimal_inaccurate" counts as solved and is
+    returned in the status, not warned about.
+
+    Parameters
+    ----------
+    problem : cvxpy.Problem
+    solver : str or None
+        :func:`default_solver` when None.
+    hint : str
+        What to check when no solution is found, for the message.
+
+    Returns
+    -------
+    solver, status : str
+
+    Raises
+    ------
+    IdentificationError
+        The solver fails or finds no solution (one line, naming the solver and status).
+    """
+    import warnings
+
+    cp = require_cvxpy()
+    solver = solver or default_solver()
+    try:
+        with warnings.catch_warnings():  # "inaccurate" is reported in the status instead
+            warnings.filterwarnings("ignore", "Solution may be inaccurate", UserWarning)
+            problem.solve(solver=solver)
+    except cp.error.SolverError as exc:
+        raise IdentificationError(f"the consistent fit failed in solver {solver}: {exc}; "
+                                  "try another solver.") from None
+    if problem.status not in ("optimal", "optimal_inaccurate") or problem.value is None:
+        raise IdentificationError(f"the consistent fit found no solution (solver {solver}, "
+                                  f"status {problem.status}); {hint}.")
+    return solver, str(problem.status)
+
+
 def project_consistent(M: np.ndarray, B: np.ndarray, std_M: np.ndarray, std_B: np.ndarray,
                        solver: str | None = None) -> ConsistentEstimate:
     """The consistent (M, B) nearest to an estimate, in standard errors (module docstring).
@@ -190,16 +234,7 @@ def project_consistent(M: np.ndarray, B: np.ndarray, std_M: np.ndarray, std_B: n
                             + cp.sum_squares(cp.multiply(W_B, B_var - B_hat)))
     constraints = [M_var - floor * np.eye(6) >> 0, B_var >> 0]
     problem = cp.Problem(objective, constraints)
-    if solver is None:
-        solver = "CLARABEL" if "CLARABEL" in cp.installed_solvers() else "SCS"
-    try:
-        problem.solve(solver=solver)
-    except cp.error.SolverError as exc:
-        raise IdentificationError(f"the consistent fit failed in solver {solver}: {exc}; "
-                                  "try another solver.") from None
-    if problem.status not in ("optimal", "optimal_inaccurate") or M_var.value is None:
-        raise IdentificationError(f"the consistent fit did not converge (solver {solver}, "
-                                  f"status {problem.status}); check the standard errors.")
+    solver, _ = solve_convex(problem, solver, "check the standard errors")
     # exact symmetry and definiteness after the solver's tolerances
     M_new, B_new = _symmetric(M_var.value), _clip_psd(_symmetric(B_var.value), 0.0)
     M_new = _clip_psd(M_new, floor)
@@ -221,4 +256,5 @@ def _clip_psd(matrix: np.ndarray, floor: float) -> np.ndarray:
 
 
 __all__ = ["STRICT_FRACTION", "ConsistentEstimate", "asymmetry", "consistency_metrics",
-           "is_consistent", "min_eigenvalue", "project_consistent", "require_cvxpy"]
+           "default_solver", "is_consistent", "min_eigenvalue", "project_consistent",
+           "require_cvxpy", "solve_convex"]

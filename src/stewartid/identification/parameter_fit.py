@@ -23,13 +23,16 @@ cvxpy (the ``convex`` extra).
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from stewartid.errors import IdentificationError
-from stewartid.identification.consistency import STRICT_FRACTION, require_cvxpy
+from stewartid.identification.consistency import (
+    STRICT_FRACTION,
+    default_solver,
+    require_cvxpy,
+    solve_convex,
+)
 from stewartid.identification.solvers import integrated_autocorrelation
 from stewartid.model.regressor import BODY_PARAMETERS, pseudo_inertia
 
@@ -277,12 +280,7 @@ def nearest_consistent(values: np.ndarray, covariance: np.ndarray, bodies: list[
     return ConsistentParameters(
         consistent, change, float(z_solved @ np.linalg.solve(block, z_solved)),
         {body.name: float(np.linalg.eigvalsh(body.pseudo_inertia(consistent))[0])
-         for body in bodies}, solver or _default_solver(), status)
-
-
-def _default_solver() -> str:
-    cp = require_cvxpy()
-    return "CLARABEL" if "CLARABEL" in cp.installed_solvers() else "SCS"
+         for body in bodies}, solver or default_solver(), status)
 
 
 def _projection(values, std, correlation, solved, bodies, bounded, solver):
@@ -310,19 +308,9 @@ def _projection(values, std, correlation, solved, bodies, bounded, solver):
         index = solved[lower]
         constraints.append(z[np.flatnonzero(lower)] >= -values[index] / std[index])
     problem = cp.Problem(cp.Minimize(cp.sum_squares(root @ z)), constraints)
-    solver = solver or _default_solver()
-    try:
-        with warnings.catch_warnings():  # "inaccurate" is reported in the status instead
-            warnings.filterwarnings("ignore", "Solution may be inaccurate", UserWarning)
-            problem.solve(solver=solver)
-    except cp.error.SolverError as exc:
-        raise IdentificationError(f"the consistent fit failed in solver {solver}: {exc}; "
-                                  "try another solver.") from None
-    if problem.status not in ("optimal", "optimal_inaccurate") or z.value is None:
-        raise IdentificationError(f"the consistent fit found no consistent parameters (solver "
-                                  f"{solver}, status {problem.status}); check the parameters "
-                                  "fixed at the platform file's values.")
-    return np.asarray(z.value, dtype=float), str(problem.status)
+    _, status = solve_convex(problem, solver,
+                             "check the parameters fixed at the platform file's values")
+    return np.asarray(z.value, dtype=float), status
 
 
 __all__ = ["Body", "ConsistentParameters", "DEAD_COLUMN", "Solution", "nearest_consistent",
