@@ -36,7 +36,7 @@ from numbers import Integral
 import numpy as np
 
 from stewartid.datasets.dataset import Dataset
-from stewartid.fields import Interval, Options, nonnegative
+from stewartid.fields import BOOLEAN, Interval, Options, nonnegative
 from stewartid.identification.base import DIFFERENTIATION_CONSTRAINTS, BaseIdentifier
 from stewartid.identification.pairs import calibrate_by_pairs
 from stewartid.identification.preparation import prepare
@@ -51,8 +51,24 @@ from stewartid.signals.differentiation import (
     differentiate,
     estimate_frequency,
     kernel_filter,
+    kernel_taps,
     trim,
 )
+
+
+def pose_noise_gram(q: np.ndarray, sample_rate: float, window: float) -> np.ndarray:
+    """Covariance (12, 12) of the noise one row [q * h'', q * h'] carries: the pose's white
+    noise Sigma (estimated from the record) times the energy of the kernel's second and first
+    derivative taps (their cross term vanishes: h'' is even, h' odd)."""
+    from stewartid.identification.wavelet.noise import white_noise_covariance
+
+    smooth = differentiate(q, sample_rate, window)[0]
+    sigma = white_noise_covariance(q, smooth)
+    _, first, second = kernel_taps(sample_rate, window, derivatives=2)
+    block = np.zeros((12, 12))
+    block[:6, :6] = sigma * np.sum(second ** 2)
+    block[6:, 6:] = sigma * np.sum(first ** 2)
+    return block
 
 
 def coulomb_regressors(joint_jacobians: np.ndarray, q_dot: np.ndarray, smoothing: float
@@ -110,6 +126,12 @@ class LeastSquaresIdentifier(BaseIdentifier):
     decimate : int
         Use every ``decimate``-th sample (the differentiated signals are smooth over the
         filter window, so little information is lost; saves time on long records).
+    noise_correction : bool
+        With ``differentiation="kernel"``: remove the bias that pose noise, carried into
+        q_dot and q_ddot by the kernel's derivatives, puts on Mt and Bt (errors in
+        variables): the pose-noise covariance is estimated from each record
+        (:func:`~stewartid.identification.wavelet.noise.white_noise_covariance`) and its
+        share of the normal equations subtracted.
 
     Attributes
     ----------
@@ -126,7 +148,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
     def __init__(self, window: float | None = None, order: int = DEFAULT_ORDER,
                  gravity: bool = True, coulomb: bool = True, coulomb_smoothing: float = 1e-4,
                  symmetric: bool = False, decimate: int = 1,
-                 differentiation: str = "kernel"):
+                 differentiation: str = "kernel", noise_correction: bool = True):
         self.window = window
         self.order = order
         self.gravity = gravity
@@ -135,19 +157,21 @@ class LeastSquaresIdentifier(BaseIdentifier):
         self.symmetric = symmetric
         self.decimate = decimate
         self.differentiation = differentiation
+        self.noise_correction = noise_correction
 
     _parameter_constraints = {
         **DIFFERENTIATION_CONSTRAINTS,
         "coulomb_smoothing": [nonnegative()],
         "differentiation": [Options(("kernel", "savgol"))],
         "decimate": [Interval(Integral, 1, None)],
+        "noise_correction": [BOOLEAN],
     }
 
     def _fit(self, datasets: list[Dataset], platform: Platform
              ) -> tuple[IdentificationResult, dict]:
         experiments = prepare(datasets, platform, gravity=self.gravity, joints=self.coulomb)
         n_exp = len(experiments)
-        phis, ys, shared, used = [], [], [], []
+        phis, ys, shared, used, noise = [], [], [], [], []
         for e, exp in enumerate(experiments):
             window = self.window or default_window(estimate_frequency(exp.q, exp.sample_rate))
             if self.differentiation == "savgol":
@@ -173,6 +197,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
                 sl = slice(cut, len(exp.t) - cut, self.decimate)
                 step = slice(None, None, self.decimate)
                 y, qd, qdd = filtered[step, :6], qd[step], qdd[step]
+                if self.noise_correction:
+                    noise.append((e, len(y), pose_noise_gram(exp.q, exp.sample_rate, window)))
                 coulomb = filtered[step, 6:].reshape(len(y), -1, 6) if self.coulomb else None
             k = len(y)
             offsets = np.zeros((k, n_exp))
@@ -184,12 +210,17 @@ class LeastSquaresIdentifier(BaseIdentifier):
             used.append({"name": exp.name, "window_s": window, "samples": k,
                          "t_start": float(exp.t[sl][0]), "t_stop": float(exp.t[sl][-1])})
         names = regressor_names("q_ddot", "q_dot") + [f"offset[{x.name}]" for x in experiments]
+        regressor_noise = None
+        if noise:
+            regressor_noise = np.zeros((12 + n_exp, 12 + n_exp))
+            for _, rows, block in noise:
+                regressor_noise[:12, :12] += rows * block
         solution = solve_least_squares(
             np.concatenate(phis), np.concatenate(ys),
             np.concatenate(shared) if self.coulomb else None, symmetric=self.symmetric,
             regressor_names=names,
             shared_names=[f"coulomb[{t}]" for t in JOINT_TYPES] if self.coulomb else None,
-            autocorrelated=True)
+            autocorrelated=True, regressor_noise=regressor_noise)
         theta, std = solution.theta, solution.theta_std.copy()
         # residual autocorrelation is in theta_std; model error (friction the joint model
         # lacks) shows as symmetric pairs that disagree beyond it

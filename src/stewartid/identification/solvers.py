@@ -138,7 +138,8 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
                         symmetric: bool = False, regressor_names: Sequence[str] | None = None,
                         shared_names: Sequence[str] | None = None,
                         max_condition: float = 1e8,
-                        autocorrelated: bool = False) -> LeastSquaresSolution:
+                        autocorrelated: bool = False,
+                        regressor_noise: np.ndarray | None = None) -> LeastSquaresSolution:
     """Least squares for y(k) = theta phi(k) + sum_s c_s S_s(k), with standard errors.
 
     Every channel i of ``y`` shares the regressor rows ``phi``; the shared terms S_s are
@@ -173,6 +174,11 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
         (filtered signals): inflate each channel's variance by its integrated
         autocorrelation time tau = 1 + 2 sum_k rho_k (summed while rho_k > 0), i.e. count
         K / tau independent equations. Without it the standard errors assume white residuals.
+    regressor_noise : ndarray, shape (p, p), optional
+        The sum over rows of the covariance of the noise the regressor rows carry (pose noise
+        through the filters that make q_dot and q_ddot): subtracted from phi^T phi, it
+        removes the attenuation bias that noise in the regressors puts on the estimate
+        (errors in variables; the noise is taken independent of the targets' noise).
 
     Returns
     -------
@@ -205,6 +211,8 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
                                   "use longer records or more (a, b) points / experiments.")
 
     gram = phi.T @ phi                                    # (p, p)
+    if regressor_noise is not None:
+        gram = gram - np.asarray(regressor_noise, dtype=float)
     cross = np.einsum("kj,ksi->ijs", phi, S)              # (6, p, s)
     shared_gram = np.einsum("ksi,kti->ist", S, S)         # (6, s, s)
     rhs_theta = phi.T @ y                                 # (p, 6)

@@ -247,10 +247,29 @@ def kernel_filter(x: np.ndarray, sample_rate: float, window: float, derivatives:
         (L = kernel samples, odd).
     """
     x = np.asarray(x, dtype=float)
-    n = window_samples(window, sample_rate, 2 * exponent)
-    if n > len(x):
+    taps = kernel_taps(sample_rate, window, derivatives, exponent)
+    if len(taps[0]) > len(x):
         raise DataError(f"record of {len(x)} samples is shorter than the filter window "
-                        f"({n} samples = {window:.3g} s); record longer or shorten the window.")
+                        f"({len(taps[0])} samples = {window:.3g} s); record longer or shorten "
+                        "the window.")
+    # the mean filtered apart, as in differentiate
+    offset = x.mean(axis=0)
+    return [y + offset * np.sum(k)
+            for y, k in zip(convolve_valid(x - offset, taps), taps, strict=True)]
+
+
+def kernel_taps(sample_rate: float, window: float, derivatives: int = 0,
+                exponent: int = KERNEL_EXPONENT) -> list[np.ndarray]:
+    """The discrete taps of :func:`kernel_filter`: h, h' and h'' sampled and scaled so that
+    convolving samples with them gives x * h, x * h' (per s) and x * h'' (per s^2).
+
+    Returns
+    -------
+    list of ndarray, each shape (L,)
+        L odd; ``derivatives + 1`` of them. White noise of variance s^2 comes out of the
+        filter with variance s^2 sum(taps^2).
+    """
+    n = window_samples(window, sample_rate, 2 * exponent)
     half = (n - 1) / 2 / sample_rate + 0.5 / sample_rate
     tau = (np.arange(n) - (n - 1) / 2) / sample_rate
     u = tau / half
@@ -261,11 +280,7 @@ def kernel_filter(x: np.ndarray, sample_rate: float, window: float, derivatives:
                (p * (p - 1) * base ** (p - 2) * (2 * u / half) ** 2
                 + p * base ** (p - 1) * (-2 / half ** 2))]
     norm = np.sum(kernels[0]) / sample_rate
-    # the mean filtered apart, as in differentiate
-    offset = x.mean(axis=0)
-    taps = [k / norm / sample_rate for k in kernels[:derivatives + 1]]
-    return [y + offset * np.sum(k)
-            for y, k in zip(convolve_valid(x - offset, taps), taps, strict=True)]
+    return [k / norm / sample_rate for k in kernels[:derivatives + 1]]
 
 
 def trim(window: float, sample_rate: float, order: int = DEFAULT_ORDER) -> int:
@@ -407,5 +422,5 @@ def minimize_bounded(cost: Callable[[float], float], lower: float, upper: float,
 
 
 __all__ = ["DEFAULT_ORDER", "DEFAULT_WINDOW_PERIODS", "convolve_valid", "default_window",
-           "differentiate", "estimate_frequency", "kernel_filter", "minimize_bounded",
+           "differentiate", "estimate_frequency", "kernel_filter", "kernel_taps", "minimize_bounded",
            "savgol_coefficients", "savgol_gain", "trim", "window_samples"]
