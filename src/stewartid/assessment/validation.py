@@ -175,14 +175,15 @@ def with_companion_friction(result: IdentificationResult, companion: Callable[[]
                             datasets: Sequence[Dataset], platform: Platform
                             ) -> IdentificationResult:
     """``result`` with the Coulomb levels of a friction-estimating fit of the same data
-    (``diagnostics["validation_coulomb"]``), when it has none of its own.
+    (``diagnostics["validation_coulomb"]``), when it predicts with none
+    (:func:`prediction_levels`; so a result that has them is returned as it is).
 
     A method that leaves friction free (Method B's interval constants) is immune to it but
     cannot predict it; without it, its held-out residual would be the friction it never
     claimed to model. The companion (Method B with ``friction="uniform"``) estimates the
     levels; Mt and Bt stay the method's own.
     """
-    if companion is None or coulomb_levels(result) is not None:
+    if companion is None or prediction_levels(result) is not None:
         return result
     try:
         levels = companion().fit(list(datasets), platform).result_.diagnostics.get("coulomb")

@@ -47,7 +47,11 @@ from stewartid.assessment.validation import (
     coulomb_estimate,
     friction_signature,
 )
-from stewartid.identification.accuracy import entry_relative_std, expected_worst_error
+from stewartid.identification.accuracy import (
+    entry_estimate,
+    entry_relative_std,
+    expected_worst_error,
+)
 from stewartid.identification.consistency import consistency_metrics
 from stewartid.identification.result import IdentificationResult
 from stewartid.platform import COORDINATES
@@ -94,12 +98,6 @@ def worst_relative_std(result: IdentificationResult) -> tuple[float, str]:
     return float(values[k]), entry_label(PAPER_ENTRIES[k])
 
 
-def _entry(result: IdentificationResult, matrix: str, i: int, j: int) -> tuple[float, float]:
-    if matrix == "M":
-        return float(result.M[i, j]), float(result.std_errors_M[i, j])
-    return float(result.B[i, j]), float(result.std_errors_B[i, j])
-
-
 def uncertain_entries(trusted: IdentificationResult,
                       others: Mapping[str, IdentificationResult]) -> list[dict]:
     """The paper's entries the trusted result is unsure of, and why.
@@ -119,11 +117,11 @@ def uncertain_entries(trusted: IdentificationResult,
     """
     found = []
     for k, (matrix, i, j) in enumerate(PAPER_ENTRIES):
-        value, std = _entry(trusted, matrix, i, j)
+        value, std = entry_estimate(trusted, matrix, i, j)
         relative = std / abs(value) if value != 0 else np.inf
         against = []
         for name, other in others.items():
-            v, s = _entry(other, matrix, i, j)
+            v, s = entry_estimate(other, matrix, i, j)
             if abs(v - value) > DISAGREEMENT * np.hypot(s, std):
                 against.append(name)
         if relative > UNCERTAIN_RELATIVE or against:

@@ -12,13 +12,20 @@ from stewartid.identification.result import IdentificationResult
 from stewartid.reference.published import PAPER_ENTRIES
 
 
+def entry_estimate(result: IdentificationResult, matrix: str, i: int, j: int
+                   ) -> tuple[float, float]:
+    """Estimate and standard error of entry (i, j) of ``matrix`` ("M" or "B")."""
+    if matrix == "M":
+        return float(result.M[i, j]), float(result.std_errors_M[i, j])
+    return float(result.B[i, j]), float(result.std_errors_B[i, j])
+
+
 def entry_relative_std(result: IdentificationResult) -> np.ndarray:
     """Relative standard error of each of the paper's 20 entries (fractions), in the order
     of :data:`~stewartid.reference.published.PAPER_ENTRIES`; infinite for a zero estimate."""
     out = []
-    for matrix, i, j in PAPER_ENTRIES:
-        value = (result.M if matrix == "M" else result.B)[i, j]
-        std = (result.std_errors_M if matrix == "M" else result.std_errors_B)[i, j]
+    for key in PAPER_ENTRIES:
+        value, std = entry_estimate(result, *key)
         out.append(std / abs(value) if value != 0 else np.inf)
     values = np.array(out, dtype=float)
     return np.where(np.isnan(values), np.inf, values)
@@ -59,4 +66,5 @@ def predicted_worst_error(result: IdentificationResult) -> float:
     return expected_worst_error(entry_relative_std(result))
 
 
-__all__ = ["entry_relative_std", "expected_worst_error", "predicted_worst_error"]
+__all__ = ["entry_estimate", "entry_relative_std", "expected_worst_error",
+           "predicted_worst_error"]

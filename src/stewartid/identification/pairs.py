@@ -108,7 +108,8 @@ def calibrate_by_pairs(M: np.ndarray, B: np.ndarray, std_M: np.ndarray,
 
 def select_symmetric_pairs(matrix: np.ndarray, std: np.ndarray,
                            preferred_rows: tuple[int, ...] = (0, 1, 2),
-                           disagreement: float = 3.0, pool: bool = False) -> list[dict]:
+                           disagreement: float = PAIR_DISAGREEMENT, pool: bool = False
+                           ) -> list[dict]:
     """For every off-diagonal pair, copy the better estimate (or, with ``pool``, the
     inverse-variance mean of two that agree) onto both entries.
 

@@ -130,9 +130,8 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
         cache = {} if record_cache is None else record_cache
         if gravity not in cache:
             cache[gravity] = record_segments(records, platform, gravity)
-        external = validate_on_records(
-            with_companion_friction(result, companion, datasets, platform)
-            if result is not unconstrained else unconstrained, cache[gravity])
+        # ``result`` holds the companion's levels: the consistent one keeps the diagnostics
+        external = validate_on_records(result, cache[gravity])
     entry = validation.to_dict()
     if external is not None:
         entry["records"] = {"vaf_percent": external.vaf_percent.tolist(),
