@@ -114,7 +114,7 @@ def payload_row(fitted, loaded, payload: dict) -> dict:
 def mt_errors(fitted, platform, data, rng) -> tuple[float, float]:
     """Largest Mt(q) errors at 50 random poses inside the motion's range: diagonal (%) and
     couplings (% of sqrt(M_ii M_jj))."""
-    q = np.concatenate([d.q for d in data])
+    q = np.concatenate([d.pose for d in data])
     lo, hi = q.min(axis=0), q.max(axis=0)
     names = list(fitted.parameters_)
     base = reg.base_parameters(platform)

@@ -14,6 +14,7 @@ from stewartid.signals.differentiation import (
     differentiate,
     estimate_frequency,
     kernel_filter,
+    kernel_filter_rows,
     savgol_gain,
 )
 
@@ -161,6 +162,21 @@ def test_kernel_filter_derivative_identities():
     # below log2(nfft) eps max|x| sum|h^(d)| = 11 * 2.2e-16 * 3.1 * (11.7, 209) <= 2e-12
     assert h1 == pytest.approx(kernel_filter(xd, fs, 0.5)[0], abs=1e-9)
     assert h2 == pytest.approx(kernel_filter(xdd, fs, 0.5)[0], abs=1e-7)
+
+
+def test_kernel_filter_rows_are_the_filtered_rows():
+    """Direct sums of the kept rows against the FFT convolution of every row: the same to
+    the FFT's round-off (log2(nfft) eps sum|x| |h|), for steps that split the record's rows
+    into blocks unevenly and for one block."""
+    fs = 500.0
+    t = np.arange(3001) / fs
+    x = np.stack([np.sin(2.0 * t) + 3.0, 0.3 * np.cos(5.0 * t) + 0.1 * t ** 2], axis=1)
+    x = np.stack([x, -2.0 * x], axis=2)  # (N, 2, 2): time on axis 0, any trailing shape
+    every = kernel_filter(x, fs, 0.5)[0]
+    for step in (1, 7, 60, 1000):
+        rows = kernel_filter_rows(x, fs, 0.5, step)
+        assert rows.shape == every[::step].shape
+        assert rows == pytest.approx(every[::step], abs=1e-11)
 
 
 def test_estimate_frequency():
