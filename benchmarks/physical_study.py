@@ -3,7 +3,8 @@
 Data: our plant (``--platform paper`` or the example platform
 ``tests/data/example_c10/platform.toml``) carrying a payload (:data:`PAYLOADS`), Coulomb
 30 N m, 6 x 20 s at 1 kHz of all-DOFs-at-once motion (experiment k moves DOF d at
-``HZ[(d + k) % 6]`` Hz, amplitude ``--scale`` times the paper's). The noise-free records are
+``HZ[(d + k) % 6] / --slower`` Hz, amplitude ``--scale`` times the paper's; the peak use of
+the stroke and leg-speed limits is printed). The noise-free records are
 simulated once and cached in the temporary folder; each seed adds the reference sensor noise
 (:func:`stewartid.simulation.sensors.degrade`). For each seed:
 
@@ -17,7 +18,8 @@ simulated once and cached in the temporary folder; each seed adds the reference 
 
 Usage::
 
-    python benchmarks/physical_study.py [--platform paper|FILE] [--scale 1] [--seeds 8]
+    python benchmarks/physical_study.py [--platform paper|example] [--scale 1] [--slower 1]
+        [--seeds 8]
         [--consistent] [--out rows.jsonl]
 """
 
@@ -68,21 +70,36 @@ def loaded_platform(name: str):
                         **{f"payload__{key}": value for key, value in payload.items()})
 
 
-def clean_records(platform, name: str, scale: float):
-    """The six noise-free records, simulated once and cached."""
-    key = hashlib.sha1(f"{name}-{scale}-{DURATION}-v1".encode()).hexdigest()[:10]
+def clean_records(platform, name: str, scale: float, slower: float = 1.0):
+    """The six noise-free records, simulated once and cached (frequencies ``HZ / slower``)."""
+    tag = f"{name}-{scale}-{DURATION}-v1" + (f"-{slower}" if slower != 1.0 else "")
+    key = hashlib.sha1(tag.encode()).hexdigest()[:10]
     cache = Path(tempfile.gettempdir()) / f"stewartid-physical-study-{key}.pkl"
     if cache.exists():
         return pickle.loads(cache.read_bytes())
     out = []
     for k in range(6):
-        sines = [Sine(d, DEFAULT_AMPLITUDES[d] * scale, HZ[(d + k) % 6], 0.5 * d + k)
+        sines = [Sine(d, DEFAULT_AMPLITUDES[d] * scale, HZ[(d + k) % 6] / slower, 0.5 * d + k)
                  for d in range(6)]
         out.append(simulate_experiment(platform, multisine_excitation(
             platform, sines, name=f"exp{k + 1}"), DURATION, noise=SensorNoise(),
             rng=np.random.default_rng(k))[0])
     cache.write_bytes(pickle.dumps(out))
     return out
+
+
+def limit_peaks(platform, data) -> dict[str, float]:
+    """Peak use (1 = the limit) of the stroke and leg speed on the recorded motion."""
+    from stewartid.design.limits import resolve_limits
+    from stewartid.model.kinematics import leg_lengths
+
+    limits = resolve_limits(platform)
+    lengths = np.concatenate([leg_lengths(platform, d.pose) for d in data])
+    rates = np.concatenate([np.gradient(leg_lengths(platform, d.pose), d.t, axis=0)
+                            for d in data])
+    half = (limits.stroke_max - limits.stroke_min) / 2
+    return {"stroke": round(float(np.abs(lengths - limits.neutral_length).max() / half), 2),
+            "leg_velocity": round(float(np.abs(rates).max() / limits.leg_velocity), 2)}
 
 
 def z_scores(fitted, truth: dict[str, float]) -> list[float]:
@@ -154,6 +171,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--platform", default="paper", choices=["paper", "example"])
     parser.add_argument("--scale", type=float, default=1.0)
+    parser.add_argument("--slower", type=float, default=1.0,
+                        help="divide the frequencies by this (larger amplitudes within the "
+                             "leg-speed limit)")
     parser.add_argument("--seeds", type=int, default=8)
     parser.add_argument("--consistent", action="store_true")
     parser.add_argument("--out", type=Path)
@@ -161,7 +181,8 @@ def main() -> None:
     loaded = loaded_platform(args.platform)
     bare = loaded.replace(payload=None)
     payload = PAYLOADS["paper" if args.platform == "paper" else "example"]
-    clean = clean_records(loaded, args.platform, args.scale)
+    clean = clean_records(loaded, args.platform, args.scale, args.slower)
+    print(f"peak use of the limits on the plant's states: {limit_peaks(loaded, clean)}")
     rows = []
     for seed in range(args.seeds):
         data = [degrade(d, loaded, reference_noise(loaded), rng=1000 * seed + k)

@@ -412,18 +412,21 @@ def inertia_regressor(platform: Platform, pose: np.ndarray | None = None) -> np.
     Parameters
     ----------
     platform : Platform
-    pose : ndarray, shape (6,), optional
-        Pose (m, rad); the neutral pose by default.
+    pose : ndarray, shape (6,) or (N, 6), optional
+        Pose(s) (m, rad); the neutral pose by default.
 
     Returns
     -------
-    ndarray, shape (6, 6, N_STANDARD)
+    ndarray, shape (6, 6, N_STANDARD) or (N, 6, 6, N_STANDARD)
         A[i, k] is the row of M[i, k] in the standard parameters.
     """
-    q0 = platform.neutral_pose if pose is None else np.asarray(pose, dtype=float)
-    accelerations = np.vstack([np.zeros(6), np.eye(6)])
-    Y = regressor(platform, np.repeat(q0[None], 7, 0), np.zeros((7, 6)), accelerations)
-    return np.moveaxis(Y[1:] - Y[0], 0, 1)
+    q, single = as_batch(platform.neutral_pose if pose is None else pose)
+    n = len(q)
+    steps = np.tile(np.vstack([np.zeros(6), np.eye(6)]), (n, 1))
+    Y = regressor(platform, np.repeat(q, 7, 0), np.zeros((7 * n, 6)), steps).reshape(
+        n, 7, 6, N_STANDARD)
+    A = np.swapaxes(Y[:, 1:] - Y[:, :1], 1, 2)
+    return A[0] if single else A
 
 
 def viscous_regressor(platform: Platform, pose: np.ndarray | None = None) -> np.ndarray:
@@ -432,17 +435,26 @@ def viscous_regressor(platform: Platform, pose: np.ndarray | None = None) -> np.
     Bt collects every term linear in the rates: the joints' viscous friction per type and
     the actuators'; the velocity products are quadratic and vanish from the linearisation.
 
+    Parameters
+    ----------
+    platform : Platform
+    pose : ndarray, shape (6,) or (N, 6), optional
+        Pose(s) (m, rad); the neutral pose by default.
+
     Returns
     -------
-    ndarray, shape (6, 6, N_STANDARD)
+    ndarray, shape (6, 6, N_STANDARD) or (N, 6, 6, N_STANDARD)
         Zero outside the columns of :data:`VISCOUS_PARAMETERS`.
     """
-    q0 = platform.neutral_pose if pose is None else np.asarray(pose, dtype=float)
-    Y = regressor(platform, np.repeat(q0[None], 6, 0), np.eye(6), np.zeros((6, 6)))
+    q, single = as_batch(platform.neutral_pose if pose is None else pose)
+    n = len(q)
+    Y = regressor(platform, np.repeat(q, 6, 0), np.tile(np.eye(6), (n, 1)),
+                  np.zeros((6 * n, 6))).reshape(n, 6, 6, N_STANDARD)
     A = np.zeros_like(Y)
     viscous = parameter_index(VISCOUS_PARAMETERS)
-    A[:, :, viscous] = Y[:, :, viscous]
-    return np.moveaxis(A, 0, 1)
+    A[..., viscous] = Y[..., viscous]
+    A = np.swapaxes(A, 1, 2)
+    return A[0] if single else A
 
 
 __all__ = ["ACTUATOR_PARAMETERS", "ACTUATOR_SMOOTHING", "BODY_PARAMETERS", "BaseParameters",

@@ -1,0 +1,94 @@
+"""Errors in variables for the physical model: the share of the normal equations that pose
+noise, carried into the regressor's rates and accelerations, adds.
+
+The physical model's regressor rows are evaluated at the measured pose and its Savitzky-Golay
+rate and acceleration, then filtered with the kernel h
+(:func:`~stewartid.identification.physical.filtered_regression`). White pose noise e (covariance
+Sigma per sample, estimated from the record by
+:func:`~stewartid.identification.wavelet.noise.white_noise_covariance`) enters a filtered row
+mostly through the terms linear in the acceleration and the rate,
+
+    delta Y(t) ~ sum_c A_c(q) (h * g2 * e_c)(t) + sum_c B_c(q) (h * g1 * e_c)(t),
+
+with A = d Y / d q_ddot (the inertia regressor), B = d Y / d q_dot at rest (the viscous
+columns) and g1, g2 the Savitzky-Golay derivative taps. Its expected outer product, summed
+over the rows kept, is what noise adds to X^T W X and what the least squares must subtract to
+be unbiased (attenuation bias; the same correction as the ``ls`` method's
+``noise_correction``). The composite filters h * g1 (odd) and h * g2 (even) give no cross term.
+Velocity products and the Coulomb signs are left out: their noise terms are of second order
+at the rates of an identification record.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stewartid.identification.preparation import Experiment
+from stewartid.identification.wavelet.noise import white_noise_covariance
+from stewartid.model import regressor as reg
+from stewartid.platform import Platform
+from stewartid.signals.differentiation import (
+    differentiate,
+    kernel_filter_rows,
+    kernel_taps,
+    savgol_coefficients,
+    window_samples,
+)
+
+
+def derivative_noise_gains(sample_rate: float, window: float, savgol_window: float,
+                           order: int) -> tuple[float, float]:
+    """Variance of h * g1 * e and h * g2 * e per unit variance of white e: the energies of
+    the composite taps of the kernel (support ``window`` s) and the Savitzky-Golay rate and
+    acceleration (``savgol_window`` s, ``order``). Units 1/s^2 and 1/s^4."""
+    h = kernel_taps(sample_rate, window)[0]
+    n = window_samples(savgol_window, sample_rate, order)
+    return tuple(float(np.sum(np.convolve(h, savgol_coefficients(n, order, d, 1 / sample_rate))
+                              ** 2)) for d in (1, 2))
+
+
+def _factor(covariance: np.ndarray) -> np.ndarray:
+    """L with L L^T = covariance (positive semidefinite; a noise-free record gives ~0)."""
+    values, vectors = np.linalg.eigh(covariance)
+    return vectors * np.sqrt(np.clip(values, 0.0, None))
+
+
+def regressor_noise(experiments: list[Experiment], windows: list[float], row_step: int,
+                    platform: Platform, savgol_fraction: float, order: int) -> np.ndarray:
+    """Per channel, the sum over the kept rows of E[delta Y_i^T delta Y_i].
+
+    Parameters
+    ----------
+    experiments : list of Experiment
+    windows : list of float
+        Each experiment's kernel support (s).
+    row_step : int
+        The rows kept (every ``row_step``-th filtered row).
+    platform : Platform
+    savgol_fraction : float
+        The Savitzky-Golay window is ``window / savgol_fraction``.
+    order : int
+        Savitzky-Golay order.
+
+    Returns
+    -------
+    ndarray, shape (6, N_STANDARD, N_STANDARD)
+        In the standard parameters, by generalized-force channel.
+    """
+    out = np.zeros((6, reg.N_STANDARD, reg.N_STANDARD))
+    for exp, window in zip(experiments, windows, strict=True):
+        rate = exp.sample_rate
+        savgol_window = window / savgol_fraction
+        sigma = white_noise_covariance(exp.q, differentiate(exp.q, rate, savgol_window,
+                                                            order)[0])
+        gains = derivative_noise_gains(rate, window, savgol_window, order)
+        poses = kernel_filter_rows(exp.q, rate, window, row_step)
+        for jacobian, gain in ((reg.viscous_regressor(platform, poses), gains[0]),
+                               (reg.inertia_regressor(platform, poses), gains[1])):
+            # jacobian[k, i, c, :]: d Y_i / d (rate or acceleration of c) at row k
+            scaled = np.einsum("cd,kicp->kidp", _factor(sigma * gain), jacobian)
+            out += np.einsum("kidp,kidq->ipq", scaled, scaled)
+    return out
+
+
+__all__ = ["derivative_noise_gains", "regressor_noise"]
