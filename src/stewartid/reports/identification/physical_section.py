@@ -35,7 +35,7 @@ from stewartid.reporting.tables import ResultTable, to_markdown
 from stewartid.reports.identification.records import PhysicalSection, Workspace
 
 #: Poses per swept coordinate in :func:`workspace`.
-WORKSPACE_POINTS = 15
+WORKSPACE_POINTS = 11
 #: Off-diagonal entries of Mt and of Bt shown beside the diagonal (the largest).
 SHOWN_COUPLINGS = 2
 #: Share of the parameters fixed at the file's values above which a report that did not ask
