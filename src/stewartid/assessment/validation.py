@@ -388,6 +388,19 @@ def validate_on_records(result: IdentificationResult, segments: Sequence[Segment
     return score(segments, [predict(s, result) for s in segments], folds=0)
 
 
+def validation_entry(held_out: ValidationResult, records: ValidationResult | None = None
+                     ) -> dict[str, Any]:
+    """The ``validation`` object of ``result.json``: the held-out scores
+    (:meth:`ValidationResult.to_dict`) and, with validation records, their ``"records"``:
+    ``vaf_percent``, ``nrmse`` and ``names``."""
+    entry = held_out.to_dict()
+    if records is not None:
+        entry["records"] = {"vaf_percent": records.vaf_percent.tolist(),
+                            "nrmse": records.nrmse.tolist(),
+                            "names": [s.name for s in records.segments]}
+    return entry
+
+
 def friction_signature(validation: ValidationResult) -> float:
     """Share of the held-out residual that has the shape of Coulomb joint friction.
 
@@ -422,4 +435,4 @@ __all__ = ["DEFAULT_FOLDS", "CrossValidation", "Segment", "ValidationResult",
            "coulomb_estimate", "coulomb_levels", "cross_validate", "excitation_window", "fold_bounds",
            "friction_signature", "held_out_segments", "in_sample", "predict", "prediction_levels",
            "prepare_segment", "record_segments", "score", "validate_on_records",
-           "with_companion_friction"]
+           "validation_entry", "with_companion_friction"]

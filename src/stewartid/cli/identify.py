@@ -54,8 +54,10 @@ def identify(
                          "consistency, friction, CSV and MATLAB exports, result.json.")] = None,
     consistent: Annotated[bool, typer.Option(
         "--consistent", help="Replace Mt, Bt by the nearest symmetric pair with Mt positive "
-                             "definite and Bt positive semidefinite (needs the 'convex' "
-                             "extra).")] = False,
+                             "definite and Bt positive semidefinite; with --model physical, "
+                             "the physically consistent parameters (pseudo-inertia positive "
+                             "semidefinite, friction nonnegative). Needs the 'convex' "
+                             "extra.")] = False,
     folds: Annotated[int | None, typer.Option(
         "--folds", metavar="N", help="--report: time segments per experiment for the validation "
                         "(default 3).")] = None,
@@ -74,7 +76,8 @@ def identify(
         "--model", metavar="NAME",
         help="'physical': identify the physical parameters of the rigid-body model (masses, "
              "first moments, inertias, friction per joint type, sensor offsets) and Mt, Bt "
-             "from them (docs/physical-model.md).")] = None,
+             "from them (docs/physical-model.md); with --report, beside every compared "
+             "method.")] = None,
     payload: Annotated[bool, typer.Option(
         "--payload", help="--model physical: identify only the payload on the platform "
                           "file's known platform.")] = False,

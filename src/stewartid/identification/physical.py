@@ -33,6 +33,7 @@ nearest to it in the metric of its covariance
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from numbers import Integral
 from typing import Any
@@ -320,10 +321,17 @@ class PhysicalIdentifier(BaseIdentifier):
         return result, learned
 
 
+@functools.lru_cache(maxsize=4)
+def _base_parameters(platform: Platform) -> reg.BaseParameters:
+    """:func:`~stewartid.model.regressor.base_parameters`, once per platform description: a
+    report fits the model several times (folds) and predicts with it (read only)."""
+    return reg.base_parameters(platform)
+
+
 def _full_model(platform: Platform):
     """(names, combination strings, selection (p, N_STANDARD) of the columns regressed on,
     nominal values (p,), known standard parameters (N_STANDARD,)) of the base parameters."""
-    base = reg.base_parameters(platform)
+    base = _base_parameters(platform)
     pi = reg.standard_parameters(platform)
     return (base.names, dict(zip(base.names, base.combinations, strict=True)),
             np.eye(reg.N_STANDARD)[base.columns], base.combination @ pi,

@@ -192,11 +192,45 @@ def model_method(model: str | None, method: str, payload: bool,
     return model
 
 
+def check_model_outputs(model: str, platform_out: Path | None,
+                        refused: dict[str, bool] | None = None,
+                        inputs: Sequence[str | Path] = ()) -> None:
+    """Refuse, before any computation, what ``identify --model`` cannot do
+    (:func:`check_model_options`) and a ``platform_out`` that would replace an input or a
+    file ``--platform-out`` did not write.
+
+    Parameters
+    ----------
+    model : str
+    platform_out : Path, optional
+    refused : dict of str to bool, optional
+        Options of the command that do not apply, by flag, and whether each was given.
+    inputs : sequence of str or Path
+        Files the command reads, which ``platform_out`` must not be.
+    """
+    check_model_options(model, platform_out, refused or {})
+    if platform_out is not None:
+        check_output_file(platform_out, False, inputs, is_result=_is_identified,
+                          option="--platform-out")
+
+
+def write_identified(platform: Platform, result: PhysicalResult, platform_out: Path,
+                     experiments: int) -> Path:
+    """Write the platform description of ``result`` (:func:`identified_platform`) to
+    ``platform_out``, under the header that marks it as written by ``identify``; returns the
+    path."""
+    identified = identified_platform(platform, result)
+    return write_text_atomic(platform_out, f"{IDENTIFIED_HEADER} {experiments} experiments\n"
+                             + identified.to_toml())
+
+
 def identify_model(datasets: list[Dataset], platform: Platform, model: str = "physical",
                    payload: bool = False, platform_out: Path | None = None,
                    refused: dict[str, bool] | None = None,
-                   inputs: Sequence[str | Path] = ()) -> PhysicalResult:
-    """``stewartid identify --model physical``: fit, and write ``platform_out``.
+                   inputs: Sequence[str | Path] = (), consistent: bool = False,
+                   settings: dict[str, Any] | None = None) -> PhysicalResult:
+    """``stewartid identify --model physical`` without a report: fit, and write
+    ``platform_out``.
 
     Parameters
     ----------
@@ -212,22 +246,23 @@ def identify_model(datasets: list[Dataset], platform: Platform, model: str = "ph
         Options of the command that do not apply, by flag, and whether each was given.
     inputs : sequence of str or Path
         Files the command reads, which ``platform_out`` must not be.
+    consistent : bool
+        The physically consistent fit (the ``convex`` extra); ``platform_out`` then holds
+        the consistent parameters.
+    settings : dict, optional
+        Further estimator settings (e.g. ``{"gravity": False}``).
 
     Returns
     -------
     PhysicalResult
     """
-    check_model_options(model, platform_out, refused or {})
+    check_model_outputs(model, platform_out, refused, inputs)
+    result = PhysicalIdentifier(**(settings or {}), payload=payload,
+                                consistent=consistent).fit(datasets, platform).result_
     if platform_out is not None:
-        check_output_file(platform_out, False, inputs, is_result=_is_identified,
-                          option="--platform-out")
-    result = PhysicalIdentifier(payload=payload).fit(datasets, platform).result_
-    if platform_out is not None:
-        identified = identified_platform(platform, result)
-        write_text_atomic(platform_out, f"{IDENTIFIED_HEADER} {len(datasets)} experiments\n"
-                          + identified.to_toml())
+        write_identified(platform, result, platform_out, len(datasets))
     return result
 
 
-__all__ = ["IDENTIFIED_HEADER", "MODELS", "check_model_options", "identified_platform",
-           "identify_model", "model_method"]
+__all__ = ["IDENTIFIED_HEADER", "MODELS", "check_model_options", "check_model_outputs",
+           "identified_platform", "identify_model", "model_method", "write_identified"]

@@ -20,7 +20,7 @@ from stewartid.identification.wavelet.intervals import joint_rates
 from stewartid.platform import Platform
 from stewartid.reporting.figures import ExperimentTrace, plot_excitation, plot_joint_rates
 from stewartid.reports.identification import method_figures as plots
-from stewartid.reports.identification.records import MethodReport
+from stewartid.reports.identification.records import MethodReport, PhysicalSection
 from stewartid.reports.identification.text import used_intervals
 from stewartid.signals.differentiation import differentiate
 
@@ -115,4 +115,17 @@ def result_figures(drawer: FigureDrawer, runs: Sequence[MethodReport],
                    colours, float(platform.friction.coulomb))
 
 
-__all__ = ["FigureDrawer", "data_figures", "result_figures"]
+def physical_figures(drawer: FigureDrawer, section: PhysicalSection | None) -> None:
+    """The physical model's figure: Mt and Bt across the measured poses (none without its
+    section)."""
+    if section is None or section.workspace is None:
+        return
+    drawer.add("workspace", "Mt and Bt of the physical model across the poses the data cover: "
+               "each coordinate swept from its smallest to its largest measured value, the "
+               "others at their mean; the diagonal entries and the largest couplings as their "
+               "change from the identified value at the mean pose, in % of the diagonal's "
+               "scale (sqrt(m_ii m_jj) for a coupling); band: ±2 standard errors (delta method); "
+               "dashed: the platform description.", plots.plot_workspace, section.workspace)
+
+
+__all__ = ["FigureDrawer", "data_figures", "physical_figures", "result_figures"]

@@ -18,6 +18,7 @@ from stewartid.assessment.validation import ValidationResult
 from stewartid.model.joints import FRICTION_TYPES
 from stewartid.platform import COORDINATES
 from stewartid.reporting.figures import new_figure, save_figure, styled, thinning_step
+from stewartid.reports.identification.records import Workspace
 
 #: Display unit and scale of a displacement in each coordinate.
 DISPLACEMENT_UNITS = (("mm", 1e3),) * 3 + (("mrad", 1e3),) * 3
@@ -314,5 +315,59 @@ def plot_friction(levels: Mapping[str, tuple[np.ndarray, np.ndarray]],
     return save_figure(figure, directory, stem, tight=False)
 
 
+def _entry_scale(matrix: np.ndarray, entry: tuple[int, int]) -> float:
+    """The scale an entry's change is shown against: sqrt(|m_ii m_jj|), 1 where zero."""
+    scale = float(np.sqrt(abs(matrix[entry[0], entry[0]] * matrix[entry[1], entry[1]])))
+    return scale if scale > 0 else 1.0
+
+
+@styled
+def plot_workspace(curves: Workspace, directory: str | Path, stem: str = "workspace"
+                   ) -> list[Path]:
+    """Mt and Bt across the measured poses: one column per swept coordinate, the diagonal
+    entries and the largest couplings as their change from the identified value at the mean
+    pose (% of the diagonal's scale), a band of ±2 standard errors, the platform description
+    dashed."""
+    figure = new_figure(figsize=(15, 6.5))
+    axes = figure.subplots(2, 6, squeeze=False, gridspec_kw={
+        "left": 0.05, "right": 0.86, "bottom": 0.1, "top": 0.9, "hspace": 0.4,
+        "wspace": 0.35})
+    colours = [f"C{k}" for k in range(10)]
+    for row, (name, key) in enumerate((("Mt", "M"), ("Bt", "B"))):
+        reference = getattr(curves.at_centre, key)[0]
+        entries = [(i, i) for i in range(6)] + list(curves.couplings[key])
+        nominal = curves.nominal_M if key == "M" else curves.nominal_B
+        for dof in range(6):
+            axis = axes[row, dof]
+            unit, factor = DISPLACEMENT_UNITS[dof]
+            x = (curves.grid[dof] - curves.centre[dof]) * factor
+            found = curves.identified[dof]
+            values, std = getattr(found, key), getattr(found, f"std_errors_{key}")
+            shown, bands = [0.0], [0.0]
+            for k, entry in enumerate(entries):
+                scale = 100.0 / _entry_scale(reference, entry)
+                y = (values[:, entry[0], entry[1]] - reference[entry]) * scale
+                band = 2.0 * std[:, entry[0], entry[1]] * scale
+                label = f"{name}[{COORDINATES[entry[0]]},{COORDINATES[entry[1]]}]"
+                axis.fill_between(x, y - band, y + band, color=colours[k], alpha=0.2, lw=0)
+                axis.plot(x, y, color=colours[k], lw=1.2, label=label)
+                dashed = (nominal[dof, :, entry[0], entry[1]] - reference[entry]) * scale
+                axis.plot(x, dashed, color=colours[k], lw=0.9, ls="--")
+                shown += [np.abs(y).max(), np.abs(dashed).max()]
+                bands.append(float(np.median(band)))
+            # the curves set the scale; a band much wider than them runs off the panel
+            limit = 1.2 * max(max(shown), float(np.median(bands))) or 1.0
+            axis.set_ylim(-limit, limit)
+            axis.set_xlabel(f"{COORDINATES[dof]} − mean ({unit})")
+            axis.set_title(f"{name} along {COORDINATES[dof]}", fontsize=9)
+            if dof == 0:
+                axis.set_ylabel("change from the mean pose (%)")
+        axes[row, -1].legend(loc="center left", bbox_to_anchor=(1.05, 0.5), fontsize=7,
+                             framealpha=0.9)
+    figure.suptitle("Physical model across the measured poses: band ±2 standard errors; "
+                    "dashed: the platform description", fontsize=10)
+    return save_figure(figure, directory, stem, tight=False)
+
+
 __all__ = ["plot_friction", "plot_intervals", "plot_matrices", "plot_residuals",
-           "plot_spectra", "plot_unexplained", "plot_validation"]
+           "plot_spectra", "plot_unexplained", "plot_validation", "plot_workspace"]

@@ -1,9 +1,10 @@
-"""What the identification report found: one :class:`MethodReport` per method and the
-:class:`IdentificationReport` that holds them with the verdict and the files written."""
+"""What the identification report found: one :class:`MethodReport` per method, the physical
+model's :class:`PhysicalSection`, and the :class:`IdentificationReport` that holds them with
+the verdict and the files written."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -12,6 +13,8 @@ from stewartid.assessment.validation import FRICTION_TYPES, ValidationResult, co
 from stewartid.assessment.verdict import Verdict
 from stewartid.errors import StewartidError
 from stewartid.identification.consistency import ConsistentEstimate
+from stewartid.identification.physical import PhysicalResult
+from stewartid.identification.physical_prediction import PoseMatrices
 from stewartid.identification.result import IdentificationResult
 
 
@@ -74,6 +77,69 @@ class MethodReport:
 
 
 @dataclass(frozen=True)
+class Workspace:
+    """Mt and Bt of the physical model and of the platform description across the poses the
+    data cover: each coordinate swept from its smallest to its largest measured value, the
+    others at their mean.
+
+    Attributes
+    ----------
+    centre : ndarray, shape (6,)
+        The mean measured pose (m, rad).
+    grid : ndarray, shape (6, P)
+        The swept values of each coordinate (m, rad).
+    identified : list of PoseMatrices
+        Per swept coordinate, at its P poses, with standard errors.
+    at_centre : PoseMatrices
+        At the mean pose (one pose).
+    nominal_M, nominal_B : ndarray, shape (6, P, 6, 6)
+        Of the platform description at the same poses.
+    couplings : dict of str to list of (int, int)
+        The largest off-diagonal entries of ``"M"`` and ``"B"`` (relative to their
+        diagonals, at the mean pose), shown beside the diagonal.
+    """
+
+    centre: np.ndarray
+    grid: np.ndarray
+    identified: list[PoseMatrices]
+    at_centre: PoseMatrices
+    nominal_M: np.ndarray
+    nominal_B: np.ndarray
+    couplings: dict[str, list[tuple[int, int]]]
+
+
+@dataclass(frozen=True)
+class PhysicalSection:
+    """The physical model in the identification report (not ranked by the verdict).
+
+    Attributes
+    ----------
+    result : PhysicalResult or None
+        Fitted on all experiments, with ``validation`` set; None when not shown.
+    covariance : ndarray, shape (p, p) or None
+        Of its parameters (``PhysicalIdentifier.covariance_``).
+    workspace : Workspace or None
+    validation : ValidationResult or None
+        Held-out prediction by the full model (:mod:`stewartid.assessment.physical_validation`).
+    records : ValidationResult or None
+        Its prediction of the validation records (``identify --validate``).
+    seconds : float
+        Fit, validation and curves.
+    note : str or None
+        Why the section is not shown (the model cannot be applied, or the data fix most of
+        its parameters).
+    """
+
+    result: PhysicalResult | None = None
+    covariance: np.ndarray | None = None
+    workspace: Workspace | None = None
+    validation: ValidationResult | None = None
+    records: ValidationResult | None = None
+    seconds: float = 0.0
+    note: str | None = None
+
+
+@dataclass(frozen=True)
 class IdentificationReport:
     """What :func:`~stewartid.reports.identification.report.write_identification_report`
     found and wrote.
@@ -85,12 +151,18 @@ class IdentificationReport:
         Which method to trust and why (:mod:`stewartid.assessment.verdict`).
     directory : Path
     files : list of Path
+    physical : PhysicalSection or None
+        The physical model's section, when asked for.
+    physical_primary : bool
+        ``identify --model physical``: ``result.json`` holds the physical model's result.
     """
 
     runs: list[MethodReport]
     verdict: Verdict
     directory: Path
     files: list[Path] = field(default_factory=list)
+    physical: PhysicalSection | None = None
+    physical_primary: bool = False
 
     @property
     def trusted(self) -> str:
@@ -102,5 +174,13 @@ class IdentificationReport:
         """The trusted method's result (with ``validation``)."""
         return next(run.result for run in self.runs if run.name == self.trusted)
 
+    @property
+    def main_result(self) -> IdentificationResult:
+        """What ``result.json`` holds: with ``physical_primary``, the physical model's result
+        with the compared methods' ``verdict``; else the trusted method's (:attr:`result`)."""
+        if self.physical_primary and self.physical is not None and self.physical.result:
+            return replace(self.physical.result, verdict=self.verdict.to_dict())
+        return self.result
 
-__all__ = ["IdentificationReport", "MethodReport"]
+
+__all__ = ["IdentificationReport", "MethodReport", "PhysicalSection", "Workspace"]

@@ -13,8 +13,13 @@ consistent pair (:mod:`stewartid.identification.consistency`), chooses the metho
 - ``figures/``: every figure as PNG and SVG (:mod:`~stewartid.reports.identification.figures` chooses them,
   :mod:`~stewartid.reports.identification.method_figures` draws them);
 - ``result.json``: the trusted method's result with its ``validation`` and ``consistency``
-  objects, and the CSV and MATLAB exports of every method
-  (:mod:`stewartid.reporting.exports`).
+  objects (with ``identify --model physical``, the physical model's result with the compared
+  methods' ``verdict``), and the CSV and MATLAB exports of every method
+  (:mod:`stewartid.reporting.exports`);
+- with the physical model asked for (:class:`~.physical_section.PhysicalRequest`), its
+  section (:mod:`.physical_section`): Mt and Bt across the measured poses, its parameters and
+  its held-out prediction beside the others', not ranked by the verdict; ``physical.json`` its
+  result when ``result.json`` holds the trusted method's.
 """
 
 from __future__ import annotations
@@ -35,6 +40,7 @@ from stewartid.assessment.validation import (
     in_sample,
     record_segments,
     validate_on_records,
+    validation_entry,
     with_companion_friction,
 )
 from stewartid.assessment.verdict import choose_trusted
@@ -48,7 +54,13 @@ from stewartid.model.linearization import nominal_matrices
 from stewartid.platform import Platform
 from stewartid.reporting.exports import ExportedModel, write_exports
 from stewartid.reporting.html import render_html
-from stewartid.reports.identification.figures import FigureDrawer, data_figures, result_figures
+from stewartid.reports.identification.figures import (
+    FigureDrawer,
+    data_figures,
+    physical_figures,
+    result_figures,
+)
+from stewartid.reports.identification.physical_section import PhysicalRequest, fit_physical
 from stewartid.reports.identification.records import IdentificationReport, MethodReport
 from stewartid.reports.identification.text import data_rows, render_report
 
@@ -132,12 +144,7 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
             cache[gravity] = record_segments(records, platform, gravity)
         # ``result`` holds the companion's levels: the consistent one keeps the diagnostics
         external = validate_on_records(result, cache[gravity])
-    entry = validation.to_dict()
-    if external is not None:
-        entry["records"] = {"vaf_percent": external.vaf_percent.tolist(),
-                            "nrmse": external.nrmse.tolist(),
-                            "names": [s.name for s in external.segments]}
-    result = dataclasses.replace(result, validation=entry)
+    result = dataclasses.replace(result, validation=validation_entry(validation, external))
     return MethodReport(name, spec.display_name, spec.color, result=result,
                         unconstrained=unconstrained, validation=validation,
                         validation_unconstrained=before,
@@ -153,7 +160,8 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
                                 nominal_source: str | None = None,
                                 sources: Sequence[str] = (),
                                 check: Callable[[IdentificationResult], None] | None = None,
-                                records: Sequence[Dataset] = (), notes: Sequence[str] = ()
+                                records: Sequence[Dataset] = (), notes: Sequence[str] = (),
+                                physical: PhysicalRequest | None = None
                                 ) -> IdentificationReport:
     """Identify, validate and report on measured experiments.
 
@@ -189,6 +197,9 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
         verdict judges the prediction on them instead of on held-out segments.
     notes : sequence of str
         Sentences added to the report's summary.
+    physical : PhysicalRequest, optional
+        Add the physical model's section (:func:`~.physical_section.fit_physical`); with
+        ``physical.required``, ``result.json`` holds its result.
 
     Returns
     -------
@@ -219,17 +230,23 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
     verdict = choose_trusted({run.name: None if run.result is None else
                               (run.result, run.evidence) for run in runs})
     trusted = verdict.trusted
+    section = None if physical is None else fit_physical(
+        datasets, platform, physical, folds, segments, records, record_cache)
     drawer = FigureDrawer(directory / "figures")
     data_figures(drawer, datasets, platform, rows)
     result_figures(drawer, runs, datasets, platform, nominal, trusted, rows)
+    physical_figures(drawer, section)
     models = [ExportedModel(run.name, run.result, *run.coulomb) for run in usable]
     files = drawer.files + write_exports(models, directory, trusted)
     if len(runs) > 1:
         runs = [dataclasses.replace(run, result=dataclasses.replace(
             run.result, verdict=verdict.to_dict())) if run.name == trusted else run
             for run in runs]
-    report = IdentificationReport(runs, verdict, directory)
-    files.append(report.result.to_json(directory / "result.json"))
+    report = IdentificationReport(runs, verdict, directory, physical=section,
+                                  physical_primary=physical is not None and physical.required)
+    files.append(report.main_result.to_json(directory / "result.json"))
+    if section is not None and section.result is not None and not report.physical_primary:
+        files.append(section.result.to_json(directory / "physical.json"))
     text = render_report(report, datasets, platform, nominal, nominal_source or "", rows,
                          drawer.entries, sources, folds, time.perf_counter() - started,
                          [d.name for d in records], notes)

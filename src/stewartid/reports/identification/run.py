@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, NamedTuple
@@ -17,7 +17,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from stewartid.assessment.validation import DEFAULT_FOLDS
-from stewartid.datasets.dataset import expand_paths, read_datasets
+from stewartid.datasets.dataset import Dataset, expand_paths, read_datasets
 from stewartid.datasets.excitation import check_experiment_set
 from stewartid.datasets.log_format import load_log_format
 from stewartid.datasets.meta import nominal_from_meta, platform_for_data
@@ -34,6 +34,7 @@ from stewartid.identification.delay import (
 from stewartid.identification.result import IdentificationResult, comparison_rows
 from stewartid.model.linearization import nominal_matrices
 from stewartid.platform import Platform
+from stewartid.reports.identification.physical_section import PhysicalRequest
 from stewartid.reports.identification.records import IdentificationReport
 
 #: ``identify --method`` value that runs every registered method.
@@ -185,6 +186,37 @@ def delay_note(sensitivity: Mapping[str, Any]) -> str:
             "excite two or more frequencies per DOF and estimate it (--delay auto).")
 
 
+def _physical_request(model: str | None, method: str, payload: bool, consistent: bool,
+                      settings: Mapping[str, Any]) -> PhysicalRequest | None:
+    """The report's physical section: asked for with ``--model physical``, shown beside the
+    comparison of ``--method all`` when the model fits the data; none otherwise."""
+    if model is None and method != ALL_METHODS:
+        return None
+    own = registry.method_spec("physical").estimator_class.param_names()
+    return PhysicalRequest(payload=payload, consistent=consistent and model is not None,
+                           required=model is not None,
+                           settings={k: v for k, v in settings.items() if k in own})
+
+
+def _fit_alone(datasets: list[Dataset], platform: Platform, method: str,
+               settings: Mapping[str, Any], consistent: bool, model: str | None,
+               payload: bool, check: Callable[[IdentificationResult], None]
+               ) -> IdentificationResult:
+    """One method (or the physical model) without a report, made consistent on request."""
+    if model is not None:
+        from stewartid.identification.physical_platform import identify_model
+
+        return identify_model(datasets, platform, model, payload, consistent=consistent,
+                              settings=dict(settings))
+    result = registry.create_identifier(method, **settings).fit(datasets, platform).result_
+    if consistent:
+        from stewartid.reports.identification.report import consistent_result
+
+        check(result)
+        result = consistent_result(result)[0]
+    return result
+
+
 def identify_files(files: Sequence[str | Path], method: str = "wavelet",
                    platform: str | None = None, *, flags: Mapping[str, FlagSetting] | None = None,
                    columns: str | None = None, out: Path | None = None, force: bool = False,
@@ -215,7 +247,9 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
         Write the identification report into this folder
         (:func:`~stewartid.reports.identification.report.write_identification_report`).
     consistent : bool
-        Replace Mt, Bt by the nearest consistent pair (needs the ``convex`` extra).
+        Replace Mt, Bt by the nearest consistent pair (needs the ``convex`` extra); with
+        ``model``, the physical model's consistent fit instead (the compared methods of its
+        report stay unconstrained).
     folds : int, optional
         Validation folds of the report (default 3).
     delay : float or 'auto', optional
@@ -228,7 +262,11 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     model, payload, platform_out : optional
         ``"physical"``: the physical model instead of ``method``, in payload mode with
         ``payload``, its platform description written to ``platform_out``
-        (:func:`~stewartid.identification.physical_platform.identify_model`).
+        (:func:`~stewartid.identification.physical_platform.identify_model`); with
+        ``report``, the report of every compared method (as ``method="all"``) with the
+        physical model's section, and its result (with their verdict) as the result. With
+        ``method="all"`` and a report, the section is added too, unless the model cannot be
+        applied (one line says why).
 
     Returns
     -------
@@ -250,6 +288,10 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     description = platform_for_data(paths, platform)
     _check_outputs(paths, (platform, columns), out, report, force, method, len(names) > 1,
                    folds)
+    if model is not None:
+        from stewartid.identification.physical_platform import check_model_outputs
+
+        check_model_outputs(model, platform_out, {}, [*paths, *([platform] if platform else [])])
     if validate and report is None:
         raise ConfigError("--validate compares the methods' predictions in a report; add "
                           "--report DIR.")
@@ -271,35 +313,30 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     def check(found: IdentificationResult) -> None:
         check_identified(found.M, found.B, description)
 
-    written = None
-    if report is not None or consistent:
+    if consistent:
         from stewartid.identification.consistency import require_cvxpy
-        from stewartid.reports.identification.report import (
-            consistent_result,
-            write_identification_report,
-        )
 
-        if consistent:
-            require_cvxpy()
-    if model is not None:  # the physical model and its platform file
-        from stewartid.identification.physical_platform import identify_model
+        require_cvxpy()
+    written = None
+    if report is not None:
+        from stewartid.reports.identification.report import write_identification_report
 
-        result = identify_model(datasets, description, model, payload, platform_out,
-                                {"--report": report is not None, "--consistent": consistent},
-                                [*paths, *([platform] if platform else [])])
-    elif report is not None:
         written = write_identification_report(
-            datasets, description, report, names, settings, consistent,
-            DEFAULT_FOLDS if folds is None else folds, None if meta is None else meta[:2],
-            None if meta is None else meta[2], [str(p) for p in paths], check, records,
-            [] if sensitivity is None else [delay_note(sensitivity)])
-        result = written.result
+            datasets, description, report, methods_for(ALL_METHODS) if model else names,
+            settings, consistent and model is None, DEFAULT_FOLDS if folds is None else folds,
+            None if meta is None else meta[:2], None if meta is None else meta[2],
+            [str(p) for p in paths], check, records,
+            [] if sensitivity is None else [delay_note(sensitivity)],
+            _physical_request(model, method, payload, consistent, settings))
+        result = written.main_result
     else:
-        result = registry.create_identifier(method, **settings).fit(datasets, description).result_
-        if consistent:
-            check(result)
-            result = consistent_result(result)[0]
+        result = _fit_alone(datasets, description, method, settings, consistent, model,
+                            payload, check)
     check(result)
+    if model is not None and platform_out is not None:
+        from stewartid.identification.physical_platform import write_identified
+
+        write_identified(description, result, platform_out, len(datasets))
     if delay_entry is not None:
         result = dataclasses.replace(result, delay=delay_entry)
     if sensitivity is not None:

@@ -21,10 +21,13 @@ from stewartid.identification.wavelet.noise import white_noise_covariance
 from stewartid.model.joints import FRICTION_TYPES
 from stewartid.platform import COORDINATES, Platform
 from stewartid.reporting.tables import ResultTable, to_markdown
+from stewartid.reports.identification.physical_section import physical_lines
 from stewartid.reports.identification.records import IdentificationReport, MethodReport
 from stewartid.signals.differentiation import differentiate, estimate_frequency
 
 _UNITS = ("mm",) * 3 + ("mrad",) * 3
+#: The physical model's row in the validation tables.
+_UNRANKED = "Physical model (full model; not ranked)"
 #: Held-out VAF (%) in the worst DOF above which a model "predicts closely", "adequately".
 CLOSE_VAF, ADEQUATE_VAF = 99.0, 95.0
 
@@ -307,7 +310,7 @@ def render_report(report: IdentificationReport, datasets: Sequence[Dataset],
                          "contains none); "
                          f"{100 * friction_signature(run.validation):.0f} % of its held-out "
                          "residual has the shape of Coulomb friction.")
-    lines += [""] + _figure(figures, "friction")
+    lines += [""] + _figure(figures, "friction") + physical_lines(report.physical, figures)
     if several:
         lines += ["## Methods compared", "", *verdict, ""]
         lines += _figure(figures, "methods")
@@ -336,6 +339,10 @@ def _validation_section(report: IdentificationReport, folds: int) -> list[str]:
                                  *(f"{v:.3f}" for v in validation.vaf_percent)))
                 nrmse_rows.append((run.display_name + suffix,
                                    *(f"{v:.2g}" for v in validation.nrmse)))
+    physical = report.physical
+    if physical is not None and physical.validation is not None:
+        vaf_rows.append((_UNRANKED, *(f"{v:.3f}" for v in physical.validation.vaf_percent)))
+        nrmse_rows.append((_UNRANKED, *(f"{v:.2g}" for v in physical.validation.nrmse)))
     kinds = ("text",) + ("value",) * 6
     return lines + [
         to_markdown(ResultTable("vaf", "Held-out VAF per DOF (%)", ("method", *COORDINATES),
@@ -353,6 +360,8 @@ def _records_section(report: IdentificationReport, records: Sequence[str]) -> li
                 "the validation record `stewartid design` writes) would show it.", ""]
     rows = tuple((run.display_name, *(f"{v:.3f}" for v in run.records.vaf_percent))
                  for run in report.runs if run.records is not None)
+    if report.physical is not None and report.physical.records is not None:
+        rows += ((_UNRANKED, *(f"{v:.3f}" for v in report.physical.records.vaf_percent)),)
     lines = ["## Validation on other records", "",
              f"Each method's model, fitted on all experiments, predicts {len(records)} "
              f"record(s) of another excitation ({', '.join(records)}), filtered as the held-out "
@@ -395,6 +404,8 @@ def _consistency_section(runs: Sequence[MethodReport]) -> list[str]:
 
 def _files_section(report: IdentificationReport) -> list[str]:
     lines = ["## Files", "",
+             "- [result.json](result.json): the physical model's result with its `validation` "
+             "and the compared methods' `verdict`" if report.physical_primary else
              f"- [result.json](result.json): {report.trusted}'s result with its `validation` "
              "and `consistency` objects",
              "- [identification.mat](identification.mat): every method's matrices, standard "
@@ -404,6 +415,9 @@ def _files_section(report: IdentificationReport) -> list[str]:
             links = ", ".join(f"[{run.name}_{key}.csv]({run.name}_{key}.csv)"
                               for key in ("M", "B", "std_errors_M", "std_errors_B"))
             lines.append(f"- {run.display_name}: {links}")
+    if (report.physical is not None and report.physical.result is not None
+            and not report.physical_primary):
+        lines.append("- [physical.json](physical.json): the physical model's result")
     return lines + [""]
 
 

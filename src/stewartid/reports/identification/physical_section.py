@@ -1,0 +1,260 @@
+"""The physical model in the identification report: fitted beside the compared methods (not
+ranked by the verdict), its held-out prediction by the full nonlinear model
+(:mod:`stewartid.assessment.physical_validation`), Mt and Bt across the poses the data cover
+with their uncertainty (:func:`workspace`), and its parameters with the fixed ones named.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from stewartid.assessment.physical_validation import (
+    cross_validate_physical,
+    validate_physical_on_records,
+)
+from stewartid.assessment.validation import (
+    Segment,
+    held_out_segments,
+    record_segments,
+    validation_entry,
+)
+from stewartid.assessment.verdict import worst_dof
+from stewartid.datasets.dataset import Dataset
+from stewartid.errors import StewartidError
+from stewartid.identification.physical import PhysicalIdentifier, PhysicalResult
+from stewartid.identification.physical_prediction import matrices_at, parameter_map
+from stewartid.model.linearization import nominal_matrices
+from stewartid.platform import COORDINATES, Platform
+from stewartid.reporting.tables import ResultTable, to_markdown
+from stewartid.reports.identification.records import PhysicalSection, Workspace
+
+#: Poses per swept coordinate in :func:`workspace`.
+WORKSPACE_POINTS = 11
+#: Off-diagonal entries of Mt and of Bt shown beside the diagonal (the largest).
+SHOWN_COUPLINGS = 2
+#: Share of the parameters fixed at the file's values above which a report that did not ask
+#: for the physical model leaves its section out (one line says why).
+MOST_FIXED = 0.5
+
+
+@dataclass(frozen=True)
+class PhysicalRequest:
+    """What the report asks of the physical model.
+
+    Attributes
+    ----------
+    payload : bool
+        Payload mode (``identify --payload``).
+    consistent : bool
+        The physically consistent fit (``identify --model physical --consistent``).
+    required : bool
+        ``identify --model physical``: a model that cannot be applied is an error. Otherwise
+        (``identify --method all --report``) one line of the report says why it is not shown.
+    settings : dict
+        Further estimator settings (e.g. ``{"gravity": False}``).
+    """
+
+    payload: bool = False
+    consistent: bool = False
+    required: bool = False
+    settings: Mapping[str, Any] = dataclasses.field(default_factory=dict)
+
+
+def largest_couplings(matrix: np.ndarray, count: int = SHOWN_COUPLINGS
+                      ) -> list[tuple[int, int]]:
+    """The ``count`` off-diagonal entries (i < j) of a (6, 6) matrix largest relative to
+    sqrt(|m_ii m_jj|), those above 1e-6 of it."""
+    d = np.sqrt(np.abs(np.diag(matrix)))
+    scale = np.outer(d, d)
+    relative = np.abs(matrix) / np.where(scale > 0, scale, np.inf)
+    pairs = sorted(((i, j) for i in range(6) for j in range(i + 1, 6)),
+                   key=lambda e: -relative[e])
+    return [e for e in pairs[:count] if relative[e] > 1e-6]
+
+
+def workspace(platform: Platform, result: PhysicalResult, covariance: np.ndarray,
+              datasets: Sequence[Dataset], points: int = WORKSPACE_POINTS) -> Workspace:
+    """Mt and Bt of ``result`` (with standard errors) and of ``platform`` with each
+    coordinate swept over its measured range, the others at their mean.
+
+    Parameters
+    ----------
+    platform : Platform
+        The description the result was fitted with (its own Mt, Bt are the nominal curves).
+    result : PhysicalResult
+    covariance : ndarray, shape (p, p)
+        Of the result's parameters.
+    datasets : sequence of Dataset
+        The experiments whose poses set the range.
+    points : int
+        Poses per coordinate.
+
+    Returns
+    -------
+    Workspace
+    """
+    poses = np.concatenate([d.pose for d in datasets])
+    centre = poses.mean(axis=0)
+    grid = np.linspace(poses.min(axis=0), poses.max(axis=0), points).T
+    mapping = parameter_map(platform, result)
+    identified, nominal = [], []
+    for dof in range(6):
+        swept = np.tile(centre, (points, 1))
+        swept[:, dof] = grid[dof]
+        identified.append(matrices_at(platform, result, covariance, swept, mapping))
+        nominal.append([nominal_matrices(platform, q) for q in swept])
+    at_centre = matrices_at(platform, result, covariance, centre[None], mapping)
+    nominal_array = np.array(nominal)  # (6, P, 2, 6, 6)
+    return Workspace(centre, grid, identified, at_centre, nominal_array[:, :, 0],
+                     nominal_array[:, :, 1],
+                     {"M": largest_couplings(at_centre.M[0]),
+                      "B": largest_couplings(at_centre.B[0])})
+
+
+def fit_physical(datasets: Sequence[Dataset], platform: Platform, request: PhysicalRequest,
+                 folds: int, segments: dict[bool, list[Segment]],
+                 records: Sequence[Dataset] = (),
+                 record_cache: dict[bool, list[Segment]] | None = None) -> PhysicalSection:
+    """Fit the physical model on all experiments, validate it on held-out segments (and on
+    ``records``) and compute its Mt, Bt across the workspace.
+
+    Parameters
+    ----------
+    datasets, platform, folds
+        As :func:`~stewartid.reports.identification.report.write_identification_report`.
+    request : PhysicalRequest
+    segments, record_cache : dict
+        Held-out segments and validation-record segments by ``gravity`` setting, shared with
+        the compared methods (filled on first use).
+    records : sequence of Dataset
+        Validation records (``identify --validate``).
+
+    Returns
+    -------
+    PhysicalSection
+        With ``note`` instead of a result when the model cannot be applied or, unless
+        ``request.required``, the data fix more than ``MOST_FIXED`` of its parameters.
+
+    Raises
+    ------
+    StewartidError
+        With ``request.required``, when the model cannot be applied.
+    """
+    start = time.perf_counter()
+    options = {**request.settings, "payload": request.payload,
+               "consistent": request.consistent}
+    gravity = bool(options.get("gravity", True))
+    try:
+        estimator = PhysicalIdentifier(**options).fit(list(datasets), platform)
+        fixed, count = estimator.fixed_, len(estimator.parameters_)
+        if not request.required and len(fixed) > MOST_FIXED * count:
+            return PhysicalSection(seconds=time.perf_counter() - start, note=(
+                f"The physical model is not shown: these data fix {len(fixed)} of its {count} "
+                "parameters at the platform file's values (not identifiable from them); "
+                "`identify --model physical` fits and names the rest."))
+        if gravity not in segments:
+            segments[gravity] = held_out_segments(datasets, platform, folds, gravity)
+        validation = cross_validate_physical(lambda: PhysicalIdentifier(**options), datasets,
+                                             platform, folds, segments[gravity])
+        external = None
+        if records:
+            cache = {} if record_cache is None else record_cache
+            if gravity not in cache:
+                cache[gravity] = record_segments(records, platform, gravity)
+            external = validate_physical_on_records(estimator.result_, records,
+                                                    cache[gravity], platform)
+        curves = workspace(platform, estimator.result_, estimator.covariance_, datasets)
+    except StewartidError as exc:
+        if request.required:
+            raise
+        return PhysicalSection(seconds=time.perf_counter() - start,
+                               note=f"The physical model is not shown: {exc}")
+    result = dataclasses.replace(estimator.result_,
+                                 validation=validation_entry(validation, external))
+    return PhysicalSection(result, estimator.covariance_, curves, validation, external,
+                           time.perf_counter() - start)
+
+
+def _value(value: float) -> str:
+    return "n/a" if not np.isfinite(value) else f"{value:.6g}"
+
+
+def parameter_table(result: PhysicalResult) -> str:
+    """The identified parameters as a Markdown table: value, standard error, the combination
+    each stands for, and which are fixed and why (or, for the consistent fit, how far each
+    moved in standard errors)."""
+    fixed = result.diagnostics.get("fixed", {})
+    moved = (result.diagnostics.get("consistent") or {}).get("change_std_errors", {})
+    rows = []
+    for name, value in result.parameters.items():
+        note = f"fixed: {fixed[name]}" if name in fixed else (
+            f"moved {moved[name]:+.2g} SE" if name in moved and moved[name] != 0 else "")
+        rows.append((f"`{name}`", _value(value), _value(result.parameter_std_errors[name]),
+                     result.base_parameters.get(name, name), note))
+    return to_markdown(ResultTable(
+        "parameters", "Identified parameters (SI units: kg, kg·m, kg·m², N·s/m, N·m·s, N, N·m)",
+        ("parameter", "value", "standard error", "stands for", "note"),
+        ("text", "value", "value", "text", "text"), tuple(rows)), heading_level=4)
+
+
+def physical_lines(section: PhysicalSection | None,
+                   figures: Mapping[str, tuple[str, str]]) -> list[str]:
+    """The report's "Physical model" section (nothing without a section)."""
+    if section is None:
+        return []
+    lines = ["## Physical model", ""]
+    if section.result is None:
+        return lines + [section.note or "", ""]
+    result = section.result
+    mode = result.diagnostics.get("mode", "full")
+    fixed = result.diagnostics.get("fixed", {})
+    lines += [
+        "The rigid-body model's physical parameters (masses, first moments, inertias, friction "
+        "per joint type, force-sensor offsets; docs/physical-model.md) fitted to all "
+        "experiments by weighted least squares"
+        + (", the payload alone on the platform file's platform" if mode == "payload" else "")
+        + f" ({section.seconds:.1f} s with its validation). It is not ranked by the verdict.",
+        "",
+        ("Fixed at the platform file's values, as these data cannot tell them: "
+         + "; ".join(f"`{name}` ({why})" for name, why in fixed.items()) + ".")
+        if fixed else "Every parameter is identified from these data (none fixed).", ""]
+    if section.validation is not None:
+        vaf, dof = worst_dof(section.validation)
+        text = (f"Held-out prediction by the full model (its gravity, friction and offsets at "
+                f"the measured poses, refitted without each segment): VAF {vaf:.3f} % in the "
+                f"worst DOF ({dof})")
+        if section.records is not None:
+            text += f", {np.min(section.records.vaf_percent):.3f} % on the validation records"
+        lines += [text + "; beside the other methods in the validation tables.", ""]
+    consistent = result.diagnostics.get("consistent")
+    if consistent:
+        lines += [f"Physically consistent fit (solver {consistent['solver']}, "
+                  f"{consistent['status']}): no parameter moved by more than "
+                  f"{consistent['max_change_std_errors']:.2g} standard errors from the "
+                  "unconstrained estimate.", ""]
+    if "workspace" in figures:
+        path, caption = figures["workspace"]
+        lines += [f"![{caption}]({path})", "", f"*{caption}* ([SVG]({path[:-4]}.svg))", ""]
+    return lines + [_range_text(section.workspace), "", parameter_table(result)]
+
+
+def _range_text(curves: Workspace | None) -> str:
+    """The measured range of each coordinate the curves cover."""
+    if curves is None:
+        return ""
+    scale = np.array([1e3] * 3 + [np.degrees(1.0)] * 3)
+    units = ("mm",) * 3 + ("°",) * 3
+    spans = ", ".join(f"{name} {lo * s:.4g} to {hi * s:.4g} {u}" for name, lo, hi, s, u in zip(
+        COORDINATES, curves.grid[:, 0], curves.grid[:, -1], scale, units, strict=True))
+    return f"Measured range (absolute pose): {spans}."
+
+
+__all__ = ["MOST_FIXED", "SHOWN_COUPLINGS", "WORKSPACE_POINTS", "PhysicalRequest",
+           "fit_physical", "largest_couplings", "parameter_table", "physical_lines",
+           "workspace"]
