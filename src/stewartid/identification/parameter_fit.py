@@ -92,7 +92,8 @@ def _weighted_fit(gram, cross, weights, free, fixed_values):
 
 def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np.ndarray,
                      scales: np.ndarray | None = None, max_condition: float = 1e5,
-                     max_relative_error: float = 0.3) -> Solution:
+                     max_relative_error: float = 0.3, regressor_noise: np.ndarray | None = None,
+                     target_noise: np.ndarray | None = None) -> Solution:
     """Weighted least squares for y = X theta with residual-autocorrelation-consistent
     standard errors, fixing at ``nominal`` what the data cannot tell.
 
@@ -114,6 +115,13 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
         The size of each parameter positive by nature (a mass, an inertia: the moving
         body's, for a payload's), zero for the others, which no relative error applies to.
     max_condition, max_relative_error : float
+    regressor_noise : ndarray, shape (6, p, p), optional
+        Per channel, the expected share of X^T X that noise in the regressor rows adds
+        (errors in variables): subtracted, so that the estimate is free of the attenuation
+        bias it causes.
+    target_noise : ndarray, shape (6, p), optional
+        Per channel, the expected share of X^T y that the same noise adds (when y holds
+        regressor columns too, as a known part moved to the left-hand side): subtracted.
 
     Returns
     -------
@@ -126,6 +134,10 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
     by_channel = np.ascontiguousarray(X.transpose(1, 0, 2))  # (6, K, p): BLAS products
     gram = np.swapaxes(by_channel, 1, 2) @ by_channel
     cross = np.einsum("ckp,kc->cp", by_channel, y, optimize=True)
+    if regressor_noise is not None:
+        gram = gram - regressor_noise
+    if target_noise is not None:
+        cross = cross - target_noise
     # a column that is zero (relative to the forces it would explain) is not excited at all
     column = np.sqrt(np.einsum("c,cpp->p", weights, gram))
     free = column > DEAD_COLUMN * column.max()

@@ -52,6 +52,7 @@ from stewartid.identification.parameter_fit import (
     nearest_consistent,
     solve_parameters,
 )
+from stewartid.identification.physical_noise import coulomb_sign_rates, regressor_noise
 from stewartid.identification.preparation import Experiment, prepare
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
@@ -190,17 +191,19 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
     for exp, w in zip(experiments, windows, strict=True):
         n = len(exp.q)
         q, q_dot, q_ddot = differentiate(exp.q, exp.sample_rate, w / SAVGOL_FRACTION, order)
+        sign_rates, sign_window = coulomb_sign_rates(exp.q, exp.sample_rate, w, q)
         signals = np.empty((n, 6, 1 + reg.N_STANDARD))
         signals[:, :, 0] = exp.generalized_force
         for lo in range(0, n, REGRESSOR_CHUNK):  # chunks keep the temporaries in cache
             hi = min(n, lo + REGRESSOR_CHUNK)
             signals[lo:hi, :, 1:] = reg.regressor(platform, q[lo:hi], q_dot[lo:hi],
-                                                  q_ddot[lo:hi], gravity, coulomb_smoothing)
+                                                  q_ddot[lo:hi], gravity, coulomb_smoothing,
+                                                  coulomb_rates=sign_rates[lo:hi])
         filtered = kernel_filter_rows(signals, exp.sample_rate, w, step)
         Ys.append(filtered[:, :, 1:])
         ys.append(filtered[:, :, 0])
         used.append({"name": exp.name, "window_s": w, "samples": len(filtered),
-                     "row_step": step})
+                     "row_step": step, "sign_window_s": sign_window})
     return Regression(np.concatenate(Ys), np.concatenate(ys), used)
 
 
@@ -252,6 +255,10 @@ class PhysicalIdentifier(BaseIdentifier):
         the moving body's (payload mode: the payload's) pseudo-inertia positive semidefinite,
         its mass positive, friction coefficients nonnegative; how far each parameter moved,
         in standard errors, in ``diagnostics["consistent"]``. Needs the ``convex`` extra.
+    noise_correction : bool
+        Remove the bias that pose noise, carried into the regressor's rates and
+        accelerations, puts on the estimate (errors in variables,
+        :func:`~stewartid.identification.physical_noise.regressor_noise`).
 
     Attributes
     ----------
@@ -271,7 +278,7 @@ class PhysicalIdentifier(BaseIdentifier):
                  order: int = SAVGOL_ORDER, gravity: bool = True,
                  coulomb_smoothing: float = 1e-4, decimate: int | None = None,
                  max_condition: float = 1e5, max_relative_error: float = 0.3,
-                 consistent: bool = False):
+                 consistent: bool = False, noise_correction: bool = True):
         self.payload = payload
         self.window = window
         self.order = order
@@ -281,6 +288,7 @@ class PhysicalIdentifier(BaseIdentifier):
         self.max_condition = max_condition
         self.max_relative_error = max_relative_error
         self.consistent = consistent
+        self.noise_correction = noise_correction
 
     _parameter_constraints = {
         **DIFFERENTIATION_CONSTRAINTS,
@@ -291,6 +299,7 @@ class PhysicalIdentifier(BaseIdentifier):
         "max_condition": [positive()],
         "max_relative_error": [positive()],
         "consistent": [BOOLEAN],
+        "noise_correction": [BOOLEAN],
     }
 
     def _fit(self, datasets: list[Dataset], platform: Platform
@@ -302,13 +311,21 @@ class PhysicalIdentifier(BaseIdentifier):
                                    self.decimate, self.gravity, self.coulomb_smoothing)
         model = _payload_model(platform) if self.payload else _full_model(platform)
         names, _, selection, nominal, offset = model
-        X = data.Y[:, :, np.argmax(selection, axis=1)]  # selection: rows of the identity
+        columns = np.argmax(selection, axis=1)  # selection: rows of the identity
+        X = data.Y[:, :, columns]
         y = data.y - data.Y @ offset
+        noise = target_noise = None
+        if self.noise_correction:  # y holds -Y offset, whose noise is that of X's rows
+            full = regressor_noise(experiments, [e["window_s"] for e in data.experiments],
+                                   data.experiments[0]["row_step"], platform,
+                                   SAVGOL_FRACTION, self.order)
+            noise = full[:, columns][:, :, columns]
+            target_noise = -full[:, columns] @ offset
         # the size of a positive parameter: the whole body's (of a payload's, too)
         positive = np.isin(reg.PARAMETERS, POSITIVE_PARAMETERS)
         scales = selection @ np.where(positive, np.abs(reg.standard_parameters(platform)), 0.0)
         solution = solve_parameters(X, y, list(names), nominal, scales, self.max_condition,
-                                    self.max_relative_error)
+                                    self.max_relative_error, noise, target_noise)
         projection = None
         if self.consistent:
             nonnegative = np.isin(names, reg.FRICTION_PARAMETERS + reg.ACTUATOR_PARAMETERS)

@@ -47,6 +47,56 @@ def derivative_noise_gains(sample_rate: float, window: float, savgol_window: flo
                               ** 2)) for d in (1, 2))
 
 
+#: Savitzky-Golay order and candidate windows (fractions of the kernel's) of the rates the
+#: Coulomb signs are taken from, shortest first.
+SIGN_ORDER, SIGN_FRACTIONS = 3, (1 / 8, 1 / 4, 1 / 2)
+#: Largest noise of the sign's rate relative to the rate's RMS (on the most moved DOF): a
+#: sine's sign is then uncertain for about (2 / pi) x this fraction of the time.
+SIGN_NOISE = 0.002
+
+
+def coulomb_sign_rates(q: np.ndarray, sample_rate: float, window: float,
+                       smooth: np.ndarray) -> tuple[np.ndarray, float]:
+    """The pose rates the Coulomb signs are taken from, and their Savitzky-Golay window (s).
+
+    A short window keeps the switches where the motion has them (a rig's reversals are not
+    pure sines: stiction, servo dynamics; on noise-free logs of our plant a window of half
+    the kernel put the legs' first moments 11 standard errors off); noise, through a short
+    window, makes the sign chatter around each reversal and biases the friction and what
+    correlates with it (the moving body's first moment 4 standard errors off on the paper's
+    sines with the reference noise). The shortest of :data:`SIGN_FRACTIONS` whose rate noise
+    (from the pose noise estimated on the record) is within :data:`SIGN_NOISE` of the rate's
+    RMS is taken.
+
+    Parameters
+    ----------
+    q : ndarray, shape (N, 6)
+        Measured poses (m, rad).
+    sample_rate : float
+        Hz.
+    window : float
+        The kernel's support (s).
+    smooth : ndarray, shape (N, 6)
+        A smoothed copy of ``q`` for the noise estimate.
+
+    Returns
+    -------
+    rates : ndarray, shape (N, 6)
+    window : float
+        s.
+    """
+    sigma = np.diag(white_noise_covariance(q, smooth))
+    for fraction in SIGN_FRACTIONS:
+        rates = differentiate(q, sample_rate, window * fraction, SIGN_ORDER)[1]
+        n = window_samples(window * fraction, sample_rate, SIGN_ORDER)
+        taps = savgol_coefficients(n, SIGN_ORDER, 1, 1 / sample_rate)
+        rms = np.sqrt(np.mean(rates ** 2, axis=0))
+        noise = np.sqrt(sigma * np.sum(taps ** 2))
+        if np.min(noise / np.maximum(rms, 1e-300)) <= SIGN_NOISE:
+            break
+    return rates, window * fraction
+
+
 def _factor(covariance: np.ndarray) -> np.ndarray:
     """L with L L^T = covariance (positive semidefinite; a noise-free record gives ~0)."""
     values, vectors = np.linalg.eigh(covariance)
@@ -91,4 +141,5 @@ def regressor_noise(experiments: list[Experiment], windows: list[float], row_ste
     return out
 
 
-__all__ = ["derivative_noise_gains", "regressor_noise"]
+__all__ = ["SIGN_FRACTIONS", "SIGN_NOISE", "SIGN_ORDER", "coulomb_sign_rates",
+           "derivative_noise_gains", "regressor_noise"]
