@@ -291,7 +291,7 @@ class PhysicalIdentifier(BaseIdentifier):
         experiments = prepare(datasets, platform, gravity=False)
         data = filtered_regression(experiments, platform, self.window, self.order,
                                    self.decimate, self.gravity, self.coulomb_smoothing)
-        model = _payload_model(platform) if self.payload else _full_model(platform)
+        model = parameter_model(platform, self.payload)
         names, _, selection, nominal, offset = model
         X = data.Y[:, :, np.argmax(selection, axis=1)]  # selection: rows of the identity
         y = data.y - data.Y @ offset
@@ -310,6 +310,33 @@ class PhysicalIdentifier(BaseIdentifier):
                    "parameter_std_errors_": result.parameter_std_errors,
                    "covariance_": solution.covariance, "fixed_": solution.fixed}
         return result, learned
+
+
+def parameter_model(platform: Platform, payload: bool = False) -> tuple:
+    """The parameters an identification regresses on.
+
+    Parameters
+    ----------
+    platform : Platform
+        The description the fit starts from (payload mode: without its payload known).
+    payload : bool
+        Payload mode's parameters (the payload's ten and the nuisance ones), else every base
+        parameter.
+
+    Returns
+    -------
+    names : tuple of str
+        The p parameters.
+    combinations : dict of str to str
+        What each stands for.
+    selection : ndarray, shape (p, N_STANDARD)
+        Rows of the identity: the regressor's columns regressed on.
+    nominal : ndarray, shape (p,)
+        The platform file's values.
+    offset : ndarray, shape (N_STANDARD,)
+        Known standard parameters, subtracted from the measured force.
+    """
+    return _payload_model(platform) if payload else _full_model(platform)
 
 
 def _full_model(platform: Platform):
@@ -413,4 +440,5 @@ def payload_section(parameters: dict[str, float]) -> dict[str, Any]:
 
 __all__ = ["NUISANCE_PARAMETERS", "PAYLOAD_PARAMETERS", "POSITIVE_PARAMETERS",
            "ROWS_PER_WINDOW", "PhysicalIdentifier", "PhysicalResult", "Regression",
-           "filtered_regression", "known_platform", "payload_section", "row_step"]
+           "filtered_regression", "known_platform", "parameter_model", "payload_section",
+           "row_step"]
