@@ -40,7 +40,7 @@ from stewartid.simulation.sensors import SensorNoise
 
 #: Bounds of the search: log-weights of the DOFs, log of the speed, second-frequency share.
 WEIGHT_BOUNDS = (-2.5, 2.5)
-SPEED_BOUNDS = (0.6, 2.0)
+SPEED_BOUNDS = (0.5, 1.0)
 SHARE_BOUNDS = (0.0, 0.6)
 #: Candidates evaluated at random, then by Nelder-Mead from the best.
 RANDOM_CANDIDATES = 12
