@@ -70,7 +70,7 @@ def test_information_matrix_predicts_the_estimators_spread(loaded):
     # a spread over 16 seeds is uncertain by 1 / sqrt(30) = 18 % (one SE): the median over
     # the 24 parameters within 30 %, every one within a factor 2
     assert 0.7 < np.median(ratio) < 1.3, ratio
-    assert np.all((ratio > 0.5) & (ratio < 2.0)), dict(zip(predicted.names, ratio))
+    assert np.all((ratio > 0.5) & (ratio < 2.0)), dict(zip(predicted.names, ratio, strict=True))
 
 
 def test_physical_design_writes_commands_prediction_and_check(loaded, tmp_path):
