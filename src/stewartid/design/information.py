@@ -24,7 +24,7 @@ information. The pose noise (leg-length noise through the kinematics) is left ou
 the filtered accelerations it adds little while the estimator's kernel is long (0.2 periods of
 the dominant frequency, about 0.2 s or more in the band of
 :func:`~stewartid.design.multisine.multisine_design`), but at 0.1 s it doubled the standard
-errors; the Monte Carlo check of the final design shows it. The share at the reference noise (checked by the Monte Carlo of the final design).
+errors; the Monte Carlo check of the final design shows it.
 
 A relative standard error is judged against a parameter's size: its nominal magnitude, at
 least a tenth of its group's scale for the first moments (mass times the radius of gyration)

@@ -89,8 +89,12 @@ def monte_carlo_check(platform: Platform, records: list, noise: SensorNoise,
         ``seeds``, ``ratio_median`` (predicted / reported), ``within_30_percent``,
         ``max_abs_z``, and per parameter ``predicted``, ``reported``, ``errors``.
     """
-    inverse = inverse_leg_jacobians(platform, [r.q for r in records])
     names = prediction.names
+    if seeds == 0:
+        return {"seeds": 0, "ratio_median": None, "within_30_percent": None,
+                "max_abs_z": None, "parameters": {n: {"predicted": None, "reported": None,
+                                                      "errors": []} for n in names}}
+    inverse = inverse_leg_jacobians(platform, [r.q for r in records])
     estimates, reported = [], []
     for seed in range(seeds):
         generators = [np.random.default_rng([seed, k]) for k in range(len(records))]
@@ -99,7 +103,7 @@ def monte_carlo_check(platform: Platform, records: list, noise: SensorNoise,
         estimates.append([fitted.parameters_[n] for n in names])
         reported.append([fitted.parameter_std_errors_[n] for n in names])
     estimates, reported = np.array(estimates), np.array(reported, dtype=float)
-    mean_se = np.nanmean(reported, axis=0) if seeds else np.full(len(names), np.nan)
+    mean_se = np.nanmean(reported, axis=0)
     expected = prediction.expected_std_errors
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = expected / mean_se
