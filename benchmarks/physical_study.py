@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from stewartid.identification.physical import PhysicalIdentifier
+from stewartid.model import matrix_regressors
 from stewartid.model import regressor as reg
 from stewartid.model.linearization import nominal_matrices
 from stewartid.platform import load_platform
@@ -139,7 +140,7 @@ def mt_errors(fitted, platform, data, rng) -> tuple[float, float]:
     values = np.array([fitted.parameters_[n] for n in names])
     diag, coupling = 0.0, 0.0
     for pose in rng.uniform(lo, hi, size=(50, 6)):
-        A = reg.inertia_regressor(platform, pose)
+        A = matrix_regressors.inertia_regressor(platform, pose)
         estimate = A[:, :, columns] @ values
         truth, _ = nominal_matrices(platform, pose)
         scale = np.sqrt(np.outer(np.diag(truth), np.diag(truth)))

@@ -76,7 +76,9 @@ PARSED_ONLY = {
 SCALED = {
     # 120 s of motion played and predicted on 120 noise seeds: about 10 min; the smallest
     # budget that holds 2 levels at the quick design's 1 Hz, 2 seeds, model data
-    "design.md": [("--budget 120", "--budget 36 --quick --seeds 2 --model-data --workers 1")],
+    "design.md": [("--budget 120", "--budget 36 --quick --seeds 2 --model-data --workers 1"),
+                  # the physical design: 16 s of motion, no Monte Carlo check (about 15 s)
+                  ("--budget 90", "--budget 16 --seeds 0")],
     # 6 x 20 s records: 2 s each
     "logs.md": [("--seed 1 --out rig/", "--seed 1 --duration 2 --out rig/")],
     # 3 x 3 grid points x 8 seeds of 6 x 20 s records: one point, one seed, 2 s records (the

@@ -14,9 +14,9 @@ from stewartid.signals.differentiation import (
     differentiate,
     estimate_frequency,
     kernel_filter,
-    kernel_filter_rows,
     savgol_gain,
 )
+from stewartid.signals.filtered_rows import kernel_filter_rows
 
 
 @pytest.fixture(scope="module")

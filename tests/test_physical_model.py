@@ -25,6 +25,7 @@ from stewartid.cli import app
 from stewartid.datasets.dataset import write_dataset
 from stewartid.identification.physical import PhysicalIdentifier
 from stewartid.identification.physical_platform import identified_platform
+from stewartid.model import matrix_regressors
 from stewartid.model import regressor as reg
 from stewartid.model.dynamics import ModelTerms, friction_forces
 from stewartid.model.linearization import nominal_matrices, nominal_terms
@@ -163,7 +164,7 @@ def test_mujoco_mass_matrix_and_gravity_through_the_regressor(loaded):
     pi = reg.standard_parameters(loaded)
     for q in reg.random_states(loaded, 3, seed=4)[0]:
         t = mujoco_state.platform_space_terms(loaded, model, data, q)
-        M = reg.inertia_regressor(loaded, q) @ pi
+        M = matrix_regressors.inertia_regressor(loaded, q) @ pi
         d = np.sqrt(np.diag(M))
         assert np.max(np.abs(t["mass_matrix"] - M) / np.outer(d, d)) < 1e-6
         G = reg.regressor(loaded, q, np.zeros(6), np.zeros(6)) @ pi
@@ -209,8 +210,8 @@ def test_nominal_mt_and_bt_through_the_regressor(loaded):
     """The acceleration and viscous columns at rest give the model's Mt and Bt."""
     pi = reg.standard_parameters(loaded)
     M, B, _ = nominal_terms(loaded)
-    assert np.abs(reg.inertia_regressor(loaded) @ pi - M).max() < 1e3 * EPS * np.abs(M).max()
-    assert np.abs(reg.viscous_regressor(loaded) @ pi - B).max() < 1e3 * EPS * np.abs(B).max()
+    assert np.abs(matrix_regressors.inertia_regressor(loaded) @ pi - M).max() < 1e3 * EPS * np.abs(M).max()
+    assert np.abs(matrix_regressors.viscous_regressor(loaded) @ pi - B).max() < 1e3 * EPS * np.abs(B).max()
 
 
 # -- identification on simulated records ---------------------------------------------------

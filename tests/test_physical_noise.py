@@ -9,11 +9,15 @@ import dataclasses
 import numpy as np
 import pytest
 
-from stewartid.identification.physical import SAVGOL_FRACTION, SAVGOL_ORDER, filtered_regression
 from stewartid.identification.physical_noise import (
     SIGN_FRACTIONS,
     coulomb_sign_rates,
     regressor_noise,
+)
+from stewartid.identification.physical_regression import (
+    SAVGOL_FRACTION,
+    SAVGOL_ORDER,
+    filtered_regression,
 )
 from stewartid.identification.preparation import prepare
 from stewartid.model import regressor as reg

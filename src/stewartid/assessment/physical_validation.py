@@ -4,7 +4,7 @@ other method's (:mod:`stewartid.assessment.validation`).
 Mt and Bt at one pose predict the other methods' held-out force. The physical model predicts
 J_lq^T f = Y(q, q_dot, q_ddot) p at the measured poses, with its gravity, Coulomb friction and
 sensor offsets: the regressor filtered as the fit filters it
-(:func:`~stewartid.identification.physical.filtered_regression`, every row, the segment's own
+(:func:`~stewartid.identification.physical_regression.filtered_regression`, every row, the segment's own
 kernel), so the error e = (J_lq^T f) * h - (Y p) * h. The segments' measured force is the
 same filtered J_lq^T f less the model's G(q) filtered; the prediction of it is that force less
 e, so VAF and NRMSE are those of the same measured signal as the other methods', one constant
@@ -30,8 +30,9 @@ from stewartid.assessment.validation import (
 )
 from stewartid.datasets.dataset import Dataset
 from stewartid.errors import DataError
-from stewartid.identification.physical import PhysicalResult, filtered_regression
+from stewartid.identification.physical import PhysicalResult
 from stewartid.identification.physical_prediction import parameter_map
+from stewartid.identification.physical_regression import filtered_regression
 from stewartid.identification.preparation import prepare
 from stewartid.platform import Platform
 from stewartid.signals.differentiation import DEFAULT_ORDER

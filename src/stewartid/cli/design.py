@@ -38,10 +38,11 @@ def design(
                                            help="Largest fraction of every limit "
                                            "the design may use on the plant's simulated "
                                            "states.")] = 0.7,
-    seeds: Annotated[int, typer.Option("--seeds", metavar="N", help="Noise realisations of the predicted "
-                                       "accuracy, >= 2 (a predicted standard error is "
-                                       "uncertain by about 1/sqrt(2 seeds): 6.5 % at "
-                                       "120).")] = 120,
+    seeds: Annotated[int | None, typer.Option(
+        "--seeds", metavar="N", help="Noise realisations of the predicted accuracy, >= 2 (a "
+        "predicted standard error is uncertain by about 1/sqrt(2 seeds): 6.5 % at 120; "
+        "default 120); with --model physical, the noisy copies of the played design the "
+        "prediction is checked on, >= 0 (default 2).")] = None,
     workers: Annotated[int | None, typer.Option(
         "--workers", metavar="N", help="Processes the predictions are spread over (default: every "
         "available core).")] = None,
@@ -52,6 +53,13 @@ def design(
                                         "(a smoke test).")] = False,
     force: Annotated[bool, typer.Option("--force", help="Overwrite a design already in "
                                         "--out.")] = False,
+    model: Annotated[str | None, typer.Option(
+        "--model", metavar="NAME", help="'physical': records that move every DOF at once across "
+        "the workspace, for the physical model (masses, first moments, inertias), chosen by "
+        "the information matrix; --method, --model-data and --quick do not apply.")] = None,
+    payload: Annotated[bool, typer.Option(
+        "--payload", help="--model physical: design for payload mode (the payload's ten "
+        "parameters; the platform file's [payload] is the expected one).")] = False,
 ) -> None:
     """Design an excitation for identification: records within the platform's [limits],
     chosen so that the predicted error of every Mt and Bt entry (|bias| + 2 standard errors)
@@ -70,12 +78,16 @@ def design(
     from stewartid.simulation.sensors import sensor_noise
 
     description = load_platform(platform)
+    physical = model is not None
     # typer has parsed the types: integer flags are checked on their range (Real)
     for flag, value, constraint, unit in (
+            ("--model", model, Options(("physical",)), ""),
             ("--method", method, Options(tuple(m.name for m in registered_methods())), ""),
             ("--budget", budget, positive(), "s"),
             ("--rate", rate, positive(), "Hz"),
-            ("--seeds", seeds, Interval(Real, 2, None), ""),  # a spread needs two realisations
+            ("--max-use", max_use, Interval(Real, 0, 1, closed="right"), ""),
+            # a spread needs two realisations; the physical check none
+            ("--seeds", seeds, Interval(Real, 0 if physical else 2, None), ""),
             ("--workers", workers, Interval(Real, 1, None), ""),
             ("--coulomb", coulomb, nonnegative(), "N m"),
             ("--length-noise", length_noise, nonnegative(), "m"),
@@ -85,6 +97,12 @@ def design(
     if coulomb is not None:
         description = description.replace(friction__coulomb=coulomb)
     noise = sensor_noise(description, "where_zero", length_noise, force_noise)
+    if physical or payload:
+        _design_physical(description, budget, noise, out, payload, rate, max_use, seeds, force,
+                         {"--model": physical, "--method": method != "wavelet",
+                          "--model-data": model_data, "--quick": quick})
+        return
+    seeds = 120 if seeds is None else seeds
     with Progress(transient=True) as bar:
         task = bar.add_task("noise realisations", total=None)
 
@@ -106,4 +124,36 @@ def design(
                f"(paper's set {b.worst_relative_std:.2f} %, ratio "
                f"{p.worst_relative_std / b.worst_relative_std:.2f})")
     typer.echo(f"identify its logs with: {identify_command(method)}")
+    typer.echo(f"wrote {len(output.files)} files to {out}; report: {out / 'report.md'}")
+
+
+def _design_physical(description, budget: float, noise, out: Path, payload: bool, rate: float,
+                     max_use: float, seeds: int | None, force: bool, given: dict) -> None:
+    """``design --model physical``: run it and print its summary."""
+    from rich.console import Console
+
+    from stewartid.design.physical_run import run_physical_design
+    from stewartid.errors import ConfigError
+
+    if not given.pop("--model"):
+        raise ConfigError("--payload needs --model physical.")
+    wrong = [flag for flag, value in given.items() if value]
+    if wrong:
+        raise ConfigError(f"{', '.join(wrong)} do not apply to --model physical; leave "
+                          f"{'them' if len(wrong) > 1 else 'it'} out.")
+    console = Console(stderr=True)
+    output = run_physical_design(
+        description, budget, noise, out, payload=payload, rate_hz=rate, max_use=max_use,
+        check_seeds=2 if seeds is None else seeds, force=force,
+        progress=lambda text: console.print(text, markup=False, highlight=False))
+    p, b = output.prediction, output.baseline
+    typer.echo(f"design: {output.design.label}")
+    typer.echo(f"predicted worst relative standard error {p.worst_relative_std:.3g} % "
+               f"({p.worst_parameter}; all-DOFs multisine of the same length "
+               f"{b.worst_relative_std:.3g} %, ratio {p.worst_relative_std / b.worst_relative_std:.2f})")
+    if output.check["seeds"]:
+        typer.echo(f"check on {output.check['seeds']} noisy copies: predicted / fitted standard "
+                   f"error, median {output.check['ratio_median']:.2f}")
+    typer.echo(f"play it with: {output.commands['play']}")
+    typer.echo(f"identify its logs with: {output.commands['identify']}")
     typer.echo(f"wrote {len(output.files)} files to {out}; report: {out / 'report.md'}")

@@ -99,6 +99,10 @@ class DesignedRecord:
         """Highest frequency of the motion (Hz), for the sampling check of the plant."""
         return self.frequency_hz
 
+    def scaled(self, factor: float) -> DesignedRecord:
+        """The record with its direction (every amplitude) times ``factor``."""
+        return dataclasses.replace(self, direction=tuple(factor * v for v in self.direction))
+
     def envelope(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Amplitude envelope a(t) and its first two time derivatives; each shape (N,)."""
         t = np.asarray(t, dtype=float)
@@ -169,6 +173,9 @@ class Design:
     Attributes
     ----------
     records : tuple of DesignedRecord
+        Or of any record with the same interface (``name``, ``duration``, ``max_frequency``,
+        ``evaluate_offsets``, ``scaled``, ``to_dict``), such as
+        :class:`~stewartid.design.multisine.MultisineRecord`.
     label : str
         Short description for reports.
     """

@@ -159,8 +159,7 @@ def within_plant_limits(platform: Platform, design: Design, max_use: float,
         changed = list(design.records)
         for k in over:
             scale = 0.995 * max_use / peaks[k]
-            changed[k] = dataclasses.replace(
-                changed[k], direction=tuple(scale * v for v in changed[k].direction))
+            changed[k] = changed[k].scaled(scale)
         design = dataclasses.replace(design, records=tuple(changed))
         again = plant_records(platform, Design(tuple(changed[k] for k in over)))
         for k, record in zip(over, again, strict=True):

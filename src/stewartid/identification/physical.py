@@ -7,9 +7,10 @@ evaluated at every sample (rates and accelerations by Savitzky-Golay, the Coulom
 the same rates) and both sides are filtered with the smooth kernel h of
 :func:`~stewartid.signals.differentiation.kernel_filter`: the filtered equation holds exactly
 because it is linear in pi, and h takes the differentiation's noise down to its band. The
-filtered signals are band-limited by h: the regression keeps ``ROWS_PER_WINDOW`` rows per
-kernel window (:func:`row_step`), which moves the estimates by a small fraction of their
-standard errors at a fraction of the cost.
+filtered signals are band-limited by h: the regression keeps
+:data:`~stewartid.identification.physical_regression.ROWS_PER_WINDOW` rows per kernel
+window, which moves the estimates by a small fraction of their standard errors at a fraction
+of the cost.
 
 Two modes:
 
@@ -22,8 +23,8 @@ Two modes:
 Where the data cannot tell a parameter (the scaled regression's condition number, or a
 relative standard error above ``max_relative_error``), it is fixed at the platform file's
 value, named in ``diagnostics["fixed"]`` and the rest fitted. Mt and Bt are linear in the
-parameters (:func:`~stewartid.model.regressor.inertia_regressor`,
-:func:`~stewartid.model.regressor.viscous_regressor`), their standard errors by the delta
+parameters (:func:`~stewartid.model.matrix_regressors.inertia_regressor`,
+:func:`~stewartid.model.matrix_regressors.viscous_regressor`), their standard errors by the delta
 method from the parameters' covariance (residual-autocorrelation consistent, as
 :func:`~stewartid.identification.solvers.solve_least_squares` with ``autocorrelated``).
 With ``consistent=True`` the estimate is replaced by the physically consistent parameters
@@ -52,18 +53,19 @@ from stewartid.identification.parameter_fit import (
     nearest_consistent,
     solve_parameters,
 )
-from stewartid.identification.physical_noise import coulomb_sign_rates, regressor_noise
-from stewartid.identification.preparation import Experiment, prepare
+from stewartid.identification.physical_noise import regressor_noise
+from stewartid.identification.physical_regression import (
+    SAVGOL_FRACTION,
+    SAVGOL_ORDER,
+    Regression,
+    filtered_regression,
+)
+from stewartid.identification.preparation import prepare
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
+from stewartid.model import matrix_regressors
 from stewartid.model import regressor as reg
 from stewartid.platform import Platform
-from stewartid.signals.differentiation import (
-    default_window,
-    differentiate,
-    estimate_frequency,
-    kernel_filter_rows,
-)
 
 #: Names of the payload's parameters in payload mode (the moving body's columns).
 PAYLOAD_PARAMETERS = tuple(f"payload.{name}" for name in reg.BODY_PARAMETERS)
@@ -108,109 +110,6 @@ class PhysicalResult(IdentificationResult):
             "base_parameters": self.base_parameters})}
 
 
-@dataclass(frozen=True)
-class Regression:
-    """The filtered regression of one set of experiments.
-
-    Attributes
-    ----------
-    Y : ndarray, shape (K, 6, N_STANDARD)
-        Filtered standard regressor rows.
-    y : ndarray, shape (K, 6)
-        Filtered measured generalized force J_lq^T f (N, N m).
-    experiments : list of dict
-        Per experiment: name, window (s), rows used.
-    """
-
-    Y: np.ndarray
-    y: np.ndarray
-    experiments: list[dict[str, Any]]
-
-
-#: Savitzky-Golay order and window (a fraction of the kernel's) of the rates and accelerations
-#: the regressor is evaluated at: order 5 over an eighth of the kernel keeps the gain of the
-#: acceleration within 1e-4 of one wherever the kernel passes the signal (order 3 over a
-#: quarter: 2 % low at 1 Hz for a 0.67 s kernel, which biased the inertias), and the kernel
-#: takes the differentiation's noise down to its own band.
-SAVGOL_ORDER, SAVGOL_FRACTION = 5, 8
-
-#: Filtered rows kept per kernel window when the row step is automatic: the filtered signals
-#: vary on the scale of the window, so denser rows add round-off-level information only.
-ROWS_PER_WINDOW = 20
-
-
-def row_step(window: float, sample_rate: float) -> int:
-    """The automatic row step of :func:`filtered_regression`: ``ROWS_PER_WINDOW`` rows per
-    kernel window (``window`` s at ``sample_rate`` Hz), at least 1."""
-    return max(1, int(window * sample_rate) // ROWS_PER_WINDOW)
-
-
-def filtered_regression(experiments: list[Experiment], platform: Platform,
-                        window: float | None = None, order: int = SAVGOL_ORDER,
-                        decimate: int | None = 1, gravity: bool = True,
-                        coulomb_smoothing: float = 1e-4) -> Regression:
-    """The regressor and the generalized force of every experiment, filtered with h.
-
-    The regressor is evaluated at every sample, from the pose and its Savitzky-Golay rates
-    and accelerations (order :data:`SAVGOL_ORDER`, window 1/:data:`SAVGOL_FRACTION` of the
-    kernel's), and filtered with h like the force. The equation J_lq^T f = Y pi is linear in
-    pi, so the filtered one holds exactly, whatever the motion's amplitude; a regressor
-    evaluated at the filtered pose, rate and acceleration instead is off by the kernel's
-    smoothing of its nonlinear terms (md_u, J_u 7 standard errors off at four times the
-    paper's amplitudes).
-
-    Parameters
-    ----------
-    experiments : list of Experiment
-        Prepared without gravity subtraction (``generalized_force`` = J_lq^T f).
-    platform : Platform
-    window : float, optional
-        Kernel support (s); 0.2 periods of each experiment's dominant frequency by default.
-    order : int
-        Savitzky-Golay order of the rates, accelerations and Coulomb signs.
-    decimate : int, optional
-        Keep every ``decimate``-th filtered row; None: the smallest :func:`row_step` of the
-        experiments' windows, the same for all so that each keeps its share of the rows (the
-        filtered signals are band-limited by the kernel: the rows between add little, and
-        the estimates move by a small fraction of their standard errors).
-    gravity : bool
-        Include the gravity columns.
-    coulomb_smoothing : float
-        Regularisation rate of the Coulomb signs (rad/s).
-
-    Returns
-    -------
-    Regression
-    """
-    Ys, ys, used = [], [], []
-    windows = [window or default_window(estimate_frequency(exp.q, exp.sample_rate))
-               for exp in experiments]
-    # one step for every experiment: each keeps its share of the rows, as without decimation
-    step = decimate or min(row_step(w, exp.sample_rate)
-                           for w, exp in zip(windows, experiments, strict=True))
-    for exp, w in zip(experiments, windows, strict=True):
-        n = len(exp.q)
-        q, q_dot, q_ddot = differentiate(exp.q, exp.sample_rate, w / SAVGOL_FRACTION, order)
-        sign_rates, sign_window = coulomb_sign_rates(exp.q, exp.sample_rate, w, q)
-        signals = np.empty((n, 6, 1 + reg.N_STANDARD))
-        signals[:, :, 0] = exp.generalized_force
-        for lo in range(0, n, REGRESSOR_CHUNK):  # chunks keep the temporaries in cache
-            hi = min(n, lo + REGRESSOR_CHUNK)
-            signals[lo:hi, :, 1:] = reg.regressor(platform, q[lo:hi], q_dot[lo:hi],
-                                                  q_ddot[lo:hi], gravity, coulomb_smoothing,
-                                                  coulomb_rates=sign_rates[lo:hi])
-        filtered = kernel_filter_rows(signals, exp.sample_rate, w, step)
-        Ys.append(filtered[:, :, 1:])
-        ys.append(filtered[:, :, 0])
-        used.append({"name": exp.name, "window_s": w, "samples": len(filtered),
-                     "row_step": step, "sign_window_s": sign_window})
-    return Regression(np.concatenate(Ys), np.concatenate(ys), used)
-
-
-#: Samples per call of the regressor in :func:`filtered_regression`.
-REGRESSOR_CHUNK = 2000
-
-
 def known_platform(platform: Platform) -> Platform:
     """The part of a platform description payload mode takes as known: all but its payload."""
     return platform.replace(payload=None)
@@ -244,7 +143,7 @@ class PhysicalIdentifier(BaseIdentifier):
         Rate (rad/s) below which a joint's Coulomb sign is attenuated.
     decimate : int, optional
         Use every ``decimate``-th filtered row; None (default): ``ROWS_PER_WINDOW`` rows per
-        kernel window (:func:`row_step`).
+        kernel window (:func:`~stewartid.identification.physical_regression.row_step`).
     max_condition : float
         Largest condition number of the scaled regression before a parameter is fixed.
     max_relative_error : float
@@ -309,7 +208,7 @@ class PhysicalIdentifier(BaseIdentifier):
         experiments = prepare(datasets, platform, gravity=False)
         data = filtered_regression(experiments, platform, self.window, self.order,
                                    self.decimate, self.gravity, self.coulomb_smoothing)
-        model = _payload_model(platform) if self.payload else _full_model(platform)
+        model = parameter_model(platform, self.payload)
         names, _, selection, nominal, offset = model
         columns = np.argmax(selection, axis=1)  # selection: rows of the identity
         X = data.Y[:, :, columns]
@@ -343,6 +242,33 @@ def _base_parameters(platform: Platform) -> reg.BaseParameters:
     """:func:`~stewartid.model.regressor.base_parameters`, once per platform description: a
     report fits the model several times (folds) and predicts with it (read only)."""
     return reg.base_parameters(platform)
+
+
+def parameter_model(platform: Platform, payload: bool = False) -> tuple:
+    """The parameters an identification regresses on.
+
+    Parameters
+    ----------
+    platform : Platform
+        The description the fit starts from (payload mode: without its payload known).
+    payload : bool
+        Payload mode's parameters (the payload's ten and the nuisance ones), else every base
+        parameter.
+
+    Returns
+    -------
+    names : tuple of str
+        The p parameters.
+    combinations : dict of str to str
+        What each stands for.
+    selection : ndarray, shape (p, N_STANDARD)
+        Rows of the identity: the regressor's columns regressed on.
+    nominal : ndarray, shape (p,)
+        The platform file's values.
+    offset : ndarray, shape (N_STANDARD,)
+        Known standard parameters, subtracted from the measured force.
+    """
+    return _payload_model(platform) if payload else _full_model(platform)
 
 
 def _full_model(platform: Platform):
@@ -401,7 +327,7 @@ def _result(estimator: PhysicalIdentifier, platform: Platform, model, solution: 
     names, combinations, selection, _, offset = model
     values = solution.values if projection is None else projection.values
     matrices, errors = [], []
-    for A in (reg.inertia_regressor(platform), reg.viscous_regressor(platform)):
+    for A in (matrix_regressors.inertia_regressor(platform), matrix_regressors.viscous_regressor(platform)):
         rows = A @ selection.T  # (6, 6, p): the matrix's entries in the parameters
         matrices.append(rows @ values + A @ offset)
         errors.append(np.sqrt(np.clip(np.einsum("ijp,pq,ijq->ij", rows, solution.covariance,
@@ -445,6 +371,5 @@ def payload_section(parameters: dict[str, float]) -> dict[str, Any]:
 
 
 __all__ = ["NUISANCE_PARAMETERS", "PAYLOAD_PARAMETERS", "POSITIVE_PARAMETERS",
-           "REGRESSOR_CHUNK", "ROWS_PER_WINDOW", "SAVGOL_FRACTION", "SAVGOL_ORDER",
-           "PhysicalIdentifier", "PhysicalResult", "Regression",
-           "filtered_regression", "known_platform", "payload_section", "row_step"]
+           "PhysicalIdentifier", "PhysicalResult", "known_platform", "parameter_model",
+           "payload_section"]

@@ -3,7 +3,7 @@ noise, carried into the regressor's rates and accelerations, adds.
 
 The physical model's regressor rows are evaluated at the measured pose and its Savitzky-Golay
 rate and acceleration, then filtered with the kernel h
-(:func:`~stewartid.identification.physical.filtered_regression`). White pose noise e (covariance
+(:func:`~stewartid.identification.physical_regression.filtered_regression`). White pose noise e (covariance
 Sigma per sample, estimated from the record by
 :func:`~stewartid.identification.wavelet.noise.white_noise_covariance`) enters a filtered row
 mostly through the terms linear in the acceleration and the rate,
@@ -25,15 +25,16 @@ import numpy as np
 
 from stewartid.identification.preparation import Experiment
 from stewartid.identification.wavelet.noise import white_noise_covariance
+from stewartid.model import matrix_regressors
 from stewartid.model import regressor as reg
 from stewartid.platform import Platform
 from stewartid.signals.differentiation import (
     differentiate,
-    kernel_filter_rows,
     kernel_taps,
     savgol_coefficients,
     window_samples,
 )
+from stewartid.signals.filtered_rows import kernel_filter_rows
 
 
 def derivative_noise_gains(sample_rate: float, window: float, savgol_window: float,
@@ -133,8 +134,8 @@ def regressor_noise(experiments: list[Experiment], windows: list[float], row_ste
                                                             order)[0])
         gains = derivative_noise_gains(rate, window, savgol_window, order)
         poses = kernel_filter_rows(exp.q, rate, window, row_step)
-        for jacobian, gain in ((reg.viscous_regressor(platform, poses), gains[0]),
-                               (reg.inertia_regressor(platform, poses), gains[1])):
+        for jacobian, gain in ((matrix_regressors.viscous_regressor(platform, poses), gains[0]),
+                               (matrix_regressors.inertia_regressor(platform, poses), gains[1])):
             # jacobian[k, i, c, :]: d Y_i / d (rate or acceleration of c) at row k
             scaled = np.einsum("cd,kicp->kidp", _factor(sigma * gain), jacobian)
             out += np.einsum("kidp,kidq->ipq", scaled, scaled)

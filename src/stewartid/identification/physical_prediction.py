@@ -8,7 +8,7 @@ known part o of the platform (payload mode: the platform and legs of the file), 
 
     J_lq^T f = Y(q, q_dot, q_ddot) (S^T p + o),   Mt(q) = A(q) (S^T p + o),
 
-with A(q) the inertia (or viscous) regressor (:func:`~stewartid.model.regressor.inertia_regressor`).
+with A(q) the inertia (or viscous) regressor (:func:`~stewartid.model.matrix_regressors.inertia_regressor`).
 Mt(q) is linear in p: its standard errors are sqrt(a^T C a) for each entry's row a = A(q) S^T
 and the parameters' covariance C (``PhysicalIdentifier.covariance_``); fixed parameters have
 zero variance.
@@ -22,7 +22,7 @@ import numpy as np
 
 from stewartid.errors import IdentificationError
 from stewartid.identification.physical import PhysicalResult, _full_model, _payload_model
-from stewartid.model import regressor as reg
+from stewartid.model import matrix_regressors
 from stewartid.platform import Platform
 
 
@@ -117,8 +117,8 @@ def matrices_at(platform: Platform, result: PhysicalResult, covariance: np.ndarr
                                   f"{len(mapping.names)} parameters.")
     out: list[list[np.ndarray]] = [[], [], [], []]
     for pose in np.atleast_2d(np.asarray(poses, dtype=float)):
-        for k, A in enumerate((reg.inertia_regressor(platform, pose),
-                               reg.viscous_regressor(platform, pose))):
+        for k, A in enumerate((matrix_regressors.inertia_regressor(platform, pose),
+                               matrix_regressors.viscous_regressor(platform, pose))):
             rows = A @ mapping.selection.T  # (6, 6, p)
             out[k].append(A @ mapping.standard)
             out[k + 2].append(np.sqrt(np.clip(np.einsum("ijp,pq,ijq->ij", rows, covariance,

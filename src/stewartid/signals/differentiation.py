@@ -258,56 +258,6 @@ def kernel_filter(x: np.ndarray, sample_rate: float, window: float, derivatives:
             for y, k in zip(convolve_valid(x - offset, taps), taps, strict=True)]
 
 
-def kernel_filter_rows(x: np.ndarray, sample_rate: float, window: float, step: int = 1,
-                       exponent: int = KERNEL_EXPONENT) -> np.ndarray:
-    """``kernel_filter(x, ...)[0][::step]`` by direct sums, for many columns and few rows.
-
-    Each kept row is the inner product of the kernel's taps with the samples under it: the
-    cost is (rows x taps x columns), not an FFT of every column, which pays when the rows kept
-    are a small fraction of the samples.
-
-    Parameters
-    ----------
-    x : ndarray, shape (N, ...)
-        Uniformly sampled signals, time on axis 0.
-    sample_rate : float
-        Hz.
-    window : float
-        Kernel support W (s).
-    step : int
-        Keep every ``step``-th output row.
-    exponent : int
-        p >= 3.
-
-    Returns
-    -------
-    ndarray, shape (ceil((N - L + 1) / step), ...)
-        Rows 0, step, 2 step, ... of x * h, aligned with the samples L//2, L//2 + step, ...
-    """
-    x = np.asarray(x, dtype=float)
-    taps = kernel_taps(sample_rate, window, 0, exponent)[0]
-    length = len(taps)
-    if length > len(x):
-        raise DataError(f"record of {len(x)} samples is shorter than the filter window "
-                        f"({length} samples = {window:.3g} s); record longer or shorten "
-                        "the window.")
-    flat = x.reshape(len(x), -1)
-    starts = np.arange(0, len(x) - length + 1, step)
-    out = np.empty((len(starts), flat.shape[1]))
-    # blocks of rows as one banded matrix product (the taps are symmetric: no flip)
-    block = max(1, min(len(starts), length // step, 64))
-    span = (block - 1) * step + length
-    band = np.zeros((block, span))
-    for k in range(block):
-        band[k, k * step:k * step + length] = taps
-    for first in range(0, len(starts), block):
-        rows = min(block, len(starts) - first)
-        start = starts[first]
-        stop = start + (rows - 1) * step + length
-        out[first:first + rows] = band[:rows, :stop - start] @ flat[start:stop]
-    return out.reshape((len(out),) + x.shape[1:])
-
-
 def kernel_taps(sample_rate: float, window: float, derivatives: int = 0,
                 exponent: int = KERNEL_EXPONENT) -> list[np.ndarray]:
     """The discrete taps of :func:`kernel_filter`: h, h' and h'' sampled and scaled so that
@@ -472,6 +422,6 @@ def minimize_bounded(cost: Callable[[float], float], lower: float, upper: float,
 
 
 __all__ = ["DEFAULT_ORDER", "DEFAULT_WINDOW_PERIODS", "convolve_valid", "default_window",
-           "differentiate", "estimate_frequency", "kernel_filter", "kernel_filter_rows",
-           "kernel_taps", "minimize_bounded",
+           "differentiate", "estimate_frequency", "kernel_filter", "kernel_taps",
+           "minimize_bounded",
            "savgol_coefficients", "savgol_gain", "trim", "window_samples"]

@@ -1,0 +1,97 @@
+"""The physical design checked on our plant: design, play, identify over seeds, compare.
+
+Our plant (the paper platform with the physical model's 2 t payload, Coulomb 30 N m), the
+reference sensor noise. ``stewartid design --model physical`` is run (timed) on the platform
+file; its records are played once on the plant without noise and each seed adds the
+reference noise as ``simulate --noise`` draws it (the pose by the first Newton step of the
+forward kinematics, :func:`stewartid.design.prediction.measured_plant_datasets`); the
+physical model is fitted as the printed ``identify`` command does (payload mode on the same
+file with ``--payload``). Printed: the payload's errors (mass %, com mm, inertia diagonal
+about the com %) or full mode's (Mt(q) at 50 random poses inside the motion's range: diagonal
+%), the predicted SE against the spread over seeds, the limit use on the plant's states.
+
+Usage::
+
+    python benchmarks/physical_design_check.py [--payload] [--seeds 8] [--budget 120]
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import physical_study  # noqa: E402
+
+from stewartid.design.candidates import Design  # noqa: E402
+from stewartid.design.information import predict_parameters  # noqa: E402
+from stewartid.design.limits import record_limit_use  # noqa: E402
+from stewartid.design.multisine import MultisineRecord  # noqa: E402
+from stewartid.design.physical_run import FINAL_RATE  # noqa: E402
+from stewartid.design.prediction import (  # noqa: E402
+    inverse_leg_jacobians,
+    measured_plant_datasets,
+    plant_records,
+)
+from stewartid.identification.physical import PhysicalIdentifier  # noqa: E402
+from stewartid.simulation.sensors import reference_noise  # noqa: E402
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--payload", action="store_true")
+    parser.add_argument("--seeds", type=int, default=8)
+    parser.add_argument("--budget", type=float, default=120.0)
+    args = parser.parse_args()
+    loaded = physical_study.loaded_platform("paper")
+    folder = Path(tempfile.mkdtemp(prefix="stewartid-physical-design-"))
+    (folder / "plant.toml").write_text(loaded.to_toml())
+    start = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "stewartid", "design", "--model", "physical",
+                    *(["--payload"] if args.payload else []), "--platform",
+                    str(folder / "plant.toml"), "--budget", str(args.budget), "--out",
+                    str(folder / "design")], check=True)
+    print(f"design: {time.perf_counter() - start:.1f} s wall")
+    import json
+
+    document = json.loads((folder / "design" / "design.json").read_text())
+    design = Design(tuple(MultisineRecord(r["amplitudes"], r["frequencies_hz"], r["phases"],
+                                          r["duration_s"], r["fade_s"], r["name"])
+                          for r in document["design"]["records"]))
+    noise = reference_noise(loaded)
+    prediction = predict_parameters(loaded, design, noise, args.payload, FINAL_RATE)
+    records = plant_records(loaded, design)
+    use = max(max(record_limit_use(loaded, r).peak.values()) for r in records)
+    inverse = inverse_leg_jacobians(loaded, [r.q for r in records])
+    rows, estimates = [], []
+    for seed in range(args.seeds):
+        generators = [np.random.default_rng([1000 + seed, k]) for k in range(len(records))]
+        data = measured_plant_datasets(loaded, records, noise, generators, inverse)
+        fitted = PhysicalIdentifier(payload=args.payload).fit(data, loaded)
+        estimates.append([fitted.parameters_[n] for n in prediction.names])
+        rows.append(physical_study.payload_row(fitted, loaded, physical_study.PAYLOADS["paper"])
+                    if args.payload else physical_study.full_row(
+                        fitted, loaded, records, np.random.default_rng(seed)))
+        print(seed, {k: round(v, 3) for k, v in rows[-1].items()
+                     if isinstance(v, float)}, flush=True)
+    spread = np.std(estimates, axis=0, ddof=1)
+    ratio = prediction.expected_std_errors / spread
+    finite = np.isfinite(ratio)
+    keys = [k for k, v in rows[0].items() if isinstance(v, float)]
+    print("worst over seeds:", {k: round(max(r[k] for r in rows), 3) for k in keys})
+    print(f"predicted SE within 30 % of the spread over {args.seeds} seeds: "
+          f"{np.mean(np.abs(ratio[finite] - 1) <= 0.3):.0%} of {finite.sum()} parameters "
+          f"(median ratio {np.median(ratio[finite]):.2f}); predicted worst relative SE "
+          f"{document['prediction']['worst_relative_std_percent']:.3g} % vs multisine "
+          f"{document['baseline']['worst_relative_std_percent']:.3g} %")
+    print(f"largest limit use on the plant's states: {use:.3f}")
+
+
+if __name__ == "__main__":
+    main()

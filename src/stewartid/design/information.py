@@ -1,0 +1,270 @@
+"""Predicted standard errors of the physical model's parameters from the information matrix.
+
+The physical estimator (:class:`~stewartid.identification.physical.PhysicalIdentifier`)
+regresses the measured generalized force J_lq^T f on the regressor's columns,
+J_lq^T f = X theta + e, with each of the six channels weighted by its residual variance. The
+force noise (white, covariance Sigma_f per sample, ``force_noise`` of every leg) reaches the
+generalized force as S = J_lq^T Sigma_f J_lq. The estimator's covariance is the sandwich
+
+    Cov(theta) = A^-1 B A^-1,   A = sum_k X_k^T W X_k,   B = sum_k X_k^T W S_k W X_k,
+
+W = diag(1 / mean_k S_k,cc) its channel weights, summed over the logged samples. The
+estimator filters both sides with a smooth kernel and keeps ``ROWS_PER_WINDOW`` rows per
+kernel window: the filtered noise is correlated over the window, and its sum over the kept
+rows is (to the kernel's attenuation of the motion, which is small in its pass band) the sum
+of the unfiltered noise over every sample, so the covariance is that of the unfiltered
+regression. The regressor along the commanded motion (analytic q, q_dot, q_ddot) is summed at
+``rate_hz`` and scaled to the sample rate: the products of the columns vary on the scale of
+the motion's periods, far slower than :data:`INFORMATION_RATE`.
+
+The parameters judged are the moving body's ten (full mode) or the payload's ten (payload
+mode); the others (legs, friction, offsets) are estimated with them, so that the judged block
+of the covariance is the inverse of the Schur complement of the others' block in the
+information. The pose noise (leg-length noise through the kinematics) is left out: through
+the filtered accelerations it adds little while the estimator's kernel is long (0.2 periods of
+the dominant frequency, about 0.2 s or more in the band of
+:func:`~stewartid.design.multisine.multisine_design`), but at 0.1 s it doubled the standard
+errors; the Monte Carlo check of the final design shows it.
+
+A relative standard error is judged against a parameter's size: its nominal magnitude, at
+least a tenth of its group's scale for the first moments (mass times the radius of gyration)
+and the products of inertia (the mean of the diagonal), which are often near zero.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any
+
+import numpy as np
+
+from stewartid.design.candidates import Design
+from stewartid.identification.physical import (
+    POSITIVE_PARAMETERS,
+    parameter_model,
+)
+from stewartid.model import regressor as reg
+from stewartid.model.kinematics import leg_jacobian
+from stewartid.platform import Platform
+from stewartid.simulation.sensors import SensorNoise
+
+#: Rate (Hz) the regressor is summed at along a commanded motion: at least ten samples per
+#: period of the fastest motion of the search (2.1 Hz).
+INFORMATION_RATE = 25.0
+
+
+@dataclasses.dataclass(frozen=True)
+class ParameterPrediction:
+    """Predicted standard errors of the physical model's parameters for one design.
+
+    Attributes
+    ----------
+    names : tuple of str
+        Every parameter the estimator fits (nuisance ones included).
+    nominal : ndarray, shape (p,)
+        Their values in the platform file.
+    std_errors : ndarray, shape (p,)
+        Predicted standard errors with every parameter estimated (the parameters' units).
+    expected_std_errors : ndarray, shape (p,)
+        The same once the parameters the estimator would fix (relative standard error above
+        its ``max_relative_error``) are fixed; NaN for those: what a fit will report, and
+        what the design criterion is taken of.
+    fixed : tuple of str
+        Those parameters.
+    sizes : ndarray, shape (p,)
+        What a relative standard error is taken of; 0 for the nuisance parameters.
+    payload : bool
+        Payload mode.
+    """
+
+    names: tuple[str, ...]
+    nominal: np.ndarray
+    std_errors: np.ndarray
+    expected_std_errors: np.ndarray
+    fixed: tuple[str, ...]
+    sizes: np.ndarray
+    payload: bool
+
+    @property
+    def judged(self) -> np.ndarray:
+        """Mask of the parameters the criterion is over (the moving body's or payload's)."""
+        return self.sizes > 0
+
+    @property
+    def relative_std(self) -> np.ndarray:
+        """Expected standard error (the estimator's fixing applied) relative to each judged
+        parameter's size (%); NaN for the others."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(self.judged, 100 * self.expected_std_errors / self.sizes, np.nan)
+
+    @property
+    def worst_relative_std(self) -> float:
+        """Largest relative standard error over the judged parameters (%)."""
+        return float(np.nanmax(self.relative_std))
+
+    @property
+    def worst_parameter(self) -> str:
+        """The judged parameter with the largest relative standard error."""
+        return self.names[int(np.nanargmax(self.relative_std))]
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain values (JSON ready): per parameter its nominal value, predicted SE and
+        relative SE (%, None for nuisance parameters)."""
+        relative = self.relative_std
+        return {"mode": "payload" if self.payload else "full",
+                "worst_relative_std_percent": self.worst_relative_std,
+                "worst_parameter": self.worst_parameter, "fixed": list(self.fixed),
+                "parameters": {name: {"nominal": float(self.nominal[k]),
+                                      "std_error": float(self.std_errors[k]),
+                                      "expected_std_error": (
+                                          None if name in self.fixed
+                                          else float(self.expected_std_errors[k])),
+                                      "relative_std_percent": (float(relative[k])
+                                                               if self.judged[k] else None)}
+                               for k, name in enumerate(self.names)}}
+
+
+def parameter_sizes(names: tuple[str, ...], nominal: np.ndarray) -> np.ndarray:
+    """The size each parameter's relative standard error is taken of; 0 for the parameters
+    not judged.
+
+    The names are the estimator's (``m``, ``mc_x``, ..., or ``payload.m``, ...). Judged are
+    the moving body's ten (the payload's in payload mode): what Mt(q) is made of. The legs'
+    combinations are a small share of it and mostly beyond any excitation within the limits
+    (the estimator fixes them at the file's values where the data cannot tell them);
+    friction and offsets are nuisance parameters. The body's first moments are judged
+    against at least a tenth of its mass times its radius of gyration about the reference
+    point, its products of inertia against at least a tenth of the mean of its inertia
+    diagonal; every other parameter against its magnitude.
+    """
+    values = dict(zip((n.removeprefix("payload.") for n in names), nominal, strict=True))
+    mass = abs(values.get("m", 0.0))
+    diagonal = np.mean([abs(values.get(f"I_{a}{a}", 0.0)) for a in "xyz"])
+    gyration = math.sqrt(1.5 * diagonal / mass) if mass > 0 else 0.0  # tr(I) / 2 m
+    sizes = np.abs(np.asarray(nominal, dtype=float))
+    for k, name in enumerate(names):
+        short = name.removeprefix("payload.")
+        if short not in reg.BODY_PARAMETERS:
+            sizes[k] = 0.0
+        elif short.startswith("mc_"):
+            sizes[k] = max(sizes[k], 0.1 * mass * gyration)
+        elif short in ("I_xy", "I_xz", "I_yz"):
+            sizes[k] = max(sizes[k], 0.1 * diagonal)
+    return sizes
+
+
+def force_noise_covariance(platform: Platform, noise: SensorNoise, q: np.ndarray) -> np.ndarray:
+    """S = J_lq^T Sigma_f J_lq: the covariance of the generalized force's noise per sample.
+
+    Returns
+    -------
+    ndarray, shape (N, 6, 6)
+        N^2, N^2 m, N^2 m^2.
+    """
+    jacobian = leg_jacobian(platform, q)
+    sigma = np.broadcast_to(np.asarray(noise.force_noise, dtype=float), 6)
+    scaled = sigma[None, :, None] * jacobian
+    return np.swapaxes(scaled, 1, 2) @ scaled
+
+
+def sandwich_covariance(X: np.ndarray, S: np.ndarray, samples_per_row: float) -> np.ndarray:
+    """The channel-weighted least-squares covariance A^-1 B A^-1 (module docstring).
+
+    Parameters
+    ----------
+    X : ndarray, shape (K, 6, p)
+        Regressor rows.
+    S : ndarray, shape (K, 6, 6)
+        Noise covariance of each row's channels.
+    samples_per_row : float
+        Logged samples each row stands for (sample rate / row rate).
+
+    Returns
+    -------
+    ndarray, shape (p, p)
+    """
+    weights = 1.0 / np.mean(np.diagonal(S, axis1=1, axis2=2), axis=0)
+    Z = weights[None, :, None] * X  # W X
+    A = np.einsum("kcp,kcq->pq", X, Z, optimize=True)
+    B = np.einsum("kcp,kcd,kdq->pq", Z, S, Z, optimize=True)
+    scale = np.sqrt(np.diag(A))
+    scale = np.where(scale > 0, scale, 1.0)
+    inverse = np.linalg.pinv(A / np.outer(scale, scale), rcond=1e-14) / np.outer(scale, scale)
+    return inverse @ B @ inverse / samples_per_row
+
+
+def design_rows(platform: Platform, design: Design, rate_hz: float = INFORMATION_RATE
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The commanded motion of every record at ``rate_hz``, concatenated: q, q_dot, q_ddot,
+    each of shape (K, 6)."""
+    parts = []
+    for playable in design.playable(platform):
+        duration = playable.record.duration
+        t = np.arange(int(math.floor(duration * rate_hz)) + 1) / rate_hz
+        parts.append(playable.evaluate(t))
+    return tuple(np.concatenate(x) for x in zip(*parts, strict=True))
+
+
+def predict_parameters(platform: Platform, design: Design, noise: SensorNoise,
+                       payload: bool = False, rate_hz: float = INFORMATION_RATE,
+                       max_relative_error: float = 0.3,
+                       states: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+                       rows: np.ndarray | None = None) -> ParameterPrediction:
+    """Predicted standard errors of the physical model's parameters for a design.
+
+    Parameters
+    ----------
+    platform : Platform
+        The description the design is for (with the expected payload in payload mode: it is
+        what the relative errors are taken of).
+    design : Design
+        Records of commanded motion (analytic q, q_dot, q_ddot).
+    noise : SensorNoise
+        ``force_noise`` (N) is used.
+    payload : bool
+        Payload mode (the payload's ten parameters, the platform file without its payload
+        known), else every base parameter.
+    rate_hz : float
+        Rate the regressor is summed at (Hz).
+    max_relative_error : float
+        The estimator's: a parameter positive by nature whose standard error exceeds this
+        fraction of its size is fixed at the file's value (the worst first, one at a time).
+    states : tuple of ndarray, optional
+        (q, q_dot, q_ddot) at ``rate_hz`` when already computed (:func:`design_rows`).
+    rows : ndarray, shape (K, 6, N_STANDARD), optional
+        The standard regressor at ``states``, when already computed.
+
+    Returns
+    -------
+    ParameterPrediction
+    """
+    names, _, selection, nominal, _ = parameter_model(platform, payload)
+    q, q_dot, q_ddot = design_rows(platform, design, rate_hz) if states is None else states
+    X = (reg.regressor(platform, q, q_dot, q_ddot) if rows is None else rows) @ selection.T
+    S = force_noise_covariance(platform, noise, q)
+    per_row = platform.sensors.sample_rate / rate_hz
+    # the estimator's own rule for what it fixes (PhysicalIdentifier's scales)
+    positive = np.isin(reg.PARAMETERS, POSITIVE_PARAMETERS)
+    size = np.maximum(np.abs(nominal), selection @ np.where(
+        positive, np.abs(reg.standard_parameters(platform)), 0.0))
+    fixable = selection @ positive > 0
+    free = np.ones(len(names), dtype=bool)
+    while True:
+        std = np.full(len(names), np.nan)
+        std[free] = np.sqrt(np.clip(np.diag(sandwich_covariance(X[:, :, free], S, per_row)),
+                                    0.0, None))
+        if free.all():
+            every = std.copy()
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.where(free & fixable & (size > 0), std / size, 0.0)
+        if not ratio.max() > max_relative_error:
+            break
+        free[int(np.argmax(ratio))] = False
+    return ParameterPrediction(tuple(names), np.asarray(nominal, dtype=float), every, std,
+                               tuple(n for n, f in zip(names, free, strict=True) if not f),
+                               parameter_sizes(tuple(names), nominal), payload)
+
+
+__all__ = ["INFORMATION_RATE", "ParameterPrediction", "design_rows", "force_noise_covariance",
+           "parameter_sizes", "predict_parameters", "sandwich_covariance"]

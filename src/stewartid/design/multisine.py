@@ -1,0 +1,194 @@
+"""Records that move every DOF at once: a few sines per DOF, faded in and out.
+
+The physical model's parameters are seen only through motion that spans the workspace (large
+rotations for the inertia tensor, translations with rotations for the first moments, joint
+rates of several speeds for viscous against Coulomb friction). A :class:`MultisineRecord`
+moves DOF d as
+
+    q_d(t) = q0_d + a(t) * sum_h A[d, h] sin(2 pi F[d, h] t + phi[d, h]),
+
+with a(t) a quintic fade-in and fade-out (:func:`~stewartid.design.candidates.quintic_ramp`),
+so that the record starts and ends at rest at the neutral pose; pose, rate and acceleration
+are analytic. It has the interface of a designed record (``duration``, ``max_frequency``,
+``evaluate_offsets``, ``scaled``, ``to_dict``), so a :class:`~stewartid.design.candidates.Design`
+holds it, the plant plays it and :func:`~stewartid.design.export.write_commands` exports it.
+
+:func:`multisine_design` is the family the physical design searches (a Fourier series per DOF,
+as BIRDy's and FIGAROH's excitations): record k moves DOF d at the frequencies of a pool
+rotated by k, so that across the records every DOF meets every frequency and no two DOFs
+share one in the same record's first harmonic. :func:`all_dofs_multisine` is the reference
+it is judged against: one sine per DOF at the paper's amplitudes (the physical model's study
+data).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from stewartid.design.candidates import Design, quintic_ramp
+from stewartid.errors import ConfigError
+from stewartid.simulation.excitation import DEFAULT_AMPLITUDES
+
+#: Frequencies (Hz) of the reference all-DOFs multisine: record k moves DOF d at
+#: ``REFERENCE_HZ[(d + k) % 6]``; whole periods in 20 s, within a factor 3.5 of each other
+#: so that the estimator's kernel, set by the dominant one, passes them all.
+REFERENCE_HZ = (0.3, 0.45, 0.6, 0.75, 0.9, 1.05)
+#: Fade-in and fade-out of every multisine record (s).
+MULTISINE_FADE = 2.0
+#: Longest record of a design (s): the budget is split into records no longer than this.
+RECORD_LENGTH = 20.0
+
+
+def _table(value, name: str) -> tuple[tuple[float, ...], ...]:
+    array = np.atleast_2d(np.asarray(value, dtype=float))
+    if array.shape[0] != 6 or not np.all(np.isfinite(array)):
+        raise ConfigError(f"multisine record: {name} must be 6 rows of finite numbers (one per "
+                          f"DOF); got shape {array.shape}.")
+    return tuple(tuple(float(v) for v in row) for row in array)
+
+
+@dataclasses.dataclass(frozen=True)
+class MultisineRecord:
+    """Every DOF at once: a sum of sines per DOF under a fade-in and fade-out.
+
+    Attributes
+    ----------
+    amplitudes : tuple of 6 tuples of H float
+        A[d, h] (m for x, y, z; rad for rx, ry, rz).
+    frequencies_hz : tuple of 6 tuples of H float
+        F[d, h] (Hz), > 0.
+    phases : tuple of 6 tuples of H float
+        phi[d, h] (rad).
+    duration : float
+        Record length (s), fades included.
+    fade : float
+        Fade-in and fade-out (s), each; at most half the duration.
+    name : str
+    """
+
+    amplitudes: tuple[tuple[float, ...], ...]
+    frequencies_hz: tuple[tuple[float, ...], ...]
+    phases: tuple[tuple[float, ...], ...]
+    duration: float
+    fade: float = MULTISINE_FADE
+    name: str = "exp"
+
+    def __post_init__(self) -> None:
+        for key in ("amplitudes", "frequencies_hz", "phases"):
+            object.__setattr__(self, key, _table(getattr(self, key), key))
+        shapes = {np.shape(getattr(self, k)) for k in ("amplitudes", "frequencies_hz", "phases")}
+        if len(shapes) != 1:
+            raise ConfigError(f"record {self.name}: amplitudes, frequencies_hz and phases must "
+                              f"have one shape; got {sorted(shapes)}.")
+        if not min(map(min, self.frequencies_hz)) > 0:
+            raise ConfigError(f"record {self.name}: frequencies must be > 0 Hz.")
+        if not (math.isfinite(self.duration) and 0 < 2 * self.fade <= self.duration):
+            raise ConfigError(f"record {self.name}: duration {self.duration!r} s must be finite "
+                              f"and at least twice the fade {self.fade!r} s.")
+
+    @property
+    def max_frequency(self) -> float:
+        """Highest frequency (Hz), for the plant's sampling check."""
+        return float(np.max(self.frequencies_hz))
+
+    def scaled(self, factor: float) -> MultisineRecord:
+        """The record with every amplitude times ``factor``."""
+        return dataclasses.replace(self, amplitudes=np.asarray(self.amplitudes) * factor)
+
+    def envelope(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Fade-in times fade-out and its first two time derivatives, shape (N,) each."""
+        rise, d_rise, dd_rise = quintic_ramp(t / self.fade)
+        fall, d_fall, dd_fall = quintic_ramp((self.duration - t) / self.fade)
+        k = 1.0 / self.fade
+        return (rise * fall, k * (d_rise * fall - rise * d_fall),
+                k * k * (dd_rise * fall - 2 * d_rise * d_fall + rise * dd_fall))
+
+    def evaluate_offsets(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Motion about the base pose: dq, dq_dot, dq_ddot, each shape (N, 6)."""
+        t = np.asarray(t, dtype=float)
+        omega = 2 * math.pi * np.asarray(self.frequencies_hz)  # (6, H)
+        amplitude = np.asarray(self.amplitudes)
+        angle = t[:, None, None] * omega + np.asarray(self.phases)
+        s, c = np.sin(angle), np.cos(angle)
+        x = np.sum(amplitude * s, axis=2)
+        dx = np.sum(amplitude * omega * c, axis=2)
+        ddx = -np.sum(amplitude * omega ** 2 * s, axis=2)
+        a, da, dda = (v[:, None] for v in self.envelope(t))
+        return a * x, da * x + a * dx, dda * x + 2 * da * dx + a * ddx
+
+    def to_dict(self) -> dict:
+        """Plain data (JSON ready)."""
+        return {"kind": "multisine", "name": self.name, "duration_s": self.duration,
+                "fade_s": self.fade,
+                **{key: [list(row) for row in getattr(self, key)]
+                   for key in ("amplitudes", "frequencies_hz", "phases")}}
+
+
+def record_lengths(budget_s: float) -> list[float]:
+    """The budget (s) split into equal records of at most :data:`RECORD_LENGTH` s."""
+    if not (math.isfinite(budget_s) and budget_s >= 4 * MULTISINE_FADE):
+        raise ConfigError(f"budget must be at least {4 * MULTISINE_FADE:g} s for records "
+                          f"that move every DOF; got {budget_s!r} s.")
+    n = max(1, math.ceil(budget_s / RECORD_LENGTH - 1e-9))
+    return [budget_s / n] * n
+
+
+def multisine_design(budget_s: float, amplitudes: Sequence[float], speed: float = 1.0,
+                     share: float = 0.0, seed: int = 0, label: str | None = None) -> Design:
+    """The physical design's family: records of every DOF at once, the pool rotated by record.
+
+    Parameters
+    ----------
+    budget_s : float
+        Total motion time (s), split by :func:`record_lengths`.
+    amplitudes : sequence of 6 float
+        Sum of the amplitudes of each DOF (m, m, m, rad, rad, rad).
+    speed : float
+        The frequency pool is ``speed * REFERENCE_HZ``.
+    share : float
+        Fraction of each DOF's amplitude at a second frequency, the pool's entry three places
+        on (0: one sine per DOF).
+    seed : int
+        Seed of the phases (uniform, fixed by it: the design is reproducible).
+    label : str, optional
+
+    Returns
+    -------
+    Design
+    """
+    if not 0 <= share < 1:
+        raise ConfigError(f"share must be in [0, 1); got {share!r}.")
+    pool = speed * np.asarray(REFERENCE_HZ)
+    amplitude = np.asarray(amplitudes, dtype=float)
+    rng = np.random.default_rng(seed)
+    records = []
+    for k, length in enumerate(record_lengths(budget_s)):
+        index = (np.arange(6) + k) % 6
+        frequencies = np.column_stack([pool[index], pool[(index + 3) % 6]])
+        weights = np.column_stack([amplitude * (1 - share), amplitude * share])
+        records.append(MultisineRecord(weights, frequencies, rng.uniform(0, 2 * math.pi, (6, 2)),
+                                       length, name=f"exp{k + 1}"))
+    text = label or (f"{len(records)} all-DOF multisine records, {min(pool):.3g}-"
+                     f"{max(pool):.3g} Hz, second-frequency share {share:.2f}")
+    return Design(tuple(records), text)
+
+
+def all_dofs_multisine(budget_s: float) -> Design:
+    """The reference: record k moves DOF d at ``REFERENCE_HZ[(d + k) % 6]`` with the paper's
+    amplitude, phase ``0.5 d + k`` rad (the physical model's study data)."""
+    records = []
+    for k, length in enumerate(record_lengths(budget_s)):
+        index = (np.arange(6) + k) % 6
+        records.append(MultisineRecord(
+            np.asarray(DEFAULT_AMPLITUDES)[:, None], np.asarray(REFERENCE_HZ)[index][:, None],
+            (0.5 * np.arange(6) + k)[:, None], length, name=f"exp{k + 1}"))
+    return Design(tuple(records), f"all-DOFs multisine at the paper's amplitudes, "
+                                  f"{len(records)} x {records[0].duration:g} s")
+
+
+__all__ = ["MULTISINE_FADE", "MultisineRecord", "RECORD_LENGTH", "REFERENCE_HZ",
+           "all_dofs_multisine", "multisine_design", "record_lengths"]

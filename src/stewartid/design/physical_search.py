@@ -1,0 +1,205 @@
+"""Choosing the physical design: all-DOF multisines at the limits, the worst predicted
+relative standard error minimised.
+
+The family (:func:`~stewartid.design.multisine.multisine_design`) has eight parameters: the
+share of each DOF in the motion (six, as log-weights on the paper's amplitudes), the speed of
+the frequency pool and the share of each DOF's amplitude at its second frequency. For each
+candidate the amplitudes are scaled together until the commanded motion uses ``max_use`` of
+the most used limit (:func:`scale_to_limits`: leg strokes, rates, accelerations and forces,
+gimbal angles), and the criterion is the largest predicted relative standard error of the
+parameters asked for (:func:`~stewartid.design.information.predict_parameters`: the
+information matrix, a fraction of a second). Random candidates first (a fixed seed), then
+Nelder-Mead from the best, each within a fixed number of evaluations: the design does not
+depend on the machine's speed.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+
+import numpy as np
+import scipy.optimize
+
+from stewartid.design.candidates import Design
+from stewartid.design.information import (
+    INFORMATION_RATE,
+    ParameterPrediction,
+    design_rows,
+    predict_parameters,
+)
+from stewartid.design.limits import LimitUse, limit_use, resolve_limits
+from stewartid.design.multisine import multisine_design
+from stewartid.errors import ConfigError
+from stewartid.model import regressor as reg
+from stewartid.model.kinematics import inverse_kinematics, leg_jacobian
+from stewartid.platform import Platform
+from stewartid.simulation.excitation import DEFAULT_AMPLITUDES
+from stewartid.simulation.sensors import SensorNoise
+
+#: Bounds of the search: log-weights of the DOFs, log of the speed, second-frequency share.
+WEIGHT_BOUNDS = (-2.5, 2.5)
+SPEED_BOUNDS = (0.5, 1.0)
+SHARE_BOUNDS = (0.0, 0.6)
+#: Candidates evaluated at random, then by Nelder-Mead from the best.
+RANDOM_CANDIDATES = 12
+LOCAL_EVALUATIONS = 48
+
+
+def commanded_limit_use(platform: Platform, design: Design, rate_hz: float = INFORMATION_RATE
+                        ) -> tuple[LimitUse, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Limit use of a design's commanded motion at ``rate_hz``, the forces those of the
+    platform's rigid-body model (J_lq^-T Y pi), and the states it was taken at.
+
+    Returns
+    -------
+    use : LimitUse
+        Of all records one after the other.
+    states : tuple of ndarray
+        (q, q_dot, q_ddot), each (K, 6), and the standard regressor there (K, 6, N_STANDARD).
+    """
+    q, q_dot, q_ddot = design_rows(platform, design, rate_hz)
+    jacobian = leg_jacobian(platform, q)
+    rows = reg.regressor(platform, q, q_dot, q_ddot)
+    generalized = rows @ reg.standard_parameters(platform)
+    forces = np.linalg.solve(np.swapaxes(jacobian, 1, 2), generalized[..., None])[..., 0]
+    rates = np.einsum("nij,nj->ni", jacobian, q_dot)
+    t = np.arange(len(q)) / rate_hz  # records back to back, each from rest: gradients hold
+    use = limit_use(platform, resolve_limits(platform), t, q,
+                    inverse_kinematics(platform, q).lengths, rates,
+                    np.gradient(rates, t, axis=0), forces)
+    return use, (q, q_dot, q_ddot, rows)
+
+
+def scale_to_limits(platform: Platform, design: Design, max_use: float,
+                    rate_hz: float = INFORMATION_RATE, rounds: int = 4
+                    ) -> tuple[Design, LimitUse, tuple]:
+    """Scale every record's amplitudes together until the commanded motion uses ``max_use``
+    of its most used limit (within 2 %).
+
+    Limit use grows about linearly with the amplitudes (but for the static leg forces and
+    the geometry), so a few rescalings settle it.
+
+    Returns
+    -------
+    design : Design
+    use : LimitUse
+    states : tuple of ndarray
+        (q, q_dot, q_ddot) of the scaled design at ``rate_hz`` and the standard regressor.
+    """
+    for _ in range(rounds):
+        use, states = commanded_limit_use(platform, design, rate_hz)
+        peak = max(use.peak.values())
+        if abs(peak - max_use) <= 0.02 * max_use:
+            break
+        # the force limit carries the static load: aim at the dynamic part's share
+        design = dataclasses.replace(design, records=tuple(
+            r.scaled(max_use / peak) for r in design.records))
+    else:
+        use, states = commanded_limit_use(platform, design, rate_hz)
+    return design, use, states
+
+
+@dataclasses.dataclass(frozen=True)
+class PhysicalCandidate:
+    """A candidate of the search with its prediction.
+
+    Attributes
+    ----------
+    design : Design
+    prediction : ParameterPrediction
+    parameters : ndarray, shape (8,)
+        Log-weights of the six DOFs, log speed, second-frequency share.
+    commanded_peak : dict of str to float
+        Peak use of every limit by the commanded motion.
+    """
+
+    design: Design
+    prediction: ParameterPrediction
+    parameters: np.ndarray
+    commanded_peak: dict[str, float]
+
+    @property
+    def score(self) -> float:
+        """The criterion: worst predicted relative standard error (%)."""
+        return self.prediction.worst_relative_std
+
+
+def candidate(platform: Platform, budget_s: float, noise: SensorNoise, payload: bool,
+              parameters: np.ndarray, max_use: float) -> PhysicalCandidate:
+    """One member of the family at the limits, with its prediction."""
+    weights, speed, share = parameters[:6], parameters[6], parameters[7]
+    amplitudes = np.exp(np.clip(weights, *WEIGHT_BOUNDS)) * np.asarray(DEFAULT_AMPLITUDES)
+    design = multisine_design(budget_s, amplitudes, math.exp(np.clip(speed, *np.log(
+        SPEED_BOUNDS))), float(np.clip(share, *SHARE_BOUNDS)))
+    design, use, states = scale_to_limits(platform, design, max_use)
+    prediction = predict_parameters(platform, design, noise, payload, states=states[:3],
+                                    rows=states[3])
+    return PhysicalCandidate(design, prediction, np.asarray(parameters, dtype=float), use.peak)
+
+
+def search_design(platform: Platform, budget_s: float, noise: SensorNoise,
+                  payload: bool = False, max_use: float = 0.7, seed: int = 0,
+                  random_candidates: int = RANDOM_CANDIDATES,
+                  local_evaluations: int = LOCAL_EVALUATIONS,
+                  progress: Callable[[str], None] | None = None) -> PhysicalCandidate:
+    """The member of the family with the smallest worst predicted relative standard error.
+
+    Parameters
+    ----------
+    platform : Platform
+    budget_s : float
+        Total motion time (s).
+    noise : SensorNoise
+    payload : bool
+        Judge the payload's ten parameters (payload mode), else every base parameter but
+        friction and offsets.
+    max_use : float
+        Fraction of the most used limit the commanded motion reaches, in (0, 1].
+    seed : int
+        Of the random candidates and the phases.
+    random_candidates, local_evaluations : int
+        Evaluations of the random stage and of Nelder-Mead.
+    progress : callable, optional
+        Receives a line of text per stage.
+
+    Returns
+    -------
+    PhysicalCandidate
+    """
+    if not 0 < max_use <= 1:
+        raise ConfigError(f"max_use must be in (0, 1]; got {max_use!r}.")
+    rng = np.random.default_rng(seed)
+    lower = np.array([WEIGHT_BOUNDS[0]] * 6 + [math.log(SPEED_BOUNDS[0]), SHARE_BOUNDS[0]])
+    upper = np.array([WEIGHT_BOUNDS[1]] * 6 + [math.log(SPEED_BOUNDS[1]), SHARE_BOUNDS[1]])
+    starts = [np.array([0.0] * 6 + [0.0, 0.0])]  # the reference's shape, at the limits
+    starts += [rng.uniform(lower, upper) for _ in range(random_candidates - 1)]
+    seen: list[PhysicalCandidate] = []
+
+    def evaluate(x: np.ndarray) -> float:
+        seen.append(candidate(platform, budget_s, noise, payload, np.clip(x, lower, upper),
+                              max_use))
+        return math.log(seen[-1].score)
+
+    for x in starts:
+        evaluate(x)
+    best = min(seen, key=lambda c: c.score)
+    if progress:
+        progress(f"{len(seen)} random candidates: best worst relative SE {best.score:.3g} % "
+                 f"({best.prediction.worst_parameter})")
+    if local_evaluations > 0:
+        simplex = best.parameters + np.vstack([np.zeros(8), 0.25 * (upper - lower) * np.eye(8)])
+        scipy.optimize.minimize(evaluate, best.parameters, method="Nelder-Mead", options={
+            "maxfev": local_evaluations, "initial_simplex": np.clip(simplex, lower, upper),
+            "xatol": 1e-3, "fatol": 1e-3})
+        best = min(seen, key=lambda c: c.score)
+        if progress:
+            progress(f"{len(seen)} candidates in all: worst relative SE {best.score:.3g} % "
+                     f"({best.prediction.worst_parameter})")
+    return best
+
+
+__all__ = ["LOCAL_EVALUATIONS", "PhysicalCandidate", "RANDOM_CANDIDATES", "SHARE_BOUNDS",
+           "SPEED_BOUNDS", "WEIGHT_BOUNDS", "candidate", "commanded_limit_use",
+           "scale_to_limits", "search_design"]

@@ -1,0 +1,102 @@
+"""The physical design: information-matrix prediction against a Monte Carlo of the estimator,
+the multisine records, the end-to-end run and the command line's refusals."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from stewartid.cli.application import app
+from stewartid.datasets.dataset import Dataset
+from stewartid.design.information import predict_parameters
+from stewartid.design.multisine import MultisineRecord, all_dofs_multisine
+from stewartid.design.physical_run import run_physical_design
+from stewartid.identification.physical import PhysicalIdentifier
+from stewartid.model import regressor as reg
+from stewartid.model.kinematics import inverse_kinematics, leg_jacobian
+from stewartid.platform import load_platform
+from stewartid.simulation import SensorNoise
+
+PAYLOAD = {"mass": 2000.0, "com": [-0.20, 0.30, -0.50],
+           "inertia": [1800.0, 2200.0, 2600.0, -120.0, 80.0, 160.0]}
+
+
+@pytest.fixture(scope="module")
+def loaded():
+    return load_platform("paper").replace(
+        friction__coulomb=30.0, **{f"payload__{k}": v for k, v in PAYLOAD.items()})
+
+
+def test_multisine_record_derivatives_match_finite_differences():
+    record = MultisineRecord([[0.02, 0.01]] * 3 + [[0.01, 0.005]] * 3,
+                             [[0.3, 0.75], [0.45, 0.9], [0.6, 1.05]] * 2,
+                             np.arange(12.0).reshape(6, 2), 10.0)
+    h = 1e-4
+    t = np.linspace(0.5, 9.5, 7)
+    q, q_dot, q_ddot = record.evaluate_offsets(t)
+    plus, minus = record.evaluate_offsets(t + h)[0], record.evaluate_offsets(t - h)[0]
+    # central differences: error h^2 / 6 q''' (q''' <= A (2 pi f)^3 plus the fade's terms)
+    assert np.allclose((plus - minus) / (2 * h), q_dot, atol=1e-7)
+    assert np.allclose((plus - 2 * q + minus) / h ** 2, q_ddot, atol=1e-4)
+    at_ends = record.evaluate_offsets(np.array([0.0, 10.0]))
+    assert all(np.allclose(x, 0.0, atol=1e-15) for x in at_ends)
+
+
+def test_information_matrix_predicts_the_estimators_spread(loaded):
+    """Rigid-body data of a short record (the commanded motion, the model's forces), white
+    force noise only; the spread of the payload fit over seeds against the prediction."""
+    design = all_dofs_multisine(20.0)
+    rate = loaded.sensors.sample_rate
+    t = np.arange(int(20.0 * rate) + 1) / rate
+    q, q_dot, q_ddot = design.playable(loaded)[0].evaluate(t)
+    generalized = reg.regressor(loaded, q, q_dot, q_ddot) @ reg.standard_parameters(loaded)
+    forces = np.linalg.solve(np.swapaxes(leg_jacobian(loaded, q), 1, 2),
+                             generalized[..., None])[..., 0]
+    lengths = inverse_kinematics(loaded, q).lengths
+    noise = SensorNoise(force_noise=170.0)
+    predicted = predict_parameters(loaded, design, noise, payload=True)
+    rng = np.random.default_rng(7)
+    estimates = []
+    for _ in range(16):
+        data = Dataset(t=t, pose=q, lengths=lengths, name="exp1",
+                       forces=forces + rng.normal(0.0, noise.force_noise, forces.shape))
+        fitted = PhysicalIdentifier(payload=True).fit([data], loaded)
+        estimates.append([fitted.parameters_[n] for n in predicted.names])
+    observed = np.std(estimates, axis=0, ddof=1)
+    ratio = predicted.expected_std_errors / observed
+    # a spread over 16 seeds is uncertain by 1 / sqrt(30) = 18 % (one SE): the median over
+    # the 24 parameters within 30 %, every one within a factor 2
+    assert 0.7 < np.median(ratio) < 1.3, ratio
+    assert np.all((ratio > 0.5) & (ratio < 2.0)), dict(zip(predicted.names, ratio, strict=True))
+
+
+def test_physical_design_writes_commands_prediction_and_check(loaded, tmp_path):
+    out = run_physical_design(loaded, 16.0, SensorNoise(force_noise=170.0), tmp_path / "d",
+                              payload=True, check_seeds=1,
+                              search={"random_candidates": 2, "local_evaluations": 0})
+    document = json.loads((tmp_path / "d" / "design.json").read_text())
+    assert document["model"] == "physical"
+    assert set(document["prediction"]["parameters"]) == set(document["baseline"]["parameters"])
+    assert all(max(peak.values()) <= 0.7 + 1e-3 for peak in document["limit_use"])
+    assert document["identify"]["identify"].endswith("--model physical --payload")
+    assert (tmp_path / "d" / "commands" / "exp1.csv").is_file()
+    assert (tmp_path / "d" / "validation" / "validation.csv").is_file()
+    assert out.check["seeds"] == 1 and out.check["ratio_median"] > 0
+
+
+@pytest.mark.parametrize(("arguments", "message"), [
+    (["--payload"], "--payload needs --model physical"),
+    (["--model", "rigid"], "--model must be 'physical'"),
+    (["--model", "physical", "--quick"], "--quick do not apply"),
+    (["--model", "physical", "--payload"], "no [payload] section"),
+    (["--model", "physical", "--seeds", "-1"], "--seeds must be >= 0"),
+    (["--model", "physical", "--max-use", "1.5"], "--max-use must be"),
+])
+def test_design_cli_refuses_bad_physical_options(tmp_path, arguments, message):
+    result = CliRunner().invoke(app, ["design", "--out", str(tmp_path / "o"), *arguments])
+    assert result.exit_code == 2, result.output
+    assert message in result.output
+    assert len(result.output.strip().splitlines()) == 1, result.output
