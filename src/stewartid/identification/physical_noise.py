@@ -98,6 +98,10 @@ def coulomb_sign_rates(q: np.ndarray, sample_rate: float, window: float,
     return rates, window * fraction
 
 
+#: Kept rows per evaluation of the noise's Jacobians in :func:`regressor_noise`.
+JACOBIAN_STRIDE = 5
+
+
 def _factor(covariance: np.ndarray) -> np.ndarray:
     """L with L L^T = covariance (positive semidefinite; a noise-free record gives ~0)."""
     values, vectors = np.linalg.eigh(covariance)
@@ -134,13 +138,19 @@ def regressor_noise(experiments: list[Experiment], windows: list[float], row_ste
                                                             order)[0])
         gains = derivative_noise_gains(rate, window, savgol_window, order)
         poses = kernel_filter_rows(exp.q, rate, window, row_step)
+        # the Jacobians vary on the kernel's scale: every JACOBIAN_STRIDE-th row stands for
+        # its neighbours (the sum scaled to the rows kept)
+        rows, poses = len(poses), poses[::JACOBIAN_STRIDE]
         for jacobian, gain in ((matrix_regressors.viscous_regressor(platform, poses), gains[0]),
                                (matrix_regressors.inertia_regressor(platform, poses), gains[1])):
             # jacobian[k, i, c, :]: d Y_i / d (rate or acceleration of c) at row k
-            scaled = np.einsum("cd,kicp->kidp", _factor(sigma * gain), jacobian)
-            out += np.einsum("kidp,kidq->ipq", scaled, scaled)
+            factor = _factor(sigma * gain)
+            for i in range(6):  # (K d, p) per channel: one BLAS product each
+                scaled = np.swapaxes(factor, 0, 1) @ jacobian[:, i]  # (K, d, p)
+                flat = scaled.reshape(-1, scaled.shape[-1])
+                out[i] += (flat.T @ flat) * (rows / len(poses))
     return out
 
 
-__all__ = ["SIGN_FRACTIONS", "SIGN_NOISE", "SIGN_ORDER", "coulomb_sign_rates",
+__all__ = ["JACOBIAN_STRIDE", "SIGN_FRACTIONS", "SIGN_NOISE", "SIGN_ORDER", "coulomb_sign_rates",
            "derivative_noise_gains", "regressor_noise"]
