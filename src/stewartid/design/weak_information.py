@@ -38,11 +38,26 @@ the shift of the mean the noise causes (the noise-free bias is one fit,
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from collections.abc import Callable
 
 import numpy as np
 
 from stewartid.datasets.dataset import Dataset
+from stewartid.design.candidates import Design
+from stewartid.design.prediction import (
+    DESIGN_SETTINGS,
+    SOURCES,
+    NoiseRuns,
+    Prediction,
+    default_estimator,
+    inverse_leg_jacobians,
+    model_datasets,
+    plant_records,
+    predict_accuracy,
+)
+from stewartid.errors import ConfigError
 from stewartid.identification.preparation import Experiment, prepare_experiment
 from stewartid.identification.wavelet.detection import (
     Detection,
@@ -63,6 +78,7 @@ from stewartid.identification.wavelet.weak_form import (
     stack_equations,
 )
 from stewartid.model.linearization import nominal_matrices
+from stewartid.parallel import worker_count
 from stewartid.platform import Platform
 from stewartid.signals.differentiation import differentiate
 from stewartid.simulation.sensors import SensorNoise
@@ -173,8 +189,10 @@ def expected_scatter(stacked: StackedEquations, designs: list[np.ndarray], theta
 
 
 def information_covariance(stacked: StackedEquations, force: np.ndarray, theta: np.ndarray,
-                           model_error: np.ndarray, scatter: np.ndarray) -> np.ndarray:
-    """Cov of every unknown of the joint weak-form fit (module docstring).
+                           model_error: np.ndarray, scatter: np.ndarray
+                           ) -> tuple[np.ndarray, np.ndarray]:
+    """The expected estimate and the covariance of every unknown of the joint weak-form fit
+    (module docstring).
 
     Parameters
     ----------
@@ -190,16 +208,21 @@ def information_covariance(stacked: StackedEquations, force: np.ndarray, theta: 
 
     Returns
     -------
-    ndarray, shape (u, u)
+    z : ndarray, shape (u,)
+        The fit of the noise-free equations with the weights of the noise: the mean of the
+        noisy fits to first order (the errors-in-variables correction removes the noise's
+        shift).
+    covariance : ndarray, shape (u, u)
         [Mt Bt] row-major, then the offsets and the Coulomb level.
     """
     n_experiments = int(stacked.owner.max()) + 1
-    designs, _ = channel_systems(stacked, n_experiments, True)
+    designs, targets = channel_systems(stacked, n_experiments, True)
     n, rows, n_unknowns = designs[0].shape
     gram = stacked.gram[..., :rows, :rows]
     coefficients = [pose_coefficients(stacked.sensitivity[:, i], theta[i]) for i in range(6)]
     weighted = []
     normal = np.zeros((n_unknowns, n_unknowns))
+    rhs = np.zeros(n_unknowns)
     for i in range(6):
         assumed = ((stacked.white[:, i] + model_error[:, i])[:, None, None] * np.eye(rows)
                    + pose_covariance(gram, stacked.sigma, coefficients[i]))
@@ -207,6 +230,7 @@ def information_covariance(stacked: StackedEquations, force: np.ndarray, theta: 
         w_d = np.linalg.solve(assumed, designs[i])                           # (n, R, u)
         weighted.append(w_d)
         normal += np.einsum("nru,nrv->uv", designs[i], w_d, optimize=True)
+        rhs += np.einsum("nru,nr->u", w_d, targets[i])
     # the true noise of the rows of channels i and j: force noise and pose noise, correlated
     meat = np.zeros((n_unknowns, n_unknowns))
     owner_force = force[stacked.owner]                                       # (n, 6, 6)
@@ -220,32 +244,42 @@ def information_covariance(stacked: StackedEquations, force: np.ndarray, theta: 
     scale = np.sqrt(np.diag(normal))
     scale = np.where(scale > 0, scale, 1.0)
     bread = np.linalg.inv(normal / np.outer(scale, scale)) / np.outer(scale, scale)
-    return bread @ meat @ bread
+    return bread @ rhs, bread @ meat @ bread
 
 
-def pooled_std(covariance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Standard errors of Mt and Bt (6, 6) each after the estimator pools every symmetric
-    pair (inverse-variance mean of both members, their correlation kept), from the
-    covariance of [Mt Bt] row-major (72 first unknowns)."""
+def pooled(z: np.ndarray, covariance: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Mt, Bt and their standard errors (6, 6) each once the estimator has pooled every
+    symmetric pair (the inverse-variance mean of both members, their correlation kept),
+    from [Mt Bt] row-major (the 72 first unknowns) and their covariance.
+
+    Returns
+    -------
+    M, B, std_M, std_B : ndarray, shape (6, 6)
+    """
     variance = np.diag(covariance)[:N_THETA].reshape(6, 12)
+    values = z[:N_THETA].reshape(6, 12)
     out = []
     for block in (0, 6):
+        value = values[:, block:block + 6].copy()
         std = np.sqrt(np.clip(variance[:, block:block + 6], 0.0, None))
         for i in range(6):
             for j in range(i + 1, 6):
                 a, b = 12 * i + block + j, 12 * j + block + i
                 w_a, w_b = 1.0 / covariance[a, a], 1.0 / covariance[b, b]
-                pooled = (w_a ** 2 * covariance[a, a] + w_b ** 2 * covariance[b, b]
+                mean = (w_a * z[a] + w_b * z[b]) / (w_a + w_b)
+                spread = (w_a ** 2 * covariance[a, a] + w_b ** 2 * covariance[b, b]
                           + 2 * w_a * w_b * covariance[a, b]) / (w_a + w_b) ** 2
-                std[i, j] = std[j, i] = math.sqrt(max(pooled, 0.0))
-        out.append(std)
-    return out[0], out[1]
+                value[i, j] = value[j, i] = mean
+                std[i, j] = std[j, i] = math.sqrt(max(spread, 0.0))
+        out.append((value, std))
+    (M, std_M), (B, std_B) = out
+    return M, B, std_M, std_B
 
 
-def information_std(platform: Platform, datasets: list[Dataset], noise: SensorNoise,
-                    settings: dict) -> tuple[np.ndarray, np.ndarray]:
-    """Predicted standard errors of Method B's Mt and Bt (6, 6) each on noisy copies of
-    noise-free data (module docstring).
+def information_estimate(platform: Platform, datasets: list[Dataset], noise: SensorNoise,
+                         settings: dict) -> tuple[np.ndarray, ...]:
+    """Method B's expected Mt and Bt and their standard errors on noisy copies of noise-free
+    data (module docstring).
 
     Parameters
     ----------
@@ -259,8 +293,10 @@ def information_std(platform: Platform, datasets: list[Dataset], noise: SensorNo
 
     Returns
     -------
+    M, B : ndarray, shape (6, 6)
+        The mean estimate to first order (kg, kg m, kg m^2; N s/m, N s, N m s).
     std_M, std_B : ndarray, shape (6, 6)
-        kg, kg m, kg m^2; N s/m, N s, N m s.
+        Standard errors (same units).
     """
     stacked, force = expected_equations(platform, datasets, noise, settings)
     designs, _ = channel_systems(stacked, len(datasets), True)
@@ -274,4 +310,100 @@ def information_std(platform: Platform, datasets: list[Dataset], noise: SensorNo
                           pose_coefficients(stacked.sensitivity[:, i], theta[i]))[:, -1, -1]
         for i in range(6)], axis=1)
     scatter = expected_scatter(stacked, designs, invariant.theta, variance)
-    return pooled_std(information_covariance(stacked, force, theta, model_error, scatter))
+    return pooled(*information_covariance(stacked, force, theta, model_error, scatter))
+
+
+def has_information(method: str) -> bool:
+    """Whether the design's estimator for ``method`` has a prediction from the information
+    matrix (Method B with its interval constants tied to the friction structure); the others
+    are predicted by the Monte Carlo alone."""
+    return method == "wavelet" and DESIGN_SETTINGS.get(method, {}).get("friction") in (
+        "shared", "uniform")
+
+
+def information_prediction(platform: Platform, design: Design, noise: SensorNoise,
+                           method: str = "wavelet", check_seeds: int = 0, seed: int = 0,
+                           source: str = "plant", records: list | None = None,
+                           workers: int | None = None,
+                           progress: Callable[[int, int], None] | None = None) -> Prediction:
+    """Predicted bias and standard errors of Mt and Bt for a design, the standard errors from
+    the information matrix (:func:`information_estimate`).
+
+    Parameters
+    ----------
+    platform : Platform
+        With the friction the machine is expected to have.
+    design : Design
+    noise : SensorNoise
+        Sensor noise standard deviations (m, N).
+    method : str
+        Registered method with :func:`has_information`.
+    check_seeds : int
+        0: the bias is the estimator's noise-free error (one fit). >= 2: a Monte Carlo of as
+        many noise realisations (:func:`~stewartid.design.prediction.predict_accuracy`)
+        gives the bias (mean estimate minus nominal, the noise's shift included) and its
+        spread, kept beside the standard errors as their check.
+    seed : int
+        Seed of the Monte Carlo's first realisation.
+    source : {"plant", "model"}
+        Noise-free data from the design played on the plant or from the rigid-body model.
+    records : list of ExperimentRecord, optional
+        The design already played on the plant, ``source="plant"``.
+    workers : int, optional
+        Processes the Monte Carlo is spread over.
+    progress : callable, optional
+        Called with (done, total) after each realisation of the Monte Carlo.
+
+    Returns
+    -------
+    Prediction
+        ``seeds`` = ``check_seeds``; ``monte_carlo_std_*`` set when checked.
+    """
+    if not has_information(method):
+        raise ConfigError(f"method {method!r} has no information-matrix prediction; use "
+                          "predict_accuracy (Monte Carlo).")
+    if source not in SOURCES:
+        raise ConfigError(f"source must be one of {', '.join(SOURCES)}; got {source!r}.")
+    if check_seeds == 1 or check_seeds < 0:
+        raise ConfigError(f"check_seeds must be 0 or >= 2; got {check_seeds!r}.")
+    if source == "plant":
+        records = plant_records(platform, design) if records is None else list(records)
+        runs = NoiseRuns(platform, noise, method, int(seed), records=records,
+                         inverse_jacobians=inverse_leg_jacobians(platform,
+                                                                 [r.q for r in records]))
+    else:
+        runs = NoiseRuns(platform, noise, method, int(seed),
+                         datasets=model_datasets(platform, design))
+    clean = runs.clean()
+    estimator = default_estimator(method)
+    M, B, std_M, std_B = information_estimate(platform, clean, noise, estimator.get_params())
+    M0, B0 = nominal_matrices(platform)
+    label = f"{method} (friction={estimator.friction}), {source} data, information matrix"
+    estimator.fit(clean, platform)
+    prediction = Prediction(nominal_M=M0, nominal_B=B0, bias_M=M - M0, bias_B=B - B0,
+                            noise_free_bias_M=estimator.M_ - M0,
+                            noise_free_bias_B=estimator.B_ - B0, std_M=std_M, std_B=std_B,
+                            seeds=0, method=label)
+    if not check_seeds:
+        return prediction
+    # the check's realisations over every core: each is a fit of about 1.5 s
+    return checked_prediction(prediction, predict_accuracy(
+        platform, design, noise, method, check_seeds, seed, source, records,
+        worker_count(workers, check_seeds), progress))
+
+
+def checked_prediction(prediction: Prediction, monte_carlo: Prediction) -> Prediction:
+    """An information-matrix prediction with the Monte Carlo of the same design as its check:
+    the standard errors stay the information matrix's (the Monte Carlo's spread, uncertain
+    by about 1 / sqrt(2 seeds), is kept beside them), the bias becomes the Monte Carlo's
+    (mean estimate minus nominal: what the first-order expected estimate leaves out)."""
+    return dataclasses.replace(monte_carlo, std_M=prediction.std_M, std_B=prediction.std_B,
+                               monte_carlo_std_M=monte_carlo.std_M,
+                               monte_carlo_std_B=monte_carlo.std_B,
+                               method=f"{prediction.method}, checked by {monte_carlo.seeds} "
+                                      "noise realisations")
+
+
+__all__ = ["checked_prediction", "expected_detection", "expected_equations", "expected_scatter",
+           "has_information", "information_covariance", "information_estimate",
+           "information_prediction", "known_noise", "pooled"]
