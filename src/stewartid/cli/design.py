@@ -124,6 +124,12 @@ def design(
     typer.echo(f"predicted worst relative standard error {p.worst_relative_std:.2f} % "
                f"(paper's set {b.worst_relative_std:.2f} %, ratio "
                f"{p.worst_relative_std / b.worst_relative_std:.2f})")
+    checked = p.relative_monte_carlo_std
+    if checked is not None:
+        ratios = sorted(p.relative_std / checked)
+        typer.echo(f"Monte Carlo check ({p.seeds} noise realisations): predicted over "
+                   f"observed standard error {ratios[0]:.2f}-{ratios[-1]:.2f}, median "
+                   f"{ratios[len(ratios) // 2]:.2f}")
     typer.echo(f"identify its logs with: {identify_command(method)}")
     typer.echo(f"wrote {len(output.files)} files to {out}; report: {out / 'report.md'}")
 
