@@ -125,9 +125,11 @@ class Prediction:
         Nominal Mt, Bt at the neutral pose (kg..., N s/m...).
     bias_M, bias_B : ndarray, shape (6, 6)
         Mean estimate over the seeds minus nominal (same units): the noise-free bias plus the
-        shift the noise causes (uncertain by std / sqrt(seeds)).
-    noise_free_bias_M, noise_free_bias_B : ndarray, shape (6, 6)
-        Noise-free estimate minus nominal (same units).
+        shift the noise causes (uncertain by std / sqrt(seeds)); without seeds, the expected
+        estimate of the information matrix's fit minus nominal.
+    noise_free_bias_M, noise_free_bias_B : ndarray, shape (6, 6), or None
+        Noise-free estimate minus nominal (same units); None when not fitted (an
+        information-matrix prediction without its Monte Carlo check).
     std_M, std_B : ndarray, shape (6, 6)
         Predicted standard errors (same units): standard deviation of the estimates over the
         seeds.
@@ -144,8 +146,8 @@ class Prediction:
     nominal_B: np.ndarray
     bias_M: np.ndarray
     bias_B: np.ndarray
-    noise_free_bias_M: np.ndarray
-    noise_free_bias_B: np.ndarray
+    noise_free_bias_M: np.ndarray | None
+    noise_free_bias_B: np.ndarray | None
     std_M: np.ndarray
     std_B: np.ndarray
     seeds: int
@@ -170,9 +172,10 @@ class Prediction:
         return self._entries("bias")
 
     @property
-    def relative_noise_free_bias(self) -> np.ndarray:
-        """|noise-free bias| of the paper's 20 entries, % of nominal; shape (20,)."""
-        return self._entries("noise_free_bias")
+    def relative_noise_free_bias(self) -> np.ndarray | None:
+        """|noise-free bias| of the paper's 20 entries, % of nominal; shape (20,); None
+        without a noise-free fit."""
+        return None if self.noise_free_bias_M is None else self._entries("noise_free_bias")
 
     @property
     def relative_monte_carlo_std(self) -> np.ndarray | None:
@@ -208,8 +211,9 @@ class Prediction:
                 "entries": entries,
                 "std_M": self.std_M.tolist(), "std_B": self.std_B.tolist(),
                 "bias_M": self.bias_M.tolist(), "bias_B": self.bias_B.tolist(),
-                "noise_free_bias_M": self.noise_free_bias_M.tolist(),
-                "noise_free_bias_B": self.noise_free_bias_B.tolist()}
+                **{f"noise_free_bias_{m}": (None if getattr(self, f"noise_free_bias_{m}") is None
+                                            else getattr(self, f"noise_free_bias_{m}").tolist())
+                   for m in "MB"}}
 
 
 #: Settings of the estimator a design is made for, per method (the rest: its defaults).
