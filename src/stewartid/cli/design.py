@@ -39,10 +39,12 @@ def design(
                                            "the design may use on the plant's simulated "
                                            "states.")] = 0.7,
     seeds: Annotated[int | None, typer.Option(
-        "--seeds", metavar="N", help="Noise realisations of the predicted accuracy, >= 2 (a "
-        "predicted standard error is uncertain by about 1/sqrt(2 seeds): 6.5 % at 120; "
-        "default 120); with --model physical, the noisy copies of the played design the "
-        "prediction is checked on, >= 0 (default 2).")] = None,
+        "--seeds", metavar="N", help="Noise realisations of the Monte Carlo that checks the "
+        "chosen design's predicted accuracy (its bias, and its spread beside the information "
+        "matrix's standard errors), >= 2 (default 8); for a --method without an "
+        "information-matrix prediction, of the prediction itself (default 120); with "
+        "--model physical, the noisy copies of the played design the prediction is checked "
+        "on, >= 0 (default 2).")] = None,
     workers: Annotated[int | None, typer.Option(
         "--workers", metavar="N", help="Processes the predictions are spread over (default: every "
         "available core).")] = None,
@@ -102,7 +104,6 @@ def design(
                          {"--model": physical, "--method": method != "wavelet",
                           "--model-data": model_data, "--quick": quick})
         return
-    seeds = 120 if seeds is None else seeds
     with Progress(transient=True) as bar:
         task = bar.add_task("noise realisations", total=None)
 
@@ -114,7 +115,7 @@ def design(
             bar.console.print(text, markup=False, highlight=False, soft_wrap=True)
 
         output = run_design(description, budget, noise, out, method=method, rate_hz=rate,
-                            max_use=max_use, seeds=seeds if not quick else min(seeds, 4),
+                            max_use=max_use, seeds=min(seeds or 4, 4) if quick else seeds,
                             source="model" if model_data else "plant", quick=quick,
                             force=force, workers=workers, progress=say,
                             realisations=realisations)
@@ -123,6 +124,12 @@ def design(
     typer.echo(f"predicted worst relative standard error {p.worst_relative_std:.2f} % "
                f"(paper's set {b.worst_relative_std:.2f} %, ratio "
                f"{p.worst_relative_std / b.worst_relative_std:.2f})")
+    checked = p.relative_monte_carlo_std
+    if checked is not None:
+        ratios = sorted(p.relative_std / checked)
+        typer.echo(f"Monte Carlo check ({p.seeds} noise realisations): predicted over "
+                   f"observed standard error {ratios[0]:.2f}-{ratios[-1]:.2f}, median "
+                   f"{ratios[len(ratios) // 2]:.2f}")
     typer.echo(f"identify its logs with: {identify_command(method)}")
     typer.echo(f"wrote {len(output.files)} files to {out}; report: {out / 'report.md'}")
 

@@ -12,15 +12,20 @@ each combination of the grid:
    more than ``max_use`` of a limit is scaled down and played again
    (:func:`within_plant_limits`): the plant's force and velocity exceed the commanded
    motion's by up to 15 % of the limit (valve dynamics, tracking, friction);
-3. its accuracy is predicted at full length (``screening_seeds`` noise realisations). Short
-   screening records scaled by 1 / sqrt(time) mis-ranked candidates: the shift the noise
-   causes in the mean estimate (on the Bt diagonal as large as the standard error) does
-   not shrink with time.
+3. its accuracy is predicted at full length: for Method B with its interval constants tied
+   to the friction (the design's estimator) the standard errors from the information matrix
+   of its weak-form equations and the bias of one noise-free fit
+   (:func:`~stewartid.design.weak_information.information_prediction`, about 3 s), for
+   other methods a Monte Carlo of ``screening_seeds`` noise realisations. Short screening
+   records scaled by 1 / sqrt(time) mis-ranked candidates: the bias (once, with Method B
+   before its errors-in-variables correction, as large as the standard error on the Bt
+   diagonal) does not shrink with time.
 
 The criterion is the largest ratio, over the 20 entries of the paper's tables, of the
 predicted |bias| + 2 SE to the accuracy the entry's group requires (``required``: by
 default 0.5 % for the Mt diagonal, 2 % for the Bt diagonal, 8 % for the couplings). The
-best candidate is then predicted again with ``seeds`` realisations.
+best candidate is then checked by a Monte Carlo of ``seeds`` realisations (its bias, the
+noise's shift of the mean included, and the spread beside the information matrix's).
 """
 
 from __future__ import annotations
@@ -34,9 +39,15 @@ import numpy as np
 from stewartid.design.candidates import Design, DesignedRecord, scheduled_design, unit_direction
 from stewartid.design.limits import LimitUse, limit_use, record_limit_use, resolve_limits
 from stewartid.design.prediction import Prediction, plant_records, predict_accuracy
+from stewartid.design.weak_information import (
+    checked_prediction,
+    has_information,
+    information_prediction,
+)
 from stewartid.errors import ConfigError
 from stewartid.model.dynamics import inverse_dynamics
 from stewartid.model.kinematics import inverse_kinematics, leg_jacobian
+from stewartid.parallel import worker_count
 from stewartid.platform import Platform
 from stewartid.reference.published import PAPER_ENTRIES
 from stewartid.simulation.excitation import DEFAULT_AMPLITUDES
@@ -87,6 +98,35 @@ def commanded_use(platform: Platform, record: DesignedRecord) -> LimitUse:
                      inverse_dynamics(platform, q, q_dot, q_ddot))
 
 
+def largest_root(g: Callable[[float], float], low: float, high: float, tolerance: float
+                 ) -> float:
+    """The largest x in [low, high] with g(x) <= 0, to within ``tolerance``, for g increasing
+    with g(high) > 0; 0 when g(low) > 0 already.
+
+    Regula falsi with the Illinois modification (the value at an end that stays twice in a
+    row halved), each point kept a quarter of ``tolerance`` inside the bracket: a limit's
+    use grows almost linearly with the amplitude, so it needs about 8 evaluations of g where
+    bisection needs 20.
+    """
+    g_low, g_high = g(low), g(high)
+    if g_low > 0:
+        return 0.0
+    side = 0
+    while high - low > tolerance:
+        x = (low * g_high - high * g_low) / (g_high - g_low)
+        x = min(max(x, low + 0.25 * tolerance), high - 0.25 * tolerance)
+        value = g(x)
+        if value <= 0:
+            low, g_low = x, value
+            g_high *= 0.5 if side == -1 else 1.0
+            side = -1
+        else:
+            high, g_high = x, value
+            g_low *= 0.5 if side == 1 else 1.0
+            side = 1
+    return low
+
+
 def largest_amplitudes(platform: Platform, frequency_hz: float | Sequence[float],
                        max_use: float = 0.7,
                        cap: float | Sequence[float] = DEFAULT_AMPLITUDE_CAP) -> np.ndarray:
@@ -121,10 +161,8 @@ def largest_amplitudes(platform: Platform, frequency_hz: float | Sequence[float]
         if peak(ceilings[k]) <= max_use:
             out[k] = ceilings[k]
             continue
-        low, high = 0.0, ceilings[k]
-        for _ in range(20):
-            middle = 0.5 * (low + high)
-            low, high = (middle, high) if peak(middle) <= max_use else (low, middle)
+        low = largest_root(lambda a, k=k: peak(a, k) - max_use, 1e-6 * ceilings[k],
+                           ceilings[k], 2.0 ** -20 * ceilings[k])
         if low == 0.0:
             raise ConfigError(f"no motion of {['x', 'y', 'z', 'rx', 'ry', 'rz'][k]} at "
                               f"{frequencies[k]:g} Hz stays within {max_use:.0%} of the "
@@ -134,9 +172,11 @@ def largest_amplitudes(platform: Platform, frequency_hz: float | Sequence[float]
 
 
 def within_plant_limits(platform: Platform, design: Design, max_use: float,
-                        rounds: int = 4) -> tuple[Design, list, list[LimitUse]]:
+                        rounds: int = 4, workers: int | None = None
+                        ) -> tuple[Design, list, list[LimitUse]]:
     """Play a design on the plant and scale down the records whose true states use more than
-    ``max_use`` of a limit, until none does.
+    ``max_use`` of a limit, until none does (the records played over ``workers`` processes,
+    every core by default).
 
     Returns
     -------
@@ -149,7 +189,7 @@ def within_plant_limits(platform: Platform, design: Design, max_use: float,
     uses : list of LimitUse
         Limit use of every record from its true states.
     """
-    records = plant_records(platform, design)
+    records = plant_records(platform, design, workers)
     uses = [record_limit_use(platform, r) for r in records]
     for _ in range(rounds):
         peaks = [max(u.peak.values()) for u in uses]
@@ -161,13 +201,36 @@ def within_plant_limits(platform: Platform, design: Design, max_use: float,
             scale = 0.995 * max_use / peaks[k]
             changed[k] = changed[k].scaled(scale)
         design = dataclasses.replace(design, records=tuple(changed))
-        again = plant_records(platform, Design(tuple(changed[k] for k in over)))
+        again = plant_records(platform, Design(tuple(changed[k] for k in over)), workers)
         for k, record in zip(over, again, strict=True):
             records[k], uses[k] = record, record_limit_use(platform, record)
     if any(u.exceeded for u in uses):
         raise ConfigError(f"the design still exceeds the limits on the plant after {rounds} "
                           "reductions; lower --max-use or check [limits].")
     return design, records, uses
+
+
+def within_plant_limits_all(platform: Platform, designs: Sequence[Design], max_use: float,
+                            workers: int | None = None
+                            ) -> list[tuple[Design, list, tuple[LimitUse, ...]]]:
+    """:func:`within_plant_limits` of several designs, each distinct record played once (the
+    candidates of a grid share most of theirs), the records over ``workers`` processes.
+
+    Returns
+    -------
+    list of (design, records, uses)
+        Per design, as :func:`within_plant_limits`.
+    """
+    distinct = list(dict.fromkeys(r for d in designs for r in d.records))
+    played, records, uses = within_plant_limits(platform, Design(tuple(distinct)), max_use,
+                                                workers=workers)
+    found = {r: k for k, r in enumerate(distinct)}
+    out = []
+    for design in designs:
+        keys = [found[r] for r in design.records]
+        out.append((dataclasses.replace(design, records=tuple(played.records[k] for k in keys)),
+                    [records[k] for k in keys], tuple(uses[k] for k in keys)))
+    return out
 
 
 def required_score(prediction: Prediction,
@@ -199,7 +262,7 @@ def optimise_design(platform: Platform, budget_s: float, noise: SensorNoise,
                     frequencies: Sequence[Sequence[float]] = DEFAULT_FREQUENCIES,
                     schedules: Sequence[Sequence] = DEFAULT_SCHEDULES,
                     max_use: float = 0.7, cap: float | Sequence[float] = DEFAULT_AMPLITUDE_CAP,
-                    screening_seeds: int = 8, seeds: int = 120, source: str = "plant",
+                    screening_seeds: int = 8, seeds: int = 8, source: str = "plant",
                     required: Mapping[str, float] = REQUIRED_ACCURACY,
                     progress: Callable[[str], None] | None = None,
                     workers: int | None = None,
@@ -224,8 +287,12 @@ def optimise_design(platform: Platform, budget_s: float, noise: SensorNoise,
         ``source="plant"``, on the commanded motion with ``"model"``).
     cap : float or sequence of 6 float
         Amplitude cap, multiple of the paper's amplitudes.
-    screening_seeds, seeds : int
-        Noise realisations per candidate, and for the final prediction of the best.
+    screening_seeds : int
+        Noise realisations per candidate of methods without an information-matrix
+        prediction (:func:`~stewartid.design.weak_information.has_information`).
+    seeds : int
+        Noise realisations of the best candidate's Monte Carlo (its check, with an
+        information-matrix prediction; else its prediction), >= 2.
     source : {"plant", "model"}
         Noise-free data of the predictions (:func:`~stewartid.design.prediction.predict_accuracy`).
     required : mapping
@@ -233,7 +300,7 @@ def optimise_design(platform: Platform, budget_s: float, noise: SensorNoise,
     progress : callable, optional
         Called with one line of text per step.
     workers : int, optional
-        Processes the realisations are spread over
+        Processes the candidates' plays on the plant and the realisations are spread over
         (:func:`~stewartid.design.prediction.predict_accuracy`).
     realisations : callable, optional
         Called with (done, total) after each noise realisation of a prediction.
@@ -241,7 +308,7 @@ def optimise_design(platform: Platform, budget_s: float, noise: SensorNoise,
     Returns
     -------
     best : Candidate
-        Predicted with ``seeds`` realisations.
+        Predicted and checked with ``seeds`` realisations.
     screened : list of Candidate
         Every candidate with its screening prediction.
     """
@@ -254,8 +321,7 @@ def optimise_design(platform: Platform, budget_s: float, noise: SensorNoise,
     if len(frequencies) != len(FREQUENCY_GROUPS):
         raise ConfigError(f"frequencies must give {len(FREQUENCY_GROUPS)} sequences (surge and "
                           f"sway, heave, rotations); got {len(frequencies)}.")
-    amplitudes = {}
-    candidates = []
+    amplitudes, designs = {}, []
     for *chosen, levels in itertools.product(*frequencies, schedules):
         f = [0.0] * 6
         for members, value in zip(FREQUENCY_GROUPS, chosen, strict=True):
@@ -264,27 +330,43 @@ def optimise_design(platform: Platform, budget_s: float, noise: SensorNoise,
         for value in set(f):
             if value not in amplitudes:
                 amplitudes[value] = largest_amplitudes(platform, value, max_use, cap)
-        design = scheduled_design([amplitudes[v][k] for k, v in enumerate(f)], f,
-                                  [budget_s / 6] * 6, levels)
-        if source == "plant":
-            design, records, uses = within_plant_limits(platform, design, max_use)
-        else:
-            records, uses = None, [commanded_use(platform, r) for r in design.records]
-        candidates.append((design, records, tuple(uses)))
+        designs.append(scheduled_design([amplitudes[v][k] for k, v in enumerate(f)], f,
+                                        [budget_s / 6] * 6, levels))
+    if source == "plant":
+        candidates = within_plant_limits_all(platform, designs, max_use, workers)
+    else:
+        candidates = [(d, None, tuple(commanded_use(platform, r) for r in d.records))
+                      for d in designs]
+    analytic = has_information(method)
+
+    def predict(design: Design, records: list | None, count: int) -> Prediction:
+        if analytic:
+            return information_prediction(platform, design, noise, method, count,
+                                          source=source, records=records, workers=workers,
+                                          progress=realisations)
+        return predict_accuracy(platform, design, noise, method, count, source=source,
+                                records=records, workers=workers, progress=realisations)
+
+    how = "information matrix" if analytic else f"{screening_seeds} seeds"
     screened = []
     for design, records, uses in candidates if len(candidates) > 1 else ():
-        prediction = predict_accuracy(platform, design, noise, method, screening_seeds,
-                                      source=source, records=records, workers=workers,
-                                      progress=realisations)
-        screened.append(Candidate(design, prediction, uses, dict(required)))
+        prediction = predict(design, records, 0 if analytic else screening_seeds)
+        screened.append(Candidate(design, prediction, tuple(uses), dict(required)))
         say(f"{design.label}: criterion {screened[-1].score:.2f} (worst |bias| + 2 SE over "
-            f"the required accuracy, {screening_seeds} seeds)")
-    best = (candidates[int(np.argmin([c.score for c in screened]))] if screened
-            else candidates[0])
-    design, records, uses = best
-    prediction = predict_accuracy(platform, design, noise, method, seeds, source=source,
-                                  records=records, workers=workers, progress=realisations)
-    final = Candidate(design, prediction, uses, dict(required))
+            f"the required accuracy, {how})")
+    index = int(np.argmin([c.score for c in screened])) if screened else 0
+    design, records, uses = candidates[index]
+    if analytic and screened:  # the best one's information-matrix prediction, checked
+        prediction = checked_prediction(
+            screened[index].prediction,
+            predict_accuracy(platform, design, noise, method, seeds, source=source,
+                             records=records, workers=worker_count(workers, seeds),
+                             progress=realisations))
+    else:
+        prediction = predict(design, records, seeds)
+    final = Candidate(design, prediction, tuple(uses), dict(required))
     say(f"{design.label}: criterion {final.score:.2f}, predicted worst relative SE "
-        f"{prediction.worst_relative_std:.2f} % ({seeds} seeds)")
+        f"{prediction.worst_relative_std:.2f} % ({prediction.method})")
     return final, screened or [final]
+
+

@@ -111,12 +111,16 @@ def render_markdown(design: Design, prediction: Prediction, baseline: Prediction
               f"(paper's set: {baseline.seeds}). Worst relative standard error: "
               f"**{prediction.worst_relative_std:.2f} %** (paper's set "
               f"{baseline.worst_relative_std:.2f} %, ratio "
-              f"{prediction.worst_relative_std / baseline.worst_relative_std:.2f}).", "",
-              "| entry | design SE (%) | design bias (%) | paper's set SE (%) |",
-              "|---|---|---|---|"]
-    for key, s, b, s0 in zip(PAPER_ENTRIES, prediction.relative_std, prediction.relative_bias,
-                             baseline.relative_std, strict=True):
-        lines.append(f"| {entry_label(key)} | {s:.3f} | {b:.3f} | {s0:.3f} |")
+              f"{prediction.worst_relative_std / baseline.worst_relative_std:.2f}).", ""]
+    checked = prediction.relative_monte_carlo_std
+    extra = "" if checked is None else " Monte Carlo SE (%) |"
+    lines += ["| entry | design SE (%) | design bias (%) | paper's set SE (%) |" + extra,
+              "|---|---|---|---|" + ("---|" if extra else "")]
+    for k, (key, s, b, s0) in enumerate(zip(PAPER_ENTRIES, prediction.relative_std,
+                                            prediction.relative_bias, baseline.relative_std,
+                                            strict=True)):
+        lines.append(f"| {entry_label(key)} | {s:.3f} | {b:.3f} | {s0:.3f} |"
+                     + ("" if checked is None else f" {checked[k]:.3f} |"))
     lines += ["", "![predicted accuracy](figures/predicted_accuracy.png)", "",
               "## Playing and identifying it", "",
               "The prediction holds for the estimator it was made with. On the plant first "

@@ -34,9 +34,14 @@ from stewartid.design.report import (
     write_design_report,
 )
 from stewartid.design.validation import write_validation_record
+from stewartid.design.weak_information import has_information, information_prediction
 from stewartid.files import check_output_folder, write_json_atomic
 from stewartid.platform import Platform
 from stewartid.simulation.sensors import SensorNoise
+
+#: Noise realisations of the Monte Carlo that checks the chosen design's information-matrix
+#: prediction (its spread is uncertain by about 1 / sqrt(2 x 8) = 25 %).
+CHECK_SEEDS = 8
 
 
 @dataclasses.dataclass(frozen=True)
@@ -65,7 +70,7 @@ def is_design_file(path: Path) -> bool:
 
 def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str | Path,
                method: str = "wavelet", rate_hz: float = 500.0, max_use: float = 0.7,
-               seeds: int = 120, source: str = "plant", quick: bool = False,
+               seeds: int | None = None, source: str = "plant", quick: bool = False,
                force: bool = False, workers: int | None = None,
                progress: Callable[[str], None] | None = None,
                realisations: Callable[[int, int], None] | None = None) -> DesignOutput:
@@ -86,8 +91,10 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
         Controller rate of the command files (Hz).
     max_use : float
         Fraction of every limit the design may use (on the plant's true states).
-    seeds : int
-        Noise realisations of the final predictions.
+    seeds : int, optional
+        Noise realisations of the Monte Carlo of the chosen design: its check beside the
+        information matrix's standard errors (default :data:`CHECK_SEEDS`), or, for a
+        method without one, its prediction and the paper's set's (default 120).
     source : {"plant", "model"}
         Noise-free data of the predictions: the design played on the plant, or the
         rigid-body model with perfect tracking (faster, optimistic).
@@ -109,6 +116,9 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
     out = Path(out)
     check_output_folder(out, force, is_design_file)
     limits = resolve_limits(platform)
+    analytic = has_information(method)
+    if seeds is None:
+        seeds = CHECK_SEEDS if analytic else 120
     grid = {"frequencies": ((1.0,),) * 3, "schedules": ((1.0, 0.5),)} if quick \
         else {"frequencies": DEFAULT_FREQUENCIES, "schedules": DEFAULT_SCHEDULES}
     best, screened = optimise_design(platform, budget_s, noise, method, max_use=max_use,
@@ -117,8 +127,12 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
     baseline_design = paper_design(duration_s=budget_s / 6)
     if progress:
         progress("predicting the paper's set of the same length")
-    baseline = predict_accuracy(platform, baseline_design, noise, method, seeds, source=source,
-                                workers=workers, progress=realisations)
+    if analytic:
+        baseline = information_prediction(platform, baseline_design, noise, method,
+                                          source=source)
+    else:
+        baseline = predict_accuracy(platform, baseline_design, noise, method, seeds,
+                                    source=source, workers=workers, progress=realisations)
     if progress:
         progress(f"paper's set: predicted worst relative SE {baseline.worst_relative_std:.2f} %")
     design, prediction = best.design, best.prediction
