@@ -111,9 +111,11 @@ def kind_rows(kind: str, platform, clean, methods, seeds) -> list[dict]:
                 mt_diag = 100 * np.abs(np.diag(estimator.M_) / np.diag(M) - 1)
                 row.update(errors=errors, ratios=ratios, mt_diag=float(mt_diag.max()))
             rows.append(row)
+            delay_text = "" if entry is None else (
+                f", delay {entry['seconds'] * 1e3:.4f} +- {entry['std_error'] * 1e3:.4f} ms")
             print(kind, method, seed, "refused" if row["refused"] else
                   f"{row['errors'].max():.3g} % ({row['ratios'].max():.2g} SE), Mt diag "
-                  f"{row['mt_diag']:.3g} %", flush=True)
+                  f"{row['mt_diag']:.3g} %{delay_text}", flush=True)
     return rows
 
 
