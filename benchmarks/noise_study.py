@@ -7,6 +7,8 @@ plant (``--platform paper|FILE``, Coulomb 30 N m, 6 x 20 s; :func:`kind_logs`): 
 frequency each) and the paper's sine at ten times its amplitude, with the reference sensor
 noise (:func:`stewartid.simulation.sensors.reference_noise`) added per seed; the truth is the
 nominal (Mt, Bt). Every registered method and the oracle run on each kind (:func:`kind_study`).
+The sibling ``imperfection_study.py`` runs the three-sine logs with a late force channel and
+with coloured noise, hum, drift and quantisation.
 
 Data: the independent simulator's example data set (``tests/data/example_c10``, truth in
 ``truth.json``) with sensor noise added as on a real hexapod: white noise on the measured
