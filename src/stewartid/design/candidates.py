@@ -38,6 +38,17 @@ def quintic_ramp(s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             60 * s * (1 - s) * (1 - 2 * s))
 
 
+def fade_envelope(t: np.ndarray, fade: float, duration: float
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Quintic fade-in over ``fade`` s times quintic fade-out ending at ``duration`` s, and
+    its first two time derivatives (1/s, 1/s^2), each of the shape of ``t``."""
+    rise, d_rise, dd_rise = quintic_ramp(t / fade)
+    fall, d_fall, dd_fall = quintic_ramp((duration - t) / fade)
+    k = 1.0 / fade
+    return (rise * fall, k * (d_rise * fall - rise * d_fall),
+            k * k * (dd_rise * fall - 2 * d_rise * d_fall + rise * dd_fall))
+
+
 @dataclasses.dataclass(frozen=True)
 class DesignedRecord:
     """One record: a sine along a fixed pose direction under a level schedule.
@@ -285,5 +296,5 @@ def schedule_label(schedules: Sequence, unit: str = "") -> str:
 
 
 __all__ = ["COORDINATES", "Design", "DesignedRecord", "PlayableRecord", "design_from_dict",
-           "paper_design", "quintic_ramp", "record_from_dict", "schedule_label", "scheduled_design",
-           "unit_direction"]
+           "fade_envelope", "paper_design", "quintic_ramp", "record_from_dict", "schedule_label",
+           "scheduled_design", "unit_direction"]

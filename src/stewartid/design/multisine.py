@@ -29,7 +29,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from stewartid.design.candidates import Design, quintic_ramp
+from stewartid.design.candidates import Design, fade_envelope
 from stewartid.errors import ConfigError
 from stewartid.simulation.excitation import DEFAULT_AMPLITUDES
 
@@ -101,11 +101,7 @@ class MultisineRecord:
 
     def envelope(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Fade-in times fade-out and its first two time derivatives, shape (N,) each."""
-        rise, d_rise, dd_rise = quintic_ramp(t / self.fade)
-        fall, d_fall, dd_fall = quintic_ramp((self.duration - t) / self.fade)
-        k = 1.0 / self.fade
-        return (rise * fall, k * (d_rise * fall - rise * d_fall),
-                k * k * (dd_rise * fall - 2 * d_rise * d_fall + rise * dd_fall))
+        return fade_envelope(t, self.fade, self.duration)
 
     def evaluate_offsets(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Motion about the base pose: dq, dq_dot, dq_ddot, each shape (N, 6)."""

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from stewartid.design.candidates import quintic_ramp
+from stewartid.design.candidates import fade_envelope
 from stewartid.files import write_text_atomic
 from stewartid.model.kinematics import inverse_kinematics
 from stewartid.platform import COORDINATES, Platform
@@ -66,11 +66,7 @@ class ValidationRecord:
 
     def envelope(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Fade-in times fade-out, and its first two time derivatives, shape (N,) each."""
-        rise, d_rise, dd_rise = quintic_ramp(t / self.fade)
-        fall, d_fall, dd_fall = quintic_ramp((self.duration - t) / self.fade)
-        k = 1.0 / self.fade
-        return (rise * fall, k * (d_rise * fall - rise * d_fall),
-                k * k * (dd_rise * fall - 2 * d_rise * d_fall + rise * dd_fall))
+        return fade_envelope(t, self.fade, self.duration)
 
     def evaluate_offsets(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Motion about the base pose: dq, dq_dot, dq_ddot, each shape (N, 6)."""
