@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from stewartid.errors import DataError
-from stewartid.signals.differentiation import KERNEL_EXPONENT, kernel_filter, kernel_taps
+from stewartid.signals.differentiation import KERNEL_EXPONENT, kernel_taps
 
 
 def kernel_filter_rows(x: np.ndarray, sample_rate: float, window: float, step: int = 1,
@@ -15,8 +15,9 @@ def kernel_filter_rows(x: np.ndarray, sample_rate: float, window: float, step: i
 
     Each kept row is the inner product of the kernel's taps with the samples under it: the
     cost is (rows x taps x columns), not an FFT of every column, which pays when the rows kept
-    are a small fraction of the samples (a step above about taps / (3 log2(8 taps)); below it
-    the FFT of :func:`~stewartid.signals.differentiation.kernel_filter` is used).
+    are a small fraction of the samples; blocks of rows go through one banded matrix product,
+    which on one BLAS thread beat the FFT of every column even at every row (0.16 s against
+    0.9 s for 180 columns of 20 000 samples and a 667-tap kernel).
 
     Parameters
     ----------
@@ -43,8 +44,6 @@ def kernel_filter_rows(x: np.ndarray, sample_rate: float, window: float, step: i
         raise DataError(f"record of {len(x)} samples is shorter than the filter window "
                         f"({length} samples = {window:.3g} s); record longer or shorten "
                         "the window.")
-    if step * 3 * np.log2(8 * length) < length:  # dense rows: the FFT of every column is cheaper
-        return kernel_filter(x, sample_rate, window, exponent=exponent)[0][::step]
     flat = x.reshape(len(x), -1)
     starts = np.arange(0, len(x) - length + 1, step)
     out = np.empty((len(starts), flat.shape[1]))
