@@ -20,6 +20,7 @@ from stewartid.identification.physical_regression import (
     filtered_regression,
 )
 from stewartid.identification.preparation import prepare
+from stewartid.identification.wavelet.noise import white_noise_covariance
 from stewartid.model import regressor as reg
 from test_physical_model import PAYLOAD, multisine_records
 
@@ -49,10 +50,11 @@ def test_regressor_noise_matches_a_monte_carlo(loaded):
     for _ in range(copies):
         noisy = [dataclasses.replace(e, q=e.q + rng.normal(size=e.q.shape) * NOISE)
                  for e in clean]
-        Y = filtered_regression(noisy, loaded, windows[0], SAVGOL_ORDER, step).Y
-        delta = (Y - base.Y)[:, :, columns]
+        found = filtered_regression(noisy, loaded, windows[0], SAVGOL_ORDER, step)
+        delta = (found.Y - base.Y)[:, :, columns]
         sums += np.einsum("kip,kip->p", delta, delta)
-        gram = regressor_noise(noisy, windows, step, loaded, SAVGOL_FRACTION, SAVGOL_ORDER)
+        gram = regressor_noise(noisy, windows, step, loaded, SAVGOL_FRACTION, SAVGOL_ORDER,
+                               found.pose_noise)
         predicted += np.einsum("ipp->p", gram[:, columns][:, :, columns])
     assert predicted / sums == pytest.approx(np.ones(len(columns)), rel=0.2)
 
@@ -62,8 +64,10 @@ def test_sign_window_follows_the_noise(loaded):
     the reference noise on the paper's small sines takes a longer one."""
     record = prepare(multisine_records(loaded, 1.0, duration=6.0)[:1], loaded, gravity=False)[0]
     window = 0.4
-    _, chosen = coulomb_sign_rates(record.q, record.sample_rate, window, record.q)
+    _, chosen = coulomb_sign_rates(record.q, record.sample_rate, window,
+                                   white_noise_covariance(record.q, record.q))
     assert chosen == pytest.approx(window * SIGN_FRACTIONS[0])
     noisy = record.q + np.random.default_rng(0).normal(size=record.q.shape) * NOISE * 3
-    _, chosen = coulomb_sign_rates(noisy, record.sample_rate, window, record.q)
+    _, chosen = coulomb_sign_rates(noisy, record.sample_rate, window,
+                                   white_noise_covariance(noisy, record.q))
     assert chosen > window * SIGN_FRACTIONS[0]

@@ -217,7 +217,7 @@ class PhysicalIdentifier(BaseIdentifier):
         if self.noise_correction:  # y holds -Y offset, whose noise is that of X's rows
             full = regressor_noise(experiments, [e["window_s"] for e in data.experiments],
                                    data.experiments[0]["row_step"], platform,
-                                   SAVGOL_FRACTION, self.order)
+                                   SAVGOL_FRACTION, self.order, data.pose_noise)
             noise = full[:, columns][:, :, columns]
             target_noise = -full[:, columns] @ offset
         # the size of a positive parameter: the whole body's (of a payload's, too)

@@ -24,7 +24,6 @@ from __future__ import annotations
 import numpy as np
 
 from stewartid.identification.preparation import Experiment
-from stewartid.identification.wavelet.noise import white_noise_covariance
 from stewartid.model import matrix_regressors
 from stewartid.model import regressor as reg
 from stewartid.platform import Platform
@@ -57,7 +56,7 @@ SIGN_NOISE = 0.002
 
 
 def coulomb_sign_rates(q: np.ndarray, sample_rate: float, window: float,
-                       smooth: np.ndarray) -> tuple[np.ndarray, float]:
+                       pose_noise: np.ndarray) -> tuple[np.ndarray, float]:
     """The pose rates the Coulomb signs are taken from, and their Savitzky-Golay window (s).
 
     A short window keeps the switches where the motion has them (a rig's reversals are not
@@ -77,8 +76,9 @@ def coulomb_sign_rates(q: np.ndarray, sample_rate: float, window: float,
         Hz.
     window : float
         The kernel's support (s).
-    smooth : ndarray, shape (N, 6)
-        A smoothed copy of ``q`` for the noise estimate.
+    pose_noise : ndarray, shape (6, 6)
+        The pose's white-noise covariance per sample
+        (:func:`~stewartid.identification.wavelet.noise.white_noise_covariance`).
 
     Returns
     -------
@@ -86,7 +86,7 @@ def coulomb_sign_rates(q: np.ndarray, sample_rate: float, window: float,
     window : float
         s.
     """
-    sigma = np.diag(white_noise_covariance(q, smooth))
+    sigma = np.diag(pose_noise)
     for fraction in SIGN_FRACTIONS:
         rates = differentiate(q, sample_rate, window * fraction, SIGN_ORDER)[1]
         n = window_samples(window * fraction, sample_rate, SIGN_ORDER)
@@ -109,7 +109,8 @@ def _factor(covariance: np.ndarray) -> np.ndarray:
 
 
 def regressor_noise(experiments: list[Experiment], windows: list[float], row_step: int,
-                    platform: Platform, savgol_fraction: float, order: int) -> np.ndarray:
+                    platform: Platform, savgol_fraction: float, order: int,
+                    pose_noise: list[np.ndarray]) -> np.ndarray:
     """Per channel, the sum over the kept rows of E[delta Y_i^T delta Y_i].
 
     Parameters
@@ -124,6 +125,9 @@ def regressor_noise(experiments: list[Experiment], windows: list[float], row_ste
         The Savitzky-Golay window is ``window / savgol_fraction``.
     order : int
         Savitzky-Golay order.
+    pose_noise : list of ndarray, each shape (6, 6)
+        Each experiment's pose white-noise covariance per sample
+        (:attr:`~stewartid.identification.physical_regression.Regression.pose_noise`).
 
     Returns
     -------
@@ -131,12 +135,9 @@ def regressor_noise(experiments: list[Experiment], windows: list[float], row_ste
         In the standard parameters, by generalized-force channel.
     """
     out = np.zeros((6, reg.N_STANDARD, reg.N_STANDARD))
-    for exp, window in zip(experiments, windows, strict=True):
+    for exp, window, sigma in zip(experiments, windows, pose_noise, strict=True):
         rate = exp.sample_rate
-        savgol_window = window / savgol_fraction
-        sigma = white_noise_covariance(exp.q, differentiate(exp.q, rate, savgol_window,
-                                                            order)[0])
-        gains = derivative_noise_gains(rate, window, savgol_window, order)
+        gains = derivative_noise_gains(rate, window, window / savgol_fraction, order)
         poses = kernel_filter_rows(exp.q, rate, window, row_step)
         # the Jacobians vary on the kernel's scale: every JACOBIAN_STRIDE-th row stands for
         # its neighbours (the sum scaled to the rows kept)

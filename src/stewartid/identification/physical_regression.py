@@ -11,6 +11,7 @@ import numpy as np
 
 from stewartid.identification.physical_noise import coulomb_sign_rates
 from stewartid.identification.preparation import Experiment
+from stewartid.identification.wavelet.noise import white_noise_covariance
 from stewartid.model import regressor as reg
 from stewartid.platform import Platform
 from stewartid.signals.differentiation import (
@@ -33,11 +34,16 @@ class Regression:
         Filtered measured generalized force J_lq^T f (N, N m).
     experiments : list of dict
         Per experiment: name, window (s), rows used.
+    pose_noise : list of ndarray, each shape (6, 6)
+        Per experiment, the pose's white-noise covariance per sample (m^2, rad^2), estimated
+        against the Savitzky-Golay smoothed pose
+        (:func:`~stewartid.identification.wavelet.noise.white_noise_covariance`).
     """
 
     Y: np.ndarray
     y: np.ndarray
     experiments: list[dict[str, Any]]
+    pose_noise: list[np.ndarray]
 
 
 #: Savitzky-Golay order and window (a fraction of the kernel's) of the rates and accelerations
@@ -95,7 +101,7 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
     -------
     Regression
     """
-    Ys, ys, used = [], [], []
+    Ys, ys, used, pose_noise = [], [], [], []
     windows = [window or default_window(estimate_frequency(exp.q, exp.sample_rate))
                for exp in experiments]
     # one step for every experiment: each keeps its share of the rows, as without decimation
@@ -104,7 +110,8 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
     for exp, w in zip(experiments, windows, strict=True):
         n = len(exp.q)
         q, q_dot, q_ddot = differentiate(exp.q, exp.sample_rate, w / SAVGOL_FRACTION, order)
-        sign_rates, sign_window = coulomb_sign_rates(exp.q, exp.sample_rate, w, q)
+        pose_noise.append(white_noise_covariance(exp.q, q))
+        sign_rates, sign_window = coulomb_sign_rates(exp.q, exp.sample_rate, w, pose_noise[-1])
         signals = np.empty((n, 6, 1 + reg.N_STANDARD))
         signals[:, :, 0] = exp.generalized_force
         for lo in range(0, n, REGRESSOR_CHUNK):  # chunks keep the temporaries in cache
@@ -117,7 +124,7 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
         ys.append(filtered[:, :, 0])
         used.append({"name": exp.name, "window_s": w, "samples": len(filtered),
                      "row_step": step, "sign_window_s": sign_window})
-    return Regression(np.concatenate(Ys), np.concatenate(ys), used)
+    return Regression(np.concatenate(Ys), np.concatenate(ys), used, pose_noise)
 
 
 #: Samples per call of the regressor in :func:`filtered_regression`.

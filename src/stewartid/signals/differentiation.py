@@ -248,14 +248,24 @@ def kernel_filter(x: np.ndarray, sample_rate: float, window: float, derivatives:
     """
     x = np.asarray(x, dtype=float)
     taps = kernel_taps(sample_rate, window, derivatives, exponent)
-    if len(taps[0]) > len(x):
-        raise DataError(f"record of {len(x)} samples is shorter than the filter window "
-                        f"({len(taps[0])} samples = {window:.3g} s); record longer or shorten "
-                        "the window.")
+    require_window(len(x), len(taps[0]), window)
     # the mean filtered apart, as in differentiate
     offset = x.mean(axis=0)
     return [y + offset * np.sum(k)
             for y, k in zip(convolve_valid(x - offset, taps), taps, strict=True)]
+
+
+def require_window(samples: int, taps: int, window: float) -> None:
+    """Refuse a record of ``samples`` shorter than a kernel of ``taps`` (``window`` s).
+
+    Raises
+    ------
+    DataError
+    """
+    if taps > samples:
+        raise DataError(f"record of {samples} samples is shorter than the filter window "
+                        f"({taps} samples = {window:.3g} s); record longer or shorten "
+                        "the window.")
 
 
 def kernel_taps(sample_rate: float, window: float, derivatives: int = 0,

@@ -5,8 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewartid.errors import DataError
-from stewartid.signals.differentiation import KERNEL_EXPONENT, kernel_taps
+from stewartid.signals.differentiation import KERNEL_EXPONENT, kernel_taps, require_window
 
 
 def kernel_filter_rows(x: np.ndarray, sample_rate: float, window: float, step: int = 1,
@@ -40,10 +39,7 @@ def kernel_filter_rows(x: np.ndarray, sample_rate: float, window: float, step: i
     x = np.asarray(x, dtype=float)
     taps = kernel_taps(sample_rate, window, 0, exponent)[0]
     length = len(taps)
-    if length > len(x):
-        raise DataError(f"record of {len(x)} samples is shorter than the filter window "
-                        f"({length} samples = {window:.3g} s); record longer or shorten "
-                        "the window.")
+    require_window(len(x), length, window)
     flat = x.reshape(len(x), -1)
     starts = np.arange(0, len(x) - length + 1, step)
     out = np.empty((len(starts), flat.shape[1]))
