@@ -280,7 +280,8 @@ def test_pose_noise_beyond_the_correction_is_not_silent(paper):
 
 def coulomb_structured_datasets(platform, M, B, levels, kind, duration=6.0, period=2e-3,
                                 rate=0.0):
-    """Experiments of the linear model plus joint Coulomb friction with the structure of
+    """Experiments of the linear model (with the platform model's nonlinear remainder, as
+    :func:`linear_model_data.make_experiment`) plus joint Coulomb friction with the structure of
     :mod:`stewartid.identification.wavelet.windows`: every axis of joint type j opposes its
     exact rate w with the torque levels[j] (times w / sqrt(w^2 + rate^2) when ``rate`` > 0,
     rad/s: a regularised friction), mapped through its joint-axis Jacobian. ``kind``:
@@ -288,6 +289,7 @@ def coulomb_structured_datasets(platform, M, B, levels, kind, duration=6.0, peri
     at once, one frequency each)."""
     from stewartid.model.joints import JOINT_TYPES
     from stewartid.model.kinematics import joint_rate_jacobians
+    from stewartid.model.linearization import linearisation_remainder
 
     t = np.arange(0.0, duration, period)
     out = []
@@ -311,8 +313,9 @@ def coulomb_structured_datasets(platform, M, B, levels, kind, duration=6.0, peri
         friction = sum(level * np.einsum("nla,nlac->nc", signs[:, :, list(axes)],
                                          jac[:, :, list(axes)])
                        for level, axes in zip(levels, JOINT_TYPES.values(), strict=True))
-        out.append(dataset_of(platform, t, q, q_ddot @ M.T + q_dot @ B.T + friction,
-                              f"exp{k + 1}"))
+        y = (q_ddot @ M.T + q_dot @ B.T + friction
+             + linearisation_remainder(platform, q, q_dot, q_ddot))
+        out.append(dataset_of(platform, t, q, y, f"exp{k + 1}"))
     return out
 
 

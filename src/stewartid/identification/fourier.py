@@ -241,6 +241,12 @@ class FourierIdentifier(BaseIdentifier):
     gravity : bool
         Subtract the model's pose-dependent gravity term G(q) (recommended; without it the
         legs' gravity stiffness biases Mt by -K_G / w^2).
+    remainder : bool
+        Subtract what the model's inertial and viscous terms add to their linearisation at
+        the neutral pose, along the measured motion
+        (:func:`~stewartid.identification.preparation.model_remainder`): the identified
+        matrices are then the linearisation's at any amplitude, not an average over the
+        poses reached.
     stiffness : bool
         Identify a stiffness matrix K as well (needs two or more frequencies).
     symmetric : bool
@@ -267,11 +273,12 @@ class FourierIdentifier(BaseIdentifier):
     def __init__(self, frequency_hz: float | Sequence[float] | None = None,
                  window: float | None = None, order: int = DEFAULT_ORDER, gravity: bool = True,
                  stiffness: bool = False, symmetric: bool = False,
-                 periods_per_segment: int = 1):
+                 periods_per_segment: int = 1, remainder: bool = True):
         self.frequency_hz = frequency_hz
         self.window = window
         self.order = order
         self.gravity = gravity
+        self.remainder = remainder
         self.stiffness = stiffness
         self.symmetric = symmetric
         self.periods_per_segment = periods_per_segment
@@ -300,7 +307,7 @@ class FourierIdentifier(BaseIdentifier):
 
     def _fit(self, datasets: list[Dataset], platform: Platform
              ) -> tuple[IdentificationResult, dict]:
-        experiments = prepare(datasets, platform, gravity=self.gravity)
+        experiments = prepare(datasets, platform, gravity=self.gravity, remainder=self.remainder)
         rows_motion, rows_force, used, rows, third = [], [], [], [], []
         for exp in experiments:
             # detected on the leg-length motion, where every DOF counts in one unit: on the

@@ -114,6 +114,12 @@ class LeastSquaresIdentifier(BaseIdentifier):
         Savitzky-Golay polynomial order.
     gravity : bool
         Subtract the model's gravity term G(q).
+    remainder : bool
+        Subtract what the model's inertial and viscous terms add to their linearisation at
+        the neutral pose, along the measured motion
+        (:func:`~stewartid.identification.preparation.model_remainder`): the identified
+        matrices are then the linearisation's at any amplitude, not an average over the
+        poses reached.
     coulomb : bool
         Include the three Coulomb regressors.
     coulomb_smoothing : float
@@ -148,10 +154,12 @@ class LeastSquaresIdentifier(BaseIdentifier):
     def __init__(self, window: float | None = None, order: int = DEFAULT_ORDER,
                  gravity: bool = True, coulomb: bool = True, coulomb_smoothing: float = 1e-4,
                  symmetric: bool = False, decimate: int = 1,
-                 differentiation: str = "kernel", noise_correction: bool = True):
+                 differentiation: str = "kernel", noise_correction: bool = True,
+                 remainder: bool = True):
         self.window = window
         self.order = order
         self.gravity = gravity
+        self.remainder = remainder
         self.coulomb = coulomb
         self.coulomb_smoothing = coulomb_smoothing
         self.symmetric = symmetric
@@ -169,7 +177,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
 
     def _fit(self, datasets: list[Dataset], platform: Platform
              ) -> tuple[IdentificationResult, dict]:
-        experiments = prepare(datasets, platform, gravity=self.gravity, joints=self.coulomb)
+        experiments = prepare(datasets, platform, gravity=self.gravity, joints=self.coulomb,
+                              remainder=self.remainder)
         n_exp = len(experiments)
         phis, ys, shared, used, noise = [], [], [], [], []
         for e, exp in enumerate(experiments):

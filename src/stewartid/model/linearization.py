@@ -79,6 +79,37 @@ def nominal_terms(platform: Platform, pose: np.ndarray | None = None
     return M, _viscous(platform, J_joint), G
 
 
+def linearisation_remainder(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
+                            q_ddot: np.ndarray, pose: np.ndarray | None = None) -> np.ndarray:
+    """What the inertial and viscous terms of the model add to their linearisation at ``pose``.
+
+    r = [M(q) - Mt] q_ddot + h(q, q_dot) + [Bt(q) - Bt] q_dot, with (Mt, Bt) =
+    :func:`nominal_matrices` at ``pose``: the equation of motion less gravity and Coulomb
+    friction is Mt q_ddot + Bt q_dot + r. It grows with the motion (the change of M(q) and
+    Bt(q) over the poses reached, the velocity products), so subtracting it from measured
+    forces leaves the linearised model exact at any amplitude, to the extent the platform
+    description's mass distribution is right.
+
+    Parameters
+    ----------
+    platform : Platform
+    q, q_dot, q_ddot : ndarray, shape (N, 6)
+        Absolute pose (m, rad), its rate and acceleration.
+    pose : ndarray, shape (6,), optional
+        Linearisation pose; the neutral pose by default.
+
+    Returns
+    -------
+    ndarray, shape (N, 6)
+        N, N m.
+    """
+    Mt, Bt = nominal_matrices(platform, pose)
+    terms = ModelTerms(platform, q, q_dot)
+    viscous = _viscous(platform, terms.joint_jacobians)
+    return (np.einsum("nij,nj->ni", terms.mass_matrix - Mt, q_ddot) + terms.velocity_product
+            + np.einsum("nij,nj->ni", viscous - Bt, q_dot))
+
+
 def gravity_stiffness(platform: Platform, pose: np.ndarray | None = None,
                       step: float = 1e-6) -> np.ndarray:
     """Gravity stiffness K_G = dG/dq at ``pose`` by central differences of the exact G(q).

@@ -33,17 +33,14 @@ idea); ``"mexican_hat"``, the paper's Gaussian wavelet, truncated at +-``truncat
 Default (``test_functions=8``): per interval a family of orthonormalised zero-mean test
 functions spanning the whole interval, the weak form of :mod:`.weak_form`, solved by
 generalized least squares with the force and pose noise estimated from the data and the pose
-noise's bias removed (:mod:`.gls`); ``test_functions=None`` uses (a, b) points
-(:mod:`.point_equations`), as the paper does.
+noise's bias removed (:mod:`.gls`), standard errors cluster-robust over intervals;
+``test_functions=None`` uses (a, b) points (:mod:`.point_equations`), as the paper does.
 
 Couplings (the paper's Mt(2,4) case): an entry and its transpose come from different
 equations (Mt(5,1) from pitch under surge, Mt(1,5) from surge under pitch), the rotational
 ones the sensitive; ``pair_selection`` combines them
 (:func:`~stewartid.identification.pairs.select_symmetric_pairs`), ``symmetric=True``
 imposes symmetry in the solve instead.
-
-Standard errors are cluster-robust over intervals (the equations of one interval share
-samples and friction state).
 
 References
 ----------
@@ -78,9 +75,10 @@ from stewartid.identification.wavelet.detection import (
     raise_no_interval,
     sine_share,
 )
-from stewartid.identification.wavelet.gls import WeakFormSolution, solve_weak_form
+from stewartid.identification.wavelet.gls import WeakFormSolution
 from stewartid.identification.wavelet.noise import estimate_noise
 from stewartid.identification.wavelet.point_equations import EXACT_DEGREE, point_equations
+from stewartid.identification.wavelet.rate_selection import solve_weak_form_over_rates
 from stewartid.identification.wavelet.weak_form import experiment_equations
 from stewartid.identification.wavelet.windows import solve_windows_over_rates, window_equations
 from stewartid.model.joints import JOINT_TYPES
@@ -135,13 +133,12 @@ class WaveletIdentifier(BaseIdentifier):
         several frequencies per DOF, all DOFs at once: plant, paper platform, 30 N m,
         noise-free, 2.2 / 0.39 % on three-sine / all-DOF logs, "free" 17 / 1343 %).
         "auto" (default): "free" for one sine per experiment (:func:`.detection.sine_share`),
-        else "coulomb". "free" leaves every interval constant free (the
-        paper's invariance to any friction law: only q_dot's shape inside an interval informs
-        Bt); "shared" models the constants as an offset per experiment plus the Coulomb
-        level of each joint type through the joint Jacobians, with a scatter estimated from
-        the data, and estimates the levels (``coulomb_``): more precise Bt under noise, biased
-        where the plant's friction departs from that structure (docs/benchmarks.md);
-        "uniform" one level for every axis, as the platform file's ``coulomb``.
+        else "coulomb". "free" leaves every interval constant free (the paper's invariance to
+        any friction law), the Coulomb levels kept only where the force inside the intervals
+        needs them (:mod:`.rate_selection`); "shared" models the constants as an offset per
+        experiment plus the Coulomb level of each joint type, with a scatter estimated from
+        the data (``coulomb_``): more precise Bt under noise, biased where the plant's
+        friction departs from that structure; "uniform" one level for every axis.
     scale_fractions : tuple of float
         Wavelet support as fractions of each interval's length, each in (0, 1].
     shifts_per_scale : int
@@ -186,6 +183,10 @@ class WaveletIdentifier(BaseIdentifier):
         better-determined member.
     gravity : bool
         Subtract the model's pose-dependent gravity G(q) before identification.
+    remainder : bool
+        Subtract the model's departure from its linearisation along the measured motion
+        (:func:`~stewartid.identification.preparation.model_remainder`): the linearisation's
+        matrices at any amplitude.
 
     Attributes
     ----------
@@ -210,7 +211,7 @@ class WaveletIdentifier(BaseIdentifier):
                  differentiation_window: float | None = None, hysteresis: float = 4.0,
                  odd_companion: bool = False, noise_correction: bool = True,
                  symmetric: bool = False,
-                 pair_selection: str = "pooled", gravity: bool = True):
+                 pair_selection: str = "pooled", gravity: bool = True, remainder: bool = True):
         self.wavelet = wavelet
         self.wavelet_order = wavelet_order
         self.truncation = truncation
@@ -230,6 +231,7 @@ class WaveletIdentifier(BaseIdentifier):
         self.symmetric = symmetric
         self.pair_selection = pair_selection
         self.gravity = gravity
+        self.remainder = remainder
 
     # ------------------------------------------------------------------ settings
     _parameter_constraints = {
@@ -287,7 +289,8 @@ class WaveletIdentifier(BaseIdentifier):
         friction = self._friction_model(datasets)
         infos, equations, sensitivities, motion = [], [], [], []
         for k, dataset in enumerate(datasets):
-            experiment = prepare_experiment(dataset, platform, self.gravity, joints=True)
+            experiment = prepare_experiment(dataset, platform, self.gravity, joints=True,
+                                            remainder=self.remainder)
             found = self._noise_and_intervals(experiment, 1.0)
             if friction == "coulomb":
                 equations += window_equations(experiment, found, int(self.wavelet_order),
@@ -307,12 +310,13 @@ class WaveletIdentifier(BaseIdentifier):
                      "force_variance": [i["force_noise_variance"] for i in infos],
                      "force_sensitivity": sensitivities}
         if friction == "coulomb":
-            solution, _ = solve_windows_over_rates(equations, **noise)
+            solution, rate = solve_windows_over_rates(equations, **noise)
         else:
             check_coverage([i["name"] for i in infos], np.array(motion),
                            [sum(e.experiment == k for e in equations) for k in range(len(infos))])
-            solution = solve_weak_form(equations, len(datasets), friction != "free", **noise)
-        return self._weak_form_result(solution, infos, len(equations), wavelet, friction)
+            solution, rate = solve_weak_form_over_rates(equations, len(datasets),
+                                                        friction != "free", **noise)
+        return self._weak_form_result(solution, infos, len(equations), wavelet, friction, rate)
 
     def _friction_model(self, datasets: list[Dataset]) -> str:
         """The friction model of the fit: ``friction``, or for "auto" "free" when every
@@ -324,8 +328,8 @@ class WaveletIdentifier(BaseIdentifier):
         return "free" if single else "coulomb"
 
     def _weak_form_result(self, solution: WeakFormSolution, infos: list[dict],
-                          n_intervals: int, wavelet: MotherWavelet, friction: str
-                          ) -> tuple[IdentificationResult, dict]:
+                          n_intervals: int, wavelet: MotherWavelet, friction: str,
+                          rate: float) -> tuple[IdentificationResult, dict]:
         """The result and the learned Coulomb levels of :meth:`_fit_weak_form`."""
         M, B = solution.theta[:, :6].copy(), solution.theta[:, 6:12].copy()
         std_M, std_B = solution.theta_std[:, :6].copy(), solution.theta_std[:, 6:12].copy()
@@ -341,6 +345,7 @@ class WaveletIdentifier(BaseIdentifier):
                              "intervals": i["intervals"].tolist()} for i in infos],
             "pair_choice": chosen, "pair_calibration": self.pair_calibration_,
             "coordinates": list(COORDINATES), "friction_model": friction,
+            "soft_sign_rate": rate,
             "coulomb": levels, "coulomb_std": levels_std,
             "offsets": solution.offsets, "noise_std": solution.noise_std,
             "constant_scatter": solution.constant_scatter,
@@ -391,7 +396,8 @@ class WaveletIdentifier(BaseIdentifier):
         phi, target, cluster, infos, noise_xx, noise_xy, motion = [], [], [], [], [], [], []
         offset = 0
         for dataset in datasets:
-            experiment = prepare_experiment(dataset, platform, self.gravity, joints=True)
+            experiment = prepare_experiment(dataset, platform, self.gravity, joints=True,
+                                            remainder=self.remainder)
             x, y, owner, xx, xy, info = self._point_equations(experiment, wavelet)
             phi.append(x)
             target.append(y)

@@ -62,6 +62,7 @@ from stewartid.identification.wavelet.variance_components import (
     excess_variance,
     pose_coefficients,
     pose_covariance,
+    row_noise,
 )
 from stewartid.identification.wavelet.weak_form import (
     IntervalEquations,
@@ -120,25 +121,37 @@ def _weighted_normal(design: np.ndarray, weights: np.ndarray, target: np.ndarray
             weighted.reshape(flat.shape).T @ target.ravel())
 
 
-def channel_systems(stacked: StackedEquations, n_experiments: int, shared_friction: bool
-                    ) -> tuple[list[np.ndarray], list[np.ndarray]]:
+def channel_systems(stacked: StackedEquations, n_experiments: int, shared_friction: bool,
+                    variation: bool = False) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """Design (n, R, u) and targets (n, R) of each of the 6 channels over all u unknowns:
-    [Mt Bt] row-major, then (shared friction) an offset per experiment and channel and the
-    Coulomb levels; R = K invariant rows, plus the mean row with shared friction."""
+    [Mt Bt] row-major, then (shared friction) an offset per experiment and channel, then the
+    Coulomb levels (shared friction, or ``variation``); R = K invariant rows, plus the mean
+    row with shared friction.
+
+    With ``variation`` the invariant rows carry the Coulomb levels too: the pose's change
+    inside an interval changes the generalized Coulomb force the interval constant holds
+    (J_j(q)^T mapped with fixed joint directions), and at large motions that change follows
+    the motion itself (paper platform, the paper's sines at ten times their amplitude,
+    30 N m: Mt(4,2) 3.5 % off, noise-free, with the constants alone; < 0.01 % with it).
+    """
     x, y, owner = stacked.regressors, stacked.targets, stacked.owner
     n, k_rows = x.shape[:2]
-    n_unknowns = N_THETA + (6 * n_experiments + stacked.coulomb.shape[1]
-                            if shared_friction else 0)
+    n_types = stacked.coulomb.shape[1]
+    offsets = 6 * n_experiments if shared_friction else 0
+    levels = n_types if shared_friction or variation else 0
+    n_unknowns = N_THETA + offsets + levels
     rows = k_rows + 1 if shared_friction else k_rows
     designs, targets = [], []
     for i in range(6):
         design = np.zeros((n, rows, n_unknowns))
         design[:, :k_rows, 12 * i:12 * i + 12] = x
+        if variation:
+            design[:, :k_rows, N_THETA + offsets:] = stacked.coulomb_rows[:, :, :, i]
         target = y[:, :, i]
         if shared_friction:
             design[:, k_rows, 12 * i:12 * i + 12] = stacked.mean_regressors
             design[np.arange(n), k_rows, N_THETA + 6 * owner + i] = stacked.weights
-            design[:, k_rows, N_THETA + 6 * n_experiments:] = stacked.coulomb[:, :, i]
+            design[:, k_rows, N_THETA + offsets:] = stacked.coulomb[:, :, i]
             target = np.concatenate([target, stacked.mean_targets[:, i:i + 1]], axis=1)
         designs.append(design)
         targets.append(target)
@@ -327,7 +340,8 @@ def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
                     shared_friction: bool = True, iterations: int = 5, max_condition: float = 1e8,
                     pose_covariance: np.ndarray | None = None,
                     force_sensitivity: np.ndarray | None = None,
-                    force_variance: np.ndarray | None = None) -> WeakFormSolution:
+                    force_variance: np.ndarray | None = None, rate_index: int = 0,
+                    variation: bool = False) -> WeakFormSolution:
     """Generalized least squares for [Mt Bt] (and the friction structure), pose noise
     propagated and its bias compensated (module docstring).
 
@@ -355,10 +369,18 @@ def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
         White noise variance per sample of each experiment's generalized force (N^2,
         N^2 m^2), e.g. :func:`~stewartid.identification.wavelet.noise.white_noise_covariance`
         of it; None: zero (the force noise then comes from the residuals alone).
+    rate_index : int
+        Soft-sign transition rate of the invariant rows' Coulomb regressors (an index into
+        each interval's ``coulomb_rows``).
+    variation : bool
+        Give the invariant rows the Coulomb levels (:func:`channel_systems`); the force-side
+        noise is then re-measured from the joint fit's residuals and the fit repeated.
 
     Returns
     -------
     WeakFormSolution
+        With ``variation`` and every constant free, ``coulomb`` holds the levels the
+        invariant rows see.
 
     Notes
     -----
@@ -368,14 +390,19 @@ def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
     noise), :func:`constant_scatter` (shared friction: the interval constants' scatter),
     :func:`fit_jointly` (all rows and channels) and :func:`standard_errors`.
     """
-    stacked = stack_equations(equations, pose_covariance, force_sensitivity, force_variance)
+    stacked = stack_equations(equations, pose_covariance, force_sensitivity, force_variance,
+                              rate_index)
     n, k_rows = stacked.regressors.shape[:2]
     flat = stacked.regressors.reshape(-1, 12)
     condition = check_rank(flat.T @ flat, regressor_names("q_ddot", "q_dot"), max_condition)
-    designs, targets = channel_systems(stacked, n_experiments, shared_friction)
+    designs, targets = channel_systems(stacked, n_experiments, shared_friction, variation)
     invariant = fit_invariant_rows(stacked, iterations)
     scatter = constant_scatter(stacked, designs, invariant) if shared_friction else None
     fit = fit_jointly(stacked, designs, targets, invariant, scatter, iterations)
+    for _ in range(VARIATION_PASSES if variation else 0):
+        # the invariant fit's residuals hold the Coulomb variation the joint fit models
+        invariant = invariant._replace(noise=row_noise(stacked, designs, targets, fit.z))
+        fit = fit_jointly(stacked, designs, targets, invariant, scatter, iterations)
     if fit.uncorrected.any():
         names = ", ".join(c for c, u in zip(COORDINATES, fit.uncorrected, strict=True) if u)
         warnings.warn(f"pose noise too large for the errors-in-variables correction of the "
@@ -385,11 +412,14 @@ def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
                       stacklevel=3)
     std = standard_errors(designs, targets, fit)
     z, n_types = fit.z, stacked.coulomb.shape[1]
+    levels = N_THETA + (6 * n_experiments if shared_friction else 0)
     if shared_friction:
-        offsets = z[N_THETA:N_THETA + 6 * n_experiments].reshape(n_experiments, 6)
-        coulomb, coulomb_std = z[N_THETA + 6 * n_experiments:], std[N_THETA + 6 * n_experiments:]
+        offsets = z[N_THETA:levels].reshape(n_experiments, 6)
     else:
         offsets = np.full((n_experiments, 6), np.nan)
+    if shared_friction or variation:
+        coulomb, coulomb_std = z[levels:], std[levels:]
+    else:
         coulomb = coulomb_std = np.full(n_types, np.nan)
     return WeakFormSolution(
         theta=z[:N_THETA].reshape(6, 12), theta_std=std[:N_THETA].reshape(6, 12),
@@ -399,6 +429,10 @@ def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
         condition_number=condition, n_equations=int(n * k_rows))
 
 
-__all__ = ["InvariantFit", "JointFit", "WeakFormSolution",
+#: Passes of :func:`solve_weak_form` with the noise re-measured from the joint fit.
+VARIATION_PASSES = 2
+
+
+__all__ = ["VARIATION_PASSES", "InvariantFit", "JointFit", "WeakFormSolution",
            "channel_covariance", "channel_systems", "constant_scatter",
            "fit_invariant_rows", "fit_jointly", "solve_weak_form", "standard_errors"]

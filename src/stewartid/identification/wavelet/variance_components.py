@@ -7,7 +7,7 @@
   :func:`compensate` subtracts (the errors-in-variables solve);
 - :func:`chi2_excess` and :func:`excess_variance`: the variance residuals hold beyond what
   the noise explains (model error, the scatter of the interval constants), matched in
-  weighted chi-square.
+  weighted chi-square; :func:`row_noise` the force-side noise of every interval from them.
 
 References
 ----------
@@ -17,7 +17,13 @@ Paule, R. C., Mandel, J. "Consensus values and weighting factors." J. Res. Natl.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
 import numpy as np
+
+if TYPE_CHECKING:
+    from stewartid.identification.wavelet.weak_form import StackedEquations
 
 
 def pose_covariance(gram: np.ndarray, sigma: np.ndarray, coefficients: np.ndarray
@@ -122,5 +128,25 @@ def excess_variance(covariance: np.ndarray, residual: np.ndarray, dof: int) -> f
     return chi2_excess(lam, np.einsum("nrk,nr->nk", vectors, residual) ** 2, dof)
 
 
+def row_noise(stacked: StackedEquations, designs: Sequence[np.ndarray],
+              targets: Sequence[np.ndarray], z: np.ndarray) -> np.ndarray:
+    """Force-side noise s (n, 6) per interval (or window) and channel: the white part
+    measured from the data plus the chi-square excess of the invariant rows' residuals at
+    the unknowns z over what the noise explains."""
+    n, k_rows = stacked.regressors.shape[:2]
+    gram = stacked.gram[..., :k_rows, :k_rows]
+    floor = 1e-24 * np.maximum(np.mean(stacked.targets.reshape(-1, 6) ** 2, axis=0), 1e-300)
+    noise = np.zeros((n, 6))
+    for i in range(6):
+        q_inv = pose_covariance(gram, stacked.sigma,
+                                pose_coefficients(stacked.sensitivity[:, i],
+                                                  z[12 * i:12 * i + 12]))
+        residual = targets[i][:, :k_rows] - designs[i][:, :k_rows] @ z
+        excess = excess_variance(stacked.white[:, i, None, None] * np.eye(k_rows) + q_inv,
+                                 residual, residual.size - 12)
+        noise[:, i] = np.maximum(stacked.white[:, i] + excess, floor[i])
+    return noise
+
+
 __all__ = ["chi2_excess", "compensate", "excess_variance", "noise_bias", "pose_coefficients",
-           "pose_covariance"]
+           "pose_covariance", "row_noise"]

@@ -40,22 +40,15 @@ from stewartid.identification.wavelet.gls import (
     fit_jointly,
     standard_errors,
 )
-from stewartid.identification.wavelet.variance_components import (
-    excess_variance,
-    pose_coefficients,
-    pose_covariance,
-)
+from stewartid.identification.wavelet.rate_selection import best_over_rates
+from stewartid.identification.wavelet.variance_components import row_noise
 from stewartid.identification.wavelet.weak_form import (
+    SOFT_SIGN_RATES,
     IntervalEquations,
+    coulomb_patterns,
     stack_equations,
     test_family,
 )
-from stewartid.model.joints import JOINT_TYPES
-
-#: Candidate transition rates r (rad/s) of the Coulomb soft sign (module docstring). No rate
-#: between 0 and 1e-4: on records of an exact sign sampled at 500 Hz, 3e-5 fitted the
-#: sampling error of the switches better than 0 and moved the rotational Bt diagonal by 3 %.
-SOFT_SIGN_RATES = (0.0, 1e-4, 3e-4, 1e-3, 3e-3)
 
 
 class WindowEquations(NamedTuple):
@@ -73,20 +66,6 @@ def window_bounds(t: np.ndarray, length: float) -> np.ndarray:
     count = max(1, int(round(span / length)))
     edges = t[0] + span * np.arange(count + 1) / count
     return np.column_stack([edges[:-1], edges[1:]])
-
-
-def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: bool,
-                     rate: float = 0.0) -> np.ndarray:
-    """W_type(t) at every sample, shape (N, n_types, 6) (or (N, 1, 6) with ``uniform``):
-    the generalized force of a unit Coulomb torque on every axis of a joint type, opposing
-    the axis's smoothed rate (soft sign over its noise level and the transition ``rate``,
-    rad/s)."""
-    rates, noise = found.joint_rates, found.rate_noise
-    direction = rates / np.sqrt(rates ** 2 + noise ** 2 + rate ** 2)          # (N, 6, 5)
-    patterns = np.stack([np.einsum("nla,nlac->nc", direction[:, :, list(axes)],
-                                   joint_jacobians[:, :, list(axes)])
-                         for axes in JOINT_TYPES.values()], axis=1)        # (N, 3, 6)
-    return patterns.sum(axis=1, keepdims=True) if uniform else patterns
 
 
 def window_equations(experiment: Experiment, found: Detection, order: int, size: int,
@@ -149,24 +128,6 @@ def _designs(regressors: np.ndarray, coulomb: np.ndarray) -> list[np.ndarray]:
     return designs
 
 
-def _row_noise(stacked, designs, targets, z: np.ndarray) -> np.ndarray:
-    """Force-side noise s (n, 6) per window and channel: the white part measured from the
-    data plus the chi-square excess of the residuals at z over what the noise explains."""
-    n, k_rows = stacked.regressors.shape[:2]
-    gram = stacked.gram[..., :k_rows, :k_rows]
-    floor = 1e-24 * np.maximum(np.mean(stacked.targets.reshape(-1, 6) ** 2, axis=0), 1e-300)
-    noise = np.zeros((n, 6))
-    for i in range(6):
-        q_inv = pose_covariance(gram, stacked.sigma,
-                                pose_coefficients(stacked.sensitivity[:, i],
-                                                  z[12 * i:12 * i + 12]))
-        residual = targets[i] - designs[i] @ z
-        excess = excess_variance(stacked.white[:, i, None, None] * np.eye(k_rows) + q_inv,
-                                 residual, residual.size - 12)
-        noise[:, i] = np.maximum(stacked.white[:, i] + excess, floor[i])
-    return noise
-
-
 def solve_windows(equations: Sequence[WindowEquations], iterations: int = 3,
                   max_condition: float = 1e8, pose_covariance: np.ndarray | None = None,
                   force_sensitivity: np.ndarray | None = None,
@@ -197,7 +158,7 @@ def solve_windows(equations: Sequence[WindowEquations], iterations: int = 3,
     z = np.linalg.lstsq(stacked_design, np.concatenate([t.ravel() for t in targets]),
                         rcond=None)[0]
     for _ in range(max(1, iterations)):
-        noise = _row_noise(stacked, designs, targets, z)
+        noise = row_noise(stacked, designs, targets, z)
         start = InvariantFit(theta=z[:N_THETA].reshape(6, 12), noise=noise,
                              pose_share=np.zeros(6))
         fit = fit_jointly(stacked, designs, targets, start, None, 1)
@@ -216,16 +177,10 @@ def solve_windows_over_rates(equations: Sequence[WindowEquations],
                              rates: Sequence[float] = SOFT_SIGN_RATES, **settings
                              ) -> tuple[WeakFormSolution, float]:
     """:func:`solve_windows` at every transition rate of the soft sign; the solution whose
-    weighted residual is smallest (the sum over channels of the log of the estimated
-    force-side noise variance, the profile likelihood of Gaussian rows), and its rate
+    weighted residual is smallest (:func:`.rate_selection.best_over_rates`), and its rate
     (rad/s). ``settings`` go to :func:`solve_windows`."""
-    best, best_cost, best_rate = None, np.inf, 0.0
-    for index, rate in enumerate(rates):
-        solution = solve_windows(equations, rate_index=index, **settings)
-        cost = float(np.sum(np.log(solution.noise_std ** 2)))
-        if cost < best_cost:
-            best, best_cost, best_rate = solution, cost, float(rate)
-    return best, best_rate
+    return best_over_rates(lambda index: solve_windows(equations, rate_index=index, **settings),
+                           rates)
 
 
 __all__ = ["SOFT_SIGN_RATES", "WindowEquations", "coulomb_patterns", "solve_windows",
