@@ -148,6 +148,10 @@ def test_savgol_gain_and_differentiation_of_a_sine():
     assert v[inner] == pytest.approx(gain_v * w * np.cos(w * t[inner]), abs=1e-9)
     assert a[inner] == pytest.approx(-gain_a * w ** 2 * np.sin(w * t[inner]), abs=2e-7)
     assert 0.999 < gain_a < 1.0
+    # the derivatives asked for alone, in the order asked, hold the same bounds
+    a_only, v_only = differentiate(np.sin(w * t), fs, window, derivatives=(2, 1))
+    assert v_only[inner] == pytest.approx(gain_v * w * np.cos(w * t[inner]), abs=1e-9)
+    assert a_only[inner] == pytest.approx(-gain_a * w ** 2 * np.sin(w * t[inner]), abs=2e-7)
 
 
 def test_kernel_filter_derivative_identities():
@@ -177,6 +181,9 @@ def test_kernel_filter_rows_are_the_filtered_rows():
         rows = kernel_filter_rows(x, fs, 0.5, step)
         assert rows.shape == every[::step].shape
         assert rows == pytest.approx(every[::step], abs=1e-11)
+        # time on the last axis: the same rows, time last
+        last = kernel_filter_rows(np.moveaxis(x, 0, -1), fs, 0.5, step, time_last=True)
+        assert np.moveaxis(last, -1, 0) == pytest.approx(every[::step], abs=1e-11)
 
 
 def test_estimate_frequency():

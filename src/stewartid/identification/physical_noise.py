@@ -88,7 +88,7 @@ def coulomb_sign_rates(q: np.ndarray, sample_rate: float, window: float,
     """
     sigma = np.diag(pose_noise)
     for fraction in SIGN_FRACTIONS:
-        rates = differentiate(q, sample_rate, window * fraction, SIGN_ORDER)[1]
+        rates = differentiate(q, sample_rate, window * fraction, SIGN_ORDER, (1,))[0]
         n = window_samples(window * fraction, sample_rate, SIGN_ORDER)
         taps = savgol_coefficients(n, SIGN_ORDER, 1, 1 / sample_rate)
         rms = np.sqrt(np.mean(rates ** 2, axis=0))
@@ -144,12 +144,14 @@ def regressor_noise(experiments: list[Experiment], windows: list[float], row_ste
         rows, poses = len(poses), poses[::JACOBIAN_STRIDE]
         for jacobian, gain in ((matrix_regressors.viscous_regressor(platform, poses), gains[0]),
                                (matrix_regressors.inertia_regressor(platform, poses), gains[1])):
-            # jacobian[k, i, c, :]: d Y_i / d (rate or acceleration of c) at row k
-            factor = _factor(sigma * gain)
+            # jacobian[k, i, c, :]: d Y_i / d (rate or acceleration of c) at row k; only
+            # its columns not zero at every row (4 viscous, the bodies' 14) add anything
+            used = np.flatnonzero(np.any(jacobian != 0.0, axis=(0, 1, 2)))
+            block = np.ix_(used, used)
+            factor = np.swapaxes(_factor(sigma * gain), 0, 1)
             for i in range(6):  # (K d, p) per channel: one BLAS product each
-                scaled = np.swapaxes(factor, 0, 1) @ jacobian[:, i]  # (K, d, p)
-                flat = scaled.reshape(-1, scaled.shape[-1])
-                out[i] += (flat.T @ flat) * (rows / len(poses))
+                flat = (factor @ jacobian[:, i][..., used]).reshape(-1, len(used))
+                out[i][block] += (flat.T @ flat) * (rows / len(poses))
     return out
 
 

@@ -107,28 +107,31 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
     # one step for every experiment: each keeps its share of the rows, as without decimation
     step = decimate or min(row_step(w, exp.sample_rate)
                            for w, exp in zip(windows, experiments, strict=True))
+    # one buffer for every experiment's signals (time last: the regressor's rows and the
+    # kernel's sums on contiguous rows), its memory touched once
+    buffer = np.empty(6 * (1 + reg.N_STANDARD) * max(len(exp.q) for exp in experiments))
     for exp, w in zip(experiments, windows, strict=True):
         n = len(exp.q)
         q, q_dot, q_ddot = differentiate(exp.q, exp.sample_rate, w / SAVGOL_FRACTION, order)
         pose_noise.append(white_noise_covariance(exp.q, q))
         sign_rates, sign_window = coulomb_sign_rates(exp.q, exp.sample_rate, w, pose_noise[-1])
-        signals = np.empty((n, 6, 1 + reg.N_STANDARD))
-        signals[:, :, 0] = exp.generalized_force
+        motion = [np.ascontiguousarray(x.T) for x in (q, q_dot, q_ddot, sign_rates)]
+        signals = buffer[:6 * (1 + reg.N_STANDARD) * n].reshape(6, 1 + reg.N_STANDARD, n)
+        signals[:, 0] = exp.generalized_force.T
         for lo in range(0, n, REGRESSOR_CHUNK):  # chunks keep the temporaries in cache
             hi = min(n, lo + REGRESSOR_CHUNK)
-            signals[lo:hi, :, 1:] = reg.regressor(platform, q[lo:hi], q_dot[lo:hi],
-                                                  q_ddot[lo:hi], gravity, coulomb_smoothing,
-                                                  coulomb_rates=sign_rates[lo:hi])
-        filtered = kernel_filter_rows(signals, exp.sample_rate, w, step)
-        Ys.append(filtered[:, :, 1:])
-        ys.append(filtered[:, :, 0])
-        used.append({"name": exp.name, "window_s": w, "samples": len(filtered),
+            reg.regressor_columns(platform, *(x[:, lo:hi] for x in motion), gravity,
+                                  coulomb_smoothing, out=signals[:, 1:, lo:hi])
+        filtered = kernel_filter_rows(signals, exp.sample_rate, w, step, time_last=True)
+        Ys.append(filtered[:, 1:].transpose(2, 0, 1))
+        ys.append(filtered[:, 0].T)
+        used.append({"name": exp.name, "window_s": w, "samples": filtered.shape[-1],
                      "row_step": step, "sign_window_s": sign_window})
     return Regression(np.concatenate(Ys), np.concatenate(ys), used, pose_noise)
 
 
 #: Samples per call of the regressor in :func:`filtered_regression`.
-REGRESSOR_CHUNK = 2000
+REGRESSOR_CHUNK = 1000
 
 
 __all__ = ["REGRESSOR_CHUNK", "ROWS_PER_WINDOW", "SAVGOL_FRACTION", "SAVGOL_ORDER", "Regression",

@@ -7,15 +7,21 @@ from __future__ import annotations
 import numpy as np
 
 from stewartid.model.kinematics import as_batch
-from stewartid.model.regressor import N_STANDARD, VISCOUS_PARAMETERS, parameter_index, regressor
+from stewartid.model.regressor import (
+    N_STANDARD,
+    VISCOUS_PARAMETERS,
+    parameter_index,
+    regressor_columns,
+)
 from stewartid.platform import Platform
 
 
 def inertia_regressor(platform: Platform, pose: np.ndarray | None = None) -> np.ndarray:
     """The mass matrix as a linear function of the parameters: M(q) = A @ pi.
 
-    Column k of M is Y(q, 0, e_k) pi - Y(q, 0, 0) pi (the gravity and offset columns do not
-    depend on the acceleration; friction and velocity products vanish at rest).
+    Column k of M is Y(q, 0, e_k) pi - Y(q, 0, 0) pi: the bodies' columns without gravity at
+    the unit acceleration e_k (the gravity and offset columns do not depend on the
+    acceleration; friction and velocity products vanish at rest).
 
     Parameters
     ----------
@@ -30,18 +36,19 @@ def inertia_regressor(platform: Platform, pose: np.ndarray | None = None) -> np.
     """
     q, single = as_batch(platform.neutral_pose if pose is None else pose)
     n = len(q)
-    steps = np.tile(np.vstack([np.zeros(6), np.eye(6)]), (n, 1))
-    Y = regressor(platform, np.repeat(q, 7, 0), np.zeros((7 * n, 6)), steps).reshape(
-        n, 7, 6, N_STANDARD)
-    A = np.swapaxes(Y[:, 1:] - Y[:, :1], 1, 2)
-    return A[0] if single else A
+    poses = np.repeat(q.T, 6, 1)  # time last: pose j, unit acceleration k at j * 6 + k
+    Y = regressor_columns(platform, poses, np.zeros_like(poses), np.tile(np.eye(6), n),
+                          gravity=False, friction=False)
+    A = Y.reshape(6, N_STANDARD, n, 6).transpose(2, 0, 3, 1)
+    return A[0] if single else np.ascontiguousarray(A)
 
 
 def viscous_regressor(platform: Platform, pose: np.ndarray | None = None) -> np.ndarray:
     """The viscous matrix as a linear function of the parameters: Bt(q) = A @ pi.
 
     Bt collects every term linear in the rates: the joints' viscous friction per type and
-    the actuators'; the velocity products are quadratic and vanish from the linearisation.
+    the actuators' (the friction columns at the unit rates); the velocity products are
+    quadratic and vanish from the linearisation.
 
     Parameters
     ----------
@@ -56,12 +63,12 @@ def viscous_regressor(platform: Platform, pose: np.ndarray | None = None) -> np.
     """
     q, single = as_batch(platform.neutral_pose if pose is None else pose)
     n = len(q)
-    Y = regressor(platform, np.repeat(q, 6, 0), np.tile(np.eye(6), (n, 1)),
-                  np.zeros((6 * n, 6))).reshape(n, 6, 6, N_STANDARD)
-    A = np.zeros_like(Y)
+    poses = np.repeat(q.T, 6, 1)  # time last: pose j, unit rate k at j * 6 + k
+    Y = regressor_columns(platform, poses, np.tile(np.eye(6), n), np.zeros_like(poses),
+                          gravity=False, rigid=False).reshape(6, N_STANDARD, n, 6)
+    A = np.zeros((n, 6, 6, N_STANDARD))
     viscous = parameter_index(VISCOUS_PARAMETERS)
-    A[..., viscous] = Y[..., viscous]
-    A = np.swapaxes(A, 1, 2)
+    A[..., viscous] = Y[:, viscous].transpose(2, 0, 3, 1)
     return A[0] if single else A
 
 

@@ -40,10 +40,10 @@ from typing import NamedTuple
 import numpy as np
 import scipy.linalg
 
+from stewartid.model import regressor_rows as rows
 from stewartid.model.dynamics import COULOMB_SMOOTHING
 from stewartid.model.joints import JOINT_TYPES
-from stewartid.model.kinematics import as_batch, compute_leg_terms
-from stewartid.model.leg_terms import leg_vectors
+from stewartid.model.kinematics import as_batch
 from stewartid.platform import GRAVITY, Platform
 
 #: The moving body's parameters: mass (kg), first moment m c (kg m) and inertia about the
@@ -137,35 +137,14 @@ def pseudo_inertia(body: np.ndarray) -> np.ndarray:
     return J
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    # by components: np.cross's axis handling costs more than the products on small blocks
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
-
-
-def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return np.einsum("...k,...k->...", a, b)[..., None]
-
-
-def _euler_maps(q: np.ndarray, q_dot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """E(q) (N, 3, 3) with omega = E q_dot[3:], and dE/dt q_dot[3:] (N, 3)."""
-    cy, sy, cz, sz = np.cos(q[:, 4]), np.sin(q[:, 4]), np.cos(q[:, 5]), np.sin(q[:, 5])
-    zero, one = np.zeros_like(cy), np.ones_like(cy)
-    E = np.stack([np.stack([cz * cy, -sz, zero], -1), np.stack([sz * cy, cz, zero], -1),
-                  np.stack([-sy, zero, one], -1)], -2)
-    dx, dy, dz = q_dot[:, 3], q_dot[:, 4], q_dot[:, 5]
-    bias = np.stack([(-sz * cy * dz - cz * sy * dy) * dx - cz * dz * dy,
-                     (cz * cy * dz - sz * sy * dy) * dx - sz * dz * dy,
-                     -cy * dy * dx], -1)
-    return E, bias
-
-
 def regressor(platform: Platform, q: np.ndarray, q_dot: np.ndarray, q_ddot: np.ndarray,
               gravity: bool = True, coulomb_smoothing: float = COULOMB_SMOOTHING,
               actuator_smoothing: float = ACTUATOR_SMOOTHING,
               coulomb_rates: np.ndarray | None = None) -> np.ndarray:
     """Y(q, q_dot, q_ddot): the measured generalized force J_lq^T f_meas = Y pi.
+
+    Computed by :func:`~stewartid.model.regressor_rows.regressor_columns` (time last, which
+    :func:`regressor_columns` returns as it is).
 
     Parameters
     ----------
@@ -189,108 +168,46 @@ def regressor(platform: Platform, q: np.ndarray, q_dot: np.ndarray, q_ddot: np.n
         Column k is the generalized force (N, N m) per unit of ``PARAMETERS[k]``.
     """
     q2, single = as_batch(q)
-    qd, qdd = as_batch(q_dot, "q_dot")[0], as_batch(q_ddot, "q_ddot")[0]
-    g = GRAVITY if gravity else 0.0
-    n = len(q2)
-    _, R, r, u, lengths = leg_vectors(platform.upper_joints, platform.base_joints, q2)
-    R = np.stack(R, -1).reshape(n, 3, 3)
-    r, u, lengths = np.stack(r, -1), np.stack(u, -1), lengths[..., None]  # (n, 6, 3), (n, 6, 1)
-    E, bias = _euler_maps(q2, qd)
-    omega = np.einsum("nij,nj->ni", E, qd[:, 3:])
-    alpha = np.einsum("nij,nj->ni", E, qdd[:, 3:]) + bias
-    a_g = qdd[:, :3] - g * np.array([0.0, 0.0, 1.0])  # a - g e_z
-    Yn = np.zeros((n, 6, N_STANDARD))  # twist coordinates
-    # at rest (the gravity, offset and Coulomb columns filtered at every sample) the
-    # velocity and acceleration terms vanish: skipped, not computed as zeros
-    moving = bool(qd.any() or qdd.any())
-    Yn[:, :3, 0] = a_g
-    for k in range(3):
-        s = R[:, :, k]
-        if moving:
-            Yn[:, :3, 1 + k] = _cross(alpha, s) + _cross(omega, _cross(omega, s))
-        Yn[:, 3:, 1 + k] = _cross(s, a_g)
-    w_b = np.einsum("nji,nj->ni", R, omega)
-    alpha_b = np.einsum("nji,nj->ni", R, alpha)
-    for k, (a, b) in enumerate(_INERTIA_ENTRIES if moving else ()):
-        unit = np.zeros((3, 3))
-        unit[a, b] = unit[b, a] = 1.0
-        moment = alpha_b @ unit + _cross(w_b, w_b @ unit)
-        Yn[:, 3:, 4 + k] = np.einsum("nij,nj->ni", R, moment)
-    _leg_columns(r, u, lengths, qd, qdd, omega, alpha, g, Yn, moving)
-    Y = Yn  # the moment rows to q coordinates, E^T m, in place
-    Y[:, 3:] = np.swapaxes(E, 1, 2) @ Y[:, 3:]
-    signs = qd if coulomb_rates is None else as_batch(coulomb_rates, "coulomb_rates")[0]
-    _friction_columns(platform, q2, qd, signs, coulomb_smoothing, actuator_smoothing, Y, moving)
+    rates = (as_batch(q_dot, "q_dot")[0], as_batch(q_ddot, "q_ddot")[0],
+             None if coulomb_rates is None else as_batch(coulomb_rates, "coulomb_rates")[0])
+    Y = regressor_columns(platform, np.ascontiguousarray(q2.T),
+                          *(None if x is None else np.ascontiguousarray(x.T) for x in rates),
+                          gravity, coulomb_smoothing, actuator_smoothing)
+    Y = np.ascontiguousarray(Y.transpose(2, 0, 1))
     return Y[0] if single else Y
 
 
-def _leg_columns(r, u, lengths, qd, qdd, omega, alpha, g, Yn, moving=True):
-    """The legs' columns (twist coordinates) into ``Yn``: every leg term is J_A^T x for a
-    3-vector x at the upper joint, i.e. the wrench [x, r x x] at the reference point.
-    ``moving`` False: the rates and accelerations are zero (gravity only)."""
-    e_z = np.array([0.0, 0.0, 1.0])
+def regressor_columns(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
+                      q_ddot: np.ndarray, coulomb_rates: np.ndarray | None = None,
+                      gravity: bool = True, coulomb_smoothing: float = COULOMB_SMOOTHING,
+                      actuator_smoothing: float = ACTUATOR_SMOOTHING, rigid: bool = True,
+                      friction: bool = True, out: np.ndarray | None = None) -> np.ndarray:
+    """:func:`regressor` with time last, for many samples: no copy into time-first rows.
 
-    def project(x):  # (I - u u^T) x / l
-        return (x - u * _dot(u, x)) / lengths
+    Parameters
+    ----------
+    platform : Platform
+    q, q_dot, q_ddot : ndarray, shape (6, N)
+        Poses (m, rad), their rates and accelerations, time last.
+    coulomb_rates : ndarray, shape (6, N), optional
+        As in :func:`regressor`.
+    gravity : bool
+    coulomb_smoothing, actuator_smoothing : float
+        As in :func:`regressor`.
+    rigid, friction : bool
+        Compute the bodies' columns, the friction and offset columns (each else zero).
+    out : ndarray, shape (6, N_STANDARD, N), optional
+        Written in place and returned (a slice of a larger array: no copy).
 
-    if moving:
-        v, a = qd[:, None, :3], qdd[:, None, :3]
-        w, al = omega[:, None], alpha[:, None]
-        v_A = v + _cross(w, r)
-        a_A = a + _cross(al, r) + _cross(w, _cross(w, r))
-        rate = _dot(u, v_A)
-        u_dot = (v_A - rate * u) / lengths
-        u_ddot = (a_A - u * _dot(u, a_A) - lengths * _dot(u_dot, u_dot) * u
-                  - 2.0 * rate * u_dot) / lengths
-        a_g = a_A - g * e_z
-        forces = {"m_u": a_g, "md_u": -(u_ddot + project(a_g)), "J_u": project(u_ddot)}
-        forces["J_l"] = forces["J_u"]
-    else:
-        a_g = np.broadcast_to(-g * e_z, u.shape)
-        forces = {"m_u": a_g, "md_u": -project(a_g)}
-    forces["md_l"] = -g * project(np.broadcast_to(e_z, u.shape))
-    for name, x in forces.items():
-        k = _INDEX[name]
-        Yn[:, :3, k] = x.sum(1)
-        Yn[:, 3:, k] = _cross(r, x).sum(1)
-
-
-# the joint axes of each friction type, as a mask over the rows (legs x axes) of a sample
-_TYPE_MASK_LEGS = np.tile([[a in axes for a in range(5)] for axes in JOINT_TYPES.values()],
-                          (1, 6)).astype(float)
-
-
-def _friction_columns(platform, q, qd, qd_signs, coulomb_smoothing, actuator_smoothing, Y,
-                      moving=True):
-    """Joint friction per type, actuator friction and sensor offsets (q coordinates) into
-    ``Y``, the Coulomb signs from the rates ``qd_signs``; ``moving`` False: ``qd`` is zero,
-    and so are the viscous columns (left as they are)."""
-    n = len(q)
-    terms = compute_leg_terms(platform, q, joints=True)
-    J, flat = terms.leg_jacobian, terms.joint_jacobians.reshape(n, -1, 6)  # legs x axes rows
-
-    def axis_rates(rates):  # (n, 6) -> (n, legs, axes)
-        return (flat @ rates[:, :, None]).reshape(n, 6, -1)
-
-    def by_type(weights):  # sum over legs and the axes of each type of weight x row
-        return np.swapaxes((weights.reshape(n, 1, -1) * _TYPE_MASK_LEGS) @ flat, 1, 2)
-
-    rates = axis_rates(qd) if moving or qd_signs is qd else None
-    signs = _smooth_sign(rates if qd_signs is qd else axis_rates(qd_signs), coulomb_smoothing)
-    friction = parameter_index(FRICTION_PARAMETERS)  # the viscous types, then the Coulomb
-    if moving:
-        Y[:, :, friction[:len(JOINT_TYPES)]] = by_type(rates)
-    Y[:, :, friction[len(JOINT_TYPES):]] = by_type(signs)
-    leg_rates = (J @ qd[:, :, None])[..., 0]
-    actuator = parameter_index(ACTUATOR_PARAMETERS)
-    Y[:, :, actuator[0]] = (leg_rates[:, None] @ J)[:, 0]
-    sign_rates = leg_rates if qd_signs is qd else (J @ qd_signs[:, :, None])[..., 0]
-    Y[:, :, actuator[1]] = (_smooth_sign(sign_rates, actuator_smoothing)[:, None] @ J)[:, 0]
-    Y[:, :, parameter_index(OFFSET_PARAMETERS)] = np.swapaxes(J, 1, 2)
-
-
-def _smooth_sign(x: np.ndarray, smoothing: float) -> np.ndarray:
-    return np.sign(x) if smoothing == 0 else x / np.sqrt(x * x + smoothing * smoothing)
+    Returns
+    -------
+    ndarray, shape (6, N_STANDARD, N)
+    """
+    return rows.regressor_columns(
+        platform.upper_joints, platform.base_joints, np.asarray(q, dtype=float),
+        np.asarray(q_dot, dtype=float), np.asarray(q_ddot, dtype=float),
+        GRAVITY if gravity else 0.0, _INDEX, coulomb_rates, coulomb_smoothing,
+        actuator_smoothing, rigid, friction, out)
 
 
 class BaseParameters(NamedTuple):
@@ -408,4 +325,4 @@ __all__ = ["ACTUATOR_PARAMETERS", "ACTUATOR_SMOOTHING", "BODY_PARAMETERS", "Base
            "PARAMETERS", "SAMPLE_ACCELERATIONS", "SAMPLE_RATES", "SAMPLE_SPAN",
            "VISCOUS_PARAMETERS", "base_parameters", "combination_text",
            "parameter_index", "pseudo_inertia", "random_states",
-           "regressor", "standard_parameters"]
+           "regressor", "regressor_columns", "standard_parameters"]
