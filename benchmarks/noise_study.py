@@ -67,8 +67,9 @@ METHODS = {"fourier": functools.partial(create_identifier, "fourier"),
 class OracleIdentifier:
     """Least squares given the Coulomb force of the noise-free motion (the efficiency bound a
     friction-immune method is measured against): y - F_coulomb = Mt q_ddot + Bt q_dot + offset
-    per experiment, Savitzky-Golay derivatives of the measured pose, standard errors for
-    autocorrelated residuals. The window is the longest that passes every excitation line of
+    per experiment (y less the model's nonlinear remainder, as every method's),
+    Savitzky-Golay derivatives of the measured pose, standard errors for autocorrelated
+    residuals. The window is the longest that passes every excitation line of
     the clean pose with a gain within 1e-3 of 1 (:func:`oracle_window`)."""
 
     def __init__(self, clean):
@@ -82,8 +83,8 @@ class OracleIdentifier:
 
         viscous_only = platform.replace(friction__coulomb=0.0)
         phis, ys = [], []
-        for k, (experiment, clean) in enumerate(zip(prepare(datasets, platform), self.clean,
-                                                    strict=True)):
+        for k, (experiment, clean) in enumerate(zip(prepare(datasets, platform, remainder=True),
+                                                    self.clean, strict=True)):
             rate = experiment.sample_rate
             window = oracle_window(clean.lengths, rate)
             _, qd_true, _ = differentiate(clean.pose, rate, window)
