@@ -15,7 +15,11 @@ paper``: the paper's 0.5 Hz sines instead); per seed they are degraded
 - ``coloured``: the reference force noise low-pass filtered at 20 Hz (fourth-order
   Butterworth, same standard deviation), a 30 N mains hum at 50 Hz, a 50 N random-walk
   drift of every force channel and the leg lengths quantised to 1 µm (:data:`COLOURED`);
-  ``lowpass`` and ``humdrift`` its parts (:data:`PARTS`).
+  ``lowpass`` and ``humdrift`` its parts (:data:`PARTS`);
+- ``filtered``: the same rig, but the force sensor's white noise itself goes through the
+  20 Hz filter (an anti-aliasing filter on the channel: the noise density below 20 Hz is the
+  white noise's, its standard deviation :func:`filtered_share` of it), where ``coloured``
+  squeezes the whole standard deviation into the filter's band.
 
 For each kind and method: the median over seeds of the largest error over the paper's 20
 entries, the share of (entry, seed) pairs within 3 reported standard errors, the largest
@@ -53,10 +57,20 @@ from stewartid.simulation.sensors import reference_noise  # noqa: E402
 #: The coloured-noise rig, on top of the reference noise (the worked example of docs/logs.md).
 COLOURED = {"force_lowpass": 20.0, "hum_amplitude": 30.0, "hum_frequency": 50.0,
             "force_drift": 50.0, "length_resolution": 1e-6}
+#: Sample rate (Hz) of the kinds' logs (simulated at the plant's default).
+LOG_RATE = 1000.0
 #: Its parts, to tell what each costs: the filtered force noise alone, and the hum, drift and
 #: quantisation on white noise.
 PARTS = {"lowpass": {"force_lowpass": 20.0},
          "humdrift": {k: v for k, v in COLOURED.items() if k != "force_lowpass"}}
+
+
+def filtered_share(cutoff: float, order: int, sample_rate: float) -> float:
+    """Standard deviation of white noise after a Butterworth low-pass (``cutoff`` Hz,
+    ``order``) as a share of its own: sqrt(noise bandwidth / Nyquist frequency), the noise
+    bandwidth of the Butterworth filter being cutoff * (pi / 2n) / sin(pi / 2n)."""
+    bandwidth = cutoff * (np.pi / (2 * order)) / np.sin(np.pi / (2 * order))
+    return float(np.sqrt(bandwidth / (0.5 * sample_rate)))
 
 
 def rig_noise(platform, kind: str):
@@ -69,9 +83,14 @@ def rig_noise(platform, kind: str):
         return dataclasses.replace(noise, **COLOURED), None
     if kind in PARTS:
         return dataclasses.replace(noise, **PARTS[kind]), None
+    if kind == "filtered":
+        share = filtered_share(COLOURED["force_lowpass"], noise.force_lowpass_order,
+                               LOG_RATE)
+        return dataclasses.replace(noise, **COLOURED, force_noise=tuple(
+            share * np.broadcast_to(noise.force_noise, 6))), None
     if kind.startswith("delay"):
         return dataclasses.replace(noise, force_delay=float(kind[5:]) * 1e-3), "auto"
-    raise ValueError(f"kind must be white, coloured, lowpass, humdrift or delayMS; got "
+    raise ValueError(f"kind must be white, coloured, filtered, lowpass, humdrift or delayMS; got "
                      f"{kind!r}.")
 
 
@@ -150,7 +169,7 @@ def summary(rows) -> list[str]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--kind", default="white,coloured,delay",
-                        help="comma-separated: white, coloured, lowpass, humdrift, delay (one "
+                        help="comma-separated: white, coloured, filtered, lowpass, humdrift, delay (one "
                              "log per --delays)")
     parser.add_argument("--base", default="three", choices=("three", "paper"),
                         help="clean logs: noise_study's three-sine or paper kind")
