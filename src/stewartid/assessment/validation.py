@@ -213,7 +213,7 @@ def coulomb_estimate(result: IdentificationResult) -> tuple[np.ndarray, np.ndarr
 
 def prepare_segment(dataset: Dataset, platform: Platform, window: float, *, gravity: bool,
                     experiment: int = 0, fold: int = 0,
-                    coulomb_smoothing: float = 1e-4) -> Segment:
+                    coulomb_smoothing: float = 1e-4, remainder: bool = False) -> Segment:
     """Filtered force, motion and Coulomb regressors of one record.
 
     Parameters
@@ -228,18 +228,24 @@ def prepare_segment(dataset: Dataset, platform: Platform, window: float, *, grav
         Labels stored in the segment.
     coulomb_smoothing : float
         Rate (rad/s) below which a joint's Coulomb sign is attenuated, as in ``ls``.
+    remainder : bool
+        Subtract the model's departure from its linearisation, as the identifier did
+        (:func:`~stewartid.identification.preparation.model_remainder`).
 
     Returns
     -------
     Segment
     """
     from stewartid.identification.least_squares import coulomb_regressors
+    from stewartid.identification.physical_noise import coulomb_sign_rates
     from stewartid.identification.preparation import prepare
+    from stewartid.identification.wavelet.noise import white_noise_covariance
     from stewartid.signals.differentiation import differentiate, kernel_filter
 
-    record = prepare([dataset], platform, gravity=gravity)[0]
-    # the signs need rates at every sample: a light Savitzky-Golay velocity decides them
-    _, q_dot_sign, _ = differentiate(record.q, record.sample_rate, window / 4)
+    record = prepare([dataset], platform, gravity=gravity, remainder=remainder)[0]
+    # the signs need rates at every sample, from the window the noise allows, as in ``ls``
+    q_dot_sign, _ = coulomb_sign_rates(record.q, record.sample_rate, window, white_noise_covariance(
+        record.q, differentiate(record.q, record.sample_rate, window / 8, 5, (0,))[0]))
     unit = coulomb_regressors(record.joint_jacobians, q_dot_sign, coulomb_smoothing)
     signals = np.concatenate([record.generalized_force, unit.reshape(len(unit), -1)], axis=1)
     filtered = kernel_filter(signals, record.sample_rate, window)[0]
@@ -298,15 +304,17 @@ def excitation_window(dataset: Dataset) -> float:
 
 
 def held_out_segments(datasets: Sequence[Dataset], platform: Platform,
-                      folds: int = DEFAULT_FOLDS, gravity: bool = True) -> list[Segment]:
+                      folds: int = DEFAULT_FOLDS, gravity: bool = True,
+                      remainder: bool = False) -> list[Segment]:
     """Every fold segment of every experiment, filtered (:func:`prepare_segment`); the same
-    for every method with the same ``gravity`` setting."""
+    for every method with the same ``gravity`` and ``remainder`` settings."""
     segments = []
     for e, dataset in enumerate(datasets):
         edges, window = fold_bounds(len(dataset), folds), excitation_window(dataset)
         for k in range(folds):
             segments.append(prepare_segment(_piece(dataset, edges[k], edges[k + 1]), platform,
-                                            window, gravity=gravity, experiment=e, fold=k))
+                                            window, gravity=gravity, experiment=e, fold=k,
+                                            remainder=remainder))
     return segments
 
 
@@ -366,12 +374,13 @@ def cross_validate(create: Callable[[], Any], datasets: Sequence[Dataset], platf
     return CrossValidation(folds=int(folds), fold_results=fold_results, segments=segments)
 
 
-def record_segments(datasets: Sequence[Dataset], platform: Platform, gravity: bool = True
-                    ) -> list[Segment]:
+def record_segments(datasets: Sequence[Dataset], platform: Platform, gravity: bool = True,
+                    remainder: bool = False) -> list[Segment]:
     """Validation records (motion the fit did not see), filtered as the held-out segments
     are, each whole (:func:`prepare_segment`, labelled with fold 0)."""
     return [prepare_segment(dataset, platform, excitation_window(dataset), gravity=gravity,
-                            experiment=k) for k, dataset in enumerate(datasets)]
+                            experiment=k, remainder=remainder)
+            for k, dataset in enumerate(datasets)]
 
 
 def validate_on_records(result: IdentificationResult, segments: Sequence[Segment]

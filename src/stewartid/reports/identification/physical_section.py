@@ -118,9 +118,10 @@ def workspace(platform: Platform, result: PhysicalResult, covariance: np.ndarray
 
 
 def fit_physical(datasets: Sequence[Dataset], platform: Platform, request: PhysicalRequest,
-                 folds: int, segments: dict[bool, list[Segment]],
+                 folds: int, segments: dict[tuple[bool, bool], list[Segment]],
                  records: Sequence[Dataset] = (),
-                 record_cache: dict[bool, list[Segment]] | None = None) -> PhysicalSection:
+                 record_cache: dict[tuple[bool, bool], list[Segment]] | None = None
+                 ) -> PhysicalSection:
     """Fit the physical model on all experiments, validate it on held-out segments (and on
     ``records``) and compute its Mt, Bt across the workspace.
 
@@ -130,8 +131,8 @@ def fit_physical(datasets: Sequence[Dataset], platform: Platform, request: Physi
         As :func:`~stewartid.reports.identification.report.write_identification_report`.
     request : PhysicalRequest
     segments, record_cache : dict
-        Held-out segments and validation-record segments by ``gravity`` setting, shared with
-        the compared methods (filled on first use).
+        Held-out segments and validation-record segments by (``gravity``, ``remainder``)
+        setting, shared with the compared methods (filled on first use).
     records : sequence of Dataset
         Validation records (``identify --validate``).
 
@@ -158,17 +159,18 @@ def fit_physical(datasets: Sequence[Dataset], platform: Platform, request: Physi
                 f"The physical model is not shown: these data fix {len(fixed)} of its {count} "
                 "parameters at the platform file's values (not identifiable from them); "
                 "`identify --model physical` fits and names the rest."))
-        if gravity not in segments:
-            segments[gravity] = held_out_segments(datasets, platform, folds, gravity)
+        terms = (gravity, False)  # the full model predicts the nonlinear terms itself
+        if terms not in segments:
+            segments[terms] = held_out_segments(datasets, platform, folds, *terms)
         validation = cross_validate_physical(lambda: PhysicalIdentifier(**options), datasets,
-                                             platform, folds, segments[gravity])
+                                             platform, folds, segments[terms])
         external = None
         if records:
             cache = {} if record_cache is None else record_cache
-            if gravity not in cache:
-                cache[gravity] = record_segments(records, platform, gravity)
+            if terms not in cache:
+                cache[terms] = record_segments(records, platform, *terms)
             external = validate_physical_on_records(estimator.result_, records,
-                                                    cache[gravity], platform)
+                                                    cache[terms], platform)
         curves = workspace(platform, estimator.result_, estimator.covariance_, datasets)
     except StewartidError as exc:
         if request.required:

@@ -84,10 +84,11 @@ def _project(result: IdentificationResult) -> IdentificationResult:
 
 def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Dataset],
                platform: Platform, folds: int, consistent: bool,
-               segments: dict[bool, list[Segment]],
+               segments: dict[tuple[bool, bool], list[Segment]],
                check: Callable[[IdentificationResult], None] | None = None,
                records: Sequence[Dataset] = (),
-               record_cache: dict[bool, list[Segment]] | None = None) -> MethodReport:
+               record_cache: dict[tuple[bool, bool], list[Segment]] | None = None
+               ) -> MethodReport:
     """Fit, validate and check one method; a method that cannot be applied to these data
     (a :class:`~stewartid.errors.StewartidError`) is reported with its message.
 
@@ -100,8 +101,8 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
     datasets, platform, folds, consistent
         As :func:`write_identification_report`.
     segments : dict
-        Held-out segments by ``gravity`` setting, filled on first use and shared between
-        methods.
+        Held-out segments by (``gravity``, ``remainder``) setting, filled on first use and
+        shared between methods.
     check : callable, optional
         Raises a StewartidError for an implausible result (the method is then reported as
         not applicable).
@@ -109,7 +110,7 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
         Validation records of another excitation (``identify --validate``), predicted by the
         full fit.
     record_cache : dict, optional
-        Their filtered segments by ``gravity`` setting, filled on first use.
+        Their filtered segments by (``gravity``, ``remainder``) setting, filled on first use.
     """
     spec = registry.method_spec(name)
     accepted = spec.estimator_class.param_names()
@@ -119,15 +120,17 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
         estimator = registry.create_identifier(name, **own).fit(list(datasets), platform)
         if check is not None:
             check(estimator.result_)
-        gravity = bool(estimator.get_params().get("gravity", True))
-        if gravity not in segments:
-            segments[gravity] = held_out_segments(datasets, platform, folds, gravity)
+        params = estimator.get_params()
+        # the measured side of the prediction with the model terms the method removed
+        terms = (bool(params.get("gravity", True)), bool(params.get("remainder", False)))
+        if terms not in segments:
+            segments[terms] = held_out_segments(datasets, platform, folds, *terms)
         companion = None
         if "friction" in accepted:
             def companion():
                 return registry.create_identifier(name, **{**own, "friction": "uniform"})
         folds_fit = cross_validate(lambda: registry.create_identifier(name, **own), datasets,
-                                   platform, folds, gravity, segments[gravity], companion)
+                                   platform, folds, terms[0], segments[terms], companion)
     except StewartidError as exc:
         return MethodReport(name, spec.display_name, spec.color, error=str(exc),
                             exception=exc, seconds=time.perf_counter() - start)
@@ -140,15 +143,15 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
     external = None
     if records:
         cache = {} if record_cache is None else record_cache
-        if gravity not in cache:
-            cache[gravity] = record_segments(records, platform, gravity)
+        if terms not in cache:
+            cache[terms] = record_segments(records, platform, *terms)
         # ``result`` holds the companion's levels: the consistent one keeps the diagnostics
-        external = validate_on_records(result, cache[gravity])
+        external = validate_on_records(result, cache[terms])
     result = dataclasses.replace(result, validation=validation_entry(validation, external))
     return MethodReport(name, spec.display_name, spec.color, result=result,
                         unconstrained=unconstrained, validation=validation,
                         validation_unconstrained=before,
-                        in_sample=in_sample(segments[gravity], result), projection=projection,
+                        in_sample=in_sample(segments[terms], result), projection=projection,
                         records=external, seconds=time.perf_counter() - start)
 
 
@@ -220,8 +223,8 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
         nominal_source = nominal_source or (f"platform description '{platform.name}' at the "
                                             "neutral pose")
     rows = data_rows(datasets, platform)
-    segments: dict[bool, list[Segment]] = {}
-    record_cache: dict[bool, list[Segment]] = {}
+    segments: dict[tuple[bool, bool], list[Segment]] = {}
+    record_cache: dict[tuple[bool, bool], list[Segment]] = {}
     runs = [run_method(name, settings or {}, datasets, platform, folds, consistent, segments,
                        check, records, record_cache) for name in dict.fromkeys(methods)]
     usable = [run for run in runs if run.result is not None]
