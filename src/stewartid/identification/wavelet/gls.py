@@ -341,7 +341,7 @@ def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
                     pose_covariance: np.ndarray | None = None,
                     force_sensitivity: np.ndarray | None = None,
                     force_variance: np.ndarray | None = None, rate_index: int = 0,
-                    variation: bool = False) -> WeakFormSolution:
+                    variation: bool = False, shared: dict | None = None) -> WeakFormSolution:
     """Generalized least squares for [Mt Bt] (and the friction structure), pose noise
     propagated and its bias compensated (module docstring).
 
@@ -375,6 +375,10 @@ def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
     variation : bool
         Give the invariant rows the Coulomb levels (:func:`channel_systems`); the force-side
         noise is then re-measured from the joint fit's residuals and the fit repeated.
+    shared : dict, optional
+        Work that does not depend on ``rate_index`` or ``variation`` (the rank check and
+        :func:`fit_invariant_rows`), kept here by the first call and reused by the next ones
+        on the same equations.
 
     Returns
     -------
@@ -393,10 +397,14 @@ def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
     stacked = stack_equations(equations, pose_covariance, force_sensitivity, force_variance,
                               rate_index)
     n, k_rows = stacked.regressors.shape[:2]
-    flat = stacked.regressors.reshape(-1, 12)
-    condition = check_rank(flat.T @ flat, regressor_names("q_ddot", "q_dot"), max_condition)
+    shared = {} if shared is None else shared
+    if "invariant" not in shared:
+        flat = stacked.regressors.reshape(-1, 12)
+        shared["condition"] = check_rank(flat.T @ flat, regressor_names("q_ddot", "q_dot"),
+                                         max_condition)
+        shared["invariant"] = fit_invariant_rows(stacked, iterations)
+    condition, invariant = shared["condition"], shared["invariant"]
     designs, targets = channel_systems(stacked, n_experiments, shared_friction, variation)
-    invariant = fit_invariant_rows(stacked, iterations)
     scatter = constant_scatter(stacked, designs, invariant) if shared_friction else None
     fit = fit_jointly(stacked, designs, targets, invariant, scatter, iterations)
     for _ in range(VARIATION_PASSES if variation else 0):

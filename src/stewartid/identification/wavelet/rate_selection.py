@@ -67,11 +67,12 @@ def solve_weak_form_over_rates(equations: Sequence[IntervalEquations], n_experim
     """
     if shared_friction:  # the mean rows carry the levels; their benchmarks are without these
         return solve_weak_form(equations, n_experiments, True, **settings), None
+    shared: dict = {}
+    plain = solve_weak_form(equations, n_experiments, False, shared=shared, **settings)
     best, best_rate = best_over_rates(
         lambda index: solve_weak_form(equations, n_experiments, False, rate_index=index,
-                                      variation=True, **settings),
+                                      variation=True, shared=shared, **settings),
         SOFT_SIGN_RATES[:len(equations[0].coulomb_rows)])
-    plain = solve_weak_form(equations, n_experiments, False, **settings)
     rows = plain.n_equations
     # likelihood ratio of the levels (with the rate picked among the candidates), and levels
     # a friction can have: a level 3 standard errors below zero says the plant's friction

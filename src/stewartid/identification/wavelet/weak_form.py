@@ -250,15 +250,19 @@ SOFT_SIGN_RATES = (0.0, 1e-4, 3e-4, 1e-3, 3e-3)
 
 
 def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: bool,
-                     rate: float = 0.0) -> np.ndarray:
+                     rate: float | Sequence[float] = 0.0) -> np.ndarray:
     """W_type(t) at every sample, shape (N, n_types, 6) (or (N, 1, 6) with ``uniform``):
     the generalized force of a unit Coulomb torque on every axis of a joint type, opposing
     the axis's smoothed rate (soft sign w / sqrt(w^2 + sigma^2 + r^2) over the rate's noise
     level sigma and the friction's transition ``rate`` r, rad/s: a regularised or Stribeck
-    friction is not a sign)."""
+    friction is not a sign). A sequence of rates gives shape (n_rates, N, n_types, 6)."""
     rates, noise = found.joint_rates, found.rate_noise
-    direction = rates / np.sqrt(rates ** 2 + noise ** 2 + rate ** 2)          # (N, 6, 5)
-    return _by_type(np.einsum("nla,nlac->nac", direction, joint_jacobians), uniform)
+    out = []
+    for r in np.atleast_1d(np.asarray(rate, dtype=float)):
+        direction = rates / np.sqrt(rates ** 2 + noise ** 2 + r ** 2)          # (N, 6, 5)
+        # per axis over the legs, then the axes summed by type: one einsum on whole arrays
+        out.append(_by_type(np.einsum("nla,nlac->nac", direction, joint_jacobians), uniform))
+    return np.stack(out) if np.ndim(rate) else out[0]
 
 
 def _by_type(pattern: np.ndarray, uniform: bool) -> np.ndarray:
@@ -298,7 +302,7 @@ def experiment_equations(experiment: Experiment, found: Detection, order: int, s
     """
     jacobians = experiment.joint_jacobians
     uniform = friction == "uniform"
-    patterns = np.stack([coulomb_patterns(found, jacobians, uniform, r) for r in rates])
+    patterns = coulomb_patterns(found, jacobians, uniform, tuple(rates))
     equations = (interval_equations(experiment.t, experiment.q, experiment.generalized_force,
                                     None if friction == "free" else jacobians,
                                     found.joint_rates, found.rate_noise, interval,

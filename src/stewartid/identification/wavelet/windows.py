@@ -95,8 +95,8 @@ def window_equations(experiment: Experiment, found: Detection, order: int, size:
     list of WindowEquations
     """
     t, q, y = experiment.t, experiment.q, experiment.generalized_force
-    patterns = np.stack([coulomb_patterns(found, experiment.joint_jacobians, uniform, r)
-                         for r in rates])                                  # (R, N, types, 6)
+    patterns = coulomb_patterns(found, experiment.joint_jacobians, uniform,
+                                tuple(rates))                              # (R, N, types, 6)
     h = float(t[1] - t[0])
     out = []
     for start, stop in window_bounds(t, length):
