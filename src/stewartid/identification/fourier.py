@@ -242,11 +242,8 @@ class FourierIdentifier(BaseIdentifier):
         Subtract the model's pose-dependent gravity term G(q) (recommended; without it the
         legs' gravity stiffness biases Mt by -K_G / w^2).
     remainder : bool
-        Subtract what the model's inertial and viscous terms add to their linearisation at
-        the neutral pose, along the measured motion
-        (:func:`~stewartid.identification.preparation.model_remainder`): the identified
-        matrices are then the linearisation's at any amplitude, not an average over the
-        poses reached.
+        Subtract the model's departure from its linearisation along the measured motion
+        first (:func:`~stewartid.identification.preparation.model_remainder`).
     stiffness : bool
         Identify a stiffness matrix K as well (needs two or more frequencies).
     symmetric : bool

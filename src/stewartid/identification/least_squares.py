@@ -117,11 +117,9 @@ class LeastSquaresIdentifier(BaseIdentifier):
     gravity : bool
         Subtract the model's gravity term G(q).
     remainder : bool
-        Subtract what the model's inertial and viscous terms add to their linearisation at
-        the neutral pose, along the measured motion
-        (:func:`~stewartid.identification.preparation.model_remainder`): the identified
-        matrices are then the linearisation's at any amplitude, not an average over the
-        poses reached.
+        Fit the force less the model's nonlinear remainder
+        (:func:`~stewartid.identification.preparation.model_remainder`): the linearisation's
+        Mt and Bt at any amplitude.
     coulomb : bool
         Include the three Coulomb regressors.
     coulomb_smoothing : float
