@@ -32,6 +32,10 @@ def identify(
                           "such as 't=Time:ms,l1..l6=Leg{k}:mm' (docs/logs.md).")] = None,
     no_gravity: Annotated[bool, typer.Option(
         "--no-gravity", help="Do not subtract the model's gravity term G(q).")] = False,
+    no_remainder: Annotated[bool, typer.Option(
+        "--no-remainder", help="Do not subtract the model's departure from its linearisation "
+                               "along the motion (the matrices then average M(q) over the "
+                               "poses reached).")] = False,
     symmetric: Annotated[bool, typer.Option(
         "--symmetric", help="Impose symmetric Mt and Bt.")] = False,
     frequency: Annotated[list[float] | None, typer.Option(
@@ -94,6 +98,7 @@ def identify(
     from stewartid.reports.identification.run import FlagSetting, identify_files
 
     flags = {"--no-gravity": FlagSetting("gravity", not no_gravity, no_gravity),
+             "--no-remainder": FlagSetting("remainder", not no_remainder, no_remainder),
              "--symmetric": FlagSetting("symmetric", symmetric, symmetric),
              "--frequency": FlagSetting("frequency_hz", frequency or None, bool(frequency)),
              "--stiffness": FlagSetting("stiffness", stiffness, stiffness),
