@@ -141,8 +141,12 @@ def is_definite(result: IdentificationResult) -> bool:
 
 def friction_immune(result: IdentificationResult) -> bool:
     """The method's Mt and Bt do not depend on a friction law: Method B with a free constant
-    per constant-direction interval (``friction_model`` "free")."""
-    return result.diagnostics.get("friction_model") == "free"
+    per constant-direction interval (``friction_model`` "free") and no Coulomb levels on its
+    invariant rows (``soft_sign_rate`` None: on large motions it fits the Coulomb force's
+    change inside the intervals, and then rests on that structure)."""
+    diagnostics = result.diagnostics
+    return (diagnostics.get("friction_model") == "free"
+            and diagnostics.get("soft_sign_rate") is None)
 
 
 def finds_friction(result: IdentificationResult) -> bool:
