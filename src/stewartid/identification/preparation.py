@@ -220,7 +220,8 @@ def model_remainder(platform: Platform, q: np.ndarray, sample_rate: float) -> np
     below 1e-5 of the remainder at three times the dominant frequency), which takes its cost
     from 0.17 s to 0.01 s per 20 000 samples.
     """
-    window = default_window(estimate_frequency(q, sample_rate)) / REMAINDER_FRACTION
+    # the window needs the frequency only roughly: the spectrum's peak without refinement
+    window = default_window(estimate_frequency(q, sample_rate, refine=False)) / REMAINDER_FRACTION
     q_s, q_dot, q_ddot = differentiate(q, sample_rate, window, REMAINDER_ORDER)
     n = len(q_s)
     step = max(1, window_samples(window, sample_rate, REMAINDER_ORDER) // REMAINDER_STEPS)
