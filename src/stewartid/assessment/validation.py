@@ -237,15 +237,13 @@ def prepare_segment(dataset: Dataset, platform: Platform, window: float, *, grav
     Segment
     """
     from stewartid.identification.least_squares import coulomb_regressors
-    from stewartid.identification.physical_noise import coulomb_sign_rates
+    from stewartid.identification.physical_noise import measured_sign_rates
     from stewartid.identification.preparation import prepare
-    from stewartid.identification.wavelet.noise import white_noise_covariance
-    from stewartid.signals.differentiation import differentiate, kernel_filter
+    from stewartid.signals.differentiation import kernel_filter
 
     record = prepare([dataset], platform, gravity=gravity, remainder=remainder)[0]
     # the signs need rates at every sample, from the window the noise allows, as in ``ls``
-    q_dot_sign, _ = coulomb_sign_rates(record.q, record.sample_rate, window, white_noise_covariance(
-        record.q, differentiate(record.q, record.sample_rate, window / 8, 5, (0,))[0]))
+    q_dot_sign = measured_sign_rates(record.q, record.sample_rate, window)
     unit = coulomb_regressors(record.joint_jacobians, q_dot_sign, coulomb_smoothing)
     signals = np.concatenate([record.generalized_force, unit.reshape(len(unit), -1)], axis=1)
     filtered = kernel_filter(signals, record.sample_rate, window)[0]

@@ -39,12 +39,11 @@ from stewartid.datasets.dataset import Dataset
 from stewartid.fields import BOOLEAN, Interval, Options, nonnegative
 from stewartid.identification.base import DIFFERENTIATION_CONSTRAINTS, BaseIdentifier
 from stewartid.identification.pairs import calibrate_by_pairs
-from stewartid.identification.physical_noise import coulomb_sign_rates
+from stewartid.identification.physical_noise import measured_sign_rates
 from stewartid.identification.preparation import prepare
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.solvers import regressor_names, solve_least_squares
-from stewartid.identification.wavelet.noise import white_noise_covariance
 from stewartid.model.joints import JOINT_TYPES
 from stewartid.platform import Platform
 from stewartid.signals.differentiation import (
@@ -196,9 +195,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
                 # allows (the physical model's rule): a quarter of the kernel, as before,
                 # made the signs chatter under the reference noise on three-sine logs
                 # (rotational Bt 3-7 % and 4.3 standard errors off; 86 % within 3)
-                qd_sign, _ = coulomb_sign_rates(
-                    exp.q, exp.sample_rate, window, white_noise_covariance(
-                        exp.q, differentiate(exp.q, exp.sample_rate, window / 8, 5, (0,))[0]))
+                qd_sign = measured_sign_rates(exp.q, exp.sample_rate, window)
                 coulomb = coulomb_regressors(exp.joint_jacobians, qd_sign,
                                              self.coulomb_smoothing) if self.coulomb else None
                 signals = np.concatenate(

@@ -24,6 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from stewartid.identification.preparation import Experiment
+from stewartid.identification.wavelet.noise import white_noise_covariance
 from stewartid.model import matrix_regressors
 from stewartid.model import regressor as reg
 from stewartid.platform import Platform
@@ -98,6 +99,14 @@ def coulomb_sign_rates(q: np.ndarray, sample_rate: float, window: float,
     return rates, window * fraction
 
 
+def measured_sign_rates(q: np.ndarray, sample_rate: float, window: float) -> np.ndarray:
+    """:func:`coulomb_sign_rates` of a record whose pose noise is not known yet: estimated
+    against the pose smoothed as the physical model's regressor is (order 5 over an eighth
+    of the kernel), the rates (N, 6) returned alone."""
+    smooth = differentiate(q, sample_rate, window / 8, 5, (0,))[0]
+    return coulomb_sign_rates(q, sample_rate, window, white_noise_covariance(q, smooth))[0]
+
+
 #: Kept rows per evaluation of the noise's Jacobians in :func:`regressor_noise`.
 JACOBIAN_STRIDE = 5
 
@@ -156,4 +165,4 @@ def regressor_noise(experiments: list[Experiment], windows: list[float], row_ste
 
 
 __all__ = ["JACOBIAN_STRIDE", "SIGN_FRACTIONS", "SIGN_NOISE", "SIGN_ORDER", "coulomb_sign_rates",
-           "derivative_noise_gains", "regressor_noise"]
+           "derivative_noise_gains", "measured_sign_rates", "regressor_noise"]

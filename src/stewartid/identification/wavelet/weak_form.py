@@ -144,10 +144,11 @@ class IntervalEquations:
     coulomb : ndarray, shape (n_types, 6), or (1, 6) with one level for every axis
         <g, W_type>: generalized Coulomb force per unit level of each joint type, with the
         interval's joint directions.
-    coulomb_rows : ndarray, shape (n_rates, K, n_types, 6), or (n_rates, K, 1, 6)
+    coulomb_rows : ndarray, shape (n_rates, K, n_types, 6), or (n_rates, K, 1, 6), or None
         <phi_k, W_type(t)> at each soft-sign transition rate of :func:`coulomb_patterns`:
         what the invariant rows see of the Coulomb force when it is not constant inside the
-        interval (the pose changes its map J_j(q)^T; idle joints reverse).
+        interval (the pose changes its map J_j(q)^T; idle joints reverse). Formed with every
+        constant free only, the one model that fits them (:mod:`.rate_selection`).
     experiment : int
         Index of the experiment the interval belongs to.
     noise_gram : ndarray, shape (3, 3, K + 1, K + 1)
@@ -204,7 +205,7 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
         One Coulomb level for every joint axis: ``coulomb`` summed over the joint types.
     patterns : ndarray, shape (n_rates, N, n_types, 6), optional
         :func:`coulomb_patterns` of the experiment at each soft-sign transition rate, for
-        ``coulomb_rows``; None: zero.
+        ``coulomb_rows``; None: no ``coulomb_rows``.
 
     Returns
     -------
@@ -231,8 +232,7 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
             np.einsum("la,nlac->nac", direction, joint_jacobians[sel]), uniform))
     # the invariant rows see the joints' soft signs at every sample (an idle joint, left out
     # of the detection, may reverse inside the interval) and the pose's change
-    rows = (np.zeros((1, size, n_types, 6)) if patterns is None
-            else np.einsum("kn,rntc->rktc", phi0, patterns[:, sel]))
+    rows = None if patterns is None else np.einsum("kn,rntc->rktc", phi0, patterns[:, sel])
     family = np.stack([np.vstack([phi0, bump0]), np.vstack([phi1, bump1]),
                        np.vstack([phi2, bump2])])                            # (3, K + 1, n)
     gram = np.einsum("arn,bsn->abrs", family, family)
@@ -293,7 +293,8 @@ def experiment_equations(experiment: Experiment, found: Detection, order: int, s
         "free": no friction structure in the mean rows; "uniform": one Coulomb level for
         every joint axis.
     rates : sequence of float
-        Soft-sign transition rates (rad/s) of the invariant rows' Coulomb regressors.
+        Soft-sign transition rates (rad/s) of the invariant rows' Coulomb regressors ("free"
+        only).
 
     Returns
     -------
@@ -301,10 +302,10 @@ def experiment_equations(experiment: Experiment, found: Detection, order: int, s
         One per interval long enough for the test functions.
     """
     jacobians = experiment.joint_jacobians
-    uniform = friction == "uniform"
-    patterns = coulomb_patterns(found, jacobians, uniform, tuple(rates))
+    uniform, free = friction == "uniform", friction == "free"
+    patterns = coulomb_patterns(found, jacobians, uniform, tuple(rates)) if free else None
     equations = (interval_equations(experiment.t, experiment.q, experiment.generalized_force,
-                                    None if friction == "free" else jacobians,
+                                    None if free else jacobians,
                                     found.joint_rates, found.rate_noise, interval,
                                     order, size, index, uniform=uniform, patterns=patterns)
                  for interval in found.intervals)
