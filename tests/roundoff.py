@@ -34,3 +34,13 @@ def newton_pose_bound(platform, poses: np.ndarray, tolerance: float = 1e-12) -> 
     poses = np.atleast_2d(poses)
     inverse_norm = np.abs(np.linalg.inv(leg_jacobian(platform, poses))).sum(axis=2).max()
     return float(inverse_norm * (tolerance + 8 * EPS * leg_lengths(platform, poses).max()))
+
+
+def convolution_bound(kernel: np.ndarray, x_max: float) -> float:
+    """Largest difference between two float64 evaluations of one convolution, a direct sum
+    and :func:`~stewartid.signals.differentiation.convolve_valid`'s overlap-save FFT, of a
+    signal bounded by ``x_max``: each within (L + log2(nfft)) eps sum|kernel| x_max (L taps,
+    nfft that function's transform length), on any CPU."""
+    length = len(kernel)
+    nfft = max(1024, 1 << int(np.ceil(np.log2(8 * length))))
+    return float(2 * (length + np.log2(nfft)) * EPS * np.abs(kernel).sum() * x_max)
