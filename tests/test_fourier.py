@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -228,3 +230,33 @@ def test_example_c10_method_a(example_dir, example_platform, example_truth):
     diag_M = table[(table.matrix == "M") & (table.i == table.j)]
     assert diag_M["error_percent"].max() < 0.1
     assert est.B_[0, 0] > 1.2 * example_truth["Bt"][0, 0]
+
+
+def test_noise_alone_adds_no_friction_allowance_and_friction_in_noise_is_caught(paper, truth):
+    """Force noise has a third harmonic of its own: below the 1 % significance point it is not
+    read as friction (the error bars stay the noise's), while a square wave whose third
+    harmonic stands well above the noise is caught and its bias covered."""
+    M, B = truth
+    rng = np.random.default_rng(3)
+    level = np.array([50.0, -20.0, 35.0, 80.0, 15.0, -60.0])
+
+    def fit(with_friction: bool) -> FourierIdentifier:
+        data = []
+        for k in range(6):
+            def square(t, q, qd, J, k=k):
+                return np.sign(qd[:, k])[:, None] * level
+            exp = make_experiment(paper, M, B, k, sample_rate=400.0, periods=12,
+                                  coulomb=square if with_friction else None)
+            noisy = exp.forces + rng.normal(0.0, 20.0, exp.forces.shape)
+            data.append(dataclasses.replace(exp, forces=noisy))
+        return FourierIdentifier(frequency_hz=1.0).fit(data, paper)
+
+    quiet = fit(False).result_.diagnostics["friction_bias"]
+    # white noise alone: the statistic is chi-squared below its 1 % point (a fixed seed)
+    assert quiet["statistic"] < quiet["threshold"]
+    assert np.count_nonzero(np.asarray(quiet["third_harmonic"])) == 0
+    assert np.all(np.asarray(quiet["bound_B"]) == 0)
+    rubbing = fit(True)
+    diagnostics = rubbing.result_.diagnostics["friction_bias"]
+    assert diagnostics["statistic"] > diagnostics["threshold"]
+    assert np.all(np.abs(rubbing.B_ - B) <= 3 * rubbing.std_errors_["B"])

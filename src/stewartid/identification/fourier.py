@@ -19,6 +19,7 @@ Coulomb friction is the method's weakness: a square wave of level Fc in phase wi
 velocity has the first harmonic (4/pi) Fc sin(w t + phase of velocity), which is
 indistinguishable from viscous friction and lands in Bt as (4/pi) Fc / (w A). The same
 square wave has a third harmonic of a third of that amplitude, which no linear term explains:
+where the force the linear model leaves shows it above the noise (:func:`third_harmonic`),
 the standard errors carry it (:func:`friction_bias_bound`), so that the entries friction
 biases are reported with the uncertainty the data show, not the noise's alone.
 
@@ -41,6 +42,7 @@ from collections.abc import Sequence
 from numbers import Integral
 
 import numpy as np
+from scipy.stats import chi2
 
 from stewartid.datasets.dataset import Dataset
 from stewartid.datasets.excitation import LINE_FRACTION, leg_space_motion, spectral_lines
@@ -138,32 +140,78 @@ def friction_bias_bound(pinv: np.ndarray, rows: Sequence[np.ndarray],
     return np.sqrt(bound)
 
 
-def third_harmonic(force: np.ndarray, t: np.ndarray, frequency_hz: float,
-                   blocks: Sequence[slice]) -> np.ndarray:
-    """Third-harmonic amplitude of each force channel, the median over whole-period blocks.
+#: Significance level of the test for friction in the third harmonic that the linear model
+#: leaves. Below its point the data do not show friction; reading the noise's own third
+#: harmonic (about 1.25 times a coefficient's noise) as friction would inflate every error bar
+#: about fourfold.
+THIRD_HARMONIC_LEVEL = 0.01
 
-    The median (of the cos and sin coefficients) keeps a start-up transient in one block out.
-    Noise is not subtracted: its share of the amplitude is friction the data cannot rule out.
+
+def third_harmonic(coefficients: Sequence[np.ndarray | None], noise_covariance: np.ndarray
+                   ) -> tuple[list[np.ndarray], float, float]:
+    """Third-harmonic amplitude per experiment and force channel that the data show as friction.
+
+    The coefficients are those of the force the fitted linear model leaves at three times the
+    excitation frequency (a servo's distortion of the sine puts a third harmonic in the
+    motion, which the model explains), averaged over each experiment's whole-period blocks.
+    Their noise is that of the first-harmonic equations' residuals (the same force noise, one
+    block per equation), with its correlation across channels (the legs' noise through the
+    same Jacobian). Coulomb friction is one property of the joints, present in every
+    experiment, so the data are tested as a whole: the sum over experiments of the Mahalanobis
+    norm of the mean coefficients is chi-squared with 12 degrees of freedom per experiment
+    without friction. If it exceeds the point of :data:`THIRD_HARMONIC_LEVEL`, every channel
+    keeps its amplitude, noise included (friction the data cannot rule out); if not, all are
+    zero.
 
     Parameters
     ----------
-    force : ndarray, shape (N, 6)
-    t : ndarray, shape (N,)
-        Time (s).
-    frequency_hz : float
-        Excitation frequency f.
-    blocks : sequence of slice
-        Whole-period blocks.
+    coefficients : sequence of (ndarray, shape (blocks, 2, 6)) or None
+        Per experiment, the (cos, sin) coefficients at 3 f of each channel's residual force,
+        per block (N, N m); None for an experiment of several frequencies (not tested).
+    noise_covariance : ndarray, shape (6, 6)
+        Covariance of one block's harmonic coefficient across the channels.
 
     Returns
     -------
-    ndarray, shape (6,)
-        (N, N m).
+    amplitude : list of ndarray, shape (6,)
+        Per experiment, the third-harmonic amplitude read as friction (N, N m).
+    statistic : float
+        The chi-squared statistic.
+    threshold : float
+        Its point at :data:`THIRD_HARMONIC_LEVEL`.
     """
-    coefficients = np.array([harmonic_coefficients(force[b], t[b], [3 * frequency_hz])
-                             for b in blocks])
-    middle = np.median(coefficients, axis=0)
-    return np.hypot(middle[0], middle[1])
+    precision = np.linalg.pinv(noise_covariance)
+    amplitudes, statistic, dof = [], 0.0, 0
+    for blocks in coefficients:
+        if blocks is None:
+            amplitudes.append(np.zeros(6))
+            continue
+        mean = blocks.mean(axis=0)
+        statistic += len(blocks) * float(np.einsum("ki,ij,kj->", mean, precision, mean))
+        dof += 2 * np.linalg.matrix_rank(noise_covariance)
+        amplitudes.append(np.hypot(mean[0], mean[1]))
+    threshold = float(chi2.isf(THIRD_HARMONIC_LEVEL, dof)) if dof else np.inf
+    if not statistic > threshold:
+        amplitudes = [np.zeros_like(a) for a in amplitudes]
+    return amplitudes, statistic, threshold
+
+
+def residual_third_harmonic(blocks: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """Third-harmonic coefficients of the force that the fitted linear model leaves.
+
+    Parameters
+    ----------
+    blocks : ndarray, shape (blocks, 2, 24)
+        (cos, sin) coefficients at 3 f of q_ddot, q_dot, q - q0 (each corrected for the
+        differentiator's gain at 3 f) and the generalized force, per block.
+    theta : ndarray, shape (6, p)
+        Fitted parameters: Mt, Bt (and K) side by side, p = 12 or 18.
+
+    Returns
+    -------
+    ndarray, shape (blocks, 2, 6)
+    """
+    return blocks[..., 18:] - blocks[..., :theta.shape[1]] @ theta.T
 
 
 def check_single_sine(name: str, pose: np.ndarray, sample_rate: float, platform: Platform,
@@ -305,7 +353,7 @@ class FourierIdentifier(BaseIdentifier):
     def _fit(self, datasets: list[Dataset], platform: Platform
              ) -> tuple[IdentificationResult, dict]:
         experiments = prepare(datasets, platform, gravity=self.gravity, remainder=self.remainder)
-        rows_motion, rows_force, used, rows, third = [], [], [], [], []
+        rows_motion, rows_force, used, rows, third_blocks = [], [], [], [], []
         for exp in experiments:
             # detected on the leg-length motion, where every DOF counts in one unit: on the
             # pose, a DOF that the excited one drags along at twice the frequency can have
@@ -349,8 +397,17 @@ class FourierIdentifier(BaseIdentifier):
                 slices.append(sl)
             rows.append(first + 2 * len(freqs) * np.arange(n_segments)[:, None]
                         + np.arange(2)[None, :])
-            third.append(third_harmonic(exp.generalized_force, exp.t, freqs[0], slices)
-                         if len(freqs) == 1 else np.zeros(6))
+            if len(freqs) == 1:
+                gains3 = np.ones(24)
+                for d, columns in ((2, slice(0, 6)), (1, slice(6, 12)), (0, slice(12, 18))):
+                    gains3[columns] = savgol_gain(3 * freqs[0], exp.sample_rate, window,
+                                                  self.order, d)
+                signals = np.concatenate([qdd, qd, q, exp.generalized_force], axis=1)
+                third_blocks.append(np.array([
+                    harmonic_coefficients(signals[sl], exp.t[sl], [3 * freqs[0]]) / gains3
+                    for sl in slices]))
+            else:
+                third_blocks.append(None)
             used.append({"name": exp.name, "frequencies_hz": freqs, "window_s": window,
                          "segments": blocks})
         motion = np.concatenate(rows_motion)
@@ -360,6 +417,11 @@ class FourierIdentifier(BaseIdentifier):
         solution = solve_least_squares(phi, force, symmetric=self.symmetric,
                                        regressor_names=regressor_names(*groups))
         theta, noise_std = solution.theta, solution.theta_std
+        residual = force - phi @ theta[:, :phi.shape[1]].T
+        covariance = residual.T @ residual / max(len(residual) - phi.shape[1], 1)
+        third, statistic, threshold = third_harmonic(
+            [None if c is None else residual_third_harmonic(c, theta) for c in third_blocks],
+            covariance)
         bias = friction_bias_bound(np.linalg.pinv(phi), rows, third)
         std = np.hypot(noise_std, bias)
         calibration = {} if self.symmetric else calibrate_by_pairs(
@@ -367,6 +429,7 @@ class FourierIdentifier(BaseIdentifier):
         stiffness = theta[:, 12:18] if self.stiffness else None
         diagnostics = {"experiments": used, "n_equations": int(solution.n_equations),
                        "friction_bias": {"third_harmonic": np.array(third),
+                                         "statistic": statistic, "threshold": threshold,
                                          "bound_M": bias[:, :6], "bound_B": bias[:, 6:12],
                                          "noise_std_M": noise_std[:, :6],
                                          "noise_std_B": noise_std[:, 6:12]},
@@ -381,5 +444,6 @@ class FourierIdentifier(BaseIdentifier):
             "stiffness_": stiffness, "frequencies_": [u["frequencies_hz"] for u in used]}
 
 
-__all__ = ["HARMONIC_FRACTION", "SQUARE_WAVE_RATIO", "FourierIdentifier", "check_single_sine",
-           "friction_bias_bound", "harmonic_coefficients", "third_harmonic"]
+__all__ = ["HARMONIC_FRACTION", "SQUARE_WAVE_RATIO", "THIRD_HARMONIC_LEVEL",
+           "FourierIdentifier", "check_single_sine", "friction_bias_bound",
+           "harmonic_coefficients", "residual_third_harmonic", "third_harmonic"]
