@@ -72,11 +72,20 @@ def test_implausible_matrices_are_ranked_after_plausible_ones():
     assert verdict.trusted == "b" and verdict.ranking == ("b", "a")
 
 
-def test_a_tie_goes_to_the_friction_immune_method():
-    verdict = choose_trusted({"ls": (_result(0.010), _validation(0.1)),
-                              "wavelet": (_result(0.015, friction_model="free"),
-                                          _validation(0.5))})
+def test_a_tie_goes_to_the_better_held_out_prediction():
+    verdict = choose_trusted({"ls": (_result(0.010), _validation(0.5)),
+                              "wavelet": (_result(0.010, friction_model="free"),
+                                          _validation(0.1))})
     assert verdict.tied == ("ls", "wavelet") and verdict.trusted == "wavelet"
+
+
+def test_immunity_to_the_friction_law_does_not_outweigh_a_smaller_predicted_error():
+    """The friction law's cost is in each method's standard errors already."""
+    verdict = choose_trusted({"ls": (_result(0.010), _validation(0.5)),
+                              "wavelet": (_result(0.013, friction_model="free"),
+                                          _validation(0.1))})
+    assert verdict.standings["wavelet"].friction_immune
+    assert verdict.tied == ("ls",) and verdict.trusted == "ls"
 
 
 def test_entries_another_method_contradicts_are_named_uncertain():

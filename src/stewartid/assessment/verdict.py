@@ -24,9 +24,11 @@ Rule, in order:
    (symmetric pairs that disagree beyond their errors,
    :func:`~stewartid.identification.pairs.pair_calibration`; for Method A the friction its
    third harmonic reveals), so a method biased by friction it does not model reports it.
-5. **Ties** (within :data:`TIE_FACTOR`): a method immune to the friction law (Method B with
-   free interval constants) before one whose errors rest on its friction model being right
-   (which the data can only partly check), then the better held-out prediction.
+5. **Ties** (within :data:`TIE_FACTOR`): the better held-out prediction. A method immune to
+   the friction law (Method B with free interval constants) is not preferred for it: with
+   every method's standard errors carrying its model error, the predicted accuracy already
+   says what the friction law costs, and on logs with a known truth the preference chose a
+   method up to twice as far off as the best (:doc:`/benchmarks`, "Which method to trust").
 
 Entries are *uncertain* when the trusted method's relative standard error exceeds
 :data:`UNCERTAIN_RELATIVE`, or when another plausible method's estimate differs from the
@@ -57,10 +59,11 @@ from stewartid.identification.result import IdentificationResult
 from stewartid.platform import COORDINATES
 from stewartid.reference.published import PAPER_ENTRIES, entry_label
 
-#: Methods whose worst relative standard error is within this factor of the least are tied:
-#: the largest of 20 errors is a noisy measure of accuracy, and the realised worst errors of
-#: two methods this close in uncertainty swap order from one noise realisation to the next.
-TIE_FACTOR = 2.0
+#: Methods whose expected largest error is within this factor of the least are tied (the held-out
+#: prediction decides): closer than the precision of standard errors estimated from the
+#: residuals. Wider ties (1.1-2) chose worse on logs with a known truth: a method whose errors
+#: predict a larger worst error was, more often than not, further off.
+TIE_FACTOR = 1.02
 #: A method leaving more than this factor times the least held-out unexplained force ...
 MISFIT_FACTOR = 4.0
 #: ... and more than this share (%) of the force in its worst DOF misses part of the physics.
@@ -301,7 +304,7 @@ def choose_trusted(assessed: Mapping[str, tuple[IdentificationResult, Validation
     candidates = [name for name in compared if not misfit[name]] or compared
     least = min(expected[name] for name in candidates)
     tied = [name for name in candidates if expected[name] <= TIE_FACTOR * least]
-    trusted = min(tied, key=lambda name: (not friction_immune(ok[name][0]), unexplained[name]))
+    trusted = min(tied, key=lambda name: unexplained[name])
     friction_source = next((name for name, (result, _) in ok.items()
                             if finds_friction(result)), None)
     reference_B = np.diag(ok[trusted][0].B)
@@ -339,9 +342,7 @@ def _reasons(trusted: str, standings: Mapping[str, Standing], tied: list[str],
                f"{best.worst_vaf_percent:.4g} % in its worst DOF ({best.worst_dof})."]
     if len(tied) > 1:
         reasons.append(f"{', '.join(tied)} are within {TIE_FACTOR:g}x in uncertainty; "
-                       + ("the friction-immune method is preferred." if any(
-                           standings[name].friction_immune for name in tied)
-                          else "the held-out prediction decided."))
+                       "the held-out prediction decided.")
     for name, standing in standings.items():
         if name == trusted:
             continue

@@ -157,9 +157,7 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
              "reveal. On held-out segments it leaves "
              f"{trusted.unexplained_percent:.3g} % of the force unexplained in its worst DOF "
              f"({trusted.worst_dof})"
-             + ((" (methods tied in uncertainty: the friction-immune method is preferred)."
-                 if trusted.friction_immune else
-                 " (methods tied in uncertainty: the held-out prediction decides).")
+             + (" (methods tied in uncertainty: the held-out prediction decides)."
                 if len(verdict.tied) > 1 else ".")]
     if verdict.uncertain:
         lines.append("Entries to treat with care: " + ", ".join(
