@@ -10,7 +10,8 @@ import pytest
 from linear_model_data import AMPLITUDES, make_experiment, random_matrices
 from roundoff import convolution_bound
 from stewartid.errors import ConfigError, IdentificationError
-from stewartid.identification.fourier import FourierIdentifier, harmonic_coefficients
+from stewartid.identification.fourier import FourierIdentifier
+from stewartid.identification.harmonics import harmonic_coefficients
 from stewartid.identification.result import IdentificationResult
 from stewartid.reference.published import PAPER_ENTRIES
 from stewartid.signals.differentiation import (

@@ -19,8 +19,9 @@ Coulomb friction is the method's weakness: a square wave of level Fc in phase wi
 velocity has the first harmonic (4/pi) Fc sin(w t + phase of velocity), which is
 indistinguishable from viscous friction and lands in Bt as (4/pi) Fc / (w A). The same
 square wave has a third harmonic of a third of that amplitude, which no linear term explains:
-where the force the linear model leaves shows it above the noise (:func:`third_harmonic`),
-the standard errors carry it (:func:`friction_bias_bound`), so that the entries friction
+where the force the linear model leaves shows it above the noise
+(:func:`~stewartid.identification.harmonics.third_harmonic`), the standard errors carry it
+(:func:`~stewartid.identification.harmonics.friction_bias_bound`), so that the entries friction
 biases are reported with the uncertainty the data show, not the noise's alone.
 
 With two or more excitation frequencies a stiffness matrix K can be identified alongside
@@ -42,13 +43,20 @@ from collections.abc import Sequence
 from numbers import Integral
 
 import numpy as np
-from scipy.stats import chi2
 
 from stewartid.datasets.dataset import Dataset
 from stewartid.datasets.excitation import LINE_FRACTION, leg_space_motion, spectral_lines
 from stewartid.errors import ConfigError, DataError, IdentificationError
 from stewartid.fields import Interval, ListOf, positive
 from stewartid.identification.base import DIFFERENTIATION_CONSTRAINTS, BaseIdentifier
+from stewartid.identification.harmonics import (
+    friction_bias_bound,
+    harmonic_coefficients,
+    motion_gains,
+    residual_third_harmonic,
+    third_harmonic,
+    third_harmonic_blocks,
+)
 from stewartid.identification.pairs import calibrate_by_pairs
 from stewartid.identification.preparation import prepare
 from stewartid.identification.registry import register_method
@@ -60,158 +68,14 @@ from stewartid.signals.differentiation import (
     default_window,
     differentiate,
     estimate_frequency,
-    savgol_gain,
     trim,
 )
-
-
-def harmonic_coefficients(x: np.ndarray, t: np.ndarray, frequencies_hz: Sequence[float]
-                          ) -> np.ndarray:
-    """In-phase and quadrature coefficients of ``x`` at ``frequencies_hz`` over a segment.
-
-    Least-squares fit of x(t) = c0 + sum_f [x_c cos(2 pi f t) + x_s sin(2 pi f t)]. Over a
-    whole number of periods of a single frequency this equals the Fourier coefficients
-    (2/N) sum x cos, (2/N) sum x sin exactly (the columns are orthogonal); for several
-    frequencies it removes the residual leakage between them.
-
-    Parameters
-    ----------
-    x : ndarray, shape (N, m)
-    t : ndarray, shape (N,)
-        Time (s).
-    frequencies_hz : sequence of float
-
-    Returns
-    -------
-    ndarray, shape (2 * F, m)
-        Rows (cos f1, sin f1, cos f2, sin f2, ...).
-    """
-    columns = [np.ones_like(t)]
-    for f in frequencies_hz:
-        columns += [np.cos(2 * np.pi * f * t), np.sin(2 * np.pi * f * t)]
-    design = np.column_stack(columns)
-    # normal equations: the columns are nearly orthogonal over whole periods
-    coefficients = np.linalg.solve(design.T @ design, design.T @ x)
-    return coefficients[1:]
-
 
 #: A harmonic of a fitted frequency passes below this amplitude relative to the largest line:
 #: a servo tracking a sine distorts it by a few per cent, and harmonics do not disturb the
 #: first-harmonic equations over whole periods (they are orthogonal to it); a line this large
 #: is a second sine of the excitation.
 HARMONIC_FRACTION = 0.2
-
-
-#: The first harmonic of a square wave over its third: the friction force at the excitation
-#: frequency that a third harmonic of the force implies.
-SQUARE_WAVE_RATIO = 3.0
-
-
-def friction_bias_bound(pinv: np.ndarray, rows: Sequence[np.ndarray],
-                        third: Sequence[np.ndarray]) -> np.ndarray:
-    """Bias of the first-harmonic estimates that the force's third harmonic implies.
-
-    A Coulomb force switching with the velocity of a sine is a square wave whose first
-    harmonic is :data:`SQUARE_WAVE_RATIO` times its third; of unknown phase relative to the
-    motion, it enters an experiment's first-harmonic equations as an error of that amplitude
-    in each channel. Propagated through the least-squares solution (the same error in every
-    block of the experiment) and summed in quadrature over experiments (their switching
-    phases are independent).
-
-    Parameters
-    ----------
-    pinv : ndarray, shape (p, n_equations)
-        Pseudo-inverse of the first-harmonic regressor.
-    rows : sequence of ndarray of int
-        Per experiment, the (cos, sin) equation rows of each of its blocks, shape (blocks, 2).
-    third : sequence of ndarray, shape (6,)
-        Per experiment, the third-harmonic amplitude of each force channel (N, N m).
-
-    Returns
-    -------
-    ndarray, shape (6, p)
-        Bias bound of every parameter of every channel's equation.
-    """
-    bound = np.zeros((len(third[0]) if len(third) else 6, pinv.shape[0]))
-    for experiment_rows, amplitude in zip(rows, third, strict=True):
-        gain = np.hypot(pinv[:, experiment_rows[:, 0]].sum(axis=1),
-                        pinv[:, experiment_rows[:, 1]].sum(axis=1))
-        bound += (SQUARE_WAVE_RATIO * np.outer(amplitude, gain)) ** 2
-    return np.sqrt(bound)
-
-
-#: Significance level of the test for friction in the third harmonic that the linear model
-#: leaves. Below its point the data do not show friction; reading the noise's own third
-#: harmonic (about 1.25 times a coefficient's noise) as friction would inflate every error bar
-#: about fourfold.
-THIRD_HARMONIC_LEVEL = 0.01
-
-
-def third_harmonic(coefficients: Sequence[np.ndarray | None], noise_covariance: np.ndarray
-                   ) -> tuple[list[np.ndarray], float, float]:
-    """Third-harmonic amplitude per experiment and force channel that the data show as friction.
-
-    The coefficients are those of the force the fitted linear model leaves at three times the
-    excitation frequency (a servo's distortion of the sine puts a third harmonic in the
-    motion, which the model explains), averaged over each experiment's whole-period blocks.
-    Their noise is that of the first-harmonic equations' residuals (the same force noise, one
-    block per equation), with its correlation across channels (the legs' noise through the
-    same Jacobian). Coulomb friction is one property of the joints, present in every
-    experiment, so the data are tested as a whole: the sum over experiments of the Mahalanobis
-    norm of the mean coefficients is chi-squared with 12 degrees of freedom per experiment
-    without friction. If it exceeds the point of :data:`THIRD_HARMONIC_LEVEL`, every channel
-    keeps its amplitude, noise included (friction the data cannot rule out); if not, all are
-    zero.
-
-    Parameters
-    ----------
-    coefficients : sequence of (ndarray, shape (blocks, 2, 6)) or None
-        Per experiment, the (cos, sin) coefficients at 3 f of each channel's residual force,
-        per block (N, N m); None for an experiment of several frequencies (not tested).
-    noise_covariance : ndarray, shape (6, 6)
-        Covariance of one block's harmonic coefficient across the channels.
-
-    Returns
-    -------
-    amplitude : list of ndarray, shape (6,)
-        Per experiment, the third-harmonic amplitude read as friction (N, N m).
-    statistic : float
-        The chi-squared statistic.
-    threshold : float
-        Its point at :data:`THIRD_HARMONIC_LEVEL`.
-    """
-    precision = np.linalg.pinv(noise_covariance)
-    amplitudes, statistic, dof = [], 0.0, 0
-    for blocks in coefficients:
-        if blocks is None:
-            amplitudes.append(np.zeros(6))
-            continue
-        mean = blocks.mean(axis=0)
-        statistic += len(blocks) * float(np.einsum("ki,ij,kj->", mean, precision, mean))
-        dof += 2 * np.linalg.matrix_rank(noise_covariance)
-        amplitudes.append(np.hypot(mean[0], mean[1]))
-    threshold = float(chi2.isf(THIRD_HARMONIC_LEVEL, dof)) if dof else np.inf
-    if not statistic > threshold:
-        amplitudes = [np.zeros_like(a) for a in amplitudes]
-    return amplitudes, statistic, threshold
-
-
-def residual_third_harmonic(blocks: np.ndarray, theta: np.ndarray) -> np.ndarray:
-    """Third-harmonic coefficients of the force that the fitted linear model leaves.
-
-    Parameters
-    ----------
-    blocks : ndarray, shape (blocks, 2, 24)
-        (cos, sin) coefficients at 3 f of q_ddot, q_dot, q - q0 (each corrected for the
-        differentiator's gain at 3 f) and the generalized force, per block.
-    theta : ndarray, shape (6, p)
-        Fitted parameters: Mt, Bt (and K) side by side, p = 12 or 18.
-
-    Returns
-    -------
-    ndarray, shape (blocks, 2, 6)
-    """
-    return blocks[..., 18:] - blocks[..., :theta.shape[1]] @ theta.T
 
 
 def check_single_sine(name: str, pose: np.ndarray, sample_rate: float, platform: Platform,
@@ -374,13 +238,7 @@ class FourierIdentifier(BaseIdentifier):
                     f"{exp.name}: {usable / exp.sample_rate:.3g} s usable after the "
                     f"differentiation window, less than {self.periods_per_segment} period(s) of "
                     f"{min(freqs):.4g} Hz; record longer or lower periods_per_segment.")
-            # undo the differentiator's amplitude bias at each frequency (exact: the filter
-            # has zero phase)
-            gains = np.ones((2 * len(freqs), 18))
-            for k, f in enumerate(freqs):
-                for d, columns in ((2, slice(0, 6)), (1, slice(6, 12)), (0, slice(12, 18))):
-                    gains[2 * k:2 * k + 2, columns] = savgol_gain(f, exp.sample_rate, window,
-                                                                  self.order, d)
+            gains = motion_gains(freqs, exp.sample_rate, window, self.order)
             blocks, slices, first = [], [], sum(len(r) for r in rows_motion)
             for s in range(n_segments):
                 start = cut + int(round(s * segment))
@@ -397,17 +255,9 @@ class FourierIdentifier(BaseIdentifier):
                 slices.append(sl)
             rows.append(first + 2 * len(freqs) * np.arange(n_segments)[:, None]
                         + np.arange(2)[None, :])
-            if len(freqs) == 1:
-                gains3 = np.ones(24)
-                for d, columns in ((2, slice(0, 6)), (1, slice(6, 12)), (0, slice(12, 18))):
-                    gains3[columns] = savgol_gain(3 * freqs[0], exp.sample_rate, window,
-                                                  self.order, d)
-                signals = np.concatenate([qdd, qd, q, exp.generalized_force], axis=1)
-                third_blocks.append(np.array([
-                    harmonic_coefficients(signals[sl], exp.t[sl], [3 * freqs[0]]) / gains3
-                    for sl in slices]))
-            else:
-                third_blocks.append(None)
+            third_blocks.append(third_harmonic_blocks(
+                np.concatenate([qdd, qd, q, exp.generalized_force], axis=1), exp.t, slices,
+                freqs[0], exp.sample_rate, window, self.order) if len(freqs) == 1 else None)
             used.append({"name": exp.name, "frequencies_hz": freqs, "window_s": window,
                          "segments": blocks})
         motion = np.concatenate(rows_motion)
@@ -444,6 +294,4 @@ class FourierIdentifier(BaseIdentifier):
             "stiffness_": stiffness, "frequencies_": [u["frequencies_hz"] for u in used]}
 
 
-__all__ = ["HARMONIC_FRACTION", "SQUARE_WAVE_RATIO", "THIRD_HARMONIC_LEVEL",
-           "FourierIdentifier", "check_single_sine", "friction_bias_bound",
-           "harmonic_coefficients", "residual_third_harmonic", "third_harmonic"]
+__all__ = ["HARMONIC_FRACTION", "FourierIdentifier", "check_single_sine"]
