@@ -9,11 +9,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from stewartid.identification.physical_noise import (
-    SIGN_FRACTIONS,
-    coulomb_sign_rates,
-    regressor_noise,
-)
+from stewartid.identification.physical_noise import regressor_noise
 from stewartid.identification.physical_regression import (
     SAVGOL_FRACTION,
     SAVGOL_ORDER,
@@ -22,6 +18,7 @@ from stewartid.identification.physical_regression import (
 from stewartid.identification.preparation import prepare
 from stewartid.identification.wavelet.noise import white_noise_covariance
 from stewartid.model import regressor as reg
+from stewartid.signals.sign_rates import SIGN_FRACTIONS, coulomb_sign_rates
 from test_physical_model import PAYLOAD, multisine_records
 
 #: Pose noise (m, rad) of the copies: white, independent per coordinate.

@@ -9,7 +9,6 @@ from typing import Any
 
 import numpy as np
 
-from stewartid.identification.physical_noise import coulomb_sign_rates
 from stewartid.identification.preparation import Experiment
 from stewartid.identification.wavelet.noise import white_noise_covariance
 from stewartid.model import regressor as reg
@@ -20,6 +19,7 @@ from stewartid.signals.differentiation import (
     estimate_frequency,
 )
 from stewartid.signals.filtered_rows import kernel_filter_rows
+from stewartid.signals.sign_rates import coulomb_sign_rates
 
 
 @dataclass(frozen=True)

@@ -21,6 +21,7 @@ from stewartid.identification.wavelet.intervals import constant_direction_interv
 from stewartid.identification.wavelet.noise import NoiseModel
 from stewartid.platform import COORDINATES
 from stewartid.signals.differentiation import default_window, estimate_frequency
+from stewartid.signals.sign_rates import coulomb_sign_rates, sign_rate_gain
 
 
 class Detection(NamedTuple):
@@ -39,6 +40,12 @@ class Detection(NamedTuple):
         Their noise levels (rad/s).
     q_dot, q_ddot : ndarray, shape (N, 6)
         Savitzky-Golay derivatives of the pose.
+    sign_rates : ndarray, shape (N, 6, 5)
+        Joint-axis rates the Coulomb signs are taken from (rad/s): the shortest window the
+        noise allows (:func:`~stewartid.signals.sign_rates.coulomb_sign_rates`), which keeps
+        each reversal where the friction's kink puts it.
+    sign_rate_noise : ndarray, shape (6, 5)
+        Their noise levels (rad/s).
     """
 
     intervals: np.ndarray
@@ -47,8 +54,13 @@ class Detection(NamedTuple):
     rate_noise: np.ndarray
     q_dot: np.ndarray
     q_ddot: np.ndarray
+    sign_rates: np.ndarray
+    sign_rate_noise: np.ndarray
 
 
+#: Largest noise of the Coulomb signs' rates relative to their RMS
+#: (:func:`~stewartid.signals.sign_rates.coulomb_sign_rates`).
+SIGN_NOISE_LIMIT = 0.0005
 #: Joints whose rate RMS is below this multiple of its noise level count as idle.
 IDLE_NOISE_RATIO = 2.0
 #: A DOF moved by the experiments that gave intervals less than this fraction of its largest
@@ -217,7 +229,22 @@ def detect_intervals(experiment: Experiment, noise: NoiseModel, *, margin: float
     return Detection(intervals=intervals, info=info,
                      joint_rates=rates[:, :30].reshape(len(t), 6, 5),
                      rate_noise=np.maximum(rate_noise[:30].reshape(6, 5), 1e-12),
-                     q_dot=noise.q_dot, q_ddot=noise.q_ddot)
+                     q_dot=noise.q_dot, q_ddot=noise.q_ddot,
+                     **_sign_rates(experiment, noise))
+
+
+def _sign_rates(experiment: Experiment, noise: NoiseModel) -> dict:
+    """``sign_rates`` and ``sign_rate_noise`` of :class:`Detection`: the joint rates of the
+    pose rates over the shortest window (a fraction of the noise model's) the pose noise
+    allows, and their noise levels."""
+    q_dot, window = coulomb_sign_rates(experiment.q, experiment.sample_rate, noise.window,
+                                       noise.pose_covariance, SIGN_NOISE_LIMIT)
+    jacobians = experiment.joint_jacobians
+    mean = jacobians.mean(axis=0)                                          # (6, 5, 6)
+    variance = np.einsum("lac,cd,lad->la", mean, noise.pose_covariance, mean)
+    level = sign_rate_gain(experiment.sample_rate, window) * np.sqrt(np.clip(variance, 0, None))
+    return {"sign_rates": np.einsum("nlac,nc->nla", jacobians, q_dot),
+            "sign_rate_noise": np.maximum(level, 1e-12)}
 
 
 __all__ = ["SINGLE_SINE_SHARE", "Detection", "check_coverage", "detect_intervals",

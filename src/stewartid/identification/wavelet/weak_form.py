@@ -253,10 +253,11 @@ def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: boo
                      rate: float | Sequence[float] = 0.0) -> np.ndarray:
     """W_type(t) at every sample, shape (N, n_types, 6) (or (N, 1, 6) with ``uniform``):
     the generalized force of a unit Coulomb torque on every axis of a joint type, opposing
-    the axis's smoothed rate (soft sign w / sqrt(w^2 + sigma^2 + r^2) over the rate's noise
-    level sigma and the friction's transition ``rate`` r, rad/s: a regularised or Stribeck
-    friction is not a sign). A sequence of rates gives shape (n_rates, N, n_types, 6)."""
-    rates, noise = found.joint_rates, found.rate_noise
+    the axis's rate over the shortest window the noise allows (``found.sign_rates``), as the
+    soft sign w / sqrt(w^2 + sigma^2 + r^2) over the rate's noise level sigma and the
+    friction's transition ``rate`` r, rad/s (a regularised or Stribeck friction is not a
+    sign). A sequence of rates gives shape (n_rates, N, n_types, 6)."""
+    rates, noise = found.sign_rates, found.sign_rate_noise
     out = []
     for r in np.atleast_1d(np.asarray(rate, dtype=float)):
         direction = rates / np.sqrt(rates ** 2 + noise ** 2 + r ** 2)          # (N, 6, 5)
