@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from scipy.stats import chi2
+from scipy.special import chdtri
 
 from stewartid.signals.differentiation import savgol_gain
 
@@ -179,7 +179,7 @@ def third_harmonic(coefficients: Sequence[np.ndarray | None], noise_covariance: 
         statistic += len(blocks) * float(np.einsum("ki,ij,kj->", mean, precision, mean))
         dof += 2 * np.linalg.matrix_rank(noise_covariance)
         amplitudes.append(np.hypot(mean[0], mean[1]))
-    threshold = float(chi2.isf(THIRD_HARMONIC_LEVEL, dof)) if dof else np.inf
+    threshold = float(chdtri(dof, THIRD_HARMONIC_LEVEL)) if dof else np.inf
     if not statistic > threshold:
         amplitudes = [np.zeros_like(a) for a in amplitudes]
     return amplitudes, statistic, threshold

@@ -14,7 +14,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 
 import numpy as np
-from scipy.stats import chi2
+from scipy.special import chdtri
 
 from stewartid.identification.wavelet.gls import WeakFormSolution, solve_weak_form
 from stewartid.identification.wavelet.weak_form import SOFT_SIGN_RATES, IntervalEquations
@@ -78,7 +78,7 @@ def solve_weak_form_over_rates(equations: Sequence[IntervalEquations], n_experim
     # a friction can have: a level 3 standard errors below zero says the plant's friction
     # does not follow the structure (MuJoCo's frictionloss on the example data: -8.9)
     gain = rows * (residual_cost(plain) - residual_cost(best))
-    explains = gain > chi2.ppf(1 - VARIATION_TEST_LEVEL, len(best.coulomb))
+    explains = gain > chdtri(len(best.coulomb), VARIATION_TEST_LEVEL)
     if explains and np.all(best.coulomb > -3.0 * best.coulomb_std):
         return best, best_rate
     return plain, None
