@@ -25,7 +25,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from stewartid.datasets.dataset import Dataset, read_datasets
 from stewartid.errors import ConfigError, DataError
@@ -38,6 +37,7 @@ from stewartid.signals.differentiation import (
     estimate_frequency,
     window_samples,
 )
+from stewartid.signals.interpolation import hermite_uniform
 
 
 @dataclass(frozen=True)
@@ -215,23 +215,28 @@ def model_remainder(platform: Platform, q: np.ndarray, sample_rate: float) -> np
     the noise the differentiation puts into the forces is 32 times smaller than over a
     fortieth of the period (the physical model's regressor window), and it showed: the
     design's Monte Carlo spread of Method B grew by up to 30 % with that window. The model
-    is evaluated every :data:`REMAINDER_STEPS`-th of the window and interpolated by a cubic
-    spline between (the smoothed signals vary on the window's scale: the spline's error is
-    below 1e-5 of the remainder at three times the dominant frequency), which takes its cost
-    from 0.17 s to 0.01 s per 20 000 samples.
+    is evaluated every :data:`REMAINDER_STEPS`-th of the window and interpolated between by
+    cubic Hermite polynomials (:func:`~stewartid.signals.interpolation.hermite_uniform`; the
+    smoothed signals vary on the window's scale: the error is below 1e-5 of the remainder at
+    three times the dominant frequency), which takes its cost from 0.17 s to 0.01 s per
+    20 000 samples.
     """
     # the window needs the frequency only roughly: the spectrum's peak without refinement
     window = default_window(estimate_frequency(q, sample_rate, refine=False)) / REMAINDER_FRACTION
     q_s, q_dot, q_ddot = differentiate(q, sample_rate, window, REMAINDER_ORDER)
     n = len(q_s)
     step = max(1, window_samples(window, sample_rate, REMAINDER_ORDER) // REMAINDER_STEPS)
-    knots = np.unique(np.r_[np.arange(0, n, step), n - 1])
-    if len(knots) < 4:
-        knots = np.arange(n)
+    knots = np.arange(0, n, step)
+    if len(knots) < 5:
+        return linearisation_remainder(platform, q_s, q_dot, q_ddot)
     values = linearisation_remainder(platform, q_s[knots], q_dot[knots], q_ddot[knots])
-    if len(knots) == n:
-        return values
-    return CubicSpline(knots, values, axis=0)(np.arange(n))
+    covered = knots[-1] + 1
+    out = np.empty((n, 6))
+    out[:covered] = hermite_uniform(values, step, covered)
+    if covered < n:   # the samples after the last knot, fewer than a step: evaluated
+        tail = slice(covered, n)
+        out[tail] = linearisation_remainder(platform, q_s[tail], q_dot[tail], q_ddot[tail])
+    return out
 
 
 #: Savitzky-Golay order and window (a fraction of a fifth of the dominant period) of

@@ -51,4 +51,51 @@ def spline_at(t: np.ndarray, values: np.ndarray, times: np.ndarray) -> np.ndarra
     return CubicSpline(t, values, axis=0, bc_type=ends)(times)
 
 
-__all__ = ["ONE_SIDED_SLOPE", "spline_at"]
+#: First derivative at the middle of five equally spaced samples, times the spacing
+#: (error h^4 x^(5) / 30).
+CENTRAL_SLOPE = np.array([1.0, -8.0, 0.0, 8.0, -1.0]) / 12.0
+#: First derivative at the second of five equally spaced samples, times the spacing
+#: (error h^4 x^(5) / 20).
+SECOND_SLOPE = np.array([-3.0, -10.0, 18.0, -6.0, 1.0]) / 12.0
+
+
+def hermite_uniform(values: np.ndarray, step: int, n: int) -> np.ndarray:
+    """A signal known every ``step``-th sample, at every sample: piecewise cubic Hermite.
+
+    The slope at each knot is the five-point difference of the knot values (central inside,
+    one-sided at the ends), so the error is (1/384) h^4 max|d4x| plus O(h^5 max|d5x|), h =
+    ``step`` samples: the order of a cubic spline's, without its linear system (nor
+    scipy.interpolate's import, 0.6 s on the command line).
+
+    Parameters
+    ----------
+    values : ndarray, shape (K, C)
+        The signal at samples 0, step, ..., (K - 1) step, K >= 5.
+    step : int
+        Samples between knots.
+    n : int
+        Samples wanted, at most (K - 1) step + 1.
+
+    Returns
+    -------
+    ndarray, shape (n, C)
+    """
+    values = np.asarray(values, dtype=float)
+    k = len(values)
+    reverse = values[::-1]
+    slopes = np.empty_like(values)
+    slopes[2:-2] = np.tensordot(CENTRAL_SLOPE,
+                                np.stack([values[i:k - 4 + i] for i in range(5)]), axes=1)
+    slopes[0] = np.tensordot(ONE_SIDED_SLOPE, values[:5], axes=1)
+    slopes[1] = np.tensordot(SECOND_SLOPE, values[:5], axes=1)
+    slopes[-1] = -np.tensordot(ONE_SIDED_SLOPE, reverse[:5], axes=1)
+    slopes[-2] = -np.tensordot(SECOND_SLOPE, reverse[:5], axes=1)
+    index = np.arange(n)
+    segment = np.minimum(index // step, k - 2)
+    u = ((index - segment * step) / step)[:, None]
+    return ((1 + 2 * u) * (1 - u) ** 2 * values[segment] + u * (1 - u) ** 2 * slopes[segment]
+            + u ** 2 * (3 - 2 * u) * values[segment + 1]
+            + u ** 2 * (u - 1) * slopes[segment + 1])
+
+
+__all__ = ["CENTRAL_SLOPE", "ONE_SIDED_SLOPE", "SECOND_SLOPE", "hermite_uniform", "spline_at"]
