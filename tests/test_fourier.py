@@ -261,3 +261,17 @@ def test_noise_alone_adds_no_friction_allowance_and_friction_in_noise_is_caught(
     diagnostics = rubbing.result_.diagnostics["friction_bias"]
     assert diagnostics["statistic"] > diagnostics["threshold"]
     assert np.all(np.abs(rubbing.B_ - B) <= 3 * rubbing.std_errors_["B"])
+
+
+def test_a_third_harmonic_in_a_noise_free_channel_counts_as_friction():
+    """A channel without noise shows any third harmonic: it is friction, not noise."""
+    from stewartid.identification.harmonics import third_harmonic
+
+    blocks = np.zeros((8, 2, 6))
+    blocks[:, 0, 2] = 0.5                      # channel z: a third harmonic, no scatter
+    covariance = np.diag([1.0, 1.0, 0.0, 1.0, 1.0, 1.0])
+    amplitudes, statistic, threshold = third_harmonic([blocks], covariance)
+    assert statistic > threshold and amplitudes[0][2] == pytest.approx(0.5)
+    quiet = np.zeros((8, 2, 6))
+    amplitudes, statistic, threshold = third_harmonic([quiet], covariance)
+    assert statistic < threshold and not np.any(amplitudes[0])

@@ -170,12 +170,16 @@ def third_harmonic(coefficients: Sequence[np.ndarray | None], noise_covariance: 
         Its point at :data:`THIRD_HARMONIC_LEVEL`.
     """
     precision = np.linalg.pinv(noise_covariance)
+    # the channels' noise-free directions: a third harmonic there is shown by any amount
+    noiseless = np.eye(len(noise_covariance)) - noise_covariance @ precision
     amplitudes, statistic, dof = [], 0.0, 0
     for blocks in coefficients:
         if blocks is None:
             amplitudes.append(np.zeros(6))
             continue
         mean = blocks.mean(axis=0)
+        if np.linalg.norm(mean @ noiseless.T) > 1e-9 * np.linalg.norm(mean):
+            statistic = np.inf
         statistic += len(blocks) * float(np.einsum("ki,ij,kj->", mean, precision, mean))
         dof += 2 * np.linalg.matrix_rank(noise_covariance)
         amplitudes.append(np.hypot(mean[0], mean[1]))
