@@ -252,7 +252,11 @@ def test_noise_alone_adds_no_friction_allowance_and_friction_in_noise_is_caught(
             data.append(dataclasses.replace(exp, forces=noisy))
         return FourierIdentifier(frequency_hz=1.0).fit(data, paper)
 
-    quiet = fit(False).result_.diagnostics["friction_bias"]
+    from stewartid.reports.identification.text import _third_harmonic_lines
+
+    quiet_fit = fit(False)
+    assert "does not show" in _third_harmonic_lines(quiet_fit.result_)[0]
+    quiet = quiet_fit.result_.diagnostics["friction_bias"]
     # white noise alone: the statistic is chi-squared below its 1 % point (a fixed seed)
     assert quiet["statistic"] < quiet["threshold"]
     assert np.count_nonzero(np.asarray(quiet["third_harmonic"])) == 0
@@ -260,6 +264,7 @@ def test_noise_alone_adds_no_friction_allowance_and_friction_in_noise_is_caught(
     rubbing = fit(True)
     diagnostics = rubbing.result_.diagnostics["friction_bias"]
     assert diagnostics["statistic"] > diagnostics["threshold"]
+    assert "shows Coulomb friction" in _third_harmonic_lines(rubbing.result_)[0]
     assert np.all(np.abs(rubbing.B_ - B) <= 3 * rubbing.std_errors_["B"])
 
 

@@ -17,6 +17,7 @@ from stewartid.assessment.validation import friction_signature
 from stewartid.assessment.verdict import Verdict, relative_std, worst_dof
 from stewartid.datasets.dataset import Dataset
 from stewartid.identification.consistency import consistency_metrics, is_consistent
+from stewartid.identification.result import IdentificationResult
 from stewartid.identification.wavelet.noise import white_noise_covariance
 from stewartid.model.joints import FRICTION_TYPES
 from stewartid.platform import COORDINATES, Platform
@@ -137,7 +138,24 @@ def method_lines(run: MethodReport) -> list[str]:
         lines.append(f"It does not estimate friction; {100 * share:.0f} % of its held-out "
                      "residual has the shape of Coulomb joint friction (`--method all` "
                      "compares it with a method that estimates friction).")
+    lines += _third_harmonic_lines(result)
     return lines
+
+
+def _third_harmonic_lines(result: IdentificationResult) -> list[str]:
+    """Method A: whether the force's third harmonic shows the Coulomb friction its Bt reads as
+    viscous, and what that puts in the standard errors."""
+    bias = result.diagnostics.get("friction_bias") or {}
+    if "statistic" not in bias or not np.isfinite(bias["threshold"]):
+        return []
+    shown = bias["statistic"] > bias["threshold"]
+    bound = np.diag(np.asarray(bias["bound_B"]))[:6] / np.abs(np.diag(result.B))
+    return [f"The third harmonic its linear model leaves {'shows' if shown else 'does not show'} "
+            f"Coulomb friction (chi-squared {bias['statistic']:.4g} against "
+            f"{bias['threshold']:.4g} at 1 %): "
+            + (f"its standard errors carry the bias the friction's first harmonic puts on Bt "
+               f"(up to {100 * np.max(bound):.2g} % of its diagonal)." if shown else
+               "its standard errors are the noise's.")]
 
 
 def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
@@ -304,10 +322,11 @@ def render_report(report: IdentificationReport, datasets: Sequence[Dataset],
             lines.append(f"- {run.display_name}: {_friction_text(run)} (platform description: "
                          f"{platform.friction.coulomb:g} N·m per joint axis).")
         else:
-            lines.append(f"- {run.display_name} does not estimate friction (its prediction "
-                         "contains none); "
-                         f"{100 * friction_signature(run.validation):.0f} % of its held-out "
-                         "residual has the shape of Coulomb friction.")
+            lines.append(" ".join([
+                f"- {run.display_name} does not estimate friction (its prediction contains "
+                f"none); {100 * friction_signature(run.validation):.0f} % of its held-out "
+                "residual has the shape of Coulomb friction.",
+                *_third_harmonic_lines(run.result)]))
     lines += [""] + _figure(figures, "friction") + physical_lines(report.physical, figures)
     if several:
         lines += ["## Methods compared", "", *verdict, ""]
