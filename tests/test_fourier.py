@@ -61,30 +61,41 @@ def test_coulomb_square_wave_biases_bt_by_four_over_pi(paper, truth):
     assert est.M_ == pytest.approx(M, rel=1e-3, abs=1e-3 * np.abs(M).max())
 
 
+#: Coulomb level per channel of the square-wave tests (N, N m).
+SQUARE_LEVEL = np.array([50.0, -20.0, 35.0, 80.0, 15.0, -60.0])
+
+
+def square_wave_fit(paper, M, B, with_friction: bool, periods: int = 4,
+                    force_noise: float = 0.0, rng=None) -> FourierIdentifier:
+    """Method A on six single-DOF sines (1 Hz, 400 Hz sampling) of the linear model, with a
+    square wave of :data:`SQUARE_LEVEL` in phase with the excited DOF's velocity, and white
+    leg-force noise of ``force_noise`` N."""
+    data = []
+    for k in range(6):
+        def square(t, q, qd, J, k=k):
+            return np.sign(qd[:, k])[:, None] * SQUARE_LEVEL
+        exp = make_experiment(paper, M, B, k, sample_rate=400.0, periods=periods,
+                              coulomb=square if with_friction else None)
+        if force_noise:
+            exp = dataclasses.replace(
+                exp, forces=exp.forces + rng.normal(0.0, force_noise, exp.forces.shape))
+        data.append(exp)
+    return FourierIdentifier(frequency_hz=1.0).fit(data, paper)
+
+
 def test_standard_errors_carry_the_coulomb_bias_the_third_harmonic_shows(paper, truth):
     """The bias (4/pi) F / (w A) of a square wave is what its third harmonic, (4/3pi) F,
     implies: the reported standard error of Bt[:, k] covers the bias; without friction the
     bound vanishes (no third harmonic in a linear system's force)."""
     M, B = truth
     w = 2 * np.pi * 1.0
-    level = np.array([50.0, -20.0, 35.0, 80.0, 15.0, -60.0])
-
-    def fit(with_friction: bool) -> FourierIdentifier:
-        data = []
-        for k in range(6):
-            def square(t, q, qd, J, k=k):
-                return np.sign(qd[:, k])[:, None] * level
-            data.append(make_experiment(paper, M, B, k, sample_rate=400.0,
-                                        coulomb=square if with_friction else None))
-        return FourierIdentifier(frequency_hz=1.0).fit(data, paper)
-
-    biased = fit(True)
-    bias = (4 / np.pi) * np.abs(level)[:, None] / (w * AMPLITUDES[None, :])
+    biased = square_wave_fit(paper, M, B, True)
+    bias = (4 / np.pi) * np.abs(SQUARE_LEVEL)[:, None] / (w * AMPLITUDES[None, :])
     bound = np.asarray(biased.result_.diagnostics["friction_bias"]["bound_B"])
     # the sampled square wave's third harmonic is exact to the switching-time resolution
     assert bound == pytest.approx(bias, rel=2e-2)
     assert np.all(np.abs(biased.B_ - B) <= 1.05 * biased.std_errors_["B"])
-    clean = fit(False)
+    clean = square_wave_fit(paper, M, B, False)
     clean_bound = np.asarray(clean.result_.diagnostics["friction_bias"]["bound_B"])
     assert np.all(clean_bound <= 1e-6 * bias)
 
@@ -239,18 +250,10 @@ def test_noise_alone_adds_no_friction_allowance_and_friction_in_noise_is_caught(
     harmonic stands well above the noise is caught and its bias covered."""
     M, B = truth
     rng = np.random.default_rng(3)
-    level = np.array([50.0, -20.0, 35.0, 80.0, 15.0, -60.0])
 
     def fit(with_friction: bool) -> FourierIdentifier:
-        data = []
-        for k in range(6):
-            def square(t, q, qd, J, k=k):
-                return np.sign(qd[:, k])[:, None] * level
-            exp = make_experiment(paper, M, B, k, sample_rate=400.0, periods=12,
-                                  coulomb=square if with_friction else None)
-            noisy = exp.forces + rng.normal(0.0, 20.0, exp.forces.shape)
-            data.append(dataclasses.replace(exp, forces=noisy))
-        return FourierIdentifier(frequency_hz=1.0).fit(data, paper)
+        return square_wave_fit(paper, M, B, with_friction, periods=12, force_noise=20.0,
+                               rng=rng)
 
     from stewartid.reports.identification.text import _third_harmonic_lines
 
