@@ -38,8 +38,8 @@ def coulomb_sign_rates(q: np.ndarray, sample_rate: float, window: float,
     window, makes the sign chatter around each reversal and biases the friction and what
     correlates with it (the moving body's first moment 4 standard errors off on the paper's
     sines with the reference noise). The shortest of :data:`SIGN_FRACTIONS` whose rate noise
-    (from the pose noise estimated on the record) is within :data:`SIGN_NOISE` of the rate's
-    RMS is taken.
+    (from the pose noise estimated on the record) is within ``noise_limit`` of the rate's RMS
+    is taken; the whole kernel when none is.
 
     Parameters
     ----------
