@@ -14,8 +14,8 @@ def test_a_cubic_is_reproduced():
     f = 1e-6 * t ** 3 - 2e-4 * t ** 2 + 0.3 * t - 5
     step = 8
     got = hermite_uniform(f[::step, None], step, len(t))[:, 0]
-    # five-point slopes are exact for a cubic: only round-off of values up to 64
-    assert got == pytest.approx(f, abs=1e-12 * 64 * 100)
+    # five-point slopes are exact for a cubic: only round-off, a few ulps of the largest value
+    assert got == pytest.approx(f, abs=1e3 * np.finfo(float).eps * np.abs(f).max())
 
 
 @pytest.mark.parametrize("step", [4, 8, 16])
@@ -33,4 +33,5 @@ def test_a_sine_within_the_hermite_error_bound(step):
     middle = slice(2 * step, len(t) - 2 * step)
     assert np.max(error[middle]) <= inside * (1 + 1e-6) + 1e-15
     assert np.max(error) <= ends * (1 + 1e-6) + 1e-15
-    assert got[::step] == pytest.approx(f[::step], abs=1e-15)
+    # at a knot the Hermite basis is exactly (1, 0, 0, 0): the sample itself
+    assert np.array_equal(got[::step], f[::step])

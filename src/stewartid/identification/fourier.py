@@ -229,6 +229,7 @@ class FourierIdentifier(BaseIdentifier):
             window = self.window or default_window(max(freqs))
             q0 = exp.q.mean(axis=0)
             q, qd, qdd = differentiate(exp.q - q0, exp.sample_rate, window, self.order)
+            signals = np.concatenate([qdd, qd, q, exp.generalized_force], axis=1)
             cut = trim(window, exp.sample_rate, self.order)
             segment = self.periods_per_segment * exp.sample_rate / min(freqs)
             usable = len(exp.t) - 2 * cut
@@ -245,9 +246,7 @@ class FourierIdentifier(BaseIdentifier):
                 stop = cut + int(round((s + 1) * segment))
                 sl = slice(start, stop)
                 t = exp.t[sl]
-                signals = np.concatenate([qdd[sl], qd[sl], q[sl], exp.generalized_force[sl]],
-                                         axis=1)
-                coefficients = harmonic_coefficients(signals, t, freqs)
+                coefficients = harmonic_coefficients(signals[sl], t, freqs)
                 coefficients[:, :18] /= gains
                 rows_motion.append(coefficients[:, :18])
                 rows_force.append(coefficients[:, 18:])
@@ -256,8 +255,8 @@ class FourierIdentifier(BaseIdentifier):
             rows.append(first + 2 * len(freqs) * np.arange(n_segments)[:, None]
                         + np.arange(2)[None, :])
             third_blocks.append(third_harmonic_blocks(
-                np.concatenate([qdd, qd, q, exp.generalized_force], axis=1), exp.t, slices,
-                freqs[0], exp.sample_rate, window, self.order) if len(freqs) == 1 else None)
+                signals, exp.t, slices, freqs[0], exp.sample_rate, window, self.order)
+                if len(freqs) == 1 else None)
             used.append({"name": exp.name, "frequencies_hz": freqs, "window_s": window,
                          "segments": blocks})
         motion = np.concatenate(rows_motion)
@@ -267,7 +266,7 @@ class FourierIdentifier(BaseIdentifier):
         solution = solve_least_squares(phi, force, symmetric=self.symmetric,
                                        regressor_names=regressor_names(*groups))
         theta, noise_std = solution.theta, solution.theta_std
-        residual = force - phi @ theta[:, :phi.shape[1]].T
+        residual = force - phi @ theta.T
         covariance = residual.T @ residual / max(len(residual) - phi.shape[1], 1)
         third, statistic, threshold = third_harmonic(
             [None if c is None else residual_third_harmonic(c, theta) for c in third_blocks],

@@ -172,6 +172,7 @@ def third_harmonic(coefficients: Sequence[np.ndarray | None], noise_covariance: 
     precision = np.linalg.pinv(noise_covariance)
     # the channels' noise-free directions: a third harmonic there is shown by any amount
     noiseless = np.eye(len(noise_covariance)) - noise_covariance @ precision
+    rank = int(np.linalg.matrix_rank(noise_covariance))
     amplitudes, statistic, dof = [], 0.0, 0
     for blocks in coefficients:
         if blocks is None:
@@ -181,7 +182,7 @@ def third_harmonic(coefficients: Sequence[np.ndarray | None], noise_covariance: 
         if np.linalg.norm(mean @ noiseless.T) > 1e-9 * np.linalg.norm(mean):
             statistic = np.inf
         statistic += len(blocks) * float(np.einsum("ki,ij,kj->", mean, precision, mean))
-        dof += 2 * np.linalg.matrix_rank(noise_covariance)
+        dof += 2 * rank
         amplitudes.append(np.hypot(mean[0], mean[1]))
     threshold = float(chdtri(dof, THIRD_HARMONIC_LEVEL)) if dof else np.inf
     if not statistic > threshold:

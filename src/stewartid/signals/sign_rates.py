@@ -75,11 +75,4 @@ def coulomb_sign_rates(q: np.ndarray, sample_rate: float, window: float,
     return rates, window * fraction
 
 
-def sign_rate_gain(sample_rate: float, window: float) -> float:
-    """Standard deviation of the sign's rate per unit of white pose noise: the norm of the
-    Savitzky-Golay rate taps of order :data:`SIGN_ORDER` over ``window`` s (1/s)."""
-    n = window_samples(window, sample_rate, SIGN_ORDER)
-    return float(np.linalg.norm(savgol_coefficients(n, SIGN_ORDER, 1, 1.0 / sample_rate)))
-
-
-__all__ = ["SIGN_FRACTIONS", "SIGN_NOISE", "SIGN_ORDER", "coulomb_sign_rates", "sign_rate_gain"]
+__all__ = ["SIGN_FRACTIONS", "SIGN_NOISE", "SIGN_ORDER", "coulomb_sign_rates"]

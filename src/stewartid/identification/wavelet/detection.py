@@ -18,10 +18,10 @@ import numpy as np
 from stewartid.errors import DataWarning, IdentificationError
 from stewartid.identification.preparation import Experiment
 from stewartid.identification.wavelet.intervals import constant_direction_intervals, joint_rates
-from stewartid.identification.wavelet.noise import NoiseModel
+from stewartid.identification.wavelet.noise import NoiseModel, joint_rate_noise
 from stewartid.platform import COORDINATES
 from stewartid.signals.differentiation import default_window, estimate_frequency
-from stewartid.signals.sign_rates import coulomb_sign_rates, sign_rate_gain
+from stewartid.signals.sign_rates import SIGN_ORDER, coulomb_sign_rates
 
 
 class Detection(NamedTuple):
@@ -243,9 +243,8 @@ def _sign_rates(experiment: Experiment, noise: NoiseModel) -> dict:
     q_dot, window = coulomb_sign_rates(experiment.q, experiment.sample_rate, noise.window,
                                        noise.pose_covariance, SIGN_NOISE_LIMIT)
     jacobians = experiment.joint_jacobians
-    mean = jacobians.mean(axis=0)                                          # (6, 5, 6)
-    variance = np.einsum("lac,cd,lad->la", mean, noise.pose_covariance, mean)
-    level = sign_rate_gain(experiment.sample_rate, window) * np.sqrt(np.clip(variance, 0, None))
+    level = joint_rate_noise(noise.pose_covariance, experiment.sample_rate, window, jacobians,
+                             experiment.leg_jacobian, SIGN_ORDER)[:30].reshape(6, 5)
     return {"sign_rates": np.einsum("nlac,nc->nla", jacobians, q_dot),
             "sign_rate_noise": np.maximum(level, 1e-12)}
 

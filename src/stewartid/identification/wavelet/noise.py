@@ -56,7 +56,8 @@ def white_noise_covariance(q: np.ndarray, smooth: np.ndarray | None = None) -> n
 
 
 def joint_rate_noise(covariance: np.ndarray, sample_rate: float, window: float,
-                     joint_jacobians: np.ndarray, leg_jacobian: np.ndarray) -> np.ndarray:
+                     joint_jacobians: np.ndarray, leg_jacobian: np.ndarray,
+                     order: int = DEFAULT_ORDER) -> np.ndarray:
     """Standard deviation of each Savitzky-Golay joint rate caused by pose noise.
 
     The velocity filter is a linear combination of samples with coefficients c, so white
@@ -72,14 +73,16 @@ def joint_rate_noise(covariance: np.ndarray, sample_rate: float, window: float,
         Hz and the differentiation window (s).
     joint_jacobians : ndarray, shape (N, 6, 5, 6)
     leg_jacobian : ndarray, shape (N, 6, 6)
+    order : int
+        Savitzky-Golay order of the rates.
 
     Returns
     -------
     ndarray, shape (36,)
         Columns as :data:`~stewartid.identification.wavelet.intervals.JOINT_RATE_NAMES`.
     """
-    n = window_samples(window, sample_rate, DEFAULT_ORDER)
-    gain = np.linalg.norm(savgol_coefficients(n, DEFAULT_ORDER, 1, 1.0 / sample_rate))
+    n = window_samples(window, sample_rate, order)
+    gain = np.linalg.norm(savgol_coefficients(n, order, 1, 1.0 / sample_rate))
     jac = np.concatenate([joint_jacobians.mean(axis=0).reshape(30, 6),
                           leg_jacobian.mean(axis=0)], axis=0)
     variance = np.einsum("ij,jk,ik->i", jac, covariance, jac)

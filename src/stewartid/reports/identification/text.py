@@ -149,7 +149,7 @@ def _third_harmonic_lines(result: IdentificationResult) -> list[str]:
     if "statistic" not in bias or not np.isfinite(bias["threshold"]):
         return []
     shown = bias["statistic"] > bias["threshold"]
-    bound = np.diag(np.asarray(bias["bound_B"]))[:6] / np.abs(np.diag(result.B))
+    bound = np.diag(np.asarray(bias["bound_B"])) / np.abs(np.diag(result.B))
     return [f"The third harmonic its linear model leaves {'shows' if shown else 'does not show'} "
             f"Coulomb friction (chi-squared {bias['statistic']:.4g} against "
             f"{bias['threshold']:.4g} at 1 %): "
