@@ -89,16 +89,19 @@ def evaluate(label, platform, data, M, B, seed) -> dict:
         if run.result is None:
             row["methods"][run.name] = {"refused": run.error.splitlines()[0]}
             continue
-        errors, ratios = [], []
+        errors, ratios, signed, stds = [], [], [], []
         for matrix, i, j in PAPER_ENTRIES:
             estimate = (run.result.M if matrix == "M" else run.result.B)[i, j]
             truth = (M if matrix == "M" else B)[i, j]
             std = (run.result.std_errors_M if matrix == "M" else run.result.std_errors_B)[i, j]
             errors.append(relative_error_percent(estimate, truth))
             ratios.append(abs(estimate - truth) / std if std > 0 else np.inf)
+            signed.append(float(estimate - truth))
+            stds.append(float(std))
         row["methods"][run.name] = {
             "worst_percent": float(max(errors)), "errors": [float(e) for e in errors],
             "ratios": [float(r) for r in ratios],
+            "signed_errors": signed, "std_errors": stds,
             "worst_vaf_percent": float(np.nanmin(run.validation.vaf_percent)),
             "seconds": run.seconds}
     fitted = [m for m in row["methods"].values() if "worst_percent" in m]

@@ -76,3 +76,40 @@ def test_a_pair_still_apart_after_the_factor_gets_half_its_difference():
     half = abs(M[0, 4] - M[4, 0]) / 2
     assert std_M[0, 4] == std_M[4, 0] == pytest.approx(half)
     assert np.max(np.delete(std_M.ravel(), [4, 24])) == pytest.approx(sigma * factor)
+
+
+def test_clipping_leaves_a_few_far_pairs_to_themselves():
+    """Two couplings biased by 50 errors among 13 honest pairs: the plain factor is about
+    50 sqrt(2 / 15) = 18 and inflates every error; with ``clip`` (a fit immune to the
+    friction law, whose model error sits in a few equations) the two pairs are left out and
+    the factor stays within the chi_13 / sqrt(13) spread of honest pairs (below 1.6 with
+    probability 0.998), the two members of each biased pair then taking their own
+    disagreement (:func:`select_symmetric_pairs`)."""
+    rng = np.random.default_rng(11)
+    sigma = 0.1
+    M = _estimates(rng, sigma)
+    M[0, 4] += 50 * sigma * np.sqrt(2)
+    M[1, 3] -= 50 * sigma * np.sqrt(2)
+    scores = symmetric_pair_scores(M, np.full((6, 6), sigma))
+    plain, clipped = pair_calibration(scores), pair_calibration(scores, clip=True)
+    assert 14 < plain["factor"] < 22 and plain["outliers"] == 0
+    assert clipped["outliers"] == 2 and clipped["factor"] < 1.6
+    assert clipped["birge_ratio"] == plain["birge_ratio"]
+
+
+@pytest.mark.parametrize("understated", [1.0, 4.0])
+def test_clipping_still_finds_errors_understated_everywhere(understated):
+    """Understated errors spread over every pair: the clipped ratio climbs from the robust
+    scale to include them, and recovers the factor as the plain ratio does (mean over 400
+    draws of 15 pairs within 6 % of chi_15 / sqrt(15) times it; clipping at 3 ratios cuts
+    0.3 % of an honest normal's mass)."""
+    rng = np.random.default_rng(3)
+    sigma = 0.2
+    ratios = []
+    for _ in range(400):
+        estimate = _estimates(rng, sigma)
+        std = np.full((6, 6), sigma / understated)
+        ratios.append(pair_calibration(symmetric_pair_scores(estimate, std), clip=True)
+                      ["factor"])
+    expected = max(0.9834 * understated, 1.0)
+    assert np.mean(ratios) == pytest.approx(expected, rel=0.06)

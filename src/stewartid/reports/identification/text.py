@@ -138,8 +138,32 @@ def method_lines(run: MethodReport) -> list[str]:
         lines.append(f"It does not estimate friction; {100 * share:.0f} % of its held-out "
                      "residual has the shape of Coulomb joint friction (`--method all` "
                      "compares it with a method that estimates friction).")
-    lines += _third_harmonic_lines(result)
+    lines += _friction_law_lines(result) + _third_harmonic_lines(result)
     return lines
+
+
+def _friction_law_lines(result: IdentificationResult) -> list[str]:
+    """Method B on one sine per experiment: which friction treatment it kept, and why."""
+    candidates = result.diagnostics.get("friction_candidates") or {}
+    law = result.diagnostics.get("friction_law_test")
+    if len(candidates) < 2 or not law:
+        return []
+    predicted = {name: 100 * value["predicted_worst_relative_error"]
+                 for name, value in candidates.items()}
+    kept = result.diagnostics.get("friction_model")
+    test = (f"its diagonals and the free constants' differ by up to "
+            f"{law['largest_disagreement']:.3g} standard errors ({law['entry']}; threshold "
+            f"{law['threshold']:.3g})")
+    if law["rejected"]:
+        reason = f"the data contradict the Coulomb law: {test}"
+    elif kept == "coulomb":
+        reason = f"the law passes its test ({test}) and predicts the smaller largest error"
+    else:
+        reason = f"they predict the smaller largest error ({test})"
+    return [f"It fitted both the free interval constants (predicted largest error "
+            f"{predicted['free']:.3g} %) and the Coulomb law of each joint type "
+            f"({predicted['coulomb']:.3g} %) and kept "
+            f"{'the law' if kept == 'coulomb' else 'the free constants'}: {reason}."]
 
 
 def _third_harmonic_lines(result: IdentificationResult) -> list[str]:
@@ -319,14 +343,16 @@ def render_report(report: IdentificationReport, datasets: Sequence[Dataset],
     lines += ["## Friction", ""]
     for run in ok:
         if np.all(np.isfinite(run.coulomb[0])):
-            lines.append(f"- {run.display_name}: {_friction_text(run)} (platform description: "
-                         f"{platform.friction.coulomb:g} N·m per joint axis).")
+            lines.append(" ".join([
+                f"- {run.display_name}: {_friction_text(run)} (platform description: "
+                f"{platform.friction.coulomb:g} N·m per joint axis).",
+                *_friction_law_lines(run.result)]))
         else:
             lines.append(" ".join([
                 f"- {run.display_name} does not estimate friction (its prediction contains "
                 f"none); {100 * friction_signature(run.validation):.0f} % of its held-out "
                 "residual has the shape of Coulomb friction.",
-                *_third_harmonic_lines(run.result)]))
+                *_friction_law_lines(run.result), *_third_harmonic_lines(run.result)]))
     lines += [""] + _figure(figures, "friction") + physical_lines(report.physical, figures)
     if several:
         lines += ["## Methods compared", "", *verdict, ""]
