@@ -255,10 +255,10 @@ def test_noise_alone_adds_no_friction_allowance_and_friction_in_noise_is_caught(
         return square_wave_fit(paper, M, B, with_friction, periods=12, force_noise=20.0,
                                rng=rng)
 
-    from stewartid.reports.identification.text import _third_harmonic_lines
+    from stewartid.reports.identification.friction_text import third_harmonic_lines
 
     quiet_fit = fit(False)
-    assert "does not show" in _third_harmonic_lines(quiet_fit.result_)[0]
+    assert "does not show" in third_harmonic_lines(quiet_fit.result_)[0]
     quiet = quiet_fit.result_.diagnostics["friction_bias"]
     # white noise alone: the statistic is chi-squared below its 1 % point (a fixed seed)
     assert quiet["statistic"] < quiet["threshold"]
@@ -267,7 +267,7 @@ def test_noise_alone_adds_no_friction_allowance_and_friction_in_noise_is_caught(
     rubbing = fit(True)
     diagnostics = rubbing.result_.diagnostics["friction_bias"]
     assert diagnostics["statistic"] > diagnostics["threshold"]
-    assert "shows Coulomb friction" in _third_harmonic_lines(rubbing.result_)[0]
+    assert "shows Coulomb friction" in third_harmonic_lines(rubbing.result_)[0]
     assert np.all(np.abs(rubbing.B_ - B) <= 3 * rubbing.std_errors_["B"])
 
 

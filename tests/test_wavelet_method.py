@@ -382,8 +382,8 @@ def test_auto_keeps_the_coulomb_law_on_sines_where_it_holds(paper):
     assert not law["rejected"] and law["largest_disagreement"] < law["threshold"]
     gain = np.diag(free.std_errors_["B"]) / np.diag(auto.std_errors_["B"])
     assert gain.min() > 1.5, np.round(gain, 2)
-    from stewartid.reports.identification.text import _friction_law_lines
-    assert "kept the law: the law passes its test" in _friction_law_lines(auto.result_)[0]
+    from stewartid.reports.identification.friction_text import friction_law_lines
+    assert "kept the law: the law passes its test" in friction_law_lines(auto.result_)[0]
     for matrix, truth in ((auto.M_, M), (auto.B_, B)):
         std = auto.std_errors_["M" if matrix is auto.M_ else "B"]
         assert np.all(np.abs(np.diag(matrix) - np.diag(truth)) < 4 * np.diag(std))
@@ -402,7 +402,7 @@ def test_auto_rejects_a_friction_law_the_data_contradict(paper, linear_truth):
     law = diagnostics["friction_law_test"]
     assert law["rejected"] and law["largest_disagreement"] > law["threshold"], law
     assert diagnostics["friction_model"] == "free"
-    from stewartid.reports.identification.text import _friction_law_lines
-    assert "the data contradict the Coulomb law" in _friction_law_lines(est.result_)[0]
+    from stewartid.reports.identification.friction_text import friction_law_lines
+    assert "the data contradict the Coulomb law" in friction_law_lines(est.result_)[0]
     np.testing.assert_allclose(est.M_, M, rtol=0, atol=1e-3 * np.abs(M).max())
     np.testing.assert_allclose(est.B_, B, rtol=0, atol=1e-3 * np.abs(B).max())

@@ -56,7 +56,6 @@ import numpy as np
 
 from stewartid.datasets.dataset import Dataset
 from stewartid.fields import Interval, ListOf, Options, nonnegative, positive, validate_parameters
-from stewartid.identification.accuracy import predicted_worst_error
 from stewartid.identification.base import BaseIdentifier
 from stewartid.identification.pairs import combine_pairs
 from stewartid.identification.preparation import Experiment, prepare_experiment
@@ -68,20 +67,21 @@ from stewartid.identification.solvers import (
     solve_least_squares,
 )
 from stewartid.identification.wavelet.detection import (
-    SINGLE_SINE_SHARE,
     Detection,
     check_coverage,
     detect_intervals,
     excitation_scales,
     raise_no_interval,
-    sine_share,
+)
+from stewartid.identification.wavelet.friction_models import (
+    choose_friction_fit,
+    friction_models,
+    model_equations,
+    solve_model,
 )
 from stewartid.identification.wavelet.gls import WeakFormSolution
 from stewartid.identification.wavelet.noise import estimate_noise
 from stewartid.identification.wavelet.point_equations import EXACT_DEGREE, point_equations
-from stewartid.identification.wavelet.rate_selection import solve_weak_form_over_rates
-from stewartid.identification.wavelet.weak_form import experiment_equations
-from stewartid.identification.wavelet.windows import solve_windows_over_rates, window_equations
 from stewartid.model.joints import JOINT_TYPES
 from stewartid.platform import COORDINATES, Platform
 from stewartid.signals.wavelets import MotherWavelet, PolynomialWavelet, make_wavelet
@@ -94,8 +94,6 @@ VARIANTS = ("position", "paper", "derivative")
 MARGIN_PERIODS = 0.015
 PAIR_SELECTIONS = ("pooled", "std_error", "none")
 FRICTION_MODELS = ("auto", "free", "shared", "uniform", "coulomb")
-#: Window length (s) of ``friction="coulomb"``.
-WINDOW_LENGTH = 2.0
 
 
 @register_method(
@@ -129,18 +127,18 @@ class WaveletIdentifier(BaseIdentifier):
         at (a, b) points set by ``scale_fractions`` and ``shifts_per_scale``, as in the paper.
         Needs the polynomial wavelet and the position variant.
     friction : {"auto", "free", "shared", "uniform", "coulomb"}
-        With ``test_functions``: "coulomb", windows of :data:`WINDOW_LENGTH` s across joint
-        reversals, every row with the Coulomb force of each joint type (:mod:`.windows`;
-        several frequencies per DOF, all DOFs at once: plant, paper platform, 30 N m,
-        noise-free, 2.2 / 0.39 % on three-sine / all-DOF logs, "free" 17 / 1343 %).
-        "auto" (default): for one sine per experiment (:func:`.detection.sine_share`) both
-        "free" and "coulomb", keeping the one whose standard errors predict the smaller
-        largest error; else "coulomb". "free" leaves every interval constant free (the paper's invariance to
-        any friction law), the Coulomb levels kept only where the force inside the intervals
-        needs them (:mod:`.rate_selection`); "shared" models the constants as an offset per
-        experiment plus the Coulomb level of each joint type, with a scatter estimated from
-        the data (``coulomb_``): more precise Bt under noise, biased where the plant's
-        friction departs from that structure; "uniform" one level for every axis.
+        With ``test_functions``: "coulomb", windows of
+        :data:`.friction_models.WINDOW_LENGTH` s across joint reversals, every row with the
+        Coulomb force of each joint type (:mod:`.windows`; several frequencies per DOF, all
+        DOFs at once: plant, paper platform, 30 N m, noise-free, 2.2 / 0.39 % on three-sine /
+        all-DOF logs, "free" 17 / 1343 %). "auto" (default): "coulomb"; on one sine per
+        experiment both it and "free", the data choosing (:mod:`.friction_models`). "free"
+        leaves every interval constant free (the paper's invariance to any friction law),
+        the Coulomb levels kept only where the force inside the intervals needs them
+        (:mod:`.rate_selection`); "shared" models the constants as an offset per experiment
+        plus the Coulomb level of each joint type, with a scatter estimated from the data
+        (``coulomb_``): more precise Bt under noise, biased where the plant's friction
+        departs from that structure; "uniform" one level for every axis.
     scale_fractions : tuple of float
         Wavelet support as fractions of each interval's length, each in (0, 1].
     shifts_per_scale : int
@@ -290,8 +288,9 @@ class WaveletIdentifier(BaseIdentifier):
         dropped once its equations are formed, so that long logs fit in memory.
 
         With ``friction="auto"`` on one sine per experiment both friction treatments are
-        formed from the same prepared experiments and solved (:meth:`_friction_models`)."""
-        models = self._friction_models(datasets)
+        formed from the same prepared experiments and solved, and one kept
+        (:mod:`.friction_models`)."""
+        models = friction_models(self.friction, datasets)
         infos, sensitivities, motion = [], [], []
         equations: dict[str, list] = {model: [] for model in models}
         for k, dataset in enumerate(datasets):
@@ -299,14 +298,9 @@ class WaveletIdentifier(BaseIdentifier):
                                             remainder=self.remainder)
             found = self._noise_and_intervals(experiment, 1.0)
             for model in models:
-                if model == "coulomb":
-                    equations[model] += window_equations(
-                        experiment, found, int(self.wavelet_order), int(self.test_functions),
-                        k, False, WINDOW_LENGTH)
-                else:
-                    equations[model] += experiment_equations(
-                        experiment, found, int(self.wavelet_order), int(self.test_functions),
-                        k, model)
+                equations[model] += model_equations(model, experiment, found,
+                                                    int(self.wavelet_order),
+                                                    int(self.test_functions), k)
             infos.append(found.info)
             sensitivities.append(experiment.force_sensitivity)
             motion.append(np.std(experiment.q, axis=0))
@@ -318,54 +312,19 @@ class WaveletIdentifier(BaseIdentifier):
                      "force_sensitivity": sensitivities}
         fits = {}
         for model in models:
-            if model == "coulomb":
-                if not equations[model]:
-                    continue
-                solution, rate = solve_windows_over_rates(equations[model], **noise)
-            else:
-                if not equations[model]:
-                    raise_no_interval(infos)
-                check_coverage([i["name"] for i in infos], np.array(motion),
-                               [sum(e.experiment == k for e in equations[model])
-                                for k in range(len(infos))])
-                solution, rate = solve_weak_form_over_rates(
-                    equations[model], len(datasets), model != "free", **noise)
+            if model == "coulomb" and not equations[model]:
+                continue
+            solution, rate = solve_model(model, equations[model], infos, motion, noise)
             fits[model] = (*self._weak_form_result(
                 solution, infos, len(equations[model]), wavelet, model, rate),
                 self.pair_calibration_, solution.theta[:, :12], solution.theta_std[:, :12])
         if not fits:
             raise_no_interval(infos)
-        predicted = {model: predicted_worst_error(fit[0]) for model, fit in fits.items()}
-        chosen = min(fits, key=lambda model: predicted[model])
-        law = None
-        if len(fits) > 1:
-            law = friction_law_test(*fits["free"][3:], *fits["coulomb"][3:])
-            if law["rejected"]:
-                chosen = "free"
+        chosen, found = choose_friction_fit({model: fit[0] for model, fit in fits.items()},
+                                            {model: fit[3:] for model, fit in fits.items()})
         result, learned, self.pair_calibration_ = fits[chosen][:3]
-        if len(fits) > 1:
-            result.diagnostics["friction_candidates"] = {
-                model: {"predicted_worst_relative_error": float(value)}
-                for model, value in predicted.items()}
-            result.diagnostics["friction_law_test"] = law
+        result.diagnostics.update(found)
         return result, learned
-
-    def _friction_models(self, datasets: list[Dataset]) -> tuple[str, ...]:
-        """The friction models to fit: ``friction``; for "auto" both "free" and "coulomb"
-        when every experiment is one sine (:func:`.detection.sine_share`), else "coulomb".
-        Of the two, "coulomb" is kept where its standard errors predict the smaller largest
-        error and :func:`friction_law_test` does not reject its friction law.
-
-        On one sine per experiment neither wins everywhere (our plant, paper platform,
-        reference noise, 4 seeds: "coulomb" 1.9-7.7 % largest error over the 20 entries where
-        "free" gives 2.5-7.7 %, median 2.7 against 7.0 %; the independent example noise-free,
-        where the plant's friction is not Coulomb's per joint type, "free" 0.016 % against
-        2.7 %), and both errors are honest, so the data decide."""
-        if self.friction != "auto":
-            return (self.friction,)
-        single = all(sine_share(d.lengths, 1.0 / float(d.t[1] - d.t[0])) >= SINGLE_SINE_SHARE
-                     for d in datasets)
-        return ("free", "coulomb") if single else ("coulomb",)
 
     def _weak_form_result(self, solution: WeakFormSolution, infos: list[dict],
                           n_intervals: int, wavelet: MotherWavelet, friction: str,
@@ -487,50 +446,5 @@ class WaveletIdentifier(BaseIdentifier):
             diagnostics=diagnostics), {}
 
 
-#: Family-wise level of :func:`friction_law_test` over the distinct entries of Mt and Bt.
-FRICTION_LAW_LEVEL = 0.01
-
-
-def friction_law_test(free: np.ndarray, free_std: np.ndarray, law: np.ndarray,
-                      law_std: np.ndarray) -> dict:
-    """Does the fit with a friction law depart from the fit immune to it?
-
-    A specification test in Hausman's spirit on the diagonals of Mt and Bt. The free
-    interval constants estimate them whatever the friction law (each DOF's own excitation;
-    their couplings carry the idle joints' friction, :mod:`stewartid.identification.pairs`);
-    the Coulomb law's rows estimate them more precisely if the law holds, and where it does
-    not, read the friction it lacks as damping. Each diagonal entry's difference is scored in
-    the residual-based standard errors of the two fits (before any allowance for model
-    error, which is what is tested), combined as sqrt(s_free^2 + s_law^2): larger than the
-    difference's when the two are positively correlated, so the test errs towards keeping
-    the law. The largest of the 12 scores is compared with the two-sided normal point at
-    :data:`FRICTION_LAW_LEVEL` shared over them.
-
-    Parameters
-    ----------
-    free, law : ndarray, shape (6, 12)
-        [Mt Bt] of the ``friction="free"`` and ``friction="coulomb"`` solves of the same
-        data, before the symmetric pairs are combined.
-    free_std, law_std : ndarray, shape (6, 12)
-        Their residual-based standard errors.
-
-    Returns
-    -------
-    dict
-        ``{"largest_disagreement": z, "entry": "Bt(6,6)", "threshold": t, "rejected": bool}``.
-    """
-    from scipy.special import ndtri
-
-    diagonal = np.concatenate([np.arange(6) * 12 + np.arange(6),
-                               np.arange(6) * 12 + 6 + np.arange(6)])
-    difference = np.abs(free.ravel()[diagonal] - law.ravel()[diagonal])
-    spread = np.hypot(free_std.ravel()[diagonal], law_std.ravel()[diagonal])
-    scores = difference / np.maximum(spread, 1e-300)
-    labels = [f"{name}t({k + 1},{k + 1})" for name in ("M", "B") for k in range(6)]
-    threshold = float(ndtri(1.0 - FRICTION_LAW_LEVEL / (2 * scores.size)))
-    worst = int(np.nanargmax(scores))
-    return {"largest_disagreement": float(scores[worst]), "entry": labels[worst],
-            "threshold": threshold, "rejected": bool(scores[worst] > threshold)}
-
-__all__ = ["EXACT_DEGREE", "FRICTION_LAW_LEVEL", "FRICTION_MODELS", "MARGIN_PERIODS",
-           "PAIR_SELECTIONS", "VARIANTS", "WaveletIdentifier", "friction_law_test"]
+__all__ = ["EXACT_DEGREE", "FRICTION_MODELS", "MARGIN_PERIODS", "PAIR_SELECTIONS", "VARIANTS",
+           "WaveletIdentifier"]

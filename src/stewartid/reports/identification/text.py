@@ -17,11 +17,15 @@ from stewartid.assessment.validation import friction_signature
 from stewartid.assessment.verdict import Verdict, relative_std, worst_dof
 from stewartid.datasets.dataset import Dataset
 from stewartid.identification.consistency import consistency_metrics, is_consistent
-from stewartid.identification.result import IdentificationResult
 from stewartid.identification.wavelet.noise import white_noise_covariance
-from stewartid.model.joints import FRICTION_TYPES
 from stewartid.platform import COORDINATES, Platform
 from stewartid.reporting.tables import ResultTable, to_markdown
+from stewartid.reports.identification.friction_text import (
+    friction_law_lines,
+    friction_section,
+    friction_text,
+    third_harmonic_lines,
+)
 from stewartid.reports.identification.physical_section import physical_lines
 from stewartid.reports.identification.records import IdentificationReport, MethodReport
 from stewartid.signals.differentiation import differentiate, estimate_frequency
@@ -92,12 +96,6 @@ def _changed(projection: Any) -> str:
     return "less than 0.001" if change < 1e-3 else f"{change:.3g}"
 
 
-def _friction_text(run: MethodReport) -> str:
-    levels, std = run.coulomb
-    return ", ".join(f"{name.replace('_', ' ')} {v:.3g} ± {s:.2g} N·m"
-                     for name, v, s in zip(FRICTION_TYPES, levels, std, strict=True))
-
-
 def _quality(vaf: float) -> str:
     if vaf >= CLOSE_VAF:
         return "predicts the held-out force closely"
@@ -132,54 +130,14 @@ def method_lines(run: MethodReport) -> list[str]:
     lines.append(f"Median relative standard error of the diagonal entries: "
                  f"{100 * relative_std(result):.2g} %.")
     if np.all(np.isfinite(run.coulomb[0])):
-        lines.append(f"Coulomb friction: {_friction_text(run)}.")
+        lines.append(f"Coulomb friction: {friction_text(run)}.")
     else:
         share = friction_signature(run.validation)
         lines.append(f"It does not estimate friction; {100 * share:.0f} % of its held-out "
                      "residual has the shape of Coulomb joint friction (`--method all` "
                      "compares it with a method that estimates friction).")
-    lines += _friction_law_lines(result) + _third_harmonic_lines(result)
+    lines += friction_law_lines(result) + third_harmonic_lines(result)
     return lines
-
-
-def _friction_law_lines(result: IdentificationResult) -> list[str]:
-    """Method B on one sine per experiment: which friction treatment it kept, and why."""
-    candidates = result.diagnostics.get("friction_candidates") or {}
-    law = result.diagnostics.get("friction_law_test")
-    if len(candidates) < 2 or not law:
-        return []
-    predicted = {name: 100 * value["predicted_worst_relative_error"]
-                 for name, value in candidates.items()}
-    kept = result.diagnostics.get("friction_model")
-    test = (f"its diagonals and the free constants' differ by up to "
-            f"{law['largest_disagreement']:.3g} standard errors ({law['entry']}; threshold "
-            f"{law['threshold']:.3g})")
-    if law["rejected"]:
-        reason = f"the data contradict the Coulomb law: {test}"
-    elif kept == "coulomb":
-        reason = f"the law passes its test ({test}) and predicts the smaller largest error"
-    else:
-        reason = f"they predict the smaller largest error ({test})"
-    return [f"It fitted both the free interval constants (predicted largest error "
-            f"{predicted['free']:.3g} %) and the Coulomb law of each joint type "
-            f"({predicted['coulomb']:.3g} %) and kept "
-            f"{'the law' if kept == 'coulomb' else 'the free constants'}: {reason}."]
-
-
-def _third_harmonic_lines(result: IdentificationResult) -> list[str]:
-    """Method A: whether the force's third harmonic shows the Coulomb friction its Bt reads as
-    viscous, and what that puts in the standard errors."""
-    bias = result.diagnostics.get("friction_bias") or {}
-    if "statistic" not in bias or not np.isfinite(bias["threshold"]):
-        return []
-    shown = bias["statistic"] > bias["threshold"]
-    bound = np.diag(np.asarray(bias["bound_B"])) / np.abs(np.diag(result.B))
-    return [f"The third harmonic its linear model leaves {'shows' if shown else 'does not show'} "
-            f"Coulomb friction (chi-squared {bias['statistic']:.4g} against "
-            f"{bias['threshold']:.4g} at 1 %): "
-            + (f"its standard errors carry the bias the friction's first harmonic puts on Bt "
-               f"(up to {100 * np.max(bound):.2g} % of its diagonal)." if shown else
-               "its standard errors are the noise's.")]
 
 
 def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
@@ -210,7 +168,7 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
     if verdict.friction_source is not None:
         source = next(run for run in ok if run.name == verdict.friction_source)
         lines.append(f"Coulomb friction is present: {source.display_name} finds "
-                     f"{_friction_text(source)}.")
+                     f"{friction_text(source)}.")
     for run in ok:
         if run is best:
             continue
@@ -340,19 +298,7 @@ def render_report(report: IdentificationReport, datasets: Sequence[Dataset],
     lines += (_validation_section(report, folds) + _figure(figures, "validation")
               + _records_section(report, records))
     lines += _consistency_section(ok)
-    lines += ["## Friction", ""]
-    for run in ok:
-        if np.all(np.isfinite(run.coulomb[0])):
-            lines.append(" ".join([
-                f"- {run.display_name}: {_friction_text(run)} (platform description: "
-                f"{platform.friction.coulomb:g} N·m per joint axis).",
-                *_friction_law_lines(run.result)]))
-        else:
-            lines.append(" ".join([
-                f"- {run.display_name} does not estimate friction (its prediction contains "
-                f"none); {100 * friction_signature(run.validation):.0f} % of its held-out "
-                "residual has the shape of Coulomb friction.",
-                *_friction_law_lines(run.result), *_third_harmonic_lines(run.result)]))
+    lines += ["## Friction", ""] + friction_section(ok, platform)
     lines += [""] + _figure(figures, "friction") + physical_lines(report.physical, figures)
     if several:
         lines += ["## Methods compared", "", *verdict, ""]

@@ -1,0 +1,82 @@
+"""The identification report's sentences about friction: the levels a method estimates, the
+friction treatment Method B kept, and the third harmonic Method A tests."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from stewartid.assessment.validation import friction_signature
+from stewartid.identification.result import IdentificationResult
+from stewartid.model.joints import FRICTION_TYPES
+from stewartid.platform import Platform
+from stewartid.reports.identification.records import MethodReport
+
+
+def friction_text(run: MethodReport) -> str:
+    levels, std = run.coulomb
+    return ", ".join(f"{name.replace('_', ' ')} {v:.3g} ± {s:.2g} N·m"
+                     for name, v, s in zip(FRICTION_TYPES, levels, std, strict=True))
+
+
+def friction_law_lines(result: IdentificationResult) -> list[str]:
+    """Method B on one sine per experiment: which friction treatment it kept, and why."""
+    candidates = result.diagnostics.get("friction_candidates") or {}
+    law = result.diagnostics.get("friction_law_test")
+    if len(candidates) < 2 or not law:
+        return []
+    predicted = {name: 100 * value["predicted_worst_relative_error"]
+                 for name, value in candidates.items()}
+    kept = result.diagnostics.get("friction_model")
+    test = (f"its diagonals and the free constants' differ by up to "
+            f"{law['largest_disagreement']:.3g} standard errors ({law['entry']}; threshold "
+            f"{law['threshold']:.3g})")
+    if law["rejected"]:
+        reason = f"the data contradict the Coulomb law: {test}"
+    elif kept == "coulomb":
+        reason = f"the law passes its test ({test}) and predicts the smaller largest error"
+    else:
+        reason = f"they predict the smaller largest error ({test})"
+    return [f"It fitted both the free interval constants (predicted largest error "
+            f"{predicted['free']:.3g} %) and the Coulomb law of each joint type "
+            f"({predicted['coulomb']:.3g} %) and kept "
+            f"{'the law' if kept == 'coulomb' else 'the free constants'}: {reason}."]
+
+
+def third_harmonic_lines(result: IdentificationResult) -> list[str]:
+    """Method A: whether the force's third harmonic shows the Coulomb friction its Bt reads as
+    viscous, and what that puts in the standard errors."""
+    bias = result.diagnostics.get("friction_bias") or {}
+    if "statistic" not in bias or not np.isfinite(bias["threshold"]):
+        return []
+    shown = bias["statistic"] > bias["threshold"]
+    bound = np.diag(np.asarray(bias["bound_B"])) / np.abs(np.diag(result.B))
+    return [f"The third harmonic its linear model leaves {'shows' if shown else 'does not show'} "
+            f"Coulomb friction (chi-squared {bias['statistic']:.4g} against "
+            f"{bias['threshold']:.4g} at 1 %): "
+            + (f"its standard errors carry the bias the friction's first harmonic puts on Bt "
+               f"(up to {100 * np.max(bound):.2g} % of its diagonal)." if shown else
+               "its standard errors are the noise's.")]
+
+
+def friction_section(ok: Sequence[MethodReport], platform: Platform) -> list[str]:
+    """The report's friction section: per method its Coulomb levels, or what its residual
+    shows of the friction it does not estimate."""
+    lines: list[str] = []
+    for run in ok:
+        if np.all(np.isfinite(run.coulomb[0])):
+            lines.append(" ".join([
+                f"- {run.display_name}: {friction_text(run)} (platform description: "
+                f"{platform.friction.coulomb:g} N·m per joint axis).",
+                *friction_law_lines(run.result)]))
+        else:
+            lines.append(" ".join([
+                f"- {run.display_name} does not estimate friction (its prediction contains "
+                f"none); {100 * friction_signature(run.validation):.0f} % of its held-out "
+                "residual has the shape of Coulomb friction.",
+                *friction_law_lines(run.result), *third_harmonic_lines(run.result)]))
+    return lines
+
+
+__all__ = ["friction_law_lines", "friction_section", "friction_text", "third_harmonic_lines"]
