@@ -53,14 +53,18 @@ from stewartid.simulation import (
 from stewartid.simulation.sensors import reference_noise
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "tests" / "data" / "example_c10"
-#: Method B (default: every interval constant free), with the shared-friction interval
-#: constants, with a 0.1 s margin, and with the paper's equations; Method A; least squares;
-#: and the oracle (least squares given the true Coulomb force, which no user has).
+#: Method B (default; on one sine per experiment the free interval constants or the Coulomb
+#: law, whichever the data choose), with the free constants, with the shared-friction
+#: interval constants, with the free constants and a 0.1 s margin, and with the paper's
+#: equations; Method A; least squares; and the oracle (least squares given the true Coulomb
+#: force, which no user has).
 METHODS = {"fourier": functools.partial(create_identifier, "fourier"),
            "ls": functools.partial(create_identifier, "ls"),
            "wavelet": functools.partial(create_identifier, "wavelet"),
+           "wavelet_free": functools.partial(create_identifier, "wavelet", friction="free"),
            "wavelet_shared": functools.partial(create_identifier, "wavelet", friction="shared"),
-           "wavelet_m01": functools.partial(create_identifier, "wavelet", margin=0.1),
+           "wavelet_m01": functools.partial(create_identifier, "wavelet", friction="free",
+                                            margin=0.1),
            "wavelet-paper": functools.partial(create_identifier, "wavelet-paper")}
 
 

@@ -15,6 +15,7 @@ from stewartid.reports.identification.records import MethodReport
 
 
 def friction_text(run: MethodReport) -> str:
+    """A method's Coulomb levels per joint type with their standard errors, for a sentence."""
     levels, std = run.coulomb
     return ", ".join(f"{name.replace('_', ' ')} {v:.3g} ± {s:.2g} N·m"
                      for name, v, s in zip(FRICTION_TYPES, levels, std, strict=True))
