@@ -107,7 +107,7 @@ def choose_friction_fit(results: Mapping[str, IdentificationResult],
         for model, value in predicted.items()}, "friction_law_test": law}
 
 
-#: Family-wise level of :func:`friction_law_test` over the distinct entries of Mt and Bt.
+#: Family-wise level of :func:`friction_law_test` over the 12 diagonal entries of Mt and Bt.
 FRICTION_LAW_LEVEL = 0.01
 
 
