@@ -77,7 +77,7 @@ from stewartid.identification.wavelet.friction_models import (
     choose_friction_fit,
     friction_models,
     model_equations,
-    solve_model,
+    solve_models,
 )
 from stewartid.identification.wavelet.gls import WeakFormSolution
 from stewartid.identification.wavelet.noise import estimate_noise
@@ -288,8 +288,7 @@ class WaveletIdentifier(BaseIdentifier):
         dropped once its equations are formed, so that long logs fit in memory.
 
         With ``friction="auto"`` on one sine per experiment both friction treatments are
-        formed from the same prepared experiments and solved, and one kept
-        (:mod:`.friction_models`)."""
+        formed from the same prepared experiments and solved, one kept (:mod:`.friction_models`)."""
         models = friction_models(self.friction, datasets)
         infos, sensitivities, motion = [], [], []
         equations: dict[str, list] = {model: [] for model in models}
@@ -305,25 +304,19 @@ class WaveletIdentifier(BaseIdentifier):
             sensitivities.append(experiment.force_sensitivity)
             motion.append(np.std(experiment.q, axis=0))
             del experiment, found
-        noise = {}
-        if self.noise_correction:
-            noise = {"pose_covariance": [i["noise_covariance"] for i in infos],
-                     "force_variance": [i["force_noise_variance"] for i in infos],
-                     "force_sensitivity": sensitivities}
-        fits = {}
-        for model in models:
-            if model == "coulomb" and not equations[model]:
-                continue
-            solution, rate = solve_model(model, equations[model], infos, motion, noise)
-            fits[model] = (*self._weak_form_result(
-                solution, infos, len(equations[model]), wavelet, model, rate),
-                self.pair_calibration_, solution.theta[:, :12], solution.theta_std[:, :12])
-        if not fits:
-            raise_no_interval(infos)
+        noise = ({"pose_covariance": [i["noise_covariance"] for i in infos],
+                  "force_variance": [i["force_noise_variance"] for i in infos],
+                  "force_sensitivity": sensitivities} if self.noise_correction else {})
+        solved, refused = solve_models(models, equations, infos, motion, noise)
+        fits = {model: (*self._weak_form_result(solution, infos, len(equations[model]),
+                                                 wavelet, model, rate),
+                        self.pair_calibration_, solution.theta[:, :12],
+                        solution.theta_std[:, :12])
+                for model, (solution, rate) in solved.items()}
         chosen, found = choose_friction_fit({model: fit[0] for model, fit in fits.items()},
                                             {model: fit[3:] for model, fit in fits.items()})
         result, learned, self.pair_calibration_ = fits[chosen][:3]
-        result.diagnostics.update(found)
+        result.diagnostics.update(found, **({"friction_refused": refused} if refused else {}))
         return result, learned
 
     def _weak_form_result(self, solution: WeakFormSolution, infos: list[dict],

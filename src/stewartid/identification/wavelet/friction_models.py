@@ -18,6 +18,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from stewartid.datasets.dataset import Dataset
+from stewartid.errors import IdentificationError
 from stewartid.identification.accuracy import predicted_worst_error
 from stewartid.identification.preparation import Experiment
 from stewartid.identification.result import IdentificationResult
@@ -63,13 +64,39 @@ def solve_model(model: str, equations: list, infos: list[dict], motion: list[np.
     """Solve one friction model's equations over the soft-sign rates
     (:func:`.windows.solve_windows_over_rates`, :func:`.rate_selection.solve_weak_form_over_rates`);
     the intervals' coverage of every DOF checked first. Returns the solution and its rate."""
-    if model == "coulomb":
-        return solve_windows_over_rates(equations, **noise)
     if not equations:
         raise_no_interval(infos)
+    if model == "coulomb":
+        return solve_windows_over_rates(equations, **noise)
     check_coverage([i["name"] for i in infos], np.array(motion),
                    [sum(e.experiment == k for e in equations) for k in range(len(infos))])
     return solve_weak_form_over_rates(equations, len(infos), model != "free", **noise)
+
+
+def solve_models(models: Sequence[str], equations: Mapping[str, list], infos: list[dict],
+                 motion: list[np.ndarray], noise: dict
+                 ) -> tuple[dict[str, tuple[WeakFormSolution, float]], dict[str, str]]:
+    """:func:`solve_model` of every friction model. One the data refuse (no interval, a DOF
+    no interval covers) is left out and its reason returned, for another may still fit;
+    when every model is refused, the first refusal is raised.
+
+    Returns
+    -------
+    solved : dict
+        Model -> (solution, soft-sign rate).
+    refused : dict
+        Model -> the first line of its refusal.
+    """
+    solved, refused, first = {}, {}, None
+    for model in models:
+        try:
+            solved[model] = solve_model(model, equations[model], infos, motion, noise)
+        except IdentificationError as error:
+            first = first or error
+            refused[model] = str(error).splitlines()[0]
+    if not solved:
+        raise first
+    return solved, refused
 
 
 def choose_friction_fit(results: Mapping[str, IdentificationResult],
@@ -154,4 +181,4 @@ def friction_law_test(free: np.ndarray, free_std: np.ndarray, law: np.ndarray,
 
 
 __all__ = ["FRICTION_LAW_LEVEL", "WINDOW_LENGTH", "choose_friction_fit", "friction_law_test",
-           "friction_models", "model_equations", "solve_model"]
+           "friction_models", "model_equations", "solve_model", "solve_models"]
