@@ -406,3 +406,23 @@ def test_auto_rejects_a_friction_law_the_data_contradict(paper, linear_truth):
     assert "the data contradict the Coulomb law" in friction_law_lines(est.result_)[0]
     np.testing.assert_allclose(est.M_, M, rtol=0, atol=1e-3 * np.abs(M).max())
     np.testing.assert_allclose(est.B_, B, rtol=0, atol=1e-3 * np.abs(B).max())
+
+
+def test_friction_law_test_scores_the_diagonals_against_the_normal_point():
+    """The largest diagonal difference in combined errors, against the two-sided normal point
+    at 1 % shared over the 12 diagonal entries (z = 3.34, by hand: Phi^-1(1 - 0.01 / 24));
+    couplings do not count; errors that are not finite judge nothing."""
+    from stewartid.identification.wavelet.friction_models import friction_law_test
+
+    free, std = np.ones((6, 12)), np.full((6, 12), 0.1)
+    law = free.copy()
+    law[0, 4] += 5.0                                   # a coupling: not tested
+    law[5, 11] += 0.3 * np.sqrt(2.0)                   # Bt(6,6) 3 combined errors apart
+    found = friction_law_test(free, std, law, std)
+    assert found["threshold"] == pytest.approx(3.3415, abs=1e-4)
+    assert found["entry"] == "Bt(6,6)" and found["largest_disagreement"] == pytest.approx(3.0)
+    assert not found["rejected"]
+    law[2, 2] += 0.4 * np.sqrt(2.0)                    # Mt(3,3) 4 apart
+    found = friction_law_test(free, std, law, std)
+    assert found["rejected"] and found["entry"] == "Mt(3,3)"
+    assert not friction_law_test(free, np.full((6, 12), np.nan), law, std)["rejected"]

@@ -175,6 +175,9 @@ def friction_law_test(free: np.ndarray, free_std: np.ndarray, law: np.ndarray,
     scores = difference / np.maximum(spread, 1e-300)
     labels = [f"{name}t({k + 1},{k + 1})" for name in ("M", "B") for k in range(6)]
     threshold = float(ndtri(1.0 - FRICTION_LAW_LEVEL / (2 * scores.size)))
+    if not np.any(np.isfinite(scores)):   # no error to judge by: nothing contradicts the law
+        return {"largest_disagreement": float("nan"), "entry": None, "threshold": threshold,
+                "rejected": False}
     worst = int(np.nanargmax(scores))
     return {"largest_disagreement": float(scores[worst]), "entry": labels[worst],
             "threshold": threshold, "rejected": bool(scores[worst] > threshold)}
