@@ -383,7 +383,7 @@ def test_auto_keeps_the_coulomb_law_on_sines_where_it_holds(paper):
     gain = np.diag(free.std_errors_["B"]) / np.diag(auto.std_errors_["B"])
     assert gain.min() > 1.5, np.round(gain, 2)
     from stewartid.reports.identification.friction_text import friction_law_lines
-    assert "kept the law: the law passes its test" in friction_law_lines(auto.result_)[0]
+    assert "kept the law, which passes its test" in friction_law_lines(auto.result_)[0]
     for matrix, truth in ((auto.M_, M), (auto.B_, B)):
         std = auto.std_errors_["M" if matrix is auto.M_ else "B"]
         assert np.all(np.abs(np.diag(matrix) - np.diag(truth)) < 4 * np.diag(std))

@@ -30,19 +30,20 @@ def friction_law_lines(result: IdentificationResult) -> list[str]:
     predicted = {name: 100 * value["predicted_worst_relative_error"]
                  for name, value in candidates.items()}
     kept = result.diagnostics.get("friction_model")
-    test = (f"its diagonals and the free constants' differ by up to "
-            f"{law['largest_disagreement']:.3g} standard errors ({law['entry']}; threshold "
-            f"{law['threshold']:.3g})")
+    test = (f"its diagonals differ from the free constants' by at most "
+            f"{law['largest_disagreement']:.3g} standard errors, at {law['entry']}, against a "
+            f"threshold of {law['threshold']:.3g}")
     if law["rejected"]:
-        reason = f"the data contradict the Coulomb law: {test}"
+        reason = f"kept the free constants: the data contradict the Coulomb law ({test})"
     elif kept == "coulomb":
-        reason = f"the law passes its test ({test}) and predicts the smaller largest error"
+        reason = (f"kept the law, which passes its test ({test}) and predicts the smaller "
+                  "largest error")
     else:
-        reason = f"they predict the smaller largest error ({test})"
+        reason = (f"kept the free constants, whose standard errors predict the smaller largest "
+                  f"error (the law passes its test: {test})")
     return [f"It fitted both the free interval constants (predicted largest error "
             f"{predicted['free']:.3g} %) and the Coulomb law of each joint type "
-            f"({predicted['coulomb']:.3g} %) and kept "
-            f"{'the law' if kept == 'coulomb' else 'the free constants'}: {reason}."]
+            f"({predicted['coulomb']:.3g} %) and {reason}."]
 
 
 def third_harmonic_lines(result: IdentificationResult) -> list[str]:
