@@ -77,8 +77,8 @@ def solve_models(models: Sequence[str], equations: Mapping[str, list], infos: li
                  motion: list[np.ndarray], noise: dict
                  ) -> tuple[dict[str, tuple[WeakFormSolution, float]], dict[str, str]]:
     """:func:`solve_model` of every friction model. One the data refuse (no interval, a DOF
-    no interval covers) is left out and its reason returned, for another may still fit;
-    when every model is refused, the first refusal is raised.
+    no interval covers, a singular system) is left out and its reason returned, for another
+    may still fit; when every model is refused, the first refusal is raised.
 
     Returns
     -------
@@ -91,7 +91,7 @@ def solve_models(models: Sequence[str], equations: Mapping[str, list], infos: li
     for model in models:
         try:
             solved[model] = solve_model(model, equations[model], infos, motion, noise)
-        except IdentificationError as error:
+        except (IdentificationError, np.linalg.LinAlgError) as error:  # singular: unexcited
             first = first or error
             refused[model] = str(error).splitlines()[0]
     if not solved:
