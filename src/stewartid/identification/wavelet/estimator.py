@@ -308,15 +308,15 @@ class WaveletIdentifier(BaseIdentifier):
                   "force_variance": [i["force_noise_variance"] for i in infos],
                   "force_sensitivity": sensitivities} if self.noise_correction else {})
         solved, refused = solve_models(models, equations, infos, motion, noise)
-        fits = {model: (*self._weak_form_result(solution, infos, len(equations[model]),
-                                                 wavelet, model, rate),
-                        self.pair_calibration_, solution.theta[:, :12],
-                        solution.theta_std[:, :12])
+        fits = {model: self._weak_form_result(solution, infos, len(equations[model]), wavelet,
+                                              model, rate)
                 for model, (solution, rate) in solved.items()}
-        chosen, found = choose_friction_fit({model: fit[0] for model, fit in fits.items()},
-                                            {model: fit[3:] for model, fit in fits.items()})
-        result, learned, self.pair_calibration_ = fits[chosen][:3]
-        result.diagnostics.update(found, **({"friction_refused": refused} if refused else {}))
+        chosen, why = choose_friction_fit({model: fit[0] for model, fit in fits.items()},
+                                          {model: solution for model, (solution, _) in
+                                           solved.items()})
+        result, learned = fits[chosen]
+        self.pair_calibration_ = result.diagnostics["pair_calibration"]
+        result.diagnostics.update(why, **({"friction_refused": refused} if refused else {}))
         return result, learned
 
     def _weak_form_result(self, solution: WeakFormSolution, infos: list[dict],

@@ -100,8 +100,7 @@ def solve_models(models: Sequence[str], equations: Mapping[str, list], infos: li
 
 
 def choose_friction_fit(results: Mapping[str, IdentificationResult],
-                        raw: Mapping[str, tuple[np.ndarray, np.ndarray]]
-                        ) -> tuple[str, dict]:
+                        solutions: Mapping[str, WeakFormSolution]) -> tuple[str, dict]:
     """Which fit to keep, and the diagnostics that say why.
 
     One fit is kept as it is. Of "free" and "coulomb", the law's is kept unless its
@@ -113,9 +112,9 @@ def choose_friction_fit(results: Mapping[str, IdentificationResult],
     ----------
     results : mapping
         Friction model -> its result.
-    raw : mapping
-        Friction model -> ([Mt Bt] (6, 12) before the symmetric pairs are combined, their
-        residual-based standard errors (6, 12)).
+    solutions : mapping
+        Friction model -> its solve, before the symmetric pairs are combined (its
+        residual-based standard errors).
 
     Returns
     -------
@@ -127,7 +126,9 @@ def choose_friction_fit(results: Mapping[str, IdentificationResult],
     if len(results) == 1:
         return next(iter(results)), {}
     predicted = {model: predicted_worst_error(result) for model, result in results.items()}
-    law = friction_law_test(*raw["free"], *raw["coulomb"])
+    free, coulomb = solutions["free"], solutions["coulomb"]
+    law = friction_law_test(free.theta[:, :12], free.theta_std[:, :12], coulomb.theta[:, :12],
+                            coulomb.theta_std[:, :12])
     chosen = "free" if law["rejected"] else min(results, key=lambda model: predicted[model])
     return chosen, {"friction_candidates": {
         model: {"predicted_worst_relative_error": float(value)}
@@ -168,11 +169,11 @@ def friction_law_test(free: np.ndarray, free_std: np.ndarray, law: np.ndarray,
     """
     from scipy.special import ndtri
 
-    diagonal = np.concatenate([np.arange(6) * 12 + np.arange(6),
-                               np.arange(6) * 12 + 6 + np.arange(6)])
-    difference = np.abs(free.ravel()[diagonal] - law.ravel()[diagonal])
-    spread = np.hypot(free_std.ravel()[diagonal], law_std.ravel()[diagonal])
-    scores = difference / np.maximum(spread, 1e-300)
+    def diagonals(x: np.ndarray) -> np.ndarray:   # Mt's, then Bt's
+        return np.r_[np.diag(x[:, :6]), np.diag(x[:, 6:12])]
+
+    spread = np.hypot(diagonals(free_std), diagonals(law_std))
+    scores = np.abs(diagonals(free) - diagonals(law)) / np.maximum(spread, 1e-300)
     labels = [f"{name}t({k + 1},{k + 1})" for name in ("M", "B") for k in range(6)]
     threshold = float(ndtri(1.0 - FRICTION_LAW_LEVEL / (2 * scores.size)))
     if not np.any(np.isfinite(scores)):   # no error to judge by: nothing contradicts the law
