@@ -31,6 +31,7 @@ inverse dynamic identification model with least squares.
 
 from __future__ import annotations
 
+import math
 from numbers import Integral
 
 import numpy as np
@@ -179,7 +180,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
         experiments = prepare(datasets, platform, gravity=self.gravity, joints=self.coulomb,
                               remainder=self.remainder)
         n_exp = len(experiments)
-        phis, ys, shared, used, noise = [], [], [], [], []
+        phis, ys, shared, used, noise, segments = [], [], [], [], [], []
         for e, exp in enumerate(experiments):
             window = self.window or default_window(estimate_frequency(exp.q, exp.sample_rate))
             if self.differentiation == "savgol":
@@ -217,6 +218,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
             ys.append(y)
             if self.coulomb:
                 shared.append(coulomb)
+            # the filters' support: rows further apart share no noise sample
+            segments.append((k, math.ceil(window * exp.sample_rate / self.decimate) + 1))
             used.append({"name": exp.name, "window_s": window, "samples": k,
                          "t_start": float(exp.t[sl][0]), "t_stop": float(exp.t[sl][-1])})
         names = regressor_names("q_ddot", "q_dot") + [f"offset[{x.name}]" for x in experiments]
@@ -230,7 +233,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
             np.concatenate(shared) if self.coulomb else None, symmetric=self.symmetric,
             regressor_names=names,
             shared_names=[f"coulomb[{t}]" for t in JOINT_TYPES] if self.coulomb else None,
-            autocorrelated=True, regressor_noise=regressor_noise)
+            autocorrelated=True, regressor_noise=regressor_noise, segments=segments)
         theta, std = solution.theta, solution.theta_std.copy()
         # residual autocorrelation is in theta_std; model error (friction the joint model
         # lacks) shows as symmetric pairs that disagree beyond it

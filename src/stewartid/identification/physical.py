@@ -35,6 +35,7 @@ nearest to it in the metric of its covariance
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass, field
 from numbers import Integral
 from typing import Any
@@ -224,7 +225,8 @@ class PhysicalIdentifier(BaseIdentifier):
         positive = np.isin(reg.PARAMETERS, POSITIVE_PARAMETERS)
         scales = selection @ np.where(positive, np.abs(reg.standard_parameters(platform)), 0.0)
         solution = solve_parameters(X, y, list(names), nominal, scales, self.max_condition,
-                                    self.max_relative_error, noise, target_noise)
+                                    self.max_relative_error, noise, target_noise,
+                                    correlation_segments(data, experiments))
         projection = None
         if self.consistent:
             nonnegative = np.isin(names, reg.FRICTION_PARAMETERS + reg.ACTUATOR_PARAMETERS)
@@ -235,6 +237,15 @@ class PhysicalIdentifier(BaseIdentifier):
                    "parameter_std_errors_": result.parameter_std_errors,
                    "covariance_": solution.covariance, "fixed_": solution.fixed}
         return result, learned
+
+
+def correlation_segments(data, experiments: list) -> list[tuple[int, int]]:
+    """Per experiment its filtered rows and the lag (rows) beyond which their noise is
+    uncorrelated: the support of the kernel convolved with the Savitzky-Golay taps (window
+    and an eighth of it), the farthest two rows sharing a noise sample."""
+    return [(e["samples"], math.ceil((1 + 1 / SAVGOL_FRACTION) * e["window_s"]
+                                     * exp.sample_rate / e["row_step"]) + 1)
+            for e, exp in zip(data.experiments, experiments, strict=True)]
 
 
 @functools.lru_cache(maxsize=4)
@@ -371,5 +382,6 @@ def payload_section(parameters: dict[str, float]) -> dict[str, Any]:
 
 
 __all__ = ["NUISANCE_PARAMETERS", "PAYLOAD_PARAMETERS", "POSITIVE_PARAMETERS",
-           "PhysicalIdentifier", "PhysicalResult", "known_platform", "parameter_model",
+           "PhysicalIdentifier", "PhysicalResult", "correlation_segments", "known_platform",
+           "parameter_model",
            "payload_section"]

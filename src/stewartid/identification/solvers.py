@@ -139,7 +139,9 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
                         shared_names: Sequence[str] | None = None,
                         max_condition: float = 1e8,
                         autocorrelated: bool = False,
-                        regressor_noise: np.ndarray | None = None) -> LeastSquaresSolution:
+                        regressor_noise: np.ndarray | None = None,
+                        segments: Sequence[tuple[int, int]] | None = None
+                        ) -> LeastSquaresSolution:
     """Least squares for y(k) = theta phi(k) + sum_s c_s S_s(k), with standard errors.
 
     Every channel i of ``y`` shares the regressor rows ``phi``; the shared terms S_s are
@@ -179,6 +181,11 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
         through the filters that make q_dot and q_ddot): subtracted from phi^T phi, it
         removes the attenuation bias that noise in the regressors puts on the estimate
         (errors in variables; the noise is taken independent of the targets' noise).
+    segments : sequence of (int, int), optional
+        The rows as consecutive records: each one's number of rows and its correlation
+        length (rows beyond which its residual is uncorrelated: the filter's support).
+        Given, the covariance is the sandwich of the unknowns' scores
+        (:func:`long_run_covariance`) instead of ``autocorrelated``'s scaled inverse.
 
     Returns
     -------
@@ -189,8 +196,7 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
     IdentificationError
         Too few equations, or rank deficiency (names the DOF that was never excited).
     """
-    phi = np.asarray(phi, dtype=float)
-    y = np.asarray(y, dtype=float)
+    phi, y = np.asarray(phi, dtype=float), np.asarray(y, dtype=float)
     K, p = phi.shape
     S = np.zeros((K, 0, 6)) if shared is None else np.asarray(shared, dtype=float)
     s = S.shape[1]
@@ -200,10 +206,8 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
     if symmetric and p < 12:
         raise IdentificationError("the symmetry constraint needs the regressors [q_ddot, "
                                   f"q_dot, ...] (at least 12 columns); got {p}.")
-    names = list(regressor_names) if regressor_names is not None else \
-        [f"phi[{j}]" for j in range(p)]
-    snames = list(shared_names) if shared_names is not None else [f"shared[{j}]" for j in
-                                                                  range(s)]
+    names = list(regressor_names or [f"phi[{j}]" for j in range(p)])
+    snames = list(shared_names or [f"shared[{j}]" for j in range(s)])
     T = _symmetric_map(p, symmetric)
     n_unknowns = T.shape[1] + s
     if 6 * K <= n_unknowns:
@@ -258,17 +262,72 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
     # floor: exact (noise-free) data must not produce infinite weights
     sigma = np.maximum(sigma, 1e-12 * scale_y)
     theta, c, residual, N, Tf, condition, scale = solve(1.0 / sigma ** 2)
-    sigma2 = np.sum(residual ** 2, axis=0) / dof
-    if autocorrelated:
-        sigma2 = sigma2 * np.array([integrated_autocorrelation(r) for r in residual.T])
-    weighted_variance = float(np.mean(sigma2 / sigma ** 2))
     Ns_inv = np.linalg.inv(N / np.outer(scale, scale)) / np.outer(scale, scale)
-    cov_full = weighted_variance * (Tf @ Ns_inv @ Tf.T)
+    if segments is not None:
+        scores = _row_scores(phi, S, residual / sigma ** 2, Tf)
+        cov_full = Tf @ Ns_inv @ long_run_covariance(scores, segments) @ Ns_inv @ Tf.T
+    else:
+        sigma2 = np.sum(residual ** 2, axis=0) / dof * (np.array([integrated_autocorrelation(
+            r) for r in residual.T]) if autocorrelated else 1.0)
+        cov_full = float(np.mean(sigma2 / sigma ** 2)) * (Tf @ Ns_inv @ Tf.T)
     std = np.sqrt(np.clip(np.diag(cov_full), 0.0, None))
     return LeastSquaresSolution(
         theta=theta, theta_std=std[:6 * p].reshape(6, p), shared=c, shared_std=std[6 * p:],
         condition_number=condition, residual_rms=np.sqrt(np.mean(residual ** 2, axis=0)),
         n_equations=K)
+
+
+def _row_scores(phi: np.ndarray, S: np.ndarray, weighted: np.ndarray, Tf: np.ndarray
+                ) -> np.ndarray:
+    """Per row, the gradient of its weighted squared residual in the solved unknowns: the
+    full unknowns' (channel i's coefficients w_i phi_k r_ki, the shared ones
+    sum_i w_i S_ksi r_ki) mapped by ``Tf``; ``weighted`` is r / sigma^2, shape (K, 6)."""
+    K, p = phi.shape
+    per_channel = (phi[:, None, :] * weighted[:, :, None]).reshape(K, 6 * p)
+    return np.concatenate([per_channel, np.einsum("ksi,ki->ks", S, weighted)], axis=1) @ Tf
+
+
+#: Length of the moving sums of :func:`long_run_covariance`, in correlation lengths.
+MOVING_SUM_LENGTHS = 4
+
+
+def long_run_covariance(scores: np.ndarray, segments: Sequence[tuple[int, int]]) -> np.ndarray:
+    """Sum over every lag of the autocovariances of a series of score vectors: the
+    covariance of their sum, for a sandwich A^-1 B A^-1.
+
+    Within each record (no lag crosses two), B is the Bartlett estimate: the second moment of
+    moving sums of m = :data:`MOVING_SUM_LENGTHS` correlation lengths, divided by m (lag l
+    weighted 1 - |l| / m; positive semidefinite by construction). Unlike an autocorrelation
+    time summed up to its first non-positive value, it keeps the negative lobes a high-pass
+    residual has (pose noise through differentiated rates and accelerations) and the
+    correlation of a residual with the regressors (model error), which both change the
+    estimate's variance. The sums start every m / 8 rows: neighbouring ones share seven
+    eighths of their terms.
+
+    Parameters
+    ----------
+    scores : ndarray, shape (K, n)
+        Per row, the gradient of its weighted squared residual in the unknowns.
+    segments : sequence of (int, int)
+        Rows of each record (summing to K) and its correlation length (rows).
+
+    Returns
+    -------
+    ndarray, shape (n, n)
+    """
+    B = np.zeros((scores.shape[1],) * 2)
+    start = 0
+    for rows, length in segments:
+        part = scores[start:start + rows]
+        start += rows
+        m = int(min(max(1, MOVING_SUM_LENGTHS * length), rows))
+        cumulative = np.concatenate([np.zeros((1, part.shape[1])), np.cumsum(part, axis=0)])
+        stride = max(1, m // 8)
+        sums = cumulative[m::stride] - cumulative[:rows - m + 1:stride]
+        # each sum stands for `stride` starting rows; the record's rows / (rows - m + 1)
+        # restores the starts the edges lack
+        B += (sums.T @ sums) * stride / m * rows / (rows - m + 1)
+    return B
 
 
 def integrated_autocorrelation(x: np.ndarray, max_lag: int | None = None) -> float:
@@ -364,6 +423,7 @@ def bias_compensated_least_squares(phi: np.ndarray, target: np.ndarray, cluster:
 
 
 __all__ = [
+    "MOVING_SUM_LENGTHS", "long_run_covariance",
     "LeastSquaresSolution",
     "bias_compensated_least_squares",
     "check_rank",
