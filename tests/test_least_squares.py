@@ -11,7 +11,11 @@ from stewartid.identification.least_squares import (
     LeastSquaresIdentifier,
     coulomb_regressors,
 )
-from stewartid.identification.solvers import integrated_autocorrelation, solve_least_squares
+from stewartid.identification.solvers import (
+    integrated_autocorrelation,
+    long_run_covariance,
+    solve_least_squares,
+)
 from stewartid.model.joints import JOINT_TYPES
 
 
@@ -113,6 +117,49 @@ def test_autocorrelated_standard_errors_match_monte_carlo():
             out.append((sol.theta - theta) / sol.theta_std)
     assert np.std(honest) == pytest.approx(1.0, abs=0.1)
     assert np.std(white) == pytest.approx(3.0, rel=0.15)
+
+
+def test_long_run_covariance_of_moving_average_and_high_pass_noise():
+    """The long-run variance (the sum of every autocovariance) of white noise of unit
+    variance through a filter h is (sum h)^2: 1 for a moving average of 20 samples (whose
+    variance is 1/20), 0 for a first difference (whose variance is 2, with no positive
+    autocorrelation for an autocorrelation time to add). Both are correlated over 20 lags
+    at most, where the sum is truncated without bias; its relative sampling error is about
+    sqrt(2 (2 L + 1) / K) = 2 % (L = 20, K = 200 000): 0.1 is five of them."""
+    rng = np.random.default_rng(11)
+    white = rng.normal(size=200_020)
+    average = np.convolve(white, np.ones(20) / 20, mode="valid")[:200_000]
+    difference = np.diff(white)[:200_000]
+    for series, expected in ((average, 1.0), (difference, 0.0)):
+        B = long_run_covariance(series[:, None], [(len(series), 20)])[0, 0] / len(series)
+        assert B == pytest.approx(expected, abs=0.1)
+    # two records: no lag crosses them, and their sums add
+    halves = long_run_covariance(average[:, None], [(100_000, 20)] * 2)[0, 0] / len(average)
+    assert halves == pytest.approx(1.0, abs=0.1)
+
+
+def test_score_standard_errors_count_a_high_pass_residual_right():
+    """Residual = AR(1) (rho 0.8, long-run variance 9) plus a first difference of white noise
+    of variance 9 (long-run variance 0, but 18 of variance and a negative lag-one
+    autocorrelation): slow regressors see only the first. The autocorrelation time stops at
+    the negative lag and counts the variance, 19: standard errors sqrt(19/9) = 1.45 times
+    the scatter over 60 records; the scores' long-run covariance matches it (within the
+    Monte Carlo's 10 %; truncating the AR(1)'s autocovariances at 25 lags leaves out
+    0.3 % of its long-run variance)."""
+    rng = np.random.default_rng(12)
+    k = np.arange(4000)
+    phi = np.column_stack([np.sin(2 * np.pi * k / period + period)
+                           for period in np.geomspace(80, 400, 12)] + [np.ones(len(k))])
+    theta = rng.normal(size=(6, 13))
+    scores, times = [], []
+    for _ in range(60):
+        y = phi @ theta.T + _ar1(rng, 0.8, (len(k), 6)) + 3 * np.diff(
+            rng.normal(size=(len(k) + 1, 6)), axis=0)
+        for segments, out in (([(len(k), 25)], scores), (None, times)):
+            sol = solve_least_squares(phi, y, autocorrelated=True, segments=segments)
+            out.append((sol.theta - theta) / sol.theta_std)
+    assert np.std(scores) == pytest.approx(1.0, abs=0.1)
+    assert np.std(times) == pytest.approx(1 / 1.45, rel=0.12)
 
 
 @pytest.mark.slow

@@ -287,29 +287,26 @@ def _row_scores(phi: np.ndarray, S: np.ndarray, weighted: np.ndarray, Tf: np.nda
     return np.concatenate([per_channel, np.einsum("ksi,ki->ks", S, weighted)], axis=1) @ Tf
 
 
-#: Length of the moving sums of :func:`long_run_covariance`, in correlation lengths.
-MOVING_SUM_LENGTHS = 4
-
-
 def long_run_covariance(scores: np.ndarray, segments: Sequence[tuple[int, int]]) -> np.ndarray:
-    """Sum over every lag of the autocovariances of a series of score vectors: the
-    covariance of their sum, for a sandwich A^-1 B A^-1.
+    """Sum of the autocovariances of a series of score vectors over every lag up to each
+    record's correlation length: the covariance of their sum, for a sandwich A^-1 B A^-1.
 
-    Within each record (no lag crosses two), B is the Bartlett estimate: the second moment of
-    moving sums of m = :data:`MOVING_SUM_LENGTHS` correlation lengths, divided by m (lag l
-    weighted 1 - |l| / m; positive semidefinite by construction). Unlike an autocorrelation
-    time summed up to its first non-positive value, it keeps the negative lobes a high-pass
-    residual has (pose noise through differentiated rates and accelerations) and the
-    correlation of a residual with the regressors (model error), which both change the
-    estimate's variance. The sums start every m / 8 rows: neighbouring ones share seven
-    eighths of their terms.
+    Filtered white noise is correlated over the filter's support only, so the sum truncated
+    there (uniform weights, no lag crossing two records) is unbiased; it is computed as
+    sum_k s_k w_k^T with w_k the sum of s over the lags within reach of k (one cumulative
+    sum), symmetrized, and negative eigenvalues, which only its sampling error can give, are
+    set to zero. Unlike an autocorrelation time summed up to its first non-positive value, it
+    keeps the negative lobes a high-pass residual has (pose noise through differentiated
+    rates and accelerations) and the correlation of a residual with the regressors (model
+    error), both of which change the estimate's variance.
 
     Parameters
     ----------
     scores : ndarray, shape (K, n)
         Per row, the gradient of its weighted squared residual in the unknowns.
     segments : sequence of (int, int)
-        Rows of each record (summing to K) and its correlation length (rows).
+        Rows of each record (summing to K) and its correlation length L (rows): rows L or
+        more apart are uncorrelated.
 
     Returns
     -------
@@ -320,14 +317,15 @@ def long_run_covariance(scores: np.ndarray, segments: Sequence[tuple[int, int]])
     for rows, length in segments:
         part = scores[start:start + rows]
         start += rows
-        m = int(min(max(1, MOVING_SUM_LENGTHS * length), rows))
+        reach = int(min(max(length - 1, 0), rows - 1))
         cumulative = np.concatenate([np.zeros((1, part.shape[1])), np.cumsum(part, axis=0)])
-        stride = max(1, m // 8)
-        sums = cumulative[m::stride] - cumulative[:rows - m + 1:stride]
-        # each sum stands for `stride` starting rows; the record's rows / (rows - m + 1)
-        # restores the starts the edges lack
-        B += (sums.T @ sums) * stride / m * rows / (rows - m + 1)
-    return B
+        k = np.arange(rows)
+        window = (cumulative[np.minimum(k + reach + 1, rows)]
+                  - cumulative[np.maximum(k - reach, 0)])
+        B += part.T @ window
+    B = 0.5 * (B + B.T)
+    values, vectors = np.linalg.eigh(B)
+    return (vectors * np.clip(values, 0.0, None)) @ vectors.T
 
 
 def integrated_autocorrelation(x: np.ndarray, max_lag: int | None = None) -> float:
@@ -423,7 +421,7 @@ def bias_compensated_least_squares(phi: np.ndarray, target: np.ndarray, cluster:
 
 
 __all__ = [
-    "MOVING_SUM_LENGTHS", "long_run_covariance",
+    "long_run_covariance",
     "LeastSquaresSolution",
     "bias_compensated_least_squares",
     "check_rank",
