@@ -138,28 +138,29 @@ def test_long_run_covariance_of_moving_average_and_high_pass_noise():
     assert halves == pytest.approx(1.0, abs=0.1)
 
 
-def test_score_standard_errors_count_a_high_pass_residual_right():
-    """Residual = AR(1) (rho 0.8, long-run variance 9) plus a first difference of white noise
-    of variance 9 (long-run variance 0, but 18 of variance and a negative lag-one
-    autocorrelation): slow regressors see only the first. The autocorrelation time stops at
-    the negative lag and counts the variance, 19: standard errors sqrt(19/9) = 1.45 times
-    the scatter over 60 records; the scores' long-run covariance matches it (within the
-    Monte Carlo's 10 %; truncating the AR(1)'s autocovariances at 25 lags leaves out
-    0.3 % of its long-run variance)."""
+def test_standard_errors_with_a_high_pass_residual_are_never_too_small():
+    """Residual = AR(1) (long-run variance (1 + rho) / (1 - rho)) plus a first difference of
+    white noise (long-run variance 0, but variance and a negative lag-one autocorrelation):
+    slow regressors see only the first. The autocorrelation time stops at the negative lag
+    and counts the variance instead: with rho 0.9 and a difference of variance 8 it counts
+    9 where the truth is 19 (standard errors sqrt(19/9) = 1.45 times too small); the scores'
+    long-run covariance gets 19, and the larger of the two is reported (scatter / SE within
+    the Monte Carlo's 10 % of 1). With rho 0.8 and a difference of variance 18, the time
+    counts 19 where the truth is 9: the reported errors are 1.45 times too large, never too
+    small."""
     rng = np.random.default_rng(12)
     k = np.arange(4000)
     phi = np.column_stack([np.sin(2 * np.pi * k / period + period)
                            for period in np.geomspace(80, 400, 12)] + [np.ones(len(k))])
     theta = rng.normal(size=(6, 13))
-    scores, times = [], []
-    for _ in range(60):
-        y = phi @ theta.T + _ar1(rng, 0.8, (len(k), 6)) + 3 * np.diff(
-            rng.normal(size=(len(k) + 1, 6)), axis=0)
-        for segments, out in (([(len(k), 25)], scores), (None, times)):
-            sol = solve_least_squares(phi, y, autocorrelated=True, segments=segments)
-            out.append((sol.theta - theta) / sol.theta_std)
-    assert np.std(scores) == pytest.approx(1.0, abs=0.1)
-    assert np.std(times) == pytest.approx(1 / 1.45, rel=0.12)
+    for rho, difference, expected in ((0.9, 2.0, 1.0), (0.8, 3.0, 1 / 1.45)):
+        z = []
+        for _ in range(60):
+            y = phi @ theta.T + _ar1(rng, rho, (len(k), 6)) + difference * np.diff(
+                rng.normal(size=(len(k) + 1, 6)), axis=0)
+            sol = solve_least_squares(phi, y, autocorrelated=True, segments=[(len(k), 60)])
+            z.append((sol.theta - theta) / sol.theta_std)
+        assert np.std(z) == pytest.approx(expected, rel=0.1)
 
 
 @pytest.mark.slow

@@ -36,6 +36,7 @@ from stewartid.identification.consistency import (
 from stewartid.identification.solvers import (
     integrated_autocorrelation,
     long_run_covariance,
+    with_larger_variances,
 )
 from stewartid.model.regressor import BODY_PARAMETERS, pseudo_inertia
 
@@ -127,10 +128,12 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
         Per channel, the expected share of X^T y that the same noise adds (when y holds
         regressor columns too, as a known part moved to the left-hand side): subtracted.
     segments : list of (int, int), optional
-        Per record, its number of rows and the lag (rows) beyond which its residual is
-        uncorrelated (the filter's support). Given, the covariance of the estimated
-        parameters is that of their scores (:func:`score_covariance`); else the residual's
-        variance and autocorrelation time per channel scale the inverse normal matrix.
+        Per record, its number of rows and the lag (rows) beyond which its noise is
+        uncorrelated (the filter's support). Given, each variance is the larger of that of
+        the parameters' scores (:func:`score_covariance`) and the inverse normal matrix
+        scaled by the residual's variance and autocorrelation time per channel (alone
+        without ``segments``), as in
+        :func:`~stewartid.identification.solvers.solve_least_squares`.
 
     Returns
     -------
@@ -183,8 +186,10 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
         sigma = np.sqrt(np.sum(residual ** 2, axis=0) / len(y))
         weights = 1.0 / np.maximum(sigma, 1e-12 * scale_y) ** 2
     covariance = np.zeros((p, p))
-    covariance[np.ix_(free, free)] = (inverse * variance if segments is None else score_covariance(
-        inverse, X[:, :, free], residual, weights, segments))
+    covariance[np.ix_(free, free)] = (inverse * variance if segments is None else
+                                      with_larger_variances(score_covariance(
+                                          inverse, X[:, :, free], residual, weights,
+                                          segments), inverse * variance))
     return Solution(values, covariance, fixed, condition, singular_all,
                     np.sqrt(np.mean(residual ** 2, axis=0)), len(y))
 

@@ -183,9 +183,12 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
         (errors in variables; the noise is taken independent of the targets' noise).
     segments : sequence of (int, int), optional
         The rows as consecutive records: each one's number of rows and its correlation
-        length (rows beyond which its residual is uncorrelated: the filter's support).
-        Given, the covariance is the sandwich of the unknowns' scores
-        (:func:`long_run_covariance`) instead of ``autocorrelated``'s scaled inverse.
+        length (rows beyond which its noise is uncorrelated: the filter's support). Given,
+        the covariance is also the sandwich of the unknowns' scores
+        (:func:`long_run_covariance`) and each variance the larger of the two
+        (:func:`with_larger_variances`): the sandwich counts the residual where the
+        regressors are (a high-pass residual adds little), the autocorrelation time counts
+        correlation beyond the filter's support (model error, periodic with the motion).
 
     Returns
     -------
@@ -263,13 +266,13 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
     sigma = np.maximum(sigma, 1e-12 * scale_y)
     theta, c, residual, N, Tf, condition, scale = solve(1.0 / sigma ** 2)
     Ns_inv = np.linalg.inv(N / np.outer(scale, scale)) / np.outer(scale, scale)
+    sigma2 = np.sum(residual ** 2, axis=0) / dof * (np.array([integrated_autocorrelation(
+        r) for r in residual.T]) if autocorrelated else 1.0)
+    cov_full = float(np.mean(sigma2 / sigma ** 2)) * (Tf @ Ns_inv @ Tf.T)
     if segments is not None:
         scores = _row_scores(phi, S, residual / sigma ** 2, Tf)
-        cov_full = Tf @ Ns_inv @ long_run_covariance(scores, segments) @ Ns_inv @ Tf.T
-    else:
-        sigma2 = np.sum(residual ** 2, axis=0) / dof * (np.array([integrated_autocorrelation(
-            r) for r in residual.T]) if autocorrelated else 1.0)
-        cov_full = float(np.mean(sigma2 / sigma ** 2)) * (Tf @ Ns_inv @ Tf.T)
+        cov_full = with_larger_variances(
+            Tf @ Ns_inv @ long_run_covariance(scores, segments) @ Ns_inv @ Tf.T, cov_full)
     std = np.sqrt(np.clip(np.diag(cov_full), 0.0, None))
     return LeastSquaresSolution(
         theta=theta, theta_std=std[:6 * p].reshape(6, p), shared=c, shared_std=std[6 * p:],
@@ -285,6 +288,26 @@ def _row_scores(phi: np.ndarray, S: np.ndarray, weighted: np.ndarray, Tf: np.nda
     K, p = phi.shape
     per_channel = (phi[:, None, :] * weighted[:, :, None]).reshape(K, 6 * p)
     return np.concatenate([per_channel, np.einsum("ksi,ki->ks", S, weighted)], axis=1) @ Tf
+
+
+def with_larger_variances(covariance: np.ndarray, other: np.ndarray) -> np.ndarray:
+    """``covariance`` with each variance raised to ``other``'s where that is larger, its
+    correlations kept: the more cautious of two standard errors, each honest under its own
+    assumption about the residual.
+
+    Parameters
+    ----------
+    covariance, other : ndarray, shape (n, n)
+
+    Returns
+    -------
+    ndarray, shape (n, n)
+    """
+    own = np.sqrt(np.clip(np.diag(covariance), 0.0, None))
+    larger = np.maximum(own, np.sqrt(np.clip(np.diag(other), 0.0, None)))
+    factor = np.where(own > 0, larger / np.where(own > 0, own, 1.0), 1.0)
+    out = covariance * np.outer(factor, factor)
+    return out + np.diag(np.where(own > 0, 0.0, larger ** 2))
 
 
 def long_run_covariance(scores: np.ndarray, segments: Sequence[tuple[int, int]]) -> np.ndarray:
@@ -422,6 +445,7 @@ def bias_compensated_least_squares(phi: np.ndarray, target: np.ndarray, cluster:
 
 __all__ = [
     "long_run_covariance",
+    "with_larger_variances",
     "LeastSquaresSolution",
     "bias_compensated_least_squares",
     "check_rank",
