@@ -9,9 +9,10 @@ with y = J_lq^T f_a - G(q), c_e a constant per channel and experiment (residual 
 force-sensor offsets), J_j the joint-rate Jacobian of joint axis j at the measured pose, and
 one Coulomb level per joint type (lower gimbal, upper gimbal, revolute). The 72 entries of Mt
 and Bt, the offsets and the three Coulomb levels are solved together by
-:func:`~stewartid.identification.solvers.solve_least_squares`, the standard errors the
-sandwich of the rows' scores with their autocovariances summed over the filter's support
-(:func:`~stewartid.identification.solvers.long_run_covariance`).
+:func:`~stewartid.identification.solvers.solve_least_squares`, each standard error the
+larger of the sandwich of the rows' scores with their autocovariances summed over the
+filter's support (:func:`~stewartid.identification.solvers.long_run_covariance`) and the
+residual's variance times its autocorrelation time.
 
 By default (``differentiation="kernel"``) both sides of the equation are filtered with one
 smooth compact kernel h (:func:`~stewartid.signals.differentiation.kernel_filter`): velocity and

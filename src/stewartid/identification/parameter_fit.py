@@ -3,9 +3,10 @@ values, and the physically consistent parameters nearest to them: the solvers of
 :mod:`stewartid.identification.physical`.
 
 Channels (forces and moments, in different units) are weighted by their residual variance
-(feasible generalized least squares); the standard errors are the sandwich of the rows'
-scores summed over the filters' correlation length
-(:func:`~stewartid.identification.solvers.long_run_covariance`), as the least squares' are.
+(feasible generalized least squares); each standard error is the larger of the sandwich of
+the rows' scores summed over the filters' correlation length
+(:func:`~stewartid.identification.solvers.long_run_covariance`) and the residual's variance
+times its autocorrelation time, as the least squares' are.
 
 :func:`nearest_consistent` projects the estimate onto the physically consistent set in the
 metric of its covariance,
