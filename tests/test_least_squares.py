@@ -11,11 +11,8 @@ from stewartid.identification.least_squares import (
     LeastSquaresIdentifier,
     coulomb_regressors,
 )
-from stewartid.identification.solvers import (
-    integrated_autocorrelation,
-    long_run_covariance,
-    solve_least_squares,
-)
+from stewartid.identification.long_run import long_run_covariance
+from stewartid.identification.solvers import integrated_autocorrelation, solve_least_squares
 from stewartid.model.joints import JOINT_TYPES
 
 

@@ -11,7 +11,7 @@ one Coulomb level per joint type (lower gimbal, upper gimbal, revolute). The 72 
 and Bt, the offsets and the three Coulomb levels are solved together by
 :func:`~stewartid.identification.solvers.solve_least_squares`, each standard error the
 larger of the sandwich of the rows' scores with their autocovariances summed over the
-filter's support (:func:`~stewartid.identification.solvers.long_run_covariance`) and the
+filter's support (:func:`~stewartid.identification.long_run.long_run_covariance`) and the
 residual's variance times its autocorrelation time.
 
 By default (``differentiation="kernel"``) both sides of the equation are filtered with one

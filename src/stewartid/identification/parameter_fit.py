@@ -5,7 +5,7 @@ values, and the physically consistent parameters nearest to them: the solvers of
 Channels (forces and moments, in different units) are weighted by their residual variance
 (feasible generalized least squares); each standard error is the larger of the sandwich of
 the rows' scores summed over the filters' correlation length
-(:func:`~stewartid.identification.solvers.long_run_covariance`) and the residual's variance
+(:func:`~stewartid.identification.long_run.long_run_covariance`) and the residual's variance
 times its autocorrelation time, as the least squares' are.
 
 :func:`nearest_consistent` projects the estimate onto the physically consistent set in the
@@ -34,11 +34,8 @@ from stewartid.identification.consistency import (
     require_cvxpy,
     solve_convex,
 )
-from stewartid.identification.solvers import (
-    integrated_autocorrelation,
-    long_run_covariance,
-    with_larger_variances,
-)
+from stewartid.identification.long_run import long_run_covariance, with_larger_variances
+from stewartid.identification.solvers import integrated_autocorrelation
 from stewartid.model.regressor import BODY_PARAMETERS, pseudo_inertia
 
 #: Weighted column norm, relative to the largest, below which a parameter counts as not
@@ -253,7 +250,7 @@ class ConsistentParameters:
 def score_covariance(inverse: np.ndarray, X: np.ndarray, residual: np.ndarray,
                      weights: np.ndarray, segments: list[tuple[int, int]]) -> np.ndarray:
     """N^-1 B N^-1, B the long-run covariance of the scores s_k = sum_c w_c X_kc r_kc
-    (:func:`~stewartid.identification.solvers.long_run_covariance`).
+    (:func:`~stewartid.identification.long_run.long_run_covariance`).
 
     The residual of filtered rows is correlated over the filter's support, and where pose
     noise reaches it through differentiated rates and accelerations it is high-pass: its

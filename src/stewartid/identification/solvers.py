@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from stewartid.errors import IdentificationError
+from stewartid.identification.long_run import long_run_covariance, with_larger_variances
 from stewartid.platform import COORDINATES
 
 
@@ -185,10 +186,12 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
         The rows as consecutive records: each one's number of rows and its correlation
         length (rows beyond which its noise is uncorrelated: the filter's support). Given,
         the covariance is also the sandwich of the unknowns' scores
-        (:func:`long_run_covariance`) and each variance the larger of the two
-        (:func:`with_larger_variances`): the sandwich counts the residual where the
-        regressors are (a high-pass residual adds little), the autocorrelation time counts
-        correlation beyond the filter's support (model error, periodic with the motion).
+        (:func:`~stewartid.identification.long_run.long_run_covariance`) and each variance
+        the larger of the two
+        (:func:`~stewartid.identification.long_run.with_larger_variances`): the sandwich
+        counts the residual where the regressors are (a high-pass residual adds little),
+        the autocorrelation time counts correlation beyond the filter's support (model
+        error, periodic with the motion).
 
     Returns
     -------
@@ -290,67 +293,6 @@ def _row_scores(phi: np.ndarray, S: np.ndarray, weighted: np.ndarray, Tf: np.nda
     return np.concatenate([per_channel, np.einsum("ksi,ki->ks", S, weighted)], axis=1) @ Tf
 
 
-def with_larger_variances(covariance: np.ndarray, other: np.ndarray) -> np.ndarray:
-    """``covariance`` with each variance raised to ``other``'s where that is larger, its
-    correlations kept: the more cautious of two standard errors, each honest under its own
-    assumption about the residual.
-
-    Parameters
-    ----------
-    covariance, other : ndarray, shape (n, n)
-
-    Returns
-    -------
-    ndarray, shape (n, n)
-    """
-    own = np.sqrt(np.clip(np.diag(covariance), 0.0, None))
-    larger = np.maximum(own, np.sqrt(np.clip(np.diag(other), 0.0, None)))
-    factor = np.where(own > 0, larger / np.where(own > 0, own, 1.0), 1.0)
-    out = covariance * np.outer(factor, factor)
-    return out + np.diag(np.where(own > 0, 0.0, larger ** 2))
-
-
-def long_run_covariance(scores: np.ndarray, segments: Sequence[tuple[int, int]]) -> np.ndarray:
-    """Sum of the autocovariances of a series of score vectors over every lag up to each
-    record's correlation length: the covariance of their sum, for a sandwich A^-1 B A^-1.
-
-    Filtered white noise is correlated over the filter's support only, so the sum truncated
-    there (uniform weights, no lag crossing two records) is unbiased; it is computed as
-    sum_k s_k w_k^T with w_k the sum of s over the lags within reach of k (one cumulative
-    sum), symmetrized, and negative eigenvalues, which only its sampling error can give, are
-    set to zero. Unlike an autocorrelation time summed up to its first non-positive value, it
-    keeps the negative lobes a high-pass residual has (pose noise through differentiated
-    rates and accelerations) and the correlation of a residual with the regressors (model
-    error), both of which change the estimate's variance.
-
-    Parameters
-    ----------
-    scores : ndarray, shape (K, n)
-        Per row, the gradient of its weighted squared residual in the unknowns.
-    segments : sequence of (int, int)
-        Rows of each record (summing to K) and its correlation length L (rows): rows L or
-        more apart are uncorrelated.
-
-    Returns
-    -------
-    ndarray, shape (n, n)
-    """
-    B = np.zeros((scores.shape[1],) * 2)
-    start = 0
-    for rows, length in segments:
-        part = scores[start:start + rows]
-        start += rows
-        reach = int(min(max(length - 1, 0), rows - 1))
-        cumulative = np.concatenate([np.zeros((1, part.shape[1])), np.cumsum(part, axis=0)])
-        k = np.arange(rows)
-        window = (cumulative[np.minimum(k + reach + 1, rows)]
-                  - cumulative[np.maximum(k - reach, 0)])
-        B += part.T @ window
-    B = 0.5 * (B + B.T)
-    values, vectors = np.linalg.eigh(B)
-    return (vectors * np.clip(values, 0.0, None)) @ vectors.T
-
-
 def integrated_autocorrelation(x: np.ndarray, max_lag: int | None = None) -> float:
     """Integrated autocorrelation time tau = 1 + 2 sum_{k>=1} rho_k of a series (samples).
 
@@ -444,8 +386,6 @@ def bias_compensated_least_squares(phi: np.ndarray, target: np.ndarray, cluster:
 
 
 __all__ = [
-    "long_run_covariance",
-    "with_larger_variances",
     "LeastSquaresSolution",
     "bias_compensated_least_squares",
     "check_rank",

@@ -1,0 +1,78 @@
+"""Covariance of an estimate from correlated residuals: the long-run covariance of its
+scores, and the more cautious of two covariances.
+
+An estimate solving sum_k s_k(theta) = 0 has, to first order, the covariance
+A^-1 B A^-1 with A the Jacobian of the summed scores and B the covariance of their sum.
+Filtered signals make the rows' residuals correlated over the filter's support, so B sums
+the scores' autocovariances over those lags (:func:`long_run_covariance`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+
+def with_larger_variances(covariance: np.ndarray, other: np.ndarray) -> np.ndarray:
+    """``covariance`` with each variance raised to ``other``'s where that is larger, its
+    correlations kept: the more cautious of two standard errors, each honest under its own
+    assumption about the residual.
+
+    Parameters
+    ----------
+    covariance, other : ndarray, shape (n, n)
+
+    Returns
+    -------
+    ndarray, shape (n, n)
+    """
+    own = np.sqrt(np.clip(np.diag(covariance), 0.0, None))
+    larger = np.maximum(own, np.sqrt(np.clip(np.diag(other), 0.0, None)))
+    factor = np.where(own > 0, larger / np.where(own > 0, own, 1.0), 1.0)
+    out = covariance * np.outer(factor, factor)
+    return out + np.diag(np.where(own > 0, 0.0, larger ** 2))
+
+
+def long_run_covariance(scores: np.ndarray, segments: Sequence[tuple[int, int]]) -> np.ndarray:
+    """Sum of the autocovariances of a series of score vectors over every lag up to each
+    record's correlation length: the covariance of their sum, for a sandwich A^-1 B A^-1.
+
+    Filtered white noise is correlated over the filter's support only, so the sum truncated
+    there (uniform weights, no lag crossing two records) is unbiased; it is computed as
+    sum_k s_k w_k^T with w_k the sum of s over the lags within reach of k (one cumulative
+    sum), symmetrized, and negative eigenvalues, which only its sampling error can give, are
+    set to zero. Unlike an autocorrelation time summed up to its first non-positive value, it
+    keeps the negative lobes a high-pass residual has (pose noise through differentiated
+    rates and accelerations) and the correlation of a residual with the regressors (model
+    error), both of which change the estimate's variance.
+
+    Parameters
+    ----------
+    scores : ndarray, shape (K, n)
+        Per row, the gradient of its weighted squared residual in the unknowns.
+    segments : sequence of (int, int)
+        Rows of each record (summing to K) and its correlation length L (rows): rows L or
+        more apart are uncorrelated.
+
+    Returns
+    -------
+    ndarray, shape (n, n)
+    """
+    B = np.zeros((scores.shape[1],) * 2)
+    start = 0
+    for rows, length in segments:
+        part = scores[start:start + rows]
+        start += rows
+        reach = int(min(max(length - 1, 0), rows - 1))
+        cumulative = np.concatenate([np.zeros((1, part.shape[1])), np.cumsum(part, axis=0)])
+        k = np.arange(rows)
+        window = (cumulative[np.minimum(k + reach + 1, rows)]
+                  - cumulative[np.maximum(k - reach, 0)])
+        B += part.T @ window
+    B = 0.5 * (B + B.T)
+    values, vectors = np.linalg.eigh(B)
+    return (vectors * np.clip(values, 0.0, None)) @ vectors.T
+
+
+__all__ = ["long_run_covariance", "with_larger_variances"]
