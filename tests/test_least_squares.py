@@ -130,6 +130,9 @@ def test_long_run_covariance_of_moving_average_and_high_pass_noise():
     for series, expected in ((average, 1.0), (difference, 0.0)):
         B = long_run_covariance(series[:, None], [(len(series), 20)])[0, 0] / len(series)
         assert B == pytest.approx(expected, abs=0.1)
+    # products at every fourth row only: the moving average varies slowly against it
+    strided = long_run_covariance(average[:, None], [(len(average), 20)], stride=4)
+    assert strided[0, 0] / len(average) == pytest.approx(1.0, abs=0.1)
     # two records: no lag crosses them, and their sums add
     halves = long_run_covariance(average[:, None], [(100_000, 20)] * 2)[0, 0] / len(average)
     assert halves == pytest.approx(1.0, abs=0.1)

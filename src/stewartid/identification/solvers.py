@@ -273,9 +273,8 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
         r) for r in residual.T]) if autocorrelated else 1.0)
     cov_full = float(np.mean(sigma2 / sigma ** 2)) * (Tf @ Ns_inv @ Tf.T)
     if segments is not None:
-        scores = _row_scores(phi, S, residual / sigma ** 2, Tf)
-        cov_full = with_larger_variances(
-            Tf @ Ns_inv @ long_run_covariance(scores, segments) @ Ns_inv @ Tf.T, cov_full)
+        cov_full = with_larger_variances(_score_sandwich(
+            _row_scores(phi, S, residual / sigma ** 2), segments, Tf, Ns_inv), cov_full)
     std = np.sqrt(np.clip(np.diag(cov_full), 0.0, None))
     return LeastSquaresSolution(
         theta=theta, theta_std=std[:6 * p].reshape(6, p), shared=c, shared_std=std[6 * p:],
@@ -283,14 +282,23 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
         n_equations=K)
 
 
-def _row_scores(phi: np.ndarray, S: np.ndarray, weighted: np.ndarray, Tf: np.ndarray
-                ) -> np.ndarray:
-    """Per row, the gradient of its weighted squared residual in the solved unknowns: the
-    full unknowns' (channel i's coefficients w_i phi_k r_ki, the shared ones
-    sum_i w_i S_ksi r_ki) mapped by ``Tf``; ``weighted`` is r / sigma^2, shape (K, 6)."""
+def _score_sandwich(scores: np.ndarray, segments: Sequence[tuple[int, int]], Tf: np.ndarray,
+                    inverse: np.ndarray) -> np.ndarray:
+    """Tf N^-1 Tf^T B Tf N^-1 Tf^T: the full unknowns' covariance from their scores' long-run
+    covariance B, the outer products taken a sixteenth of a correlation length apart
+    (filtered rows vary slowly) and mapped to the solved unknowns by ``Tf``."""
+    stride = max(1, min(length for _, length in segments) // 16)
+    B = Tf.T @ long_run_covariance(scores, segments, stride) @ Tf
+    return Tf @ inverse @ B @ inverse @ Tf.T
+
+
+def _row_scores(phi: np.ndarray, S: np.ndarray, weighted: np.ndarray) -> np.ndarray:
+    """Per row, the gradient of its weighted squared residual in the full unknowns: channel
+    i's coefficients w_i phi_k r_ki, the shared ones sum_i w_i S_ksi r_ki; ``weighted`` is
+    r / sigma^2, shape (K, 6)."""
     K, p = phi.shape
     per_channel = (phi[:, None, :] * weighted[:, :, None]).reshape(K, 6 * p)
-    return np.concatenate([per_channel, np.einsum("ksi,ki->ks", S, weighted)], axis=1) @ Tf
+    return np.concatenate([per_channel, np.einsum("ksi,ki->ks", S, weighted)], axis=1)
 
 
 def integrated_autocorrelation(x: np.ndarray, max_lag: int | None = None) -> float:
