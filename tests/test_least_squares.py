@@ -11,7 +11,7 @@ from stewartid.identification.least_squares import (
     LeastSquaresIdentifier,
     coulomb_regressors,
 )
-from stewartid.identification.long_run import long_run_covariance
+from stewartid.identification.long_run import long_run_covariance, with_larger_variances
 from stewartid.identification.solvers import integrated_autocorrelation, solve_least_squares
 from stewartid.model.joints import JOINT_TYPES
 
@@ -136,6 +136,15 @@ def test_long_run_covariance_of_moving_average_and_high_pass_noise():
     # two records: no lag crosses them, and their sums add
     halves = long_run_covariance(average[:, None], [(100_000, 20)] * 2)[0, 0] / len(average)
     assert halves == pytest.approx(1.0, abs=0.1)
+
+
+def test_the_larger_variances_keep_the_first_covariance_correlations():
+    """Worked by hand: variances (4, 1, 0) against (1, 9, 2.25) give (4, 9, 2.25); the first
+    pair's correlation 0.5 stays, so their covariance becomes 0.5 * 2 * 3 = 3."""
+    first = np.array([[4.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 0.0, 0.0]])
+    other = np.diag([1.0, 9.0, 2.25])
+    expected = np.array([[4.0, 3.0, 0.0], [3.0, 9.0, 0.0], [0.0, 0.0, 2.25]])
+    np.testing.assert_allclose(with_larger_variances(first, other), expected, rtol=1e-12)
 
 
 def test_standard_errors_with_a_high_pass_residual_are_never_too_small():
