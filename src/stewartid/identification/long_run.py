@@ -80,4 +80,35 @@ def long_run_covariance(scores: np.ndarray, segments: Sequence[tuple[int, int]],
     return (vectors * np.clip(values, 0.0, None)) @ vectors.T
 
 
-__all__ = ["long_run_covariance", "with_larger_variances"]
+def score_sandwich(inverse: np.ndarray, scores: np.ndarray,
+                   segments: Sequence[tuple[int, int]], basis: np.ndarray | None = None
+                   ) -> np.ndarray:
+    """The covariance A^-1 B A^-1 of an estimate from its rows' scores: B their
+    :func:`long_run_covariance`, the outer products taken a sixteenth of the shortest
+    correlation length apart (filtered rows vary slowly; every row when the rows are already
+    that sparse).
+
+    Parameters
+    ----------
+    inverse : ndarray, shape (m, m)
+        A^-1, in the unknowns the estimate is solved for.
+    scores : ndarray, shape (K, n)
+        Per row, the gradient of its weighted squared residual (n = m, or in the unknowns
+        ``basis`` maps from).
+    segments : sequence of (int, int)
+        Rows of each record and its correlation length (rows).
+    basis : ndarray, shape (n, m), optional
+        Maps the solved unknowns to the scores' (B becomes basis^T B basis).
+
+    Returns
+    -------
+    ndarray, shape (m, m)
+    """
+    stride = max(1, min(length for _, length in segments) // 16)
+    B = long_run_covariance(scores, segments, stride)
+    if basis is not None:
+        B = basis.T @ B @ basis
+    return inverse @ B @ inverse
+
+
+__all__ = ["long_run_covariance", "score_sandwich", "with_larger_variances"]

@@ -34,7 +34,7 @@ from stewartid.identification.consistency import (
     require_cvxpy,
     solve_convex,
 )
-from stewartid.identification.long_run import long_run_covariance, with_larger_variances
+from stewartid.identification.long_run import score_sandwich, with_larger_variances
 from stewartid.identification.solvers import integrated_autocorrelation
 from stewartid.model.regressor import BODY_PARAMETERS, pseudo_inertia
 
@@ -184,10 +184,11 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
         sigma = np.sqrt(np.sum(residual ** 2, axis=0) / len(y))
         weights = 1.0 / np.maximum(sigma, 1e-12 * scale_y) ** 2
     covariance = np.zeros((p, p))
-    covariance[np.ix_(free, free)] = (inverse * variance if segments is None else
-                                      with_larger_variances(score_covariance(
-                                          inverse, X[:, :, free], residual, weights,
-                                          segments), inverse * variance))
+    solved = inverse * variance
+    if segments is not None:
+        solved = with_larger_variances(score_covariance(inverse, X[:, :, free], residual,
+                                                        weights, segments), solved)
+    covariance[np.ix_(free, free)] = solved
     return Solution(values, covariance, fixed, condition, singular_all,
                     np.sqrt(np.mean(residual ** 2, axis=0)), len(y))
 
@@ -250,7 +251,7 @@ class ConsistentParameters:
 def score_covariance(inverse: np.ndarray, X: np.ndarray, residual: np.ndarray,
                      weights: np.ndarray, segments: list[tuple[int, int]]) -> np.ndarray:
     """N^-1 B N^-1, B the long-run covariance of the scores s_k = sum_c w_c X_kc r_kc
-    (:func:`~stewartid.identification.long_run.long_run_covariance`).
+    (:func:`~stewartid.identification.long_run.score_sandwich`).
 
     The residual of filtered rows is correlated over the filter's support, and where pose
     noise reaches it through differentiated rates and accelerations it is high-pass: its
@@ -274,7 +275,7 @@ def score_covariance(inverse: np.ndarray, X: np.ndarray, residual: np.ndarray,
     ndarray, shape (p, p)
     """
     scores = np.einsum("kcp,kc->kp", X, residual * weights, optimize=True)
-    return inverse @ long_run_covariance(scores, segments) @ inverse
+    return score_sandwich(inverse, scores, segments)
 
 
 def nearest_consistent(values: np.ndarray, covariance: np.ndarray, bodies: list[Body],

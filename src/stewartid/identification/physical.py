@@ -385,5 +385,4 @@ def payload_section(parameters: dict[str, float]) -> dict[str, Any]:
 
 __all__ = ["NUISANCE_PARAMETERS", "PAYLOAD_PARAMETERS", "POSITIVE_PARAMETERS",
            "PhysicalIdentifier", "PhysicalResult", "correlation_segments", "known_platform",
-           "parameter_model",
-           "payload_section"]
+           "parameter_model", "payload_section"]

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from stewartid.errors import IdentificationError
-from stewartid.identification.long_run import long_run_covariance, with_larger_variances
+from stewartid.identification.long_run import score_sandwich, with_larger_variances
 from stewartid.platform import COORDINATES
 
 
@@ -186,7 +186,7 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
         The rows as consecutive records: each one's number of rows and its correlation
         length (rows beyond which its noise is uncorrelated: the filter's support). Given,
         the covariance is also the sandwich of the unknowns' scores
-        (:func:`~stewartid.identification.long_run.long_run_covariance`) and each variance
+        (:func:`~stewartid.identification.long_run.score_sandwich`) and each variance
         the larger of the two
         (:func:`~stewartid.identification.long_run.with_larger_variances`): the sandwich
         counts the residual where the regressors are (a high-pass residual adds little),
@@ -273,23 +273,13 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
         r) for r in residual.T]) if autocorrelated else 1.0)
     cov_full = float(np.mean(sigma2 / sigma ** 2)) * (Tf @ Ns_inv @ Tf.T)
     if segments is not None:
-        cov_full = with_larger_variances(_score_sandwich(
-            _row_scores(phi, S, residual / sigma ** 2), segments, Tf, Ns_inv), cov_full)
+        cov_full = with_larger_variances(Tf @ score_sandwich(
+            Ns_inv, _row_scores(phi, S, residual / sigma ** 2), segments, Tf) @ Tf.T, cov_full)
     std = np.sqrt(np.clip(np.diag(cov_full), 0.0, None))
     return LeastSquaresSolution(
         theta=theta, theta_std=std[:6 * p].reshape(6, p), shared=c, shared_std=std[6 * p:],
         condition_number=condition, residual_rms=np.sqrt(np.mean(residual ** 2, axis=0)),
         n_equations=K)
-
-
-def _score_sandwich(scores: np.ndarray, segments: Sequence[tuple[int, int]], Tf: np.ndarray,
-                    inverse: np.ndarray) -> np.ndarray:
-    """Tf N^-1 Tf^T B Tf N^-1 Tf^T: the full unknowns' covariance from their scores' long-run
-    covariance B, the outer products taken a sixteenth of a correlation length apart
-    (filtered rows vary slowly) and mapped to the solved unknowns by ``Tf``."""
-    stride = max(1, min(length for _, length in segments) // 16)
-    B = Tf.T @ long_run_covariance(scores, segments, stride) @ Tf
-    return Tf @ inverse @ B @ inverse @ Tf.T
 
 
 def _row_scores(phi: np.ndarray, S: np.ndarray, weighted: np.ndarray) -> np.ndarray:
