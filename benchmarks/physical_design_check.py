@@ -77,7 +77,7 @@ def main() -> None:
         estimates.append([fitted.parameters_[n] for n in prediction.names])
         rows.append(physical_study.payload_row(fitted, loaded, physical_study.PAYLOADS["paper"])
                     if args.payload else physical_study.full_row(
-                        fitted, loaded, records, np.random.default_rng(seed)))
+                        fitted, loaded, data, np.random.default_rng(seed)))
         print(seed, {k: round(v, 3) for k, v in rows[-1].items()
                      if isinstance(v, float)}, flush=True)
     spread = np.std(estimates, axis=0, ddof=1)

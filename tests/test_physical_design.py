@@ -11,9 +11,11 @@ from typer.testing import CliRunner
 
 from stewartid.cli.application import app
 from stewartid.datasets.dataset import Dataset
-from stewartid.design.information import predict_parameters
-from stewartid.design.multisine import MultisineRecord, all_dofs_multisine
+from stewartid.design.candidates import Design
+from stewartid.design.information import parameter_sizes, predict_parameters
+from stewartid.design.multisine import MultisineRecord, all_dofs_multisine, multisine_design
 from stewartid.design.physical_run import run_physical_design
+from stewartid.design.physical_search import commanded_limit_use, scale_to_limits
 from stewartid.identification.physical import PhysicalIdentifier
 from stewartid.model import regressor as reg
 from stewartid.model.kinematics import inverse_kinematics, leg_jacobian
@@ -71,6 +73,34 @@ def test_information_matrix_predicts_the_estimators_spread(loaded):
     # the 24 parameters within 30 %, every one within a factor 2
     assert 0.7 < np.median(ratio) < 1.3, ratio
     assert np.all((ratio > 0.5) & (ratio < 2.0)), dict(zip(predicted.names, ratio, strict=True))
+
+
+def test_every_record_is_scaled_to_its_own_limit(loaded):
+    """Records whose DOFs meet the pool's frequencies in another order reach the leg-speed
+    limit at different amplitudes: each is scaled until its own motion, judged alone, uses
+    the share asked for."""
+    design = multisine_design(40.0, [0.2, 0.002, 0.002, 0.002, 0.002, 0.002])
+    alone = [max(commanded_limit_use(loaded, Design((r,)))[0].peak.values())
+             for r in design.records]
+    assert abs(alone[0] / alone[1] - 1) > 0.1  # unequal before: one factor would not do
+    scaled = scale_to_limits(loaded, design, 0.8)[0]
+    for record in scaled.records:
+        peak = max(commanded_limit_use(loaded, Design((record,)))[0].peak.values())
+        assert peak == pytest.approx(0.8, rel=0.021)
+
+
+def test_parameter_sizes_are_those_of_the_vector_and_the_tensor():
+    """Worked by hand: mass 10 kg, first moment (3, -4, 0) kg m (length 5), inertia diagonal
+    (1, 2, 6) kg m^2 (mean 3); every component of a group is judged against one size, so
+    that turning the frame does not change the criterion. A centre of mass at the reference
+    point falls back to a tenth of the mass times the radius of gyration sqrt(1.5 * 3 / 10)."""
+    names = ("payload.m", "payload.mc_x", "payload.mc_y", "payload.mc_z", "payload.I_xx",
+             "payload.I_yy", "payload.I_zz", "payload.I_xy", "payload.I_xz", "payload.I_yz",
+             "viscous[actuator]")
+    nominal = np.array([10.0, 3.0, -4.0, 0.0, 1.0, 2.0, 6.0, 0.0, -0.5, 0.1, 50.0])
+    assert np.allclose(parameter_sizes(names, nominal), [10, 5, 5, 5, 3, 3, 3, 3, 3, 3, 0])
+    nominal[1:4] = 0.0
+    assert np.allclose(parameter_sizes(names, nominal)[1:4], 0.1 * 10 * np.sqrt(0.45))
 
 
 def test_physical_design_writes_commands_prediction_and_check(loaded, tmp_path):

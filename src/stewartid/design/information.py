@@ -1,14 +1,15 @@
 """Predicted standard errors of the physical model's parameters from the information matrix.
 
 The physical estimator (:class:`~stewartid.identification.physical.PhysicalIdentifier`)
-regresses the measured generalized force J_lq^T f on the regressor's columns,
-J_lq^T f = X theta + e, with each of the six channels weighted by its residual variance. The
-force noise (white, covariance Sigma_f per sample, ``force_noise`` of every leg) reaches the
-generalized force as S = J_lq^T Sigma_f J_lq. The estimator's covariance is the sandwich
+regresses the measured leg forces on the regressor's columns mapped to them,
+f = J_lq^-T X theta + e, with each leg's channel weighted by its residual variance. The force
+noise (white, ``force_noise`` of every leg, covariance S = Sigma_f per sample) is then that
+of the channels themselves. The estimator's covariance is the sandwich
 
     Cov(theta) = A^-1 B A^-1,   A = sum_k X_k^T W X_k,   B = sum_k X_k^T W S_k W X_k,
 
-W = diag(1 / mean_k S_k,cc) its channel weights, summed over the logged samples. The
+X_k the rows in leg forces and W = diag(1 / mean_k S_k,cc) its channel weights, summed over
+the logged samples (with legs alike, generalized least squares). The
 estimator filters both sides with a smooth kernel and keeps ``ROWS_PER_WINDOW`` rows per
 kernel window: the filtered noise is correlated over the window, and its sum over the kept
 rows is (to the kernel's attenuation of the motion, which is small in its pass band) the sum
@@ -26,9 +27,13 @@ the dominant frequency, about 0.2 s or more in the band of
 :func:`~stewartid.design.multisine.multisine_design`), but at 0.1 s it doubled the standard
 errors; the Monte Carlo check of the final design shows it.
 
-A relative standard error is judged against a parameter's size: its nominal magnitude, at
-least a tenth of its group's scale for the first moments (mass times the radius of gyration)
-and the products of inertia (the mean of the diagonal), which are often near zero.
+A relative standard error is judged against a parameter's size, the same for the components
+of one vector or tensor so that the criterion does not depend on how the platform frame is
+turned: the mass against itself, each first moment against the first-moment vector's
+length (at least a tenth of the mass times the radius of gyration, for a centre of mass near
+the reference point), each entry of the inertia matrix, products included, against the mean
+of its diagonal. Judged by their own magnitudes, a first moment along a long lever arm and a
+product near zero would set the design's aim by the frame's orientation alone.
 """
 
 from __future__ import annotations
@@ -44,8 +49,8 @@ from stewartid.identification.physical import (
     POSITIVE_PARAMETERS,
     parameter_model,
 )
+from stewartid.identification.physical_regression import leg_force_transforms
 from stewartid.model import regressor as reg
-from stewartid.model.kinematics import leg_jacobian
 from stewartid.platform import Platform
 from stewartid.simulation.sensors import SensorNoise
 
@@ -133,39 +138,40 @@ def parameter_sizes(names: tuple[str, ...], nominal: np.ndarray) -> np.ndarray:
     the moving body's ten (the payload's in payload mode): what Mt(q) is made of. The legs'
     combinations are a small share of it and mostly beyond any excitation within the limits
     (the estimator fixes them at the file's values where the data cannot tell them);
-    friction and offsets are nuisance parameters. The body's first moments are judged
-    against at least a tenth of its mass times its radius of gyration about the reference
-    point, its products of inertia against at least a tenth of the mean of its inertia
-    diagonal; every other parameter against its magnitude.
+    friction and offsets are nuisance parameters. The mass is judged against itself, every
+    first moment against the length of the first-moment vector (at least a tenth of the mass
+    times the radius of gyration about the reference point) and every entry of the inertia
+    matrix against the mean of its diagonal: sizes that turning the frame leaves alone.
     """
     values = dict(zip((n.removeprefix("payload.") for n in names), nominal, strict=True))
     mass = abs(values.get("m", 0.0))
     diagonal = np.mean([abs(values.get(f"I_{a}{a}", 0.0)) for a in "xyz"])
     gyration = math.sqrt(1.5 * diagonal / mass) if mass > 0 else 0.0  # tr(I) / 2 m
-    sizes = np.abs(np.asarray(nominal, dtype=float))
+    moment = math.hypot(*(values.get(f"mc_{a}", 0.0) for a in "xyz"))
+    sizes = np.zeros(len(names))
     for k, name in enumerate(names):
         short = name.removeprefix("payload.")
         if short not in reg.BODY_PARAMETERS:
-            sizes[k] = 0.0
+            continue
+        if short == "m":
+            sizes[k] = mass
         elif short.startswith("mc_"):
-            sizes[k] = max(sizes[k], 0.1 * mass * gyration)
-        elif short in ("I_xy", "I_xz", "I_yz"):
-            sizes[k] = max(sizes[k], 0.1 * diagonal)
+            sizes[k] = max(moment, 0.1 * mass * gyration)
+        else:
+            sizes[k] = diagonal
     return sizes
 
 
-def force_noise_covariance(platform: Platform, noise: SensorNoise, q: np.ndarray) -> np.ndarray:
-    """S = J_lq^T Sigma_f J_lq: the covariance of the generalized force's noise per sample.
+def force_noise_covariance(noise: SensorNoise, rows: int) -> np.ndarray:
+    """S = Sigma_f: the covariance of the leg forces' noise per sample, at every row.
 
     Returns
     -------
-    ndarray, shape (N, 6, 6)
-        N^2, N^2 m, N^2 m^2.
+    ndarray, shape (rows, 6, 6)
+        N^2.
     """
-    jacobian = leg_jacobian(platform, q)
     sigma = np.broadcast_to(np.asarray(noise.force_noise, dtype=float), 6)
-    scaled = sigma[None, :, None] * jacobian
-    return np.swapaxes(scaled, 1, 2) @ scaled
+    return np.broadcast_to(np.diag(sigma ** 2), (rows, 6, 6))
 
 
 def sandwich_covariance(X: np.ndarray, S: np.ndarray, samples_per_row: float) -> np.ndarray:
@@ -242,7 +248,8 @@ def predict_parameters(platform: Platform, design: Design, noise: SensorNoise,
     names, _, selection, nominal, _ = parameter_model(platform, payload)
     q, q_dot, q_ddot = design_rows(platform, design, rate_hz) if states is None else states
     X = (reg.regressor(platform, q, q_dot, q_ddot) if rows is None else rows) @ selection.T
-    S = force_noise_covariance(platform, noise, q)
+    X = np.einsum("kij,kjp->kip", leg_force_transforms(platform, q), X, optimize=True)
+    S = force_noise_covariance(noise, len(q))
     per_row = platform.sensors.sample_rate / rate_hz
     # the estimator's own rule for what it fixes (PhysicalIdentifier's scales)
     positive = np.isin(reg.PARAMETERS, POSITIVE_PARAMETERS)

@@ -62,6 +62,7 @@ from stewartid.identification.physical_regression import (
     SAVGOL_ORDER,
     Regression,
     filtered_regression,
+    leg_force_transforms,
 )
 from stewartid.identification.preparation import prepare
 from stewartid.identification.registry import register_method
@@ -214,13 +215,18 @@ class PhysicalIdentifier(BaseIdentifier):
         model = parameter_model(platform, self.payload)
         names, _, selection, nominal, offset = model
         columns = np.argmax(selection, axis=1)  # selection: rows of the identity
-        X = data.Y[:, :, columns]
-        y = data.y - data.Y @ offset
+        # rows in leg forces, whose noise is alike and uncorrelated across the channels
+        transforms = leg_force_transforms(platform, data.poses)
+        X = np.einsum("kij,kjp->kip", transforms, data.Y[:, :, columns], optimize=True)
+        y = np.einsum("kij,kj->ki", transforms, data.y - data.Y @ offset)
         noise = target_noise = None
         if self.noise_correction:  # y holds -Y offset, whose noise is that of X's rows
+            ends = np.cumsum([0] + [e["samples"] for e in data.experiments])
+            per_experiment = [transforms[a:b] for a, b in zip(ends[:-1], ends[1:], strict=True)]
             full = regressor_noise(experiments, [e["window_s"] for e in data.experiments],
                                    data.experiments[0]["row_step"], platform,
-                                   SAVGOL_FRACTION, self.order, data.pose_noise)
+                                   SAVGOL_FRACTION, self.order, data.pose_noise,
+                                   per_experiment)
             noise = full[:, columns][:, :, columns]
             target_noise = -full[:, columns] @ offset
         # the size of a positive parameter: the whole body's (of a payload's, too)
@@ -347,6 +353,8 @@ def _result(estimator: PhysicalIdentifier, platform: Platform, model, solution: 
                                                 rows), 0.0, None)))
     std = np.sqrt(np.diag(solution.covariance))
     std[[names.index(name) for name in solution.fixed]] = np.nan
+    # of the generalized force (the fit's channels are the leg forces)
+    residual = data.y - data.Y @ (selection.T @ solution.values + offset)
     diagnostics = {"experiments": data.experiments, "fixed": solution.fixed,
                    "mode": "payload" if estimator.payload else "full",
                    "singular_values": solution.singular_values,
@@ -364,8 +372,9 @@ def _result(estimator: PhysicalIdentifier, platform: Platform, model, solution: 
         diagnostics["payload"] = payload_section(dict(zip(names, values, strict=True)))
     return PhysicalResult(
         M=matrices[0], B=matrices[1], std_errors_M=errors[0], std_errors_B=errors[1],
-        condition_number=solution.condition_number, residual_rms=solution.residual_rms,
-        method=estimator.method, settings=estimator.get_params(), diagnostics=diagnostics,
+        condition_number=solution.condition_number,
+        residual_rms=np.sqrt(np.mean(residual ** 2, axis=0)), method=estimator.method,
+        settings=estimator.get_params(), diagnostics=diagnostics,
         parameters=dict(zip(names, values.tolist(), strict=True)),
         parameter_std_errors=dict(zip(names, std.tolist(), strict=True)),
         base_parameters=dict(combinations))

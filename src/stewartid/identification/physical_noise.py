@@ -69,7 +69,8 @@ def _factor(covariance: np.ndarray) -> np.ndarray:
 
 def regressor_noise(experiments: list[Experiment], windows: list[float], row_step: int,
                     platform: Platform, savgol_fraction: float, order: int,
-                    pose_noise: list[np.ndarray]) -> np.ndarray:
+                    pose_noise: list[np.ndarray],
+                    transforms: list[np.ndarray] | None = None) -> np.ndarray:
     """Per channel, the sum over the kept rows of E[delta Y_i^T delta Y_i].
 
     Parameters
@@ -87,14 +88,21 @@ def regressor_noise(experiments: list[Experiment], windows: list[float], row_ste
     pose_noise : list of ndarray, each shape (6, 6)
         Each experiment's pose white-noise covariance per sample
         (:attr:`~stewartid.identification.physical_regression.Regression.pose_noise`).
+    transforms : list of ndarray, each shape (K_e, 6, 6), optional
+        Per experiment, a map applied to each kept row's channels (the leg forces'
+        :func:`~stewartid.identification.physical_regression.leg_force_transforms`).
 
     Returns
     -------
     ndarray, shape (6, N_STANDARD, N_STANDARD)
-        In the standard parameters, by generalized-force channel.
+        In the standard parameters, by channel (of the generalized force, or of what
+        ``transforms`` maps it to).
     """
     out = np.zeros((6, reg.N_STANDARD, reg.N_STANDARD))
-    for exp, window, sigma in zip(experiments, windows, pose_noise, strict=True):
+    if transforms is None:
+        transforms = [None] * len(experiments)
+    for exp, window, sigma, transform in zip(experiments, windows, pose_noise, transforms,
+                                             strict=True):
         rate = exp.sample_rate
         gains = derivative_noise_gains(rate, window, window / savgol_fraction, order)
         poses = kernel_filter_rows(exp.q, rate, window, row_step)
@@ -103,6 +111,9 @@ def regressor_noise(experiments: list[Experiment], windows: list[float], row_ste
         rows, poses = len(poses), poses[::JACOBIAN_STRIDE]
         for jacobian, gain in ((matrix_regressors.viscous_regressor(platform, poses), gains[0]),
                                (matrix_regressors.inertia_regressor(platform, poses), gains[1])):
+            if transform is not None:
+                jacobian = np.einsum("kji,kicp->kjcp", transform[::JACOBIAN_STRIDE], jacobian,
+                                     optimize=True)
             # jacobian[k, i, c, :]: d Y_i / d (rate or acceleration of c) at row k; only
             # its columns not zero at every row (4 viscous, the bodies' 14) add anything
             used = np.flatnonzero(np.any(jacobian != 0.0, axis=(0, 1, 2)))
