@@ -90,6 +90,9 @@ def main() -> None:
           f"(median ratio {np.median(ratio[finite]):.2f}); predicted worst relative SE "
           f"{document['prediction']['worst_relative_std_percent']:.3g} % vs multisine "
           f"{document['baseline']['worst_relative_std_percent']:.3g} %")
+    outside = {n: round(float(r), 2) for n, r, f in zip(prediction.names, ratio, finite,
+                                                        strict=True) if f and abs(r - 1) > 0.3}
+    print(f"predicted / spread beyond 30 %: {outside}")
     print(f"largest limit use on the plant's states: {use:.3f}")
 
 
