@@ -4,7 +4,9 @@ scores, and the more cautious of two covariances.
 An estimate solving sum_k s_k(theta) = 0 has, to first order, the covariance
 A^-1 B A^-1 with A the Jacobian of the summed scores and B the covariance of their sum.
 Filtered signals make the rows' residuals correlated over the filter's support, so B sums
-the scores' autocovariances over those lags (:func:`long_run_covariance`).
+the scores' autocovariances over those lags (:func:`long_run_covariance`); model error
+correlated with the motion over a whole record is seen by the scores summed per record
+(:func:`record_sandwich`).
 """
 
 from __future__ import annotations
@@ -111,4 +113,38 @@ def score_sandwich(inverse: np.ndarray, scores: np.ndarray,
     return inverse @ B @ inverse
 
 
-__all__ = ["long_run_covariance", "score_sandwich", "with_larger_variances"]
+def record_sandwich(inverse: np.ndarray, scores: np.ndarray,
+                    segments: Sequence[tuple[int, int]]) -> np.ndarray:
+    """The covariance A^-1 B A^-1 with the records as independent clusters: B the sum over
+    the records of the outer product of their summed scores, times R / (R - 1) for R records.
+
+    Model error (a friction law or a sensor lag the model does not have) leaves a residual
+    correlated with the motion over a whole record, beyond any filter's support; its share
+    in the estimate is A^-1 times the summed scores, which the residual's short-lag
+    autocovariances do not see. Summed per record, the part that differs between records
+    shows (the part common to all is what the fit removed: the scores of all records sum to
+    zero, or, for an estimate corrected for errors in variables, to the correction, which is
+    shared out by rows). Under noise alone B is unbiased, with R - 1 degrees of freedom.
+
+    Parameters
+    ----------
+    inverse : ndarray, shape (m, m)
+    scores : ndarray, shape (K, m)
+    segments : sequence of (int, int)
+        Rows of each record (summing to K) and its correlation length (unused here).
+
+    Returns
+    -------
+    ndarray, shape (m, m)
+    """
+    rows = np.array([n for n, _ in segments])
+    ends = np.cumsum([0, *rows])
+    sums = np.add.reduceat(scores, ends[:-1], axis=0)
+    # less each record's share of the total, which a corrected estimate leaves nonzero
+    sums = sums - np.outer(rows / rows.sum(), sums.sum(axis=0))
+    records = len(sums)
+    B = sums.T @ sums * records / max(records - 1, 1)
+    return inverse @ B @ inverse
+
+
+__all__ = ["long_run_covariance", "record_sandwich", "score_sandwich", "with_larger_variances"]

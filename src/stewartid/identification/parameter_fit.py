@@ -34,7 +34,11 @@ from stewartid.identification.consistency import (
     require_cvxpy,
     solve_convex,
 )
-from stewartid.identification.long_run import score_sandwich, with_larger_variances
+from stewartid.identification.long_run import (
+    record_sandwich,
+    score_sandwich,
+    with_larger_variances,
+)
 from stewartid.identification.solvers import integrated_autocorrelation
 from stewartid.model.regressor import BODY_PARAMETERS, pseudo_inertia
 
@@ -251,7 +255,9 @@ class ConsistentParameters:
 def score_covariance(inverse: np.ndarray, X: np.ndarray, residual: np.ndarray,
                      weights: np.ndarray, segments: list[tuple[int, int]]) -> np.ndarray:
     """N^-1 B N^-1, B the long-run covariance of the scores s_k = sum_c w_c X_kc r_kc
-    (:func:`~stewartid.identification.long_run.score_sandwich`).
+    (:func:`~stewartid.identification.long_run.score_sandwich`), each variance raised to
+    that of the scores summed per record where larger (model error correlated with the
+    motion over a record: :func:`~stewartid.identification.long_run.record_sandwich`).
 
     The residual of filtered rows is correlated over the filter's support, and where pose
     noise reaches it through differentiated rates and accelerations it is high-pass: its
@@ -275,7 +281,8 @@ def score_covariance(inverse: np.ndarray, X: np.ndarray, residual: np.ndarray,
     ndarray, shape (p, p)
     """
     scores = np.einsum("kcp,kc->kp", X, residual * weights, optimize=True)
-    return score_sandwich(inverse, scores, segments)
+    return with_larger_variances(score_sandwich(inverse, scores, segments),
+                                 record_sandwich(inverse, scores, segments))
 
 
 def nearest_consistent(values: np.ndarray, covariance: np.ndarray, bodies: list[Body],
