@@ -25,10 +25,9 @@ relative standard error above ``max_relative_error``), it is fixed at the platfo
 value, named in ``diagnostics["fixed"]`` and the rest fitted. Mt and Bt are linear in the
 parameters (:func:`~stewartid.model.matrix_regressors.inertia_regressor`,
 :func:`~stewartid.model.matrix_regressors.viscous_regressor`), their standard errors by the delta
-method from the parameters' covariance (each variance the largest of the sandwich of the
-rows' scores over the filters' correlation length, that of the scores summed per record,
-:func:`~stewartid.identification.parameter_fit.score_covariance`, and the residual's
-variance times its autocorrelation time). The rows are mapped to the leg forces
+method from the parameters' covariance (each variance the larger of the sandwich of the
+rows' scores over the filters' correlation length and that of the scores summed per record,
+:func:`~stewartid.identification.parameter_fit.score_covariance`). The rows are mapped to the leg forces
 (:func:`~stewartid.identification.physical_regression.leg_force_transforms`) and each leg
 weighted by its residual variance: generalized least squares for the legs' force noise.
 With ``consistent=True`` the estimate is replaced by the physically consistent parameters
