@@ -65,7 +65,8 @@ def main() -> None:
                                           r["duration_s"], r["fade_s"], r["name"])
                           for r in document["design"]["records"]))
     noise = reference_noise(loaded)
-    prediction = predict_parameters(loaded, design, noise, args.payload, FINAL_RATE)
+    prediction = predict_parameters(loaded, design, noise, args.payload, FINAL_RATE,
+                                    filtered=True)
     records = plant_records(loaded, design)
     use = max(max(record_limit_use(loaded, r).peak.values()) for r in records)
     inverse = inverse_leg_jacobians(loaded, [r.q for r in records])

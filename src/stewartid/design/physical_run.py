@@ -38,8 +38,10 @@ from stewartid.identification.physical import PhysicalIdentifier
 from stewartid.platform import Platform
 from stewartid.simulation.sensors import SensorNoise
 
-#: Information-matrix rate of the final prediction (Hz): twice the search's.
-FINAL_RATE = 50.0
+#: Information-matrix rate of the final prediction (Hz): the regressor is filtered with the
+#: estimator's kernel there (:func:`~stewartid.design.information.kernel_filtered`), which
+#: needs a few dozen samples per kernel window.
+FINAL_RATE = 100.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -182,9 +184,10 @@ def run_physical_design(platform: Platform, budget_s: float, noise: SensorNoise,
     if progress:
         progress("playing the design on the plant")
     design, records, uses = within_plant_limits(platform, best.design, max_use)
-    prediction = predict_parameters(platform, design, noise, payload, FINAL_RATE)
+    prediction = predict_parameters(platform, design, noise, payload, FINAL_RATE, filtered=True)
     baseline_design = all_dofs_multisine(budget_s)
-    baseline = predict_parameters(platform, baseline_design, noise, payload, FINAL_RATE)
+    baseline = predict_parameters(platform, baseline_design, noise, payload, FINAL_RATE,
+                                  filtered=True)
     if progress:
         progress(f"checking the prediction on {check_seeds} noisy copies")
     check = monte_carlo_check(platform, records, noise, prediction, check_seeds)
