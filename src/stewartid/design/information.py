@@ -210,20 +210,23 @@ def sandwich_covariance(X: np.ndarray, S: np.ndarray, samples_per_row: float,
     return inverse @ B @ inverse / samples_per_row
 
 
+def record_rows(design: Design, rate_hz: float = INFORMATION_RATE) -> list[int]:
+    """Rows of each record in :func:`design_rows` at ``rate_hz``: its samples from 0 s to
+    its duration."""
+    return [int(math.floor(r.duration * rate_hz)) + 1 for r in design.records]
+
+
 def design_rows(platform: Platform, design: Design, rate_hz: float = INFORMATION_RATE
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The commanded motion of every record at ``rate_hz``, concatenated: q, q_dot, q_ddot,
-    each of shape (K, 6)."""
-    parts = []
-    for playable in design.playable(platform):
-        duration = playable.record.duration
-        t = np.arange(int(math.floor(duration * rate_hz)) + 1) / rate_hz
-        parts.append(playable.evaluate(t))
+    each of shape (K, 6); :func:`record_rows` rows per record."""
+    parts = [playable.evaluate(np.arange(rows) / rate_hz) for playable, rows
+             in zip(design.playable(platform), record_rows(design, rate_hz), strict=True)]
     return tuple(np.concatenate(x) for x in zip(*parts, strict=True))
 
 
 def kernel_filtered(design: Design, rate_hz: float, q: np.ndarray, X: np.ndarray
-                    ) -> tuple[np.ndarray, np.ndarray]:
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The pose and the regressor of every record filtered with the physical estimator's
     kernel (its window: :data:`~stewartid.signals.differentiation.DEFAULT_WINDOW_PERIODS`
     periods of the record's dominant frequency), the records' ends dropped, as the
@@ -252,8 +255,7 @@ def kernel_filtered(design: Design, rate_hz: float, q: np.ndarray, X: np.ndarray
         the filtered noise's correlation makes of the rows (``noise_rows`` of
         :func:`sandwich_covariance`).
     """
-    counts = [int(math.floor(r.duration * rate_hz)) + 1 for r in design.records]
-    ends = np.cumsum([0, *counts])
+    ends = np.cumsum([0, *record_rows(design, rate_hz)])
     poses, rows, twice = [], [], []
     for a, b in zip(ends[:-1], ends[1:], strict=True):
         window = default_window(estimate_frequency(q[a:b], rate_hz))
@@ -338,4 +340,5 @@ def predict_parameters(platform: Platform, design: Design, noise: SensorNoise,
 
 
 __all__ = ["INFORMATION_RATE", "ParameterPrediction", "design_rows", "force_noise_covariance",
-           "kernel_filtered", "parameter_sizes", "predict_parameters", "sandwich_covariance"]
+           "kernel_filtered", "parameter_sizes", "predict_parameters", "record_rows",
+           "sandwich_covariance"]
