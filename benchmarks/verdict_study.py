@@ -103,6 +103,8 @@ def evaluate(label, platform, data, M, B, seed) -> dict:
             "ratios": [float(r) for r in ratios],
             "signed_errors": signed, "std_errors": stds,
             "worst_vaf_percent": float(np.nanmin(run.validation.vaf_percent)),
+            "sampling": {k: v for k, v in run.result.diagnostics.get("sampling", {}).items()
+                         if k in ("limited", "std_ratio", "shift")},
             "seconds": run.seconds}
     fitted = [m for m in row["methods"].values() if "worst_percent" in m]
     best = min(m["worst_percent"] for m in fitted)

@@ -49,7 +49,7 @@ from stewartid.datasets.dataset import Dataset
 from stewartid.design.candidates import Design
 from stewartid.design.export import simulate_excitations
 from stewartid.errors import ConfigError
-from stewartid.identification.registry import create_identifier
+from stewartid.identification.registry import create_identifier, estimates_only
 from stewartid.model.dynamics import inverse_dynamics
 from stewartid.model.kinematics import inverse_kinematics, leg_jacobian
 from stewartid.model.linearization import nominal_matrices
@@ -230,6 +230,11 @@ def default_estimator(method: str = "wavelet"):
     return create_identifier(method, **DESIGN_SETTINGS.get(method, {}))
 
 
+def _monte_carlo_estimator(method: str):
+    """:func:`default_estimator` for the Monte Carlo, which reads the estimates only."""
+    return estimates_only(method, **DESIGN_SETTINGS.get(method, {}))
+
+
 def identify_options(method: str = "wavelet") -> list[str]:
     """The ``stewartid identify`` options that fit :func:`default_estimator`."""
     options = ["--method", method]
@@ -346,7 +351,7 @@ def predict_accuracy(platform: Platform, design: Design, noise: SensorNoise,
         runs = NoiseRuns(platform, noise, method, int(seed), datasets=clean,
                          inverse_jacobians=inverse_leg_jacobians(platform,
                                                                  [d.pose for d in clean]))
-    estimator = default_estimator(method).fit(runs.clean(), platform)
+    estimator = _monte_carlo_estimator(method).fit(runs.clean(), platform)
     M_clean, B_clean = estimator.M_.copy(), estimator.B_.copy()
     fits = runs.estimates(range(int(seeds)), workers, progress)         # (seeds, 2, 6, 6)
     settings = estimator.get_params()
@@ -406,7 +411,7 @@ class NoiseRuns:
             ) -> np.ndarray:
         """``[M_, B_]`` of the estimator on realisations ``ks``; shape (len(ks), 2, 6, 6).
         ``progress(done, total)`` after each."""
-        estimator = default_estimator(self.method)
+        estimator = _monte_carlo_estimator(self.method)
         out = np.empty((len(ks), 2, 6, 6))
         for i, k in enumerate(ks):
             estimator.fit(self.noisy(int(k)), self.platform)

@@ -22,6 +22,7 @@ from stewartid.errors import ConfigError, NotFittedError
 from stewartid.fields import Constraint, Interval, positive, validate_parameters
 from stewartid.identification.preparation import resolve_datasets, resolve_platform
 from stewartid.identification.result import IdentificationResult
+from stewartid.identification.sampling import check_sampling
 from stewartid.platform import Platform
 
 
@@ -33,7 +34,9 @@ class BaseIdentifier:
     ``M_``, ``B_`` : ndarray (6, 6)
         Identified inertial and viscous matrices (paper frame).
     ``std_errors_`` : dict with ``"M"`` and ``"B"`` : ndarray (6, 6)
-        Standard errors from the residuals.
+        Standard errors from the residuals; with the setting ``sampling_check`` (the
+        compared methods'), widened where the log's sampling rather than its noise limits
+        the estimate (:mod:`stewartid.identification.sampling`).
     ``condition_number_`` : float
         Condition number of the (equilibrated) regression.
     ``result_`` : IdentificationResult
@@ -117,6 +120,8 @@ class BaseIdentifier:
         platform = resolve_platform(platform)
         data = resolve_datasets(datasets, platform)
         result, learned = self._fit(data, platform)
+        if getattr(self, "sampling_check", False):
+            result = check_sampling(lambda part: self._fit(part, platform)[0], data, result)
         attributes = {"result_": result, "M_": result.M, "B_": result.B,
                       "std_errors_": {"M": result.std_errors_M, "B": result.std_errors_B},
                       "condition_number_": result.condition_number, **learned}

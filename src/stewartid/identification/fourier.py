@@ -47,7 +47,7 @@ import numpy as np
 from stewartid.datasets.dataset import Dataset
 from stewartid.datasets.excitation import LINE_FRACTION, leg_space_motion, spectral_lines
 from stewartid.errors import ConfigError, DataError, IdentificationError
-from stewartid.fields import Interval, ListOf, positive
+from stewartid.fields import BOOLEAN, Interval, ListOf, positive
 from stewartid.identification.base import DIFFERENTIATION_CONSTRAINTS, BaseIdentifier
 from stewartid.identification.harmonics import (
     friction_bias_bound,
@@ -156,6 +156,10 @@ class FourierIdentifier(BaseIdentifier):
     remainder : bool
         Subtract the model's departure from its linearisation along the measured motion
         first (:func:`~stewartid.identification.preparation.model_remainder`).
+    sampling_check : bool
+        Refit at a half, a third and a quarter of the log's rate where the residual is not
+        noise, and add the estimate's change to the standard errors
+        (:mod:`~stewartid.identification.sampling`).
     stiffness : bool
         Identify a stiffness matrix K as well (needs two or more frequencies).
     symmetric : bool
@@ -182,7 +186,8 @@ class FourierIdentifier(BaseIdentifier):
     def __init__(self, frequency_hz: float | Sequence[float] | None = None,
                  window: float | None = None, order: int = DEFAULT_ORDER, gravity: bool = True,
                  stiffness: bool = False, symmetric: bool = False,
-                 periods_per_segment: int = 1, remainder: bool = True):
+                 periods_per_segment: int = 1, remainder: bool = True,
+                 sampling_check: bool = True):
         self.frequency_hz = frequency_hz
         self.window = window
         self.order = order
@@ -191,11 +196,13 @@ class FourierIdentifier(BaseIdentifier):
         self.stiffness = stiffness
         self.symmetric = symmetric
         self.periods_per_segment = periods_per_segment
+        self.sampling_check = sampling_check
 
     _parameter_constraints = {
         "frequency_hz": [positive(), ListOf(positive()), None],
         **DIFFERENTIATION_CONSTRAINTS,
         "periods_per_segment": [Interval(Integral, 1, None)],
+        "sampling_check": [BOOLEAN],
     }
 
     def _validate_params(self) -> None:

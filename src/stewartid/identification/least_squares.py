@@ -123,6 +123,10 @@ class LeastSquaresIdentifier(BaseIdentifier):
         Fit the force less the model's nonlinear remainder
         (:func:`~stewartid.identification.preparation.model_remainder`): the linearisation's
         Mt and Bt at any amplitude.
+    sampling_check : bool
+        Refit at a half, a third and a quarter of the log's rate where the residual is not
+        noise, and add the estimate's change to the standard errors
+        (:mod:`~stewartid.identification.sampling`).
     coulomb : bool
         Include the three Coulomb regressors.
     coulomb_smoothing : float
@@ -158,7 +162,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
                  gravity: bool = True, coulomb: bool = True, coulomb_smoothing: float = 1e-4,
                  symmetric: bool = False, decimate: int = 1,
                  differentiation: str = "kernel", noise_correction: bool = True,
-                 remainder: bool = True):
+                 remainder: bool = True, sampling_check: bool = True):
         self.window = window
         self.order = order
         self.gravity = gravity
@@ -169,6 +173,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
         self.decimate = decimate
         self.differentiation = differentiation
         self.noise_correction = noise_correction
+        self.sampling_check = sampling_check
 
     _parameter_constraints = {
         **DIFFERENTIATION_CONSTRAINTS,
@@ -176,6 +181,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
         "differentiation": [Options(("kernel", "savgol"))],
         "decimate": [Interval(Integral, 1, None)],
         "noise_correction": [BOOLEAN],
+        "sampling_check": [BOOLEAN],
     }
 
     def _fit(self, datasets: list[Dataset], platform: Platform

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from stewartid.errors import StewartidError
-from stewartid.identification.registry import create_identifier
+from stewartid.identification.registry import estimates_only
 from stewartid.platform import Platform
 from stewartid.reference.published import PAPER_ENTRIES, entry_label, relative_error_percent
 from stewartid.simulation import simulate_experiments
@@ -86,7 +86,7 @@ def run_task(task: StudyTask, platform: Platform, methods: Sequence[str],
     methods : sequence of str
         Registered method names.
     method_settings : mapping, optional
-        ``{method: {setting: value}}`` passed to :func:`create_identifier`.
+        ``{method: {setting: value}}`` passed to :func:`~stewartid.identification.registry.estimates_only`.
     actuator : {"hydraulic", "ideal"}, optional
         Override ``[hydraulics] mode``.
 
@@ -120,7 +120,7 @@ def run_task(task: StudyTask, platform: Platform, methods: Sequence[str],
         settings = dict((method_settings or {}).get(method, {}))
         start = time.perf_counter()
         try:
-            estimator = create_identifier(method, **settings).fit(run.datasets, plant)
+            estimator = estimates_only(method, **settings).fit(run.datasets, plant)
         except StewartidError as exc:
             row = _failed(f"{method}: {exc}")
         else:

@@ -55,7 +55,7 @@ from numbers import Integral, Real
 import numpy as np
 
 from stewartid.datasets.dataset import Dataset
-from stewartid.fields import Interval, ListOf, Options, nonnegative, positive, validate_parameters
+from stewartid.fields import BOOLEAN, Interval, ListOf, Options, nonnegative, positive, validate_parameters
 from stewartid.identification.base import BaseIdentifier
 from stewartid.identification.pairs import combine_pairs
 from stewartid.identification.preparation import Experiment, prepare_experiment
@@ -187,6 +187,10 @@ class WaveletIdentifier(BaseIdentifier):
         Subtract the model's departure from its linearisation along the measured motion
         (:func:`~stewartid.identification.preparation.model_remainder`): the linearisation's
         matrices at any amplitude.
+    sampling_check : bool
+        Refit at a half, a third and a quarter of the log's rate where the residual is not
+        noise, and add the estimate's change to the standard errors
+        (:mod:`~stewartid.identification.sampling`).
 
     Attributes
     ----------
@@ -211,7 +215,8 @@ class WaveletIdentifier(BaseIdentifier):
                  differentiation_window: float | None = None, hysteresis: float = 4.0,
                  odd_companion: bool = False, noise_correction: bool = True,
                  symmetric: bool = False,
-                 pair_selection: str = "pooled", gravity: bool = True, remainder: bool = True):
+                 pair_selection: str = "pooled", gravity: bool = True, remainder: bool = True,
+                 sampling_check: bool = True):
         self.wavelet = wavelet
         self.wavelet_order = wavelet_order
         self.truncation = truncation
@@ -232,6 +237,7 @@ class WaveletIdentifier(BaseIdentifier):
         self.pair_selection = pair_selection
         self.gravity = gravity
         self.remainder = remainder
+        self.sampling_check = sampling_check
 
     # ------------------------------------------------------------------ settings
     _parameter_constraints = {
@@ -247,6 +253,7 @@ class WaveletIdentifier(BaseIdentifier):
         "hysteresis": [nonnegative()],
         "test_functions": [Interval(Integral, 1, 12, "both"), None],
         "friction": [Options(FRICTION_MODELS)],
+        "sampling_check": [BOOLEAN],
         "pair_selection": [Options(PAIR_SELECTIONS)],
     }
 

@@ -125,11 +125,12 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
         terms = (bool(params.get("gravity", True)), bool(params.get("remainder", False)))
         if terms not in segments:
             segments[terms] = held_out_segments(datasets, platform, folds, *terms)
+        # the folds and the companion predict: their standard errors are never read
         companion = None
         if "friction" in accepted:
             def companion():
-                return registry.create_identifier(name, **{**own, "friction": "uniform"})
-        folds_fit = cross_validate(lambda: registry.create_identifier(name, **own), datasets,
+                return registry.estimates_only(name, **{**own, "friction": "uniform"})
+        folds_fit = cross_validate(lambda: registry.estimates_only(name, **own), datasets,
                                    platform, folds, terms[0], segments[terms], companion)
     except StewartidError as exc:
         return MethodReport(name, spec.display_name, spec.color, error=str(exc),

@@ -1,0 +1,166 @@
+"""Whether a result is limited by its log's sampling rather than by its noise.
+
+A method's standard errors come from its residual, and describe the error of the estimate when
+that residual is noise. On a log with little or no noise the residual is what the sampling
+leaves (the simulator's integration step, the differentiation at the log's rate, a
+zero-order hold): deterministic, repeated with the motion, and no residual-based standard
+error sees it. On our plant's noise-free logs the estimates are 1e-7 to 1e-5 relative off at
+7 to 46 of their standard errors (``docs/benchmarks.md``, "Which method to trust").
+
+The check fits the log again at half its sample rate (every second sample). The result is
+limited by the sampling, not the noise, when either
+
+- the standard errors grow faster than noise makes them: noise gives standard errors larger
+  by about sqrt(2) at half the rate (half the samples of twice the filtered variance in each
+  window), an error of the sampling of order p gives 2**p; the median ratio over the
+  diagonals of Mt and Bt is compared with :data:`RATIO_LIMIT`; or
+- the estimate moves by more than noise can move it: a diagonal entry changes by more than
+  :data:`SHIFT_LIMIT` of its half-rate standard errors (a residual at round-off, as on logs
+  of the identified model itself, where the standard errors are 1e-9 relative).
+
+Then the log is also fitted at a third and a quarter of its rate, and each entry's largest
+change over the three thinned fits is added to its standard error in quadrature. The change
+is an empirical bound of what the sampling does to the estimate: on our plant's noise-free
+logs 0.3 to 800 times the error, where the residual-based standard error was 1/46 to 1 times
+it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import warnings
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from stewartid.datasets.dataset import MIN_SAMPLES, Dataset
+from stewartid.errors import StewartidError
+from stewartid.identification.result import IdentificationResult
+
+#: Thinning factors: the first decides whether the others are fitted.
+FACTORS = (2, 3, 4)
+
+#: Median ratio of the standard errors at half the rate to those at the full rate above which
+#: the residual counts as the sampling's (noise: about sqrt(2); a sampling error of order p:
+#: 2**p). Measured with the reference noise, 65 logs of two platforms: 0.9-1.93; their
+#: noise-free versions: 2.7-44.
+RATIO_LIMIT = 2.5
+
+#: Largest change of a diagonal entry at half the rate, in its half-rate standard errors,
+#: that noise explains. Measured with noise: at most 2.8 on the 65 logs at 1 kHz, 5.7 for
+#: Method B at 200 Hz (whose half rate is coarse for its wavelets); on noise-free logs of the
+#: linear model itself, whose residual is round-off: 15 to 1e8.
+SHIFT_LIMIT = 10.0
+
+
+def thinned(dataset: Dataset, factor: int) -> Dataset:
+    """Every ``factor``-th sample of an experiment, from the first.
+
+    Parameters
+    ----------
+    dataset : Dataset
+        N samples at rate fs.
+    factor : int
+        Thinning factor k >= 1.
+
+    Returns
+    -------
+    Dataset
+        ceil(N / k) samples at fs / k, same name.
+    """
+    rows = slice(0, None, factor)
+    return Dataset(dataset.t[rows], dataset.pose[rows], dataset.lengths[rows],
+                   dataset.forces[rows], dataset.name)
+
+
+def _diagonals(result: IdentificationResult) -> tuple[np.ndarray, np.ndarray]:
+    """The diagonals of Mt and Bt and their standard errors, shape (12,) each (the
+    off-diagonal entries a method does not estimate carry round-off)."""
+    return (np.concatenate([np.diag(result.M), np.diag(result.B)]),
+            np.concatenate([np.diag(result.std_errors_M), np.diag(result.std_errors_B)]))
+
+
+def _compare(result: IdentificationResult, half: IdentificationResult) -> tuple[float, float]:
+    """Median over the diagonals of the half-rate standard error over the full-rate one,
+    and the largest change of a diagonal entry in its half-rate standard errors."""
+    (value, std), (other, other_std) = _diagonals(result), _diagonals(half)
+    usable = np.isfinite(std) & np.isfinite(other_std) & (std > 0) & (other_std > 0)
+    if not usable.any():
+        return float("nan"), float("nan")
+    return (float(np.median(other_std[usable] / std[usable])),
+            float(np.max(np.abs(value - other)[usable] / other_std[usable])))
+
+
+def _fit_quietly(fit: Callable[[list[Dataset]], IdentificationResult],
+                 datasets: Sequence[Dataset], factor: int
+                 ) -> IdentificationResult | str:
+    """The fit of the thinned log, or why it failed (one line)."""
+    if min(len(d) for d in datasets) // factor < MIN_SAMPLES:
+        return f"fewer than {MIN_SAMPLES} samples at 1/{factor} of the rate"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the full-rate fit has warned about these data
+        try:
+            return fit([thinned(d, factor) for d in datasets])
+        except StewartidError as error:
+            return str(error).splitlines()[0]
+
+
+def check_sampling(fit: Callable[[list[Dataset]], IdentificationResult],
+                   datasets: Sequence[Dataset], result: IdentificationResult
+                   ) -> IdentificationResult:
+    """The result, its standard errors widened where the log's sampling limits it.
+
+    Parameters
+    ----------
+    fit : callable
+        Fits a list of experiments with the method's settings and returns its result.
+    datasets : sequence of Dataset
+        The experiments ``result`` was fitted on.
+    result : IdentificationResult
+        The full-rate fit.
+
+    Returns
+    -------
+    IdentificationResult
+        ``result`` with ``diagnostics["sampling"]``: ``std_ratio`` (the median ratio over
+        the diagonals of the half-rate standard errors to these), ``shift`` (the largest
+        change of a diagonal entry at half the rate, in its half-rate standard errors),
+        ``limited`` (either above its limit, :data:`RATIO_LIMIT`, :data:`SHIFT_LIMIT`),
+        ``factors`` fitted, ``spread_M``/``spread_B`` (6, 6) (each entry's largest change
+        over the thinned fits, added to its standard error in quadrature; zero when not
+        limited), or ``reason`` when the half-rate fit was not possible.
+    """
+    half = _fit_quietly(fit, datasets, FACTORS[0])
+    if isinstance(half, str):
+        return _with(result, {"limited": False, "reason": half}, None, None)
+    ratio, shift = _compare(result, half)
+    summary = {"std_ratio": ratio, "shift": shift}
+    if not (ratio > RATIO_LIMIT or shift > SHIFT_LIMIT):
+        return _with(result, {"limited": False, **summary, "factors": [FACTORS[0]]},
+                     None, None)
+    fits = {FACTORS[0]: half}
+    for factor in FACTORS[1:]:
+        other = _fit_quietly(fit, datasets, factor)
+        if not isinstance(other, str):
+            fits[factor] = other
+    spread_M = np.max([np.abs(result.M - f.M) for f in fits.values()], axis=0)
+    spread_B = np.max([np.abs(result.B - f.B) for f in fits.values()], axis=0)
+    return _with(result, {"limited": True, **summary, "factors": sorted(fits)},
+                 np.nan_to_num(spread_M), np.nan_to_num(spread_B))
+
+
+def _with(result: IdentificationResult, summary: dict[str, Any],
+          spread_M: np.ndarray | None, spread_B: np.ndarray | None) -> IdentificationResult:
+    """``result`` with the check's summary in its diagnostics and the spreads added."""
+    if spread_M is None or spread_B is None:
+        return dataclasses.replace(
+            result, diagnostics={**result.diagnostics, "sampling": summary})
+    summary = {**summary, "spread_M": spread_M, "spread_B": spread_B}
+    return dataclasses.replace(
+        result, std_errors_M=np.hypot(result.std_errors_M, spread_M),
+        std_errors_B=np.hypot(result.std_errors_B, spread_B),
+        diagnostics={**result.diagnostics, "sampling": summary})
+
+
+__all__ = ["FACTORS", "RATIO_LIMIT", "SHIFT_LIMIT", "check_sampling", "thinned"]
