@@ -121,7 +121,7 @@ class BaseIdentifier:
         data = resolve_datasets(datasets, platform)
         result, learned = self._fit(data, platform)
         if getattr(self, "sampling_check", False):
-            result = check_sampling(lambda part: self._fit(part, platform)[0], data, result)
+            result, learned = self._check_sampling(data, platform, result, learned)
         attributes = {"result_": result, "M_": result.M, "B_": result.B,
                       "std_errors_": {"M": result.std_errors_M, "B": result.std_errors_B},
                       "condition_number_": result.condition_number, **learned}
@@ -136,6 +136,15 @@ class BaseIdentifier:
              ) -> tuple[IdentificationResult, dict[str, Any]]:
         """The result and the method-specific learned attributes (names ending in ``_``)."""
         raise NotImplementedError
+
+    def _check_sampling(self, datasets: list[Dataset], platform: Platform,
+                        result: IdentificationResult, learned: dict[str, Any]
+                        ) -> tuple[IdentificationResult, dict[str, Any]]:
+        """``_fit``'s result and learned attributes with the standard errors widened where
+        the log's sampling limits them (:func:`~stewartid.identification.sampling.check_sampling`);
+        a method whose learned attributes hold errors too extends this."""
+        return check_sampling(lambda part: self._fit(part, platform)[0], datasets,
+                              result), learned
 
 
 #: Constraints of the Savitzky-Golay settings of the time-domain methods: the window (s),

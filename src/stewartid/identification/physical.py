@@ -37,6 +37,7 @@ nearest to it in the metric of its covariance
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass, field
@@ -68,6 +69,7 @@ from stewartid.identification.physical_regression import (
 from stewartid.identification.preparation import prepare
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
+from stewartid.identification.sampling import thinned_fits
 from stewartid.model import matrix_regressors
 from stewartid.model import regressor as reg
 from stewartid.platform import Platform
@@ -163,6 +165,11 @@ class PhysicalIdentifier(BaseIdentifier):
         Remove the bias that pose noise, carried into the regressor's rates and
         accelerations, puts on the estimate (errors in variables,
         :func:`~stewartid.identification.physical_noise.regressor_noise`).
+    sampling_check : bool
+        Refit at a half, a third and a quarter of the log's rate where the residual is not
+        noise, and add each free parameter's change to its variance
+        (:mod:`~stewartid.identification.sampling`); Mt, Bt and Mt(q) follow by the delta
+        method.
 
     Attributes
     ----------
@@ -182,7 +189,8 @@ class PhysicalIdentifier(BaseIdentifier):
                  order: int = SAVGOL_ORDER, gravity: bool = True,
                  coulomb_smoothing: float = 1e-4, decimate: int | None = None,
                  max_condition: float = 1e5, max_relative_error: float = 0.3,
-                 consistent: bool = False, noise_correction: bool = True):
+                 consistent: bool = False, noise_correction: bool = True,
+                 sampling_check: bool = True):
         self.payload = payload
         self.window = window
         self.order = order
@@ -193,6 +201,7 @@ class PhysicalIdentifier(BaseIdentifier):
         self.max_relative_error = max_relative_error
         self.consistent = consistent
         self.noise_correction = noise_correction
+        self.sampling_check = sampling_check
 
     _parameter_constraints = {
         **DIFFERENTIATION_CONSTRAINTS,
@@ -204,6 +213,7 @@ class PhysicalIdentifier(BaseIdentifier):
         "max_relative_error": [positive()],
         "consistent": [BOOLEAN],
         "noise_correction": [BOOLEAN],
+        "sampling_check": [BOOLEAN],
     }
 
     def _fit(self, datasets: list[Dataset], platform: Platform
@@ -246,6 +256,38 @@ class PhysicalIdentifier(BaseIdentifier):
                    "parameter_std_errors_": result.parameter_std_errors,
                    "covariance_": solution.covariance, "fixed_": solution.fixed}
         return result, learned
+
+    def _check_sampling(self, datasets: list[Dataset], platform: Platform,
+                        result: IdentificationResult, learned: dict
+                        ) -> tuple[IdentificationResult, dict]:
+        """The sampling check on the parameters: each free parameter's largest change over
+        the thinned (unconstrained) fits joins its variance, where it was free in them too."""
+        quick = type(self)(**{**self.get_params(), "consistent": False,
+                              "sampling_check": False})
+        summary, fits = thinned_fits(lambda part: quick._fit(part, platform)[0], datasets,
+                                     result)
+        if fits:
+            values = result.diagnostics.get("consistent", {}).get("unconstrained",
+                                                                  result.parameters)
+            spread = np.array([max([abs(values[name] - f.parameters[name]) for f in fits
+                                    if np.isfinite(f.parameter_std_errors[name])], default=0.0)
+                               if name not in learned["fixed_"] else 0.0
+                               for name in result.parameters])
+            covariance = learned["covariance_"] + np.diag(spread ** 2)
+            std = np.sqrt(np.diag(covariance))
+            std[[list(result.parameters).index(name) for name in learned["fixed_"]]] = np.nan
+            from stewartid.identification.physical_prediction import matrices_at  # imports this
+
+            at = matrices_at(platform, result, covariance, platform.neutral_pose)
+            result = dataclasses.replace(
+                result, std_errors_M=at.std_errors_M[0], std_errors_B=at.std_errors_B[0],
+                parameter_std_errors=dict(zip(result.parameters, std.tolist(), strict=True)))
+            learned = {**learned, "covariance_": covariance,
+                       "parameter_std_errors_": result.parameter_std_errors}
+            summary = {**summary, "parameter_spread": dict(zip(result.parameters,
+                                                               spread.tolist(), strict=True))}
+        return dataclasses.replace(result, diagnostics={**result.diagnostics,
+                                                        "sampling": summary}), learned
 
 
 def correlation_segments(data, experiments: list) -> list[tuple[int, int]]:

@@ -106,6 +106,39 @@ def _fit_quietly(fit: Callable[[list[Dataset]], IdentificationResult],
             return str(error).splitlines()[0]
 
 
+def thinned_fits(fit: Callable[[list[Dataset]], IdentificationResult],
+                 datasets: Sequence[Dataset], result: IdentificationResult
+                 ) -> tuple[dict[str, Any], list[IdentificationResult]]:
+    """Whether ``result`` is limited by the sampling, and the thinned fits that say by how much.
+
+    Parameters
+    ----------
+    fit, datasets, result
+        As :func:`check_sampling`.
+
+    Returns
+    -------
+    summary : dict
+        ``limited``, ``std_ratio``, ``shift``, ``factors`` (or ``reason``), as
+        :func:`check_sampling` reports them.
+    fits : list of IdentificationResult
+        The fits at 1/2, 1/3, 1/4 of the rate that succeeded when limited; else empty.
+    """
+    half = _fit_quietly(fit, datasets, FACTORS[0])
+    if isinstance(half, str):
+        return {"limited": False, "reason": half}, []
+    ratio, shift = _compare(result, half)
+    summary = {"std_ratio": ratio, "shift": shift}
+    if not (ratio > RATIO_LIMIT or shift > SHIFT_LIMIT):
+        return {"limited": False, **summary, "factors": [FACTORS[0]]}, []
+    fits = {FACTORS[0]: half}
+    for factor in FACTORS[1:]:
+        other = _fit_quietly(fit, datasets, factor)
+        if not isinstance(other, str):
+            fits[factor] = other
+    return {"limited": True, **summary, "factors": sorted(fits)}, list(fits.values())
+
+
 def check_sampling(fit: Callable[[list[Dataset]], IdentificationResult],
                    datasets: Sequence[Dataset], result: IdentificationResult
                    ) -> IdentificationResult:
@@ -131,23 +164,12 @@ def check_sampling(fit: Callable[[list[Dataset]], IdentificationResult],
         over the thinned fits, added to its standard error in quadrature; zero when not
         limited), or ``reason`` when the half-rate fit was not possible.
     """
-    half = _fit_quietly(fit, datasets, FACTORS[0])
-    if isinstance(half, str):
-        return _with(result, {"limited": False, "reason": half}, None, None)
-    ratio, shift = _compare(result, half)
-    summary = {"std_ratio": ratio, "shift": shift}
-    if not (ratio > RATIO_LIMIT or shift > SHIFT_LIMIT):
-        return _with(result, {"limited": False, **summary, "factors": [FACTORS[0]]},
-                     None, None)
-    fits = {FACTORS[0]: half}
-    for factor in FACTORS[1:]:
-        other = _fit_quietly(fit, datasets, factor)
-        if not isinstance(other, str):
-            fits[factor] = other
-    spread_M = np.max([np.abs(result.M - f.M) for f in fits.values()], axis=0)
-    spread_B = np.max([np.abs(result.B - f.B) for f in fits.values()], axis=0)
-    return _with(result, {"limited": True, **summary, "factors": sorted(fits)},
-                 np.nan_to_num(spread_M), np.nan_to_num(spread_B))
+    summary, fits = thinned_fits(fit, datasets, result)
+    if not fits:
+        return _with(result, summary, None, None)
+    spread_M = np.max([np.abs(result.M - f.M) for f in fits], axis=0)
+    spread_B = np.max([np.abs(result.B - f.B) for f in fits], axis=0)
+    return _with(result, summary, np.nan_to_num(spread_M), np.nan_to_num(spread_B))
 
 
 def _with(result: IdentificationResult, summary: dict[str, Any],
@@ -163,4 +185,5 @@ def _with(result: IdentificationResult, summary: dict[str, Any],
         diagnostics={**result.diagnostics, "sampling": summary})
 
 
-__all__ = ["FACTORS", "RATIO_LIMIT", "SHIFT_LIMIT", "check_sampling", "thinned"]
+__all__ = ["FACTORS", "RATIO_LIMIT", "SHIFT_LIMIT", "check_sampling", "thinned",
+           "thinned_fits"]
