@@ -3,6 +3,8 @@ estimate, and leave noise-limited results alone."""
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -126,3 +128,17 @@ def test_the_physical_model_widens_its_parameters_on_a_noise_free_plant_log():
     std = np.array(list(estimator.parameter_std_errors_.values()))
     np.testing.assert_allclose(std[free], np.sqrt(np.diag(estimator.covariance_))[free],
                                rtol=1e-12)
+
+
+def test_the_report_says_which_results_the_sampling_limits(tmp_path, noise_free, paper):
+    from stewartid.reports.identification.report import write_identification_report
+
+    data, M, B = noise_free
+    write_identification_report(data, paper, tmp_path, methods=("fourier", "ls"), folds=3,
+                                 nominal=(M, B), nominal_source="the generating model")
+    text = (tmp_path / "report.md").read_text()
+    line = next(line for line in text.splitlines() if "Limited by the log's sampling" in line)
+    # least squares' residual is round-off there (flagged), Method A's errors do not scale
+    assert "Time-domain least squares" in line and "Method A" not in line
+    document = json.loads((tmp_path / "result.json").read_text())
+    assert document["diagnostics"]["sampling"]["factors"]

@@ -129,13 +129,7 @@ def method_lines(run: MethodReport) -> list[str]:
                      f"{np.min(run.validation.vaf_percent):.3f} %.")
     lines.append(f"Median relative standard error of the diagonal entries: "
                  f"{100 * relative_std(result):.2g} %.")
-    sampling = result.diagnostics.get("sampling", {})
-    if sampling.get("limited"):
-        lines.append(f"Its result is limited by the log's sampling, not its noise (standard "
-                     f"errors {sampling['std_ratio']:.3g}× larger at half the rate, where noise "
-                     f"gives about 1.4×; a diagonal entry moved by {sampling['shift']:.3g} of "
-                     "them): each entry's error includes its largest change at 1/2, 1/3 and "
-                     "1/4 of the rate.")
+    lines += _sampling_lines([run])
     if np.all(np.isfinite(run.coulomb[0])):
         lines.append(f"Coulomb friction: {friction_text(run)}.")
     else:
@@ -172,6 +166,7 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
                           if u["disagrees_with"] else
                           f" ({100 * u['relative_std']:.3g} % standard error)")
             for u in verdict.uncertain) + ".")
+    lines += _sampling_lines(ok)
     if verdict.friction_source is not None:
         source = next(run for run in ok if run.name == verdict.friction_source)
         lines.append(f"Coulomb friction is present: {source.display_name} finds "
@@ -204,6 +199,20 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
         if run.result is None:
             lines.append(f"{run.display_name} could not be applied to these data: {run.error}")
     return lines
+
+
+def _sampling_lines(runs: Sequence[MethodReport]) -> list[str]:
+    """A sentence naming the methods whose result the log's sampling limits, if any
+    (:mod:`stewartid.identification.sampling`)."""
+    limited = [(run.display_name, run.result.diagnostics["sampling"]) for run in runs
+               if run.result.diagnostics.get("sampling", {}).get("limited")]
+    if not limited:
+        return []
+    return ["Limited by the log's sampling, not its noise: " + "; ".join(
+        f"{name} (standard errors {s['std_ratio']:.3g}× larger at half the rate, where noise "
+        f"gives about 1.4×; an entry moved by {s['shift']:.3g} of them)" for name, s in limited)
+        + ". Each entry's standard error includes its largest change at 1/2, 1/3 and 1/4 of "
+        "the rate: a bound of what the sampling does, not an estimate of the noise."]
 
 
 def _number(value: float) -> str:
