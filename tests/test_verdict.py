@@ -95,3 +95,19 @@ def test_entries_another_method_contradicts_are_named_uncertain():
     # every Mt entry of the paper's 20 differs by 5 % at 0.14 % combined error: all ten named
     assert labels == [f"Mt({i},{j})" for i, j in ((1, 1), (2, 2), (3, 3), (4, 4), (5, 5),
                                                    (6, 6), (1, 5), (2, 4), (4, 2), (5, 1))]
+
+
+def test_a_close_call_is_named_and_a_clear_one_is_not():
+    close = choose_trusted({"a": (_result(0.010), _validation(0.1)),
+                            "b": (_result(0.012), _validation(0.1)),
+                            "c": (_result(0.020), _validation(0.1))})
+    assert close.trusted == "a" and close.close == ("a", "b")
+    assert close.to_dict()["close"] == ["a", "b"]
+    assert any(reason.startswith("close call: a, b") for reason in close.reasons)
+    clear = choose_trusted({"a": (_result(0.010), _validation(0.1)),
+                            "b": (_result(0.013), _validation(0.1))})
+    assert clear.close == ("a",) and not any("close call" in r for r in clear.reasons)
+    # an implausible method is no close call, however small its errors
+    implausible = choose_trusted({"a": (_result(0.010), _validation(0.1)),
+                                  "b": (_result(0.010, definite=False), _validation(0.1))})
+    assert implausible.close == ("a",)

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from stewartid.assessment.validation import friction_signature
-from stewartid.assessment.verdict import Verdict, relative_std, worst_dof
+from stewartid.assessment.verdict import CLOSE_FACTOR, Verdict, relative_std, worst_dof
 from stewartid.datasets.dataset import Dataset
 from stewartid.identification.consistency import consistency_metrics, is_consistent
 from stewartid.identification.wavelet.noise import white_noise_covariance
@@ -160,6 +160,14 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
              f"({trusted.worst_dof})"
              + (" (methods tied in uncertainty: the held-out prediction decides)."
                 if len(verdict.tied) > 1 else ".")]
+    if len(verdict.close) > 1:
+        names = [next(run.display_name for run in ok if run.name == name)
+                 for name in verdict.close]
+        lines.append(f"This is a close call: {' and '.join(names)} predict largest errors "
+                     f"within {CLOSE_FACTOR:g}× of each other, and on such data the noise "
+                     "decides which is the more accurate (on logs with a known truth the one "
+                     "predicting less was the more accurate in half to two thirds of such "
+                     "cases). Where their entries differ, both are in the tables below.")
     if verdict.uncertain:
         lines.append("Entries to treat with care: " + ", ".join(
             u["entry"] + (f" (other methods disagree: {', '.join(u['disagrees_with'])})"
