@@ -276,18 +276,16 @@ class PhysicalIdentifier(BaseIdentifier):
             covariance = learned["covariance_"] + np.diag(spread ** 2)
             std = np.sqrt(np.diag(covariance))
             std[[list(result.parameters).index(name) for name in learned["fixed_"]]] = np.nan
-            from stewartid.identification.physical_prediction import matrices_at  # imports this
-
-            at = matrices_at(platform, result, covariance, platform.neutral_pose)
+            std_M, std_B = matrix_std_errors(
+                platform, parameter_model(platform, self.payload)[2], covariance)
             result = dataclasses.replace(
-                result, std_errors_M=at.std_errors_M[0], std_errors_B=at.std_errors_B[0],
+                result, std_errors_M=std_M, std_errors_B=std_B,
                 parameter_std_errors=dict(zip(result.parameters, std.tolist(), strict=True)))
             learned = {**learned, "covariance_": covariance,
                        "parameter_std_errors_": result.parameter_std_errors}
-            summary = {**summary, "parameter_spread": dict(zip(result.parameters,
-                                                               spread.tolist(), strict=True))}
-        return dataclasses.replace(result, diagnostics={**result.diagnostics,
-                                                        "sampling": summary}), learned
+            summary["parameter_spread"] = dict(zip(result.parameters, spread.tolist(), strict=True))
+        diagnostics = {**result.diagnostics, "sampling": summary}
+        return dataclasses.replace(result, diagnostics=diagnostics), learned
 
 
 def correlation_segments(data, experiments: list) -> list[tuple[int, int]]:
@@ -388,12 +386,10 @@ def _result(estimator: PhysicalIdentifier, platform: Platform, model, solution: 
     estimate), and the parameters (the consistent ones when ``projection`` is given)."""
     names, combinations, selection, _, offset = model
     values = solution.values if projection is None else projection.values
-    matrices, errors = [], []
-    for A in (matrix_regressors.inertia_regressor(platform), matrix_regressors.viscous_regressor(platform)):
-        rows = A @ selection.T  # (6, 6, p): the matrix's entries in the parameters
-        matrices.append(rows @ values + A @ offset)
-        errors.append(np.sqrt(np.clip(np.einsum("ijp,pq,ijq->ij", rows, solution.covariance,
-                                                rows), 0.0, None)))
+    matrices = [A @ (selection.T @ values + offset)
+                for A in (matrix_regressors.inertia_regressor(platform),
+                          matrix_regressors.viscous_regressor(platform))]
+    errors = matrix_std_errors(platform, selection, solution.covariance)
     std = np.sqrt(np.diag(solution.covariance))
     std[[names.index(name) for name in solution.fixed]] = np.nan
     # of the generalized force (the fit's channels are the leg forces)
@@ -423,6 +419,20 @@ def _result(estimator: PhysicalIdentifier, platform: Platform, model, solution: 
         base_parameters=dict(combinations))
 
 
+def matrix_std_errors(platform: Platform, selection: np.ndarray, covariance: np.ndarray,
+                      pose: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Delta-method standard errors, (6, 6) each, of Mt and Bt at ``pose`` (absolute, m and
+    rad; neutral by default) from the covariance (p, p) of the parameters that ``selection``
+    (p, N_STANDARD) places among the standard ones."""
+    out = []
+    for A in (matrix_regressors.inertia_regressor(platform, pose),
+              matrix_regressors.viscous_regressor(platform, pose)):
+        rows = A @ selection.T  # (6, 6, p): the matrix's entries in the parameters
+        out.append(np.sqrt(np.clip(np.einsum("ijp,pq,ijq->ij", rows, covariance, rows),
+                                   0.0, None)))
+    return out[0], out[1]
+
+
 def payload_section(parameters: dict[str, float]) -> dict[str, Any]:
     """The ``[payload]`` keys (mass, com, inertia about the centre of mass) of the payload's
     identified mass, first moment and inertia about the reference point."""
@@ -437,4 +447,4 @@ def payload_section(parameters: dict[str, float]) -> dict[str, Any]:
 
 __all__ = ["NUISANCE_PARAMETERS", "PAYLOAD_PARAMETERS", "POSITIVE_PARAMETERS",
            "PhysicalIdentifier", "PhysicalResult", "correlation_segments", "known_platform",
-           "parameter_model", "payload_section"]
+           "matrix_std_errors", "parameter_model", "payload_section"]

@@ -21,7 +21,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from stewartid.errors import IdentificationError
-from stewartid.identification.physical import PhysicalResult, _full_model, _payload_model
+from stewartid.identification.physical import (
+    PhysicalResult,
+    _full_model,
+    _payload_model,
+    matrix_std_errors,
+)
 from stewartid.model import matrix_regressors
 from stewartid.platform import Platform
 
@@ -119,10 +124,10 @@ def matrices_at(platform: Platform, result: PhysicalResult, covariance: np.ndarr
     for pose in np.atleast_2d(np.asarray(poses, dtype=float)):
         for k, A in enumerate((matrix_regressors.inertia_regressor(platform, pose),
                                matrix_regressors.viscous_regressor(platform, pose))):
-            rows = A @ mapping.selection.T  # (6, 6, p)
             out[k].append(A @ mapping.standard)
-            out[k + 2].append(np.sqrt(np.clip(np.einsum("ijp,pq,ijq->ij", rows, covariance,
-                                                        rows), 0.0, None)))
+        for k, std in enumerate(matrix_std_errors(platform, mapping.selection, covariance,
+                                                  pose)):
+            out[k + 2].append(std)
     return PoseMatrices(*(np.array(x) for x in out))
 
 
