@@ -19,10 +19,10 @@ limited by the sampling, not the noise, when either
   of the identified model itself, where the standard errors are 1e-9 relative).
 
 Then the log is also fitted at a third and a quarter of its rate, and each entry's largest
-change over the three thinned fits is added to its standard error in quadrature. The change
-is an empirical bound of what the sampling does to the estimate: on our plant's noise-free
-logs 0.3 to 800 times the error, where the residual-based standard error was 1/46 to 1 times
-it.
+change over the three thinned fits is added to its standard error in quadrature: an
+empirical bound of what the sampling does to the estimate, conservative (a coarser rate errs
+more). On the 13 noise-free logs of the verdict study every entry of every method is then
+within 3 standard errors (largest 2.74), where 7 to 46 were before.
 """
 
 from __future__ import annotations
