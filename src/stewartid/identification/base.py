@@ -34,8 +34,8 @@ class BaseIdentifier:
     ``M_``, ``B_`` : ndarray (6, 6)
         Identified inertial and viscous matrices (paper frame).
     ``std_errors_`` : dict with ``"M"`` and ``"B"`` : ndarray (6, 6)
-        Standard errors from the residuals; with the setting ``sampling_check`` (the
-        compared methods'), widened where the log's sampling rather than its noise limits
+        Standard errors from the residuals; with the setting ``sampling_check`` (every
+        built-in method's), widened where the log's sampling rather than its noise limits
         the estimate (:mod:`stewartid.identification.sampling`).
     ``condition_number_`` : float
         Condition number of the (equilibrated) regression.

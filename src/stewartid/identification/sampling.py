@@ -160,29 +160,19 @@ def check_sampling(fit: Callable[[list[Dataset]], IdentificationResult],
         the diagonals of the half-rate standard errors to these), ``shift`` (the largest
         change of a diagonal entry at half the rate, in its half-rate standard errors),
         ``limited`` (either above its limit, :data:`RATIO_LIMIT`, :data:`SHIFT_LIMIT`),
-        ``factors`` fitted, ``spread_M``/``spread_B`` (6, 6) (each entry's largest change
-        over the thinned fits, added to its standard error in quadrature; zero when not
-        limited), or ``reason`` when the half-rate fit was not possible.
+        ``factors`` fitted, and when limited ``spread_M``/``spread_B`` (6, 6) (each
+        entry's largest change over the thinned fits, added to its standard error in
+        quadrature); ``reason`` instead when the half-rate fit was not possible.
     """
     summary, fits = thinned_fits(fit, datasets, result)
-    if not fits:
-        return _with(result, summary, None, None)
-    spread_M = np.max([np.abs(result.M - f.M) for f in fits], axis=0)
-    spread_B = np.max([np.abs(result.B - f.B) for f in fits], axis=0)
-    return _with(result, summary, np.nan_to_num(spread_M), np.nan_to_num(spread_B))
-
-
-def _with(result: IdentificationResult, summary: dict[str, Any],
-          spread_M: np.ndarray | None, spread_B: np.ndarray | None) -> IdentificationResult:
-    """``result`` with the check's summary in its diagnostics and the spreads added."""
-    if spread_M is None or spread_B is None:
-        return dataclasses.replace(
-            result, diagnostics={**result.diagnostics, "sampling": summary})
-    summary = {**summary, "spread_M": spread_M, "spread_B": spread_B}
-    return dataclasses.replace(
-        result, std_errors_M=np.hypot(result.std_errors_M, spread_M),
-        std_errors_B=np.hypot(result.std_errors_B, spread_B),
-        diagnostics={**result.diagnostics, "sampling": summary})
+    if fits:
+        spread_M = np.nan_to_num(np.max([np.abs(result.M - f.M) for f in fits], axis=0))
+        spread_B = np.nan_to_num(np.max([np.abs(result.B - f.B) for f in fits], axis=0))
+        summary = {**summary, "spread_M": spread_M, "spread_B": spread_B}
+        result = dataclasses.replace(result,
+                                     std_errors_M=np.hypot(result.std_errors_M, spread_M),
+                                     std_errors_B=np.hypot(result.std_errors_B, spread_B))
+    return dataclasses.replace(result, diagnostics={**result.diagnostics, "sampling": summary})
 
 
 __all__ = ["FACTORS", "RATIO_LIMIT", "SHIFT_LIMIT", "check_sampling", "thinned",
