@@ -16,10 +16,15 @@ simulated once and cached in the temporary folder; each seed adds the reference 
 - the share of (parameter, seed) pairs within 3 standard errors, and the largest |z|;
 - with ``--consistent``, how far the consistent fit moved the parameters (SE).
 
+With ``--engine mujoco`` the records come from the MuJoCo model of the same loaded platform
+(:func:`stewartid.mujoco.closed_loop.simulate_mujoco`: another engine's rigid-body algorithms,
+Cardan chains and friction constraints, ideal actuators under the PD servo) instead of our
+plant.
+
 Usage::
 
     python benchmarks/physical_study.py [--platform paper|example] [--scale 1] [--slower 1]
-        [--seeds 8]
+        [--seeds 8] [--engine ours|mujoco]
         [--consistent] [--out rows.jsonl]
 """
 
@@ -60,6 +65,9 @@ PAYLOADS = {
                 "inertia": [900.0, 1100.0, 1400.0, 60.0, -40.0, 90.0]},
 }
 DURATION = 20.0
+#: MuJoCo's RK4 step (s) for ``--engine mujoco``: its force records then depart from the
+#: rigid-body dynamics by O(step^2) (0.5 N rms at 0.25 ms, 2.5 N at 0.5 ms).
+MUJOCO_STEP = 2.5e-4
 EXAMPLE = Path(__file__).resolve().parents[1] / "tests" / "data" / "example_c10" / "platform.toml"
 
 
@@ -71,9 +79,13 @@ def loaded_platform(name: str):
                         **{f"payload__{key}": value for key, value in payload.items()})
 
 
-def clean_records(platform, name: str, scale: float, slower: float = 1.0):
-    """The six noise-free records, simulated once and cached (frequencies ``HZ / slower``)."""
+def clean_records(platform, name: str, scale: float, slower: float = 1.0,
+                  engine: str = "ours"):
+    """The six noise-free records, simulated once and cached (frequencies ``HZ / slower``):
+    on our hydraulic plant, or on the MuJoCo model with ideal actuators (``engine``)."""
     tag = f"{name}-{scale}-{DURATION}-v1" + (f"-{slower}" if slower != 1.0 else "")
+    if engine == "mujoco":
+        tag += f"-mujoco-{MUJOCO_STEP}-v2"
     key = hashlib.sha1(tag.encode()).hexdigest()[:10]
     cache = Path(tempfile.gettempdir()) / f"stewartid-physical-study-{key}.pkl"
     if cache.exists():
@@ -82,9 +94,15 @@ def clean_records(platform, name: str, scale: float, slower: float = 1.0):
     for k in range(6):
         sines = [Sine(d, DEFAULT_AMPLITUDES[d] * scale, HZ[(d + k) % 6] / slower, 0.5 * d + k)
                  for d in range(6)]
-        out.append(simulate_experiment(platform, multisine_excitation(
-            platform, sines, name=f"exp{k + 1}"), DURATION, noise=SensorNoise(),
-            rng=np.random.default_rng(k))[0])
+        excitation = multisine_excitation(platform, sines, name=f"exp{k + 1}")
+        if engine == "mujoco":
+            from stewartid.mujoco.closed_loop import simulate_mujoco
+
+            out.append(simulate_mujoco(platform.replace(controller__integral_gain=0.0),
+                                       excitation, DURATION, step=MUJOCO_STEP))
+        else:
+            out.append(simulate_experiment(platform, excitation, DURATION, noise=SensorNoise(),
+                                           rng=np.random.default_rng(k))[0])
     cache.write_bytes(pickle.dumps(out))
     return out
 
@@ -176,13 +194,16 @@ def main() -> None:
                         help="divide the frequencies by this (larger amplitudes within the "
                              "leg-speed limit)")
     parser.add_argument("--seeds", type=int, default=8)
+    parser.add_argument("--engine", default="ours", choices=["ours", "mujoco"],
+                        help="simulate the records on our hydraulic plant or on the MuJoCo "
+                             "model (ideal actuators, the mujoco extra)")
     parser.add_argument("--consistent", action="store_true")
     parser.add_argument("--out", type=Path)
     args = parser.parse_args()
     loaded = loaded_platform(args.platform)
     bare = loaded.replace(payload=None)
     payload = PAYLOADS["paper" if args.platform == "paper" else "example"]
-    clean = clean_records(loaded, args.platform, args.scale, args.slower)
+    clean = clean_records(loaded, args.platform, args.scale, args.slower, args.engine)
     print(f"peak use of the limits on the plant's states: {limit_peaks(loaded, clean)}")
     rows = []
     for seed in range(args.seeds):

@@ -49,7 +49,13 @@ damped gimbal rates at first order: the viscous matrix V^T D V differs from our 
 
 Friction: joint damping ``gimbal_viscous`` on the four gimbal hinges, none on the revolute
 or the slide; Coulomb ``coulomb`` as MuJoCo ``frictionloss`` on all five hinges (MuJoCo
-resolves it as a constraint, not regularised as our ``Fc w / sqrt(w^2 + s^2)``).
+resolves it as a constraint, not regularised as our ``Fc w / sqrt(w^2 + s^2)``). A friction
+row is soft like any constraint: its regulariser is (1 - d)/d times the row's inverse
+effective mass, so at MuJoCo's default impedance (0.9-0.95) the upper hinges, which carry only
+the light end bodies, passed 1-2 N m of a 30 N m friction at 0.05 rad/s, while the lower
+gimbals, which carry the cylinders, passed all of it. The friction rows therefore take the
+welds' time constant and impedance (``solreffriction``, ``solimpfriction``): every hinge then
+passes its full level once it slides.
 
 Closure stiffness: MuJoCo's equality constraints are soft. With time constant tau and
 impedance d a weld row obeys r'' = -b r' - k r + (1 - d)/d A_ii lambda (k ~ 1/tau^2, A_ii the
@@ -205,7 +211,12 @@ def build_mjcf(platform: Platform, *, integrator: str = "RK4", timestep: float =
     if not 0.0 < constraint_impedance < 1.0:
         raise ValueError(f"constraint_impedance must lie in (0, 1); got {constraint_impedance!r}.")
     friction = platform.friction.coulomb if coulomb else 0.0
-    frictionloss = f' frictionloss="{friction:.17g}"' if friction > 0 else ""
+    # the friction rows as stiff as the welds: at MuJoCo's default softness a row's
+    # regulariser scales with the joint's inverse inertia, and the light end bodies' hinges
+    # would pass 1-2 N m of a 30 N m friction (see the module docstring)
+    imp = f"{constraint_impedance:.17g}"
+    frictionloss = (f' frictionloss="{friction:.17g}" solreffriction="{tau:.17g} 1" '
+                    f'solimpfriction="{imp} {imp} 0.001 0.5 2"') if friction > 0 else ""
     mass, com, full, end_mass, end_inertia = _platform_inertial(platform)
     lines = _world_lines(platform, integrator, timestep, mass, com, full)
     frames = leg_frames(platform)
