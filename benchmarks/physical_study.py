@@ -67,7 +67,7 @@ PAYLOADS = {
 DURATION = 20.0
 #: MuJoCo's RK4 step (s) for ``--engine mujoco``: its force records then depart from the
 #: rigid-body dynamics by O(step^2) (0.5 N rms at 0.25 ms, 2.5 N at 0.5 ms).
-MUJOCO_STEP = 2.5e-4
+MUJOCO_STEP = 2.5e-4  # simulate_mujoco's default
 EXAMPLE = Path(__file__).resolve().parents[1] / "tests" / "data" / "example_c10" / "platform.toml"
 
 
