@@ -318,16 +318,23 @@ def kind_platform(name: str):
     return load_platform(name).replace(friction__coulomb=KIND_COULOMB)
 
 
-def kind_logs(kind: str, platform, folder: Path) -> list[Dataset]:
-    """Noise-free logs exp1..exp6 of a kind on our plant, read from ``folder`` when there,
-    else simulated (ideal sensors, 1 kHz) and written there first."""
+def kind_logs(kind: str, platform, folder: Path, engine: str = "ours") -> list[Dataset]:
+    """Noise-free logs exp1..exp6 of a kind, read from ``folder`` when there, else simulated
+    (ideal sensors, 1 kHz) and written there first: on our plant, or with ``engine="mujoco"``
+    on the MuJoCo model of the same platform (ideal actuators under the PD servo)."""
     paths = [folder / f"exp{k + 1}.csv" for k in range(6)]
     if not all(path.exists() for path in paths):
         folder.mkdir(parents=True, exist_ok=True)
         for k, path in enumerate(paths):
-            dataset, _ = simulate_experiment(
-                platform, multisine_excitation(platform, kind_sines(kind, k), name=f"exp{k + 1}"),
-                KIND_DURATION, noise=SensorNoise(), rng=np.random.default_rng(0))
+            excitation = multisine_excitation(platform, kind_sines(kind, k), name=f"exp{k + 1}")
+            if engine == "mujoco":
+                from stewartid.mujoco.closed_loop import simulate_mujoco
+
+                dataset = simulate_mujoco(platform.replace(controller__integral_gain=0.0),
+                                          excitation, KIND_DURATION)
+            else:
+                dataset, _ = simulate_experiment(platform, excitation, KIND_DURATION,
+                                                 noise=SensorNoise(), rng=np.random.default_rng(0))
             write_dataset(dataset, path)
     return read_datasets(paths, platform)
 

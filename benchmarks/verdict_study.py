@@ -15,10 +15,14 @@ the share of entries within 3 reported standard errors, the largest error in sta
 and the worst held-out VAF. ``--out FILE`` appends one JSON line per log and seed;
 ``--summary FILE`` prints the Markdown tables of ``docs/benchmarks.md`` from such a file.
 
+With ``--engine mujoco`` the plant's logs come from the MuJoCo model of the same platform
+(:func:`stewartid.mujoco.closed_loop.simulate_mujoco`) instead of our plant.
+
 Usage::
 
     python benchmarks/verdict_study.py [--platform paper|FILE] [--kinds paper,tenx,three,alldof]
-        [--coulomb 0,5,30] [--seeds 4] [--example] [--clean DIR] [--out FILE]
+        [--coulomb 0,5,30] [--seeds 4] [--example] [--engine ours|mujoco] [--clean DIR]
+        [--out FILE]
     python benchmarks/verdict_study.py --summary FILE
 """
 
@@ -51,15 +55,19 @@ TRUST_FACTOR = 1.5
 TRUST_MARGIN = 0.1
 
 
-def log_sets(platform_name: str, kinds, coulombs, clean_folder: Path, example: bool):
-    """(label, platform, clean datasets, truth M, truth B, noise function) per log."""
+def log_sets(platform_name: str, kinds, coulombs, clean_folder: Path, example: bool,
+             engine: str = "ours"):
+    """(label, platform, clean datasets, truth M, truth B, noise function) per log; the
+    plant's logs simulated by ``engine`` ("ours" or "mujoco")."""
     out = []
     tag = "paper" if platform_name == "paper" else Path(platform_name).stem
+    if engine != "ours":
+        tag += f"-{engine}"
     for kind in kinds:
         for coulomb in (coulombs if kind == "paper" else (noise_study.KIND_COULOMB,)):
             platform = load_platform(platform_name).replace(friction__coulomb=float(coulomb))
             folder = clean_folder / f"{tag}_{kind}_c{coulomb:g}"
-            clean = noise_study.kind_logs(kind, platform, folder)
+            clean = noise_study.kind_logs(kind, platform, folder, engine)
             M, B = nominal_matrices(platform)
 
             def noisy(seed, platform=platform, clean=clean):
@@ -166,6 +174,9 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, default=4)
     parser.add_argument("--example", action="store_true",
                         help="also the independent simulator's example data set")
+    parser.add_argument("--engine", default="ours", choices=["ours", "mujoco"],
+                        help="simulate the plant's logs on our hydraulic plant or on the MuJoCo "
+                             "model (ideal actuators, the mujoco extra)")
     parser.add_argument("--clean", type=Path, default=Path("noise_study_logs"),
                         help="folder of the clean logs (simulated there when missing)")
     parser.add_argument("--out", type=Path, default=None, help="append JSON lines here")
@@ -179,7 +190,7 @@ def main() -> None:
     rows = []
     for label, platform, clean, M, B, noisy in log_sets(
             args.platform, args.kinds.split(","), [float(c) for c in args.coulomb.split(",")],
-            args.clean, args.example):
+            args.clean, args.example, args.engine):
         for seed in [None, *range(args.seeds)]:
             start = time.perf_counter()
             row = evaluate(label, platform, clean if seed is None else noisy(seed), M, B, seed)
