@@ -10,9 +10,16 @@ file with ``--payload``). Printed: the payload's errors (mass %, com mm, inertia
 about the com %) or full mode's (Mt(q) at 50 random poses inside the motion's range: diagonal
 %), the predicted SE against the spread over seeds, the limit use on the plant's states.
 
+With ``--engine mujoco`` the design's exported pose command files (``commands/exp*.csv``) are
+played on MuJoCo's model of the same platform instead
+(:func:`stewartid.mujoco.closed_loop.simulate_mujoco`), as another simulator would play
+them; each seed then adds the reference noise with :func:`stewartid.simulation.degrade`, and
+the limit use is the stroke and leg speed of the recorded motion.
+
 Usage::
 
     python benchmarks/physical_design_check.py [--payload] [--seeds 8] [--budget 120]
+        [--engine ours|mujoco]
 """
 
 from __future__ import annotations
@@ -40,7 +47,23 @@ from stewartid.design.prediction import (  # noqa: E402
     plant_records,
 )
 from stewartid.identification.physical import PhysicalIdentifier  # noqa: E402
+from stewartid.simulation import degrade  # noqa: E402
 from stewartid.simulation.sensors import reference_noise  # noqa: E402
+
+
+def mujoco_datasets(platform, paths: list[Path]) -> list:
+    """The design's exported pose command files played on the MuJoCo model of ``platform``,
+    as another simulator would play them (no noise)."""
+    from stewartid.design.export import read_excitation
+    from stewartid.mujoco.closed_loop import simulate_mujoco
+
+    plant = platform.replace(controller__integral_gain=0.0)
+    out = []
+    for path in paths:
+        excitation = read_excitation(path, platform)
+        out.append(simulate_mujoco(plant, excitation, excitation.duration))
+        print(f"played {path.name} on MuJoCo ({excitation.duration:.0f} s)", flush=True)
+    return out
 
 
 def main() -> None:
@@ -48,6 +71,9 @@ def main() -> None:
     parser.add_argument("--payload", action="store_true")
     parser.add_argument("--seeds", type=int, default=8)
     parser.add_argument("--budget", type=float, default=120.0)
+    parser.add_argument("--engine", default="ours", choices=["ours", "mujoco"],
+                        help="play the design's command files on our plant or on the MuJoCo "
+                             "model (ideal actuators, the mujoco extra)")
     args = parser.parse_args()
     loaded = physical_study.loaded_platform("paper")
     folder = Path(tempfile.mkdtemp(prefix="stewartid-physical-design-"))
@@ -67,13 +93,21 @@ def main() -> None:
     noise = reference_noise(loaded)
     prediction = predict_parameters(loaded, design, noise, args.payload, FINAL_RATE,
                                     filtered=True)
-    records = plant_records(loaded, design)
-    use = max(max(record_limit_use(loaded, r).peak.values()) for r in records)
-    inverse = inverse_leg_jacobians(loaded, [r.q for r in records])
+    if args.engine == "mujoco":
+        clean = mujoco_datasets(loaded, sorted((folder / "design" / "commands").glob("*.csv")))
+        use = max(physical_study.limit_peaks(loaded, clean).values())
+    else:
+        records = plant_records(loaded, design)
+        use = max(max(record_limit_use(loaded, r).peak.values()) for r in records)
+        inverse = inverse_leg_jacobians(loaded, [r.q for r in records])
     rows, estimates = [], []
     for seed in range(args.seeds):
-        generators = [np.random.default_rng([1000 + seed, k]) for k in range(len(records))]
-        data = measured_plant_datasets(loaded, records, noise, generators, inverse)
+        if args.engine == "mujoco":
+            data = [degrade(d, loaded, noise, rng=np.random.default_rng([1000 + seed, k]))
+                    for k, d in enumerate(clean)]
+        else:
+            generators = [np.random.default_rng([1000 + seed, k]) for k in range(len(records))]
+            data = measured_plant_datasets(loaded, records, noise, generators, inverse)
         fitted = PhysicalIdentifier(payload=args.payload).fit(data, loaded)
         estimates.append([fitted.parameters_[n] for n in prediction.names])
         rows.append(physical_study.payload_row(fitted, loaded, physical_study.PAYLOADS["paper"])

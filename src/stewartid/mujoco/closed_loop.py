@@ -12,16 +12,28 @@ regularised Coulomb law, its integrator, and no hydraulics (the actuators are id
 
 from __future__ import annotations
 
+from typing import Protocol
+
 import numpy as np
 
 from stewartid.datasets.dataset import Dataset
 from stewartid.mujoco import model as mjcf
 from stewartid.mujoco import state as mujoco_state
 from stewartid.platform import Platform
-from stewartid.simulation.excitation import Excitation
 
 
-def simulate_mujoco(platform: Platform, excitation: Excitation, duration: float, *,
+class Commanded(Protocol):
+    """A commanded motion: a :class:`~stewartid.simulation.excitation.Excitation` or a command
+    file's :class:`~stewartid.design.export.TabulatedExcitation`."""
+
+    name: str
+
+    def evaluate(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Pose, rate and acceleration at ``t`` (s), each of shape (N, 6)."""
+        ...
+
+
+def simulate_mujoco(platform: Platform, excitation: Commanded, duration: float, *,
                     step: float = 2.5e-4, integrator: str = "RK4") -> Dataset:
     """Play ``excitation`` on the MuJoCo model and record it at the sensors' rate.
 
@@ -37,16 +49,21 @@ def simulate_mujoco(platform: Platform, excitation: Excitation, duration: float,
     ----------
     platform : Platform
         Mechanism, friction, ``[controller]`` gains and ``[sensors] sample_rate``.
-    excitation : Excitation
-        The commanded motion.
+    excitation : Commanded
+        The commanded motion (a sine excitation, or a command file read by
+        :func:`stewartid.design.export.read_excitation`).
     duration : float
         Record length (s).
     step : float
-        MuJoCo's time step (s); rounded down to divide the sample period. The stiff servo
-        turns MuJoCo's O(step^2) state error into forces that depart from the rigid-body
-        dynamics of the recorded motion: on the paper platform with a 2 t payload, 2.5 N rms
-        at 0.5 ms and 0.5 N at 0.25 ms (forces up to 44 kN; our reference force noise is
-        0.5 % of the static leg force, about 140 N there).
+        MuJoCo's time step (s); rounded down to divide the sample period. The recorded forces
+        depart from the rigid-body dynamics of the recorded motion by O(step^2): on the paper
+        platform with a 2 t payload, 2.5 N rms at 0.5 ms and 0.5 N at 0.25 ms (forces up to
+        44 kN; our reference force noise is 0.5 % of the static leg force, about 140 N there).
+        Most of it acts like a damper along the legs: 21 N s/m at 0.5 ms, 5.3 at 0.25 ms and
+        1.3 at 0.125 ms, proportional to each of the servo's gains and not to the welds' time
+        constant (the stiff servo integrated with its command held over each step). At
+        0.25 ms it raises the heave damping Bt(3,3) of the paper platform by 0.9 % and the
+        other Bt entries by 0.15 %: compare noise-free fits at that level.
     integrator : {"RK4", "implicitfast", "implicit", "Euler"}
         MuJoCo integrator.
 
