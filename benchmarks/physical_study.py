@@ -65,9 +65,8 @@ PAYLOADS = {
                 "inertia": [900.0, 1100.0, 1400.0, 60.0, -40.0, 90.0]},
 }
 DURATION = 20.0
-#: MuJoCo's RK4 step (s) for ``--engine mujoco``: its force records then depart from the
-#: rigid-body dynamics by O(step^2) (0.5 N rms at 0.25 ms, 2.5 N at 0.5 ms).
-MUJOCO_STEP = 2.5e-4  # simulate_mujoco's default
+#: MuJoCo's RK4 step (s) for ``--engine mujoco`` (simulate_mujoco's default).
+MUJOCO_STEP = 5e-4
 EXAMPLE = Path(__file__).resolve().parents[1] / "tests" / "data" / "example_c10" / "platform.toml"
 
 
@@ -85,7 +84,7 @@ def clean_records(platform, name: str, scale: float, slower: float = 1.0,
     on our hydraulic plant, or on the MuJoCo model with ideal actuators (``engine``)."""
     tag = f"{name}-{scale}-{DURATION}-v1" + (f"-{slower}" if slower != 1.0 else "")
     if engine == "mujoco":
-        tag += f"-mujoco-{MUJOCO_STEP}-v2"
+        tag += f"-mujoco-{MUJOCO_STEP}-v3"
     key = hashlib.sha1(tag.encode()).hexdigest()[:10]
     cache = Path(tempfile.gettempdir()) / f"stewartid-physical-study-{key}.pkl"
     if cache.exists():

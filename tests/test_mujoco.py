@@ -166,8 +166,8 @@ def _closed_loop(platform, step=5e-4, duration=2.0):
 
     Ideal actuators; the plant's PD servo on leg length with gravity feed-forward (integral
     gain 0: MuJoCo would need an extra state per leg for it). Our plant integrates with RK4
-    at ``step``; MuJoCo too, with the servo's PD part in the motors' bias (evaluated at every
-    RK4 stage, like ours) and the command part held over each step at its midpoint value.
+    at ``step``; MuJoCo too, with the servo's PD part in the motors' bias and the command
+    part through the control callback, both evaluated at every RK4 stage, like ours.
     Returns the two pose records at 1 kHz and the commanded poses.
     """
     plant = platform.replace(hydraulics__mode="ideal", controller__integral_gain=0.0)
@@ -184,10 +184,10 @@ def _closed_loop(platform, step=5e-4, duration=2.0):
 def test_closed_loop_without_friction_agrees_to_integration_error(paper):
     """No joint friction: the two engines differ only by O(h^2) effects of MuJoCo's side.
 
-    The command held at the step's midpoint and the welds' compliance (time constant 2h)
-    are both second order in the step h: measured 8.8e-8 m and 2.3e-8 rad at h = 0.5 ms,
-    2.2e-8 m at 0.25 ms. The tracking error itself is about 7 mm: the engines agree to
-    1e-5 of it. Tolerance 5e-7 (m and rad).
+    The command is evaluated at every stage of both integrators; the welds' compliance (time
+    constant 2h) is second order in the step h: measured 1.1e-7 m and 2.4e-8 rad at
+    h = 0.5 ms, 2.8e-8 m and 6.0e-9 rad at 0.25 ms. The tracking error itself is about 7 mm:
+    the engines agree to 2e-5 of it. Tolerance 5e-7 (m and rad).
     """
     ours, theirs, command = _closed_loop(paper.replace(friction__gimbal_viscous=0.0))
     assert np.abs(ours - command)[:, :3].max() > 1e-3  # a real tracking error to reproduce

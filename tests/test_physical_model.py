@@ -261,9 +261,8 @@ def test_another_engines_log_identifies_the_payload(loaded):
     """Two 3 s records of the MuJoCo model (its own rigid-body algorithms, Cardan chains and
     friction constraints, ideal actuators; every DOF at three times the paper's amplitude),
     noise-free: payload mode meets the acceptance's 0.5 %, 5 mm and 5 % with every payload
-    parameter within 4.5 of its standard errors (measured: 0.034 %, 1.5 mm, 1.0 %, largest
-    1.1 SE; the residual is MuJoCo's O(step^2) integration error, 2.5 N rms at 0.5 ms), and
-    full mode the moving body's mass within 0.2 %."""
+    parameter within 4.5 of its standard errors (measured: 0.068 %, 1.5 mm, 0.56 %, largest
+    1.4 SE), and full mode the moving body's mass within 0.2 % (0.084 %)."""
     pytest.importorskip("mujoco")
     from stewartid.mujoco.closed_loop import simulate_mujoco
 

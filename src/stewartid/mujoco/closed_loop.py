@@ -34,16 +34,23 @@ class Commanded(Protocol):
 
 
 def simulate_mujoco(platform: Platform, excitation: Commanded, duration: float, *,
-                    step: float = 2.5e-4, integrator: str = "RK4") -> Dataset:
+                    step: float = 5e-4, integrator: str = "RK4") -> Dataset:
     """Play ``excitation`` on the MuJoCo model and record it at the sensors' rate.
 
     The legs are ideal force actuators under the PD part of the plant's leg-length servo with
     its gravity feed-forward (:func:`~stewartid.mujoco.state.add_leg_servo`; MuJoCo would need
-    an extra state per leg for the integral term, which is left out). The command enters each
-    step at the step's midpoint value. Every sample is MuJoCo's exact state: the platform's
-    pose, the slides' leg lengths and the actuator forces, the latter with the command at
-    the sample's time (the forces a load cell would read then). No sensor errors: add them
-    with :func:`stewartid.simulation.degrade`.
+    an extra state per leg for the integral term, which is left out). Every sample is
+    MuJoCo's exact state: the platform's pose, the slides' leg lengths and the actuator
+    forces (the forces a load cell would read then). No sensor errors: add them with
+    :func:`stewartid.simulation.degrade`.
+
+    The command is evaluated at every stage of the integrator, through MuJoCo's control
+    callback (set for the run, the previous one restored after), from a table at half steps.
+    Held over each step instead, as ``ctrl`` is by default, RK4 integrates the stiff servo
+    with an error that acts like a damper along the legs, K_p K_d step^2 / (12 m) for a mass
+    m on the servo: on the paper platform 21 N s/m at 0.5 ms, which raised the heave damping
+    Bt(3,3) by 3.7 % and put 2.5 N rms between the recorded forces and the recorded motion.
+    Evaluated at every stage, that gap is 2e-4 N rms at 0.5 ms (forces up to 44 kN).
 
     Parameters
     ----------
@@ -55,19 +62,10 @@ def simulate_mujoco(platform: Platform, excitation: Commanded, duration: float, 
     duration : float
         Record length (s).
     step : float
-        MuJoCo's time step (s); rounded down to divide the sample period. The recorded forces
-        depart from the rigid-body dynamics of the recorded motion by O(step^2): on the paper
-        platform with a 2 t payload, 2.5 N rms at 0.5 ms and 0.5 N at 0.25 ms (forces up to
-        44 kN; our reference force noise is 0.5 % of the static leg force, about 140 N there).
-        Most of it acts like a damper along the legs: 21 N s/m at 0.5 ms, 5.3 at 0.25 ms and
-        1.3 at 0.125 ms, proportional to each of the servo's gains and not to the welds' time
-        constant: the stiff servo integrated by RK4 with its command held over each step (a
-        mass m on the same servo, integrated so, shows K_p K_d step^2 / (12 m), 31 N s/m at
-        0.5 ms for m = 2700 kg; none with the command evaluated at every stage). At
-        0.25 ms it raises the heave damping Bt(3,3) of the paper platform by 0.9 % and the
-        other Bt entries by 0.15 %: compare noise-free fits at that level.
+        MuJoCo's time step (s); rounded down to divide the sample period.
     integrator : {"RK4", "implicitfast", "implicit", "Euler"}
-        MuJoCo integrator.
+        MuJoCo integrator; its stages must lie on the half-step table (RK4's do, and the
+        one-stage integrators').
 
     Returns
     -------
@@ -93,23 +91,27 @@ def simulate_mujoco(platform: Platform, excitation: Commanded, duration: float, 
     model = mjcf.load_model(platform, integrator=integrator, timestep=step)
     data = mj.MjData(model)
     mujoco_state.add_leg_servo(platform, model)
-    q_mid, qd_mid, _ = excitation.evaluate((np.arange((n_samples - 1) * per_sample) + 0.5) * step)
-    ctrl = mujoco_state.servo_controls(platform, q_mid, qd_mid)
-    t = np.arange(n_samples) / rate  # as simulate_experiment's
-    q_at, qd_at, _ = excitation.evaluate(t)
-    ctrl_at = mujoco_state.servo_controls(platform, q_at, qd_at)
-    mujoco_state.set_state(platform, model, data, q_at[0], qd_at[0])
+    half = step / 2
+    q_cmd, qd_cmd, _ = excitation.evaluate(np.arange(2 * (n_samples - 1) * per_sample + 3) * half)
+    table = mujoco_state.servo_controls(platform, q_cmd, qd_cmd)
+
+    def control(_model: object, state: object) -> None:
+        state.ctrl[:] = table[int(round(state.time / half))]
+
+    mujoco_state.set_state(platform, model, data, q_cmd[0], qd_cmd[0])
     pose = np.empty((n_samples, 6))
     lengths = np.empty((n_samples, 6))
     forces = np.empty((n_samples, 6))
-    for i in range(n_samples):
-        if i:
-            for k in range((i - 1) * per_sample, i * per_sample):
-                data.ctrl[:] = ctrl[k]
+    previous = mj.get_mjcb_control()
+    mj.set_mjcb_control(control)
+    try:
+        for i in range(n_samples):
+            for _ in range(per_sample if i else 0):
                 mj.mj_step(model, data)
-        data.ctrl[:] = ctrl_at[i]
-        mj.mj_forward(model, data)  # the forces at the sample's own command
-        pose[i] = mujoco_state.platform_state(model, data)[0]
-        lengths[i] = mujoco_state.leg_lengths(platform, model, data)
-        forces[i] = data.actuator_force
-    return Dataset(t, pose, lengths, forces, name=excitation.name)
+            mj.mj_forward(model, data)  # the forces at the sample's own command
+            pose[i] = mujoco_state.platform_state(model, data)[0]
+            lengths[i] = mujoco_state.leg_lengths(platform, model, data)
+            forces[i] = data.actuator_force
+    finally:
+        mj.set_mjcb_control(previous)
+    return Dataset(np.arange(n_samples) / rate, pose, lengths, forces, name=excitation.name)
