@@ -46,6 +46,8 @@ def simulate_mujoco(platform: Platform, excitation: Commanded, duration: float, 
 
     The command is evaluated at every stage of the integrator, through MuJoCo's control
     callback (set for the run, the previous one restored after), from a table at half steps.
+    That callback is global to the process: run one simulation per process at a time (worker
+    processes, not threads).
     Held over each step instead, as ``ctrl`` is by default, RK4 integrates the stiff servo
     with an error that acts like a damper along the legs, K_p K_d step^2 / (12 m) for a mass
     m on the servo: on the paper platform 21 N s/m at 0.5 ms, which raised the heave damping
