@@ -330,8 +330,7 @@ def kind_logs(kind: str, platform, folder: Path, engine: str = "ours") -> list[D
             if engine == "mujoco":
                 from stewartid.mujoco.closed_loop import simulate_mujoco
 
-                dataset = simulate_mujoco(platform.replace(controller__integral_gain=0.0),
-                                          excitation, KIND_DURATION)
+                dataset = simulate_mujoco(platform, excitation, KIND_DURATION)
             else:
                 dataset, _ = simulate_experiment(platform, excitation, KIND_DURATION,
                                                  noise=SensorNoise(), rng=np.random.default_rng(0))

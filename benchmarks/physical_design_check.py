@@ -57,11 +57,10 @@ def mujoco_datasets(platform, paths: list[Path]) -> list:
     from stewartid.design.export import read_excitation
     from stewartid.mujoco.closed_loop import simulate_mujoco
 
-    plant = platform.replace(controller__integral_gain=0.0)
     out = []
     for path in paths:
         excitation = read_excitation(path, platform)
-        out.append(simulate_mujoco(plant, excitation, excitation.duration))
+        out.append(simulate_mujoco(platform, excitation, excitation.duration))
         print(f"played {path.name} on MuJoCo ({excitation.duration:.0f} s)", flush=True)
     return out
 

@@ -97,8 +97,7 @@ def clean_records(platform, name: str, scale: float, slower: float = 1.0,
         if engine == "mujoco":
             from stewartid.mujoco.closed_loop import simulate_mujoco
 
-            out.append(simulate_mujoco(platform.replace(controller__integral_gain=0.0),
-                                       excitation, DURATION, step=MUJOCO_STEP))
+            out.append(simulate_mujoco(platform, excitation, DURATION, step=MUJOCO_STEP))
         else:
             out.append(simulate_experiment(platform, excitation, DURATION, noise=SensorNoise(),
                                            rng=np.random.default_rng(k))[0])
