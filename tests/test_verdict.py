@@ -8,7 +8,11 @@ import pytest
 
 from stewartid.assessment.validation import Segment, ValidationResult
 from stewartid.assessment.verdict import choose_trusted
-from stewartid.identification.accuracy import expected_worst_error
+from stewartid.identification.accuracy import (
+    PRECISION_FACTOR,
+    cross_checked_relative_std,
+    expected_worst_error,
+)
 from stewartid.identification.result import IdentificationResult
 
 
@@ -111,3 +115,34 @@ def test_a_close_call_is_named_and_a_clear_one_is_not():
     implausible = choose_trusted({"a": (_result(0.010), _validation(0.1)),
                                   "b": (_result(0.010, definite=False), _validation(0.1))})
     assert implausible.close == ("a",)
+
+
+def test_a_more_precise_estimate_measures_an_entrys_error():
+    """Worked by hand on Bt(1,5) (index 16) and its partner Bt(5,1)."""
+    a, b, c = _result(0.001), _result(0.001), _result(0.001)
+    a.B[0, 4], a.std_errors_B[0, 4] = 1000.0, 100.0
+    b.B[0, 4], b.std_errors_B[0, 4] = 1003.0, 10.0        # 10x as precise: measures
+    b.B[4, 0], b.std_errors_B[4, 0] = 1040.0, 5.0         # the partner measures too
+    c.std_errors_B[0, 4] = c.std_errors_B[4, 0] = 100.0 / (0.9 * PRECISION_FACTOR)  # too few
+    relative, measured = cross_checked_relative_std(a, [b, c])
+    assert measured == [16]
+    assert relative[16] == pytest.approx(np.hypot(3.0, 10.0) / 1000.0, rel=1e-12)
+    assert cross_checked_relative_std(a, [c])[1] == []
+
+
+def test_a_standard_error_widened_for_a_model_error_a_precise_fit_shows_absent():
+    """Method B's pair-widened coupling (6 %) is exact; least squares, 1 % everywhere and
+    1 % off, measures it: Method B is trusted, as its errors without the widened entry
+    say. Without the cross-check its predicted largest error would be about 6 %."""
+    wavelet, ls = _result(0.001), _result(0.01, shift=0.01)
+    ls.B[:] *= 1.01
+    wavelet.std_errors_B[0, 4] = wavelet.std_errors_B[4, 0] = 0.06 * abs(wavelet.B[0, 4])
+    verdict = choose_trusted({"wavelet": (wavelet, _validation(0.1)),
+                              "ls": (ls, _validation(0.1))})
+    assert verdict.trusted == "wavelet"
+    assert verdict.standings["wavelet"].measured_entries == ("Bt(1,5)", "Bt(5,1)")
+    assert verdict.standings["wavelet"].expected_worst < 0.02
+    # Method B measures least squares' other 18 entries: 1 % off, as their errors said
+    assert len(verdict.standings["ls"].measured_entries) == 18
+    assert verdict.standings["ls"].expected_worst > 0.02
+    assert expected_worst_error(np.r_[0.06, 0.06, np.full(18, 0.001)]) > 0.05
