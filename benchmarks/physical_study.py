@@ -44,6 +44,7 @@ from stewartid.identification.physical import PhysicalIdentifier
 from stewartid.model import matrix_regressors
 from stewartid.model import regressor as reg
 from stewartid.model.linearization import nominal_matrices
+from stewartid.mujoco.model import DEFAULT_TIMESTEP
 from stewartid.platform import load_platform
 from stewartid.simulation import (
     DEFAULT_AMPLITUDES,
@@ -66,7 +67,7 @@ PAYLOADS = {
 }
 DURATION = 20.0
 #: MuJoCo's RK4 step (s) for ``--engine mujoco`` (simulate_mujoco's default).
-MUJOCO_STEP = 5e-4
+MUJOCO_STEP = DEFAULT_TIMESTEP
 EXAMPLE = Path(__file__).resolve().parents[1] / "tests" / "data" / "example_c10" / "platform.toml"
 
 

@@ -9,10 +9,13 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
+from stewartid.errors import ConfigError
 from stewartid.files import check_output_folder
 from stewartid.platform import load_platform
 
 if TYPE_CHECKING:
+    from stewartid.platform import Platform
+    from stewartid.simulation.experiments import SimulationResult
     from stewartid.simulation.sensors import SensorNoise
 
 #: The sensor imperfections set on the command line: flag -> (SensorNoise field, help).
@@ -89,6 +92,11 @@ def simulate(
         "--excitation", metavar="FILE", help="Play this excitation file instead of the paper's sines: CSV "
         "with t and the pose x..rz (m, rad) or t and l1..l6 (m), e.g. a command file of "
         "`stewartid design`; repeat for more experiments (exp1, exp2, ...).")] = None,
+    engine: Annotated[str, typer.Option(
+        "--engine", metavar="ours|mujoco", help="'ours' (the hydraulic plant) or 'mujoco' (the "
+        "same platform in MuJoCo, an independent engine: ideal leg actuators under the "
+        "servo's PD law, MuJoCo's friction constraints; needs the [mujoco] extra). The sensor "
+        "errors are the same on both.")] = "ours",
     jobs: Annotated[int | None, typer.Option(
         "--jobs", metavar="N", help="Worker processes for the paper's experiments (default: every core); "
         "the data do not depend on it.")] = None,
@@ -117,6 +125,10 @@ def simulate(
 
     description = load_platform(platform)
     check("--format", format, [Options(("csv", "parquet"))])
+    check("--engine", engine, [Options(("ours", "mujoco"))])
+    if engine == "mujoco" and actuator == "hydraulic":
+        raise ConfigError("--actuator hydraulic: MuJoCo's legs are ideal force actuators; "
+                          "leave --actuator out or use --engine ours.")
     # before the simulation, which takes a while; write_experiments checks again
     check_output_folder(out, force, is_experiment_file)
     for flag, value, constraint, unit in (
@@ -141,7 +153,11 @@ def simulate(
         def progress(done: int, total: int, name: str) -> None:
             bar.update(task, completed=done, description=f"simulated {name}")
 
-        if excitation:
+        workers = (os.cpu_count() or 1) if jobs is None else jobs
+        if engine == "mujoco":
+            result = _on_mujoco(description, coulomb, viscous, excitation, frequency, duration,
+                                noise, seed, progress, workers)
+        elif excitation:
             from stewartid.design.export import read_excitation, simulate_excitations  # as above
 
             overrides = {key: value for key, value in (
@@ -155,10 +171,41 @@ def simulate(
             result = simulate_experiments(description, coulomb=coulomb, viscous=viscous,
                                           frequency_hz=frequency, duration_s=duration,
                                           noise=noise, seed=seed, actuator=actuator,
-                                          progress=progress,
-                                          jobs=(os.cpu_count() or 1) if jobs is None else jobs)
+                                          progress=progress, jobs=workers)
     paths = write_experiments(result, out, format=format, force=force)
-    typer.echo(f"wrote {len(paths) - 1} experiments and meta.json to {out}")
+    engine_note = " (MuJoCo: ideal leg actuators, no hydraulics)" if engine == "mujoco" else ""
+    typer.echo(f"wrote {len(paths) - 1} experiments and meta.json to {out}{engine_note}")
+
+
+def _on_mujoco(description: Platform, coulomb: float | None, viscous: float | None,
+               excitation: list[Path] | None, frequency: float, duration: float,
+               noise: SensorNoise, seed: int, progress: Any, jobs: int) -> SimulationResult:
+    """``simulate --engine mujoco``: the paper's experiments or the excitation files played on
+    the MuJoCo model (:func:`stewartid.mujoco.experiments.simulate_on_mujoco`)."""
+    from stewartid.design.export import read_excitation
+    from stewartid.simulation import paper_experiments
+
+    try:
+        from stewartid.mujoco.experiments import simulate_on_mujoco
+        from stewartid.mujoco.model import require_mujoco
+
+        require_mujoco()
+    except ImportError as exc:
+        raise ConfigError(f"--engine mujoco: {exc}.") from None
+    overrides = {key: value for key, value in (
+        ("friction__coulomb", coulomb), ("friction__gimbal_viscous", viscous))
+        if value is not None}
+    description = description.replace(**overrides) if overrides else description
+    if excitation:
+        played = [read_excitation(path, description) for path in excitation]
+        durations = [e.duration for e in played]
+        meta = {"sources": [e.name for e in played]}
+    else:
+        played = paper_experiments(description, frequency)
+        durations = [duration] * len(played)
+        meta = {"frequency_hz": frequency, "duration_s": duration}
+    return simulate_on_mujoco(description, played, durations, noise, seed, progress=progress,
+                              jobs=jobs, excitation_meta=meta)
 
 
 def with_imperfections(noise: SensorNoise, sample_rate: float,

@@ -34,7 +34,7 @@ class Commanded(Protocol):
 
 
 def simulate_mujoco(platform: Platform, excitation: Commanded, duration: float, *,
-                    step: float = 5e-4, integrator: str = "RK4") -> Dataset:
+                    step: float = mjcf.DEFAULT_TIMESTEP, integrator: str = "RK4") -> Dataset:
     """Play ``excitation`` on the MuJoCo model and record it at the sensors' rate.
 
     The legs are ideal force actuators under the PD part of the plant's leg-length servo with

@@ -94,6 +94,9 @@ END_MASS_FRACTION = 1e-4
 END_RADIUS = 0.3
 #: Integrators accepted by :func:`build_mjcf` (MuJoCo's names).
 INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast")
+#: MuJoCo's default time step here (s): with RK4, the welds' error is then 1.1e-7 m against our
+#: plant in closed loop without friction, below the reference length noise (20 um).
+DEFAULT_TIMESTEP = 5e-4
 
 
 def require_mujoco() -> Any:
@@ -174,7 +177,8 @@ def _platform_inertial(platform: Platform) -> tuple[float, np.ndarray, np.ndarra
     return mass, com, full, end_mass, end_inertia
 
 
-def build_mjcf(platform: Platform, *, integrator: str = "RK4", timestep: float = 5e-4,
+def build_mjcf(platform: Platform, *, integrator: str = "RK4",
+               timestep: float = DEFAULT_TIMESTEP,
                constraint_timeconst: float | None = None, constraint_impedance: float = 0.9999,
                coulomb: bool = True) -> str:
     """MJCF text of the platform's mechanism (frames and bodies in the module docstring).

@@ -101,7 +101,9 @@ class SimulationResult:
     states: list[ExperimentRecord]
 
 
-def _check_timing(duration_s: float, sample_rate: float, max_frequency: float) -> None:
+def check_timing(duration_s: float, sample_rate: float, max_frequency: float) -> None:
+    """Raise ConfigError, in one line, on a record length that is not positive or an
+    excitation frequency (Hz) not below the Nyquist limit of ``sample_rate`` (Hz)."""
     if not (math.isfinite(duration_s) and duration_s > 0):
         raise ConfigError(f"duration must be > 0 s; got {duration_s!r}.")
     nyquist = sample_rate / 2
@@ -156,7 +158,7 @@ def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: 
         If a leg leaves its stroke or the integration diverges.
     """
     fs = platform.sensors.sample_rate
-    _check_timing(duration_s, fs, excitation.max_frequency)
+    check_timing(duration_s, fs, excitation.max_frequency)
     if not (step > 0 and math.isfinite(step)):
         raise ConfigError(f"integration step must be > 0 s; got {step!r}.")
     noise = SensorNoise.from_sensors(platform.sensors) if noise is None else noise
@@ -273,7 +275,7 @@ def simulate_experiments(platform: Platform, coulomb: float | None = None,
     if updates:
         platform = platform.replace(**updates)
     noise = SensorNoise.from_sensors(platform.sensors) if noise is None else noise
-    _check_timing(duration_s, platform.sensors.sample_rate, frequency_hz)
+    check_timing(duration_s, platform.sensors.sample_rate, frequency_hz)
     noise.check_sampling(platform.sensors.sample_rate)
     if not (isinstance(seed, int | np.integer) and seed >= 0):
         raise ConfigError(f"seed must be an integer >= 0; got {seed!r}.")

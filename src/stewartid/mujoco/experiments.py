@@ -1,0 +1,109 @@
+"""Experiments played on the MuJoCo model, with sensor errors, as ``stewartid simulate``
+writes the plant's (``--engine mujoco``).
+
+A second engine for every check a user runs on our plant: the paper's six sine experiments or
+any command files (a design's), each played by
+:func:`~stewartid.mujoco.closed_loop.simulate_mujoco` and then measured by the same sensor
+model (:func:`~stewartid.simulation.sensors.degrade`, the noise stream of experiment k of
+:func:`~stewartid.simulation.experiments.noise_generator`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import stewartid
+from stewartid.model.linearization import nominal_matrices
+from stewartid.mujoco.model import DEFAULT_TIMESTEP, require_mujoco
+from stewartid.parallel import run_in_order
+from stewartid.platform import Platform
+from stewartid.simulation.experiments import SimulationResult, check_timing, noise_generator
+from stewartid.simulation.sensors import SensorNoise, degrade
+
+#: What the MuJoCo model's legs are, for the record's metadata.
+ACTUATORS = ("ideal force actuators under the leg-length servo's PD law with gravity "
+             "feed-forward (no hydraulics, no integral term)")
+
+
+def _play(run: tuple) -> Any:
+    from stewartid.mujoco.closed_loop import simulate_mujoco
+
+    platform, excitation, duration, noise, seed, k, count, step = run
+    clean = simulate_mujoco(platform, excitation, duration, step=step)
+    measured = degrade(clean, platform, noise, noise_generator(seed, k, count))
+    return dataclasses.replace(measured, name=f"exp{k + 1}")
+
+
+def simulate_on_mujoco(platform: Platform, excitations: Sequence[Any],
+                       durations: Sequence[float], noise: SensorNoise | None = None,
+                       seed: int = 0, step: float = DEFAULT_TIMESTEP,
+                       progress: Callable[[int, int, str], Any] | None = None,
+                       jobs: int = 1, excitation_meta: dict | None = None
+                       ) -> SimulationResult:
+    """Play excitations on the MuJoCo model, one experiment each, with sensor errors.
+
+    Parameters
+    ----------
+    platform : Platform
+        Mechanism, friction, ``[controller]`` gains and ``[sensors]``.
+    excitations : sequence
+        Commanded motions (:class:`~stewartid.mujoco.closed_loop.Commanded`); experiment k
+        is named ``exp{k+1}``.
+    durations : sequence of float
+        Record length of each (s).
+    noise : SensorNoise, optional
+        Sensor errors; the platform's ``[sensors]`` section by default.
+    seed : int
+        Seed of the sensor errors (one independent stream per experiment, as our plant's).
+    step : float
+        MuJoCo's time step (s).
+    progress : callable, optional
+        ``progress(done, total, name)`` as experiments finish.
+    jobs : int
+        Worker processes (MuJoCo's control callback is global to a process, so experiments
+        run in separate processes or one after another); the data do not depend on it.
+    excitation_meta : dict, optional
+        The ``excitation`` entry of the metadata (default: the experiments' names).
+
+    Returns
+    -------
+    SimulationResult
+        No true states (``states`` empty); ``meta["engine"]`` is ``"mujoco"``.
+
+    Raises
+    ------
+    ImportError
+        If MuJoCo is not installed (``pip install "stewartid[mujoco]"``).
+    ConfigError
+        On a record length that is not positive, or an excitation or sensor-filter
+        frequency at or above the Nyquist limit.
+    """
+    mujoco = require_mujoco()
+    noise = SensorNoise.from_sensors(platform.sensors) if noise is None else noise
+    rate = platform.sensors.sample_rate
+    noise.check_sampling(rate)
+    for excitation, duration in zip(excitations, durations, strict=True):
+        check_timing(duration, rate, excitation.max_frequency)
+    runs = [(platform, excitation, float(duration), noise, seed, k, len(excitations), step)
+            for k, (excitation, duration) in enumerate(zip(excitations, durations, strict=True))]
+
+    def finished(done: int, total: int, index: int) -> None:
+        progress(done, total, excitations[index].name)
+
+    per_sample = max(1, math.ceil(1.0 / (rate * step) - 1e-9))  # as simulate_mujoco rounds
+    datasets = run_in_order(_play, runs, jobs, finished if progress is not None else None)
+    M, B = nominal_matrices(platform)
+    meta = {"engine": "mujoco", "platform": platform.to_dict(),
+            "platform_name": platform.name,
+            "excitation": excitation_meta or {"sources": [e.name for e in excitations]},
+            "integration": {"engine": "mujoco", "version": mujoco.__version__,
+                            "integrator": "RK4", "step": 1.0 / (rate * per_sample)},
+            "actuators": ACTUATORS, "noise": dataclasses.asdict(noise), "seed": int(seed),
+            "nominal": {"M": M.tolist(), "B": B.tolist()}, "version": stewartid.__version__}
+    return SimulationResult(list(datasets), meta, [])
+
+
+__all__ = ["ACTUATORS", "simulate_on_mujoco"]
