@@ -46,7 +46,7 @@ trusted one's by more than :data:`DISAGREEMENT` combined standard errors.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -117,6 +117,11 @@ def worst_relative_std(result: IdentificationResult) -> tuple[float, str]:
     values = entry_relative_std(result)
     k = int(np.argmax(values))
     return float(values[k]), entry_label(PAPER_ENTRIES[k])
+
+
+def named_entries(entries: Sequence[str]) -> str:
+    """Entry labels for a sentence: listed up to six, counted beyond."""
+    return ", ".join(entries) if len(entries) <= 6 else f"{len(entries)} of the paper's 20 entries"
 
 
 def uncertain_entries(trusted: IdentificationResult,
@@ -377,11 +382,9 @@ def _reasons(trusted: str, standings: Mapping[str, Standing], tied: list[str],
                f"{best.worst_vaf_percent:.4g} % in its worst DOF ({best.worst_dof})."]
     for name, standing in standings.items():
         if standing.measured_entries:
-            entries = standing.measured_entries
-            named = (", ".join(entries) if len(entries) <= 6 else
-                     f"{len(entries)} of the paper's 20 entries")
             reasons.append(f"{name}: another method's estimates, over {PRECISION_FACTOR:g}x "
-                           f"more precise, measure its errors of {named}; they replace those "
+                           f"more precise, measure its errors of "
+                           f"{named_entries(standing.measured_entries)}; they replace those "
                            "standard errors in its predicted largest error.")
     if len(tied) > 1:
         reasons.append(f"{', '.join(tied)} predict the same largest error (within "
@@ -420,5 +423,5 @@ def _reasons(trusted: str, standings: Mapping[str, Standing], tied: list[str],
 __all__ = ["CLOSE_FACTOR", "DAMPING_EXCESS", "DISAGREEMENT", "MISFIT_FACTOR", "MISFIT_FLOOR", "SIGNIFICANT",
            "TIE_FACTOR", "UNCERTAIN_RELATIVE", "Standing", "Verdict", "choose_trusted",
            "finds_friction", "friction_immune",
-           "is_definite", "relative_std", "uncertain_entries", "worst_dof",
+           "is_definite", "named_entries", "relative_std", "uncertain_entries", "worst_dof",
            "worst_relative_std"]

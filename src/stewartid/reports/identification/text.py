@@ -14,8 +14,9 @@ from typing import Any
 import numpy as np
 
 from stewartid.assessment.validation import friction_signature
-from stewartid.assessment.verdict import CLOSE_FACTOR, Verdict, relative_std, worst_dof
+from stewartid.assessment.verdict import CLOSE_FACTOR, Verdict, named_entries, relative_std, worst_dof
 from stewartid.datasets.dataset import Dataset
+from stewartid.identification.accuracy import PRECISION_FACTOR
 from stewartid.identification.consistency import consistency_metrics, is_consistent
 from stewartid.identification.wavelet.noise import white_noise_covariance
 from stewartid.platform import COORDINATES, Platform
@@ -160,6 +161,13 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
              f"({trusted.worst_dof})"
              + (" (methods tied in uncertainty: the held-out prediction decides)."
                 if len(verdict.tied) > 1 else ".")]
+    measured = [f"{run.display_name}, {named_entries(standing.measured_entries)}"
+                for run in ok if (standing := verdict.standings[run.name]).measured_entries]
+    if measured:
+        lines.append(f"Where another method estimates an entry over {PRECISION_FACTOR:g}× more "
+                     "precisely, the difference between the two measures the error there and "
+                     "replaces the standard error in these predictions: "
+                     + "; ".join(measured) + ".")
     if len(verdict.close) > 1:
         names = [next(run.display_name for run in ok if run.name == name)
                  for name in verdict.close]
