@@ -78,6 +78,7 @@ def cross_checked_relative_std(result: IdentificationResult,
     symmetric) with a standard error s_o at most 1 / :data:`PRECISION_FACTOR` of this
     result's s, this result's error there is its difference d from that estimate, known to
     within s_o: the scale is sqrt(d^2 + s_o^2) (the least over such results) instead of s.
+    An estimate without a positive, finite standard error measures nothing.
     A standard error widened for model error (a symmetric pair whose members disagree, a
     log limited by its sampling) covers a bias the data cannot place; a more precise fit that
     agrees shows it absent, and one that disagrees shows it present.
@@ -103,7 +104,7 @@ def cross_checked_relative_std(result: IdentificationResult,
         scales = [float(np.hypot(v - value, s)) for other in others
                   for v, s in {entry_estimate(other, matrix, i, j),
                                entry_estimate(other, matrix, j, i)}
-                  if PRECISION_FACTOR * s <= std and np.isfinite(v)]
+                  if 0 < PRECISION_FACTOR * s <= std and np.isfinite(v)]
         if scales and value != 0:
             relative[k] = min(scales) / abs(value)
             measured.append(k)
