@@ -113,7 +113,8 @@ def simulate(
     length_resolution: Annotated[float | None,
                                  imperfection_option("--length-resolution")] = None,
 ) -> None:
-    """Simulate the six experiments (experiment k excites DOF k) on the hydraulic plant."""
+    """Simulate the six experiments (experiment k excites DOF k) on the hydraulic plant, or
+    with ``--engine mujoco`` on MuJoCo's model of the platform."""
     # simulation, design and rich.progress load in 0.4-0.5 s; every command's module is
     # imported when the command line starts, so they are imported when this one runs
     from rich.progress import Progress
@@ -160,10 +161,7 @@ def simulate(
         elif excitation:
             from stewartid.design.export import read_excitation, simulate_excitations  # as above
 
-            overrides = {key: value for key, value in (
-                ("friction__coulomb", coulomb), ("friction__gimbal_viscous", viscous),
-                ("hydraulics__mode", actuator)) if value is not None}
-            description = description.replace(**overrides) if overrides else description
+            description = _overridden(description, coulomb, viscous, actuator)
             result = simulate_excitations(
                 description, [read_excitation(path, description) for path in excitation],
                 noise, seed, progress)
@@ -175,6 +173,15 @@ def simulate(
     paths = write_experiments(result, out, format=format, force=force)
     engine_note = " (MuJoCo: ideal leg actuators, no hydraulics)" if engine == "mujoco" else ""
     typer.echo(f"wrote {len(paths) - 1} experiments and meta.json to {out}{engine_note}")
+
+
+def _overridden(description: Platform, coulomb: float | None, viscous: float | None,
+                actuator: str | None) -> Platform:
+    """The platform with the friction and actuator flags given on the command line."""
+    overrides = {key: value for key, value in (
+        ("friction__coulomb", coulomb), ("friction__gimbal_viscous", viscous),
+        ("hydraulics__mode", actuator)) if value is not None}
+    return description.replace(**overrides) if overrides else description
 
 
 def _on_mujoco(description: Platform, coulomb: float | None, viscous: float | None,
@@ -192,10 +199,7 @@ def _on_mujoco(description: Platform, coulomb: float | None, viscous: float | No
         require_mujoco()
     except ImportError as exc:
         raise ConfigError(f"--engine mujoco: {exc}.") from None
-    overrides = {key: value for key, value in (
-        ("friction__coulomb", coulomb), ("friction__gimbal_viscous", viscous))
-        if value is not None}
-    description = description.replace(**overrides) if overrides else description
+    description = _overridden(description, coulomb, viscous, None)
     if excitation:
         played = [read_excitation(path, description) for path in excitation]
         durations = [e.duration for e in played]
