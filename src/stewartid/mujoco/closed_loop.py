@@ -27,6 +27,8 @@ class Commanded(Protocol):
     file's :class:`~stewartid.design.export.TabulatedExcitation`."""
 
     name: str
+    #: Highest frequency in the motion (Hz): what the log's rate must resolve.
+    max_frequency: float
 
     def evaluate(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Pose, rate and acceleration at ``t`` (s), each of shape (N, 6)."""
