@@ -31,10 +31,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import physical_study  # noqa: E402  (a sibling script)
 
-from stewartid.design.candidates import Design  # noqa: E402
 from stewartid.design.information import predict_parameters  # noqa: E402
-from stewartid.design.multisine import REFERENCE_HZ, MultisineRecord, record_lengths  # noqa: E402
-from stewartid.simulation import DEFAULT_AMPLITUDES  # noqa: E402
+from stewartid.design.multisine import all_dofs_multisine  # noqa: E402
 from stewartid.simulation.sensors import reference_noise  # noqa: E402
 
 #: The acceptance: first moments (kg m) and friction coefficients (%), worst of 8 seeds.
@@ -43,19 +41,6 @@ FRICTION_TARGET = 5.0
 SEEDS = 8
 #: Rate the information is summed at (Hz); the kernel needs 100 Hz or more.
 RATE = 200.0
-
-
-def multisine(scale: float, slower: float, budget_s: float = 120.0) -> Design:
-    """The physical study's records: DOF d of record k at REFERENCE_HZ[(d + k) % 6] / slower,
-    scale times the paper's amplitude."""
-    records = []
-    for k, length in enumerate(record_lengths(budget_s)):
-        index = (np.arange(6) + k) % 6
-        records.append(MultisineRecord(
-            scale * np.asarray(DEFAULT_AMPLITUDES)[:, None],
-            np.asarray(REFERENCE_HZ)[index][:, None] / slower,
-            (0.5 * np.arange(6) + k)[:, None], length, name=f"exp{k + 1}"))
-    return Design(tuple(records), f"multisine S {scale:g} K {slower:g}")
 
 
 def chance(std: np.ndarray, target: float, draws: int, rng: np.random.Generator) -> float:
@@ -80,7 +65,7 @@ def main() -> None:
         noise = reference_noise(platform)
         for motion in args.motions.split(","):
             scale, slower = (float(x) for x in motion.split(":"))
-            design = multisine(scale, slower)
+            design = all_dofs_multisine(120.0, scale, slower)
             found = {}
             for filtered in (False, True):
                 prediction = predict_parameters(platform, design, noise, False, RATE,

@@ -173,16 +173,20 @@ def multisine_design(budget_s: float, amplitudes: Sequence[float], speed: float 
     return Design(tuple(records), text)
 
 
-def all_dofs_multisine(budget_s: float) -> Design:
-    """The reference: record k moves DOF d at ``REFERENCE_HZ[(d + k) % 6]`` with the paper's
-    amplitude, phase ``0.5 d + k`` rad (the physical model's study data)."""
+def all_dofs_multisine(budget_s: float, scale: float = 1.0, slower: float = 1.0) -> Design:
+    """The reference: record k moves DOF d at ``REFERENCE_HZ[(d + k) % 6] / slower`` with
+    ``scale`` times the paper's amplitude, phase ``0.5 d + k`` rad (the physical model's study
+    data)."""
     records = []
     for k, length in enumerate(record_lengths(budget_s)):
         index = (np.arange(6) + k) % 6
         records.append(MultisineRecord(
-            np.asarray(DEFAULT_AMPLITUDES)[:, None], np.asarray(REFERENCE_HZ)[index][:, None],
+            scale * np.asarray(DEFAULT_AMPLITUDES)[:, None],
+            np.asarray(REFERENCE_HZ)[index][:, None] / slower,
             (0.5 * np.arange(6) + k)[:, None], length, name=f"exp{k + 1}"))
-    return Design(tuple(records), f"all-DOFs multisine at the paper's amplitudes, "
+    amplitude = "the paper's amplitudes" if scale == 1 else f"{scale:g} x the paper's amplitudes"
+    pace = "" if slower == 1 else f", frequencies / {slower:g}"
+    return Design(tuple(records), f"all-DOFs multisine at {amplitude}{pace}, "
                                   f"{len(records)} x {records[0].duration:g} s")
 
 

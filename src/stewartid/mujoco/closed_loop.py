@@ -35,6 +35,12 @@ class Commanded(Protocol):
         ...
 
 
+def steps_per_sample(rate: float, step: float) -> int:
+    """MuJoCo steps per logged sample at ``rate`` (Hz): ``step`` (s) rounded down to divide
+    the sample period."""
+    return max(1, int(np.ceil(1.0 / (rate * step) - 1e-9)))
+
+
 def simulate_mujoco(platform: Platform, excitation: Commanded, duration: float, *,
                     step: float = mjcf.DEFAULT_TIMESTEP, integrator: str = "RK4") -> Dataset:
     """Play ``excitation`` on the MuJoCo model and record it at the sensors' rate.
@@ -92,7 +98,7 @@ def simulate_mujoco(platform: Platform, excitation: Commanded, duration: float, 
     if not (np.isfinite(step) and step > 0):
         raise ValueError(f"step must be > 0 s; got {step!r}.")
     rate = platform.sensors.sample_rate
-    per_sample = max(1, int(np.ceil(1.0 / (rate * step) - 1e-9)))
+    per_sample = steps_per_sample(rate, step)
     step = 1.0 / (rate * per_sample)
     n_samples = int(np.floor(duration * rate + 1e-9)) + 1
     model = mjcf.load_model(platform, integrator=integrator, timestep=step)

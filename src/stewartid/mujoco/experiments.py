@@ -11,12 +11,12 @@ model (:func:`~stewartid.simulation.sensors.degrade`, the noise stream of experi
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Callable, Sequence
 from typing import Any
 
 import stewartid
 from stewartid.model.linearization import nominal_matrices
+from stewartid.mujoco.closed_loop import simulate_mujoco, steps_per_sample
 from stewartid.mujoco.model import DEFAULT_TIMESTEP, require_mujoco
 from stewartid.parallel import run_in_order
 from stewartid.platform import Platform
@@ -29,8 +29,6 @@ ACTUATORS = ("ideal force actuators under the leg-length servo's PD law with gra
 
 
 def _play(run: tuple) -> Any:
-    from stewartid.mujoco.closed_loop import simulate_mujoco
-
     platform, excitation, duration, noise, seed, k, count, step = run
     clean = simulate_mujoco(platform, excitation, duration, step=step)
     measured = degrade(clean, platform, noise, noise_generator(seed, k, count))
@@ -93,14 +91,14 @@ def simulate_on_mujoco(platform: Platform, excitations: Sequence[Any],
     def finished(done: int, total: int, index: int) -> None:
         progress(done, total, excitations[index].name)
 
-    per_sample = max(1, math.ceil(1.0 / (rate * step) - 1e-9))  # as simulate_mujoco rounds
     datasets = run_in_order(_play, runs, jobs, finished if progress is not None else None)
     M, B = nominal_matrices(platform)
     meta = {"engine": "mujoco", "platform": platform.to_dict(),
             "platform_name": platform.name,
             "excitation": excitation_meta or {"sources": [e.name for e in excitations]},
             "integration": {"engine": "mujoco", "version": mujoco.__version__,
-                            "integrator": "RK4", "step": 1.0 / (rate * per_sample)},
+                            "integrator": "RK4",
+                            "step": 1.0 / (rate * steps_per_sample(rate, step))},
             "actuators": ACTUATORS, "noise": dataclasses.asdict(noise), "seed": int(seed),
             "nominal": {"M": M.tolist(), "B": B.tolist()}, "version": stewartid.__version__}
     return SimulationResult(list(datasets), meta, [])
