@@ -114,7 +114,8 @@ def score_sandwich(inverse: np.ndarray, scores: np.ndarray,
 
 
 def record_sandwich(inverse: np.ndarray, scores: np.ndarray,
-                    segments: Sequence[tuple[int, int]]) -> np.ndarray:
+                    segments: Sequence[tuple[int, int]], expected: np.ndarray | None = None
+                    ) -> np.ndarray:
     """The covariance A^-1 B A^-1 with the records as independent clusters: B the sum over
     the records of the outer product of their summed scores, times R / (R - 1) for R records.
 
@@ -123,8 +124,9 @@ def record_sandwich(inverse: np.ndarray, scores: np.ndarray,
     in the estimate is A^-1 times the summed scores, which the residual's short-lag
     autocovariances do not see. Summed per record, the part that differs between records
     shows (the part common to all is what the fit removed: the scores of all records sum to
-    zero, or, for an estimate corrected for errors in variables, to the correction, which is
-    shared out by rows). Under noise alone B is unbiased, with R - 1 degrees of freedom.
+    zero, or, for an estimate corrected for errors in variables, to the correction: each
+    record's own share of it is taken out when ``expected`` is given, else the total shared
+    out by rows). Under noise alone B is unbiased, with R - 1 degrees of freedom.
 
     Parameters
     ----------
@@ -132,6 +134,9 @@ def record_sandwich(inverse: np.ndarray, scores: np.ndarray,
     scores : ndarray, shape (K, m)
     segments : sequence of (int, int)
         Rows of each record (summing to K) and its correlation length (unused here).
+    expected : ndarray, shape (R, m), optional
+        Each record's expected summed score under noise alone (its errors-in-variables
+        correction, which depends on its own motion and filter; summing to the total).
 
     Returns
     -------
@@ -140,8 +145,10 @@ def record_sandwich(inverse: np.ndarray, scores: np.ndarray,
     rows = np.array([n for n, _ in segments])
     ends = np.cumsum([0, *rows])
     sums = np.add.reduceat(scores, ends[:-1], axis=0)
-    # less each record's share of the total, which a corrected estimate leaves nonzero
-    sums = sums - np.outer(rows / rows.sum(), sums.sum(axis=0))
+    # less what noise alone gives each record, which a corrected estimate leaves nonzero
+    if expected is None:
+        expected = np.outer(rows / rows.sum(), sums.sum(axis=0))
+    sums = sums - expected
     records = len(sums)
     B = sums.T @ sums * records / max(records - 1, 1)
     return inverse @ B @ inverse

@@ -127,11 +127,12 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
         The size of each parameter positive by nature (a mass, an inertia: the moving
         body's, for a payload's), zero for the others, which no relative error applies to.
     max_condition, max_relative_error : float
-    regressor_noise : ndarray, shape (6, p, p), optional
+    regressor_noise : ndarray, shape (6, p, p) or (R, 6, p, p), optional
         Per channel, the expected share of X^T X that noise in the regressor rows adds
         (errors in variables): subtracted, so that the estimate is free of the attenuation
-        bias it causes.
-    target_noise : ndarray, shape (6, p), optional
+        bias it causes. With a first axis, per record (R = ``len(segments)``): each
+        record's share is then also what noise alone leaves in its summed scores.
+    target_noise : ndarray, shape (6, p) or (R, 6, p), optional
         Per channel, the expected share of X^T y that the same noise adds (when y holds
         regressor columns too, as a known part moved to the left-hand side): subtracted.
     segments : list of (int, int), optional
@@ -151,10 +152,11 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
     by_channel = np.ascontiguousarray(X.transpose(1, 0, 2))  # (6, K, p): BLAS products
     gram = np.swapaxes(by_channel, 1, 2) @ by_channel
     cross = np.einsum("ckp,kc->cp", by_channel, y, optimize=True)
+    by_record = regressor_noise is not None and regressor_noise.ndim == 4
     if regressor_noise is not None:
-        gram = gram - regressor_noise
+        gram = gram - (regressor_noise.sum(axis=0) if by_record else regressor_noise)
     if target_noise is not None:
-        cross = cross - target_noise
+        cross = cross - (target_noise.sum(axis=0) if target_noise.ndim == 3 else target_noise)
     # a column that is zero (relative to the forces it would explain) is not excited at all
     column = np.sqrt(np.einsum("c,cpp->p", weights, gram))
     free = column > DEAD_COLUMN * column.max()
@@ -188,12 +190,17 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
             fixed[names[index[j]]] = (f"not identifiable from these data: standard error "
                                       f"{std[j]:.3g} against a value of {theta[j]:.4g}")
             free[index[j]] = False
-        sigma = np.sqrt(np.sum(residual ** 2, axis=0) / len(y))
+        used, sigma = weights, np.sqrt(np.sum(residual ** 2, axis=0) / len(y))
         weights = 1.0 / np.maximum(sigma, 1e-12 * scale_y) ** 2
     covariance = np.zeros((p, p))
     solved = inverse * variance
     if segments is not None:
-        solved = score_covariance(inverse, X[:, :, free], residual, weights, segments)
+        expected = None
+        if by_record:  # E[sum of a record's scores] = its sum_c w_c (t_c - N_c theta)
+            target = 0.0 if target_noise is None else target_noise
+            expected = np.einsum("c,rcp->rp", used,
+                                 target - regressor_noise @ values)[:, free]
+        solved = score_covariance(inverse, X[:, :, free], residual, used, segments, expected)
     covariance[np.ix_(free, free)] = solved
     return Solution(values, covariance, fixed, condition, singular_all,
                     np.sqrt(np.mean(residual ** 2, axis=0)), len(y))
@@ -255,7 +262,8 @@ class ConsistentParameters:
 
 
 def score_covariance(inverse: np.ndarray, X: np.ndarray, residual: np.ndarray,
-                     weights: np.ndarray, segments: list[tuple[int, int]]) -> np.ndarray:
+                     weights: np.ndarray, segments: list[tuple[int, int]],
+                     expected: np.ndarray | None = None) -> np.ndarray:
     """N^-1 B N^-1, B the long-run covariance of the scores s_k = sum_c w_c X_kc r_kc
     (:func:`~stewartid.identification.long_run.score_sandwich`), each variance raised to
     that of the scores summed per record where larger (model error correlated with the
@@ -277,14 +285,23 @@ def score_covariance(inverse: np.ndarray, X: np.ndarray, residual: np.ndarray,
         Channel weights w_c.
     segments : list of (int, int)
         Rows of each record (summing to K) and its correlation length in rows.
+    expected : ndarray, shape (R, p), optional
+        Each record's expected summed score under noise alone (an errors-in-variables
+        correction's per record); without, the scores' total shared out by rows. Taken out
+        of the record sums and, spread evenly over the record's rows, of the scores: the
+        correction's mean is no fluctuation.
 
     Returns
     -------
     ndarray, shape (p, p)
     """
     scores = np.einsum("kcp,kc->kp", X, residual * weights, optimize=True)
-    return with_larger_variances(score_sandwich(inverse, scores, segments),
-                                 record_sandwich(inverse, scores, segments))
+    rows = np.array([n for n, _ in segments])
+    if expected is None:
+        expected = np.outer(rows / rows.sum(), scores.sum(axis=0))
+    centred = scores - np.repeat(expected / rows[:, None], rows, axis=0)
+    return with_larger_variances(score_sandwich(inverse, centred, segments),
+                                 record_sandwich(inverse, scores, segments, expected))
 
 
 def nearest_consistent(values: np.ndarray, covariance: np.ndarray, bodies: list[Body],

@@ -237,9 +237,9 @@ class PhysicalIdentifier(BaseIdentifier):
             full = regressor_noise(experiments, [e["window_s"] for e in data.experiments],
                                    data.experiments[0]["row_step"], platform,
                                    SAVGOL_FRACTION, self.order, data.pose_noise,
-                                   per_experiment)
-            noise = full[:, columns][:, :, columns]
-            target_noise = -full[:, columns] @ offset
+                                   per_experiment, by_experiment=True)
+            noise = full[:, :, columns][:, :, :, columns]
+            target_noise = -full[:, :, columns] @ offset
         # the size of a positive parameter: the whole body's (of a payload's, too)
         positive = np.isin(reg.PARAMETERS, POSITIVE_PARAMETERS)
         scales = selection @ np.where(positive, np.abs(reg.standard_parameters(platform)), 0.0)

@@ -70,7 +70,8 @@ def _factor(covariance: np.ndarray) -> np.ndarray:
 def regressor_noise(experiments: list[Experiment], windows: list[float], row_step: int,
                     platform: Platform, savgol_fraction: float, order: int,
                     pose_noise: list[np.ndarray],
-                    transforms: list[np.ndarray] | None = None) -> np.ndarray:
+                    transforms: list[np.ndarray] | None = None, by_experiment: bool = False
+                    ) -> np.ndarray:
     """Per channel, the sum over the kept rows of E[delta Y_i^T delta Y_i].
 
     Parameters
@@ -91,18 +92,20 @@ def regressor_noise(experiments: list[Experiment], windows: list[float], row_ste
     transforms : list of ndarray, each shape (K_e, 6, 6), optional
         Per experiment, a map applied to each kept row's channels (the leg forces'
         :func:`~stewartid.identification.physical_regression.leg_force_transforms`).
+    by_experiment : bool
+        Return each experiment's sum, not their total.
 
     Returns
     -------
-    ndarray, shape (6, N_STANDARD, N_STANDARD)
+    ndarray, shape (6, N_STANDARD, N_STANDARD), or (E, 6, N_STANDARD, N_STANDARD)
         In the standard parameters, by channel (of the generalized force, or of what
         ``transforms`` maps it to).
     """
-    out = np.zeros((6, reg.N_STANDARD, reg.N_STANDARD))
+    terms = np.zeros((len(experiments), 6, reg.N_STANDARD, reg.N_STANDARD))
     if transforms is None:
         transforms = [None] * len(experiments)
-    for exp, window, sigma, transform in zip(experiments, windows, pose_noise, transforms,
-                                             strict=True):
+    for out, exp, window, sigma, transform in zip(terms, experiments, windows, pose_noise,
+                                                  transforms, strict=True):
         rate = exp.sample_rate
         gains = derivative_noise_gains(rate, window, window / savgol_fraction, order)
         poses = kernel_filter_rows(exp.q, rate, window, row_step)
@@ -122,7 +125,7 @@ def regressor_noise(experiments: list[Experiment], windows: list[float], row_ste
             for i in range(6):  # (K d, p) per channel: one BLAS product each
                 flat = (factor @ jacobian[:, i][..., used]).reshape(-1, len(used))
                 out[i][block] += (flat.T @ flat) * (rows / len(poses))
-    return out
+    return terms if by_experiment else terms.sum(axis=0)
 
 
 __all__ = ["JACOBIAN_STRIDE", "derivative_noise_gains", "measured_sign_rates", "regressor_noise"]
