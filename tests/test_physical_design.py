@@ -120,6 +120,13 @@ def test_physical_design_writes_commands_prediction_and_check(loaded, tmp_path):
     assert (tmp_path / "d" / "commands" / "exp1.csv").is_file()
     assert (tmp_path / "d" / "validation" / "validation.csv").is_file()
     assert out.check["seeds"] == 1 and out.check["ratio_median"] > 0
+    # the report names the parameters whose fitted errors the prediction falls short of
+    checked = document["check"]["parameters"]
+    short = [n for n, v in checked.items()
+             if v["reported"] is not None and v["reported"] > 1.5 * v["predicted"]]
+    assert document["check"]["underpredicted"] == short
+    report = (tmp_path / "d" / "report.md").read_text()
+    assert ("the prediction counts the force noise only" in report) == bool(short)
 
 
 @pytest.mark.parametrize(("arguments", "message"), [

@@ -69,6 +69,11 @@ class PhysicalDesignOutput:
     files: list[Path]
 
 
+#: Reported over predicted standard error above which the check names a parameter: beyond
+#: what the fits' own errors scatter by over a couple of seeds.
+UNDERPREDICTED = 1.5
+
+
 def physical_identify_command(payload: bool, run: str = "RUN") -> str:
     """The ``stewartid identify`` command of the physical model (payload mode or full)."""
     return (f"stewartid identify {run} --platform PLATFORM --model physical"
@@ -90,12 +95,14 @@ def monte_carlo_check(platform: Platform, records: list, noise: SensorNoise,
     -------
     dict
         ``seeds``, ``ratio_median`` (predicted / reported), ``within_30_percent``,
-        ``max_abs_z``, and per parameter ``predicted``, ``reported``, ``errors``.
+        ``max_abs_z``, ``underpredicted`` (the parameters whose reported standard error is
+        over :data:`UNDERPREDICTED` times the prediction), and per parameter ``predicted``,
+        ``reported``, ``errors``.
     """
     names = prediction.names
     if seeds == 0:
         return {"seeds": 0, "ratio_median": None, "within_30_percent": None,
-                "max_abs_z": None, "parameters": {n: {"predicted": None, "reported": None,
+                "max_abs_z": None, "underpredicted": [], "parameters": {n: {"predicted": None, "reported": None,
                                                       "errors": []} for n in names}}
     inverse = inverse_leg_jacobians(platform, [r.q for r in records])
     estimates, reported = [], []
@@ -119,6 +126,8 @@ def monte_carlo_check(platform: Platform, records: list, noise: SensorNoise,
             "within_30_percent": (float(np.mean(np.abs(ratio[finite] - 1) <= 0.3))
                                   if finite.any() else None),
             "max_abs_z": float(np.nanmax(np.abs(z))) if np.isfinite(z).any() else None,
+            "underpredicted": [n for n, r in zip(names, ratio, strict=True)
+                               if np.isfinite(r) and r * UNDERPREDICTED < 1.0],
             "parameters": {n: {"predicted": _number(expected[k]),
                                "reported": _number(mean_se[k]),
                                "errors": [_number(v) for v in estimates[:, k]
@@ -255,6 +264,13 @@ def render_physical_markdown(design: Design, prediction: ParameterPrediction,
                   f"noisy copies; predicted / reported standard error, median "
                   f"{check['ratio_median']:.2f}, within 30 % for "
                   f"{check['within_30_percent']:.0%} of the parameters."]
+        if check["underpredicted"]:
+            lines += ["", f"The fits' standard errors are over {UNDERPREDICTED:g} times the "
+                      f"prediction for {', '.join(check['underpredicted'])}. The prediction "
+                      "counts the force noise only: the pose noise adds to it, most to the "
+                      "friction at high frequencies (through the Coulomb signs and the "
+                      "filtered rates), and a fit's own standard error over few records is "
+                      "itself uncertain. Rely on the larger of the two for those."]
     lines += ["", "## Playing and identifying it", "", "On the plant first (PLATFORM: the "
               "platform file of the design), then on the machine's logs:", "", "```bash",
               commands["play"], commands["identify"], "```", "",
@@ -263,5 +279,5 @@ def render_physical_markdown(design: Design, prediction: ParameterPrediction,
     return "\n".join(lines)
 
 
-__all__ = ["FINAL_RATE", "PhysicalDesignOutput", "monte_carlo_check",
+__all__ = ["FINAL_RATE", "PhysicalDesignOutput", "UNDERPREDICTED", "monte_carlo_check",
            "physical_identify_command", "render_physical_markdown", "run_physical_design"]
