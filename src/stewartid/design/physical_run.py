@@ -102,8 +102,9 @@ def monte_carlo_check(platform: Platform, records: list, noise: SensorNoise,
     names = prediction.names
     if seeds == 0:
         return {"seeds": 0, "ratio_median": None, "within_30_percent": None,
-                "max_abs_z": None, "underpredicted": [], "parameters": {n: {"predicted": None, "reported": None,
-                                                      "errors": []} for n in names}}
+                "max_abs_z": None, "underpredicted": [],
+                "parameters": {n: {"predicted": None, "reported": None, "errors": []}
+                               for n in names}}
     inverse = inverse_leg_jacobians(platform, [r.q for r in records])
     estimates, reported = [], []
     for seed in range(seeds):
