@@ -80,6 +80,43 @@ def test_information_matrix_predicts_the_estimators_spread(loaded):
     assert 0.8 < np.median(ratio[coulomb]) < 1.3, ratio[coulomb]
 
 
+def test_final_prediction_counts_the_pose_noise(loaded):
+    """Rigid-body data of a record at twice the reference frequencies and half its amplitude,
+    the leg lengths with the reference white noise (the pose from them by the first Newton
+    step of forward kinematics), the forces with a tenth of it: the pose noise, through the
+    filtered rates and accelerations, sets most parameters' spread, the friction's above
+    all. Predicted from the force noise alone the errors came out 0.06-0.61 of the spread
+    over 12 seeds (median 0.23, the friction's 0.06-0.19); with the pose noise's share
+    0.69-1.46 (median 1.16). A 12-seed spread is itself uncertain by 21 %: the median within
+    30 %, the friction's within a factor 2."""
+    design = all_dofs_multisine(20.0, scale=0.5, slower=0.5)
+    rate = loaded.sensors.sample_rate
+    t = np.arange(int(20.0 * rate) + 1) / rate
+    q, q_dot, q_ddot = design.playable(loaded)[0].evaluate(t)
+    generalized = reg.regressor(loaded, q, q_dot, q_ddot) @ reg.standard_parameters(loaded)
+    jacobian = leg_jacobian(loaded, q)
+    forces = np.linalg.solve(np.swapaxes(jacobian, 1, 2), generalized[..., None])[..., 0]
+    lengths = inverse_kinematics(loaded, q).lengths
+    noise = SensorNoise(length_noise=2e-5, force_noise=17.0)
+    predicted = predict_parameters(loaded, design, noise, payload=True, rate_hz=100.0,
+                                   filtered=True)
+    rng = np.random.default_rng(11)
+    estimates = []
+    for _ in range(12):
+        error = rng.normal(0.0, noise.length_noise, lengths.shape)
+        pose = q + np.linalg.solve(jacobian, error[..., None])[..., 0]
+        data = Dataset(t=t, pose=pose, lengths=lengths + error, name="exp1",
+                       forces=forces + rng.normal(0.0, noise.force_noise, forces.shape))
+        fitted = PhysicalIdentifier(payload=True).fit([data], loaded)
+        estimates.append([fitted.parameters_[n] for n in predicted.names])
+    ratio = predicted.expected_std_errors / np.std(estimates, axis=0, ddof=1)
+    named = dict(zip(predicted.names, ratio, strict=True))
+    assert 0.7 < np.nanmedian(ratio) < 1.3, named
+    friction = [k for k, name in enumerate(predicted.names)
+                if name.startswith(("coulomb", "viscous")) and np.isfinite(ratio[k])]
+    assert np.all((ratio[friction] > 0.5) & (ratio[friction] < 2.0)), named
+
+
 def test_every_record_is_scaled_to_its_own_limit(loaded):
     """Records whose DOFs meet the pool's frequencies in another order reach the leg-speed
     limit at different amplitudes: each is scaled until its own motion, judged alone, uses

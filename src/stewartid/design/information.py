@@ -23,11 +23,10 @@ the motion's periods, far slower than :data:`INFORMATION_RATE`.
 The parameters judged are the moving body's ten (full mode) or the payload's ten (payload
 mode); the others (legs, friction, offsets) are estimated with them, so that the judged block
 of the covariance is the inverse of the Schur complement of the others' block in the
-information. The pose noise (leg-length noise through the kinematics) is left out: through
-the filtered accelerations it adds little while the estimator's kernel is long (0.2 periods of
-the dominant frequency, about 0.2 s or more in the band of
-:func:`~stewartid.design.multisine.multisine_design`), but at 0.1 s it doubled the standard
-errors; the Monte Carlo check of the final design shows it.
+information. The pose noise (leg-length noise through the kinematics) reaches the rows
+through the filtered rates and accelerations, high-pass: the search leaves it out (its
+payload's parameters take a tenth or less of their variance from it), the final prediction
+adds it (:mod:`stewartid.design.pose_noise`; most of the friction's variance at 2 Hz).
 
 A relative standard error is judged against a parameter's size, the same for the components
 of one vector or tensor so that the criterion does not depend on how the platform frame is
@@ -48,6 +47,7 @@ import numpy as np
 import scipy.signal
 
 from stewartid.design.candidates import Design
+from stewartid.design.pose_noise import pose_noise_scores
 from stewartid.identification.physical import (
     POSITIVE_PARAMETERS,
     parameter_model,
@@ -179,7 +179,8 @@ def force_noise_covariance(noise: SensorNoise, rows: int) -> np.ndarray:
 
 
 def sandwich_covariance(X: np.ndarray, S: np.ndarray, samples_per_row: float,
-                        noise_rows: np.ndarray | None = None) -> np.ndarray:
+                        noise_rows: np.ndarray | None = None,
+                        extra: np.ndarray | None = None) -> np.ndarray:
     """The channel-weighted least-squares covariance A^-1 B A^-1 (module docstring).
 
     Parameters
@@ -193,6 +194,9 @@ def sandwich_covariance(X: np.ndarray, S: np.ndarray, samples_per_row: float,
     noise_rows : ndarray, shape (K, 6, p), optional
         The rows B is taken of, when not ``X``: for rows and noise filtered with a kernel
         h, h * X (the filtered noise's correlation over the kernel, carried to the rows).
+    extra : ndarray, shape (p, p), optional
+        Another noise's share of B, in the same units (the pose noise's:
+        :func:`~stewartid.design.pose_noise.pose_noise_scores`).
 
     Returns
     -------
@@ -204,6 +208,8 @@ def sandwich_covariance(X: np.ndarray, S: np.ndarray, samples_per_row: float,
     if noise_rows is not None:
         Z = weights[None, :, None] * noise_rows
     B = np.einsum("kcp,kcd,kdq->pq", Z, S, Z, optimize=True)
+    if extra is not None:
+        B = B + extra
     scale = np.sqrt(np.diag(A))
     scale = np.where(scale > 0, scale, 1.0)
     inverse = np.linalg.pinv(A / np.outer(scale, scale), rcond=1e-14) / np.outer(scale, scale)
@@ -223,6 +229,15 @@ def design_rows(platform: Platform, design: Design, rate_hz: float = INFORMATION
     parts = [playable.evaluate(np.arange(rows) / rate_hz) for playable, rows
              in zip(design.playable(platform), record_rows(design, rate_hz), strict=True)]
     return tuple(np.concatenate(x) for x in zip(*parts, strict=True))
+
+
+def record_kernels(design: Design, rate_hz: float, q: np.ndarray) -> list[np.ndarray]:
+    """Each record's taps of the physical estimator's kernel at ``rate_hz`` (its window:
+    :data:`~stewartid.signals.differentiation.DEFAULT_WINDOW_PERIODS` periods of the
+    record's dominant frequency in ``q``, shape (K, 6), records one after the other)."""
+    ends = np.cumsum([0, *record_rows(design, rate_hz)])
+    return [kernel_taps(rate_hz, default_window(estimate_frequency(q[a:b], rate_hz)))[0]
+            for a, b in zip(ends[:-1], ends[1:], strict=True)]
 
 
 def kernel_filtered(design: Design, rate_hz: float, q: np.ndarray, X: np.ndarray
@@ -257,9 +272,8 @@ def kernel_filtered(design: Design, rate_hz: float, q: np.ndarray, X: np.ndarray
     """
     ends = np.cumsum([0, *record_rows(design, rate_hz)])
     poses, rows, twice = [], [], []
-    for a, b in zip(ends[:-1], ends[1:], strict=True):
-        window = default_window(estimate_frequency(q[a:b], rate_hz))
-        taps = kernel_taps(rate_hz, window)[0]
+    for (a, b), taps in zip(zip(ends[:-1], ends[1:], strict=True),
+                            record_kernels(design, rate_hz, q), strict=True):
         poses.append(scipy.signal.convolve(q[a:b], taps[:, None], mode="valid"))
         rows.append(scipy.signal.convolve(X[a:b], taps[:, None, None], mode="valid"))
         twice.append(scipy.signal.convolve(rows[-1], taps[:, None, None], mode="same"))
@@ -297,16 +311,18 @@ def predict_parameters(platform: Platform, design: Design, noise: SensorNoise,
         The standard regressor at ``states``, when already computed.
     filtered : bool
         Filter the regressor with the estimator's kernel first (:func:`kernel_filtered`):
-        what the Coulomb columns' reversals lose to it. Needs ``rate_hz`` well above the
-        kernel's taps per window (100 Hz or more).
+        what the Coulomb columns' reversals lose to it; and add the pose noise's share
+        (``length_noise``, :func:`~stewartid.design.pose_noise.pose_noise_scores`). Needs
+        ``rate_hz`` well above the kernel's taps per window (100 Hz or more).
 
     Returns
     -------
     ParameterPrediction
     """
     names, _, selection, nominal, _ = parameter_model(platform, payload)
-    q, q_dot, q_ddot = design_rows(platform, design, rate_hz) if states is None else states
-    X = (reg.regressor(platform, q, q_dot, q_ddot) if rows is None else rows) @ selection.T
+    states = design_rows(platform, design, rate_hz) if states is None else states
+    q = states[0]
+    X = (reg.regressor(platform, *states) if rows is None else rows) @ selection.T
     twice = None
     if filtered:
         q, X, twice = kernel_filtered(design, rate_hz, q, X)
@@ -316,6 +332,13 @@ def predict_parameters(platform: Platform, design: Design, noise: SensorNoise,
         twice = np.einsum("kij,kjp->kip", to_legs, twice, optimize=True)
     S = force_noise_covariance(noise, len(q))
     per_row = platform.sensors.sample_rate / rate_hz
+    extra = np.zeros((len(names),) * 2)
+    if filtered:
+        weights = 1.0 / np.mean(np.diagonal(S, axis1=1, axis2=2), axis=0)
+        extra = pose_noise_scores(
+            platform, noise, rate_hz, states, np.cumsum([0, *record_rows(design, rate_hz)]),
+            record_kernels(design, rate_hz, states[0]), X, to_legs, weights,
+            reg.standard_parameters(platform))
     # the estimator's own rule for what it fixes (PhysicalIdentifier's scales)
     positive = np.isin(reg.PARAMETERS, POSITIVE_PARAMETERS)
     size = np.maximum(np.abs(nominal), selection @ np.where(
@@ -325,8 +348,8 @@ def predict_parameters(platform: Platform, design: Design, noise: SensorNoise,
     while True:
         std = np.full(len(names), np.nan)
         std[free] = np.sqrt(np.clip(np.diag(sandwich_covariance(
-            X[:, :, free], S, per_row, None if twice is None else twice[:, :, free])),
-                                    0.0, None))
+            X[:, :, free], S, per_row, None if twice is None else twice[:, :, free],
+            extra[np.ix_(free, free)])), 0.0, None))
         if free.all():
             every = std.copy()
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -340,5 +363,6 @@ def predict_parameters(platform: Platform, design: Design, noise: SensorNoise,
 
 
 __all__ = ["INFORMATION_RATE", "ParameterPrediction", "design_rows", "force_noise_covariance",
-           "kernel_filtered", "parameter_sizes", "predict_parameters", "record_rows",
+           "kernel_filtered", "parameter_sizes", "predict_parameters", "record_kernels",
+           "record_rows",
            "sandwich_covariance"]

@@ -1,0 +1,146 @@
+"""The pose noise's share of the physical model's predicted parameter covariance.
+
+The estimator's rows are the regressor at the measured pose and its Savitzky-Golay rate and
+acceleration, filtered with the kernel h and mapped to the leg forces. White pose noise e
+(leg-length noise through the kinematics, covariance Sigma_q = J_lq^-1 Sigma_l J_lq^-T per
+sample) enters a row's model force Y theta mostly through the acceleration and the rate,
+
+    n_j = D_a(j) (g2 * e)_j + D_v(j) (g1 * e)_j,    D_a = M(q),  D_v = d(Y theta)/d q_dot,
+
+g1, g2 the derivative taps, and the residual of filtered row k is -T_k (h * n)_k. The scores'
+share is sum_k Z_k (h * n)_k with Z_k = X_k^T W T_k, which is sum_j U_j n_j for U = h * Z
+(the kernel is symmetric), and, with P = U D_a and Q = U D_v,
+
+    sum_i [ sum_j P_j g2(j - i) + Q_j g1(j - i) ] e_i  =  sum_i [ P''(t_i) - Q'(t_i) ] e_i,
+
+the taps being exact derivatives on P and Q, which vary on the kernel's scale. Its
+covariance, sum_i G_i Sigma_q G_i^T with G = P'' - Q', adds to the force noise's B of the
+sandwich A^-1 B A^-1 (:func:`~stewartid.design.information.sandwich_covariance`). For a
+slowly varying column the high-pass noise cancels (the mass through gravity); what is left
+is seen through how fast the motion's rows change, so the friction and the leg offsets take
+most of it and more at higher frequencies. On the 2 Hz payload design of our plant (8 seeds
+with the leg-length noise alone) the prediction gives 1.67 / 1.23 N m for the lower gimbals'
+and revolute joints' Coulomb levels against a spread of 1.94 / 1.31, 72 against 70 N m s/rad
+for the lower gimbals' viscous coefficient, 1.0 against 1.1 kg for the payload's mass.
+
+Left out: the pose itself (no derivative gain), and the Coulomb signs, whose rates are taken
+where their noise is within 0.2 % of the rate's RMS
+(:data:`~stewartid.signals.sign_rates.SIGN_NOISE`): the reversals they shift by 0.1 ms or so
+moved no parameter by more than a twentieth of this share there.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.signal
+
+from stewartid.model import matrix_regressors
+from stewartid.model import regressor as reg
+from stewartid.model.kinematics import leg_jacobian
+from stewartid.platform import Platform
+from stewartid.simulation.sensors import SensorNoise
+
+#: Relative step of the rates in the central differences of the rigid-body forces (the
+#: velocity products are quadratic: exact up to round-off).
+RATE_STEP = 1e-3
+
+
+def pose_covariance(platform: Platform, noise: SensorNoise, q: np.ndarray) -> np.ndarray:
+    """Sigma_q = J_lq^-1 Sigma_l J_lq^-T: the pose's white noise per sample from the legs'
+    length noise, to first order.
+
+    Parameters
+    ----------
+    platform : Platform
+    noise : SensorNoise
+        ``length_noise`` (m).
+    q : ndarray, shape (K, 6)
+
+    Returns
+    -------
+    ndarray, shape (K, 6, 6)
+        m^2, rad^2.
+    """
+    sigma = np.broadcast_to(np.asarray(noise.length_noise, dtype=float), 6)
+    inverse = np.linalg.inv(leg_jacobian(platform, q))
+    return np.einsum("kij,j,klj->kil", inverse, sigma ** 2, inverse, optimize=True)
+
+
+def rate_sensitivity(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
+                     q_ddot: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """d(Y theta)/d q_dot along a motion: the viscous matrix and the velocity products'
+    derivative (Coulomb signs left out).
+
+    Returns
+    -------
+    ndarray, shape (K, 6, 6)
+        Generalized force per unit rate.
+    """
+    out = matrix_regressors.viscous_regressor(platform, q) @ theta
+    step = RATE_STEP * max(float(np.max(np.abs(q_dot))), 1e-12)
+    for c in range(6):
+        shift = np.zeros(6)
+        shift[c] = step
+        ahead, behind = (reg.regressor_columns(platform, q.T, (q_dot + s).T, q_ddot.T,
+                                               gravity=False, friction=False)
+                         for s in (shift, -shift))
+        out[:, :, c] += np.einsum("ipk,p->ki", ahead - behind, theta) / (2 * step)
+    return out
+
+
+def pose_noise_scores(platform: Platform, noise: SensorNoise, rate_hz: float,
+                      states: tuple[np.ndarray, np.ndarray, np.ndarray], ends: np.ndarray,
+                      taps: list[np.ndarray], rows: np.ndarray, transforms: np.ndarray,
+                      weights: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """The pose noise's share of the scores' covariance B, in the units of
+    :func:`~stewartid.design.information.sandwich_covariance` (summed over the rows at
+    ``rate_hz``, which stand for every logged sample).
+
+    Parameters
+    ----------
+    platform : Platform
+    noise : SensorNoise
+    rate_hz : float
+        Rate of the states and rows (Hz).
+    states : tuple of ndarray, each shape (K, 6)
+        q, q_dot, q_ddot of every record, one after the other.
+    ends : ndarray, shape (R + 1,)
+        Each record's first row in ``states`` and, last, K.
+    taps : list of ndarray
+        Each record's kernel taps at ``rate_hz``.
+    rows : ndarray, shape (K', 6, p)
+        The filtered rows in leg forces (each record's ``valid`` part, in turn).
+    transforms : ndarray, shape (K', 6, 6)
+        J_lq^-T at the filtered rows' poses.
+    weights : ndarray, shape (6,)
+        The leg channels' weights.
+    theta : ndarray, shape (N_STANDARD,)
+        The standard parameters the forces are of.
+
+    Returns
+    -------
+    ndarray, shape (p, p)
+    """
+    p = rows.shape[2]
+    B = np.zeros((p, p))
+    if not np.any(np.asarray(noise.length_noise, dtype=float) > 0):
+        return B
+    dt, start = 1.0 / rate_hz, 0
+    for (a, b), h in zip(zip(ends[:-1], ends[1:], strict=True), taps, strict=True):
+        q, q_dot, q_ddot = (x[a:b] for x in states)
+        filtered = b - a - len(h) + 1
+        part = slice(start, start + filtered)
+        start += filtered
+        Z = np.einsum("kip,i,kij->kpj", rows[part], weights, transforms[part], optimize=True)
+        U = scipy.signal.convolve(Z, h[:, None, None], mode="full")  # (b - a, p, 6)
+        P = np.einsum("kpi,kic->kpc", U,
+                      matrix_regressors.inertia_regressor(platform, q) @ theta, optimize=True)
+        Q = np.einsum("kpi,kic->kpc", U, rate_sensitivity(platform, q, q_dot, q_ddot, theta),
+                      optimize=True)
+        G = np.gradient(np.gradient(P, dt, axis=0), dt, axis=0) - np.gradient(Q, dt, axis=0)
+        B += np.einsum("kpc,kcd,kqd->pq", G, pose_covariance(platform, noise, q), G,
+                       optimize=True)
+    return B
+
+
+__all__ = ["RATE_STEP", "pose_covariance", "pose_noise_scores", "rate_sensitivity"]
