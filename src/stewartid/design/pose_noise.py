@@ -26,7 +26,7 @@ for the lower gimbals' viscous coefficient, 1.0 against 1.1 kg for the payload's
 Left out: the pose itself (no derivative gain), and the Coulomb signs, whose rates are taken
 where their noise is within 0.2 % of the rate's RMS
 (:data:`~stewartid.signals.sign_rates.SIGN_NOISE`): the reversals they shift by 0.1 ms or so
-moved no parameter by more than a twentieth of this share there.
+gave standard errors a tenth or less of this share's there (a hundredth of its variance).
 """
 
 from __future__ import annotations
