@@ -163,7 +163,7 @@ def test_physical_design_writes_commands_prediction_and_check(loaded, tmp_path):
              if v["reported"] is not None and v["reported"] > 1.5 * v["predicted"]]
     assert document["check"]["underpredicted"] == short
     report = (tmp_path / "d" / "report.md").read_text()
-    assert ("The prediction counts the force noise only" in report) == bool(short)
+    assert ("The prediction counts the force noise and the pose noise" in report) == bool(short)
 
 
 @pytest.mark.parametrize(("arguments", "message"), [

@@ -268,9 +268,9 @@ def render_physical_markdown(design: Design, prediction: ParameterPrediction,
         if check["underpredicted"]:
             lines += ["", f"The fits' standard errors are over {UNDERPREDICTED:g} times the "
                       f"prediction for {', '.join(check['underpredicted'])}. The prediction "
-                      "counts the force noise only: the pose noise adds to it, most to the "
-                      "friction at high frequencies (through the Coulomb signs and the "
-                      "filtered rates), and a fit's own standard error over few records is "
+                      "counts the force noise and the pose noise to first order, not the "
+                      "pose noise's share through the Coulomb signs of joints that barely "
+                      "move, and a fit's own standard error over few records and seeds is "
                       "itself uncertain. Rely on the larger of the two for those."]
     lines += ["", "## Playing and identifying it", "", "On the plant first (PLATFORM: the "
               "platform file of the design), then on the machine's logs:", "", "```bash",
