@@ -15,7 +15,13 @@ from stewartid.design.candidates import Design
 from stewartid.design.information import parameter_sizes, predict_parameters
 from stewartid.design.multisine import MultisineRecord, all_dofs_multisine, multisine_design
 from stewartid.design.physical_run import run_physical_design
-from stewartid.design.physical_search import commanded_limit_use, scale_to_limits
+from stewartid.design.physical_search import (
+    candidate,
+    commanded_limit_use,
+    plant_scales,
+    refine_for_plant,
+    scale_to_limits,
+)
 from stewartid.identification.physical import PhysicalIdentifier
 from stewartid.model import regressor as reg
 from stewartid.model.kinematics import inverse_kinematics, leg_jacobian
@@ -117,6 +123,27 @@ def test_final_prediction_counts_the_pose_noise(loaded):
     assert np.all((ratio[friction] > 0.5) & (ratio[friction] < 2.0)), named
 
 
+def test_refinement_against_the_plant_scales_each_record_by_its_own(loaded):
+    """A played design whose records the plant allowed 0.5 and 0.8 of: the scales read
+    back, and every candidate of the refined search carries them, record by record, on
+    top of its own commanded motion at the limits."""
+    noise = SensorNoise(force_noise=170.0)
+    first = candidate(loaded, 32.0, noise, True, np.zeros(8), 0.7)
+    played = Design(tuple(r.scaled(k) for r, k in zip(first.design.records, (0.5, 0.8),
+                                                      strict=True)))
+    scales = plant_scales(first.design, played)
+    assert np.allclose(scales, [0.5, 0.8], rtol=1e-12)
+    refined = refine_for_plant(loaded, 32.0, noise, True, 0.7, np.zeros(8), scales,
+                               evaluations=3)
+    own = candidate(loaded, 32.0, noise, True, refined.parameters, 0.7).design
+    ratio = [np.linalg.norm(r.amplitudes) / np.linalg.norm(o.amplitudes)
+             for r, o in zip(refined.design.records, own.records, strict=True)]
+    assert np.allclose(ratio, [0.5, 0.8], rtol=1e-9)
+    # the smaller motion tells less: its prediction is worse than the unscaled candidate's
+    assert refined.score > candidate(loaded, 32.0, noise, True, refined.parameters,
+                                     0.7).score
+
+
 def test_every_record_is_scaled_to_its_own_limit(loaded):
     """Records whose DOFs meet the pool's frequencies in another order reach the leg-speed
     limit at different amplitudes: each is scaled until its own motion, judged alone, uses
@@ -148,7 +175,8 @@ def test_parameter_sizes_are_those_of_the_vector_and_the_tensor():
 def test_physical_design_writes_commands_prediction_and_check(loaded, tmp_path):
     out = run_physical_design(loaded, 16.0, SensorNoise(force_noise=170.0), tmp_path / "d",
                               payload=True, check_seeds=1,
-                              search={"random_candidates": 2, "local_evaluations": 0})
+                              search={"random_candidates": 2, "local_evaluations": 0,
+                                      "plant_evaluations": 2})
     document = json.loads((tmp_path / "d" / "design.json").read_text())
     assert document["model"] == "physical"
     assert set(document["prediction"]["parameters"]) == set(document["baseline"]["parameters"])

@@ -178,6 +178,12 @@ def force_noise_covariance(noise: SensorNoise, rows: int) -> np.ndarray:
     return np.broadcast_to(np.diag(sigma ** 2), (rows, 6, 6))
 
 
+def channel_weights(S: np.ndarray) -> np.ndarray:
+    """W: each leg channel weighted by its mean noise variance over the rows of ``S``
+    (K, 6, 6), as the estimator weights by its residual's. Shape (6,), 1/N^2."""
+    return 1.0 / np.mean(np.diagonal(S, axis1=1, axis2=2), axis=0)
+
+
 def sandwich_covariance(X: np.ndarray, S: np.ndarray, samples_per_row: float,
                         noise_rows: np.ndarray | None = None,
                         extra: np.ndarray | None = None) -> np.ndarray:
@@ -202,7 +208,7 @@ def sandwich_covariance(X: np.ndarray, S: np.ndarray, samples_per_row: float,
     -------
     ndarray, shape (p, p)
     """
-    weights = 1.0 / np.mean(np.diagonal(S, axis1=1, axis2=2), axis=0)
+    weights = channel_weights(S)
     Z = weights[None, :, None] * X  # W X
     A = np.einsum("kcp,kcq->pq", X, Z, optimize=True)
     if noise_rows is not None:
@@ -240,7 +246,8 @@ def record_kernels(design: Design, rate_hz: float, q: np.ndarray) -> list[np.nda
             for a, b in zip(ends[:-1], ends[1:], strict=True)]
 
 
-def kernel_filtered(design: Design, rate_hz: float, q: np.ndarray, X: np.ndarray
+def kernel_filtered(design: Design, rate_hz: float, q: np.ndarray, X: np.ndarray,
+                    taps: list[np.ndarray] | None = None
                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The pose and the regressor of every record filtered with the physical estimator's
     kernel (its window: :data:`~stewartid.signals.differentiation.DEFAULT_WINDOW_PERIODS`
@@ -262,6 +269,8 @@ def kernel_filtered(design: Design, rate_hz: float, q: np.ndarray, X: np.ndarray
         Rate of ``q`` and ``X`` (Hz), records one after the other (:func:`design_rows`).
     q : ndarray, shape (K, 6)
     X : ndarray, shape (K, 6, p)
+    taps : list of ndarray, optional
+        Each record's kernel (:func:`record_kernels`), when already computed.
 
     Returns
     -------
@@ -272,11 +281,11 @@ def kernel_filtered(design: Design, rate_hz: float, q: np.ndarray, X: np.ndarray
     """
     ends = np.cumsum([0, *record_rows(design, rate_hz)])
     poses, rows, twice = [], [], []
-    for (a, b), taps in zip(zip(ends[:-1], ends[1:], strict=True),
-                            record_kernels(design, rate_hz, q), strict=True):
-        poses.append(scipy.signal.convolve(q[a:b], taps[:, None], mode="valid"))
-        rows.append(scipy.signal.convolve(X[a:b], taps[:, None, None], mode="valid"))
-        twice.append(scipy.signal.convolve(rows[-1], taps[:, None, None], mode="same"))
+    taps = record_kernels(design, rate_hz, q) if taps is None else taps
+    for (a, b), h in zip(zip(ends[:-1], ends[1:], strict=True), taps, strict=True):
+        poses.append(scipy.signal.convolve(q[a:b], h[:, None], mode="valid"))
+        rows.append(scipy.signal.convolve(X[a:b], h[:, None, None], mode="valid"))
+        twice.append(scipy.signal.convolve(rows[-1], h[:, None, None], mode="same"))
     return np.concatenate(poses), np.concatenate(rows), np.concatenate(twice)
 
 
@@ -323,9 +332,10 @@ def predict_parameters(platform: Platform, design: Design, noise: SensorNoise,
     states = design_rows(platform, design, rate_hz) if states is None else states
     q = states[0]
     X = (reg.regressor(platform, *states) if rows is None else rows) @ selection.T
-    twice = None
+    twice = taps = None
     if filtered:
-        q, X, twice = kernel_filtered(design, rate_hz, q, X)
+        taps = record_kernels(design, rate_hz, q)
+        q, X, twice = kernel_filtered(design, rate_hz, q, X, taps)
     to_legs = leg_force_transforms(platform, q)
     X = np.einsum("kij,kjp->kip", to_legs, X, optimize=True)
     if twice is not None:
@@ -334,11 +344,9 @@ def predict_parameters(platform: Platform, design: Design, noise: SensorNoise,
     per_row = platform.sensors.sample_rate / rate_hz
     extra = np.zeros((len(names),) * 2)
     if filtered:
-        weights = 1.0 / np.mean(np.diagonal(S, axis1=1, axis2=2), axis=0)
         extra = pose_noise_scores(
             platform, noise, rate_hz, states, np.cumsum([0, *record_rows(design, rate_hz)]),
-            record_kernels(design, rate_hz, states[0]), X, to_legs, weights,
-            reg.standard_parameters(platform))
+            taps, X, to_legs, channel_weights(S), reg.standard_parameters(platform))
     # the estimator's own rule for what it fixes (PhysicalIdentifier's scales)
     positive = np.isin(reg.PARAMETERS, POSITIVE_PARAMETERS)
     size = np.maximum(np.abs(nominal), selection @ np.where(
@@ -362,7 +370,6 @@ def predict_parameters(platform: Platform, design: Design, noise: SensorNoise,
                                parameter_sizes(tuple(names), nominal), payload)
 
 
-__all__ = ["INFORMATION_RATE", "ParameterPrediction", "design_rows", "force_noise_covariance",
-           "kernel_filtered", "parameter_sizes", "predict_parameters", "record_kernels",
-           "record_rows",
-           "sandwich_covariance"]
+__all__ = ["INFORMATION_RATE", "ParameterPrediction", "channel_weights", "design_rows",
+           "force_noise_covariance", "kernel_filtered", "parameter_sizes", "predict_parameters",
+           "record_kernels", "record_rows", "sandwich_covariance"]

@@ -27,7 +27,14 @@ from stewartid.design.information import ParameterPrediction, predict_parameters
 from stewartid.design.limits import LIMIT_NAMES, resolve_limits
 from stewartid.design.multisine import all_dofs_multisine
 from stewartid.design.optimise import within_plant_limits
-from stewartid.design.physical_search import search_design
+from stewartid.design.physical_search import (
+    PLANT_EVALUATIONS,
+    PLANT_TOLERANCE,
+    PhysicalCandidate,
+    plant_scales,
+    refine_for_plant,
+    search_design,
+)
 from stewartid.design.prediction import inverse_leg_jacobians, measured_plant_datasets
 from stewartid.design.report import play_command, plot_limit_use, write_design_report
 from stewartid.design.run import is_design_file
@@ -140,6 +147,40 @@ def _number(value: float) -> float | None:
     return float(value) if np.isfinite(value) else None
 
 
+def played_pick(platform: Platform, best: PhysicalCandidate, budget_s: float,
+                noise: SensorNoise, payload: bool, max_use: float,
+                evaluations: int = PLANT_EVALUATIONS,
+                progress: Callable[[str], None] | None = None
+                ) -> tuple[PhysicalCandidate, Design, list, list, ParameterPrediction]:
+    """The search's pick played on the plant (records over ``max_use`` scaled down) and
+    predicted as the final design is; where the plant allowed less of a record than its
+    commanded motion at the limits (:func:`~stewartid.design.physical_search.plant_scales`:
+    its tracking adds motion at the higher frequencies), the search refined against that
+    (:func:`~stewartid.design.physical_search.refine_for_plant`) and its pick played too,
+    the better of the two kept.
+
+    Returns
+    -------
+    pick, design, records, uses, prediction
+        The candidate kept and, as played, its design, plant records, their limit use and
+        the final prediction.
+    """
+    if progress:
+        progress("playing the design on the plant")
+    picks = [(best, *within_plant_limits(platform, best.design, max_use))]
+    scales = plant_scales(best.design, picks[0][1])
+    if evaluations > 0 and np.any(scales < 1 - PLANT_TOLERANCE):
+        if progress:
+            progress(f"the plant allows {scales.min():.2f} of a record's commanded "
+                     "amplitudes: refining the search against that")
+        refined = refine_for_plant(platform, budget_s, noise, payload, max_use,
+                                   best.parameters, scales, evaluations)
+        picks.append((refined, *within_plant_limits(platform, refined.design, max_use)))
+    played = [(*pick, predict_parameters(platform, pick[1], noise, payload, FINAL_RATE,
+                                         filtered=True)) for pick in picks]
+    return min(played, key=lambda p: p[4].worst_relative_std)
+
+
 def run_physical_design(platform: Platform, budget_s: float, noise: SensorNoise,
                         out: str | Path, payload: bool = False, rate_hz: float = 500.0,
                         max_use: float = 0.7, check_seeds: int = 2, force: bool = False,
@@ -172,7 +213,8 @@ def run_physical_design(platform: Platform, budget_s: float, noise: SensorNoise,
     progress : callable, optional
     search : dict, optional
         ``random_candidates`` and ``local_evaluations`` of
-        :func:`~stewartid.design.physical_search.search_design` (tests: fewer).
+        :func:`~stewartid.design.physical_search.search_design` and ``plant_evaluations``
+        of :func:`played_pick` (tests: fewer).
 
     Returns
     -------
@@ -189,12 +231,12 @@ def run_physical_design(platform: Platform, budget_s: float, noise: SensorNoise,
                           "expected payload's mass, com and inertia there (the design is "
                           "judged against them; identify --payload fits it anew).")
     check_output_folder(out, force, is_design_file)
+    search = dict(search or {})
+    refinement = search.pop("plant_evaluations", PLANT_EVALUATIONS)
     best = search_design(platform, budget_s, noise, payload, max_use, progress=progress,
-                         **(search or {}))
-    if progress:
-        progress("playing the design on the plant")
-    design, records, uses = within_plant_limits(platform, best.design, max_use)
-    prediction = predict_parameters(platform, design, noise, payload, FINAL_RATE, filtered=True)
+                         **search)
+    best, design, records, uses, prediction = played_pick(
+        platform, best, budget_s, noise, payload, max_use, refinement, progress)
     baseline_design = all_dofs_multisine(budget_s)
     baseline = predict_parameters(platform, baseline_design, noise, payload, FINAL_RATE,
                                   filtered=True)
@@ -281,4 +323,5 @@ def render_physical_markdown(design: Design, prediction: ParameterPrediction,
 
 
 __all__ = ["FINAL_RATE", "PhysicalDesignOutput", "UNDERPREDICTED", "monte_carlo_check",
+           "played_pick",
            "physical_identify_command", "render_physical_markdown", "run_physical_design"]

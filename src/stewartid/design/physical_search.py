@@ -53,6 +53,10 @@ PAYLOAD_SPEED_BOUNDS = (0.5, 2.0)
 #: Candidates evaluated at random, then by Nelder-Mead from the best.
 RANDOM_CANDIDATES = 12
 LOCAL_EVALUATIONS = 48
+#: Nelder-Mead evaluations of :func:`refine_for_plant`, and how far below 1 a record's plant
+#: scale (:func:`plant_scales`) must be for the search to be refined.
+PLANT_EVALUATIONS = 24
+PLANT_TOLERANCE = 0.02
 
 
 def commanded_limit_use(platform: Platform, design: Design, rate_hz: float = INFORMATION_RATE
@@ -88,11 +92,11 @@ def record_peaks(design: Design, use: LimitUse, rate_hz: float = INFORMATION_RAT
     return np.array([use.use[a:b].max() for a, b in zip(edges[:-1], edges[1:], strict=True)])
 
 
-def scale_to_limits(platform: Platform, design: Design, max_use: float,
+def scale_to_limits(platform: Platform, design: Design, max_use: float | np.ndarray,
                     rate_hz: float = INFORMATION_RATE, rounds: int = 4
                     ) -> tuple[Design, LimitUse, tuple]:
     """Scale each record's amplitudes until its commanded motion uses ``max_use`` of its
-    most used limit (within 2 %).
+    most used limit (within 2 %; one value for all records, or one per record).
 
     Each record on its own: records of one family move the DOFs at different frequencies,
     so the one that reaches a rate limit first would otherwise hold the others below
@@ -108,13 +112,15 @@ def scale_to_limits(platform: Platform, design: Design, max_use: float,
     states : tuple of ndarray
         (q, q_dot, q_ddot) of the scaled design at ``rate_hz`` and the standard regressor.
     """
+    target = np.broadcast_to(np.asarray(max_use, dtype=float), len(design.records))
     for _ in range(rounds):
         use, states = commanded_limit_use(platform, design, rate_hz)
         peaks = record_peaks(design, use, rate_hz)
-        if np.all(np.abs(peaks - max_use) <= 0.02 * max_use):
+        if np.all(np.abs(peaks - target) <= 0.02 * target):
             break
         design = dataclasses.replace(design, records=tuple(
-            r.scaled(max_use / peak) for r, peak in zip(design.records, peaks, strict=True)))
+            r.scaled(aim / peak) for r, peak, aim in zip(design.records, peaks, target,
+                                                         strict=True)))
     else:
         use, states = commanded_limit_use(platform, design, rate_hz)
     return design, use, states
@@ -145,6 +151,13 @@ class PhysicalCandidate:
         return self.prediction.worst_relative_std
 
 
+def _bounds(payload: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper bounds of the search's eight parameters."""
+    speeds = np.log(speed_bounds(payload))
+    return (np.array([WEIGHT_BOUNDS[0]] * 6 + [speeds[0], SHARE_BOUNDS[0]]),
+            np.array([WEIGHT_BOUNDS[1]] * 6 + [speeds[1], SHARE_BOUNDS[1]]))
+
+
 def speed_bounds(payload: bool) -> tuple[float, float]:
     """The search's bounds on the frequency pool's speed (:data:`SPEED_BOUNDS`, or
     :data:`PAYLOAD_SPEED_BOUNDS` in payload mode)."""
@@ -152,16 +165,61 @@ def speed_bounds(payload: bool) -> tuple[float, float]:
 
 
 def candidate(platform: Platform, budget_s: float, noise: SensorNoise, payload: bool,
-              parameters: np.ndarray, max_use: float) -> PhysicalCandidate:
-    """One member of the family at the limits, with its prediction."""
+              parameters: np.ndarray, max_use: float, scales: np.ndarray | None = None
+              ) -> PhysicalCandidate:
+    """One member of the family at the limits, with its prediction; with ``scales``
+    (:func:`plant_scales`), each record's amplitudes then times its own."""
     weights, speed, share = parameters[:6], parameters[6], parameters[7]
     amplitudes = np.exp(np.clip(weights, *WEIGHT_BOUNDS)) * np.asarray(DEFAULT_AMPLITUDES)
     design = multisine_design(budget_s, amplitudes, math.exp(np.clip(speed, *np.log(
         speed_bounds(payload)))), float(np.clip(share, *SHARE_BOUNDS)))
     design, use, states = scale_to_limits(platform, design, max_use)
-    prediction = predict_parameters(platform, design, noise, payload, states=states[:3],
-                                    rows=states[3])
+    if scales is None:
+        prediction = predict_parameters(platform, design, noise, payload, states=states[:3],
+                                        rows=states[3])
+    else:
+        design = dataclasses.replace(design, records=tuple(
+            r.scaled(k) for r, k in zip(design.records, scales, strict=True)))
+        prediction = predict_parameters(platform, design, noise, payload)
     return PhysicalCandidate(design, prediction, np.asarray(parameters, dtype=float), use.peak)
+
+
+def plant_scales(design: Design, played: Design) -> np.ndarray:
+    """Per record, the factor its amplitudes were scaled by to keep the plant's states
+    within the limits (``played``, of :func:`~stewartid.design.optimise.within_plant_limits`,
+    against ``design``): what the plant's tracking (lag, the servo's coupling at the higher
+    frequencies) takes from motion the rigid-body model of the command allows.
+    Shape (records,), at most 1."""
+    return np.array([np.linalg.norm(b.amplitudes) / np.linalg.norm(a.amplitudes)
+                     for a, b in zip(design.records, played.records, strict=True)])
+
+
+def refine_for_plant(platform: Platform, budget_s: float, noise: SensorNoise, payload: bool,
+                     max_use: float, start: np.ndarray, scales: np.ndarray,
+                     evaluations: int = PLANT_EVALUATIONS) -> PhysicalCandidate:
+    """Nelder-Mead again from ``start``, every candidate's record k, at ``max_use`` of its
+    commanded limits, scaled by the plant's scale of the played pick's record k
+    (:func:`plant_scales`): the motion judged as the plant will allow it. Record k of the
+    family keeps its order of frequencies from one candidate to the next, so its scale
+    carries over to the neighbours.
+
+    Returns
+    -------
+    PhysicalCandidate
+        The best candidate seen.
+    """
+    lower, upper = _bounds(payload)
+    seen: list[PhysicalCandidate] = []
+
+    def evaluate(x: np.ndarray) -> float:
+        seen.append(candidate(platform, budget_s, noise, payload, np.clip(x, lower, upper),
+                              max_use, scales))
+        return math.log(seen[-1].score)
+
+    simplex = start + np.vstack([np.zeros(8), 0.15 * (upper - lower) * np.eye(8)])
+    scipy.optimize.minimize(evaluate, start, method="Nelder-Mead", options={
+        "maxfev": evaluations, "initial_simplex": np.clip(simplex, lower, upper)})
+    return min(seen, key=lambda c: c.score)
 
 
 def search_design(platform: Platform, budget_s: float, noise: SensorNoise,
@@ -196,9 +254,7 @@ def search_design(platform: Platform, budget_s: float, noise: SensorNoise,
     if not 0 < max_use <= 1:
         raise ConfigError(f"max_use must be in (0, 1]; got {max_use!r}.")
     rng = np.random.default_rng(seed)
-    speeds = np.log(speed_bounds(payload))
-    lower = np.array([WEIGHT_BOUNDS[0]] * 6 + [speeds[0], SHARE_BOUNDS[0]])
-    upper = np.array([WEIGHT_BOUNDS[1]] * 6 + [speeds[1], SHARE_BOUNDS[1]])
+    lower, upper = _bounds(payload)
     starts = [np.array([0.0] * 6 + [0.0, 0.0])]  # the reference's shape, at the limits
     starts += [rng.uniform(lower, upper) for _ in range(random_candidates - 1)]
     seen: list[PhysicalCandidate] = []
@@ -226,6 +282,8 @@ def search_design(platform: Platform, budget_s: float, noise: SensorNoise,
     return best
 
 
-__all__ = ["LOCAL_EVALUATIONS", "PAYLOAD_SPEED_BOUNDS", "PhysicalCandidate", "RANDOM_CANDIDATES",
-           "SHARE_BOUNDS", "SPEED_BOUNDS", "WEIGHT_BOUNDS", "candidate", "commanded_limit_use",
-           "record_peaks", "scale_to_limits", "search_design", "speed_bounds"]
+__all__ = ["LOCAL_EVALUATIONS", "PAYLOAD_SPEED_BOUNDS", "PLANT_EVALUATIONS", "PLANT_TOLERANCE",
+           "PhysicalCandidate", "RANDOM_CANDIDATES", "SHARE_BOUNDS", "SPEED_BOUNDS",
+           "WEIGHT_BOUNDS", "candidate", "commanded_limit_use", "plant_scales",
+           "record_peaks", "refine_for_plant", "scale_to_limits", "search_design",
+           "speed_bounds"]
