@@ -45,10 +45,11 @@ SPEED_BOUNDS = (0.5, 1.0)
 SHARE_BOUNDS = (0.0, 0.6)
 #: The speed's bounds in payload mode. Faster motion at the same leg speeds (smaller
 #: amplitudes) raises the accelerations the payload's inertia is seen through; the pose
-#: noise it brings into the filtered rates and accelerations, which the prediction leaves
-#: out, falls mostly on the friction (a nuisance there). In full mode the friction is among
-#: the results: at twice the speed its Coulomb levels' spread over seeds was 2-4 times their
-#: prediction, so full mode keeps to the reference band.
+#: noise it brings into the filtered rates and accelerations, which the search's prediction
+#: leaves out (the final one adds it), falls mostly on the friction (a nuisance there). In
+#: full mode the friction is among the results: at twice the speed its Coulomb levels'
+#: spread over seeds was 2-4 times their prediction, so full mode keeps to the reference
+#: band.
 PAYLOAD_SPEED_BOUNDS = (0.5, 2.0)
 #: Candidates evaluated at random, then by Nelder-Mead from the best.
 RANDOM_CANDIDATES = 12

@@ -45,16 +45,16 @@ from stewartid.simulation.sensors import SensorNoise
 RATE_STEP = 1e-3
 
 
-def pose_covariance(platform: Platform, noise: SensorNoise, q: np.ndarray) -> np.ndarray:
+def pose_covariance(noise: SensorNoise, jacobian: np.ndarray) -> np.ndarray:
     """Sigma_q = J_lq^-1 Sigma_l J_lq^-T: the pose's white noise per sample from the legs'
     length noise, to first order.
 
     Parameters
     ----------
-    platform : Platform
     noise : SensorNoise
         ``length_noise`` (m).
-    q : ndarray, shape (K, 6)
+    jacobian : ndarray, shape (K, 6, 6)
+        J_lq at each pose (:func:`~stewartid.model.kinematics.leg_jacobian`).
 
     Returns
     -------
@@ -62,7 +62,7 @@ def pose_covariance(platform: Platform, noise: SensorNoise, q: np.ndarray) -> np
         m^2, rad^2.
     """
     sigma = np.broadcast_to(np.asarray(noise.length_noise, dtype=float), 6)
-    inverse = np.linalg.inv(leg_jacobian(platform, q))
+    inverse = np.linalg.inv(jacobian)
     return np.einsum("kij,j,klj->kil", inverse, sigma ** 2, inverse, optimize=True)
 
 
@@ -138,8 +138,8 @@ def pose_noise_scores(platform: Platform, noise: SensorNoise, rate_hz: float,
         Q = np.einsum("kpi,kic->kpc", U, rate_sensitivity(platform, q, q_dot, q_ddot, theta),
                       optimize=True)
         G = np.gradient(np.gradient(P, dt, axis=0), dt, axis=0) - np.gradient(Q, dt, axis=0)
-        B += np.einsum("kpc,kcd,kqd->pq", G, pose_covariance(platform, noise, q), G,
-                       optimize=True)
+        B += np.einsum("kpc,kcd,kqd->pq", G, pose_covariance(noise, leg_jacobian(platform, q)),
+                       G, optimize=True)
     return B
 
 

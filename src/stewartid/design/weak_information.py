@@ -47,6 +47,7 @@ from collections.abc import Callable
 import numpy as np
 
 from stewartid.datasets.dataset import Dataset
+from stewartid.design import pose_noise
 from stewartid.design.candidates import Design
 from stewartid.design.prediction import (
     DESIGN_SETTINGS,
@@ -97,11 +98,9 @@ def known_noise(experiment: Experiment, noise: SensorNoise) -> tuple[np.ndarray,
     force : ndarray, shape (6, 6)
         J_lq^T Sigma_f J_lq + K pose K^T averaged over the samples (N^2, N^2 m, N^2 m^2).
     """
-    lengths = np.broadcast_to(np.asarray(noise.length_noise, dtype=float), 6) ** 2
     forces = np.broadcast_to(np.asarray(noise.force_noise, dtype=float), 6) ** 2
     jacobian = experiment.leg_jacobian
-    inverse = np.linalg.inv(jacobian)
-    pose = np.einsum("nij,j,nkj->ik", inverse, lengths, inverse) / len(jacobian)
+    pose = pose_noise.pose_covariance(noise, jacobian).mean(axis=0)
     force = np.einsum("nji,j,njk->ik", jacobian, forces, jacobian) / len(jacobian)
     sensitivity = experiment.force_sensitivity
     return pose, force + sensitivity @ pose @ sensitivity.T
