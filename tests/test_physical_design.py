@@ -4,6 +4,7 @@ the multisine records, the end-to-end run and the command line's refusals."""
 from __future__ import annotations
 
 import json
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -12,7 +13,12 @@ from typer.testing import CliRunner
 from stewartid.cli.application import app
 from stewartid.datasets.dataset import Dataset
 from stewartid.design.candidates import Design
-from stewartid.design.information import parameter_sizes, predict_parameters
+from stewartid.design.information import (
+    design_rows,
+    parameter_sizes,
+    played_states,
+    predict_parameters,
+)
 from stewartid.design.multisine import MultisineRecord, all_dofs_multisine, multisine_design
 from stewartid.design.physical_run import run_physical_design
 from stewartid.design.physical_search import (
@@ -121,6 +127,30 @@ def test_final_prediction_counts_the_pose_noise(loaded):
     friction = [k for k, name in enumerate(predicted.names)
                 if name.startswith(("coulomb", "viscous")) and np.isfinite(ratio[k])]
     assert np.all((ratio[friction] > 0.5) & (ratio[friction] < 2.0)), named
+
+
+def test_final_prediction_follows_the_motion_the_plant_played(loaded):
+    """A plant that plays every record at 0.6 of its commanded amplitude, logged at 1 kHz:
+    the prediction along its states (interpolated to the prediction's rate) is that of the
+    design commanded at 0.6, within the interpolation of the 1 kHz samples (exact on the
+    100 Hz grid), and differs from the commanded design's."""
+    design = all_dofs_multisine(12.0)
+    smaller = Design(tuple(r.scaled(0.6) for r in design.records))
+    records = []
+    for playable in smaller.playable(loaded):
+        t = np.arange(int(12.0 * 1000) + 1) / 1000.0
+        q, q_dot, q_ddot = playable.evaluate(t)
+        records.append(SimpleNamespace(t=t, q=q, q_dot=q_dot, q_ddot=q_ddot))
+    noise = SensorNoise(length_noise=2e-5, force_noise=170.0)
+    states = played_states(records, design, 100.0)
+    assert all(np.allclose(a, b, rtol=0, atol=1e-12 * max(1.0, np.abs(b).max()))
+               for a, b in zip(states, design_rows(loaded, smaller, 100.0), strict=True))
+    played = predict_parameters(loaded, design, noise, True, 100.0, states=states,
+                                filtered=True)
+    expected = predict_parameters(loaded, smaller, noise, True, 100.0, filtered=True)
+    commanded = predict_parameters(loaded, design, noise, True, 100.0, filtered=True)
+    assert np.allclose(played.std_errors, expected.std_errors, rtol=1e-9)
+    assert played.worst_relative_std > 1.3 * commanded.worst_relative_std
 
 
 def test_refinement_against_the_plant_scales_each_record_by_its_own(loaded):

@@ -23,7 +23,11 @@ import numpy as np
 
 from stewartid.design.candidates import Design
 from stewartid.design.export import write_commands
-from stewartid.design.information import ParameterPrediction, predict_parameters
+from stewartid.design.information import (
+    ParameterPrediction,
+    played_states,
+    predict_parameters,
+)
 from stewartid.design.limits import LIMIT_NAMES, resolve_limits
 from stewartid.design.multisine import all_dofs_multisine
 from stewartid.design.optimise import within_plant_limits
@@ -35,7 +39,11 @@ from stewartid.design.physical_search import (
     refine_for_plant,
     search_design,
 )
-from stewartid.design.prediction import inverse_leg_jacobians, measured_plant_datasets
+from stewartid.design.prediction import (
+    inverse_leg_jacobians,
+    measured_plant_datasets,
+    plant_records,
+)
 from stewartid.design.report import play_command, plot_limit_use, write_design_report
 from stewartid.design.run import is_design_file
 from stewartid.design.validation import write_validation_record
@@ -153,7 +161,8 @@ def played_pick(platform: Platform, best: PhysicalCandidate, budget_s: float,
                 progress: Callable[[str], None] | None = None
                 ) -> tuple[PhysicalCandidate, Design, list, list, ParameterPrediction]:
     """The search's pick played on the plant (records over ``max_use`` scaled down) and
-    predicted as the final design is; where the plant allowed less of a record than its
+    predicted as the final design is, along the motion the plant played
+    (:func:`~stewartid.design.information.played_states`); where the plant allowed less of a record than its
     commanded motion at the limits (:func:`~stewartid.design.physical_search.plant_scales`:
     its tracking adds motion at the higher frequencies), the search refined against that
     (:func:`~stewartid.design.physical_search.refine_for_plant`) and its pick played too,
@@ -177,6 +186,7 @@ def played_pick(platform: Platform, best: PhysicalCandidate, budget_s: float,
                                    best.parameters, scales, evaluations)
         picks.append((refined, *within_plant_limits(platform, refined.design, max_use)))
     played = [(*pick, predict_parameters(platform, pick[1], noise, payload, FINAL_RATE,
+                                         states=played_states(pick[2], pick[1], FINAL_RATE),
                                          filtered=True)) for pick in picks]
     return min(played, key=lambda p: p[4].worst_relative_std)
 
@@ -238,8 +248,11 @@ def run_physical_design(platform: Platform, budget_s: float, noise: SensorNoise,
     best, design, records, uses, prediction = played_pick(
         platform, best, budget_s, noise, payload, max_use, refinement, progress)
     baseline_design = all_dofs_multisine(budget_s)
-    baseline = predict_parameters(platform, baseline_design, noise, payload, FINAL_RATE,
-                                  filtered=True)
+    # predicted as the design is, along its motion on the plant: like for like
+    baseline = predict_parameters(
+        platform, baseline_design, noise, payload, FINAL_RATE, filtered=True,
+        states=played_states(plant_records(platform, baseline_design), baseline_design,
+                             FINAL_RATE))
     if progress:
         progress(f"checking the prediction on {check_seeds} noisy copies")
     check = monte_carlo_check(platform, records, noise, prediction, check_seeds)
