@@ -127,6 +127,11 @@ def main() -> None:
           f"(median ratio {np.median(ratio[finite]):.2f}); predicted worst relative SE "
           f"{document['prediction']['worst_relative_std_percent']:.3g} % vs multisine "
           f"{document['baseline']['worst_relative_std_percent']:.3g} %")
+    commanded = document["prediction_commanded"]["parameters"]
+    along = np.array([np.nan if commanded[n]["expected_std_error"] is None
+                      else commanded[n]["expected_std_error"] for n in names]) / spread
+    print(f"  along the commanded motion: {np.mean(np.abs(along[finite] - 1) <= 0.3):.0%} "
+          f"within 30 % (median ratio {np.median(along[finite]):.2f})")
     for start in range(0, args.seeds - 7 if args.seeds > 8 else 0, 8):
         block = expected / np.std(estimates[start:start + 8], axis=0, ddof=1)
         print(f"  seeds {1000 + start}-{1007 + start}: "

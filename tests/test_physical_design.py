@@ -210,6 +210,8 @@ def test_physical_design_writes_commands_prediction_and_check(loaded, tmp_path):
     document = json.loads((tmp_path / "d" / "design.json").read_text())
     assert document["model"] == "physical"
     assert set(document["prediction"]["parameters"]) == set(document["baseline"]["parameters"])
+    assert (set(document["prediction_commanded"]["parameters"])
+            == set(document["prediction"]["parameters"]))
     assert all(max(peak.values()) <= 0.7 + 1e-3 for peak in document["limit_use"])
     assert document["identify"]["identify"].endswith("--model physical --payload")
     assert (tmp_path / "d" / "commands" / "exp1.csv").is_file()
@@ -221,6 +223,7 @@ def test_physical_design_writes_commands_prediction_and_check(loaded, tmp_path):
              if v["reported"] is not None and v["reported"] > 1.5 * v["predicted"]]
     assert document["check"]["underpredicted"] == short
     report = (tmp_path / "d" / "report.md").read_text()
+    assert "Along the commanded motion" in report
     assert ("The prediction counts the force noise and the pose noise" in report) == bool(short)
 
 

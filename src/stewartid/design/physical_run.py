@@ -247,6 +247,8 @@ def run_physical_design(platform: Platform, budget_s: float, noise: SensorNoise,
                          **search)
     best, design, records, uses, prediction = played_pick(
         platform, best, budget_s, noise, payload, max_use, refinement, progress)
+    # a machine that tracks the command exactly moves less than the plant: its prediction
+    commanded = predict_parameters(platform, design, noise, payload, FINAL_RATE, filtered=True)
     baseline_design = all_dofs_multisine(budget_s)
     # predicted as the design is, along its motion on the plant: like for like
     baseline = predict_parameters(
@@ -271,6 +273,7 @@ def run_physical_design(platform: Platform, budget_s: float, noise: SensorNoise,
                 "search parameters": [round(float(v), 4) for v in best.parameters]}
     document = {"model": "physical", "design": design.to_dict(),
                 "prediction": prediction.to_dict(),
+                "prediction_commanded": commanded.to_dict(),
                 "baseline": {"design": baseline_design.to_dict(), **baseline.to_dict()},
                 "check": check, "limits": resolve_limits(platform).to_dict(),
                 "limit_use": peaks, "limit_use_from": "the plant's simulated states",
@@ -278,15 +281,17 @@ def run_physical_design(platform: Platform, budget_s: float, noise: SensorNoise,
                 "validation": {"record": "validation/validation.csv"}}
     files.append(write_json_atomic(out / "design.json", document))
     files += write_design_report(out, render_physical_markdown(
-        design, prediction, baseline, check, peaks, settings, commands))
+        design, prediction, baseline, check, peaks, settings, commands, commanded))
     return PhysicalDesignOutput(design, prediction, baseline, check, commands, files)
 
 
 def render_physical_markdown(design: Design, prediction: ParameterPrediction,
                              baseline: ParameterPrediction, check: dict,
                              peaks: list[dict[str, float]], settings: dict,
-                             commands: dict[str, str]) -> str:
-    """The report text of a physical design."""
+                             commands: dict[str, str],
+                             commanded: ParameterPrediction | None = None) -> str:
+    """The report text of a physical design (``commanded``: its prediction along the
+    commanded motion, beside the one along the plant's)."""
     ratio = prediction.worst_relative_std / baseline.worst_relative_std
     lines = ["# Excitation design for the physical model", "",
              f"{design.label}; {design.duration:.1f} s of motion.", "", "## Settings", ""]
@@ -304,7 +309,7 @@ def render_physical_markdown(design: Design, prediction: ParameterPrediction,
               f"({prediction.worst_parameter}); the all-DOFs multisine at the paper's "
               f"amplitudes, same length: {baseline.worst_relative_std:.3g} % (ratio "
               f"{ratio:.2f}). Fixed by the estimator (too uncertain): "
-              f"{', '.join(prediction.fixed) or 'none'}.", "",
+              f"{', '.join(prediction.fixed) or 'none'}.", "", *_commanded_lines(prediction, commanded),
               "| parameter | nominal | design SE | relative (%) | multisine SE | fit's SE (check) |",
               "|---|---|---|---|---|---|"]
     for k, name in enumerate(prediction.names):
@@ -333,6 +338,20 @@ def render_physical_markdown(design: Design, prediction: ParameterPrediction,
               "`validation/validation.csv` moves every DOF at once at frequencies of its own: "
               "motion the fit does not see (`identify --validate`).", ""]
     return "\n".join(lines)
+
+
+def _commanded_lines(prediction: ParameterPrediction,
+                     commanded: ParameterPrediction | None) -> list[str]:
+    if commanded is None:
+        return []
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = commanded.expected_std_errors / prediction.expected_std_errors
+    return [f"Predicted along the motion the plant played, whose servo adds motion of its own "
+            f"at the higher frequencies. Along the commanded motion, as a machine that tracks "
+            f"it exactly would move: worst {commanded.worst_relative_std:.3g} % "
+            f"({commanded.worst_parameter}), each standard error up to "
+            f"{np.nanmax(ratio):.2f} times the table's (`prediction_commanded` in "
+            f"`design.json`).", ""]
 
 
 __all__ = ["FINAL_RATE", "PhysicalDesignOutput", "UNDERPREDICTED", "monte_carlo_check",
