@@ -224,7 +224,7 @@ def test_physical_design_writes_commands_prediction_and_check(loaded, tmp_path):
     assert document["check"]["underpredicted"] == short
     report = (tmp_path / "d" / "report.md").read_text()
     assert "Along the commanded motion" in report
-    assert ("The prediction counts the force noise and the pose noise" in report) == bool(short)
+    assert ("Rely on the larger of the two" in report) == bool(short)
 
 
 @pytest.mark.parametrize(("arguments", "message"), [

@@ -327,11 +327,12 @@ def render_physical_markdown(design: Design, prediction: ParameterPrediction,
                   f"{check['within_30_percent']:.0%} of the parameters."]
         if check["underpredicted"]:
             lines += ["", f"The fits' standard errors are over {UNDERPREDICTED:g} times the "
-                      f"prediction for {', '.join(check['underpredicted'])}. The prediction "
-                      "counts the force noise and the pose noise to first order, not the "
-                      "pose noise's share through the Coulomb signs of joints that barely "
-                      "move, and a fit's own standard error over few records and seeds is "
-                      "itself uncertain. Rely on the larger of the two for those."]
+                      f"prediction for {', '.join(check['underpredicted'])}. Either the "
+                      "prediction falls short (it counts the force noise and the pose noise "
+                      "to first order, not the pose noise's share through the Coulomb signs "
+                      "of joints that barely move) or the fits' own standard errors, taken "
+                      "from the spread of a few records' sums over few seeds, are "
+                      "conservative. Rely on the larger of the two for those."]
     lines += ["", "## Playing and identifying it", "", "On the plant first (PLATFORM: the "
               "platform file of the design), then on the machine's logs:", "", "```bash",
               commands["play"], commands["identify"], "```", "",
