@@ -9,7 +9,8 @@ physical model is fitted as the printed ``identify`` command does (payload mode 
 file with ``--payload``). Printed: the payload's errors (mass %, com mm, inertia diagonal
 about the com %) or full mode's (Mt(q) at 50 random poses inside the motion's range: diagonal
 %), the predicted SE (``design.json``'s) against the spread over seeds (with more than 8
-seeds, also over each block of 8), the limit use on the plant's states.
+seeds, also over each block of 8) and the fits' own standard errors against it, the limit
+use on the plant's states.
 
 With ``--engine mujoco`` the design's exported pose command files (``commands/exp*.csv``) are
 played on MuJoCo's model of the same platform instead
@@ -101,7 +102,7 @@ def main() -> None:
         records = plant_records(loaded, design)
         use = max(max(record_limit_use(loaded, r).peak.values()) for r in records)
         inverse = inverse_leg_jacobians(loaded, [r.q for r in records])
-    rows, estimates = [], []
+    rows, estimates, fitted_errors = [], [], []
     for seed in range(args.seeds):
         if args.engine == "mujoco":
             data = [degrade(d, loaded, noise, rng=np.random.default_rng([1000 + seed, k]))
@@ -111,6 +112,7 @@ def main() -> None:
             data = measured_plant_datasets(loaded, records, noise, generators, inverse)
         fitted = PhysicalIdentifier(payload=args.payload).fit(data, loaded)
         estimates.append([fitted.parameters_[n] for n in names])
+        fitted_errors.append([fitted.parameter_std_errors_.get(n, np.nan) for n in names])
         rows.append(physical_study.payload_row(fitted, loaded, physical_study.PAYLOADS["paper"])
                     if args.payload else physical_study.full_row(
                         fitted, loaded, data, np.random.default_rng(seed)))
@@ -127,6 +129,9 @@ def main() -> None:
           f"(median ratio {np.median(ratio[finite]):.2f}); predicted worst relative SE "
           f"{document['prediction']['worst_relative_std_percent']:.3g} % vs multisine "
           f"{document['baseline']['worst_relative_std_percent']:.3g} %")
+    own = np.nanmean(fitted_errors, axis=0) / spread
+    print(f"  the fits' own standard errors: {np.nanmedian(own):.2f} times the spread in the "
+          f"median ({np.nanmin(own):.2f}-{np.nanmax(own):.2f})")
     commanded = document["prediction_commanded"]["parameters"]
     along = np.array([np.nan if commanded[n]["expected_std_error"] is None
                       else commanded[n]["expected_std_error"] for n in names]) / spread
