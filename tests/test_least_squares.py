@@ -144,6 +144,33 @@ def test_long_run_covariance_of_moving_average_and_high_pass_noise():
     assert halves == pytest.approx(1.0, abs=0.1)
 
 
+def test_long_run_variances_are_unbiased_where_the_clipped_covariance_is_not():
+    """Scores X_k (e_k+1 - 0.8 e_k) of six slowly varying regressors and one white noise:
+    the variance of their sum is sum_j (X_j-1 - 0.8 X_j)^2 exactly, a small remainder of
+    the lag-0 and lag-1 autocovariances, so the long-run sum's sampling error gives it
+    eigenvalues of either sign. Its diagonal as it is averages to the exact variance over
+    2000 draws (sampling error of the mean about 2.5 %: 0.1 is four of them); with the
+    negative eigenvalues zeroed it came out 1.45-1.6 times it. ``psd="variances"`` keeps
+    the diagonal as it is (zero where negative) on a positive semidefinite matrix."""
+    rng = np.random.default_rng(5)
+    K, n = 4000, 6
+    t = np.arange(K) / K
+    X = np.stack([np.sin(2 * np.pi * (k + 1) * t + k) for k in range(n)], axis=1)
+    padded = np.vstack([np.zeros((1, n)), X, np.zeros((1, n))])
+    exact = np.sum((padded[:-1] - 0.8 * padded[1:]) ** 2, axis=0)
+    raw, clipped = [], []
+    for _ in range(2000):
+        e = rng.normal(size=K + 1)
+        scores = X * (e[1:] - 0.8 * e[:-1])[:, None]
+        raw.append(np.diag(score_sandwich(np.eye(n), scores, [(K, 6)], psd=False)))
+        clipped.append(np.diag(score_sandwich(np.eye(n), scores, [(K, 6)])))
+    assert np.allclose(np.mean(raw, axis=0) / exact, 1.0, atol=0.1)
+    assert np.all(np.mean(clipped, axis=0) / exact > 1.3)
+    mixed = score_sandwich(np.eye(n), scores, [(K, 6)], psd="variances")
+    assert np.allclose(np.diag(mixed), np.clip(raw[-1], 0.0, None), rtol=1e-12, atol=0.0)
+    assert np.linalg.eigvalsh(mixed).min() > -1e-9 * np.abs(mixed).max()
+
+
 def test_the_larger_variances_keep_the_first_covariance_correlations():
     """Worked by hand: variances (4, 1, 0) against (1, 9, 2.25) give (4, 9, 2.25); the first
     pair's correlation 0.5 stays, so their covariance becomes 0.5 * 2 * 3 = 3."""
