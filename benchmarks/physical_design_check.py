@@ -31,6 +31,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -129,7 +130,9 @@ def main() -> None:
           f"(median ratio {np.median(ratio[finite]):.2f}); predicted worst relative SE "
           f"{document['prediction']['worst_relative_std_percent']:.3g} % vs multisine "
           f"{document['baseline']['worst_relative_std_percent']:.3g} %")
-    own = np.nanmean(fitted_errors, axis=0) / spread
+    with warnings.catch_warnings():  # a parameter fixed in every fit has no error at all
+        warnings.simplefilter("ignore", RuntimeWarning)
+        own = np.nanmean(fitted_errors, axis=0) / spread
     print(f"  the fits' own standard errors: {np.nanmedian(own):.2f} times the spread in the "
           f"median ({np.nanmin(own):.2f}-{np.nanmax(own):.2f})")
     commanded = document["prediction_commanded"]["parameters"]
