@@ -107,8 +107,9 @@ def nearest_psd(matrix: np.ndarray) -> np.ndarray:
     Where a long-run sum's true value is the small remainder of large positive and negative
     autocovariances (pose noise through differentiated rates and accelerations, high-pass),
     its sampling error gives eigenvalues of either sign, and zeroing the negative ones raises
-    the diagonal: on a 2 Hz payload design dominated by pose noise the mass's variance came
-    out 6.2 times its spread's square over 12 seeds clipped, 1.00 times unclipped.
+    the diagonal: on a 2 Hz payload design dominated by pose noise the physical fit's
+    variances came out 6.2 times the square of their spread over 12 seeds clipped, 1.00
+    times unclipped (medians over the parameters).
     """
     values, vectors = np.linalg.eigh(matrix)
     return (vectors * np.clip(values, 0.0, None)) @ vectors.T

@@ -274,7 +274,8 @@ def score_covariance(inverse: np.ndarray, X: np.ndarray, residual: np.ndarray,
                      weights: np.ndarray, segments: list[tuple[int, int]],
                      expected: np.ndarray | None = None) -> np.ndarray:
     """N^-1 B N^-1, B the long-run covariance of the scores s_k = sum_c w_c X_kc r_kc
-    (:func:`~stewartid.identification.long_run.score_sandwich`), each variance raised to
+    (:func:`~stewartid.identification.long_run.score_sandwich`, its variances from B as it
+    is, its correlations from B made positive semidefinite), each variance raised to
     that of the scores summed per record where larger (model error correlated with the
     motion over a record: :func:`~stewartid.identification.long_run.record_sandwich`).
 
