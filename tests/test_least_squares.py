@@ -151,7 +151,8 @@ def test_long_run_variances_are_unbiased_where_the_clipped_covariance_is_not():
     eigenvalues of either sign. Its diagonal as it is averages to the exact variance over
     2000 draws (sampling error of the mean about 2.5 %: 0.1 is four of them); with the
     negative eigenvalues zeroed it came out 1.45-1.6 times it. ``psd="variances"`` keeps
-    the diagonal as it is (zero where negative) on a positive semidefinite matrix."""
+    the diagonal as it is (the clipped one where negative: never a zero standard error) on
+    a positive semidefinite matrix."""
     rng = np.random.default_rng(5)
     K, n = 4000, 6
     t = np.arange(K) / K
@@ -166,8 +167,10 @@ def test_long_run_variances_are_unbiased_where_the_clipped_covariance_is_not():
         clipped.append(np.diag(score_sandwich(np.eye(n), scores, [(K, 6)])))
     assert np.allclose(np.mean(raw, axis=0) / exact, 1.0, atol=0.1)
     assert np.all(np.mean(clipped, axis=0) / exact > 1.3)
+    # the diagonal as it is; where it came out negative (18 % here), the clipped one's
     mixed = score_sandwich(np.eye(n), scores, [(K, 6)], psd="variances")
-    assert np.allclose(np.diag(mixed), np.clip(raw[-1], 0.0, None), rtol=1e-12, atol=0.0)
+    assert np.allclose(np.diag(mixed), np.where(raw[-1] > 0, raw[-1], clipped[-1]),
+                       rtol=1e-12, atol=0.0)
     assert np.linalg.eigvalsh(mixed).min() > -1e-9 * np.abs(mixed).max()
 
 

@@ -137,7 +137,7 @@ def score_sandwich(inverse: np.ndarray, scores: np.ndarray,
     psd : bool or "variances"
         B with its negative eigenvalues set to zero (:func:`long_run_covariance`), or not;
         ``"variances"``: the correlations of the first and the variances of the second
-        (zero where negative), which stay unbiased where the clipping raises them
+        (the first's where negative), which stay unbiased where the clipping raises them
         (:func:`nearest_psd`).
 
     Returns
@@ -149,9 +149,12 @@ def score_sandwich(inverse: np.ndarray, scores: np.ndarray,
     B = nearest_psd(raw) if psd else raw
     if basis is not None:
         B, raw = basis.T @ B @ basis, basis.T @ raw @ basis
+    covariance = inverse @ B @ inverse
     if psd == "variances":
-        return with_variances(inverse @ B @ inverse, np.diag(inverse @ raw @ inverse))
-    return inverse @ B @ inverse
+        # a variance whose estimate came out negative has nothing better than the clipped
+        unbiased = np.diag(inverse @ raw @ inverse)
+        return with_variances(covariance, np.where(unbiased > 0, unbiased, np.diag(covariance)))
+    return covariance
 
 
 def record_sandwich(inverse: np.ndarray, scores: np.ndarray,
