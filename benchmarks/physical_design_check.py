@@ -135,6 +135,14 @@ def main() -> None:
         own = np.nanmean(fitted_errors, axis=0) / spread
     print(f"  the fits' own standard errors: {np.nanmedian(own):.2f} times the spread in the "
           f"median ({np.nanmin(own):.2f}-{np.nanmax(own):.2f})")
+    # against the truth: the platform file's values, which the plant (or MuJoCo) simulates
+    truth = np.array([reported[n]["nominal"] for n in names])
+    z = np.abs(estimates - truth) / np.array(fitted_errors)
+    kept = np.isfinite(z)
+    beyond = {n: round(float(np.nanmax(z[:, k])), 2) for k, n in enumerate(names)
+              if np.nanmax(z[:, k], initial=0.0) > 3}
+    print(f"  within 3 of the fits' own standard errors: {np.mean(z[kept] <= 3):.1%} of "
+          f"{kept.sum()} (parameter, seed) pairs; beyond: {beyond}")
     commanded = document["prediction_commanded"]["parameters"]
     along = np.array([np.nan if commanded[n]["expected_std_error"] is None
                       else commanded[n]["expected_std_error"] for n in names]) / spread
