@@ -229,6 +229,12 @@ def record_rows(design: Design, rate_hz: float = INFORMATION_RATE) -> list[int]:
     return [int(math.floor(r.duration * rate_hz)) + 1 for r in design.records]
 
 
+def record_ends(design: Design, rate_hz: float = INFORMATION_RATE) -> np.ndarray:
+    """Each record's first row in :func:`design_rows` at ``rate_hz`` and, last, the total:
+    shape (records + 1,)."""
+    return np.cumsum([0, *record_rows(design, rate_hz)])
+
+
 def design_rows(platform: Platform, design: Design, rate_hz: float = INFORMATION_RATE
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The commanded motion of every record at ``rate_hz``, concatenated: q, q_dot, q_ddot,
@@ -270,7 +276,7 @@ def record_kernels(design: Design, rate_hz: float, q: np.ndarray) -> list[np.nda
     """Each record's taps of the physical estimator's kernel at ``rate_hz`` (its window:
     :data:`~stewartid.signals.differentiation.DEFAULT_WINDOW_PERIODS` periods of the
     record's dominant frequency in ``q``, shape (K, 6), records one after the other)."""
-    ends = np.cumsum([0, *record_rows(design, rate_hz)])
+    ends = record_ends(design, rate_hz)
     return [kernel_taps(rate_hz, default_window(estimate_frequency(q[a:b], rate_hz)))[0]
             for a, b in zip(ends[:-1], ends[1:], strict=True)]
 
@@ -308,7 +314,7 @@ def kernel_filtered(design: Design, rate_hz: float, q: np.ndarray, X: np.ndarray
         the filtered noise's correlation makes of the rows (``noise_rows`` of
         :func:`sandwich_covariance`).
     """
-    ends = np.cumsum([0, *record_rows(design, rate_hz)])
+    ends = record_ends(design, rate_hz)
     poses, rows, twice = [], [], []
     taps = record_kernels(design, rate_hz, q) if taps is None else taps
     for (a, b), h in zip(zip(ends[:-1], ends[1:], strict=True), taps, strict=True):
@@ -375,7 +381,7 @@ def predict_parameters(platform: Platform, design: Design, noise: SensorNoise,
     extra = np.zeros((len(names),) * 2)
     if filtered:
         extra = pose_noise_scores(
-            platform, noise, rate_hz, states, np.cumsum([0, *record_rows(design, rate_hz)]),
+            platform, noise, rate_hz, states, record_ends(design, rate_hz),
             taps, X, to_legs, channel_weights(S), reg.standard_parameters(platform))
     # the estimator's own rule for what it fixes (PhysicalIdentifier's scales)
     positive = np.isin(reg.PARAMETERS, POSITIVE_PARAMETERS)
@@ -402,4 +408,5 @@ def predict_parameters(platform: Platform, design: Design, noise: SensorNoise,
 
 __all__ = ["INFORMATION_RATE", "ParameterPrediction", "channel_weights", "design_rows",
            "force_noise_covariance", "kernel_filtered", "parameter_sizes", "played_states",
-           "predict_parameters", "record_kernels", "record_rows", "sandwich_covariance"]
+           "predict_parameters", "record_ends", "record_kernels", "record_rows",
+           "sandwich_covariance"]

@@ -162,9 +162,10 @@ def played_pick(platform: Platform, best: PhysicalCandidate, budget_s: float,
                 ) -> tuple[PhysicalCandidate, Design, list, list, ParameterPrediction]:
     """The search's pick played on the plant (records over ``max_use`` scaled down) and
     predicted as the final design is, along the motion the plant played
-    (:func:`~stewartid.design.information.played_states`); where the plant allowed less of a record than its
-    commanded motion at the limits (:func:`~stewartid.design.physical_search.plant_scales`:
-    its tracking adds motion at the higher frequencies), the search refined against that
+    (:func:`~stewartid.design.information.played_states`); where the plant allowed less of
+    a record than its commanded motion at the limits
+    (:func:`~stewartid.design.physical_search.plant_scales`: its tracking adds motion at the
+    higher frequencies), the search refined against that
     (:func:`~stewartid.design.physical_search.refine_for_plant`) and its pick played too,
     the better of the two kept.
 
@@ -309,7 +310,8 @@ def render_physical_markdown(design: Design, prediction: ParameterPrediction,
               f"({prediction.worst_parameter}); the all-DOFs multisine at the paper's "
               f"amplitudes, same length: {baseline.worst_relative_std:.3g} % (ratio "
               f"{ratio:.2f}). Fixed by the estimator (too uncertain): "
-              f"{', '.join(prediction.fixed) or 'none'}.", "", *_commanded_lines(prediction, commanded),
+              f"{', '.join(prediction.fixed) or 'none'}.", "",
+              *_commanded_lines(prediction, commanded),
               "| parameter | nominal | design SE | relative (%) | multisine SE | fit's SE (check) |",
               "|---|---|---|---|---|---|"]
     for k, name in enumerate(prediction.names):

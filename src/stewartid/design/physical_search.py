@@ -28,7 +28,7 @@ from stewartid.design.information import (
     ParameterPrediction,
     design_rows,
     predict_parameters,
-    record_rows,
+    record_ends,
 )
 from stewartid.design.limits import LimitUse, limit_use, resolve_limits
 from stewartid.design.multisine import multisine_design
@@ -89,7 +89,7 @@ def record_peaks(design: Design, use: LimitUse, rate_hz: float = INFORMATION_RAT
                  ) -> np.ndarray:
     """Largest use of any limit in each record of a design, from the use of all records one
     after the other at ``rate_hz`` (:func:`commanded_limit_use`); shape (records,)."""
-    edges = np.cumsum([0, *record_rows(design, rate_hz)])
+    edges = record_ends(design, rate_hz)
     return np.array([use.use[a:b].max() for a, b in zip(edges[:-1], edges[1:], strict=True)])
 
 

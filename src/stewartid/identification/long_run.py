@@ -148,13 +148,15 @@ def score_sandwich(inverse: np.ndarray, scores: np.ndarray,
     raw = long_run_covariance(scores, segments, stride, psd=False)
     B = nearest_psd(raw) if psd else raw
     if basis is not None:
-        B, raw = basis.T @ B @ basis, basis.T @ raw @ basis
+        B = basis.T @ B @ basis
     covariance = inverse @ B @ inverse
-    if psd == "variances":
-        # a variance whose estimate came out negative has nothing better than the clipped
-        unbiased = np.diag(inverse @ raw @ inverse)
-        return with_variances(covariance, np.where(unbiased > 0, unbiased, np.diag(covariance)))
-    return covariance
+    if psd != "variances":
+        return covariance
+    if basis is not None:
+        raw = basis.T @ raw @ basis
+    # a variance whose estimate came out negative has nothing better than the clipped
+    unbiased = np.diag(inverse @ raw @ inverse)
+    return with_variances(covariance, np.where(unbiased > 0, unbiased, np.diag(covariance)))
 
 
 def record_sandwich(inverse: np.ndarray, scores: np.ndarray,

@@ -15,9 +15,9 @@ autocovariances as it is, its correlations those of the sum made positive semide
 pose noise that sum is the small remainder of large positive and negative autocovariances,
 and zeroing its negative eigenvalues, as a covariance needs, had raised the fits' standard
 errors to 1.23 times their spread over 12 seeds at the reference noise on a 2 Hz payload
-design (2.5 times with the pose noise alone; 1.02 and 1.52 now, a
-variance whose estimate came out negative taking the clipped one). The residual's variance times
-its autocorrelation time, which the least squares also take, is not among them here: the
+design (2.5 times with the pose noise alone; 1.02 and 1.52 now, a variance whose estimate
+came out negative taking the clipped one). The residual's variance times its
+autocorrelation time, which the least squares also take, is not among them here: the
 pose noise reaches this residual through the differentiated accelerations, high-pass, and
 that time counts it as if it were slow (the fits' errors 1.3 times the information-matrix
 prediction on the reference multisine, 4 times at 2 Hz), while the per-record sums see the model error
