@@ -103,7 +103,7 @@ def main() -> None:
         records = plant_records(loaded, design)
         use = max(max(record_limit_use(loaded, r).peak.values()) for r in records)
         inverse = inverse_leg_jacobians(loaded, [r.q for r in records])
-    rows, estimates, fitted_errors = [], [], []
+    rows, estimates, fitted_errors, sections = [], [], [], []
     for seed in range(args.seeds):
         if args.engine == "mujoco":
             data = [degrade(d, loaded, noise, rng=np.random.default_rng([1000 + seed, k]))
@@ -114,6 +114,9 @@ def main() -> None:
         fitted = PhysicalIdentifier(payload=args.payload).fit(data, loaded)
         estimates.append([fitted.parameters_[n] for n in names])
         fitted_errors.append([fitted.parameter_std_errors_.get(n, np.nan) for n in names])
+        if args.payload:
+            section = fitted.result_.diagnostics["payload"]
+            sections.append([section["mass"], *section["com"], *section["inertia"]])
         rows.append(physical_study.payload_row(fitted, loaded, physical_study.PAYLOADS["paper"])
                     if args.payload else physical_study.full_row(
                         fitted, loaded, data, np.random.default_rng(seed)))
@@ -143,6 +146,14 @@ def main() -> None:
               if np.nanmax(z[:, k], initial=0.0) > 3}
     print(f"  within 3 of the fits' own standard errors: {np.mean(z[kept] <= 3):.1%} of "
           f"{kept.sum()} (parameter, seed) pairs; beyond: {beyond}")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        bias = np.nanmean((estimates - truth) / np.array(fitted_errors), axis=0)
+    # a mean over seeds of errors in units of their SE: beyond 3 / sqrt(seeds), a bias
+    print("  mean error over seeds in SE (bias test, 3/sqrt(seeds) = "
+          f"{3 / np.sqrt(args.seeds):.2f}): " + ", ".join(
+              f"{n} {b:+.2f}" for n, b in zip(names, bias, strict=True)
+              if np.isfinite(b) and abs(b) > 3 / np.sqrt(args.seeds)))
     commanded = document["prediction_commanded"]["parameters"]
     along = np.array([np.nan if commanded[n]["expected_std_error"] is None
                       else commanded[n]["expected_std_error"] for n in names]) / spread
@@ -156,6 +167,27 @@ def main() -> None:
                                                         strict=True) if f and abs(r - 1) > 0.3}
     print(f"predicted / spread beyond 30 %: {outside}")
     print(f"largest limit use on the plant's states: {use:.3f}")
+    if args.payload:
+        payload_spread(document, np.array(sections))
+
+
+def payload_spread(document: dict, sections: np.ndarray) -> None:
+    """The payload's mass (relative), centre of mass (m, along its least certain direction)
+    and inertia about it (largest entry relative to the mean diagonal): predicted standard
+    errors (design.json's) beside their spread over seeds, and the criterion against the
+    multisine's."""
+    mass = sections[:, 0]
+    inertia = sections[:, 4:]
+    spread = {"mass": np.std(mass, ddof=1) / np.mean(mass),
+              "com": np.sqrt(np.linalg.eigvalsh(np.cov(sections[:, 1:4].T))[-1]),
+              "inertia": np.std(inertia, axis=0, ddof=1).max() / np.mean(inertia[:, :3])}
+    for key in ("prediction", "prediction_commanded", "baseline"):
+        predicted = document[key]["payload_std_errors"]
+        print(f"  {key}: criterion {document[key]['criterion']:.3g}; "
+              + ", ".join(f"{k} {predicted[k]:.3g}" for k in spread))
+    print("  spread over seeds: " + ", ".join(f"{k} {v:.3g}" for k, v in spread.items()))
+    print(f"  criterion against the multisine's: "
+          f"{document['prediction']['criterion'] / document['baseline']['criterion']:.2f}")
 
 
 if __name__ == "__main__":

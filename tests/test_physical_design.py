@@ -20,6 +20,7 @@ from stewartid.design.information import (
     predict_parameters,
 )
 from stewartid.design.multisine import MultisineRecord, all_dofs_multisine, multisine_design
+from stewartid.design.payload_accuracy import payload_jacobian
 from stewartid.design.physical_run import run_physical_design
 from stewartid.design.physical_search import (
     candidate,
@@ -74,12 +75,14 @@ def test_information_matrix_predicts_the_estimators_spread(loaded):
     predicted = predict_parameters(loaded, design, noise, payload=True, rate_hz=100.0,
                                    filtered=True)  # as the design's final prediction
     rng = np.random.default_rng(7)
-    estimates = []
+    estimates, sections = [], []
     for _ in range(16):
         data = Dataset(t=t, pose=q, lengths=lengths, name="exp1",
                        forces=forces + rng.normal(0.0, noise.force_noise, forces.shape))
         fitted = PhysicalIdentifier(payload=True).fit([data], loaded)
         estimates.append([fitted.parameters_[n] for n in predicted.names])
+        section = fitted.result_.diagnostics["payload"]
+        sections.append([section["mass"], *section["com"], *section["inertia"]])
     observed = np.std(estimates, axis=0, ddof=1)
     ratio = predicted.expected_std_errors / observed
     # a spread over 16 seeds is uncertain by 1 / sqrt(30) = 18 % (one SE): the median over
@@ -90,6 +93,43 @@ def test_information_matrix_predicts_the_estimators_spread(loaded):
     # from the unfiltered regressor they came out 0.57-0.76 of their spread (median 0.65)
     coulomb = [k for k, name in enumerate(predicted.names) if name.startswith("coulomb")]
     assert 0.8 < np.median(ratio[coulomb]) < 1.3, ratio[coulomb]
+    # the payload's mass, centre of mass and inertia about it, as the file holds them: the
+    # covariance carried through the parallel-axis theorem against their spread
+    sections = np.array(sections)
+    quantities = predicted.payload_std_errors
+    spread = {"mass": np.std(sections[:, 0], ddof=1) / PAYLOAD["mass"],
+              "com": np.sqrt(np.linalg.eigvalsh(np.cov(sections[:, 1:4].T))[-1]),
+              "inertia": np.std(sections[:, 4:], axis=0, ddof=1).max()
+              / np.mean(PAYLOAD["inertia"][:3])}
+    # the largest of 3 (com) or 6 (inertia) spreads runs high by up to a SE of 18 %
+    assert all(0.6 < quantities[k] / spread[k] < 1.5 for k in spread), (quantities, spread)
+
+
+def test_payload_quantities_and_their_derivative(loaded):
+    """The payload's mass, centre of mass and inertia about it from its ten parameters
+    about the reference point: the platform file's ``[payload]`` (which the platform turns
+    into standard parameters by its own parallel-axis code) recovered; the derivative
+    against central differences (error h^2 / 6 times the third derivative, which for
+    h = 1e-4 of each parameter's size is below 1e-8 of the entries)."""
+    body = reg.parameter_index(reg.BODY_PARAMETERS)
+    own = (reg.standard_parameters(loaded)
+           - reg.standard_parameters(loaded.replace(payload=None)))[body]
+    m, c, inertia = reg.about_centre_of_mass(own)
+    assert m == pytest.approx(PAYLOAD["mass"], rel=1e-12)
+    assert np.allclose(c, PAYLOAD["com"], rtol=1e-12, atol=1e-12)
+    assert np.allclose(inertia, PAYLOAD["inertia"], rtol=1e-10, atol=1e-9)
+    J = payload_jacobian(own)
+
+    def flat(body):
+        m, c, inertia = reg.about_centre_of_mass(body)
+        return np.hstack([[m], c, inertia])
+
+    numeric = np.zeros((10, 10))
+    for k in range(10):
+        step = np.zeros(10)
+        step[k] = 1e-4 * max(abs(own[k]), 1.0)
+        numeric[:, k] = (flat(own + step) - flat(own - step)) / (2 * step[k])
+    assert np.allclose(J, numeric, rtol=1e-6, atol=1e-8 * np.abs(numeric).max())
 
 
 def test_final_prediction_counts_the_pose_noise(loaded):

@@ -139,7 +139,7 @@ def _design_physical(description, budget: float, noise, out: Path, payload: bool
     """``design --model physical``: run it and print its summary."""
     from rich.console import Console
 
-    from stewartid.design.physical_run import run_physical_design
+    from stewartid.design.physical_run import criterion_summary, run_physical_design
     from stewartid.errors import ConfigError
 
     if not given.pop("--model"):
@@ -155,9 +155,7 @@ def _design_physical(description, budget: float, noise, out: Path, payload: bool
         progress=lambda text: console.print(text, markup=False, highlight=False))
     p, b = output.prediction, output.baseline
     typer.echo(f"design: {output.design.label}")
-    typer.echo(f"predicted worst relative standard error {p.worst_relative_std:.3g} % "
-               f"({p.worst_parameter}; all-DOFs multisine of the same length "
-               f"{b.worst_relative_std:.3g} %, ratio {p.worst_relative_std / b.worst_relative_std:.2f})")
+    typer.echo(criterion_summary(p, b))
     if output.check["seeds"]:
         typer.echo(f"check on {output.check['seeds']} noisy copies: predicted / fitted standard "
                    f"error, median {output.check['ratio_median']:.2f}")

@@ -35,7 +35,10 @@ turned: the mass against itself, each first moment against the first-moment vect
 length (at least a tenth of the mass times the radius of gyration, for a centre of mass near
 the reference point), each entry of the inertia matrix, products included, against the mean
 of its diagonal. Judged by their own magnitudes, a first moment along a long lever arm and a
-product near zero would set the design's aim by the frame's orientation alone.
+product near zero would set the design's aim by the frame's orientation alone. Payload mode
+judges the payload as it is wanted, its mass, centre of mass and inertia about it, each
+against the accuracy it is needed to (:mod:`stewartid.design.payload_accuracy`), from the
+same covariance.
 """
 
 from __future__ import annotations
@@ -48,6 +51,11 @@ import numpy as np
 import scipy.signal
 
 from stewartid.design.candidates import Design
+from stewartid.design.payload_accuracy import (
+    REQUIRED_PAYLOAD_ACCURACY,
+    payload_criterion,
+    payload_std_errors,
+)
 from stewartid.design.pose_noise import pose_noise_scores
 from stewartid.identification.physical import (
     POSITIVE_PARAMETERS,
@@ -82,6 +90,8 @@ class ParameterPrediction:
         what the design criterion is taken of.
     fixed : tuple of str
         Those parameters.
+    expected_covariance : ndarray, shape (p, p)
+        The covariance ``expected_std_errors`` are of; NaN rows and columns for the fixed.
     sizes : ndarray, shape (p,)
         What a relative standard error is taken of; 0 for the nuisance parameters.
     payload : bool
@@ -93,6 +103,7 @@ class ParameterPrediction:
     std_errors: np.ndarray
     expected_std_errors: np.ndarray
     fixed: tuple[str, ...]
+    expected_covariance: np.ndarray
     sizes: np.ndarray
     payload: bool
 
@@ -118,11 +129,30 @@ class ParameterPrediction:
         """The judged parameter with the largest relative standard error."""
         return self.names[int(np.nanargmax(self.relative_std))]
 
+    @property
+    def payload_std_errors(self) -> dict[str, float] | None:
+        """Payload mode: the standard errors of the payload's mass (relative), centre of
+        mass (m) and inertia about it (relative,
+        :func:`~stewartid.design.payload_accuracy.payload_std_errors`); else None."""
+        if not self.payload:
+            return None
+        return payload_std_errors(self.names, self.nominal, self.expected_covariance)
+
+    @property
+    def criterion(self) -> float:
+        """What the design minimises. Payload mode: the largest ratio of the payload's
+        quantities' standard errors to their required accuracy
+        (:func:`~stewartid.design.payload_accuracy.payload_criterion`); full mode: the
+        worst relative standard error (%)."""
+        if self.payload:
+            return payload_criterion(self.payload_std_errors)[0]
+        return self.worst_relative_std
+
     def to_dict(self) -> dict[str, Any]:
         """Plain values (JSON ready): per parameter its nominal value, predicted SE and
         relative SE (%, None for nuisance parameters)."""
         relative = self.relative_std
-        return {"mode": "payload" if self.payload else "full",
+        out = {"mode": "payload" if self.payload else "full", "criterion": self.criterion,
                 "worst_relative_std_percent": self.worst_relative_std,
                 "worst_parameter": self.worst_parameter, "fixed": list(self.fixed),
                 "parameters": {name: {"nominal": float(self.nominal[k]),
@@ -133,6 +163,10 @@ class ParameterPrediction:
                                       "relative_std_percent": (float(relative[k])
                                                                if self.judged[k] else None)}
                                for k, name in enumerate(self.names)}}
+        if self.payload:
+            out["payload_std_errors"] = self.payload_std_errors
+            out["required_accuracy"] = dict(REQUIRED_PAYLOAD_ACCURACY)
+        return out
 
 
 def parameter_sizes(names: tuple[str, ...], nominal: np.ndarray) -> np.ndarray:
@@ -390,10 +424,11 @@ def predict_parameters(platform: Platform, design: Design, noise: SensorNoise,
     fixable = selection @ positive > 0
     free = np.ones(len(names), dtype=bool)
     while True:
-        std = np.full(len(names), np.nan)
-        std[free] = np.sqrt(np.clip(np.diag(sandwich_covariance(
+        covariance = np.full((len(names),) * 2, np.nan)
+        covariance[np.ix_(free, free)] = sandwich_covariance(
             X[:, :, free], S, per_row, None if twice is None else twice[:, :, free],
-            extra[np.ix_(free, free)])), 0.0, None))
+            extra[np.ix_(free, free)])
+        std = np.sqrt(np.clip(np.diag(covariance), 0.0, None))
         if free.all():
             every = std.copy()
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -403,7 +438,7 @@ def predict_parameters(platform: Platform, design: Design, noise: SensorNoise,
         free[int(np.argmax(ratio))] = False
     return ParameterPrediction(tuple(names), np.asarray(nominal, dtype=float), every, std,
                                tuple(n for n, f in zip(names, free, strict=True) if not f),
-                               parameter_sizes(tuple(names), nominal), payload)
+                               covariance, parameter_sizes(tuple(names), nominal), payload)
 
 
 __all__ = ["INFORMATION_RATE", "ParameterPrediction", "channel_weights", "design_rows",

@@ -31,6 +31,7 @@ from stewartid.design.information import (
 from stewartid.design.limits import LIMIT_NAMES, resolve_limits
 from stewartid.design.multisine import all_dofs_multisine
 from stewartid.design.optimise import within_plant_limits
+from stewartid.design.payload_accuracy import REQUIRED_PAYLOAD_ACCURACY, payload_criterion
 from stewartid.design.physical_search import (
     PLANT_EVALUATIONS,
     PLANT_TOLERANCE,
@@ -189,7 +190,7 @@ def played_pick(platform: Platform, best: PhysicalCandidate, budget_s: float,
     played = [(*pick, predict_parameters(platform, pick[1], noise, payload, FINAL_RATE,
                                          states=played_states(pick[2], pick[1], FINAL_RATE),
                                          filtered=True)) for pick in picks]
-    return min(played, key=lambda p: p[4].worst_relative_std)
+    return min(played, key=lambda p: p[4].criterion)
 
 
 def run_physical_design(platform: Platform, budget_s: float, noise: SensorNoise,
@@ -293,7 +294,6 @@ def render_physical_markdown(design: Design, prediction: ParameterPrediction,
                              commanded: ParameterPrediction | None = None) -> str:
     """The report text of a physical design (``commanded``: its prediction along the
     commanded motion, beside the one along the plant's)."""
-    ratio = prediction.worst_relative_std / baseline.worst_relative_std
     lines = ["# Excitation design for the physical model", "",
              f"{design.label}; {design.duration:.1f} s of motion.", "", "## Settings", ""]
     lines += [f"- {key}: {value}" for key, value in settings.items()]
@@ -304,13 +304,9 @@ def render_physical_markdown(design: Design, prediction: ParameterPrediction,
                      + " | ".join(f"{peak[n]:.0%}" for n in LIMIT_NAMES) + " |")
     lines += ["", "Limit use: the largest over the legs and the record on the plant's "
               "simulated states, 100 % = the limit.", "", "![limit use](figures/limit_use.png)",
-              "", "## Predicted standard errors", "",
-              f"Worst relative standard error of the {'payload' if prediction.payload else 'moving body'}"
-              f"'s parameters: **{prediction.worst_relative_std:.3g} %** "
-              f"({prediction.worst_parameter}); the all-DOFs multisine at the paper's "
-              f"amplitudes, same length: {baseline.worst_relative_std:.3g} % (ratio "
-              f"{ratio:.2f}). Fixed by the estimator (too uncertain): "
-              f"{', '.join(prediction.fixed) or 'none'}.", "",
+              "", "## Predicted standard errors", "", criterion_summary(prediction, baseline)
+              + f" Fixed by the estimator (too uncertain): {', '.join(prediction.fixed) or 'none'}.",
+              "",
               *_commanded_lines(prediction, commanded),
               "| parameter | nominal | design SE | relative (%) | multisine SE | fit's SE (check) |",
               "|---|---|---|---|---|---|"]
@@ -343,6 +339,28 @@ def render_physical_markdown(design: Design, prediction: ParameterPrediction,
     return "\n".join(lines)
 
 
+def criterion_summary(prediction: ParameterPrediction, baseline: ParameterPrediction) -> str:
+    """The design's criterion beside the all-DOFs multisine's, in a sentence (payload mode:
+    the payload's quantities against their required accuracy, then the ten parameters'
+    worst relative standard error)."""
+    worst = (f"worst relative standard error of the "
+             f"{'payload' if prediction.payload else 'moving body'}'s ten parameters "
+             f"{prediction.worst_relative_std:.3g} % ({prediction.worst_parameter}; the "
+             f"all-DOFs multisine at the paper's amplitudes, same length, "
+             f"{baseline.worst_relative_std:.3g} %, ratio "
+             f"{prediction.worst_relative_std / baseline.worst_relative_std:.2f})")
+    if not prediction.payload:
+        return f"Predicted {worst}."
+    std, needed = prediction.payload_std_errors, REQUIRED_PAYLOAD_ACCURACY
+    ratio, quantity = payload_criterion(std)
+    return (f"Predicted standard errors of the payload: mass {100 * std['mass']:.3g} %, "
+            f"centre of mass {1e3 * std['com']:.3g} mm, inertia about it "
+            f"{100 * std['inertia']:.3g} % (needed: {100 * needed['mass']:g} %, "
+            f"{1e3 * needed['com']:g} mm, {100 * needed['inertia']:g} %); the largest "
+            f"share of its accuracy {ratio:.3g} ({quantity}; multisine {baseline.criterion:.3g}, "
+            f"ratio {ratio / baseline.criterion:.2f}). The {worst}.")
+
+
 def _commanded_lines(prediction: ParameterPrediction,
                      commanded: ParameterPrediction | None) -> list[str]:
     if commanded is None:
@@ -357,6 +375,7 @@ def _commanded_lines(prediction: ParameterPrediction,
             f"`design.json`).", ""]
 
 
-__all__ = ["FINAL_RATE", "PhysicalDesignOutput", "UNDERPREDICTED", "monte_carlo_check",
+__all__ = ["FINAL_RATE", "PhysicalDesignOutput", "UNDERPREDICTED", "criterion_summary",
+           "monte_carlo_check",
            "played_pick",
            "physical_identify_command", "render_physical_markdown", "run_physical_design"]

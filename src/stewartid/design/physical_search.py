@@ -1,13 +1,15 @@
-"""Choosing the physical design: all-DOF multisines at the limits, the worst predicted
-relative standard error minimised.
+"""Choosing the physical design: all-DOF multisines at the limits, the criterion minimised
+(payload mode: the payload's quantities against their required accuracy; full mode: the
+worst predicted relative standard error).
 
 The family (:func:`~stewartid.design.multisine.multisine_design`) has eight parameters: the
 share of each DOF in the motion (six, as log-weights on the paper's amplitudes), the speed of
 the frequency pool and the share of each DOF's amplitude at its second frequency. For each
 candidate every record's amplitudes are scaled until its commanded motion uses ``max_use`` of
 its most used limit (:func:`scale_to_limits`: leg strokes, rates, accelerations and forces,
-gimbal angles), and the criterion is the largest predicted relative standard error of the
-parameters asked for (:func:`~stewartid.design.information.predict_parameters`: the
+gimbal angles), and the criterion
+(:attr:`~stewartid.design.information.ParameterPrediction.criterion`) is taken of the
+predicted covariance (:func:`~stewartid.design.information.predict_parameters`: the
 information matrix, a fraction of a second). Random candidates first (a fixed seed), then
 Nelder-Mead from the best, each within a fixed number of evaluations: the design does not
 depend on the machine's speed.
@@ -32,6 +34,7 @@ from stewartid.design.information import (
 )
 from stewartid.design.limits import LimitUse, limit_use, resolve_limits
 from stewartid.design.multisine import multisine_design
+from stewartid.design.payload_accuracy import payload_criterion
 from stewartid.errors import ConfigError
 from stewartid.model import regressor as reg
 from stewartid.model.kinematics import inverse_kinematics, leg_jacobian
@@ -148,8 +151,17 @@ class PhysicalCandidate:
 
     @property
     def score(self) -> float:
-        """The criterion: worst predicted relative standard error (%)."""
-        return self.prediction.worst_relative_std
+        """The criterion (:attr:`~stewartid.design.information.ParameterPrediction.criterion`)."""
+        return self.prediction.criterion
+
+
+def criterion_text(prediction: ParameterPrediction) -> str:
+    """The criterion's value, with its unit and what sets it, in words."""
+    if not prediction.payload:
+        return (f"worst relative SE {prediction.worst_relative_std:.3g} % "
+                f"({prediction.worst_parameter})")
+    ratio, worst = payload_criterion(prediction.payload_std_errors)
+    return f"worst SE over required accuracy {ratio:.3g} ({worst})"
 
 
 def _bounds(payload: bool) -> tuple[np.ndarray, np.ndarray]:
@@ -228,7 +240,7 @@ def search_design(platform: Platform, budget_s: float, noise: SensorNoise,
                   random_candidates: int = RANDOM_CANDIDATES,
                   local_evaluations: int = LOCAL_EVALUATIONS,
                   progress: Callable[[str], None] | None = None) -> PhysicalCandidate:
-    """The member of the family with the smallest worst predicted relative standard error.
+    """The member of the family with the smallest criterion.
 
     Parameters
     ----------
@@ -269,8 +281,7 @@ def search_design(platform: Platform, budget_s: float, noise: SensorNoise,
         evaluate(x)
     best = min(seen, key=lambda c: c.score)
     if progress:
-        progress(f"{len(seen)} random candidates: best worst relative SE {best.score:.3g} % "
-                 f"({best.prediction.worst_parameter})")
+        progress(f"{len(seen)} random candidates: best {criterion_text(best.prediction)}")
     if local_evaluations > 0:
         simplex = best.parameters + np.vstack([np.zeros(8), 0.25 * (upper - lower) * np.eye(8)])
         scipy.optimize.minimize(evaluate, best.parameters, method="Nelder-Mead", options={
@@ -278,13 +289,13 @@ def search_design(platform: Platform, budget_s: float, noise: SensorNoise,
             "xatol": 1e-3, "fatol": 1e-3})
         best = min(seen, key=lambda c: c.score)
         if progress:
-            progress(f"{len(seen)} candidates in all: worst relative SE {best.score:.3g} % "
-                     f"({best.prediction.worst_parameter})")
+            progress(f"{len(seen)} candidates in all: {criterion_text(best.prediction)}")
     return best
 
 
 __all__ = ["LOCAL_EVALUATIONS", "PAYLOAD_SPEED_BOUNDS", "PLANT_EVALUATIONS", "PLANT_TOLERANCE",
            "PhysicalCandidate", "RANDOM_CANDIDATES", "SHARE_BOUNDS", "SPEED_BOUNDS",
+           "criterion_text",
            "WEIGHT_BOUNDS", "candidate", "commanded_limit_use", "plant_scales",
            "record_peaks", "refine_for_plant", "scale_to_limits", "search_design",
            "speed_bounds"]

@@ -435,14 +435,13 @@ def matrix_std_errors(platform: Platform, selection: np.ndarray, covariance: np.
 
 def payload_section(parameters: dict[str, float]) -> dict[str, Any]:
     """The ``[payload]`` keys (mass, com, inertia about the centre of mass) of the payload's
-    identified mass, first moment and inertia about the reference point."""
-    m = parameters["payload.m"]
-    first = np.array([parameters[f"payload.mc_{a}"] for a in "xyz"])
-    about_reference = [parameters[f"payload.I_{e}"] for e in ("xx", "yy", "zz", "xy", "xz", "yz")]
-    c = first / m if m > 0 else np.zeros(3)
-    shift = m * (c @ c * np.eye(3) - np.outer(c, c))
-    inertia = np.array(about_reference) - shift[[0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]]
-    return {"mass": float(m), "com": c.tolist(), "inertia": inertia.tolist()}
+    identified mass, first moment and inertia about the reference point (a mass of zero or
+    less gives the centre of mass at the reference point)."""
+    body = np.array([parameters[f"payload.{n}"] for n in reg.BODY_PARAMETERS])
+    if not body[0] > 0:
+        return {"mass": float(body[0]), "com": [0.0] * 3, "inertia": body[4:].tolist()}
+    m, c, inertia = reg.about_centre_of_mass(body)
+    return {"mass": m, "com": c.tolist(), "inertia": inertia.tolist()}
 
 
 __all__ = ["NUISANCE_PARAMETERS", "PAYLOAD_PARAMETERS", "POSITIVE_PARAMETERS",

@@ -107,6 +107,30 @@ def standard_parameters(platform: Platform) -> np.ndarray:
     return pi
 
 
+def about_centre_of_mass(body: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
+    """A rigid body's mass, centre of mass and inertia about it, from its ten standard
+    parameters (the parallel-axis theorem, I_c = I_o - (h.h 1 - h h^T) / m, h = m c).
+
+    Parameters
+    ----------
+    body : ndarray, shape (10,)
+        In the order of :data:`BODY_PARAMETERS`; a positive mass.
+
+    Returns
+    -------
+    m : float
+        kg.
+    c : ndarray, shape (3,)
+        m.
+    inertia : ndarray, shape (6,)
+        I_xx, I_yy, I_zz, I_xy, I_xz, I_yz about the centre of mass (kg m^2).
+    """
+    body = np.asarray(body, dtype=float)
+    m, h = float(body[0]), body[1:4]
+    shift = (h @ h * np.eye(3) - np.outer(h, h)) / m
+    return m, h / m, body[4:10] - shift[tuple(np.array(_INERTIA_ENTRIES).T)]
+
+
 def pseudo_inertia(body: np.ndarray) -> np.ndarray:
     """The pseudo-inertia matrix of a rigid body from its ten standard parameters.
 
@@ -323,6 +347,6 @@ def combination_text(row: np.ndarray) -> str:
 __all__ = ["ACTUATOR_PARAMETERS", "ACTUATOR_SMOOTHING", "BODY_PARAMETERS", "BaseParameters",
            "FRICTION_PARAMETERS", "LEG_PARAMETERS", "N_STANDARD", "OFFSET_PARAMETERS",
            "PARAMETERS", "SAMPLE_ACCELERATIONS", "SAMPLE_RATES", "SAMPLE_SPAN",
-           "VISCOUS_PARAMETERS", "base_parameters", "combination_text",
+           "VISCOUS_PARAMETERS", "about_centre_of_mass", "base_parameters", "combination_text",
            "parameter_index", "pseudo_inertia", "random_states",
            "regressor", "regressor_columns", "standard_parameters"]
