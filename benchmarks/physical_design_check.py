@@ -10,7 +10,9 @@ file with ``--payload``). Printed: the payload's errors (mass %, com mm, inertia
 about the com %) or full mode's (Mt(q) at 50 random poses inside the motion's range: diagonal
 %), the predicted SE (``design.json``'s) against the spread over seeds (with more than 8
 seeds, also over each block of 8) and the fits' own standard errors against it, the limit
-use on the plant's states.
+use on the plant's states; in payload mode the payload's mass, centre of mass and inertia
+about it, predicted against their spread, and each parameter's mean error over seeds in its
+fits' standard errors where beyond 3/sqrt(seeds) (a bias).
 
 With ``--engine mujoco`` the design's exported pose command files (``commands/exp*.csv``) are
 played on MuJoCo's model of the same platform instead
@@ -21,7 +23,7 @@ the limit use is the stroke and leg speed of the recorded motion.
 Usage::
 
     python benchmarks/physical_design_check.py [--payload] [--seeds 8] [--budget 120]
-        [--engine ours|mujoco]
+        [--engine ours|mujoco] [--save FILE.npz]
 """
 
 from __future__ import annotations
@@ -74,6 +76,9 @@ def main() -> None:
     parser.add_argument("--engine", default="ours", choices=["ours", "mujoco"],
                         help="play the design's command files on our plant or on the MuJoCo "
                              "model (ideal actuators, the mujoco extra)")
+    parser.add_argument("--save", type=Path, default=None,
+                        help="write the estimates, the fits' standard errors and the truth "
+                             "(.npz)")
     args = parser.parse_args()
     loaded = physical_study.loaded_platform("paper")
     folder = Path(tempfile.mkdtemp(prefix="stewartid-physical-design-"))
@@ -123,6 +128,10 @@ def main() -> None:
         print(seed, {k: round(v, 3) for k, v in rows[-1].items()
                      if isinstance(v, float)}, flush=True)
     estimates = np.array(estimates)
+    if args.save:
+        np.savez(args.save, names=np.array(names), estimates=estimates,
+                 fitted_errors=np.array(fitted_errors),
+                 truth=np.array([reported[n]["nominal"] for n in names]))
     spread = np.std(estimates, axis=0, ddof=1)
     ratio = expected / spread
     finite = np.isfinite(ratio)
