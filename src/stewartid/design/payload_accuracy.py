@@ -27,11 +27,6 @@ from stewartid.model import regressor as reg
 #: every entry of the inertia about the centre of mass relative to the mean of its diagonal.
 REQUIRED_PAYLOAD_ACCURACY = {"mass": 0.002, "com": 0.002, "inertia": 0.02}
 
-#: The inertia's six entries (row of :func:`payload_jacobian` after the first four).
-_INDEX = {("x", "x"): 0, ("y", "y"): 1, ("z", "z"): 2, ("x", "y"): 3, ("x", "z"): 4,
-          ("y", "z"): 5}
-
-
 def payload_jacobian(parameters: np.ndarray) -> np.ndarray:
     """Derivative of (mass, centre of mass, inertia about it) by the body parameters.
 
@@ -54,8 +49,7 @@ def payload_jacobian(parameters: np.ndarray) -> np.ndarray:
     J[1:4, 1:4] = np.eye(3) / m
     J[4:10, 4:10] = np.eye(6)
     shift = h @ h * np.eye(3) - np.outer(h, h)  # times 1/m
-    for (a, b), row in _INDEX.items():
-        i, j = "xyz".index(a), "xyz".index(b)
+    for row, (i, j) in enumerate(reg.INERTIA_ENTRIES):
         J[4 + row, 0] = shift[i, j] / m**2
         for k in range(3):
             # d(h.h delta_ij - h_i h_j)/dh_k = 2 h_k delta_ij - delta_ik h_j - h_i delta_jk

@@ -71,8 +71,7 @@ VISCOUS_PARAMETERS = FRICTION_PARAMETERS[:3] + ACTUATOR_PARAMETERS[:1]
 ACTUATOR_SMOOTHING = 1e-4
 
 _INDEX = {name: k for k, name in enumerate(PARAMETERS)}
-# inertia entries (row, column) of I_xx ... I_yz
-_INERTIA_ENTRIES = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
+INERTIA_ENTRIES = rows.INERTIA_ENTRIES
 
 
 def parameter_index(names: tuple[str, ...] | list[str]) -> np.ndarray:
@@ -91,7 +90,7 @@ def standard_parameters(platform: Platform) -> np.ndarray:
     pi = np.zeros(N_STANDARD)
     pi[0] = body.mass
     pi[1:4] = body.mass * body.com
-    pi[4:10] = [body.inertia[a, b] for a, b in _INERTIA_ENTRIES]
+    pi[4:10] = [body.inertia[a, b] for a, b in INERTIA_ENTRIES]
     values = {"m_u": i.upper_leg_mass, "md_u": i.upper_leg_mass * i.upper_leg_com,
               "md_l": i.lower_leg_mass * i.lower_leg_com,
               "J_u": i.upper_leg_inertia + i.upper_leg_mass * i.upper_leg_com ** 2,
@@ -128,7 +127,7 @@ def about_centre_of_mass(body: np.ndarray) -> tuple[float, np.ndarray, np.ndarra
     body = np.asarray(body, dtype=float)
     m, h = float(body[0]), body[1:4]
     shift = (h @ h * np.eye(3) - np.outer(h, h)) / m
-    return m, h / m, body[4:10] - shift[tuple(np.array(_INERTIA_ENTRIES).T)]
+    return m, h / m, body[4:10] - shift[tuple(np.array(INERTIA_ENTRIES).T)]
 
 
 def pseudo_inertia(body: np.ndarray) -> np.ndarray:
@@ -152,7 +151,7 @@ def pseudo_inertia(body: np.ndarray) -> np.ndarray:
     """
     body = np.asarray(body, dtype=float)
     inertia = np.zeros(body.shape[:-1] + (3, 3))
-    for k, (a, b) in enumerate(_INERTIA_ENTRIES):
+    for k, (a, b) in enumerate(INERTIA_ENTRIES):
         inertia[..., a, b] = inertia[..., b, a] = body[..., 4 + k]
     J = np.zeros(body.shape[:-1] + (4, 4))
     J[..., :3, :3] = np.trace(inertia, axis1=-2, axis2=-1)[..., None, None] / 2 * np.eye(3) - inertia
@@ -345,8 +344,8 @@ def combination_text(row: np.ndarray) -> str:
 
 
 __all__ = ["ACTUATOR_PARAMETERS", "ACTUATOR_SMOOTHING", "BODY_PARAMETERS", "BaseParameters",
-           "FRICTION_PARAMETERS", "LEG_PARAMETERS", "N_STANDARD", "OFFSET_PARAMETERS",
-           "PARAMETERS", "SAMPLE_ACCELERATIONS", "SAMPLE_RATES", "SAMPLE_SPAN",
+           "FRICTION_PARAMETERS", "INERTIA_ENTRIES", "LEG_PARAMETERS", "N_STANDARD",
+           "OFFSET_PARAMETERS", "PARAMETERS", "SAMPLE_ACCELERATIONS", "SAMPLE_RATES", "SAMPLE_SPAN",
            "VISCOUS_PARAMETERS", "about_centre_of_mass", "base_parameters", "combination_text",
            "parameter_index", "pseudo_inertia", "random_states",
            "regressor", "regressor_columns", "standard_parameters"]

@@ -35,8 +35,9 @@ import numpy as np
 
 from stewartid.model.kernels import euler_rate_entries, leg_frame, leg_vector, rotation_entries
 
-# inertia entries (row, column) of I_xx ... I_yz
-_INERTIA_ENTRIES = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
+#: The inertia matrix's (row, column) of I_xx, I_yy, I_zz, I_xy, I_xz, I_yz: the order of a
+#: body's inertia parameters.
+INERTIA_ENTRIES = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
 
 
 def _cross(a, b):
@@ -129,7 +130,7 @@ def _body_columns(geo: _Geometry, omega, alpha, a_g, Y, index, moving) -> None:
     turn = np.stack(_cross(omega, R))  # omega x s_k
     Y[:3, first:first + 3] = np.stack(_cross(alpha, R)) + np.stack(_cross(omega, turn))
     w_b, alpha_b = (R[0] * v[0] + R[1] * v[1] + R[2] * v[2] for v in (omega, alpha))
-    a, b = ([e[j] for e in _INERTIA_ENTRIES] for j in (0, 1))
+    a, b = ([e[j] for e in INERTIA_ENTRIES] for j in (0, 1))
     moment = R[:, a] * alpha_b[b] + turn[:, a] * w_b[b]
     moment[:, 3:] += R[:, b[3:]] * alpha_b[a[3:]] + turn[:, b[3:]] * w_b[a[3:]]
     Y[3:, index["I_xx"]:index["I_xx"] + 6] = moment
@@ -283,4 +284,4 @@ def regressor_columns(upper: np.ndarray, base: np.ndarray, q: np.ndarray, qd: np
     return Y
 
 
-__all__ = ["regressor_columns", "smooth_sign"]
+__all__ = ["INERTIA_ENTRIES", "regressor_columns", "smooth_sign"]
