@@ -28,6 +28,7 @@ from stewartid.design.physical_search import (
     plant_scales,
     refine_for_plant,
     scale_to_limits,
+    search_design,
 )
 from stewartid.identification.physical import PhysicalIdentifier
 from stewartid.model import regressor as reg
@@ -216,6 +217,23 @@ def test_refinement_against_the_plant_scales_each_record_by_its_own(loaded):
                                      0.7).score
 
 
+def test_payload_design_aims_at_the_accuracy_asked_for(loaded):
+    """The same search asked for a centre of mass ten times tighter than the inertia, then
+    the other way round: each pick's predicted standard error of what was asked more
+    tightly is the smaller of the two picks' (0.96 against 1.57 mm, 0.30 against 0.47 %
+    of the inertia)."""
+    noise = SensorNoise(force_noise=170.0)
+    picks = {}
+    for tight, loose in (("com", "inertia"), ("inertia", "com")):
+        accuracy = {"mass": 0.02, tight: 0.002, loose: 0.02}
+        best = search_design(loaded, 32.0, noise, payload=True, random_candidates=8,
+                             local_evaluations=40, accuracy=accuracy)
+        assert best.prediction.accuracy == accuracy
+        picks[tight] = best.prediction.payload_std_errors
+    assert picks["com"]["com"] < picks["inertia"]["com"]
+    assert picks["inertia"]["inertia"] < picks["com"]["inertia"]
+
+
 def test_every_record_is_scaled_to_its_own_limit(loaded):
     """Records whose DOFs meet the pool's frequencies in another order reach the leg-speed
     limit at different amplitudes: each is scaled until its own motion, judged alone, uses
@@ -245,12 +263,18 @@ def test_parameter_sizes_are_those_of_the_vector_and_the_tensor():
 
 
 def test_physical_design_writes_commands_prediction_and_check(loaded, tmp_path):
+    needed = {"mass": 0.003, "com": 0.001, "inertia": 0.02}
     out = run_physical_design(loaded, 16.0, SensorNoise(force_noise=170.0), tmp_path / "d",
                               payload=True, check_seeds=1,
                               search={"random_candidates": 2, "local_evaluations": 0,
-                                      "plant_evaluations": 2})
+                                      "plant_evaluations": 2}, accuracy=needed)
     document = json.loads((tmp_path / "d" / "design.json").read_text())
     assert document["model"] == "physical"
+    for key in ("prediction", "prediction_commanded", "baseline"):
+        judged = document[key]
+        assert judged["required_accuracy"] == needed
+        assert judged["criterion"] == pytest.approx(max(
+            judged["payload_std_errors"][k] / needed[k] for k in needed), rel=1e-12)
     assert set(document["prediction"]["parameters"]) == set(document["baseline"]["parameters"])
     assert (set(document["prediction_commanded"]["parameters"])
             == set(document["prediction"]["parameters"]))
@@ -276,6 +300,12 @@ def test_physical_design_writes_commands_prediction_and_check(loaded, tmp_path):
     (["--model", "physical", "--payload"], "no [payload] section"),
     (["--model", "physical", "--seeds", "-1"], "--seeds must be >= 0"),
     (["--model", "physical", "--max-use", "1.5"], "--max-use must be"),
+    (["--accuracy", "0.2,2,2"], "--accuracy needs --model physical"),
+    (["--model", "physical", "--accuracy", "0.2,2,2"], "--accuracy applies to payload mode"),
+    (["--model", "physical", "--payload", "--accuracy", "0.2,x,2"],
+     "--accuracy must be three positive numbers"),
+    (["--model", "physical", "--payload", "--accuracy", "0.2,2,0"],
+     "--accuracy must be three positive numbers"),
 ])
 def test_design_cli_refuses_bad_physical_options(tmp_path, arguments, message):
     result = CliRunner().invoke(app, ["design", "--out", str(tmp_path / "o"), *arguments])

@@ -62,6 +62,11 @@ def design(
     payload: Annotated[bool, typer.Option(
         "--payload", help="--model physical: design for payload mode (the payload's ten "
         "parameters; the platform file's [payload] is the expected one).")] = False,
+    accuracy: Annotated[str | None, typer.Option(
+        "--accuracy", metavar="MASS,COM,INERTIA", help="--payload: the accuracy the payload's "
+        "mass (%), centre of mass (mm) and inertia about it (% of its mean diagonal) are "
+        "needed to, one standard error; the design minimises the largest share of "
+        "them. Default 0.2,2,2.")] = None,
 ) -> None:
     """Design an excitation for identification: records within the platform's [limits],
     chosen so that the predicted error of every Mt and Bt entry (|bias| + 2 standard errors)
@@ -99,10 +104,10 @@ def design(
     if coulomb is not None:
         description = description.replace(friction__coulomb=coulomb)
     noise = sensor_noise(description, "where_zero", length_noise, force_noise)
-    if physical or payload:
+    if physical or payload or accuracy is not None:
         _design_physical(description, budget, noise, out, payload, rate, max_use, seeds, force,
                          {"--model": physical, "--method": method != "wavelet",
-                          "--model-data": model_data, "--quick": quick})
+                          "--model-data": model_data, "--quick": quick}, accuracy)
         return
     with Progress(transient=True) as bar:
         task = bar.add_task("noise realisations", total=None)
@@ -135,15 +140,21 @@ def design(
 
 
 def _design_physical(description, budget: float, noise, out: Path, payload: bool, rate: float,
-                     max_use: float, seeds: int | None, force: bool, given: dict) -> None:
+                     max_use: float, seeds: int | None, force: bool, given: dict,
+                     accuracy: str | None) -> None:
     """``design --model physical``: run it and print its summary."""
     from rich.console import Console
 
+    from stewartid.design.payload_accuracy import parse_accuracy
     from stewartid.design.physical_run import criterion_summary, run_physical_design
     from stewartid.errors import ConfigError
 
     if not given.pop("--model"):
-        raise ConfigError("--payload needs --model physical.")
+        raise ConfigError(f"{'--payload' if payload else '--accuracy'} needs --model physical.")
+    if accuracy is not None and not payload:
+        raise ConfigError("--accuracy applies to payload mode: add --payload (full mode "
+                          "judges the moving body's parameters by their relative errors).")
+    needed = None if accuracy is None else parse_accuracy(accuracy)
     wrong = [flag for flag, value in given.items() if value]
     if wrong:
         raise ConfigError(f"{', '.join(wrong)} do not apply to --model physical; leave "
@@ -151,7 +162,7 @@ def _design_physical(description, budget: float, noise, out: Path, payload: bool
     console = Console(stderr=True)
     output = run_physical_design(
         description, budget, noise, out, payload=payload, rate_hz=rate, max_use=max_use,
-        check_seeds=2 if seeds is None else seeds, force=force,
+        check_seeds=2 if seeds is None else seeds, force=force, accuracy=needed,
         progress=lambda text: console.print(text, markup=False, highlight=False))
     p, b = output.prediction, output.baseline
     typer.echo(f"design: {output.design.label}")

@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -96,6 +97,10 @@ class ParameterPrediction:
         What a relative standard error is taken of; 0 for the nuisance parameters.
     payload : bool
         Payload mode.
+    accuracy : mapping of str to float
+        Payload mode: the accuracy each payload quantity is needed to
+        (:data:`~stewartid.design.payload_accuracy.REQUIRED_PAYLOAD_ACCURACY`'s keys and
+        units), what :attr:`criterion` judges against.
     """
 
     names: tuple[str, ...]
@@ -106,6 +111,8 @@ class ParameterPrediction:
     expected_covariance: np.ndarray
     sizes: np.ndarray
     payload: bool
+    accuracy: Mapping[str, float] = dataclasses.field(
+        default_factory=lambda: dict(REQUIRED_PAYLOAD_ACCURACY))
 
     @property
     def judged(self) -> np.ndarray:
@@ -145,7 +152,7 @@ class ParameterPrediction:
         (:func:`~stewartid.design.payload_accuracy.payload_criterion`); full mode: the
         worst relative standard error (%)."""
         if self.payload:
-            return payload_criterion(self.payload_std_errors)[0]
+            return payload_criterion(self.payload_std_errors, self.accuracy)[0]
         return self.worst_relative_std
 
     def to_dict(self) -> dict[str, Any]:
@@ -165,7 +172,7 @@ class ParameterPrediction:
                                for k, name in enumerate(self.names)}}
         if self.payload:
             out["payload_std_errors"] = self.payload_std_errors
-            out["required_accuracy"] = dict(REQUIRED_PAYLOAD_ACCURACY)
+            out["required_accuracy"] = dict(self.accuracy)
         return out
 
 

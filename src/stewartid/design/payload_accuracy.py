@@ -18,13 +18,18 @@ The standard errors of the three follow from the parameters' covariance to first
 
 from __future__ import annotations
 
+import math
+from collections.abc import Mapping
+
 import numpy as np
 
+from stewartid.errors import ConfigError
 from stewartid.model import regressor as reg
 
-#: Accuracy each payload quantity is needed to (one standard error is judged against it):
-#: the mass relative to itself, the centre of mass along its least certain direction (m),
-#: every entry of the inertia about the centre of mass relative to the mean of its diagonal.
+#: Accuracy each payload quantity is needed to by default (one standard error is judged
+#: against it; ``design --accuracy`` sets others): the mass relative to itself, the centre
+#: of mass along its least certain direction (m), every entry of the inertia about the
+#: centre of mass relative to the mean of its diagonal.
 REQUIRED_PAYLOAD_ACCURACY = {"mass": 0.002, "com": 0.002, "inertia": 0.02}
 
 def payload_jacobian(parameters: np.ndarray) -> np.ndarray:
@@ -92,14 +97,36 @@ def payload_std_errors(names: tuple[str, ...], nominal: np.ndarray, covariance: 
                              / np.mean(np.abs(inertia[:3])))}
 
 
-def payload_criterion(std_errors: dict[str, float]) -> tuple[float, str]:
-    """The largest ratio of a payload quantity's standard error to its required accuracy,
-    and the quantity (below 1 every one is expected within its accuracy at one standard
-    error)."""
-    ratios = {k: std_errors[k] / REQUIRED_PAYLOAD_ACCURACY[k] for k in REQUIRED_PAYLOAD_ACCURACY}
+def payload_criterion(std_errors: Mapping[str, float],
+                      accuracy: Mapping[str, float] | None = None) -> tuple[float, str]:
+    """The largest ratio of a payload quantity's standard error to the accuracy it is needed
+    to (``accuracy``, default :data:`REQUIRED_PAYLOAD_ACCURACY`), and the quantity (below 1
+    every one is expected within its accuracy at one standard error)."""
+    accuracy = REQUIRED_PAYLOAD_ACCURACY if accuracy is None else accuracy
+    ratios = {k: std_errors[k] / accuracy[k] for k in REQUIRED_PAYLOAD_ACCURACY}
     worst = max(ratios, key=ratios.__getitem__)
     return ratios[worst], worst
 
 
-__all__ = ["REQUIRED_PAYLOAD_ACCURACY", "payload_criterion", "payload_jacobian",
-           "payload_std_errors"]
+def parse_accuracy(text: str) -> dict[str, float]:
+    """The ``design --accuracy`` value ``MASS,COM,INERTIA`` (%, mm, %) as
+    :data:`REQUIRED_PAYLOAD_ACCURACY` holds it (fractions and metres).
+
+    Raises
+    ------
+    ConfigError
+        Not three positive numbers.
+    """
+    parts = text.split(",")
+    try:
+        values = [float(v) for v in parts]
+    except ValueError:
+        values = []
+    if len(values) != 3 or not all(math.isfinite(v) and v > 0 for v in values):
+        raise ConfigError(f"--accuracy must be three positive numbers MASS,COM,INERTIA (%, mm, "
+                          f"%), e.g. 0.2,2,2; got {text!r}.")
+    return {"mass": values[0] / 100, "com": values[1] / 1000, "inertia": values[2] / 100}
+
+
+__all__ = ["REQUIRED_PAYLOAD_ACCURACY", "parse_accuracy", "payload_criterion",
+           "payload_jacobian", "payload_std_errors"]

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -31,11 +31,12 @@ from stewartid.design.information import (
 from stewartid.design.limits import LIMIT_NAMES, resolve_limits
 from stewartid.design.multisine import all_dofs_multisine
 from stewartid.design.optimise import within_plant_limits
-from stewartid.design.payload_accuracy import REQUIRED_PAYLOAD_ACCURACY, payload_criterion
+from stewartid.design.payload_accuracy import payload_criterion
 from stewartid.design.physical_search import (
     PLANT_EVALUATIONS,
     PLANT_TOLERANCE,
     PhysicalCandidate,
+    judged_against,
     plant_scales,
     refine_for_plant,
     search_design,
@@ -159,7 +160,8 @@ def _number(value: float) -> float | None:
 def played_pick(platform: Platform, best: PhysicalCandidate, budget_s: float,
                 noise: SensorNoise, payload: bool, max_use: float,
                 evaluations: int = PLANT_EVALUATIONS,
-                progress: Callable[[str], None] | None = None
+                progress: Callable[[str], None] | None = None,
+                accuracy: Mapping[str, float] | None = None
                 ) -> tuple[PhysicalCandidate, Design, list, list, ParameterPrediction]:
     """The search's pick played on the plant (records over ``max_use`` scaled down) and
     predicted as the final design is, along the motion the plant played
@@ -185,11 +187,12 @@ def played_pick(platform: Platform, best: PhysicalCandidate, budget_s: float,
             progress(f"the plant allows {scales.min():.2f} of a record's commanded "
                      "amplitudes: refining the search against that")
         refined = refine_for_plant(platform, budget_s, noise, payload, max_use,
-                                   best.parameters, scales, evaluations)
+                                   best.parameters, scales, evaluations, accuracy)
         picks.append((refined, *within_plant_limits(platform, refined.design, max_use)))
-    played = [(*pick, predict_parameters(platform, pick[1], noise, payload, FINAL_RATE,
-                                         states=played_states(pick[2], pick[1], FINAL_RATE),
-                                         filtered=True)) for pick in picks]
+    played = [(*pick, judged_against(predict_parameters(
+        platform, pick[1], noise, payload, FINAL_RATE,
+        states=played_states(pick[2], pick[1], FINAL_RATE), filtered=True), accuracy))
+        for pick in picks]
     return min(played, key=lambda p: p[4].criterion)
 
 
@@ -197,7 +200,8 @@ def run_physical_design(platform: Platform, budget_s: float, noise: SensorNoise,
                         out: str | Path, payload: bool = False, rate_hz: float = 500.0,
                         max_use: float = 0.7, check_seeds: int = 2, force: bool = False,
                         progress: Callable[[str], None] | None = None,
-                        search: dict[str, int] | None = None) -> PhysicalDesignOutput:
+                        search: dict[str, int] | None = None,
+                        accuracy: Mapping[str, float] | None = None) -> PhysicalDesignOutput:
     """Design records for the physical model and write them with their report to ``out``.
 
     Parameters
@@ -227,6 +231,10 @@ def run_physical_design(platform: Platform, budget_s: float, noise: SensorNoise,
         ``random_candidates`` and ``local_evaluations`` of
         :func:`~stewartid.design.physical_search.search_design` and ``plant_evaluations``
         of :func:`played_pick` (tests: fewer).
+    accuracy : mapping, optional
+        Payload mode: the accuracy each payload quantity is needed to (keys and units of
+        :data:`~stewartid.design.payload_accuracy.REQUIRED_PAYLOAD_ACCURACY`, its values by
+        default).
 
     Returns
     -------
@@ -246,17 +254,18 @@ def run_physical_design(platform: Platform, budget_s: float, noise: SensorNoise,
     search = dict(search or {})
     refinement = search.pop("plant_evaluations", PLANT_EVALUATIONS)
     best = search_design(platform, budget_s, noise, payload, max_use, progress=progress,
-                         **search)
+                         accuracy=accuracy, **search)
     best, design, records, uses, prediction = played_pick(
-        platform, best, budget_s, noise, payload, max_use, refinement, progress)
+        platform, best, budget_s, noise, payload, max_use, refinement, progress, accuracy)
     # a machine that tracks the command exactly moves less than the plant: its prediction
-    commanded = predict_parameters(platform, design, noise, payload, FINAL_RATE, filtered=True)
+    commanded = judged_against(predict_parameters(platform, design, noise, payload, FINAL_RATE,
+                                                  filtered=True), accuracy)
     baseline_design = all_dofs_multisine(budget_s)
     # predicted as the design is, along its motion on the plant: like for like
-    baseline = predict_parameters(
+    baseline = judged_against(predict_parameters(
         platform, baseline_design, noise, payload, FINAL_RATE, filtered=True,
         states=played_states(plant_records(platform, baseline_design), baseline_design,
-                             FINAL_RATE))
+                             FINAL_RATE)), accuracy)
     if progress:
         progress(f"checking the prediction on {check_seeds} noisy copies")
     check = monte_carlo_check(platform, records, noise, prediction, check_seeds)
@@ -351,8 +360,8 @@ def criterion_summary(prediction: ParameterPrediction, baseline: ParameterPredic
              f"{prediction.worst_relative_std / baseline.worst_relative_std:.2f})")
     if not prediction.payload:
         return f"Predicted {worst}."
-    std, needed = prediction.payload_std_errors, REQUIRED_PAYLOAD_ACCURACY
-    ratio, quantity = payload_criterion(std)
+    std, needed = prediction.payload_std_errors, prediction.accuracy
+    ratio, quantity = payload_criterion(std, needed)
     return (f"Predicted standard errors of the payload: mass {100 * std['mass']:.3g} %, "
             f"centre of mass {1e3 * std['com']:.3g} mm, inertia about it "
             f"{100 * std['inertia']:.3g} % (needed: {100 * needed['mass']:g} %, "

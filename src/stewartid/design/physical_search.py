@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 import numpy as np
 import scipy.optimize
@@ -160,7 +160,7 @@ def criterion_text(prediction: ParameterPrediction) -> str:
     if not prediction.payload:
         return (f"worst relative SE {prediction.worst_relative_std:.3g} % "
                 f"({prediction.worst_parameter})")
-    ratio, worst = payload_criterion(prediction.payload_std_errors)
+    ratio, worst = payload_criterion(prediction.payload_std_errors, prediction.accuracy)
     return f"worst SE over required accuracy {ratio:.3g} ({worst})"
 
 
@@ -178,10 +178,11 @@ def speed_bounds(payload: bool) -> tuple[float, float]:
 
 
 def candidate(platform: Platform, budget_s: float, noise: SensorNoise, payload: bool,
-              parameters: np.ndarray, max_use: float, scales: np.ndarray | None = None
-              ) -> PhysicalCandidate:
+              parameters: np.ndarray, max_use: float, scales: np.ndarray | None = None,
+              accuracy: Mapping[str, float] | None = None) -> PhysicalCandidate:
     """One member of the family at the limits, with its prediction; with ``scales``
-    (:func:`plant_scales`), each record's amplitudes then times its own."""
+    (:func:`plant_scales`), each record's amplitudes then times its own; ``accuracy``: what
+    payload mode judges against (:func:`judged_against`)."""
     weights, speed, share = parameters[:6], parameters[6], parameters[7]
     amplitudes = np.exp(np.clip(weights, *WEIGHT_BOUNDS)) * np.asarray(DEFAULT_AMPLITUDES)
     design = multisine_design(budget_s, amplitudes, math.exp(np.clip(speed, *np.log(
@@ -194,7 +195,17 @@ def candidate(platform: Platform, budget_s: float, noise: SensorNoise, payload: 
         design = dataclasses.replace(design, records=tuple(
             r.scaled(k) for r, k in zip(design.records, scales, strict=True)))
         prediction = predict_parameters(platform, design, noise, payload)
-    return PhysicalCandidate(design, prediction, np.asarray(parameters, dtype=float), use.peak)
+    return PhysicalCandidate(design, judged_against(prediction, accuracy),
+                             np.asarray(parameters, dtype=float), use.peak)
+
+
+def judged_against(prediction: ParameterPrediction, accuracy: Mapping[str, float] | None
+                   ) -> ParameterPrediction:
+    """``prediction`` with payload mode's criterion taken against ``accuracy`` (keys and
+    units of :data:`~stewartid.design.payload_accuracy.REQUIRED_PAYLOAD_ACCURACY`; None:
+    those)."""
+    return prediction if accuracy is None else dataclasses.replace(prediction,
+                                                                   accuracy=dict(accuracy))
 
 
 def plant_scales(design: Design, played: Design) -> np.ndarray:
@@ -209,7 +220,8 @@ def plant_scales(design: Design, played: Design) -> np.ndarray:
 
 def refine_for_plant(platform: Platform, budget_s: float, noise: SensorNoise, payload: bool,
                      max_use: float, start: np.ndarray, scales: np.ndarray,
-                     evaluations: int = PLANT_EVALUATIONS) -> PhysicalCandidate:
+                     evaluations: int = PLANT_EVALUATIONS,
+                     accuracy: Mapping[str, float] | None = None) -> PhysicalCandidate:
     """Nelder-Mead again from ``start``, every candidate's record k, at ``max_use`` of its
     commanded limits, scaled by the plant's scale of the played pick's record k
     (:func:`plant_scales`): the motion judged as the plant will allow it. Record k of the
@@ -226,7 +238,7 @@ def refine_for_plant(platform: Platform, budget_s: float, noise: SensorNoise, pa
 
     def evaluate(x: np.ndarray) -> float:
         seen.append(candidate(platform, budget_s, noise, payload, np.clip(x, lower, upper),
-                              max_use, scales))
+                              max_use, scales, accuracy))
         return math.log(seen[-1].score)
 
     simplex = start + np.vstack([np.zeros(8), 0.15 * (upper - lower) * np.eye(8)])
@@ -239,7 +251,8 @@ def search_design(platform: Platform, budget_s: float, noise: SensorNoise,
                   payload: bool = False, max_use: float = 0.7, seed: int = 0,
                   random_candidates: int = RANDOM_CANDIDATES,
                   local_evaluations: int = LOCAL_EVALUATIONS,
-                  progress: Callable[[str], None] | None = None) -> PhysicalCandidate:
+                  progress: Callable[[str], None] | None = None,
+                  accuracy: Mapping[str, float] | None = None) -> PhysicalCandidate:
     """The member of the family with the smallest criterion.
 
     Parameters
@@ -259,6 +272,9 @@ def search_design(platform: Platform, budget_s: float, noise: SensorNoise,
         Evaluations of the random stage and of Nelder-Mead.
     progress : callable, optional
         Receives a line of text per stage.
+    accuracy : mapping, optional
+        Payload mode: the accuracy each payload quantity is needed to (default
+        :data:`~stewartid.design.payload_accuracy.REQUIRED_PAYLOAD_ACCURACY`).
 
     Returns
     -------
@@ -274,7 +290,7 @@ def search_design(platform: Platform, budget_s: float, noise: SensorNoise,
 
     def evaluate(x: np.ndarray) -> float:
         seen.append(candidate(platform, budget_s, noise, payload, np.clip(x, lower, upper),
-                              max_use))
+                              max_use, accuracy=accuracy))
         return math.log(seen[-1].score)
 
     for x in starts:
@@ -295,7 +311,7 @@ def search_design(platform: Platform, budget_s: float, noise: SensorNoise,
 
 __all__ = ["LOCAL_EVALUATIONS", "PAYLOAD_SPEED_BOUNDS", "PLANT_EVALUATIONS", "PLANT_TOLERANCE",
            "PhysicalCandidate", "RANDOM_CANDIDATES", "SHARE_BOUNDS", "SPEED_BOUNDS",
-           "criterion_text",
+           "criterion_text", "judged_against",
            "WEIGHT_BOUNDS", "candidate", "commanded_limit_use", "plant_scales",
            "record_peaks", "refine_for_plant", "scale_to_limits", "search_design",
            "speed_bounds"]
