@@ -101,6 +101,45 @@ def long_run_covariance(scores: np.ndarray, segments: Sequence[tuple[int, int]],
     return nearest_psd(B) if psd else B
 
 
+def filtered_noise_covariance(X: np.ndarray, weights: np.ndarray,
+                              segments: Sequence[tuple[int, int]],
+                              noises: Sequence[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
+    """B = Cov(sum_k s_k) for scores s_k = sum_c w_c X_kc e_kc whose e is a known noise: white
+    per sample with covariance S across the channels, then filtered, so that
+    Cov(e_k, e_j) = S rho(|k - j|) over the rows of one record and 0 across records.
+
+    Unlike :func:`long_run_covariance` it estimates nothing from the residual, so it does not
+    scatter from one realisation to the next; it counts only this noise (a lower bound of
+    the residual's when the others are independent of it).
+
+    Parameters
+    ----------
+    X : ndarray, shape (K, c, n)
+    weights : ndarray, shape (c,)
+    segments : sequence of (int, int)
+        Rows of each record (summing to K); the second item is not used.
+    noises : sequence of (ndarray, ndarray)
+        Per record, S (c, c) and rho (L,): the filter's autocorrelation at lags of 0, 1, ...
+        rows (rho[0] the filtered noise's variance per unit S).
+
+    Returns
+    -------
+    ndarray, shape (n, n)
+    """
+    Z = X * weights[None, :, None]
+    B = np.zeros((X.shape[2],) * 2)
+    start = 0
+    for (rows, _), (S, rho) in zip(segments, noises, strict=True):
+        part = Z[start:start + rows]
+        start += rows
+        weighted = np.einsum("cd,kdp->kcp", S, part, optimize=True)
+        B += rho[0] * np.einsum("kcp,kcq->pq", part, weighted, optimize=True)
+        for lag in range(1, min(len(rho), rows)):
+            C = np.einsum("kcp,kcq->pq", part[:-lag], weighted[lag:], optimize=True)
+            B += rho[lag] * (C + C.T)
+    return B
+
+
 def nearest_psd(matrix: np.ndarray) -> np.ndarray:
     """A symmetric matrix with its negative eigenvalues set to zero.
 
@@ -200,5 +239,5 @@ def record_sandwich(inverse: np.ndarray, scores: np.ndarray,
     return inverse @ B @ inverse
 
 
-__all__ = ["long_run_covariance", "nearest_psd", "record_sandwich", "score_sandwich",
-           "with_larger_variances", "with_variances"]
+__all__ = ["filtered_noise_covariance", "long_run_covariance", "nearest_psd", "record_sandwich",
+           "score_sandwich", "with_larger_variances", "with_variances"]

@@ -50,6 +50,7 @@ from stewartid.identification.consistency import (
     solve_convex,
 )
 from stewartid.identification.long_run import (
+    filtered_noise_covariance,
     record_sandwich,
     score_sandwich,
     with_larger_variances,
@@ -115,7 +116,9 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
                      scales: np.ndarray | None = None, max_condition: float = 1e5,
                      max_relative_error: float = 0.3, regressor_noise: np.ndarray | None = None,
                      target_noise: np.ndarray | None = None,
-                     segments: list[tuple[int, int]] | None = None) -> Solution:
+                     segments: list[tuple[int, int]] | None = None,
+                     measured_noise: list[tuple[np.ndarray, np.ndarray]] | None = None
+                     ) -> Solution:
     """Weighted least squares for y = X theta with residual-autocorrelation-consistent
     standard errors, fixing at ``nominal`` what the data cannot tell.
 
@@ -150,6 +153,9 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
         uncorrelated (the filter's support). Given, the covariance is that of the
         parameters' scores (:func:`score_covariance`); without, the inverse normal matrix
         scaled by the residual's variance and autocorrelation time per channel.
+    measured_noise : list of (ndarray, ndarray), optional
+        With ``segments``: per record, a noise of the rows measured apart from the fit,
+        which the standard errors do not fall below (:func:`score_covariance`).
 
     Returns
     -------
@@ -210,7 +216,8 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
             target = 0.0 if target_noise is None else target_noise
             expected = np.einsum("c,rcp->rp", used,
                                  target - regressor_noise @ values)[:, free]
-        solved = score_covariance(inverse, X[:, :, free], residual, used, segments, expected)
+        solved = score_covariance(inverse, X[:, :, free], residual, used, segments, expected,
+                                  measured_noise)
     covariance[np.ix_(free, free)] = solved
     return Solution(values, covariance, fixed, condition, singular_all,
                     np.sqrt(np.mean(residual ** 2, axis=0)), len(y))
@@ -273,7 +280,9 @@ class ConsistentParameters:
 
 def score_covariance(inverse: np.ndarray, X: np.ndarray, residual: np.ndarray,
                      weights: np.ndarray, segments: list[tuple[int, int]],
-                     expected: np.ndarray | None = None) -> np.ndarray:
+                     expected: np.ndarray | None = None,
+                     measured_noise: list[tuple[np.ndarray, np.ndarray]] | None = None
+                     ) -> np.ndarray:
     """N^-1 B N^-1, B the long-run covariance of the scores s_k = sum_c w_c X_kc r_kc
     (:func:`~stewartid.identification.long_run.score_sandwich`, its variances from B as it
     is, its correlations from B made positive semidefinite), each variance raised to
@@ -301,6 +310,14 @@ def score_covariance(inverse: np.ndarray, X: np.ndarray, residual: np.ndarray,
         correction's per record); without, the scores' total shared out by rows. Taken out
         of the record sums and, spread evenly over the record's rows, of the scores: the
         correction's mean is no fluctuation.
+    measured_noise : list of (ndarray, ndarray), optional
+        Per record, a noise of the rows measured apart from the fit (the force sensors',
+        white, filtered): its covariance S per sample and the filter's autocorrelation at
+        row lags (:func:`~stewartid.identification.long_run.filtered_noise_covariance`).
+        Each variance is raised to its share where larger: the sums above scatter from one
+        log to the next (their variances are estimated from the residual's products over
+        the lags, and a high-pass residual leaves a small sum of large terms), and on one
+        log in 24 they put a parameter's standard error at a third of its spread.
 
     Returns
     -------
@@ -311,8 +328,13 @@ def score_covariance(inverse: np.ndarray, X: np.ndarray, residual: np.ndarray,
     if expected is None:
         expected = np.outer(rows / rows.sum(), scores.sum(axis=0))
     centred = scores - np.repeat(expected / rows[:, None], rows, axis=0)
-    return with_larger_variances(score_sandwich(inverse, centred, segments, psd="variances"),
-                                 record_sandwich(inverse, scores, segments, expected))
+    covariance = with_larger_variances(
+        score_sandwich(inverse, centred, segments, psd="variances"),
+        record_sandwich(inverse, scores, segments, expected))
+    if measured_noise is None:
+        return covariance
+    floor = inverse @ filtered_noise_covariance(X, weights, segments, measured_noise) @ inverse
+    return with_larger_variances(covariance, floor)
 
 
 def nearest_consistent(values: np.ndarray, covariance: np.ndarray, bodies: list[Body],

@@ -245,7 +245,8 @@ class PhysicalIdentifier(BaseIdentifier):
         scales = selection @ np.where(positive, np.abs(reg.standard_parameters(platform)), 0.0)
         solution = solve_parameters(X, y, list(names), nominal, scales, self.max_condition,
                                     self.max_relative_error, noise, target_noise,
-                                    correlation_segments(data, experiments))
+                                    correlation_segments(data, experiments),
+                                    data.measured_force_noise())
         projection = None
         if self.consistent:
             nonnegative = np.isin(names, reg.FRICTION_PARAMETERS + reg.ACTUATOR_PARAMETERS)

@@ -18,6 +18,7 @@ from stewartid.signals.differentiation import (
     default_window,
     differentiate,
     estimate_frequency,
+    kernel_taps,
 )
 from stewartid.signals.filtered_rows import kernel_filter_rows
 from stewartid.signals.sign_rates import coulomb_sign_rates
@@ -41,6 +42,9 @@ class Regression:
         (:func:`~stewartid.identification.wavelet.noise.white_noise_covariance`).
     poses : ndarray, shape (K, 6)
         The filtered pose at every row (m, rad): where the leg Jacobian of a row is taken.
+    force_noise : list of ndarray, each shape (6, 6)
+        Per experiment, the leg forces' white-noise covariance per sample (N^2), estimated
+        against their Savitzky-Golay smoothed copy.
     """
 
     Y: np.ndarray
@@ -48,6 +52,18 @@ class Regression:
     experiments: list[dict[str, Any]]
     pose_noise: list[np.ndarray]
     poses: np.ndarray
+    force_noise: list[np.ndarray]
+
+    def measured_force_noise(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Per experiment, the leg forces' noise as the rows carry it: its covariance per
+        sample and the kernel's autocorrelation at lags of 0, 1, ... rows (the filtered
+        rows' noise, for :func:`~stewartid.identification.long_run.filtered_noise_covariance`)."""
+        out = []
+        for S, e in zip(self.force_noise, self.experiments, strict=True):
+            h = kernel_taps(e["sample_rate"], e["window_s"])[0]
+            autocorrelation = np.correlate(h, h, "full")[len(h) - 1:]
+            out.append((S, autocorrelation[::e["row_step"]]))
+        return out
 
 
 #: Savitzky-Golay order and window (a fraction of the kernel's) of the rates and accelerations
@@ -105,7 +121,7 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
     -------
     Regression
     """
-    Ys, ys, used, pose_noise, poses = [], [], [], [], []
+    Ys, ys, used, pose_noise, poses, force_noise = [], [], [], [], [], []
     windows = [window or default_window(estimate_frequency(exp.q, exp.sample_rate))
                for exp in experiments]
     # one step for every experiment: each keeps its share of the rows, as without decimation
@@ -119,6 +135,10 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
         n = len(exp.q)
         q, q_dot, q_ddot = differentiate(exp.q, exp.sample_rate, w / SAVGOL_FRACTION, order)
         pose_noise.append(white_noise_covariance(exp.q, q))
+        forces = np.linalg.solve(np.swapaxes(exp.leg_jacobian, 1, 2),
+                                 exp.generalized_force[..., None])[..., 0]
+        force_noise.append(white_noise_covariance(forces, differentiate(
+            forces, exp.sample_rate, w / SAVGOL_FRACTION, order, (0,))[0]))
         sign_rates, sign_window = coulomb_sign_rates(exp.q, exp.sample_rate, w, pose_noise[-1])
         motion = [np.ascontiguousarray(x.T) for x in (q, q_dot, q_ddot, sign_rates)]
         signals = buffer[:6 * width * n].reshape(6, width, n)
@@ -133,9 +153,10 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
         ys.append(filtered[:, 0].T)
         poses.append(filtered[:, -1].T)
         used.append({"name": exp.name, "window_s": w, "samples": filtered.shape[-1],
-                     "row_step": step, "sign_window_s": sign_window})
+                     "row_step": step, "sign_window_s": sign_window,
+                     "sample_rate": exp.sample_rate})
     return Regression(np.concatenate(Ys), np.concatenate(ys), used, pose_noise,
-                      np.concatenate(poses))
+                      np.concatenate(poses), force_noise)
 
 
 def leg_force_transforms(platform: Platform, poses: np.ndarray) -> np.ndarray:
