@@ -63,10 +63,10 @@ def design(
         "--payload", help="--model physical: design for payload mode (the payload's ten "
         "parameters; the platform file's [payload] is the expected one).")] = False,
     accuracy: Annotated[str | None, typer.Option(
-        "--accuracy", metavar="MASS,COM,INERTIA", help="--payload: the accuracy the payload's "
-        "mass (%), centre of mass (mm) and inertia about it (% of its mean diagonal) are "
-        "needed to, one standard error; the design minimises the largest share of "
-        "them. Default 0.2,2,2.")] = None,
+        "--accuracy", metavar="ACCURACY", help="--payload: MASS,COM,INERTIA, the accuracy "
+        "the payload's mass (%), centre of mass (mm) and inertia about it (% of its mean "
+        "diagonal) are needed to, one standard error; the design minimises the largest "
+        "share of them. Default 0.2,2,2.")] = None,
 ) -> None:
     """Design an excitation for identification: records within the platform's [limits],
     chosen so that the predicted error of every Mt and Bt entry (|bias| + 2 standard errors)
