@@ -36,9 +36,7 @@ length (at least a tenth of the mass times the radius of gyration, for a centre 
 the reference point), each entry of the inertia matrix, products included, against the mean
 of its diagonal. Judged by their own magnitudes, a first moment along a long lever arm and a
 product near zero would set the design's aim by the frame's orientation alone. Payload mode
-judges the payload as it is wanted, its mass, centre of mass and inertia about it, each
-against the accuracy it is needed to (:mod:`stewartid.design.payload_accuracy`), from the
-same covariance.
+judges the payload's quantities instead (:mod:`stewartid.design.payload_accuracy`).
 """
 
 from __future__ import annotations
@@ -98,9 +96,8 @@ class ParameterPrediction:
     payload : bool
         Payload mode.
     accuracy : mapping of str to float
-        Payload mode: the accuracy each payload quantity is needed to
-        (:data:`~stewartid.design.payload_accuracy.REQUIRED_PAYLOAD_ACCURACY`'s keys and
-        units), what :attr:`criterion` judges against.
+        Payload mode: what :attr:`criterion` judges against (keys and units of
+        :data:`~stewartid.design.payload_accuracy.REQUIRED_PAYLOAD_ACCURACY`).
     """
 
     names: tuple[str, ...]
@@ -138,9 +135,8 @@ class ParameterPrediction:
 
     @property
     def payload_std_errors(self) -> dict[str, float] | None:
-        """Payload mode: the standard errors of the payload's mass (relative), centre of
-        mass (m) and inertia about it (relative,
-        :func:`~stewartid.design.payload_accuracy.payload_std_errors`); else None."""
+        """Payload mode: the payload's quantities' standard errors
+        (:func:`~stewartid.design.payload_accuracy.payload_std_errors`); else None."""
         if not self.payload:
             return None
         return payload_std_errors(self.names, self.nominal, self.expected_covariance)
