@@ -63,7 +63,7 @@ def test_filtered_noise_covariance_equals_the_dense_sum():
     channels' S times rho at every pair of rows of a record, none across records), against
     the lag sums."""
     rng = np.random.default_rng(5)
-    segments = [(23, 0), (17, 0)]
+    segments = [(23, 0), (2, 0), (15, 0)]  # one record shorter than the correlation
     X = rng.normal(size=(40, 3, 2))
     weights = np.array([0.5, 1.0, 2.0])
     noises = []

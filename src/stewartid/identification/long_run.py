@@ -14,6 +14,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
+import scipy.ndimage
 
 
 def with_variances(covariance: np.ndarray, variances: np.ndarray) -> np.ndarray:
@@ -132,11 +133,11 @@ def filtered_noise_covariance(X: np.ndarray, weights: np.ndarray,
     for (rows, _), (S, rho) in zip(segments, noises, strict=True):
         part = Z[start:start + rows]
         start += rows
-        weighted = np.einsum("cd,kdp->kcp", S, part, optimize=True)
-        B += rho[0] * np.einsum("kcp,kcq->pq", part, weighted, optimize=True)
-        for lag in range(1, min(len(rho), rows)):
-            C = np.einsum("kcp,kcq->pq", part[:-lag], weighted[lag:], optimize=True)
-            B += rho[lag] * (C + C.T)
+        # sum_j rho(|k - j|) Z_j: one symmetric convolution along the rows, zero outside
+        near = rho[:rows]
+        taps = np.concatenate([near[:0:-1], near])
+        smeared = scipy.ndimage.convolve1d(part, taps, axis=0, mode="constant")
+        B += np.einsum("kcp,cd,kdq->pq", part, S, smeared, optimize=True)
     return B
 
 
