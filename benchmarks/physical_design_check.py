@@ -128,10 +128,11 @@ def main() -> None:
         print(seed, {k: round(v, 3) for k, v in rows[-1].items()
                      if isinstance(v, float)}, flush=True)
     estimates = np.array(estimates)
+    # the truth: the platform file's values, which the plant (or MuJoCo) simulates
+    truth = np.array([reported[n]["nominal"] for n in names])
     if args.save:
         np.savez(args.save, names=np.array(names), estimates=estimates,
-                 fitted_errors=np.array(fitted_errors),
-                 truth=np.array([reported[n]["nominal"] for n in names]))
+                 fitted_errors=np.array(fitted_errors), truth=truth)
     spread = np.std(estimates, axis=0, ddof=1)
     ratio = expected / spread
     finite = np.isfinite(ratio)
@@ -147,8 +148,6 @@ def main() -> None:
         own = np.nanmean(fitted_errors, axis=0) / spread
     print(f"  the fits' own standard errors: {np.nanmedian(own):.2f} times the spread in the "
           f"median ({np.nanmin(own):.2f}-{np.nanmax(own):.2f})")
-    # against the truth: the platform file's values, which the plant (or MuJoCo) simulates
-    truth = np.array([reported[n]["nominal"] for n in names])
     z = np.abs(estimates - truth) / np.array(fitted_errors)
     kept = np.isfinite(z)
     beyond = {n: round(float(np.nanmax(z[:, k])), 2) for k, n in enumerate(names)

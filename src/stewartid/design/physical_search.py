@@ -311,7 +311,6 @@ def search_design(platform: Platform, budget_s: float, noise: SensorNoise,
 
 __all__ = ["LOCAL_EVALUATIONS", "PAYLOAD_SPEED_BOUNDS", "PLANT_EVALUATIONS", "PLANT_TOLERANCE",
            "PhysicalCandidate", "RANDOM_CANDIDATES", "SHARE_BOUNDS", "SPEED_BOUNDS",
-           "criterion_text", "judged_against",
-           "WEIGHT_BOUNDS", "candidate", "commanded_limit_use", "plant_scales",
-           "record_peaks", "refine_for_plant", "scale_to_limits", "search_design",
-           "speed_bounds"]
+           "WEIGHT_BOUNDS", "candidate", "commanded_limit_use", "criterion_text",
+           "judged_against", "plant_scales", "record_peaks", "refine_for_plant",
+           "scale_to_limits", "search_design", "speed_bounds"]
