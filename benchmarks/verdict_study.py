@@ -7,7 +7,8 @@ sines per DOF, all DOFs at once), clean and with the reference sensor noise per 
 independent simulator's example data set (``example``, truth in ``truth.json``), with the
 noise of :func:`noise_study.add_noise`. For each log every registered method is fitted and
 validated exactly as the report does (:func:`stewartid.reports.identification.report.run_method`)
-and the verdict is taken (:func:`stewartid.assessment.verdict.choose_trusted`).
+and judged as it is (:func:`stewartid.reports.identification.report.judge`: the verdict, and
+where it names a close call the consensus of the close methods, trusted).
 
 Per log and seed it prints: the trusted method, whether its largest error over the paper's 20
 entries is within 1.5x (+0.1 point) of the best method's, and per method the largest error,
@@ -40,12 +41,11 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import noise_study  # noqa: E402  (a sibling script)
 
-from stewartid.assessment.verdict import choose_trusted  # noqa: E402
 from stewartid.identification import registry  # noqa: E402
 from stewartid.model.linearization import nominal_matrices  # noqa: E402
 from stewartid.platform import load_platform  # noqa: E402
 from stewartid.reference.published import PAPER_ENTRIES, relative_error_percent  # noqa: E402
-from stewartid.reports.identification.report import run_method  # noqa: E402
+from stewartid.reports.identification.report import judge, run_method  # noqa: E402
 from stewartid.simulation import degrade  # noqa: E402
 from stewartid.simulation.sensors import reference_noise  # noqa: E402
 
@@ -88,9 +88,9 @@ def evaluate(label, platform, data, M, B, seed) -> dict:
     """Every registered method fitted and validated as the report does, and the verdict."""
     names = [spec.name for spec in registry.registered_methods()
              if spec.preset_of is None and spec.compared]
-    runs = [run_method(name, {}, data, platform, 3, False, {}) for name in names]
-    verdict = choose_trusted({run.name: None if run.result is None else
-                              (run.result, run.validation) for run in runs})
+    segments = {}  # prepared once, shared by the methods as in the report
+    runs, verdict = judge([run_method(name, {}, data, platform, 3, False, segments)
+                           for name in names])
     row = {"log": label, "seed": seed, "trusted": verdict.trusted,
            "verdict": verdict.to_dict(), "methods": {}}
     for run in runs:
@@ -139,10 +139,12 @@ def summary(rows: list[dict]) -> list[str]:
     by_log = defaultdict(list)
     for row in rows:
         by_log[row["log"]].append(row)
+    # the consensus is built only where the verdict names a close call
+    names = list(dict.fromkeys(name for row in rows for name in row["methods"]))
     lines = ["| log | trusted (clean; noisy seeds) | trusted within 1.5x of the best | "
              + " | ".join(f"{name}: largest error clean / median noisy (%), in 3 SE (%), "
-                          "largest (SE)" for name in rows[0]["methods"]) + " |",
-             "|---|---|---|" + "---|" * len(rows[0]["methods"])]
+                          "largest (SE)" for name in names) + " |",
+             "|---|---|---|" + "---|" * len(names)]
     for log, group in by_log.items():
         clean = [r for r in group if r["seed"] is None]
         noisy = [r for r in group if r["seed"] is not None]
@@ -150,16 +152,18 @@ def summary(rows: list[dict]) -> list[str]:
                    + ", ".join(r["trusted"] for r in noisy))
         ok = f"{sum(r['trusted_ok'] for r in group)}/{len(group)}"
         cells = []
-        for name in group[0]["methods"]:
-            fitted = [r["methods"][name] for r in group if "worst_percent" in r["methods"][name]]
+        for name in names:
+            fitted = [r["methods"][name] for r in group
+                      if "worst_percent" in r["methods"].get(name, {})]
             if not fitted:
-                cells.append("refused")
+                cells.append("refused" if any(name in r["methods"] for r in group) else "-")
                 continue
             ratios = np.concatenate([m["ratios"] for m in fitted])
             clean_worst = next((r["methods"][name]["worst_percent"] for r in clean
-                                if "worst_percent" in r["methods"][name]), float("nan"))
+                                if "worst_percent" in r["methods"].get(name, {})), float("nan"))
             noisy_worst = np.median([r["methods"][name]["worst_percent"] for r in noisy
-                                     if "worst_percent" in r["methods"][name]] or [np.nan])
+                                     if "worst_percent" in r["methods"].get(name, {})]
+                                    or [np.nan])
             cells.append(f"{clean_worst:.3g} / {noisy_worst:.3g}, "
                          f"{100 * np.mean(ratios <= 3):.0f}, {ratios.max():.3g}")
         lines.append(f"| {log} | {trusted} | {ok} | " + " | ".join(cells) + " |")

@@ -21,7 +21,7 @@ import numpy as np
 from stewartid import load_platform
 from stewartid.identification.registry import registered_methods
 from stewartid.reports.identification.report import write_identification_report
-from stewartid.reports.identification.text import verdict_lines
+from stewartid.reports.identification.verdict_text import verdict_lines
 from stewartid.simulation import simulate_experiments
 from stewartid.simulation.sensors import reference_noise
 

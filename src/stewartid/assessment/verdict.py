@@ -412,16 +412,22 @@ def _reasons(trusted: str, standings: Mapping[str, Standing], tied: list[str],
                            f"{100 * standing.worst_relative_std:.3g} %, {standing.worst_entry}).")
     reasons += [f"{name}: not applicable to these data." for name in not_applicable]
     if uncertain:
-        reasons.append("uncertain entries: " + ", ".join(
-            u["entry"] + (f" (disagrees with {', '.join(u['disagrees_with'])})"
-                          if u["disagrees_with"] else
-                          f" ({100 * u['relative_std']:.3g} % standard error)")
-            for u in uncertain) + ".")
+        reasons.append(uncertain_sentence(uncertain))
     return reasons
+
+
+def uncertain_sentence(uncertain: Sequence[dict]) -> str:
+    """The reason naming the uncertain entries (:func:`uncertain_entries`) and why."""
+    return "uncertain entries: " + ", ".join(
+        u["entry"] + (f" (disagrees with {', '.join(u['disagrees_with'])})"
+                      if u["disagrees_with"] else
+                      f" ({100 * u['relative_std']:.3g} % standard error)")
+        for u in uncertain) + "."
 
 
 __all__ = ["CLOSE_FACTOR", "DAMPING_EXCESS", "DISAGREEMENT", "MISFIT_FACTOR", "MISFIT_FLOOR", "SIGNIFICANT",
            "TIE_FACTOR", "UNCERTAIN_RELATIVE", "Standing", "Verdict", "choose_trusted",
            "finds_friction", "friction_immune",
-           "is_definite", "named_entries", "relative_std", "uncertain_entries", "worst_dof",
+           "is_definite", "named_entries", "relative_std", "uncertain_entries", "uncertain_sentence",
+           "worst_dof",
            "worst_relative_std"]

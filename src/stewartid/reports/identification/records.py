@@ -9,7 +9,12 @@ from pathlib import Path
 
 import numpy as np
 
-from stewartid.assessment.validation import FRICTION_TYPES, ValidationResult, coulomb_estimate
+from stewartid.assessment.validation import (
+    FRICTION_TYPES,
+    CrossValidation,
+    ValidationResult,
+    coulomb_estimate,
+)
 from stewartid.assessment.verdict import Verdict
 from stewartid.errors import StewartidError
 from stewartid.identification.consistency import ConsistentEstimate
@@ -44,6 +49,8 @@ class MethodReport:
         Fit and validation time.
     error : str or None
         Why the method could not be applied.
+    cross_validation : CrossValidation or None
+        The fold fits ``validation`` scores (a consensus of close methods is built from them).
     """
 
     name: str
@@ -59,6 +66,7 @@ class MethodReport:
     seconds: float = 0.0
     error: str | None = None
     exception: StewartidError | None = field(default=None, repr=False, compare=False)
+    cross_validation: CrossValidation | None = field(default=None, repr=False, compare=False)
 
     @property
     def coulomb(self) -> tuple[np.ndarray, np.ndarray]:

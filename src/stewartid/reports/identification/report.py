@@ -32,8 +32,10 @@ from typing import Any
 
 import numpy as np
 
+from stewartid.assessment.close_call import CONSENSUS, consensus_members, trust_consensus
 from stewartid.assessment.validation import (
     DEFAULT_FOLDS,
+    CrossValidation,
     Segment,
     cross_validate,
     held_out_segments,
@@ -43,11 +45,12 @@ from stewartid.assessment.validation import (
     validation_entry,
     with_companion_friction,
 )
-from stewartid.assessment.verdict import choose_trusted
+from stewartid.assessment.verdict import Verdict, choose_trusted
 from stewartid.datasets.dataset import Dataset
 from stewartid.errors import ConfigError, StewartidError
 from stewartid.files import write_text_atomic
 from stewartid.identification import registry
+from stewartid.identification.consensus import combine_results
 from stewartid.identification.consistency import ConsistentEstimate, project_consistent
 from stewartid.identification.result import IdentificationResult
 from stewartid.model.linearization import nominal_matrices
@@ -153,7 +156,75 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
                         unconstrained=unconstrained, validation=validation,
                         validation_unconstrained=before,
                         in_sample=in_sample(segments[terms], result), projection=projection,
-                        records=external, seconds=time.perf_counter() - start)
+                        records=external, seconds=time.perf_counter() - start,
+                        cross_validation=folds_fit)
+
+
+def same_segments(a: Sequence[Segment], b: Sequence[Segment]) -> bool:
+    """Whether two methods' held-out segments are the same pieces, prepared alike (the same
+    ``gravity`` setting gives the same measured force)."""
+    return a is b or (len(a) == len(b) and all(
+        x.name == y.name and np.array_equal(x.force, y.force) for x, y in zip(a, b, strict=True)))
+
+
+def consensus_run(members: Sequence[MethodReport], consistent: bool) -> MethodReport | None:
+    """The consensus of fitted methods (:func:`~stewartid.identification.consensus.combine_results`),
+    validated as :func:`run_method` validates a method: each fold's consensus of the members'
+    fold fits predicts the held-out segments, the full consensus the validation records.
+    None when the members were validated on differently prepared segments (their ``gravity``
+    settings differ)."""
+    start = time.perf_counter()
+    names = [run.name for run in members]
+    folds = [run.cross_validation for run in members]
+    if any(f is None or not same_segments(f.segments, folds[0].segments) for f in folds):
+        return None
+    unconstrained = combine_results([run.unconstrained for run in members], names)
+    fitted = CrossValidation(folds[0].folds, [
+        combine_results([f.fold_results[k] for f in folds], names)
+        for k in range(folds[0].folds)], folds[0].segments)
+    validation = fitted.scores()
+    result, projection, before = unconstrained, None, None
+    if consistent:
+        result, projection = consistent_result(unconstrained)
+        before, validation = validation, fitted.scores(_project)
+    records = members[0].records
+    external = None if records is None else validate_on_records(result, records.segments)
+    result = dataclasses.replace(result, validation=validation_entry(validation, external))
+    spec = registry.method_spec(CONSENSUS)
+    return MethodReport(CONSENSUS, spec.display_name, spec.color, result=result,
+                        unconstrained=unconstrained, validation=validation,
+                        validation_unconstrained=before,
+                        in_sample=in_sample(fitted.segments, result), projection=projection,
+                        records=external, seconds=time.perf_counter() - start,
+                        cross_validation=fitted)
+
+
+def judge(runs: Sequence[MethodReport], consistent: bool = False
+          ) -> tuple[list[MethodReport], Verdict]:
+    """The verdict on the methods' runs (:func:`~stewartid.assessment.verdict.choose_trusted`)
+    and, where it names a close call, the consensus of the close methods added to the runs
+    and trusted (:mod:`stewartid.assessment.close_call`).
+
+    Returns
+    -------
+    runs : list of MethodReport
+        ``runs``, with the consensus's last when it was built.
+    verdict : Verdict
+    """
+    runs = list(runs)
+    verdict = choose_trusted({run.name: None if run.result is None else
+                              (run.result, run.evidence) for run in runs})
+    by_name = {run.name: run for run in runs}
+    members = consensus_members(verdict)
+    if not members or CONSENSUS in by_name:
+        return runs, verdict
+    consensus = consensus_run([by_name[name] for name in members], consistent)
+    if consensus is None:
+        return runs, verdict
+    compared = {name: by_name[name].result for name, standing in verdict.standings.items()
+                if standing.compared}
+    return [*runs, consensus], trust_consensus(verdict, consensus.result, consensus.evidence,
+                                               compared)
 
 
 def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
@@ -228,11 +299,9 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
     record_cache: dict[tuple[bool, bool], list[Segment]] = {}
     runs = [run_method(name, settings or {}, datasets, platform, folds, consistent, segments,
                        check, records, record_cache) for name in dict.fromkeys(methods)]
-    usable = [run for run in runs if run.result is not None]
-    if not usable:
+    if all(run.result is None for run in runs):
         raise runs[0].exception
-    verdict = choose_trusted({run.name: None if run.result is None else
-                              (run.result, run.evidence) for run in runs})
+    runs, verdict = judge(runs, consistent)
     trusted = verdict.trusted
     section = None if physical is None else fit_physical(
         datasets, platform, physical, folds, segments, records, record_cache)
@@ -240,7 +309,8 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
     data_figures(drawer, datasets, platform, rows)
     result_figures(drawer, runs, datasets, platform, nominal, trusted, rows)
     physical_figures(drawer, section)
-    models = [ExportedModel(run.name, run.result, *run.coulomb) for run in usable]
+    models = [ExportedModel(run.name, run.result, *run.coulomb) for run in runs
+              if run.result is not None]
     files = drawer.files + write_exports(models, directory, trusted)
     if len(runs) > 1:
         runs = [dataclasses.replace(run, result=dataclasses.replace(
@@ -260,4 +330,5 @@ def write_identification_report(datasets: Sequence[Dataset], platform: Platform,
     return dataclasses.replace(report, files=files)
 
 
-__all__ = ["consistent_result", "run_method", "write_identification_report"]
+__all__ = ["consensus_run", "consistent_result", "judge", "run_method", "same_segments",
+           "write_identification_report"]

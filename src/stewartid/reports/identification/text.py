@@ -13,29 +13,22 @@ from typing import Any
 
 import numpy as np
 
-from stewartid.assessment.validation import friction_signature
-from stewartid.assessment.verdict import CLOSE_FACTOR, Verdict, named_entries, relative_std, worst_dof
 from stewartid.datasets.dataset import Dataset
-from stewartid.identification.accuracy import PRECISION_FACTOR
 from stewartid.identification.consistency import consistency_metrics, is_consistent
 from stewartid.identification.wavelet.noise import white_noise_covariance
 from stewartid.platform import COORDINATES, Platform
 from stewartid.reporting.tables import ResultTable, to_markdown
 from stewartid.reports.identification.friction_text import (
-    friction_law_lines,
     friction_section,
-    friction_text,
-    third_harmonic_lines,
 )
 from stewartid.reports.identification.physical_section import physical_lines
 from stewartid.reports.identification.records import IdentificationReport, MethodReport
+from stewartid.reports.identification.verdict_text import changed_text, verdict_lines
 from stewartid.signals.differentiation import differentiate, estimate_frequency
 
 _UNITS = ("mm",) * 3 + ("mrad",) * 3
 #: The physical model's row in the validation tables.
 _UNRANKED = "Physical model (full model; not ranked)"
-#: Held-out VAF (%) in the worst DOF above which a model "predicts closely", "adequately".
-CLOSE_VAF, ADEQUATE_VAF = 99.0, 95.0
 
 
 def data_rows(datasets: Sequence[Dataset], platform: Platform) -> list[dict[str, Any]]:
@@ -89,146 +82,6 @@ def used_intervals(runs: Sequence[MethodReport], trusted: str, datasets: Sequenc
                                np.asarray(e["shifts"], dtype=float)])
               if "scales" in e and "shifts" in e else None for e in experiments]
     return chosen.display_name, intervals, points
-
-
-def _changed(projection: Any) -> str:
-    """The largest change of the consistent fit, in standard errors, for a sentence."""
-    change = projection.max_change
-    return "less than 0.001" if change < 1e-3 else f"{change:.3g}"
-
-
-def _quality(vaf: float) -> str:
-    if vaf >= CLOSE_VAF:
-        return "predicts the held-out force closely"
-    if vaf >= ADEQUATE_VAF:
-        return "predicts the held-out force adequately"
-    return ("predicts the held-out force poorly: the model misses part of the dynamics "
-            "(see the residual spectrum and the friction section)")
-
-
-def method_lines(run: MethodReport) -> list[str]:
-    """What to know about one method's result, one Markdown sentence group each."""
-    result = run.result
-    vaf, dof = worst_dof(run.validation)
-    lines = [f"**{run.display_name}** {_quality(vaf)}: VAF ≥ {vaf:.2f} % in every DOF "
-             f"(worst {dof}) over {run.validation.folds} folds."]
-    metrics = consistency_metrics(result.M, result.B)
-    if is_consistent(result.M, result.B):
-        lines.append(f"Its Mt is symmetric positive definite (smallest eigenvalue "
-                     f"{metrics['M_min_eigenvalue']:,.4g}) and its Bt symmetric positive "
-                     f"semidefinite (smallest eigenvalue {metrics['B_min_eigenvalue']:,.4g}).")
-    else:
-        lines.append(f"Its matrices are not physically consistent (Mt smallest eigenvalue "
-                     f"{metrics['M_min_eigenvalue']:,.4g}, asymmetry "
-                     f"{metrics['M_asymmetry']:.2g}; Bt {metrics['B_min_eigenvalue']:,.4g}, "
-                     f"{metrics['B_asymmetry']:.2g}); `--consistent` gives the nearest "
-                     "consistent pair.")
-    if run.projection is not None:
-        lines.append(f"The consistent fit (`--consistent`) moves no entry by more than "
-                     f"{_changed(run.projection)} standard errors; held-out VAF in the worst DOF "
-                     f"{np.min(run.validation_unconstrained.vaf_percent):.3f} % → "
-                     f"{np.min(run.validation.vaf_percent):.3f} %.")
-    lines.append(f"Median relative standard error of the diagonal entries: "
-                 f"{100 * relative_std(result):.2g} %.")
-    lines += _sampling_lines([run])
-    if np.all(np.isfinite(run.coulomb[0])):
-        lines.append(f"Coulomb friction: {friction_text(run)}.")
-    else:
-        share = friction_signature(run.validation)
-        lines.append(f"It does not estimate friction; {100 * share:.0f} % of its held-out "
-                     "residual has the shape of Coulomb joint friction (`--method all` "
-                     "compares it with a method that estimates friction).")
-    lines += friction_law_lines(result) + third_harmonic_lines(result)
-    return lines
-
-
-def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
-    """The verdict in plain language, Markdown sentences: for one applicable method what to
-    know about it (:func:`method_lines`), for several which to trust and what set the others
-    back."""
-    ok = [run for run in runs if run.result is not None]
-    if len(ok) == 1:
-        return method_lines(ok[0])
-    best = next(run for run in ok if run.name == verdict.trusted)
-    trusted = verdict.standings[best.name]
-    lines = [f"**Trust {best.display_name} on these data.** Of the physically plausible "
-             "methods that predict held-out data, its standard errors predict the smallest "
-             f"largest error over the paper's 20 entries: {100 * trusted.expected_worst:.3g} % "
-             f"(largest standard error {100 * trusted.worst_relative_std:.3g} %, "
-             f"{trusted.worst_entry}); they include the model error its symmetric pairs "
-             "reveal. On held-out segments it leaves "
-             f"{trusted.unexplained_percent:.3g} % of the force unexplained in its worst DOF "
-             f"({trusted.worst_dof})"
-             + (" (methods tied in uncertainty: the held-out prediction decides)."
-                if len(verdict.tied) > 1 else ".")]
-    measured = [f"{run.display_name}, {named_entries(standing.measured_entries)}"
-                for run in ok if (standing := verdict.standings[run.name]).measured_entries]
-    if measured:
-        lines.append(f"Where another method estimates an entry over {PRECISION_FACTOR:g}× more "
-                     "precisely, the difference between the two measures the error there and "
-                     "replaces the standard error in these predictions: "
-                     + "; ".join(measured) + ".")
-    if len(verdict.close) > 1:
-        names = [next(run.display_name for run in ok if run.name == name)
-                 for name in verdict.close]
-        lines.append(f"This is a close call: {' and '.join(names)} predict largest errors "
-                     f"within {CLOSE_FACTOR:g}× of each other, and on such data the noise "
-                     "decides which is the more accurate (on logs with a known truth the one "
-                     "predicting less was the more accurate in half to two thirds of such "
-                     "cases). Where their entries differ, both are in the tables below.")
-    if verdict.uncertain:
-        lines.append("Entries to treat with care: " + ", ".join(
-            u["entry"] + (f" (other methods disagree: {', '.join(u['disagrees_with'])})"
-                          if u["disagrees_with"] else
-                          f" ({100 * u['relative_std']:.3g} % standard error)")
-            for u in verdict.uncertain) + ".")
-    lines += _sampling_lines(ok)
-    if verdict.friction_source is not None:
-        source = next(run for run in ok if run.name == verdict.friction_source)
-        lines.append(f"Coulomb friction is present: {source.display_name} finds "
-                     f"{friction_text(source)}.")
-    for run in ok:
-        if run is best:
-            continue
-        standing = verdict.standings[run.name]
-        text = (f"{run.display_name}: predicted largest error "
-                f"{100 * standing.expected_worst:.3g} % (largest standard error "
-                f"{100 * standing.worst_relative_std:.3g} %, {standing.worst_entry}); it leaves "
-                f"{standing.unexplained_percent:.3g} % unexplained in its worst held-out DOF "
-                f"({standing.worst_dof}), {standing.unexplained_ratio:.3g}× as much")
-        if standing.misfit:
-            text += ", more than the held-out prediction allows for a trusted method"
-        if not standing.compared:
-            text += ("; its Mt or Bt has a negative eigenvalue, which no physical "
-                     "platform has")
-        if standing.friction_effect == "damping":
-            text += (f"; it does not model Coulomb friction, and its Bt diagonal is "
-                     f"{100 * standing.damping_excess:.0f} % above that of {best.display_name}: "
-                     "the friction's first harmonic is read as viscous damping, which pulls "
-                     "Bt up")
-        elif standing.friction_effect == "residuals":
-            text += ("; it does not model Coulomb friction, which stays in its residuals "
-                     f"({100 * standing.friction_share:.0f} % of its held-out residual has the "
-                     "shape of Coulomb friction)")
-        lines.append(text + ".")
-    for run in runs:
-        if run.result is None:
-            lines.append(f"{run.display_name} could not be applied to these data: {run.error}")
-    return lines
-
-
-def _sampling_lines(runs: Sequence[MethodReport]) -> list[str]:
-    """A sentence naming the methods whose result the log's sampling limits, if any
-    (:mod:`stewartid.identification.sampling`)."""
-    limited = [(run.display_name, run.result.diagnostics["sampling"]) for run in runs
-               if run.result.diagnostics.get("sampling", {}).get("limited")]
-    if not limited:
-        return []
-    return ["Limited by the log's sampling, not its noise: " + "; ".join(
-        f"{name} (standard errors {s['std_ratio']:.3g}× larger at half the rate, where noise "
-        f"gives about 1.4×; an entry moved by {s['shift']:.3g} of them)" for name, s in limited)
-        + ". Each entry's standard error includes its largest change at 1/2, 1/3 and 1/4 of "
-        "the rate: a bound of what the sampling does, not an estimate of the noise."]
 
 
 def _number(value: float) -> str:
@@ -418,7 +271,7 @@ def _consistency_section(runs: Sequence[MethodReport]) -> list[str]:
         after = run.validation.vaf_percent
         lines += [f"`--consistent` ({run.display_name}, solver {run.projection.solver}): the "
                   "nearest consistent pair in standard errors of the estimate moves no entry "
-                  f"by more than {_changed(run.projection)} standard errors; held-out "
+                  f"by more than {changed_text(run.projection)} standard errors; held-out "
                   f"VAF in the worst DOF {np.min(before):.3f} % → {np.min(after):.3f} %.", ""]
     return lines
 
@@ -442,5 +295,4 @@ def _files_section(report: IdentificationReport) -> list[str]:
     return lines + [""]
 
 
-__all__ = ["data_rows", "matrix_table", "method_lines", "render_report", "used_intervals",
-           "verdict_lines"]
+__all__ = ["data_rows", "matrix_table", "render_report", "used_intervals"]

@@ -1,0 +1,104 @@
+"""The verdict's answer to a close call: trust the consensus of the close methods.
+
+Where :func:`~stewartid.assessment.verdict.choose_trusted` finds several plausible methods
+whose standard errors predict largest errors within
+:data:`~stewartid.assessment.verdict.CLOSE_FACTOR` of each other, which of them is the more
+accurate is decided by the noise (the one predicting the smaller error realised it in 50-79 %
+of such pairs). The report then builds their consensus
+(:func:`~stewartid.identification.consensus.combine_results`, from the fits and folds it
+already has) and trusts it: on the verdict study's 76 noisy logs with a known truth, the
+consensus was within 1.5x of the most accurate method on 74, the single method on 69
+(``docs/benchmarks.md``, "Which method to trust").
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from stewartid.assessment.validation import ValidationResult, coulomb_estimate, friction_signature
+from stewartid.assessment.verdict import (
+    Standing,
+    Verdict,
+    uncertain_entries,
+    uncertain_sentence,
+    worst_dof,
+    worst_relative_std,
+)
+from stewartid.identification.accuracy import entry_relative_std, expected_worst_error
+from stewartid.identification.result import IdentificationResult
+from stewartid.reference.published import PAPER_ENTRIES
+
+#: Registry name of the consensus.
+CONSENSUS = "consensus"
+
+
+def consensus_members(verdict: Verdict) -> tuple[str, ...]:
+    """The methods whose consensus the verdict trusts: its close call
+    (:attr:`~stewartid.assessment.verdict.Verdict.close`, the trusted method first) when it
+    holds two or more, else none."""
+    return verdict.close if len(verdict.close) > 1 else ()
+
+
+def combined_entries(result: IdentificationResult) -> int:
+    """How many of the paper's 20 entries the consensus ``result`` averaged over two or more
+    members (the others are its reference member's)."""
+    found = result.diagnostics.get("consensus", {})
+    used = {"M": np.asarray(found.get("used_M")), "B": np.asarray(found.get("used_B"))}
+    if used["M"].ndim != 3 or used["B"].ndim != 3:
+        return 0
+    return sum(int(used[matrix][:, i, j].sum() > 1) for matrix, i, j in PAPER_ENTRIES)
+
+
+def trust_consensus(verdict: Verdict, result: IdentificationResult,
+                    validation: ValidationResult,
+                    compared: dict[str, IdentificationResult]) -> Verdict:
+    """``verdict`` with the consensus of its close call trusted and ranked first.
+
+    Parameters
+    ----------
+    verdict : Verdict
+        With a close call (:func:`consensus_members` not empty).
+    result : IdentificationResult
+        The consensus of the close methods, the trusted one first.
+    validation : ValidationResult
+        Its held-out (or validation records') scores.
+    compared : dict of str to IdentificationResult
+        The plausible methods' results, by name: the entries the consensus is unsure of are
+        those its relative error leaves uncertain or one of them contradicts.
+
+    Returns
+    -------
+    Verdict
+        Trusted :data:`CONSENSUS`; the earlier trusted method's reasons follow the
+        consensus's; every standing's unexplained force relative to the consensus's.
+    """
+    members = consensus_members(verdict)
+    vaf, dof = worst_dof(validation)
+    worst, entry = worst_relative_std(result)
+    unexplained = max(100 - vaf, 1e-12)
+    standings = {CONSENSUS: Standing(
+        CONSENSUS, vaf, dof, 1.0, True, bool(np.all(np.isfinite(coulomb_estimate(result)[0]))),
+        None, float("nan"), friction_signature(validation), worst, entry, False, False,
+        expected_worst_error(entry_relative_std(result)))}
+    standings.update({name: dataclasses.replace(
+        standing, unexplained_ratio=standing.unexplained_percent / unexplained)
+        for name, standing in verdict.standings.items()})
+    agreement = result.diagnostics.get("consensus", {}).get("agreement", float("nan"))
+    reason = (f"{CONSENSUS}: {', '.join(members)} are a close call, so their estimates are "
+              "averaged, weighted by their inverse variances, where they agree within "
+              f"{agreement:g} standard error of their difference ({combined_entries(result)} of "
+              f"the paper's 20 entries; {members[0]}'s elsewhere); its standard errors take "
+              "the members' errors as fully correlated, and predict a largest error of "
+              f"{100 * standings[CONSENSUS].expected_worst:.3g} %; held-out VAF {vaf:.4g} % in "
+              f"its worst DOF ({dof}).")
+    uncertain = uncertain_entries(result, compared)
+    reasons = [reason, *(r for r in verdict.reasons if not r.startswith("uncertain entries:"))]
+    if uncertain:
+        reasons.append(uncertain_sentence(uncertain))
+    return dataclasses.replace(verdict, trusted=CONSENSUS, ranking=(CONSENSUS, *verdict.ranking),
+                               standings=standings, uncertain=uncertain, reasons=reasons)
+
+
+__all__ = ["CONSENSUS", "combined_entries", "consensus_members", "trust_consensus"]
