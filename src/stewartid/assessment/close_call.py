@@ -51,6 +51,15 @@ def combined_entries(result: IdentificationResult) -> int:
     return sum(int(used[matrix][:, i, j].sum() > 1) for matrix, i, j in PAPER_ENTRIES)
 
 
+def combined_text(result: IdentificationResult, reference: str) -> str:
+    """Which of the paper's 20 entries the consensus ``result`` averaged, for a sentence
+    (``reference``: how to name its reference member)."""
+    count = combined_entries(result)
+    if count == len(PAPER_ENTRIES):
+        return f"all {count} of the paper's entries"
+    return f"{count} of the paper's {len(PAPER_ENTRIES)} entries; {reference}'s elsewhere"
+
+
 def trust_consensus(verdict: Verdict, result: IdentificationResult,
                     validation: ValidationResult,
                     compared: dict[str, IdentificationResult]) -> Verdict:
@@ -88,8 +97,8 @@ def trust_consensus(verdict: Verdict, result: IdentificationResult,
     agreement = result.diagnostics.get("consensus", {}).get("agreement", float("nan"))
     reason = (f"{CONSENSUS}: {', '.join(members)} are a close call, so their estimates are "
               "averaged, weighted by their inverse variances, where they agree within "
-              f"{agreement:g} standard error of their difference ({combined_entries(result)} of "
-              f"the paper's 20 entries; {members[0]}'s elsewhere); its standard errors take "
+              f"{agreement:g} standard error of their difference "
+              f"({combined_text(result, members[0])}); its standard errors take "
               "the members' errors as fully correlated, and predict a largest error of "
               f"{100 * standings[CONSENSUS].expected_worst:.3g} %; held-out VAF {vaf:.4g} % in "
               f"its worst DOF ({dof}).")
@@ -101,4 +110,5 @@ def trust_consensus(verdict: Verdict, result: IdentificationResult,
                                standings=standings, uncertain=uncertain, reasons=reasons)
 
 
-__all__ = ["CONSENSUS", "combined_entries", "consensus_members", "trust_consensus"]
+__all__ = ["CONSENSUS", "combined_entries", "combined_text", "consensus_members",
+           "trust_consensus"]

@@ -38,6 +38,10 @@ Rule, in order:
    says what the friction law costs, and on logs with a known truth the preference chose a
    method up to twice as far off as the best (:doc:`/benchmarks`, "Which method to trust").
 
+6. **Close calls**: where other plausible methods predict largest errors within
+   :data:`CLOSE_FACTOR` of the trusted one's, the noise decides which is the more accurate;
+   the report then trusts their consensus (:mod:`stewartid.assessment.close_call`).
+
 Entries are *uncertain* when the trusted method's relative standard error exceeds
 :data:`UNCERTAIN_RELATIVE`, or when another plausible method's estimate differs from the
 trusted one's by more than :data:`DISAGREEMENT` combined standard errors.

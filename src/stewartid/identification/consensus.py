@@ -131,7 +131,7 @@ def combine_results(results: Sequence[IdentificationResult], names: Sequence[str
 
 @register_method(
     name="consensus", color="#17becf", compared=False,
-    display_name="Consensus (Method B and least squares)",
+    display_name="Consensus",
     description="the members' estimates averaged by inverse variance where they agree within "
                 "one standard error of their difference; what the verdict trusts in a close call",
     reference="Hartung, J., Knapp, G., Sinha, B. K. Statistical Meta-Analysis with "

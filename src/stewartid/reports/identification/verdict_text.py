@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from stewartid.assessment.close_call import CONSENSUS, combined_entries
+from stewartid.assessment.close_call import CONSENSUS, combined_text
 from stewartid.assessment.validation import friction_signature
 from stewartid.assessment.verdict import CLOSE_FACTOR, Verdict, named_entries, relative_std, worst_dof
 from stewartid.identification.accuracy import PRECISION_FACTOR
@@ -33,6 +33,8 @@ def changed_text(projection: Any) -> str:
 
 
 def quality_text(vaf: float) -> str:
+    """How well a model predicts the held-out force, in words, from the VAF (%) of its worst
+    DOF (:data:`CLOSE_VAF`, :data:`ADEQUATE_VAF`)."""
     if vaf >= CLOSE_VAF:
         return "predicts the held-out force closely"
     if vaf >= ADEQUATE_VAF:
@@ -167,8 +169,8 @@ def consensus_text(verdict: Verdict, best: MethodReport, names: dict[str, str]) 
             "predicting less was the more accurate in half to two thirds of such cases). The "
             "consensus averages their estimates, weighted by their inverse variances, where "
             f"they agree within {agreement:g} standard error of their difference "
-            f"({combined_entries(best.result)} of the 20 entries; {names[members[0]]}'s "
-            "elsewhere). Its standard errors take the members' errors as fully correlated and "
+            f"({combined_text(best.result, names[members[0]])}). Its standard errors take the "
+            "members' errors as fully correlated and "
             f"predict a largest error of {100 * standing.expected_worst:.3g} % (largest "
             f"standard error {100 * standing.worst_relative_std:.3g} %, "
             f"{standing.worst_entry}); on held-out segments it leaves "
