@@ -36,6 +36,7 @@ from stewartid.design.physical_search import (
     PLANT_EVALUATIONS,
     PLANT_TOLERANCE,
     PhysicalCandidate,
+    design_objective,
     judged_against,
     plant_scales,
     refine_for_plant,
@@ -162,7 +163,8 @@ def played_pick(platform: Platform, best: PhysicalCandidate, budget_s: float,
                 evaluations: int = PLANT_EVALUATIONS,
                 progress: Callable[[str], None] | None = None,
                 accuracy: Mapping[str, float] | None = None
-                ) -> tuple[PhysicalCandidate, Design, list, list, ParameterPrediction]:
+                ) -> tuple[PhysicalCandidate, Design, list, list, ParameterPrediction,
+                           ParameterPrediction]:
     """The search's pick played on the plant (records over ``max_use`` scaled down) and
     predicted as the final design is, along the motion the plant played
     (:func:`~stewartid.design.information.played_states`); where the plant allowed less of
@@ -174,9 +176,11 @@ def played_pick(platform: Platform, best: PhysicalCandidate, budget_s: float,
 
     Returns
     -------
-    pick, design, records, uses, prediction
-        The candidate kept and, as played, its design, plant records, their limit use and
-        the final prediction.
+    pick, design, records, uses, prediction, commanded
+        The candidate kept and, as played, its design, plant records, their limit use, the
+        final prediction and the prediction along its commanded motion; of the two picks,
+        the one whose worse prediction has the smaller
+        :func:`~stewartid.design.physical_search.design_objective`.
     """
     if progress:
         progress("playing the design on the plant")
@@ -189,11 +193,13 @@ def played_pick(platform: Platform, best: PhysicalCandidate, budget_s: float,
         refined = refine_for_plant(platform, budget_s, noise, payload, max_use,
                                    best.parameters, scales, evaluations, accuracy)
         picks.append((refined, *within_plant_limits(platform, refined.design, max_use)))
-    played = [(*pick, judged_against(predict_parameters(
-        platform, pick[1], noise, payload, FINAL_RATE,
-        states=played_states(pick[2], pick[1], FINAL_RATE), filtered=True), accuracy))
+    # judged along the plant's motion and along the command (a machine that tracks it
+    # exactly moves less): the worse of the two, so the pick holds on either
+    played = [(*pick, *(judged_against(predict_parameters(
+        platform, pick[1], noise, payload, FINAL_RATE, states=states, filtered=True), accuracy)
+        for states in (played_states(pick[2], pick[1], FINAL_RATE), None)))
         for pick in picks]
-    return min(played, key=lambda p: p[4].criterion)
+    return min(played, key=lambda p: max(design_objective(p[4]), design_objective(p[5])))
 
 
 def run_physical_design(platform: Platform, budget_s: float, noise: SensorNoise,
@@ -255,11 +261,8 @@ def run_physical_design(platform: Platform, budget_s: float, noise: SensorNoise,
     refinement = search.pop("plant_evaluations", PLANT_EVALUATIONS)
     best = search_design(platform, budget_s, noise, payload, max_use, progress=progress,
                          accuracy=accuracy, **search)
-    best, design, records, uses, prediction = played_pick(
+    best, design, records, uses, prediction, commanded = played_pick(
         platform, best, budget_s, noise, payload, max_use, refinement, progress, accuracy)
-    # a machine that tracks the command exactly moves less than the plant: its prediction
-    commanded = judged_against(predict_parameters(platform, design, noise, payload, FINAL_RATE,
-                                                  filtered=True), accuracy)
     baseline_design = all_dofs_multisine(budget_s)
     # predicted as the design is, along its motion on the plant: like for like
     baseline = judged_against(predict_parameters(

@@ -1,14 +1,13 @@
-"""Choosing the physical design: all-DOF multisines at the limits, the criterion minimised
-(payload mode: the payload's quantities against their required accuracy; full mode: the
-worst predicted relative standard error).
+"""Choosing the physical design: all-DOF multisines at the limits, the worst predicted
+relative standard error minimised (payload mode: with the payload's quantities held within a
+margin of their required accuracy, :func:`design_objective`).
 
 The family (:func:`~stewartid.design.multisine.multisine_design`) has eight parameters: the
 share of each DOF in the motion (six, as log-weights on the paper's amplitudes), the speed of
 the frequency pool and the share of each DOF's amplitude at its second frequency. For each
 candidate every record's amplitudes are scaled until its commanded motion uses ``max_use`` of
 its most used limit (:func:`scale_to_limits`: leg strokes, rates, accelerations and forces,
-gimbal angles), and the criterion
-(:attr:`~stewartid.design.information.ParameterPrediction.criterion`) is taken of the
+gimbal angles), and :func:`design_objective` is taken of the
 predicted covariance (:func:`~stewartid.design.information.predict_parameters`: the
 information matrix, a fraction of a second). Random candidates first (a fixed seed), then
 Nelder-Mead from the best, each within a fixed number of evaluations: the design does not
@@ -34,7 +33,7 @@ from stewartid.design.information import (
 )
 from stewartid.design.limits import LimitUse, limit_use, resolve_limits
 from stewartid.design.multisine import multisine_design
-from stewartid.design.payload_accuracy import payload_criterion
+from stewartid.design.payload_accuracy import payload_criterion, payload_objective
 from stewartid.errors import ConfigError
 from stewartid.model import regressor as reg
 from stewartid.model.kinematics import inverse_kinematics, leg_jacobian
@@ -151,8 +150,19 @@ class PhysicalCandidate:
 
     @property
     def score(self) -> float:
-        """The criterion (:attr:`~stewartid.design.information.ParameterPrediction.criterion`)."""
-        return self.prediction.criterion
+        """What the search minimises (:func:`design_objective`)."""
+        return design_objective(self.prediction)
+
+
+def design_objective(prediction: ParameterPrediction) -> float:
+    """What the search minimises: full mode the criterion (the worst relative standard error,
+    :attr:`~stewartid.design.information.ParameterPrediction.criterion`); payload mode the
+    ten parameters' worst relative standard error with the payload's quantities held within
+    :data:`~stewartid.design.payload_accuracy.ACCURACY_MARGIN` of their accuracy
+    (:func:`~stewartid.design.payload_accuracy.payload_objective`)."""
+    if not prediction.payload:
+        return prediction.criterion
+    return payload_objective(prediction.worst_relative_std, prediction.criterion)
 
 
 def criterion_text(prediction: ParameterPrediction) -> str:
@@ -161,7 +171,8 @@ def criterion_text(prediction: ParameterPrediction) -> str:
         return (f"worst relative SE {prediction.worst_relative_std:.3g} % "
                 f"({prediction.worst_parameter})")
     ratio, worst = payload_criterion(prediction.payload_std_errors, prediction.accuracy)
-    return f"worst SE over required accuracy {ratio:.3g} ({worst})"
+    return (f"worst SE over required accuracy {ratio:.3g} ({worst}), worst relative SE "
+            f"{prediction.worst_relative_std:.3g} % ({prediction.worst_parameter})")
 
 
 def _bounds(payload: bool) -> tuple[np.ndarray, np.ndarray]:
@@ -253,7 +264,7 @@ def search_design(platform: Platform, budget_s: float, noise: SensorNoise,
                   local_evaluations: int = LOCAL_EVALUATIONS,
                   progress: Callable[[str], None] | None = None,
                   accuracy: Mapping[str, float] | None = None) -> PhysicalCandidate:
-    """The member of the family with the smallest criterion.
+    """The member of the family with the smallest :func:`design_objective`.
 
     Parameters
     ----------
@@ -311,6 +322,6 @@ def search_design(platform: Platform, budget_s: float, noise: SensorNoise,
 
 __all__ = ["LOCAL_EVALUATIONS", "PAYLOAD_SPEED_BOUNDS", "PLANT_EVALUATIONS", "PLANT_TOLERANCE",
            "PhysicalCandidate", "RANDOM_CANDIDATES", "SHARE_BOUNDS", "SPEED_BOUNDS",
-           "WEIGHT_BOUNDS", "candidate", "commanded_limit_use", "criterion_text",
+           "WEIGHT_BOUNDS", "candidate", "commanded_limit_use", "criterion_text", "design_objective",
            "judged_against", "plant_scales", "record_peaks", "refine_for_plant",
            "scale_to_limits", "search_design", "speed_bounds"]
