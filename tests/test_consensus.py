@@ -102,3 +102,28 @@ def test_the_report_builds_and_trusts_the_consensus_of_a_close_call(tmp_path, pa
     # its held-out prediction is scored like the members' (fold consensus on the same segments)
     assert runs[CONSENSUS].validation.vaf_percent.min() > 99.0
     assert "**Trust the consensus of" in (tmp_path / "report.md").read_text()
+
+
+def test_no_consensus_of_members_validated_on_differently_prepared_segments():
+    """Members whose held-out forces differ (one subtracted gravity, the other not) cannot be
+    validated as one model: no consensus is built, and the verdict stays with one method."""
+    from stewartid.assessment.validation import CrossValidation, Segment
+    from stewartid.reports.identification.records import MethodReport
+    from stewartid.reports.identification.report import consensus_run, same_segments
+
+    rng = np.random.default_rng(2)
+
+    def segment(force):
+        n = len(force)
+        return Segment("exp1[0-2 s]", 0, 0, np.arange(n) / 100.0, force,
+                       rng.normal(size=(n, 6)), rng.normal(size=(n, 6)),
+                       rng.normal(size=(n, 3, 6)))
+
+    force = rng.normal(size=(40, 6))
+    with_gravity, without = [segment(force)], [segment(force + 9.81)]
+    assert same_segments(with_gravity, [segment(force.copy())])
+    assert not same_segments(with_gravity, without)
+    members = [MethodReport(name, name, "k", result=_result(0.01), unconstrained=_result(0.01),
+                            cross_validation=CrossValidation(2, [_result(0.01)] * 2, segments))
+               for name, segments in (("a", with_gravity), ("b", without))]
+    assert consensus_run(members, consistent=False) is None
