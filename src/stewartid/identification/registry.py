@@ -67,7 +67,8 @@ class MethodSpec:
         Run by ``identify --method all`` (and so judged by its verdict) and by the
         reproduction. False for a method whose standard errors are not yet calibrated on the
         logs the verdict is measured on (the physical model: ``docs/benchmarks.md``, "Which
-        method to trust"); it runs by name.
+        method to trust"), and for the consensus, which the report builds from the compared
+        methods' fits where its verdict names a close call; each runs by name.
     """
 
     name: str
