@@ -272,12 +272,18 @@ def plot_unexplained(vaf: Mapping[str, np.ndarray], colours: Mapping[str, str],
                                         "top": 0.9})
     width = 0.8 / max(len(vaf), 1)
     x = np.arange(6)
-    for k, (label, values) in enumerate(vaf.items()):
-        axis.bar(x + (k - (len(vaf) - 1) / 2) * width,
-                 np.maximum(100.0 - np.asarray(values), 1e-5), width, color=colours[label],
+    heights = {label: np.maximum(100.0 - np.asarray(values, dtype=float), 1e-5)
+               for label, values in vaf.items()}
+    for k, (label, values) in enumerate(heights.items()):
+        axis.bar(x + (k - (len(vaf) - 1) / 2) * width, values, width, color=colours[label],
                  label=label)
     axis.set_yscale("log")
     _log_floor(axis, np.zeros(0), decades=None)
+    every = np.concatenate([h[np.isfinite(h)] for h in heights.values()] or [np.ones(1)])
+    if every.size:
+        # whole decades: bars within one decade would otherwise leave the axis unlabelled
+        axis.set_ylim(10.0 ** np.floor(np.log10(every.min() / 2)),
+                      10.0 ** (np.floor(np.log10(every.max())) + 1))
     axis.set_xticks(x, COORDINATES)
     axis.set_ylabel("100 − VAF (%), held out")
     axis.set_title("Force the model does not explain on data it was not fitted on "
