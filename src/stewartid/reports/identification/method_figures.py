@@ -257,6 +257,9 @@ def plot_validation(validations: Mapping[str, ValidationResult], colours: Mappin
         axis.set_title(f"{COORDINATES[c]} equation, {first.segments[picks[0]].name.split('[')[0]}")
         axis.set_xlabel("time (s)")
         axis.set_ylabel(f"force ({FORCE_UNITS[c]})")
+        # headroom for the legend's lines above the data, which it would otherwise hide
+        low, high = axis.get_ylim()
+        axis.set_ylim(low, high + (high - low) * (0.05 + 0.075 * (len(validations) + 1)))
         axis.legend(loc="upper right", fontsize=7, framealpha=0.9)
     figure.suptitle("Held-out data: measured generalized force and the identified model's "
                     "prediction (each segment predicted by the fit without it)")
