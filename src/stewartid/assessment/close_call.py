@@ -18,10 +18,11 @@ import dataclasses
 
 import numpy as np
 
-from stewartid.assessment.validation import ValidationResult, coulomb_estimate, friction_signature
+from stewartid.assessment.validation import ValidationResult, friction_signature
 from stewartid.assessment.verdict import (
     Standing,
     Verdict,
+    models_friction,
     uncertain_entries,
     uncertain_sentence,
     worst_dof,
@@ -89,7 +90,7 @@ def trust_consensus(verdict: Verdict, result: IdentificationResult,
     worst, entry = worst_relative_std(result)
     unexplained = max(100 - vaf, 1e-12)
     standings = {CONSENSUS: Standing(
-        CONSENSUS, vaf, dof, 1.0, True, bool(np.all(np.isfinite(coulomb_estimate(result)[0]))),
+        CONSENSUS, vaf, dof, 1.0, True, models_friction(result),
         None, float("nan"), friction_signature(validation), worst, entry, False, False,
         expected_worst_error(entry_relative_std(result)))}
     standings.update({name: dataclasses.replace(

@@ -179,6 +179,11 @@ def friction_immune(result: IdentificationResult) -> bool:
             and diagnostics.get("soft_sign_rate") is None)
 
 
+def models_friction(result: IdentificationResult) -> bool:
+    """The method estimates a Coulomb level for every joint type."""
+    return bool(np.all(np.isfinite(coulomb_estimate(result)[0])))
+
+
 def finds_friction(result: IdentificationResult) -> bool:
     """The method estimates a Coulomb level above :data:`SIGNIFICANT` standard errors."""
     levels, std = coulomb_estimate(result)
@@ -350,15 +355,15 @@ def choose_trusted(assessed: Mapping[str, tuple[IdentificationResult, Validation
     reference_B = np.diag(ok[trusted][0].B)
     standings = {}
     for name, (result, validation) in ok.items():
-        models_friction = bool(np.all(np.isfinite(coulomb_estimate(result)[0])))
+        modelled = models_friction(result)
         excess, effect = float("nan"), None
-        if friction_source is not None and not models_friction and name != trusted:
+        if friction_source is not None and not modelled and name != trusted:
             excess = float(np.mean(np.diag(result.B) / reference_B) - 1.0)
             effect = "damping" if excess > DAMPING_EXCESS else "residuals"
         standings[name] = Standing(
             name, worst[name][0], worst[name][1],
             (100 - worst[name][0]) / max(100 - worst[trusted][0], 1e-12), name in compared,
-            models_friction, effect, excess, friction_signature(validation),
+            modelled, effect, excess, friction_signature(validation),
             spread[name][0], spread[name][1], misfit[name], friction_immune(result),
             expected[name], tuple(entry_label(PAPER_ENTRIES[k]) for k in checked[name][1]))
     others = sorted((name for name in ok if name != trusted),
@@ -431,7 +436,6 @@ def uncertain_sentence(uncertain: Sequence[dict]) -> str:
 
 __all__ = ["CLOSE_FACTOR", "DAMPING_EXCESS", "DISAGREEMENT", "MISFIT_FACTOR", "MISFIT_FLOOR", "SIGNIFICANT",
            "TIE_FACTOR", "UNCERTAIN_RELATIVE", "Standing", "Verdict", "choose_trusted",
-           "finds_friction", "friction_immune",
-           "is_definite", "named_entries", "relative_std", "uncertain_entries", "uncertain_sentence",
-           "worst_dof",
+           "finds_friction", "friction_immune", "is_definite", "models_friction", "named_entries",
+           "relative_std", "uncertain_entries", "uncertain_sentence", "worst_dof",
            "worst_relative_std"]

@@ -143,7 +143,7 @@ class ParameterPrediction:
 
     @property
     def criterion(self) -> float:
-        """What the design minimises. Payload mode: the largest ratio of the payload's
+        """What the design is judged by. Payload mode: the largest ratio of the payload's
         quantities' standard errors to their required accuracy
         (:func:`~stewartid.design.payload_accuracy.payload_criterion`); full mode: the
         worst relative standard error (%)."""

@@ -20,7 +20,7 @@ that, sharpens every one of the ten parameters (:func:`payload_objective`). Mini
 largest share of accuracy alone left a flat direction the search wandered along: on the
 paper platform with a 2 t payload it reached 0.385 of the accuracy (the centre of mass) with
 the ten's worst relative standard error at 0.67 of the all-DOFs multisine's; held within the
-margin and sharpened, 0.39 and 0.50.
+margin and sharpened, 0.38 and 0.52.
 """
 
 from __future__ import annotations
@@ -42,6 +42,7 @@ REQUIRED_PAYLOAD_ACCURACY = {"mass": 0.002, "com": 0.002, "inertia": 0.02}
 #: accuracy (:func:`payload_objective`): the error of one run is then within the accuracy
 #: at two standard errors (95 % of runs), and the largest of 8 runs' usually so.
 ACCURACY_MARGIN = 0.5
+
 
 def payload_jacobian(parameters: np.ndarray) -> np.ndarray:
     """Derivative of (mass, centre of mass, inertia about it) by the body parameters.
