@@ -39,7 +39,7 @@ from stewartid.simulation.excitation import DEFAULT_AMPLITUDES
 REFERENCE_HZ = (0.3, 0.45, 0.6, 0.75, 0.9, 1.05)
 #: Fade-in and fade-out of every multisine record (s).
 MULTISINE_FADE = 2.0
-#: Longest record of a design (s): the budget is split into records no longer than this.
+#: Longest record (s): the budget is split into records no longer than this.
 RECORD_LENGTH = 20.0
 
 
@@ -124,17 +124,19 @@ class MultisineRecord:
                    for key in ("amplitudes", "frequencies_hz", "phases")}}
 
 
-def record_lengths(budget_s: float) -> list[float]:
-    """The budget (s) split into equal records of at most :data:`RECORD_LENGTH` s."""
+def record_lengths(budget_s: float, length: float = RECORD_LENGTH) -> list[float]:
+    """The budget (s) split into equal records of at most ``length`` s."""
     if not (math.isfinite(budget_s) and budget_s >= 4 * MULTISINE_FADE):
         raise ConfigError(f"budget must be at least {4 * MULTISINE_FADE:g} s for records "
                           f"that move every DOF; got {budget_s!r} s.")
-    n = max(1, math.ceil(budget_s / RECORD_LENGTH - 1e-9))
+    n = max(1, math.ceil(budget_s / length - 1e-9))
     return [budget_s / n] * n
 
 
 def multisine_design(budget_s: float, amplitudes: Sequence[float], speed: float = 1.0,
-                     share: float = 0.0, seed: int = 0, label: str | None = None) -> Design:
+                     share: float = 0.0, seed: int = 0, label: str | None = None,
+                     record_length: float = RECORD_LENGTH, fade: float = MULTISINE_FADE
+                     ) -> Design:
     """The physical design's family: records of every DOF at once, the pool rotated by record.
 
     Parameters
@@ -151,6 +153,8 @@ def multisine_design(budget_s: float, amplitudes: Sequence[float], speed: float 
     seed : int
         Seed of the phases (uniform, fixed by it: the design is reproducible).
     label : str, optional
+    record_length, fade : float
+        Longest record, and each record's fade-in and fade-out (s).
 
     Returns
     -------
@@ -162,12 +166,12 @@ def multisine_design(budget_s: float, amplitudes: Sequence[float], speed: float 
     amplitude = np.asarray(amplitudes, dtype=float)
     rng = np.random.default_rng(seed)
     records = []
-    for k, length in enumerate(record_lengths(budget_s)):
+    for k, length in enumerate(record_lengths(budget_s, record_length)):
         index = (np.arange(6) + k) % 6
         frequencies = np.column_stack([pool[index], pool[(index + 3) % 6]])
         weights = np.column_stack([amplitude * (1 - share), amplitude * share])
         records.append(MultisineRecord(weights, frequencies, rng.uniform(0, 2 * math.pi, (6, 2)),
-                                       length, name=f"exp{k + 1}"))
+                                       length, fade, name=f"exp{k + 1}"))
     text = label or (f"{len(records)} all-DOF multisine records, {min(pool):.3g}-"
                      f"{max(pool):.3g} Hz, second-frequency share {share:.2f}")
     return Design(tuple(records), text)
