@@ -290,7 +290,8 @@ def test_the_summary_says_whether_the_margin_was_held():
         text = criterion_summary(prediction, baseline)
         assert f"the largest share of its accuracy {com / 0.002:.3g} (com;" in text
         assert ("the search sharpened the ten parameters" in text) is held
-        assert ("the com within its accuracy in fewer than the 95 % of runs" in text) is not held
+        assert ("the centre of mass within its accuracy in fewer than the 95 % of runs"
+                in text) is not held
 
 
 def test_every_record_is_scaled_to_its_own_limit(loaded):

@@ -64,9 +64,9 @@ def design(
         "parameters; the platform file's [payload] is the expected one).")] = False,
     accuracy: Annotated[str | None, typer.Option(
         "--accuracy", metavar="ACCURACY", help="--payload: MASS,COM,INERTIA, the accuracy "
-        "the payload's mass (%), centre of mass (mm) and inertia about it (% of its mean "
-        "diagonal) are needed to, one standard error; the design holds each within half of "
-        "it and sharpens the ten parameters there. Default 0.2,2,2.")] = None,
+        "the payload's mass (%), centre of mass (mm, a distance) and inertia about it (% of "
+        "its mean diagonal) are needed to; the design holds each within it in 95 % of runs "
+        "and sharpens the ten parameters there. Default 0.2,2,2.")] = None,
 ) -> None:
     """Design an excitation for identification: records within the platform's [limits],
     chosen so that the predicted error of every Mt and Bt entry (|bias| + 2 standard errors)

@@ -36,10 +36,11 @@ from scipy import special
 from stewartid.errors import ConfigError
 from stewartid.model import regressor as reg
 
-#: Accuracy each payload quantity is needed to by default (one standard error is judged
-#: against it; ``design --accuracy`` sets others): the mass relative to itself, the centre
-#: of mass along its least certain direction (m), every entry of the inertia about the
-#: centre of mass relative to the mean of its diagonal.
+#: Accuracy each payload quantity is needed to by default (``design --accuracy`` sets
+#: others): the mass relative to itself, the centre of mass as a distance (m; its standard
+#: error along its least certain direction in :func:`payload_criterion`), every entry of
+#: the inertia about the centre of mass relative to the mean of its diagonal. The design
+#: holds one run's error within it in :data:`ACCURACY_COVERAGE` of runs (:func:`held_share`).
 REQUIRED_PAYLOAD_ACCURACY = {"mass": 0.002, "com": 0.002, "inertia": 0.02}
 #: Share of runs whose error payload mode's design holds within the required accuracy
 #: (:func:`held_share`).

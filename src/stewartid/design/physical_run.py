@@ -61,6 +61,8 @@ from stewartid.simulation.sensors import SensorNoise
 #: estimator's kernel there (:func:`~stewartid.design.information.kernel_filtered`), which
 #: needs a few dozen samples per kernel window.
 FINAL_RATE = 100.0
+#: The payload's quantities in words.
+QUANTITY_NAMES = {"mass": "mass", "com": "centre of mass", "inertia": "inertia"}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -399,8 +401,9 @@ def criterion_summary(prediction: ParameterPrediction, baseline: ParameterPredic
     coverage = f"{100 * ACCURACY_COVERAGE:g} %"
     margin = (f"each within its accuracy in {coverage} of runs, and within that the search "
               "sharpened the ten parameters" if share <= 1 else
-              f"the {held} within its accuracy in fewer than the {coverage} of runs the search "
-              "aims at: a longer budget or more of the limits (--max-use) sharpens it")
+              f"the {QUANTITY_NAMES[held]} within its accuracy in fewer than the {coverage} of "
+              "runs the search aims at: a longer budget or more of the limits (--max-use) "
+              "sharpens it")
     return (f"Predicted standard errors of the payload: mass {100 * std['mass']:.3g} %, "
             f"centre of mass {1e3 * std['com']:.3g} mm, inertia about it "
             f"{100 * std['inertia']:.3g} % (needed: {100 * needed['mass']:g} %, "
@@ -423,7 +426,6 @@ def _commanded_lines(prediction: ParameterPrediction,
             f"`design.json`).", ""]
 
 
-__all__ = ["FINAL_RATE", "PhysicalDesignOutput", "UNDERPREDICTED", "criterion_summary",
-           "monte_carlo_check",
-           "played_pick",
-           "physical_identify_command", "render_physical_markdown", "run_physical_design"]
+__all__ = ["FINAL_RATE", "PhysicalDesignOutput", "QUANTITY_NAMES", "UNDERPREDICTED",
+           "criterion_summary", "monte_carlo_check", "physical_identify_command", "played_pick",
+           "render_physical_markdown", "run_physical_design", "search_correction"]
