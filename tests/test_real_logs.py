@@ -221,3 +221,21 @@ def test_identified_matrices_far_from_nominal(example_platform):
     with pytest.raises(DataError, match=r"Mt\(4,4\) = 370.38 is 0.0175 times the nominal "
                                         r"21223.*rx..rz rad"):
         check_identified(M @ rotation, B, example_platform)
+
+
+def test_a_method_blind_to_friction_is_told_its_damping_holds_the_friction(example_platform):
+    """Method A's Bt, inflated by the Coulomb friction it does not model, is not blamed on
+    the units; a Bt far below the nominal one, or an inflated Bt of a method that models
+    friction, still is, and a report names the method."""
+    from stewartid.datasets.plausibility import check_identified
+    from stewartid.model.linearization import nominal_matrices
+
+    M, B = nominal_matrices(example_platform)
+    with pytest.warns(DataWarning) as caught:
+        check_identified(M, 2.3 * B, example_platform, "fourier", friction_blind=True)
+    text = str(caught[0].message)
+    assert text.startswith("fourier: identified Bt(1,1)")
+    assert "does not model Coulomb friction" in text and "rx..rz rad" not in text
+    for factor, blind in ((0.2, True), (2.3, False)):
+        with pytest.warns(DataWarning, match="rx..rz rad"):
+            check_identified(M, factor * B, example_platform, friction_blind=blind)

@@ -299,7 +299,8 @@ def check_dataset(pose: np.ndarray, lengths: np.ndarray, forces: np.ndarray,
     check_static_balance(pose, forces, platform, where)
 
 
-def check_identified(M: np.ndarray, B: np.ndarray, platform: Platform) -> None:
+def check_identified(M: np.ndarray, B: np.ndarray, platform: Platform,
+                     method: str | None = None, friction_blind: bool = False) -> None:
     """Identified Mt, Bt against the nominal ones of the platform description.
 
     Parameters
@@ -307,6 +308,12 @@ def check_identified(M: np.ndarray, B: np.ndarray, platform: Platform) -> None:
     M, B : ndarray, shape (6, 6)
         Identified inertia (kg, kg m, kg m^2) and viscous (N s/m, N m s/rad) matrices.
     platform : Platform
+    method : str, optional
+        Names the method in the messages (several methods are checked for one report).
+    friction_blind : bool
+        The method neither estimates Coulomb friction nor is immune to it (Method A): a Bt
+        above the nominal one is then the friction it takes for damping, and the warning
+        says so instead of pointing at the units.
 
     Raises
     ------
@@ -328,13 +335,18 @@ def check_identified(M: np.ndarray, B: np.ndarray, platform: Platform) -> None:
             ratios = np.where(reference > 0, values / reference, 1.0)
         worst = int(np.argmax(np.abs(np.log(np.abs(ratios) + 1e-300))))
         factor = ratios[worst]
-        entry = (f"identified {label}({worst + 1},{worst + 1}) = {values[worst]:.5g} is "
-                 f"{factor:.3g} times the nominal {reference[worst]:.5g} of platform "
-                 f"'{platform.name}'")
+        entry = (f"{f'{method}: ' if method else ''}identified {label}({worst + 1},"
+                 f"{worst + 1}) = {values[worst]:.5g} is {factor:.3g} times the nominal "
+                 f"{reference[worst]:.5g} of platform '{platform.name}'")
         if label == "Mt" and not 1 / NOMINAL_ERROR_FACTOR <= factor <= NOMINAL_ERROR_FACTOR:
             raise DataError(f"{entry}; {hint}.")
         if not 1 / NOMINAL_WARNING_FACTOR <= factor <= NOMINAL_WARNING_FACTOR:
-            _warn(f"{entry}; {hint}.")
+            if label == "Bt" and friction_blind and factor > 1:
+                _warn(f"{entry}: the method does not model Coulomb friction, which it takes "
+                      "for damping (--method wavelet or ls model it; were their Bt as far off, "
+                      "check the units and --platform).")
+            else:
+                _warn(f"{entry}; {hint}.")
 
 
 __all__ = ["check_dataset", "check_identified", "check_inverse_kinematics",

@@ -311,7 +311,10 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     meta = nominal_from_meta(paths)
 
     def check(found: IdentificationResult) -> None:
-        check_identified(found.M, found.B, description)
+        from stewartid.assessment.verdict import friction_immune, models_friction
+
+        check_identified(found.M, found.B, description, found.method if report else None,
+                         not (models_friction(found) or friction_immune(found)))
 
     if consistent:
         from stewartid.identification.consistency import require_cvxpy
