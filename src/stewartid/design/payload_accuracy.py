@@ -174,7 +174,7 @@ def payload_objective(worst_relative_std: float, std_errors: Mapping[str, float]
                       accuracy: Mapping[str, float] | None = None) -> float:
     """What payload mode's search minimises: the ten parameters' worst relative standard
     error, times :func:`held_share` ^10 where that exceeds 1: a constraint the search may
-    cross only to where a few percent over the margin would halve the worst error."""
+    cross only to where a few percent beyond it would halve the worst error."""
     return worst_relative_std * max(1.0, held_share(std_errors, accuracy)[0]) ** 10
 
 

@@ -405,7 +405,9 @@ def criterion_summary(prediction: ParameterPrediction, baseline: ParameterPredic
               "runs the search aims at: a longer budget or more of the limits (--max-use) "
               "sharpens it")
     return (f"Predicted standard errors of the payload: mass {100 * std['mass']:.3g} %, "
-            f"centre of mass {1e3 * std['com']:.3g} mm, inertia about it "
+            f"centre of mass {1e3 * std['com']:.3g} mm along its least certain direction "
+            f"(its error within {1e3 * std['com_distance']:.3g} mm in {coverage} of runs), "
+            f"inertia about it "
             f"{100 * std['inertia']:.3g} % (needed: {100 * needed['mass']:g} %, "
             f"{1e3 * needed['com']:g} mm, {100 * needed['inertia']:g} %); the largest "
             f"share of its accuracy {ratio:.3g} ({quantity}; multisine {baseline.criterion:.3g}, "
