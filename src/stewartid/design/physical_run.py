@@ -30,19 +30,9 @@ from stewartid.design.information import (
 )
 from stewartid.design.limits import LIMIT_NAMES, resolve_limits
 from stewartid.design.multisine import all_dofs_multisine
-from stewartid.design.optimise import within_plant_limits
 from stewartid.design.payload_accuracy import ACCURACY_COVERAGE, held_share, payload_criterion
-from stewartid.design.physical_search import (
-    PLANT_EVALUATIONS,
-    PLANT_ROUNDS,
-    PLANT_TOLERANCE,
-    PhysicalCandidate,
-    design_objective,
-    judged_against,
-    plant_scales,
-    refine_for_plant,
-    search_design,
-)
+from stewartid.design.physical_refine import FINAL_RATE, played_pick
+from stewartid.design.physical_search import PLANT_EVALUATIONS, judged_against, search_design
 from stewartid.design.prediction import (
     inverse_leg_jacobians,
     measured_plant_datasets,
@@ -57,10 +47,6 @@ from stewartid.identification.physical import PhysicalIdentifier
 from stewartid.platform import Platform
 from stewartid.simulation.sensors import SensorNoise
 
-#: Information-matrix rate of the final prediction (Hz): the regressor is filtered with the
-#: estimator's kernel there (:func:`~stewartid.design.information.kernel_filtered`), which
-#: needs a few dozen samples per kernel window.
-FINAL_RATE = 100.0
 #: The payload's quantities in words.
 QUANTITY_NAMES = {"mass": "mass", "com": "centre of mass", "inertia": "inertia"}
 
@@ -159,79 +145,6 @@ def monte_carlo_check(platform: Platform, records: list, noise: SensorNoise,
 
 def _number(value: float) -> float | None:
     return float(value) if np.isfinite(value) else None
-
-
-def played_pick(platform: Platform, best: PhysicalCandidate, budget_s: float,
-                noise: SensorNoise, payload: bool, max_use: float,
-                evaluations: int = PLANT_EVALUATIONS,
-                progress: Callable[[str], None] | None = None,
-                accuracy: Mapping[str, float] | None = None
-                ) -> tuple[PhysicalCandidate, Design, list, list, ParameterPrediction,
-                           ParameterPrediction]:
-    """The search's pick played on the plant (records over ``max_use`` scaled down) and
-    predicted as the final design is, along the motion the plant played
-    (:func:`~stewartid.design.information.played_states`); where the plant allowed less of
-    a record than its commanded motion at the limits
-    (:func:`~stewartid.design.physical_search.plant_scales`: its tracking adds motion at the
-    higher frequencies), the search refined against that
-    (:func:`~stewartid.design.physical_search.refine_for_plant`, its predictions corrected
-    by :func:`search_correction` of the last pick) and its pick played too, for up to
-    :data:`~stewartid.design.physical_search.PLANT_ROUNDS` rounds, the best of the picks
-    kept.
-
-    Returns
-    -------
-    pick, design, records, uses, prediction, commanded
-        The candidate kept and, as played, its design, plant records, their limit use, the
-        final prediction and the prediction along its commanded motion; of the picks,
-        the one whose worse prediction has the smallest
-        :func:`~stewartid.design.physical_search.design_objective`.
-    """
-    if progress:
-        progress("playing the design on the plant")
-    picks = [_played(platform, best, noise, payload, max_use, accuracy)]
-    scales = plant_scales(best.design, picks[0][1])
-    for _ in range(PLANT_ROUNDS if evaluations > 0 else 0):
-        if np.all(scales >= 1 - PLANT_TOLERANCE):
-            break
-        if progress:
-            progress(f"the plant allows {scales.min():.2f} of a record's commanded "
-                     "amplitudes: refining the search against that")
-        refined = refine_for_plant(platform, budget_s, noise, payload, max_use,
-                                   picks[-1][0].parameters, scales, evaluations, accuracy,
-                                   search_correction(platform, picks[-1], noise, payload))
-        picks.append(_played(platform, refined, noise, payload, max_use, accuracy))
-        scales = scales * plant_scales(refined.design, picks[-1][1])
-    return min(picks, key=lambda p: max(design_objective(p[4]), design_objective(p[5])))
-
-
-def _played(platform: Platform, pick: PhysicalCandidate, noise: SensorNoise, payload: bool,
-            max_use: float, accuracy: Mapping[str, float] | None) -> tuple:
-    """``pick`` played on the plant within ``max_use``, and its final predictions along the
-    plant's motion and along the command (a machine that tracks it exactly moves less)."""
-    design, records, uses = within_plant_limits(platform, pick.design, max_use)
-    return (pick, design, records, uses, *(judged_against(predict_parameters(
-        platform, design, noise, payload, FINAL_RATE, states=states, filtered=True), accuracy)
-        for states in (played_states(records, design, FINAL_RATE), None)))
-
-
-def search_correction(platform: Platform, played: tuple, noise: SensorNoise,
-                      payload: bool) -> dict[str, float]:
-    """How much the final prediction of a played pick (:func:`_played`: along the plant's
-    motion and along the command, filtered, the worse of the two) exceeds the search's
-    prediction of the same records (commanded, unfiltered), per payload quantity and for
-    the worst relative standard error (``"worst"``): what
-    :func:`~stewartid.design.physical_search.refine_for_plant` multiplies its candidates'
-    predictions by. On the paper platform with a 2 t payload (payload mode) the plant's
-    servo moved the centre of mass's standard error 1.11-1.13 times, the ten's worst 1.04
-    times and the mass's 1.01 times."""
-    search = predict_parameters(platform, played[1], noise, payload)
-    final = played[4:6]
-    correction = {"worst": max(p.worst_relative_std for p in final) / search.worst_relative_std}
-    if payload:
-        correction.update({k: max(p.payload_std_errors[k] for p in final) / value
-                           for k, value in search.payload_std_errors.items()})
-    return correction
 
 
 def run_physical_design(platform: Platform, budget_s: float, noise: SensorNoise,
@@ -428,6 +341,6 @@ def _commanded_lines(prediction: ParameterPrediction,
             f"`design.json`).", ""]
 
 
-__all__ = ["FINAL_RATE", "PhysicalDesignOutput", "QUANTITY_NAMES", "UNDERPREDICTED",
-           "criterion_summary", "monte_carlo_check", "physical_identify_command", "played_pick",
-           "render_physical_markdown", "run_physical_design", "search_correction"]
+__all__ = ["PhysicalDesignOutput", "QUANTITY_NAMES", "UNDERPREDICTED", "criterion_summary",
+           "monte_carlo_check", "physical_identify_command", "render_physical_markdown",
+           "run_physical_design"]

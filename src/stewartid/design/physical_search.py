@@ -172,7 +172,7 @@ def design_objective(prediction: ParameterPrediction,
     ten parameters' worst relative standard error with the payload's quantities held within
     their accuracy in :data:`~stewartid.design.payload_accuracy.ACCURACY_COVERAGE` of runs
     (:func:`~stewartid.design.payload_accuracy.payload_objective`). ``correction``
-    (:func:`~stewartid.design.physical_run.search_correction`) multiplies the worst relative
+    (:func:`~stewartid.design.physical_refine.search_correction`) multiplies the worst relative
     standard error (``"worst"``) and each payload quantity's."""
     factor = dict(correction or {})
     if not prediction.payload:
@@ -259,7 +259,7 @@ def refine_for_plant(platform: Platform, budget_s: float, noise: SensorNoise, pa
     family keeps its order of frequencies from one candidate to the next, so its scale
     carries over to the neighbours.
 
-    ``correction`` (:func:`~stewartid.design.physical_run.search_correction`) carries
+    ``correction`` (:func:`~stewartid.design.physical_refine.search_correction`) carries
     the played pick's final prediction over to its neighbours: the plant's servo adds motion
     of its own, which moves the standard errors by quantity (the centre of mass's 1.11-1.13
     times, the mass's 1.01 on the paper platform with a 2 t payload).
