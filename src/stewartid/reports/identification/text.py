@@ -18,9 +18,7 @@ from stewartid.identification.consistency import consistency_metrics, is_consist
 from stewartid.identification.wavelet.noise import white_noise_covariance
 from stewartid.platform import COORDINATES, Platform
 from stewartid.reporting.tables import ResultTable, to_markdown
-from stewartid.reports.identification.friction_text import (
-    friction_section,
-)
+from stewartid.reports.identification.friction_text import friction_section
 from stewartid.reports.identification.physical_section import physical_lines
 from stewartid.reports.identification.records import IdentificationReport, MethodReport
 from stewartid.reports.identification.verdict_text import changed_text, verdict_lines
