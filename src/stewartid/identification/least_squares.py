@@ -22,9 +22,12 @@ filtered signals, including across the friction switches where a differentiating
 would smear the jump of the acceleration. ``differentiation="savgol"`` uses
 Savitzky-Golay derivatives at each sample instead (the textbook variant).
 
-sign() is regularised as w / sqrt(w^2 + s^2) with s = ``coulomb_smoothing`` (rad/s), so that
-joints that barely move (rates at the noise level of the differentiated signal) do not
-contribute random full-size signs.
+sign() is regularised over s = ``coulomb_smoothing`` (rad/s), so that joints that barely move
+(rates at the noise level of the differentiated signal) do not contribute random full-size
+signs. How it is regularised (the friction's shape near a reversal) is the rig's, and one log
+rarely shows it: by default the fit is made with both shapes of
+:mod:`~stewartid.identification.friction_shape` and averaged by their Akaike weights, the
+spread between the two in the standard errors.
 
 References
 ----------
@@ -36,15 +39,22 @@ from __future__ import annotations
 
 import math
 from numbers import Integral
+from typing import NamedTuple
 
 import numpy as np
 
 from stewartid.datasets.dataset import Dataset
 from stewartid.fields import BOOLEAN, Interval, Options, nonnegative
 from stewartid.identification.base import DIFFERENTIATION_CONSTRAINTS, BaseIdentifier
+from stewartid.identification.friction_shape import (
+    COULOMB_SHAPES,
+    akaike_weights,
+    average_solutions,
+    shaped_sign,
+)
 from stewartid.identification.pairs import calibrate_by_pairs
 from stewartid.identification.physical_noise import measured_sign_rates
-from stewartid.identification.preparation import prepare
+from stewartid.identification.preparation import Experiment, prepare
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.solvers import regressor_names, solve_least_squares
@@ -76,8 +86,8 @@ def pose_noise_gram(q: np.ndarray, sample_rate: float, window: float) -> np.ndar
     return block
 
 
-def coulomb_regressors(joint_jacobians: np.ndarray, q_dot: np.ndarray, smoothing: float
-                       ) -> np.ndarray:
+def coulomb_regressors(joint_jacobians: np.ndarray, q_dot: np.ndarray, smoothing: float,
+                       shape: str = "algebraic") -> np.ndarray:
     """Generalized Coulomb force per unit level, one per joint type.
 
     Parameters
@@ -85,7 +95,9 @@ def coulomb_regressors(joint_jacobians: np.ndarray, q_dot: np.ndarray, smoothing
     joint_jacobians : ndarray, shape (N, 6, 5, 6)
     q_dot : ndarray, shape (N, 6)
     smoothing : float
-        Regularisation rate s (rad/s) of sign(w) ~ w / sqrt(w^2 + s^2); 0 for the exact sign.
+        Regularisation rate s (rad/s) of sign(w); 0 for the exact sign.
+    shape : {"algebraic", "erf"}
+        sign(w)'s shape over s (:func:`~stewartid.identification.friction_shape.shaped_sign`).
 
     Returns
     -------
@@ -93,11 +105,27 @@ def coulomb_regressors(joint_jacobians: np.ndarray, q_dot: np.ndarray, smoothing
         S_type(t) for the types of :data:`JOINT_TYPES` (N m per N m of level, or N per N m).
     """
     rates = np.einsum("nlac,nc->nla", joint_jacobians, q_dot)
-    signs = np.sign(rates) if smoothing == 0 else rates / np.sqrt(rates ** 2 + smoothing ** 2)
+    signs = shaped_sign(rates, smoothing, shape)
     out = np.empty((len(q_dot), len(JOINT_TYPES), 6))
     for k, axes in enumerate(JOINT_TYPES.values()):
         out[:, k] = np.einsum("nla,nlac->nc", signs[:, :, axes], joint_jacobians[:, :, axes])
     return out
+
+
+
+class _Rows(NamedTuple):
+    """One experiment's rows of the regression (:meth:`LeastSquaresIdentifier._experiment_rows`):
+    their times (s), the kernel's support (s), the force, velocity and acceleration, (K, 6)
+    each, per Coulomb shape the regressors (K, 3, 6), and the rows' pose-noise covariance
+    (12, 12) or None."""
+
+    t: np.ndarray
+    window: float
+    y: np.ndarray
+    q_dot: np.ndarray
+    q_ddot: np.ndarray
+    coulomb: list[np.ndarray]
+    noise: np.ndarray | None
 
 
 @register_method(
@@ -131,6 +159,10 @@ class LeastSquaresIdentifier(BaseIdentifier):
         Include the three Coulomb regressors.
     coulomb_smoothing : float
         Rate (rad/s) below which a joint's Coulomb sign is attenuated.
+    coulomb_shape : {'average', 'algebraic', 'erf'}
+        The sign's shape over ``coulomb_smoothing``
+        (:data:`~stewartid.identification.friction_shape.COULOMB_SHAPES`), or the average of
+        fits with each, weighted by their likelihoods (default).
     symmetric : bool
         Impose Mt = Mt^T and Bt = Bt^T.
     differentiation : {'kernel', 'savgol'}
@@ -152,6 +184,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
     std_errors_ : dict of ndarray (6, 6)
     coulomb_ : dict
         Identified Coulomb level per joint type (N m).
+    coulomb_shape_weights_ : dict
+        Weight of each Coulomb shape in the fit.
     coulomb_std_ : dict
     offsets_ : ndarray, shape (n_experiments, 6)
     condition_number_ : float
@@ -160,7 +194,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
 
     def __init__(self, window: float | None = None, order: int = DEFAULT_ORDER,
                  gravity: bool = True, coulomb: bool = True, coulomb_smoothing: float = 1e-4,
-                 symmetric: bool = False, decimate: int = 1,
+                 coulomb_shape: str = "average", symmetric: bool = False, decimate: int = 1,
                  differentiation: str = "kernel", noise_correction: bool = True,
                  remainder: bool = True, sampling_check: bool = True):
         self.window = window
@@ -169,6 +203,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
         self.remainder = remainder
         self.coulomb = coulomb
         self.coulomb_smoothing = coulomb_smoothing
+        self.coulomb_shape = coulomb_shape
         self.symmetric = symmetric
         self.decimate = decimate
         self.differentiation = differentiation
@@ -178,71 +213,87 @@ class LeastSquaresIdentifier(BaseIdentifier):
     _parameter_constraints = {
         **DIFFERENTIATION_CONSTRAINTS,
         "coulomb_smoothing": [nonnegative()],
+        "coulomb_shape": [Options(("average", *COULOMB_SHAPES))],
         "differentiation": [Options(("kernel", "savgol"))],
         "decimate": [Interval(Integral, 1, None)],
         "noise_correction": [BOOLEAN],
         "sampling_check": [BOOLEAN],
     }
 
+    def _experiment_rows(self, exp: Experiment, shapes: tuple[str, ...]) -> _Rows:
+        """One prepared experiment's rows: the force, the filtered or differentiated motion
+        and, per shape, the Coulomb regressors."""
+        window = self.window or default_window(estimate_frequency(exp.q, exp.sample_rate))
+        if self.differentiation == "savgol":
+            _, qd, qdd = differentiate(exp.q, exp.sample_rate, window, self.order)
+            cut = trim(window, exp.sample_rate, self.order)
+            sl = slice(cut, len(exp.t) - cut, self.decimate)
+            coulomb = [coulomb_regressors(exp.joint_jacobians[sl], qd[sl], self.coulomb_smoothing,
+                                          shape) for shape in shapes] if self.coulomb else []
+            return _Rows(exp.t[sl], window, exp.generalized_force[sl], qd[sl], qdd[sl], coulomb,
+                         None)
+        # the Coulomb signs need the rates at every sample, from a window the noise allows
+        # (the physical model's rule): a quarter of the kernel, as before, made the signs
+        # chatter under the reference noise on three-sine logs (rotational Bt 3-7 % and 4.3
+        # standard errors off; 86 % within 3)
+        qd_sign = measured_sign_rates(exp.q, exp.sample_rate, window)
+        units = [coulomb_regressors(exp.joint_jacobians, qd_sign, self.coulomb_smoothing, shape)
+                 for shape in shapes] if self.coulomb else []
+        signals = np.concatenate(
+            [exp.generalized_force] + [u.reshape(len(u), -1) for u in units], axis=1)
+        filtered = kernel_filter(signals, exp.sample_rate, window)[0]
+        _, qd, qdd = kernel_filter(exp.q, exp.sample_rate, window, derivatives=2)
+        cut = (len(exp.t) - len(qd)) // 2
+        sl = slice(cut, len(exp.t) - cut, self.decimate)
+        step = slice(None, None, self.decimate)
+        y = filtered[step, :6]
+        coulomb = [filtered[step, 6 + 18 * k:24 + 18 * k].reshape(len(y), -1, 6)
+                   for k in range(len(units))]
+        noise = (pose_noise_gram(exp.q, exp.sample_rate, window) if self.noise_correction
+                 else None)
+        return _Rows(exp.t[sl], window, y, qd[step], qdd[step], coulomb, noise)
+
     def _fit(self, datasets: list[Dataset], platform: Platform
              ) -> tuple[IdentificationResult, dict]:
         experiments = prepare(datasets, platform, gravity=self.gravity, joints=self.coulomb,
                               remainder=self.remainder)
         n_exp = len(experiments)
-        phis, ys, shared, used, noise, segments = [], [], [], [], [], []
+        shapes = COULOMB_SHAPES if self.coulomb_shape == "average" else (self.coulomb_shape,)
+        # per shape, the Coulomb regressors of every experiment
+        shared: list[list[np.ndarray]] = [[] for _ in shapes]
+        phis, ys, used, noise, segments = [], [], [], [], []
         for e, exp in enumerate(experiments):
-            window = self.window or default_window(estimate_frequency(exp.q, exp.sample_rate))
-            if self.differentiation == "savgol":
-                _, qd, qdd = differentiate(exp.q, exp.sample_rate, window, self.order)
-                cut = trim(window, exp.sample_rate, self.order)
-                sl = slice(cut, len(exp.t) - cut, self.decimate)
-                y = exp.generalized_force[sl]
-                qd_sign, qd, qdd = qd[sl], qd[sl], qdd[sl]
-                coulomb = coulomb_regressors(exp.joint_jacobians[sl], qd_sign,
-                                             self.coulomb_smoothing) if self.coulomb else None
-            else:
-                # the Coulomb signs need the rates at every sample, from a window the noise
-                # allows (the physical model's rule): a quarter of the kernel, as before,
-                # made the signs chatter under the reference noise on three-sine logs
-                # (rotational Bt 3-7 % and 4.3 standard errors off; 86 % within 3)
-                qd_sign = measured_sign_rates(exp.q, exp.sample_rate, window)
-                coulomb = coulomb_regressors(exp.joint_jacobians, qd_sign,
-                                             self.coulomb_smoothing) if self.coulomb else None
-                signals = np.concatenate(
-                    [exp.generalized_force] + ([coulomb.reshape(len(coulomb), -1)]
-                                               if self.coulomb else []), axis=1)
-                filtered = kernel_filter(signals, exp.sample_rate, window)[0]
-                _, qd, qdd = kernel_filter(exp.q, exp.sample_rate, window, derivatives=2)
-                cut = (len(exp.t) - len(qd)) // 2
-                sl = slice(cut, len(exp.t) - cut, self.decimate)
-                step = slice(None, None, self.decimate)
-                y, qd, qdd = filtered[step, :6], qd[step], qdd[step]
-                if self.noise_correction:
-                    noise.append((e, len(y), pose_noise_gram(exp.q, exp.sample_rate, window)))
-                coulomb = filtered[step, 6:].reshape(len(y), -1, 6) if self.coulomb else None
-            k = len(y)
+            rows = self._experiment_rows(exp, shapes)
+            k = len(rows.y)
             offsets = np.zeros((k, n_exp))
             offsets[:, e] = 1.0
-            phis.append(np.concatenate([qdd, qd, offsets], axis=1))
-            ys.append(y)
-            if self.coulomb:
-                shared.append(coulomb)
+            phis.append(np.concatenate([rows.q_ddot, rows.q_dot, offsets], axis=1))
+            ys.append(rows.y)
+            for per_shape, regressors in zip(shared, rows.coulomb, strict=False):
+                per_shape.append(regressors)
+            if rows.noise is not None:
+                noise.append((e, k, rows.noise))
             # the filters' support: rows further apart share no noise sample
-            segments.append((k, math.ceil(window * exp.sample_rate / self.decimate) + 1))
-            used.append({"name": exp.name, "window_s": window, "samples": k,
-                         "t_start": float(exp.t[sl][0]), "t_stop": float(exp.t[sl][-1])})
+            segments.append((k, math.ceil(rows.window * exp.sample_rate / self.decimate) + 1))
+            used.append({"name": exp.name, "window_s": rows.window, "samples": k,
+                         "t_start": float(rows.t[0]), "t_stop": float(rows.t[-1])})
         names = regressor_names("q_ddot", "q_dot") + [f"offset[{x.name}]" for x in experiments]
         regressor_noise = None
         if noise:
             regressor_noise = np.zeros((12 + n_exp, 12 + n_exp))
-            for _, rows, block in noise:
-                regressor_noise[:12, :12] += rows * block
-        solution = solve_least_squares(
-            np.concatenate(phis), np.concatenate(ys),
-            np.concatenate(shared) if self.coulomb else None, symmetric=self.symmetric,
-            regressor_names=names,
+            for _, count, block in noise:
+                regressor_noise[:12, :12] += count * block
+        phi, y = np.concatenate(phis), np.concatenate(ys)
+        solutions = [solve_least_squares(
+            phi, y, np.concatenate(per_shape) if self.coulomb else None,
+            symmetric=self.symmetric, regressor_names=names,
             shared_names=[f"coulomb[{t}]" for t in JOINT_TYPES] if self.coulomb else None,
             autocorrelated=True, regressor_noise=regressor_noise, segments=segments)
+            for per_shape in (shared if self.coulomb else [None])]
+        weights = akaike_weights(solutions)
+        solution = average_solutions(solutions, weights)
+        shape_weights = ({shape: float(w) for shape, w in zip(shapes, weights, strict=True)}
+                         if self.coulomb else {})
         theta, std = solution.theta, solution.theta_std.copy()
         # residual autocorrelation is in theta_std; model error (friction the joint model
         # lacks) shows as symmetric pairs that disagree beyond it
@@ -253,13 +304,15 @@ class LeastSquaresIdentifier(BaseIdentifier):
         levels_std = dict(zip(JOINT_TYPES, solution.shared_std.tolist(), strict=False))
         diagnostics = {"experiments": used, "offsets": offsets,
                        "coulomb": levels, "coulomb_std": levels_std,
+                       "coulomb_shape_weights": shape_weights,
                        "n_equations": int(solution.n_equations),
                        "pair_calibration": calibration}
         return IdentificationResult(
             M=theta[:, :6], B=theta[:, 6:12], std_errors_M=std[:, :6], std_errors_B=std[:, 6:12],
             condition_number=solution.condition_number, residual_rms=solution.residual_rms,
             method=self.method, settings=self.get_params(), diagnostics=diagnostics), {
-            "offsets_": offsets, "coulomb_": levels, "coulomb_std_": levels_std}
+            "offsets_": offsets, "coulomb_": levels, "coulomb_std_": levels_std,
+            "coulomb_shape_weights_": shape_weights}
 
 
 __all__ = ["LeastSquaresIdentifier", "coulomb_regressors"]

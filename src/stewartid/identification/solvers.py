@@ -39,6 +39,10 @@ class LeastSquaresSolution:
         Per channel (units of y).
     n_equations : int
         Rows per channel.
+    effective_equations : ndarray, shape (6,)
+        Independent rows per channel: ``n_equations`` over the residual's autocorrelation
+        time (``n_equations`` without ``autocorrelated``); the sample size of the Gaussian
+        log-likelihood by which fits of other regressors on the same rows are compared.
     """
 
     theta: np.ndarray
@@ -48,6 +52,7 @@ class LeastSquaresSolution:
     condition_number: float
     residual_rms: np.ndarray
     n_equations: int
+    effective_equations: np.ndarray
 
 
 def _regressor_dof(name: str) -> str | None:
@@ -269,8 +274,9 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
     sigma = np.maximum(sigma, 1e-12 * scale_y)
     theta, c, residual, N, Tf, condition, scale = solve(1.0 / sigma ** 2)
     Ns_inv = np.linalg.inv(N / np.outer(scale, scale)) / np.outer(scale, scale)
-    sigma2 = np.sum(residual ** 2, axis=0) / dof * (np.array([integrated_autocorrelation(
-        r) for r in residual.T]) if autocorrelated else 1.0)
+    tau = (np.array([integrated_autocorrelation(r) for r in residual.T]) if autocorrelated
+           else np.ones(residual.shape[1]))
+    sigma2 = np.sum(residual ** 2, axis=0) / dof * tau
     cov_full = float(np.mean(sigma2 / sigma ** 2)) * (Tf @ Ns_inv @ Tf.T)
     if segments is not None:
         cov_full = with_larger_variances(Tf @ score_sandwich(
@@ -279,7 +285,7 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
     return LeastSquaresSolution(
         theta=theta, theta_std=std[:6 * p].reshape(6, p), shared=c, shared_std=std[6 * p:],
         condition_number=condition, residual_rms=np.sqrt(np.mean(residual ** 2, axis=0)),
-        n_equations=K)
+        n_equations=K, effective_equations=K / tau)
 
 
 def _row_scores(phi: np.ndarray, S: np.ndarray, weighted: np.ndarray) -> np.ndarray:

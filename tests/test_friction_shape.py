@@ -1,0 +1,115 @@
+"""The Coulomb sign's shapes near a reversal, and least squares averaged over them, against
+hand values, finite differences and two plants whose friction has one shape or the other."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from roundoff import EPS
+from stewartid.identification.friction_shape import (
+    COULOMB_SHAPES,
+    akaike_weights,
+    average_solutions,
+    shaped_sign,
+)
+from stewartid.identification.registry import create_identifier
+from stewartid.identification.solvers import LeastSquaresSolution
+from stewartid.model.linearization import nominal_matrices
+from stewartid.simulation import DEFAULT_AMPLITUDES, Sine, multisine_excitation, simulate_experiment
+from stewartid.simulation.sensors import SensorNoise
+
+
+@pytest.mark.parametrize("shape", COULOMB_SHAPES)
+def test_shapes_have_slope_one_over_s_at_zero_and_saturate(shape):
+    s, h = 1e-4, 1e-9
+    slope = (shaped_sign(np.array(h), s, shape) - shaped_sign(np.array(-h), s, shape)) / (2 * h)
+    # central difference of an odd function: truncation O(h^2 / s^3), far below this
+    assert slope == pytest.approx(1.0 / s, rel=1e-6)
+    w = np.array([-1.0, -1e-2, 1e-2, 1.0])
+    assert np.allclose(shaped_sign(w, s, shape), np.sign(w), atol=1e-4)
+    assert np.array_equal(shaped_sign(w, 0.0, shape), np.sign(w))
+
+
+def test_erf_saturates_faster_than_the_algebraic_sign():
+    # at three smoothing rates: 1 - 3 / sqrt(10) = 5.1e-2 against 1 - erf(3 sqrt(pi) / 2) = 1.7e-4
+    w = np.array(3e-4)
+    assert 1 - shaped_sign(w, 1e-4, "algebraic") == pytest.approx(1 - 3 / np.sqrt(10), rel=1e-9)
+    assert 1 - shaped_sign(w, 1e-4, "erf") < 2e-4
+
+
+def test_unknown_shape_is_refused():
+    with pytest.raises(ValueError, match="unknown Coulomb shape"):
+        shaped_sign(np.ones(3), 1e-4, "tanh")
+
+
+def _solution(theta, std, rms, n):
+    return LeastSquaresSolution(
+        theta=np.full((6, 12), theta), theta_std=np.full((6, 12), std), shared=np.array([theta]),
+        shared_std=np.array([std]), condition_number=10.0, residual_rms=np.full(6, rms),
+        n_equations=1000, effective_equations=np.full(6, n))
+
+
+def test_akaike_weights_by_hand():
+    # l_k = -1/2 sum_c n log(rms_k^2): the difference is 6 n log(rms_b / rms_a)
+    a, b = _solution(1.0, 1.0, 1.0, 10.0), _solution(3.0, 1.0, 1.01, 10.0)
+    ratio = np.exp(-60.0 * np.log(1.01))
+    assert akaike_weights([a, b]) == pytest.approx([1 / (1 + ratio), ratio / (1 + ratio)],
+                                                   rel=1e-12)
+    # the sample size is the first fit's: a second fit's autocorrelation does not weigh
+    c = dataclasses.replace(b, effective_equations=np.full(6, 1e6))
+    assert akaike_weights([a, c]) == pytest.approx(akaike_weights([a, b]), rel=1e-12)
+
+
+def test_average_is_the_mixture_mean_and_variance():
+    a, b = _solution(1.0, 1.0, 1.0, 10.0), _solution(3.0, 2.0, 1.0, 10.0)
+    out = average_solutions([a, b], np.array([0.25, 0.75]))
+    # mean 2.5; variance 0.25 (1 + 1.5^2) + 0.75 (4 + 0.5^2) = 0.8125 + 3.1875 = 4
+    assert np.allclose(out.theta, 2.5, rtol=4 * EPS)
+    assert np.allclose(out.theta_std, 2.0, rtol=4 * EPS)
+    assert np.allclose(out.shared_std, 2.0, rtol=4 * EPS)
+    only = average_solutions([a, b], np.array([1.0, 0.0]))
+    assert np.array_equal(only.theta, a.theta) and np.array_equal(only.theta_std, a.theta_std)
+
+
+def _sine_logs(platform, simulate, duration):
+    return [simulate(platform, multisine_excitation(
+        platform, [Sine(k, DEFAULT_AMPLITUDES[k], 1.0)], name=f"exp{k + 1}"), duration)
+        for k in range(6)]
+
+
+def _ours(platform, excitation, duration):
+    return simulate_experiment(platform, excitation, duration, noise=SensorNoise(),
+                               rng=np.random.default_rng(0))[0]
+
+
+def _bt_diagonal_errors(estimator, B):
+    return np.abs(np.diag(estimator.B_) - np.diag(B)) / np.diag(B)
+
+
+def test_our_plant_shows_its_algebraic_sign(paper):
+    # the plant's joint friction is the algebraic sign over 1e-4 rad/s
+    platform = paper.replace(friction__coulomb=30.0)
+    data = _sine_logs(platform, _ours, 3.0)
+    _, B = nominal_matrices(platform)
+    est = create_identifier("ls", sampling_check=False).fit(data, platform)
+    assert est.coulomb_shape_weights_["algebraic"] > 0.999
+    assert np.max(_bt_diagonal_errors(est, B)) < 1e-4
+
+
+def test_mujoco_constraint_friction_shows_the_erf_sign(paper):
+    pytest.importorskip("mujoco")
+    from stewartid.mujoco.closed_loop import simulate_mujoco
+
+    # MuJoCo's dry friction is a constraint: sharper than the algebraic sign; fitting that
+    # shape alone left the Bt diagonal 0.5-1.3 % low, the erf shape half as far
+    platform = paper.replace(friction__coulomb=30.0)
+    data = _sine_logs(platform, simulate_mujoco, 3.0)
+    _, B = nominal_matrices(platform)
+    average = create_identifier("ls", sampling_check=False).fit(data, platform)
+    algebraic = create_identifier("ls", sampling_check=False,
+                                  coulomb_shape="algebraic").fit(data, platform)
+    assert average.coulomb_shape_weights_["erf"] > 0.999
+    assert np.all(_bt_diagonal_errors(average, B) < 0.7 * _bt_diagonal_errors(algebraic, B))
