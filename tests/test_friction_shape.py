@@ -113,3 +113,16 @@ def test_mujoco_constraint_friction_shows_the_erf_sign(paper):
                                   coulomb_shape="algebraic").fit(data, platform)
     assert average.coulomb_shape_weights_["erf"] > 0.999
     assert np.all(_bt_diagonal_errors(average, B) < 0.7 * _bt_diagonal_errors(algebraic, B))
+
+
+def test_report_says_how_the_data_weigh_the_shapes():
+    from stewartid.reports.identification.friction_text import friction_shape_lines
+
+    class Result:
+        diagnostics = {"coulomb_shape_weights": {"algebraic": 0.003, "erf": 0.997}}
+
+    assert "algebraic 0.00, erf 1.00 (they show the shape)" in friction_shape_lines(Result)[0]
+    Result.diagnostics = {"coulomb_shape_weights": {"algebraic": 0.4, "erf": 0.6}}
+    assert "cannot tell the shape" in friction_shape_lines(Result)[0]
+    Result.diagnostics = {"coulomb_shape_weights": {"erf": 1.0}}  # one shape asked for
+    assert friction_shape_lines(Result) == []

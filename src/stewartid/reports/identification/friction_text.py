@@ -46,6 +46,19 @@ def friction_law_lines(result: IdentificationResult) -> list[str]:
             f"({predicted['coulomb']:.3g} %) and {reason}."]
 
 
+def friction_shape_lines(result: IdentificationResult) -> list[str]:
+    """Least squares: how the data weigh the two shapes of the Coulomb sign near a reversal
+    (:mod:`~stewartid.identification.friction_shape`)."""
+    weights = result.diagnostics.get("coulomb_shape_weights") or {}
+    if len(weights) < 2:
+        return []
+    shown = max(weights.values()) > 0.95
+    return ["Its Coulomb sign near a reversal was fitted with two shapes of one slope; the "
+            "data weigh them " + ", ".join(f"{name} {w:.2f}" for name, w in weights.items())
+            + (" (they show the shape" if shown else " (they cannot tell the shape; the "
+               "spread between the two fits is in its standard errors") + ")."]
+
+
 def third_harmonic_lines(result: IdentificationResult) -> list[str]:
     """Method A: whether the force's third harmonic shows the Coulomb friction its Bt reads as
     viscous, and what that puts in the standard errors."""
@@ -71,7 +84,7 @@ def friction_section(ok: Sequence[MethodReport], platform: Platform) -> list[str
             lines.append(" ".join([
                 f"- {run.display_name}: {friction_text(run)} (platform description: "
                 f"{platform.friction.coulomb:g} N·m per joint axis).",
-                *friction_law_lines(run.result)]))
+                *friction_law_lines(run.result), *friction_shape_lines(run.result)]))
         else:
             lines.append(" ".join([
                 f"- {run.display_name} does not estimate friction (its prediction contains "
@@ -81,4 +94,5 @@ def friction_section(ok: Sequence[MethodReport], platform: Platform) -> list[str
     return lines
 
 
-__all__ = ["friction_law_lines", "friction_section", "friction_text", "third_harmonic_lines"]
+__all__ = ["friction_law_lines", "friction_section", "friction_shape_lines", "friction_text",
+           "third_harmonic_lines"]

@@ -17,6 +17,7 @@ from stewartid.identification.accuracy import PRECISION_FACTOR
 from stewartid.identification.consistency import consistency_metrics, is_consistent
 from stewartid.reports.identification.friction_text import (
     friction_law_lines,
+    friction_shape_lines,
     friction_text,
     third_harmonic_lines,
 )
@@ -75,7 +76,7 @@ def method_lines(run: MethodReport) -> list[str]:
         lines.append(f"It does not estimate friction; {100 * share:.0f} % of its held-out "
                      "residual has the shape of Coulomb joint friction (`--method all` "
                      "compares it with a method that estimates friction).")
-    lines += friction_law_lines(result) + third_harmonic_lines(result)
+    lines += friction_law_lines(result) + friction_shape_lines(result) + third_harmonic_lines(result)
     return lines
 
 
