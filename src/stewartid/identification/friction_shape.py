@@ -13,10 +13,12 @@ Least squares fits both and averages them by their Akaike weights, the spread be
 fits added to each variance (model averaging: Buckland, Burnham & Augustin, Biometrics 53,
 1997; Burnham & Anderson, Model Selection and Multimodel Inference, ch. 4, 2002). A log that
 shows the shape (noise-free, or many slow reversals) weights it near 1; a log that cannot tell
-averages the two and says so in the standard errors. On logs of the MuJoCo model, whose
-friction is a constraint, the algebraic shape alone left the rotational Bt diagonal 1.6-5.0 %
-off on noise-free three-sine logs and one entry 4.7 standard errors off with the reference
-noise; the average 0.8-2.7 % and 3.8.
+averages the two and says so in the standard errors. On logs of the MuJoCo model of
+``example_c10``'s platform, whose dry friction is a constraint, the algebraic shape alone left
+the rotational Bt diagonal 1.6 / 1.5 / 5.0 % off on noise-free three-sine logs and one entry
+4.7 standard errors off with the reference noise; the average 0.8 / 0.8 / 2.7 % and 3.3. On
+logs of our plant, whose friction is the algebraic sign, nothing changed (the noisy logs'
+largest errors 3.60 % -> 3.62 % on average).
 """
 
 from __future__ import annotations
