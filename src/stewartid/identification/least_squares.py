@@ -112,7 +112,6 @@ def coulomb_regressors(joint_jacobians: np.ndarray, q_dot: np.ndarray, smoothing
     return out
 
 
-
 class _Rows(NamedTuple):
     """One experiment's rows of the regression (:meth:`LeastSquaresIdentifier._experiment_rows`):
     their times (s), the kernel's support (s), the force, velocity and acceleration, (K, 6)
@@ -184,9 +183,9 @@ class LeastSquaresIdentifier(BaseIdentifier):
     std_errors_ : dict of ndarray (6, 6)
     coulomb_ : dict
         Identified Coulomb level per joint type (N m).
+    coulomb_std_ : dict
     coulomb_shape_weights_ : dict
         Weight of each Coulomb shape in the fit.
-    coulomb_std_ : dict
     offsets_ : ndarray, shape (n_experiments, 6)
     condition_number_ : float
     result_ : IdentificationResult
