@@ -174,7 +174,7 @@ def design_objective(prediction: ParameterPrediction,
     (:func:`~stewartid.design.payload_accuracy.payload_objective`). ``correction``
     (:func:`~stewartid.design.physical_refine.search_correction`) multiplies the worst relative
     standard error (``"worst"``) and each payload quantity's."""
-    factor = dict(correction or {})
+    factor = correction or {}
     if not prediction.payload:
         return prediction.criterion * factor.get("worst", 1.0)
     std = {k: v * factor.get(k, 1.0) for k, v in prediction.payload_std_errors.items()}

@@ -228,7 +228,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
             cut = trim(window, exp.sample_rate, self.order)
             sl = slice(cut, len(exp.t) - cut, self.decimate)
             coulomb = [coulomb_regressors(exp.joint_jacobians[sl], qd[sl], self.coulomb_smoothing,
-                                          shape) for shape in shapes] if self.coulomb else []
+                                          shape) for shape in shapes]
             return _Rows(exp.t[sl], window, exp.generalized_force[sl], qd[sl], qdd[sl], coulomb,
                          None)
         # the Coulomb signs need the rates at every sample, from a window the noise allows
@@ -237,7 +237,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
         # standard errors off; 86 % within 3)
         qd_sign = measured_sign_rates(exp.q, exp.sample_rate, window)
         units = [coulomb_regressors(exp.joint_jacobians, qd_sign, self.coulomb_smoothing, shape)
-                 for shape in shapes] if self.coulomb else []
+                 for shape in shapes]
         signals = np.concatenate(
             [exp.generalized_force] + [u.reshape(len(u), -1) for u in units], axis=1)
         filtered = kernel_filter(signals, exp.sample_rate, window)[0]
@@ -257,7 +257,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
         experiments = prepare(datasets, platform, gravity=self.gravity, joints=self.coulomb,
                               remainder=self.remainder)
         n_exp = len(experiments)
-        shapes = COULOMB_SHAPES if self.coulomb_shape == "average" else (self.coulomb_shape,)
+        shapes = (() if not self.coulomb else COULOMB_SHAPES if self.coulomb_shape == "average"
+                  else (self.coulomb_shape,))
         # per shape, the Coulomb regressors of every experiment
         shared: list[list[np.ndarray]] = [[] for _ in shapes]
         phis, ys, used, noise, segments = [], [], [], [], []
@@ -268,10 +269,10 @@ class LeastSquaresIdentifier(BaseIdentifier):
             offsets[:, e] = 1.0
             phis.append(np.concatenate([rows.q_ddot, rows.q_dot, offsets], axis=1))
             ys.append(rows.y)
-            for per_shape, regressors in zip(shared, rows.coulomb, strict=False):
+            for per_shape, regressors in zip(shared, rows.coulomb, strict=True):
                 per_shape.append(regressors)
             if rows.noise is not None:
-                noise.append((e, k, rows.noise))
+                noise.append((k, rows.noise))
             # the filters' support: rows further apart share no noise sample
             segments.append((k, math.ceil(rows.window * exp.sample_rate / self.decimate) + 1))
             used.append({"name": exp.name, "window_s": rows.window, "samples": k,
@@ -280,19 +281,19 @@ class LeastSquaresIdentifier(BaseIdentifier):
         regressor_noise = None
         if noise:
             regressor_noise = np.zeros((12 + n_exp, 12 + n_exp))
-            for _, count, block in noise:
+            for count, block in noise:
                 regressor_noise[:12, :12] += count * block
         phi, y = np.concatenate(phis), np.concatenate(ys)
         solutions = [solve_least_squares(
-            phi, y, np.concatenate(per_shape) if self.coulomb else None,
+            phi, y, None if per_shape is None else np.concatenate(per_shape),
             symmetric=self.symmetric, regressor_names=names,
-            shared_names=[f"coulomb[{t}]" for t in JOINT_TYPES] if self.coulomb else None,
+            shared_names=[f"coulomb[{t}]" for t in JOINT_TYPES] if shapes else None,
             autocorrelated=True, regressor_noise=regressor_noise, segments=segments)
-            for per_shape in (shared if self.coulomb else [None])]
+            for per_shape in (shared or [None])]
         weights = akaike_weights(solutions)
         solution = average_solutions(solutions, weights)
         shape_weights = ({shape: float(w) for shape, w in zip(shapes, weights, strict=True)}
-                         if self.coulomb else {})
+                         if shapes else {})
         theta, std = solution.theta, solution.theta_std.copy()
         # residual autocorrelation is in theta_std; model error (friction the joint model
         # lacks) shows as symmetric pairs that disagree beyond it
