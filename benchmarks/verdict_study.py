@@ -13,8 +13,10 @@ where it names a close call the consensus of the close methods, trusted).
 Per log and seed it prints: the trusted method, whether its largest error over the paper's 20
 entries is within 1.5x (+0.1 point) of the best method's, and per method the largest error,
 the share of entries within 3 reported standard errors, the largest error in standard errors,
-and the worst held-out VAF. ``--out FILE`` appends one JSON line per log and seed;
-``--summary FILE`` prints the Markdown tables of ``docs/benchmarks.md`` from such a file.
+and the worst held-out VAF. ``--out FILE`` appends one JSON line per log and seed (with
+every method's whole Mt, Bt, standard errors and fold fits, and the truth, so that a verdict
+rule can be judged again on the same fits); ``--summary FILE`` prints the Markdown tables of
+``docs/benchmarks.md`` from such a file.
 
 With ``--engine mujoco`` the plant's logs come from the MuJoCo model of the same platform
 (:func:`stewartid.mujoco.closed_loop.simulate_mujoco`) instead of our plant.
@@ -92,6 +94,7 @@ def evaluate(label, platform, data, M, B, seed) -> dict:
     runs, verdict = judge([run_method(name, {}, data, platform, 3, False, segments)
                            for name in names])
     row = {"log": label, "seed": seed, "trusted": verdict.trusted,
+           "truth": {"M": np.asarray(M).tolist(), "B": np.asarray(B).tolist()},
            "verdict": verdict.to_dict(), "methods": {}}
     for run in runs:
         if run.result is None:
@@ -110,6 +113,13 @@ def evaluate(label, platform, data, M, B, seed) -> dict:
             "worst_percent": float(max(errors)), "errors": [float(e) for e in errors],
             "ratios": [float(r) for r in ratios],
             "signed_errors": signed, "std_errors": stds,
+            # the whole matrices, so that a rule can be replayed on the stored rows
+            "M": run.result.M.tolist(), "B": run.result.B.tolist(),
+            "std_M": run.result.std_errors_M.tolist(), "std_B": run.result.std_errors_B.tolist(),
+            "folds_M": [] if run.cross_validation is None else
+            [fit.M.tolist() for fit in run.cross_validation.fold_results],
+            "folds_B": [] if run.cross_validation is None else
+            [fit.B.tolist() for fit in run.cross_validation.fold_results],
             "worst_vaf_percent": float(np.nanmin(run.validation.vaf_percent)),
             "sampling": {k: v for k, v in run.result.diagnostics.get("sampling", {}).items()
                          if k in ("limited", "std_ratio", "shift")},

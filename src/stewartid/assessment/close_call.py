@@ -3,13 +3,12 @@
 Where :func:`~stewartid.assessment.verdict.choose_trusted` finds several plausible methods
 whose standard errors predict largest errors within
 :data:`~stewartid.assessment.verdict.CLOSE_FACTOR` of each other, which of them is the more
-accurate is decided by the noise (the one predicting the smaller error realised it in 50-79 %
+accurate is decided by the noise (the one predicting the smaller error realised it in 60-72 %
 of such pairs). The report then builds their consensus
 (:func:`~stewartid.identification.consensus.combine_results`, from the fits and folds it
 already has) and trusts it: on the verdict study's 100 noisy logs with a known truth, the
 trusted result was then within 1.5x of the most accurate method on 97, with the single
-method on 91
-(``docs/benchmarks.md``, "Which method to trust").
+method on 88 (``docs/benchmarks.md``, "Which method to trust").
 """
 
 from __future__ import annotations

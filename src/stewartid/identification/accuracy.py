@@ -33,82 +33,198 @@ def entry_relative_std(result: IdentificationResult) -> np.ndarray:
     return np.where(np.isnan(values), np.inf, values)
 
 
-def expected_worst_error(relative_std: np.ndarray) -> float:
-    """Expected largest |error| of independent Gaussian errors with these standard errors.
+def expected_worst_error(relative_std: np.ndarray, mean: np.ndarray | None = None) -> float:
+    """Expected largest |error| of independent Gaussian errors N(mean_k, s_k^2).
 
-    E[max_k |e_k|] = integral over x > 0 of 1 - prod_k (2 Phi(x / s_k) - 1), on a grid of
-    4000 steps up to 8 times the largest s_k (the tail beyond holds less than 1e-14 of it).
+    E[max_k |e_k|] = integral over x > 0 of 1 - prod_k P(|e_k| <= x), where
+    P(|e_k| <= x) = Phi((x - m_k) / s_k) - Phi((-x - m_k) / s_k) (a step at |m_k| for
+    s_k = 0), on a grid of 4000 steps up to the largest |m_k| + 8 s_k (the tail beyond holds
+    less than 1e-14 of it).
 
     Parameters
     ----------
     relative_std : ndarray, shape (K,)
         Standard errors (any unit; non-finite ones make the result infinite).
+    mean : ndarray, shape (K,), optional
+        The errors' means, in the same unit (zero by default).
 
     Returns
     -------
     float
         In the unit of ``relative_std``.
     """
-    from scipy.special import erf
+    from scipy.special import ndtr
 
     s = np.asarray(relative_std, dtype=float)
-    if not np.all(np.isfinite(s)):
+    m = np.zeros_like(s) if mean is None else np.abs(np.asarray(mean, dtype=float))
+    if not (np.all(np.isfinite(s)) and np.all(np.isfinite(m))):
         return float("inf")
-    s = s[s > 0]
+    keep = (s > 0) | (m > 0)
+    s, m = s[keep], m[keep]
     if s.size == 0:
         return 0.0
-    x = np.linspace(0.0, 8.0 * s.max(), 4001)
-    below = np.prod(erf(x[:, None] / (np.sqrt(2.0) * s[None, :])), axis=1)
-    return float(np.trapezoid(1.0 - below, x))
+    x = np.linspace(0.0, float(np.max(m + 8.0 * s)), 4001)[:, None]
+    scale = np.where(s > 0, s, 1.0)
+    within = np.where(s > 0, ndtr((x - m) / scale) - ndtr((-x - m) / scale), x >= m)
+    return float(np.trapezoid(1.0 - np.prod(within, axis=1), x[:, 0]))
 
 
-#: Another method's estimate of an entry at least this many times more precise than this
-#: method's measures this method's error there (their difference, to within a fifth of this
-#: method's own standard error).
+#: Other methods' estimates of an entry, pooled, at least this many times more precise than
+#: this method's measure its error there: their difference, to within a fifth of its own
+#: standard error (:func:`error_posterior` names such entries).
 PRECISION_FACTOR = 5.0
 
 
-def cross_checked_relative_std(result: IdentificationResult,
-                               others: Sequence[IdentificationResult]
-                               ) -> tuple[np.ndarray, list[int]]:
-    """Relative error scale of each of the paper's 20 entries, where other fits of the same
-    data measure it.
+def symmetric_members(result: IdentificationResult, matrix: str, i: int, j: int
+                      ) -> list[tuple[float, float]]:
+    """The distinct estimates (value, standard error) of entry (i, j) of ``matrix`` and of its
+    symmetric partner (j, i): one where they are the same (a diagonal entry, a fit that
+    estimates one parameter for both, or keeps one member of the pair), none without a
+    finite value and a positive, finite standard error."""
+    found: list[tuple[float, float]] = []
+    for a, b in ((i, j), (j, i)):
+        value, std = entry_estimate(result, matrix, a, b)
+        if np.isfinite(value) and np.isfinite(std) and std > 0 and (value, std) not in found:
+            found.append((value, std))
+    return found
 
-    Where another result estimates the entry (or its symmetric partner: Mt and Bt are
-    symmetric) with a standard error s_o at most 1 / :data:`PRECISION_FACTOR` of this
-    result's s, this result's error there is its difference d from that estimate, known to
-    within s_o: the scale is sqrt(d^2 + s_o^2) (the least over such results) instead of s.
-    An estimate without a positive, finite standard error measures nothing.
-    A standard error widened for model error (a symmetric pair whose members disagree, a
-    log limited by its sampling) covers a bias the data cannot place; a more precise fit that
-    agrees shows it absent, and one that disagrees shows it present.
+
+def pooled(estimates: Sequence[tuple[float, float]]) -> tuple[float, float]:
+    """Inverse-variance mean of independent estimates (value, standard error) and its
+    variance."""
+    weights = np.array([std ** -2.0 for _, std in estimates])
+    variance = 1.0 / float(weights.sum())
+    return variance * float(weights @ np.array([value for value, _ in estimates])), variance
+
+
+def fold_correlation(results: Sequence[IdentificationResult],
+                     folds: Sequence[Sequence[IdentificationResult] | None]) -> np.ndarray:
+    """Correlation of several methods' errors on the same data, from their fits of the same
+    folds.
+
+    Methods that fit the same record share its noise, and their errors correlate (least
+    squares and Method B at 0.70 over the entries of noisy logs with a known truth, Method A
+    and Method B at 0.04). A fold's estimate departs from the folds' mean by the noise of
+    the data it was given; standardised by the method's standard error, the departures of
+    two methods on the same folds over the paper's 20 entries correlate as their errors do.
+
+    Parameters
+    ----------
+    results : sequence of IdentificationResult
+        The methods' fits of all the data (their standard errors scale the departures).
+    folds : sequence of (sequence of IdentificationResult or None)
+        Each method's fits of the same folds, in the same order (None: not available).
+
+    Returns
+    -------
+    ndarray, shape (n, n)
+        The correlation matrix (positive semidefinite); 0 off the diagonal for a method
+        without two or more folds, with another number of folds, or whose departures do not
+        vary.
+    """
+    n = len(results)
+    correlation = np.eye(n)
+    counts = {len(f) for f in folds if f is not None and len(f) >= 2}
+    if len(counts) != 1:
+        return correlation
+    rows, used = [], []
+    for k, (result, fits) in enumerate(zip(results, folds, strict=True)):
+        if fits is None or len(fits) not in counts:
+            continue
+        departures = []
+        for matrix, i, j in PAPER_ENTRIES:
+            values = np.array([entry_estimate(fit, matrix, i, j)[0] for fit in fits])
+            departures.append((values - values.mean()) / entry_estimate(result, matrix, i, j)[1])
+        rows.append(np.concatenate(departures))
+        used.append(k)
+    table = np.array(rows)
+    finite = np.all(np.isfinite(table), axis=0) if rows else np.array([], dtype=bool)
+    if len(used) < 2 or finite.sum() < 3:
+        return correlation
+    with np.errstate(divide="ignore", invalid="ignore"):
+        found = np.corrcoef(table[:, finite])
+    found = np.nan_to_num(found, nan=0.0)
+    np.fill_diagonal(found, 1.0)
+    correlation[np.ix_(used, used)] = found
+    return correlation
+
+
+def error_posterior(result: IdentificationResult, others: Sequence[IdentificationResult],
+                    correlation: np.ndarray | None = None
+                    ) -> tuple[np.ndarray, np.ndarray, list[int]]:
+    """This result's error on each of the paper's 20 entries, given other estimates of the
+    same quantities: the Gaussian posterior of its error conditioned on them.
+
+    Mt and Bt are symmetric, so entry (i, j) is estimated by every other fit of the same data
+    (its members (i, j) and (j, i), pooled by inverse variance where they differ: they come
+    from different experiments' equations) and by this result's own partner (j, i) where it
+    differs from (i, j). With the errors Gaussian and unbiased, at their standard errors and
+    correlated between methods as ``correlation`` says, this result's error e given its
+    differences d from those estimates is Gaussian with mean c' V^-1 d and variance
+    s^2 - c' V^-1 c (c = Cov(e, d), V = Cov(d)). For independent errors this is, with the
+    others pooled into p +- s_p and g = s^2 / (s^2 + s_p^2): mean g (v - p), variance
+    g s_p^2.
+
+    Averaged over d the error's scale is s, as its standard error says; on one data set the
+    differences place it. Where the others are far more precise (s_p << s) the error is the
+    difference, known to within s_p: a standard error widened for a model error (a symmetric
+    pair whose members disagree, a log limited by its sampling) is replaced by what the more
+    precise fits measure. Where they are far less precise it is this result's own N(0, s^2).
+    Two alike that disagree are blamed for half each, and the noise decides (the verdict's
+    close call). Errors correlated with the others' are shared with them, so agreeing with
+    them shows less than it would for independent errors.
 
     Parameters
     ----------
     result : IdentificationResult
     others : sequence of IdentificationResult
         Other methods' fits of the same data.
+    correlation : ndarray, shape (1 + len(others), 1 + len(others)), optional
+        Correlation of the methods' errors, ``result`` first (:func:`fold_correlation`);
+        independent by default. A result's own partner is taken as independent of all.
 
     Returns
     -------
-    relative : ndarray, shape (20,)
-        Fractions, in the order of :data:`~stewartid.reference.published.PAPER_ENTRIES`
-        (as :func:`entry_relative_std` where no other result is precise enough).
+    mean, std : ndarray, shape (20,)
+        The error's posterior mean and standard deviation relative to the estimate
+        (fractions), in the order of :data:`~stewartid.reference.published.PAPER_ENTRIES`;
+        (0, :func:`entry_relative_std`) where nothing else estimates the entry.
     measured : list of int
-        Indices of the entries whose scale another result measured.
+        Indices of the entries the other estimates measure: pooled, their standard error is
+        at most s / :data:`PRECISION_FACTOR`.
     """
-    relative = entry_relative_std(result)
+    links = np.eye(1 + len(others)) if correlation is None else np.asarray(correlation, float)
+    std = entry_relative_std(result)
+    mean = np.zeros_like(std)
     measured = []
     for k, (matrix, i, j) in enumerate(PAPER_ENTRIES):
-        value, std = entry_estimate(result, matrix, i, j)
-        scales = [float(np.hypot(v - value, s)) for other in others
-                  for v, s in {entry_estimate(other, matrix, i, j),
-                               entry_estimate(other, matrix, j, i)}
-                  if 0 < PRECISION_FACTOR * s <= std and np.isfinite(v)]
-        if scales and value != 0:
-            relative[k] = min(scales) / abs(value)
+        value, own = entry_estimate(result, matrix, i, j)
+        if not (value != 0 and np.isfinite(value) and np.isfinite(own) and own > 0):
+            continue
+        # (value, standard error, row of ``links``; -1 for the own partner)
+        estimates = [(v, np.sqrt(var), m) for m, other in enumerate(others, start=1)
+                     if (found := symmetric_members(other, matrix, i, j))
+                     for v, var in [pooled(found)]]
+        estimates += [(v, s, -1) for v, s in symmetric_members(result, matrix, i, j)
+                      if (v, s) != (value, own)]
+        if not estimates:
+            continue
+        rows = np.array([0] + [m for *_, m in estimates])
+        scale = np.array([own] + [s for _, s, _ in estimates])
+        linked = np.where((rows[:, None] >= 0) & (rows[None, :] >= 0),
+                          links[np.ix_(np.maximum(rows, 0), np.maximum(rows, 0))],
+                          np.eye(rows.size))
+        cov = linked * np.outer(scale, scale)
+        # d_p = e_0 - e_p: Cov(e_0, d) and Cov(d)
+        with_d = cov[0, 0] - cov[0, 1:]
+        of_d = cov[0, 0] - cov[0, 1:][None, :] - cov[1:, 0][:, None] + cov[1:, 1:]
+        weights = np.linalg.pinv(of_d, hermitian=True) @ with_d
+        differences = value - np.array([v for v, _, _ in estimates])
+        mean[k] = float(weights @ differences) / abs(value)
+        std[k] = np.sqrt(max(own ** 2 - float(with_d @ weights), 0.0)) / abs(value)
+        if PRECISION_FACTOR ** 2 * pooled([(v, s) for v, s, _ in estimates])[1] <= own ** 2:
             measured.append(k)
-    return relative, measured
+    return mean, std, measured
 
 
 def predicted_worst_error(result: IdentificationResult) -> float:
@@ -117,5 +233,5 @@ def predicted_worst_error(result: IdentificationResult) -> float:
     return expected_worst_error(entry_relative_std(result))
 
 
-__all__ = ["PRECISION_FACTOR", "cross_checked_relative_std", "entry_estimate",
-           "entry_relative_std", "expected_worst_error", "predicted_worst_error"]
+__all__ = ["PRECISION_FACTOR", "entry_estimate", "entry_relative_std", "error_posterior",
+           "expected_worst_error", "fold_correlation", "pooled", "predicted_worst_error", "symmetric_members"]

@@ -92,7 +92,8 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
     names = {run.name: run.display_name for run in ok}
     lines = [consensus_text(verdict, best, names)] if best.name == CONSENSUS else [
              f"**Trust {best.display_name} on these data.** Of the physically plausible "
-             "methods that predict held-out data, its standard errors predict the smallest "
+             "methods that predict held-out data, its standard errors, each entry's checked "
+             "against the other methods' estimates, predict the smallest "
              f"largest error over the paper's 20 entries: {100 * trusted.expected_worst:.3g} % "
              f"(largest standard error {100 * trusted.worst_relative_std:.3g} %, "
              f"{trusted.worst_entry}); they include the model error its symmetric pairs "
@@ -104,16 +105,17 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
     measured = [f"{run.display_name}, {named_entries(standing.measured_entries)}"
                 for run in ok if (standing := verdict.standings[run.name]).measured_entries]
     if measured:
-        lines.append(f"Where another method estimates an entry over {PRECISION_FACTOR:g}× more "
-                     "precisely, the difference between the two measures the error there and "
-                     "replaces the standard error in these predictions: "
+        lines.append(f"Where the other methods estimate an entry over {PRECISION_FACTOR:g}× "
+                     "more precisely, the difference measures the error there and replaces "
+                     "the standard error in these predictions (elsewhere a disagreement is "
+                     "shared out by the methods' standard errors): "
                      + "; ".join(measured) + ".")
     if len(verdict.close) > 1 and best.name != CONSENSUS:
         lines.append(f"This is a close call: {' and '.join(names[n] for n in verdict.close)} "
                      "predict largest errors "
                      f"within {CLOSE_FACTOR:g}× of each other, and on such data the noise "
                      "decides which is the more accurate (on logs with a known truth the one "
-                     "predicting less was the more accurate in half to two thirds of such "
+                     "predicting less was the more accurate in six or seven of ten such "
                      "cases). Where their entries differ, both are in the tables below.")
     if verdict.uncertain:
         lines.append("Entries to treat with care: " + ", ".join(
@@ -167,7 +169,7 @@ def consensus_text(verdict: Verdict, best: MethodReport, names: dict[str, str]) 
             f"data.** Their standard errors predict largest errors within {CLOSE_FACTOR:g}× "
             f"of each other over the paper's 20 entries ({predicted}): a close call, in which "
             "the noise decides which is the more accurate (on logs with a known truth the one "
-            "predicting less was the more accurate in half to two thirds of such cases). The "
+            "predicting less was the more accurate in six or seven of ten such cases). The "
             "consensus averages their estimates, weighted by their inverse variances, where "
             f"they agree within {agreement:g} standard error of their difference "
             f"({combined_text(best.result, names[members[0]])}). Its standard errors take the "
