@@ -280,3 +280,25 @@ def test_a_method_several_of_its_errors_from_a_more_precise_one_is_not_trusted()
                               "ls": (ls, _validation(0.1))})
     assert verdict.trusted == "ls"
     assert verdict.standings["wavelet"].expected_worst > 0.06
+
+
+def test_the_verdict_conditions_on_the_correlation_its_fold_fits_show():
+    """Three methods' fits of 40 shared folds, correlated as a known matrix: the verdict's
+    evidence carries the estimated correlations, and its predictions use them (they differ
+    from those of the same fits taken as independent)."""
+    rng = np.random.default_rng(5)
+    truth = _result(0.0)
+    scales = np.full((3, 6, 6), 0.01)
+    fits = list(zip(*_draws(rng, truth, scales, CORRELATED, 40), strict=True))
+    results = next(_draws(rng, truth, scales, CORRELATED, 1))
+    assessed = {name: (result, _validation(0.1)) for name, result in zip("abc", results, strict=True)}
+    folds = dict(zip("abc", fits, strict=True))
+    verdict = choose_trusted(assessed, folds)
+    expected = fold_correlation(results, fits)
+    evidence = verdict.to_dict()["evidence"]
+    assert evidence["a"]["error_correlation"] == {"b": expected[0, 1], "c": expected[0, 2]}
+    assert evidence["c"]["error_correlation"]["b"] == expected[2, 1]
+    independent = choose_trusted(assessed)
+    assert independent.standings["a"].error_correlation == {"b": 0.0, "c": 0.0}
+    assert all(verdict.standings[n].expected_worst != independent.standings[n].expected_worst
+               for n in "abc")

@@ -107,13 +107,6 @@ def worst_dof(validation: ValidationResult) -> tuple[float, str]:
     return float(vaf[k]), COORDINATES[k]
 
 
-def relative_std(result: IdentificationResult) -> float:
-    """Median relative standard error of the diagonals of Mt and Bt (a fraction)."""
-    values = np.concatenate([np.diag(result.std_errors_M) / np.abs(np.diag(result.M)),
-                             np.diag(result.std_errors_B) / np.abs(np.diag(result.B))])
-    return float(np.nanmedian(values))
-
-
 def worst_relative_std(result: IdentificationResult) -> tuple[float, str]:
     """The largest relative standard error over the paper's 20 entries and the entry's label
     (``"Bt(5,1)"``)."""
@@ -233,6 +226,9 @@ class Standing:
     measured_entries : tuple of str
         Entries whose error the other plausible methods' estimates measure (over
         :data:`~stewartid.identification.accuracy.PRECISION_FACTOR` times more precise).
+    error_correlation : dict of str to float
+        Correlation of its errors with each other applicable method's, from their fits of the
+        same folds (:func:`~stewartid.identification.accuracy.fold_correlation`; 0 without).
     """
 
     name: str
@@ -250,6 +246,7 @@ class Standing:
     friction_immune: bool = False
     expected_worst: float = float("nan")
     measured_entries: tuple[str, ...] = ()
+    error_correlation: dict[str, float] = dataclasses.field(default_factory=dict)
 
     @property
     def unexplained_percent(self) -> float:
@@ -313,7 +310,8 @@ class Verdict:
                 "heldout_worst_dof": st.worst_dof, "plausible": st.compared,
                 "misfit": st.misfit, "models_friction": st.models_friction,
                 "friction_immune": st.friction_immune,
-                "measured_entries": list(st.measured_entries)}
+                "measured_entries": list(st.measured_entries),
+                "error_correlation": dict(st.error_correlation)}
                 for name, st in self.standings.items()},
             "uncertain_detail": self.uncertain}
 
@@ -373,7 +371,9 @@ def choose_trusted(assessed: Mapping[str, tuple[IdentificationResult, Validation
             (100 - worst[name][0]) / max(100 - worst[trusted][0], 1e-12), name in compared,
             modelled, effect, excess, friction_signature(validation),
             spread[name][0], spread[name][1], misfit[name], friction_immune(result),
-            expected[name], tuple(entry_label(PAPER_ENTRIES[k]) for k in checked[name][2]))
+            expected[name], tuple(entry_label(PAPER_ENTRIES[k]) for k in checked[name][2]),
+            {other: float(links[names.index(name), k]) for k, other in enumerate(names)
+             if other != name})
     others = sorted((name for name in ok if name != trusted),
                     key=lambda name: (name not in compared, misfit[name], expected[name]))
     uncertain = uncertain_entries(ok[trusted][0], {name: ok[name][0] for name in compared
@@ -446,5 +446,4 @@ def uncertain_sentence(uncertain: Sequence[dict]) -> str:
 __all__ = ["CLOSE_FACTOR", "DAMPING_EXCESS", "DISAGREEMENT", "MISFIT_FACTOR", "MISFIT_FLOOR", "SIGNIFICANT",
            "TIE_FACTOR", "UNCERTAIN_RELATIVE", "Standing", "Verdict", "choose_trusted",
            "finds_friction", "friction_immune", "is_definite", "models_friction", "named_entries",
-           "relative_std", "uncertain_entries", "uncertain_sentence", "worst_dof",
-           "worst_relative_std"]
+           "uncertain_entries", "uncertain_sentence", "worst_dof", "worst_relative_std"]

@@ -33,6 +33,13 @@ def entry_relative_std(result: IdentificationResult) -> np.ndarray:
     return np.where(np.isnan(values), np.inf, values)
 
 
+def relative_std(result: IdentificationResult) -> float:
+    """Median relative standard error of the diagonals of Mt and Bt (a fraction)."""
+    values = np.concatenate([np.diag(result.std_errors_M) / np.abs(np.diag(result.M)),
+                             np.diag(result.std_errors_B) / np.abs(np.diag(result.B))])
+    return float(np.nanmedian(values))
+
+
 def expected_worst_error(relative_std: np.ndarray, mean: np.ndarray | None = None) -> float:
     """Expected largest |error| of independent Gaussian errors N(mean_k, s_k^2).
 
@@ -234,4 +241,5 @@ def predicted_worst_error(result: IdentificationResult) -> float:
 
 
 __all__ = ["PRECISION_FACTOR", "entry_estimate", "entry_relative_std", "error_posterior",
-           "expected_worst_error", "fold_correlation", "pooled", "predicted_worst_error", "symmetric_members"]
+           "expected_worst_error", "fold_correlation", "pooled", "predicted_worst_error",
+           "relative_std", "symmetric_members"]

@@ -12,8 +12,8 @@ import numpy as np
 
 from stewartid.assessment.close_call import CONSENSUS, combined_text
 from stewartid.assessment.validation import friction_signature
-from stewartid.assessment.verdict import CLOSE_FACTOR, Verdict, named_entries, relative_std, worst_dof
-from stewartid.identification.accuracy import PRECISION_FACTOR
+from stewartid.assessment.verdict import CLOSE_FACTOR, Verdict, named_entries, worst_dof
+from stewartid.identification.accuracy import PRECISION_FACTOR, relative_std
 from stewartid.identification.consistency import consistency_metrics, is_consistent
 from stewartid.reports.identification.friction_text import (
     friction_law_lines,
