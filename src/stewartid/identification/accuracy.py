@@ -126,8 +126,8 @@ def fold_correlation(results: Sequence[IdentificationResult],
     -------
     ndarray, shape (n, n)
         The correlation matrix (positive semidefinite); 0 off the diagonal for a method
-        without two or more folds, with another number of folds, or whose departures do not
-        vary.
+        without two or more folds or whose departures do not vary, and everywhere when the
+        methods' numbers of folds differ (they are then not the same folds).
     """
     n = len(results)
     correlation = np.eye(n)
@@ -209,18 +209,22 @@ def error_posterior(result: IdentificationResult, others: Sequence[Identificatio
         if not (value != 0 and np.isfinite(value) and np.isfinite(own) and own > 0):
             continue
         # (value, standard error, row of ``links``; -1 for the own partner)
-        estimates = [(v, np.sqrt(var), m) for m, other in enumerate(others, start=1)
-                     if (found := symmetric_members(other, matrix, i, j))
-                     for v, var in [pooled(found)]]
+        estimates = []
+        for row, other in enumerate(others, start=1):
+            found = symmetric_members(other, matrix, i, j)
+            if found:
+                centre, variance = pooled(found)
+                estimates.append((centre, np.sqrt(variance), row))
         estimates += [(v, s, -1) for v, s in symmetric_members(result, matrix, i, j)
                       if (v, s) != (value, own)]
         if not estimates:
             continue
-        rows = np.array([0] + [m for *_, m in estimates])
+        rows = np.array([0] + [row for *_, row in estimates])
         scale = np.array([own] + [s for _, s, _ in estimates])
-        linked = np.where((rows[:, None] >= 0) & (rows[None, :] >= 0),
-                          links[np.ix_(np.maximum(rows, 0), np.maximum(rows, 0))],
-                          np.eye(rows.size))
+        # the own partner is independent of every method's error
+        linked = np.eye(rows.size)
+        methods = rows >= 0
+        linked[np.ix_(methods, methods)] = links[np.ix_(rows[methods], rows[methods])]
         cov = linked * np.outer(scale, scale)
         # d_p = e_0 - e_p: Cov(e_0, d) and Cov(d)
         with_d = cov[0, 0] - cov[0, 1:]
