@@ -24,7 +24,7 @@ With ``--engine mujoco`` the plant's logs come from the MuJoCo model of the same
 Usage::
 
     python benchmarks/verdict_study.py [--platform paper|FILE] [--kinds paper,tenx,three,alldof]
-        [--coulomb 0,5,30] [--seeds 4] [--example] [--engine ours|mujoco] [--clean DIR]
+        [--coulomb 0,5,30] [--seeds 4] [--first-seed 0] [--example] [--engine ours|mujoco] [--clean DIR]
         [--out FILE]
     python benchmarks/verdict_study.py --summary FILE
 """
@@ -186,6 +186,8 @@ def main() -> None:
     parser.add_argument("--kinds", default="paper,tenx,three,alldof")
     parser.add_argument("--coulomb", default="0,5,30", help="N m, for the paper's sines")
     parser.add_argument("--seeds", type=int, default=4)
+    parser.add_argument("--first-seed", type=int, default=0,
+                        help="noise seeds first-seed .. first-seed + seeds - 1 (fresh draws)")
     parser.add_argument("--example", action="store_true",
                         help="also the independent simulator's example data set")
     parser.add_argument("--engine", default="ours", choices=["ours", "mujoco"],
@@ -205,7 +207,7 @@ def main() -> None:
     for label, platform, clean, M, B, noisy in log_sets(
             args.platform, args.kinds.split(","), [float(c) for c in args.coulomb.split(",")],
             args.clean, args.example, args.engine):
-        for seed in [None, *range(args.seeds)]:
+        for seed in [None, *range(args.first_seed, args.first_seed + args.seeds)]:
             start = time.perf_counter()
             row = evaluate(label, platform, clean if seed is None else noisy(seed), M, B, seed)
             rows.append(row)
