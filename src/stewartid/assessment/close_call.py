@@ -7,7 +7,7 @@ accurate is decided by the noise (the one predicting the smaller error realised 
 of such pairs). The report then builds their consensus
 (:func:`~stewartid.identification.consensus.combine_results`, from the fits and folds it
 already has) and trusts it: on the verdict study's 100 noisy logs with a known truth, the
-trusted result was then within 1.5x of the most accurate method on 97, with the single
+trusted result was then within 1.5x of the most accurate method on 98, with the single
 method on 88 (``docs/benchmarks.md``, "Which method to trust").
 """
 
@@ -96,8 +96,9 @@ def trust_consensus(verdict: Verdict, result: IdentificationResult,
         standing, unexplained_ratio=standing.unexplained_percent / unexplained)
         for name, standing in verdict.standings.items()})
     agreement = result.diagnostics.get("consensus", {}).get("agreement", float("nan"))
-    reason = (f"{CONSENSUS}: {', '.join(members)} are a close call, so their estimates are "
-              "averaged, weighted by their inverse variances, where they agree within "
+    reason = (f"{CONSENSUS}: {', '.join(members)} are a close call, so their estimates (each "
+              "one's symmetric pairs pooled) are averaged, weighted by their inverse "
+              "variances, where they agree within "
               f"{agreement:g} standard error of their difference "
               f"({combined_text(result, members[0])}); its standard errors take "
               "the members' errors as fully correlated, and predict a largest error of "

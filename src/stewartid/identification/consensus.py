@@ -17,10 +17,20 @@ The members' errors are correlated: they fit the same record, and their z-scores
 method to trust"). The standard error is therefore the bound for fully correlated members,
 sum_k w_k s_k, never below the mean's true one and at most the largest member's.
 
+Mt and Bt are symmetric, and a member that estimates the two entries of a pair (i, j), (j, i)
+apart (least squares: from different experiments' equations) holds two estimates of one
+quantity. Before the members are combined, each member's pair is pooled
+(:func:`pooled_pairs`): their inverse-variance mean, with the standard error for fully
+correlated estimates scaled by the pair's Birge ratio where the two disagree beyond their
+standard errors (the Particle Data Group's scale factor). A member that already gives both
+entries one estimate (Method B) is unchanged. The consensus is then symmetric.
+
 Measured on the verdict study's noisy logs (100 logs: our plant and MuJoCo, two platforms),
 with the consensus of the close methods trusted wherever the verdict named a close call, the
-trusted result was within 1.5x of the most accurate method on 97, with the verdict's single
-method on 88.
+trusted result was within 1.5x of the most accurate method on 98 with the pairs pooled (97
+without; the verdict's single method on 88); pooling lowered the trusted result's largest
+error on 32 of those logs and raised it on none (``docs/benchmarks.md``, "Which method to
+trust").
 """
 
 from __future__ import annotations
@@ -78,6 +88,48 @@ def combine_estimates(values: np.ndarray, std_errors: np.ndarray, agreement: flo
     return value, std, used
 
 
+def pooled_pairs(value: np.ndarray, std_error: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """One member's symmetric pairs pooled: each pair of entries (i, j), (j, i) replaced by
+    their inverse-variance mean.
+
+    The two estimates may share data, so the standard error is the bound for fully correlated
+    ones, w_1 s_1 + w_2 s_2 (weights w_k proportional to 1 / s_k^2, summing to one); where they
+    disagree by more than the standard error of their difference, their Birge ratio
+    |v_1 - v_2| / sqrt(s_1^2 + s_2^2) scales it (the Particle Data Group's scale factor for two
+    measurements): a disagreement the standard errors do not cover is carried into the pooled
+    one. A pair whose two entries are the same estimate is unchanged; one without two finite
+    values and positive, finite standard errors is left as it is.
+
+    Parameters
+    ----------
+    value, std_error : ndarray, shape (n, n)
+        A member's estimate of a symmetric matrix and its standard errors.
+
+    Returns
+    -------
+    value, std_error : ndarray, shape (n, n)
+        Symmetric where pooled.
+    """
+    value, std_error = np.array(value, dtype=float), np.array(std_error, dtype=float)
+    upper = np.triu_indices(value.shape[0], 1)
+    lower = upper[::-1]
+    a, b = value[upper], value[lower]
+    s_a, s_b = std_error[upper], std_error[lower]
+    usable = (np.isfinite(a) & np.isfinite(b) & np.isfinite(s_a) & np.isfinite(s_b)
+              & (s_a > 0) & (s_b > 0))
+    s_a, s_b = np.where(usable, s_a, 1.0), np.where(usable, s_b, 1.0)
+    w_a, w_b = 1.0 / s_a ** 2, 1.0 / s_b ** 2
+    total = w_a + w_b
+    mean = np.where(usable, (w_a * np.where(usable, a, 0.0) + w_b * np.where(usable, b, 0.0))
+                    / total, np.nan)
+    birge = np.abs(np.where(usable, a - b, 0.0)) / np.hypot(s_a, s_b)
+    pooled_std = (w_a * s_a + w_b * s_b) / total * np.maximum(1.0, birge)
+    for index in (upper, lower):
+        value[index] = np.where(usable, mean, value[index])
+        std_error[index] = np.where(usable, pooled_std, std_error[index])
+    return value, std_error
+
+
 def friction_diagnostics(results: Sequence[IdentificationResult]) -> dict[str, Any]:
     """The Coulomb levels the consensus predicts with: those of the first member that
     estimates them (``"coulomb"``, ``"coulomb_std"``; a member with free interval constants
@@ -94,7 +146,8 @@ def friction_diagnostics(results: Sequence[IdentificationResult]) -> dict[str, A
 
 def combine_results(results: Sequence[IdentificationResult], names: Sequence[str],
                     agreement: float = AGREEMENT) -> IdentificationResult:
-    """The consensus of fitted results (:func:`combine_estimates` on Mt and Bt).
+    """The consensus of fitted results (:func:`combine_estimates` on Mt and Bt, each member's
+    symmetric pairs pooled first by :func:`pooled_pairs`).
 
     Parameters
     ----------
@@ -115,10 +168,10 @@ def combine_results(results: Sequence[IdentificationResult], names: Sequence[str
     """
     if len(results) != len(names) or not results:
         raise ConfigError("a consensus needs one name per member result, and a member.")
-    M, std_M, used_M = combine_estimates(np.stack([r.M for r in results]),
-                                         np.stack([r.std_errors_M for r in results]), agreement)
-    B, std_B, used_B = combine_estimates(np.stack([r.B for r in results]),
-                                         np.stack([r.std_errors_B for r in results]), agreement)
+    M, std_M, used_M = combine_estimates(
+        *np.stack([pooled_pairs(r.M, r.std_errors_M) for r in results], axis=1), agreement)
+    B, std_B, used_B = combine_estimates(
+        *np.stack([pooled_pairs(r.B, r.std_errors_B) for r in results], axis=1), agreement)
     diagnostics = {"consensus": {"members": list(names), "agreement": float(agreement),
                                  "used_M": used_M, "used_B": used_B},
                    **friction_diagnostics(results)}
@@ -133,10 +186,12 @@ def combine_results(results: Sequence[IdentificationResult], names: Sequence[str
 @register_method(
     name="consensus", color="#17becf", compared=False,
     display_name="Consensus",
-    description="the members' estimates averaged by inverse variance where they agree within "
-                "one standard error of their difference; what the verdict trusts in a close call",
+    description="the members' estimates (each one's symmetric pairs pooled) averaged by inverse "
+                "variance where they agree within one standard error of their difference; what "
+                "the verdict trusts in a close call",
     reference="Hartung, J., Knapp, G., Sinha, B. K. Statistical Meta-Analysis with "
-              "Applications, ch. 4 (2008): inverse-variance weighting")
+              "Applications, ch. 4 (2008): inverse-variance weighting; Particle Data Group, "
+              "Review of Particle Physics, Introduction, sec. 5.2 (2024): the scale factor")
 class ConsensusIdentifier(BaseIdentifier):
     """Fits each member method and combines their Mt and Bt (:func:`combine_results`).
 
@@ -199,4 +254,4 @@ class ConsensusIdentifier(BaseIdentifier):
 
 
 __all__ = ["AGREEMENT", "DEFAULT_MEMBERS", "ConsensusIdentifier", "combine_estimates",
-           "combine_results", "friction_diagnostics"]
+           "combine_results", "friction_diagnostics", "pooled_pairs"]
