@@ -29,8 +29,8 @@ Measured on the verdict study's noisy logs (100 logs: our plant and MuJoCo, two 
 with the consensus of the close methods trusted wherever the verdict named a close call, the
 trusted result was within 1.5x of the most accurate method on 98 with the pairs pooled (97
 without; the verdict's single method on 88); pooling lowered the trusted result's largest
-error on 32 of those logs and raised it on none (``docs/benchmarks.md``, "Which method to
-trust").
+error on 32 of those logs and the 25 clean ones, and raised it on none
+(``docs/benchmarks.md``, "Which method to trust").
 """
 
 from __future__ import annotations
