@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from stewartid.identification.wavelet.variance_components import chi2_excess
 
@@ -30,3 +31,68 @@ def test_interval_constant_scatter_is_estimated_in_weighted_chi_square():
     # no excess in the data: zero, not a negative variance
     r = rng.normal(0.0, np.sqrt(v))
     assert chi2_excess(v, 0.01 * r ** 2, n) == 0.0
+
+
+def _candidate_fits(y, u, shapes):
+    """Least squares of y on [u, shape] for each candidate shape, as weak-form solutions: the
+    coefficient of u as theta, the shape's as the Coulomb level, one channel."""
+    from stewartid.identification.wavelet.gls import WeakFormSolution
+
+    out = []
+    for shape in shapes:
+        design = np.column_stack([u, shape])
+        coef = np.linalg.lstsq(design, y, rcond=None)[0]
+        residual = y - design @ coef
+        cov = np.linalg.inv(design.T @ design) * (residual @ residual / (len(y) - 2))
+        std = np.sqrt(np.diag(cov))
+        out.append(WeakFormSolution(
+            theta=coef[:1], theta_std=std[:1], coulomb=coef[1:], coulomb_std=std[1:],
+            offsets=np.zeros(1), noise_std=np.sqrt([residual @ residual / len(y)]),
+            pose_noise_share=np.zeros(1), constant_scatter=np.zeros(1), condition_number=1.0,
+            n_equations=len(y)))
+    return out
+
+
+def test_averaging_over_soft_sign_rates_keeps_the_coverage_that_choosing_one_loses():
+    """Four candidate soft-sign shapes tanh(u / r) beside a viscous-like regressor u; the data
+    hold the second at a level the noise barely shows. Choosing the candidate of least
+    residual, the 2-SE interval of u's coefficient covers the truth in 87.9 % of 1000
+    draws (95 % nominal: the choice's variance is missing); averaged with Akaike weights, in
+    99.9 %. The binomial sampling error at 95 % is 0.7 %."""
+    from stewartid.identification.wavelet.rate_selection import (
+        averaged_over_rates,
+        residual_cost,
+    )
+
+    rng = np.random.default_rng(1)
+    u = np.sin(np.linspace(0.0, 4 * np.pi, 200))
+    rates = (0.01, 0.1, 0.3, 1.0)
+    shapes = [np.tanh(u / r) for r in rates]
+    chosen = averaged = 0
+    draws = 1000
+    for _ in range(draws):
+        fits = _candidate_fits(u + 0.5 * shapes[1] + rng.standard_normal(u.size), u, shapes)
+        best = min(fits, key=residual_cost)
+        mean, _ = averaged_over_rates(lambda k, fits=fits: fits[k], rates)
+        chosen += abs(best.theta[0] - 1.0) <= 2 * best.theta_std[0]
+        averaged += abs(mean.theta[0] - 1.0) <= 2 * mean.theta_std[0]
+        assert residual_cost(mean) == residual_cost(best)
+        assert sum(mean.rate_weights.values()) == pytest.approx(1.0, abs=1e-12)
+    assert chosen / draws < 0.92
+    assert averaged / draws >= 0.95
+
+
+def test_a_rate_the_data_single_out_takes_all_the_weight():
+    """The soft-sign shape at 20 noise levels: the others' likelihoods are far below, their
+    weights vanish and the average is the chosen fit."""
+    from stewartid.identification.wavelet.rate_selection import averaged_over_rates
+
+    rng = np.random.default_rng(2)
+    u = np.sin(np.linspace(0.0, 4 * np.pi, 200))
+    rates = (0.01, 0.1, 0.3, 1.0)
+    shapes = [np.tanh(u / r) for r in rates]
+    fits = _candidate_fits(u + 20.0 * shapes[2] + rng.standard_normal(u.size), u, shapes)
+    mean, rate = averaged_over_rates(lambda k: fits[k], rates)
+    assert rate == 0.3 and mean.rate_weights["0.3"] > 1 - 1e-9
+    assert mean.theta[0] == pytest.approx(fits[2].theta[0], rel=1e-9)
+    assert mean.theta_std[0] == pytest.approx(fits[2].theta_std[0], rel=1e-6)

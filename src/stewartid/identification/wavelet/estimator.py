@@ -344,7 +344,7 @@ class WaveletIdentifier(BaseIdentifier):
                              "intervals": i["intervals"].tolist()} for i in infos],
             "pair_choice": chosen, "pair_calibration": self.pair_calibration_,
             "coordinates": list(COORDINATES), "friction_model": friction,
-            "soft_sign_rate": rate,
+            "soft_sign_rate": rate, "soft_sign_weights": solution.rate_weights,
             "coulomb": levels, "coulomb_std": levels_std,
             "offsets": solution.offsets, "noise_std": solution.noise_std,
             "constant_scatter": solution.constant_scatter,

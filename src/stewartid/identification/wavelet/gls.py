@@ -97,6 +97,9 @@ class WeakFormSolution:
         Of the column-equilibrated invariant regression.
     n_equations : int
         Rows per channel.
+    rate_weights : dict of str to float, optional
+        Weight of each soft-sign transition rate (rad/s, as text) the solution averages
+        (:func:`.rate_selection.averaged_over_rates`); None for a single fit.
     """
 
     theta: np.ndarray
@@ -109,6 +112,7 @@ class WeakFormSolution:
     constant_scatter: np.ndarray
     condition_number: float
     n_equations: int
+    rate_weights: dict[str, float] | None = None
 
 
 def _weighted_normal(design: np.ndarray, weights: np.ndarray, target: np.ndarray

@@ -17,8 +17,8 @@ the zero-mean test functions still removing each window's constant (what the gra
 leaves). The joint directions come from the smoothed joint rates, w / sqrt(w^2 + s^2) with
 s^2 = sigma^2 + r^2: sigma the rate's noise level, so a reversal inside the noise band is
 weighed as uncertain, and r the friction's own transition rate (a regularised or Stribeck
-friction is not a sign), chosen from :data:`SOFT_SIGN_RATES` by the fit's residual
-(:func:`solve_windows_over_rates`). The solve is
+friction is not a sign): the fits at every rate of :data:`SOFT_SIGN_RATES`, averaged by
+how well each explains the rows (:func:`solve_windows_over_rates`). The solve is
 :func:`~stewartid.identification.wavelet.gls.fit_jointly`'s generalized least squares, pose
 noise weighted and its bias removed, the Coulomb levels shared by the channels.
 """
@@ -40,7 +40,7 @@ from stewartid.identification.wavelet.gls import (
     fit_jointly,
     standard_errors,
 )
-from stewartid.identification.wavelet.rate_selection import best_over_rates
+from stewartid.identification.wavelet.rate_selection import averaged_over_rates
 from stewartid.identification.wavelet.variance_components import row_noise
 from stewartid.identification.wavelet.weak_form import (
     SOFT_SIGN_RATES,
@@ -176,10 +176,10 @@ def solve_windows(equations: Sequence[WindowEquations], iterations: int = 3,
 def solve_windows_over_rates(equations: Sequence[WindowEquations],
                              rates: Sequence[float] = SOFT_SIGN_RATES, **settings
                              ) -> tuple[WeakFormSolution, float]:
-    """:func:`solve_windows` at every transition rate of the soft sign; the solution whose
-    weighted residual is smallest (:func:`.rate_selection.best_over_rates`), and its rate
-    (rad/s). ``settings`` go to :func:`solve_windows`."""
-    return best_over_rates(lambda index: solve_windows(equations, rate_index=index, **settings),
+    """:func:`solve_windows` at every transition rate of the soft sign, averaged over the rates
+    (:func:`.rate_selection.averaged_over_rates`), and the rate of greatest weight (rad/s).
+    ``settings`` go to :func:`solve_windows`."""
+    return averaged_over_rates(lambda index: solve_windows(equations, rate_index=index, **settings),
                            rates)
 
 
