@@ -51,12 +51,11 @@ ENTRY_QUANTITY = np.array([QUANTITIES.index((m, min(i, j), max(i, j)))
                            for m, i, j in PAPER_ENTRIES])
 
 
-def stored_result(method: dict, matrices=("M", "B"), stds=("std_M", "std_B")
-                  ) -> IdentificationResult:
+def stored_result(method: dict) -> IdentificationResult:
     """A method's stored fit (or, without standard errors, one of its fold fits) as a result."""
-    M, B = (np.asarray(method[key], dtype=float) for key in matrices)
+    M, B = (np.asarray(method[key], dtype=float) for key in ("M", "B"))
     std_M, std_B = ((np.asarray(method[key], dtype=float) if key in method else np.ones((6, 6)))
-                    for key in stds)
+                    for key in ("std_M", "std_B"))
     return IdentificationResult(M=M, B=B, std_errors_M=std_M, std_errors_B=std_B,
                                 condition_number=1.0, residual_rms=np.ones(6), method="stored")
 

@@ -117,12 +117,13 @@ def pooled_pairs(value: np.ndarray, std_error: np.ndarray) -> tuple[np.ndarray, 
     s_a, s_b = std_error[upper], std_error[lower]
     usable = (np.isfinite(a) & np.isfinite(b) & np.isfinite(s_a) & np.isfinite(s_b)
               & (s_a > 0) & (s_b > 0))
+    # placeholders where unusable (those entries are kept as they are below)
+    a, b = np.where(usable, a, 0.0), np.where(usable, b, 0.0)
     s_a, s_b = np.where(usable, s_a, 1.0), np.where(usable, s_b, 1.0)
     w_a, w_b = 1.0 / s_a ** 2, 1.0 / s_b ** 2
     total = w_a + w_b
-    mean = np.where(usable, (w_a * np.where(usable, a, 0.0) + w_b * np.where(usable, b, 0.0))
-                    / total, np.nan)
-    birge = np.abs(np.where(usable, a - b, 0.0)) / np.hypot(s_a, s_b)
+    mean = (w_a * a + w_b * b) / total
+    birge = np.abs(a - b) / np.hypot(s_a, s_b)
     pooled_std = (w_a * s_a + w_b * s_b) / total * np.maximum(1.0, birge)
     for index in (upper, lower):
         value[index] = np.where(usable, mean, value[index])

@@ -179,8 +179,8 @@ def solve_windows_over_rates(equations: Sequence[WindowEquations],
     """:func:`solve_windows` at every transition rate of the soft sign, averaged over the rates
     (:func:`.rate_selection.averaged_over_rates`), and the rate of greatest weight (rad/s).
     ``settings`` go to :func:`solve_windows`."""
-    return averaged_over_rates(lambda index: solve_windows(equations, rate_index=index, **settings),
-                           rates)
+    return averaged_over_rates(
+        lambda index: solve_windows(equations, rate_index=index, **settings), rates)
 
 
 __all__ = ["SOFT_SIGN_RATES", "WindowEquations", "coulomb_patterns", "solve_windows",
