@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from stewartid.identification.physical import PhysicalIdentifier
+from stewartid.physical.estimator import PhysicalIdentifier
 from stewartid.platform import load_platform
 from stewartid.simulation import (
     DEFAULT_AMPLITUDES,

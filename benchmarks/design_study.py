@@ -163,7 +163,7 @@ def _figure(predicted, observed, baseline, directory: Path) -> None:
     import matplotlib
     from matplotlib.figure import Figure
 
-    from stewartid.reporting.figures import STYLE, save_figure
+    from stewartid.reports.drawing import STYLE, save_figure
 
     labels = [entry_label(k) for k in PAPER_ENTRIES]
     x = np.arange(len(labels))

@@ -2,7 +2,7 @@
 unbiased estimator can reach on the first moments and the friction coefficients.
 
 The information matrix of every base parameter in full mode
-(:func:`stewartid.design.information.predict_parameters`): the leg forces' white noise of the
+(:func:`stewartid.design.physical.information.predict_parameters`): the leg forces' white noise of the
 reference sensors, each leg weighted alike (generalized least squares is then the maximum
 likelihood estimator), the motion known exactly. Pose noise only adds to it, so every figure
 is optimistic for a log. Beside it, the same with the estimator's differentiating kernel
@@ -34,8 +34,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import physical_study  # noqa: E402  (a sibling script)
 
-from stewartid.design.information import predict_parameters  # noqa: E402
 from stewartid.design.multisine import all_dofs_multisine  # noqa: E402
+from stewartid.design.physical.information import predict_parameters  # noqa: E402
 from stewartid.simulation.sensors import reference_noise  # noqa: E402
 
 #: The acceptance: first moments (kg m) and friction coefficients (%), worst of 8 seeds.

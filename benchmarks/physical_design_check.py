@@ -49,7 +49,7 @@ from stewartid.design.prediction import (  # noqa: E402
     measured_plant_datasets,
     plant_records,
 )
-from stewartid.identification.physical import PhysicalIdentifier  # noqa: E402
+from stewartid.physical.estimator import PhysicalIdentifier  # noqa: E402
 from stewartid.simulation import degrade  # noqa: E402
 from stewartid.simulation.sensors import reference_noise  # noqa: E402
 

@@ -40,11 +40,11 @@ from pathlib import Path
 
 import numpy as np
 
-from stewartid.identification.physical import PhysicalIdentifier
 from stewartid.model import matrix_regressors
 from stewartid.model import regressor as reg
 from stewartid.model.linearization import nominal_matrices
 from stewartid.mujoco.model import DEFAULT_TIMESTEP
+from stewartid.physical.estimator import PhysicalIdentifier
 from stewartid.platform import load_platform
 from stewartid.simulation import (
     DEFAULT_AMPLITUDES,

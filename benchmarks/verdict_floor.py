@@ -9,9 +9,9 @@ This script measures that floor on the study's stored fits (``--out`` files).
 For each noisy log, the truth of each of the 16 distinct quantities behind the 20 entries
 (Mt and Bt are symmetric) is given its Gaussian posterior under the methods' own error model:
 every plausible method that is not a misfit estimates it (its two symmetric members pooled by
-inverse variance, :func:`~stewartid.identification.accuracy.pooled`) with its reported standard
+inverse variance, :func:`~stewartid.verdict.accuracy.pooled`) with its reported standard
 error, the methods' errors correlated as their fold fits show
-(:func:`~stewartid.identification.accuracy.fold_correlation`), a flat prior. Truths drawn from
+(:func:`~stewartid.verdict.accuracy.fold_correlation`), a flat prior. Truths drawn from
 it give each method's largest error, so the chance that an answer passes the bar on that log
 can be computed for any answer: the verdict's trusted result (a consensus rebuilt from its
 stored members by this version of the package), each method's, the posterior mean,
@@ -35,10 +35,10 @@ from pathlib import Path
 
 import numpy as np
 
-from stewartid.identification.accuracy import fold_correlation, pooled, symmetric_members
-from stewartid.identification.consensus import combine_results
 from stewartid.identification.result import IdentificationResult
 from stewartid.reference.published import PAPER_ENTRIES
+from stewartid.verdict.accuracy import fold_correlation, pooled, symmetric_members
+from stewartid.verdict.consensus import combine_results
 
 #: The bar of the verdict study: within this factor of the best method's largest error ...
 TRUST_FACTOR = 1.5
@@ -67,7 +67,7 @@ def entries(result: IdentificationResult) -> np.ndarray:
 
 def answers_of(row: dict) -> dict[str, np.ndarray]:
     """Every fitted method's 20 entries; the consensus rebuilt from its close call's stored
-    members by this version of :func:`~stewartid.identification.consensus.combine_results`
+    members by this version of :func:`~stewartid.verdict.consensus.combine_results`
     (the study may have stored an earlier one)."""
     answers = {n: entries(stored_result(m)) for n, m in row["methods"].items()
                if "M" in m and n != "consensus"}

@@ -15,9 +15,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from stewartid import load_platform
-from stewartid.identification.physical import PAYLOAD_PARAMETERS, payload_section
 from stewartid.identification.registry import create_identifier
 from stewartid.model import regressor as reg
+from stewartid.physical.estimator import PAYLOAD_PARAMETERS, payload_section
 from stewartid.simulation import DEFAULT_AMPLITUDES, Sine, multisine_excitation, simulate_experiment
 from stewartid.simulation.sensors import reference_noise
 

@@ -8,9 +8,9 @@ import json
 import numpy as np
 import pytest
 
-from stewartid.assessment.close_call import CONSENSUS, consensus_members, trust_consensus
-from stewartid.assessment.verdict import choose_trusted
-from stewartid.identification.consensus import combine_estimates, combine_results, pooled_pairs
+from stewartid.verdict.close_call import CONSENSUS, consensus_members, trust_consensus
+from stewartid.verdict.consensus import combine_estimates, combine_results, pooled_pairs
+from stewartid.verdict.rule import choose_trusted
 from test_verdict import _result, _validation
 
 
@@ -160,9 +160,9 @@ def test_the_report_builds_and_trusts_the_consensus_of_a_close_call(tmp_path, pa
 def test_no_consensus_of_members_validated_on_differently_prepared_segments():
     """Members whose held-out forces differ (one subtracted gravity, the other not) cannot be
     validated as one model: no consensus is built, and the verdict stays with one method."""
-    from stewartid.assessment.validation import CrossValidation, Segment
     from stewartid.reports.identification.records import MethodReport
     from stewartid.reports.identification.report import consensus_run, same_segments
+    from stewartid.validation.heldout import CrossValidation, Segment
 
     rng = np.random.default_rng(2)
 

@@ -25,7 +25,7 @@ from stewartid.identification.consistency import (
     project_consistent,
 )
 from stewartid.reference.published import PAPER_ENTRIES, relative_error_percent
-from stewartid.reporting.exports import read_matrix_csv
+from stewartid.reports.exports import read_matrix_csv
 from stewartid.reports.identification.report import write_identification_report
 
 SAMPLE_RATE = 200.0
@@ -136,7 +136,7 @@ def test_validation_of_the_exact_model_is_perfect(linear_report, linear_data):
     # VAF of the true matrices on the same segments: what the disturbance alone leaves
     report, _ = linear_report
     _, M, B = linear_data
-    from stewartid.assessment.validation import predict, score
+    from stewartid.validation.heldout import predict, score
 
     run = report.runs[0]
     truth = report.result.__class__(M=M, B=B, std_errors_M=M * 0, std_errors_B=B * 0,

@@ -54,7 +54,7 @@ def test_an_existing_output_folder_is_one_error_type(tmp_path):
 def test_figures_leave_matplotlib_global_state_alone(tmp_path):
     import matplotlib
 
-    from stewartid.reporting.figures import ExperimentTrace, plot_excitation
+    from stewartid.reports.drawing import ExperimentTrace, plot_excitation
 
     backend = matplotlib.get_backend()
     before = dict(matplotlib.rcParams)

@@ -17,9 +17,9 @@ from stewartid.identification.long_run import (
     score_sandwich,
     with_larger_variances,
 )
-from stewartid.identification.parameter_fit import solve_parameters
 from stewartid.identification.solvers import integrated_autocorrelation, solve_least_squares
 from stewartid.model.joints import JOINT_TYPES
+from stewartid.physical.parameter_fit import solve_parameters
 
 
 def _coulomb(levels):

@@ -19,10 +19,10 @@ from scipy.optimize import minimize
 
 from stewartid.datasets.dataset import Dataset
 from stewartid.errors import ConfigError
-from stewartid.identification.parameter_fit import Body, nearest_consistent
-from stewartid.identification.physical import PhysicalIdentifier
 from stewartid.model import regressor as reg
 from stewartid.model.kinematics import leg_jacobian, leg_lengths
+from stewartid.physical.estimator import PhysicalIdentifier
+from stewartid.physical.parameter_fit import Body, nearest_consistent
 from stewartid.simulation import DEFAULT_AMPLITUDES
 
 pytest.importorskip("cvxpy")

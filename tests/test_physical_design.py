@@ -13,20 +13,19 @@ from typer.testing import CliRunner
 from stewartid.cli.application import app
 from stewartid.datasets.dataset import Dataset
 from stewartid.design.candidates import Design
-from stewartid.design.information import (
+from stewartid.design.multisine import MultisineRecord, all_dofs_multisine, multisine_design
+from stewartid.design.physical.information import (
     design_rows,
     parameter_sizes,
     played_states,
     predict_parameters,
 )
-from stewartid.design.multisine import MultisineRecord, all_dofs_multisine, multisine_design
-from stewartid.design.payload_accuracy import (
+from stewartid.design.physical.payload_accuracy import (
     distance_quantile,
     held_share,
     payload_jacobian,
 )
-from stewartid.design.physical_run import run_physical_design
-from stewartid.design.physical_search import (
+from stewartid.design.physical.search import (
     candidate,
     commanded_limit_use,
     plant_scales,
@@ -34,9 +33,10 @@ from stewartid.design.physical_search import (
     scale_to_limits,
     search_design,
 )
-from stewartid.identification.physical import PhysicalIdentifier
+from stewartid.design.physical.workflow import run_physical_design
 from stewartid.model import regressor as reg
 from stewartid.model.kinematics import inverse_kinematics, leg_jacobian
+from stewartid.physical.estimator import PhysicalIdentifier
 from stewartid.platform import load_platform
 from stewartid.simulation import SensorNoise
 
@@ -246,7 +246,7 @@ def test_payload_design_sharpens_the_ten_within_the_accuracy_margin(loaded, monk
     sharpens the ten parameters there: against a search of the same candidates judged on
     the quantities alone, its pick's worst relative standard error of the ten is smaller,
     while its quantities stay within the margin whenever that pick's do."""
-    import stewartid.design.physical_search as search
+    import stewartid.design.physical.search as search
 
     noise = SensorNoise(force_noise=170.0)
     kept = search_design(loaded, 32.0, noise, payload=True, random_candidates=8,
@@ -278,7 +278,7 @@ def test_the_centre_of_mass_distance_quantile_matches_a_monte_carlo():
 def test_the_summary_says_whether_the_margin_was_held():
     """Within the margin the sentence says the ten were sharpened; beyond it, what lowers it
     (a 40 s design of a 1.2 t payload reached 0.67 of the accuracy)."""
-    from stewartid.design.physical_run import criterion_summary
+    from stewartid.design.physical.workflow import criterion_summary
 
     needed = {"mass": 0.002, "com": 0.002, "inertia": 0.02}
     baseline = SimpleNamespace(criterion=0.8, worst_relative_std=0.5)

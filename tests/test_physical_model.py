@@ -24,12 +24,12 @@ from typer.testing import CliRunner
 from roundoff import EPS
 from stewartid.cli import app
 from stewartid.datasets.dataset import write_dataset
-from stewartid.identification.physical import PhysicalIdentifier
-from stewartid.identification.physical_platform import identified_platform
 from stewartid.model import matrix_regressors
 from stewartid.model import regressor as reg
 from stewartid.model.dynamics import ModelTerms, friction_forces
 from stewartid.model.linearization import nominal_matrices, nominal_terms
+from stewartid.physical.estimator import PhysicalIdentifier
+from stewartid.physical.identified_platform import identified_platform
 from stewartid.platform import load_platform
 from stewartid.simulation import (
     DEFAULT_AMPLITUDES,

@@ -10,15 +10,15 @@ import numpy as np
 import pytest
 
 from stewartid.identification.long_run import filtered_noise_covariance
-from stewartid.identification.physical_noise import regressor_noise
-from stewartid.identification.physical_regression import (
+from stewartid.identification.preparation import prepare
+from stewartid.identification.wavelet.noise import white_noise_covariance
+from stewartid.model import regressor as reg
+from stewartid.physical.noise import regressor_noise
+from stewartid.physical.regression import (
     SAVGOL_FRACTION,
     SAVGOL_ORDER,
     filtered_regression,
 )
-from stewartid.identification.preparation import prepare
-from stewartid.identification.wavelet.noise import white_noise_covariance
-from stewartid.model import regressor as reg
 from stewartid.signals.filtered_rows import kernel_filter_rows
 from stewartid.signals.sign_rates import SIGN_FRACTIONS, coulomb_sign_rates
 from test_physical_model import PAYLOAD, multisine_records

@@ -15,18 +15,18 @@ from stewartid.files import write_text_atomic
 from stewartid.identification.result import IdentificationResult
 from stewartid.model.linearization import nominal_matrices
 from stewartid.reference.published import load_published
-from stewartid.reporting.figures import ExperimentTrace, plot_joint_rates
-from stewartid.reporting.html import render_html
-from stewartid.reporting.tables import to_csv, to_markdown
-from stewartid.reports.reproduction.comparison import ComparisonResults, MethodRun
-from stewartid.reports.reproduction.figures import plot_errors, plot_force_budget
-from stewartid.reports.reproduction.report import (
+from stewartid.reports.drawing import ExperimentTrace, plot_joint_rates
+from stewartid.reports.html import render_html
+from stewartid.reports.tables import to_csv, to_markdown
+from stewartid.reproduction.comparison import ComparisonResults, MethodRun
+from stewartid.reproduction.figures import plot_errors, plot_force_budget
+from stewartid.reproduction.report import (
     FigureEntry,
     fourier_summary,
     render_markdown,
     wavelet_summary,
 )
-from stewartid.reports.reproduction.tables import build_tables, paper_table
+from stewartid.reproduction.tables import build_tables, paper_table
 
 
 @pytest.fixture(scope="module")

@@ -14,8 +14,8 @@ from typer.testing import CliRunner
 from stewartid.cli import app
 from stewartid.errors import ConfigError
 from stewartid.model.linearization import nominal_matrices
-from stewartid.reports.reproduction.document import load_results
-from stewartid.reports.reproduction.settings import default_methods, make_settings
+from stewartid.reproduction.document import load_results
+from stewartid.reproduction.settings import default_methods, make_settings
 
 LEVELS = (0, 5, 30)
 TABLES = ["summary", "table3", "table4", "table5", "table6"] + [

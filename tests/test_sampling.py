@@ -108,8 +108,8 @@ def test_the_physical_model_widens_its_parameters_on_a_noise_free_plant_log():
     """Our plant's noise-free log (the paper's sines, 8 s, Coulomb 30 N m): the residual-based
     errors put 15 % of Mt, Bt beyond 3 SE (6.5 SE); the parameters' changes over the thinned
     fits join their variances and Mt, Bt follow."""
-    from stewartid.identification.physical import PhysicalIdentifier
     from stewartid.model.linearization import nominal_matrices
+    from stewartid.physical.estimator import PhysicalIdentifier
     from stewartid.platform import load_platform
     from stewartid.simulation import simulate_experiments
 

@@ -6,17 +6,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stewartid.assessment.validation import Segment, ValidationResult
-from stewartid.assessment.verdict import choose_trusted
-from stewartid.identification.accuracy import (
+from stewartid.identification.result import IdentificationResult
+from stewartid.reference.published import PAPER_ENTRIES
+from stewartid.validation.heldout import Segment, ValidationResult
+from stewartid.verdict.accuracy import (
     PRECISION_FACTOR,
     entry_relative_std,
     error_posterior,
     expected_worst_error,
     fold_correlation,
 )
-from stewartid.identification.result import IdentificationResult
-from stewartid.reference.published import PAPER_ENTRIES
+from stewartid.verdict.rule import choose_trusted
 
 
 def test_expected_worst_error_against_analytic_and_monte_carlo_values():

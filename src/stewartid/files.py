@@ -12,7 +12,7 @@ JSON: :func:`to_jsonable` turns arrays, NumPy scalars, tuples and paths into pla
 values. JSON has no non-finite numbers, so NaN and ±infinity are written as ``null``
 (readers turn ``null`` back into NaN: :meth:`IdentificationResult.from_dict
 <stewartid.identification.result.IdentificationResult.from_dict>` and
-:func:`stewartid.reports.reproduction.document.load_results` do). Any other object is a bug and
+:func:`stewartid.reproduction.document.load_results` do). Any other object is a bug and
 raises TypeError.
 """
 

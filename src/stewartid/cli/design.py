@@ -80,7 +80,7 @@ def design(
     from rich.progress import Progress
 
     from stewartid.design.report import identify_command
-    from stewartid.design.run import run_design
+    from stewartid.design.workflow import run_design
     from stewartid.fields import Interval, Options, check, nonnegative, positive
     from stewartid.simulation.sensors import sensor_noise
 
@@ -145,8 +145,8 @@ def _design_physical(description, budget: float, noise, out: Path, payload: bool
     """``design --model physical``: run it and print its summary."""
     from rich.console import Console
 
-    from stewartid.design.payload_accuracy import parse_accuracy
-    from stewartid.design.physical_run import criterion_summary, run_physical_design
+    from stewartid.design.physical.payload_accuracy import parse_accuracy
+    from stewartid.design.physical.workflow import criterion_summary, run_physical_design
     from stewartid.errors import ConfigError
 
     if not given.pop("--model"):

@@ -93,9 +93,9 @@ def identify(
     known (platform description, or meta.json/truth.json beside the data) and write JSON."""
     import numpy as np
 
-    from stewartid.identification.physical_platform import model_method
-    from stewartid.reporting.terminal import print_comparison
+    from stewartid.physical.identified_platform import model_method
     from stewartid.reports.identification.run import FlagSetting, identify_files
+    from stewartid.reports.terminal import print_comparison
 
     flags = {"--no-gravity": FlagSetting("gravity", not no_gravity, no_gravity),
              "--no-remainder": FlagSetting("remainder", not no_remainder, no_remainder),

@@ -72,7 +72,7 @@ def nominal(
             out["K_G"] = gravity_stiffness(description, q).tolist()
         sys.stdout.write(json.dumps(out) + "\n")
         return
-    from stewartid.reporting.terminal import print_matrix, print_vector
+    from stewartid.reports.terminal import print_matrix, print_vector
 
     where = "neutral pose" if q is None else f"pose {','.join(f'{v:g}' for v in q)}"
     print_matrix(M, f"Mt ({description.name}, {where})")

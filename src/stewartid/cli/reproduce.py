@@ -26,13 +26,13 @@ def reproduce(
     """Regenerate the paper's Tables 3-6 on the simulated plant, beside the published values:
     every method at Coulomb friction 0, 5 and 30 N·m, with tables (Markdown, CSV),
     results.json, figures (PNG, SVG) and report.md/report.html."""
-    from stewartid.reports.reproduction.run import run_reproduce
+    from stewartid.reproduction.run import run_reproduce
 
     output = run_reproduce(out=out, quick=quick, jobs=jobs, force=force, seed=seed,
                            progress=True)
     typer.echo(f"wrote {len(output.files)} files to {output.directory} in "
                f"{output.runtime_s:.1f} s; report: {output.directory / 'report.md'}")
-    from stewartid.reports.reproduction.report import summary_lines
+    from stewartid.reproduction.report import summary_lines
 
     for line in summary_lines(output.results):
         typer.echo("  " + line.replace("**", ""))

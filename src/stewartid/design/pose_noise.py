@@ -15,7 +15,7 @@ share is sum_k Z_k (h * n)_k with Z_k = X_k^T W T_k, which is sum_j U_j n_j for 
 
 the taps being exact derivatives on P and Q, which vary on the kernel's scale. Its
 covariance, sum_i G_i Sigma_q G_i^T with G = P'' - Q', adds to the force noise's B of the
-sandwich A^-1 B A^-1 (:func:`~stewartid.design.information.sandwich_covariance`). For a
+sandwich A^-1 B A^-1 (:func:`~stewartid.design.physical.information.sandwich_covariance`). For a
 slowly varying column the high-pass noise cancels (the mass through gravity); what is left
 is seen through how fast the motion's rows change, so the friction and the leg offsets take
 most of it and more at higher frequencies. On the 2 Hz payload design of our plant (8 seeds
@@ -93,7 +93,7 @@ def pose_noise_scores(platform: Platform, noise: SensorNoise, rate_hz: float,
                       taps: list[np.ndarray], rows: np.ndarray, transforms: np.ndarray,
                       weights: np.ndarray, theta: np.ndarray) -> np.ndarray:
     """The pose noise's share of the scores' covariance B, in the units of
-    :func:`~stewartid.design.information.sandwich_covariance` (summed over the rows at
+    :func:`~stewartid.design.physical.information.sandwich_covariance` (summed over the rows at
     ``rate_hz``, which stand for every logged sample).
 
     Parameters

@@ -1,7 +1,7 @@
 """The design report: limit use over time, interval lengths, predicted accuracy vs the paper's set.
 
-Figures are matplotlib PNG + SVG (:func:`stewartid.reporting.figures.save_figure`), the text is
-Markdown, rendered to a self-contained HTML page by :func:`stewartid.reporting.html.render_html`.
+Figures are matplotlib PNG + SVG (:func:`stewartid.reports.drawing.save_figure`), the text is
+Markdown, rendered to a self-contained HTML page by :func:`stewartid.reports.html.render_html`.
 """
 
 from __future__ import annotations
@@ -17,8 +17,8 @@ from stewartid.design.limits import LIMIT_NAMES, LimitUse
 from stewartid.design.prediction import Prediction, identify_options
 from stewartid.files import write_text_atomic
 from stewartid.reference.published import PAPER_ENTRIES, entry_label
-from stewartid.reporting.figures import STYLE, save_figure
-from stewartid.reporting.html import render_html
+from stewartid.reports.drawing import STYLE, save_figure
+from stewartid.reports.html import render_html
 
 
 def plot_limit_use(uses: Sequence[LimitUse], names: Sequence[str], directory: str | Path

@@ -53,12 +53,12 @@ from stewartid.identification.friction_shape import (
     shaped_sign,
 )
 from stewartid.identification.pairs import calibrate_by_pairs
-from stewartid.identification.physical_noise import measured_sign_rates
 from stewartid.identification.preparation import Experiment, prepare
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.solvers import regressor_names, solve_least_squares
 from stewartid.model.joints import JOINT_TYPES
+from stewartid.physical.noise import measured_sign_rates
 from stewartid.platform import Platform
 from stewartid.signals.differentiation import (
     DEFAULT_ORDER,

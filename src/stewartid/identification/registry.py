@@ -8,11 +8,9 @@ the benchmarks read it from here.
 
 Adding a method is one new file: put a module in ``stewartid/identification/`` whose
 estimator class (a :class:`~stewartid.identification.base.BaseIdentifier`) carries
-``@register_method(...)``. Discovery imports every module of the ``stewartid.identification``
-package once (``pkgutil``), the built-in methods first in the order of
-:data:`BUILTIN_MODULES` (the paper's Method B, Method A, then least squares), the others
-alphabetically; the infrastructure modules register nothing. Presets come after every
-method.
+``@register_method(...)``. Discovery imports the built-in methods' modules
+(:data:`BUILTIN_MODULES`, in their order) and then every other module of the
+``stewartid.identification`` package, alphabetically. Presets come after every method.
 
 Example
 -------
@@ -35,7 +33,9 @@ from typing import Any
 from stewartid.errors import ConfigError
 
 #: Modules of the built-in methods, in registration order.
-BUILTIN_MODULES = ("wavelet", "fourier", "least_squares")
+BUILTIN_MODULES = ("stewartid.identification.wavelet", "stewartid.identification.fourier",
+                   "stewartid.identification.least_squares", "stewartid.verdict.consensus",
+                   "stewartid.physical.estimator")
 
 
 @dataclass(frozen=True)
@@ -154,10 +154,10 @@ def _qualified(cls: type) -> str:
 
 def _module_order() -> list[str]:
     package = importlib.import_module("stewartid.identification")
-    found = sorted(info.name for info in pkgutil.iter_modules(package.__path__)
+    found = sorted(f"stewartid.identification.{info.name}"
+                   for info in pkgutil.iter_modules(package.__path__)
                    if not info.name.startswith("_"))
-    return [m for m in BUILTIN_MODULES if m in found] + [m for m in found
-                                                        if m not in BUILTIN_MODULES]
+    return [*BUILTIN_MODULES, *(m for m in found if m not in BUILTIN_MODULES)]
 
 
 def _discover() -> None:
@@ -165,20 +165,21 @@ def _discover() -> None:
     if _discovered:
         return
     for module in _module_order():
-        importlib.import_module(f"stewartid.identification.{module}")
+        importlib.import_module(module)
     _discovered = True
 
 
 def registered_methods() -> tuple[MethodSpec, ...]:
     """Every registered method, built-ins first (wavelet, fourier, ls), then presets."""
     _discover()
-    modules = {f"stewartid.identification.{m}": k for k, m in enumerate(_module_order())}
+    modules = _module_order()
     position = {name: k for k, name in enumerate(_REGISTRY)}
 
     def module_rank(cls: type) -> int:
-        # a method is a module or a subpackage of stewartid.identification
-        parts = cls.__module__.split(".")
-        return modules.get(".".join(parts[:3]), len(modules))
+        # a method is a module or a subpackage of one of the discovered modules
+        return next((k for k, m in enumerate(modules)
+                     if cls.__module__ == m or cls.__module__.startswith(m + ".")),
+                    len(modules))
 
     def order(spec: MethodSpec) -> tuple[bool, int, int]:
         return (spec.preset_of is not None, module_rank(spec.estimator_class), position[spec.name])

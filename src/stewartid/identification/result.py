@@ -39,7 +39,7 @@ class IdentificationResult:
         Method-specific: intervals, (a, b) points, frequencies, Coulomb levels, ...
     validation : dict, optional
         Held-out prediction scores, ``{"vaf_percent": [6], "nrmse": [6], "folds": N}``
-        (:mod:`stewartid.assessment.validation`); None when not validated.
+        (:mod:`stewartid.validation.heldout`); None when not validated.
     delay : dict, optional
         The delay of the force channels relative to the motion the data were aligned by,
         ``{"seconds", "std_error", "applied", "source": "given" | "estimated", ...}``
@@ -47,7 +47,7 @@ class IdentificationResult:
     verdict : dict, optional
         With several methods compared, which to trust and why,
         ``{"trusted", "ranking", "uncertain_entries", "reasons", ...}``
-        (:meth:`stewartid.assessment.verdict.Verdict.to_dict`); None otherwise.
+        (:meth:`stewartid.verdict.rule.Verdict.to_dict`); None otherwise.
 
     ``to_dict`` also writes ``consistency``, the symmetry and definiteness of M and B
     (:func:`~stewartid.identification.consistency.consistency_metrics`).

@@ -1,2 +1,2 @@
-"""The two reports: :mod:`~stewartid.reports.identification` (``identify --report``) and
-:mod:`~stewartid.reports.reproduction` (``stewartid reproduce``)."""
+"""Reports render results: tables, figures, the HTML page, method labels, terminal tables,
+matrix exports and the identification report. Nothing here fits a model."""

@@ -20,10 +20,10 @@ import numpy as np
 import pandas as pd
 
 from stewartid.files import write_text_atomic
-from stewartid.reporting.figures import STYLE, save_figure
-from stewartid.reporting.html import render_html
-from stewartid.reporting.methods import method_color, method_name, report_order
-from stewartid.reporting.tables import ResultTable, to_markdown, write_tables
+from stewartid.reports.drawing import STYLE, save_figure
+from stewartid.reports.html import render_html
+from stewartid.reports.methods import method_color, method_name, report_order
+from stewartid.reports.tables import ResultTable, to_markdown, write_tables
 from stewartid.studies.spec import PARAMETERS, StudySpec
 
 #: Error columns summarised, with their labels.

@@ -19,7 +19,6 @@ import numpy as np
 
 from stewartid.datasets.dataset import Dataset
 from stewartid.errors import IdentificationError
-from stewartid.identification.accuracy import predicted_worst_error
 from stewartid.identification.preparation import Experiment
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.wavelet.detection import (
@@ -33,6 +32,7 @@ from stewartid.identification.wavelet.gls import WeakFormSolution
 from stewartid.identification.wavelet.rate_selection import solve_weak_form_over_rates
 from stewartid.identification.wavelet.weak_form import experiment_equations
 from stewartid.identification.wavelet.windows import solve_windows_over_rates, window_equations
+from stewartid.verdict.accuracy import predicted_worst_error
 
 #: Window length (s) of ``friction="coulomb"``.
 WINDOW_LENGTH = 2.0
@@ -105,7 +105,7 @@ def choose_friction_fit(results: Mapping[str, IdentificationResult],
 
     One fit is kept as it is. Of "free" and "coulomb", the law's is kept unless its
     standard errors predict the larger worst error
-    (:func:`~stewartid.identification.accuracy.predicted_worst_error`) or
+    (:func:`~stewartid.verdict.accuracy.predicted_worst_error`) or
     :func:`friction_law_test` rejects the law.
 
     Parameters

@@ -2,7 +2,7 @@
 in report order.
 
 The drawing itself is :mod:`~stewartid.reports.identification.method_figures` and
-:mod:`stewartid.reporting.figures`; this module decides what is drawn, with which data and
+:mod:`stewartid.reports.drawing`; this module decides what is drawn, with which data and
 caption.
 """
 
@@ -18,7 +18,7 @@ from stewartid.datasets.dataset import Dataset
 from stewartid.identification.preparation import prepare
 from stewartid.identification.wavelet.intervals import joint_rates
 from stewartid.platform import Platform
-from stewartid.reporting.figures import ExperimentTrace, plot_excitation, plot_joint_rates
+from stewartid.reports.drawing import ExperimentTrace, plot_excitation, plot_joint_rates
 from stewartid.reports.identification import method_figures as plots
 from stewartid.reports.identification.records import MethodReport, PhysicalSection
 from stewartid.reports.identification.text import used_intervals

@@ -7,11 +7,11 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from stewartid.assessment.validation import friction_signature
 from stewartid.identification.result import IdentificationResult
 from stewartid.model.joints import FRICTION_TYPES
 from stewartid.platform import Platform
 from stewartid.reports.identification.records import MethodReport
+from stewartid.validation.heldout import friction_signature
 
 
 def friction_text(run: MethodReport) -> str:

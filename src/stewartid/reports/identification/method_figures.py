@@ -1,8 +1,8 @@
 """Figures of an identification report on measured data, each written as PNG and SVG.
 
-Drawn like every figure of the package (:mod:`stewartid.reporting.figures`): a
+Drawn like every figure of the package (:mod:`stewartid.reports.drawing`): a
 :class:`matplotlib.figure.Figure` inside ``rc_context(STYLE)``, no pyplot, lines thinned to a
-few thousand points, saved by :func:`~stewartid.reporting.figures.save_figure`. Every
+few thousand points, saved by :func:`~stewartid.reports.drawing.save_figure`. Every
 function returns the written paths. The layouts are regular grids with fixed margins rather
 than matplotlib's constrained layout, which would triple the drawing time of a report.
 """
@@ -14,11 +14,11 @@ from pathlib import Path
 
 import numpy as np
 
-from stewartid.assessment.validation import ValidationResult
 from stewartid.model.joints import FRICTION_TYPES
 from stewartid.platform import COORDINATES
-from stewartid.reporting.figures import new_figure, save_figure, styled, thinning_step
+from stewartid.reports.drawing import new_figure, save_figure, styled, thinning_step
 from stewartid.reports.identification.records import Workspace
+from stewartid.validation.heldout import ValidationResult
 
 #: Display unit and scale of a displacement in each coordinate.
 DISPLACEMENT_UNITS = (("mm", 1e3),) * 3 + (("mrad", 1e3),) * 3

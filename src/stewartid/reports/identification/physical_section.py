@@ -1,6 +1,6 @@
 """The physical model in the identification report: fitted beside the compared methods (not
 ranked by the verdict), its held-out prediction by the full nonlinear model
-(:mod:`stewartid.assessment.physical_validation`), Mt and Bt across the poses the data cover
+(:mod:`stewartid.physical.validation`), Mt and Bt across the poses the data cover
 with their uncertainty (:func:`workspace`), and its parameters with the fixed ones named.
 """
 
@@ -14,25 +14,25 @@ from typing import Any
 
 import numpy as np
 
-from stewartid.assessment.physical_validation import (
+from stewartid.datasets.dataset import Dataset
+from stewartid.errors import StewartidError
+from stewartid.model.linearization import nominal_matrices
+from stewartid.physical.estimator import PhysicalIdentifier, PhysicalResult
+from stewartid.physical.prediction import matrices_at, parameter_map
+from stewartid.physical.validation import (
     cross_validate_physical,
     validate_physical_on_records,
 )
-from stewartid.assessment.validation import (
+from stewartid.platform import COORDINATES, Platform
+from stewartid.reports.identification.records import PhysicalSection, Workspace
+from stewartid.reports.tables import ResultTable, to_markdown
+from stewartid.validation.heldout import (
     Segment,
     held_out_segments,
     record_segments,
     validation_entry,
 )
-from stewartid.assessment.verdict import worst_dof
-from stewartid.datasets.dataset import Dataset
-from stewartid.errors import StewartidError
-from stewartid.identification.physical import PhysicalIdentifier, PhysicalResult
-from stewartid.identification.physical_prediction import matrices_at, parameter_map
-from stewartid.model.linearization import nominal_matrices
-from stewartid.platform import COORDINATES, Platform
-from stewartid.reporting.tables import ResultTable, to_markdown
-from stewartid.reports.identification.records import PhysicalSection, Workspace
+from stewartid.verdict.rule import worst_dof
 
 #: Poses per swept coordinate in :func:`workspace`.
 WORKSPACE_POINTS = 11

@@ -9,18 +9,18 @@ from pathlib import Path
 
 import numpy as np
 
-from stewartid.assessment.validation import (
+from stewartid.errors import StewartidError
+from stewartid.identification.consistency import ConsistentEstimate
+from stewartid.identification.result import IdentificationResult
+from stewartid.physical.estimator import PhysicalResult
+from stewartid.physical.prediction import PoseMatrices
+from stewartid.validation.heldout import (
     FRICTION_TYPES,
     CrossValidation,
     ValidationResult,
     coulomb_estimate,
 )
-from stewartid.assessment.verdict import Verdict
-from stewartid.errors import StewartidError
-from stewartid.identification.consistency import ConsistentEstimate
-from stewartid.identification.physical import PhysicalResult
-from stewartid.identification.physical_prediction import PoseMatrices
-from stewartid.identification.result import IdentificationResult
+from stewartid.verdict.rule import Verdict
 
 
 @dataclass(frozen=True)
@@ -128,7 +128,7 @@ class PhysicalSection:
         Of its parameters (``PhysicalIdentifier.covariance_``).
     workspace : Workspace or None
     validation : ValidationResult or None
-        Held-out prediction by the full model (:mod:`stewartid.assessment.physical_validation`).
+        Held-out prediction by the full model (:mod:`stewartid.physical.validation`).
     records : ValidationResult or None
         Its prediction of the validation records (``identify --validate``).
     seconds : float
@@ -156,7 +156,7 @@ class IdentificationReport:
     ----------
     runs : list of MethodReport
     verdict : Verdict
-        Which method to trust and why (:mod:`stewartid.assessment.verdict`).
+        Which method to trust and why (:mod:`stewartid.verdict.rule`).
     directory : Path
     files : list of Path
     physical : PhysicalSection or None

@@ -2,10 +2,10 @@
 --report DIR``).
 
 :func:`write_identification_report` fits one or several registered methods to the same
-experiments, validates each on held-out time segments (:mod:`stewartid.assessment.validation`),
+experiments, validates each on held-out time segments (:mod:`stewartid.validation.heldout`),
 checks the physical consistency of the matrices and, on request, replaces them by the nearest
 consistent pair (:mod:`stewartid.identification.consistency`), chooses the method to trust
-(:mod:`stewartid.assessment.verdict`) and writes into ``DIR``:
+(:mod:`stewartid.verdict.rule`) and writes into ``DIR``:
 
 - ``report.md`` and a self-contained ``report.html`` (:mod:`.text`): the data, the
   constant-direction intervals, Mt and Bt with standard errors beside the nominal values,
@@ -15,7 +15,7 @@ consistent pair (:mod:`stewartid.identification.consistency`), chooses the metho
 - ``result.json``: the trusted method's result with its ``validation`` and ``consistency``
   objects (with ``identify --model physical``, the physical model's result with the compared
   methods' ``verdict``), and the CSV and MATLAB exports of every method
-  (:mod:`stewartid.reporting.exports`);
+  (:mod:`stewartid.reports.exports`);
 - with the physical model asked for (:class:`~.physical_section.PhysicalRequest`), its
   section (:mod:`.physical_section`): Mt and Bt across the measured poses, its parameters and
   its held-out prediction beside the others', not ranked by the verdict; ``physical.json`` its
@@ -32,8 +32,26 @@ from typing import Any
 
 import numpy as np
 
-from stewartid.assessment.close_call import CONSENSUS, consensus_members, trust_consensus
-from stewartid.assessment.validation import (
+from stewartid.datasets.dataset import Dataset
+from stewartid.errors import ConfigError, StewartidError
+from stewartid.files import write_text_atomic
+from stewartid.identification import registry
+from stewartid.identification.consistency import ConsistentEstimate, project_consistent
+from stewartid.identification.result import IdentificationResult
+from stewartid.model.linearization import nominal_matrices
+from stewartid.platform import Platform
+from stewartid.reports.exports import ExportedModel, write_exports
+from stewartid.reports.html import render_html
+from stewartid.reports.identification.figures import (
+    FigureDrawer,
+    data_figures,
+    physical_figures,
+    result_figures,
+)
+from stewartid.reports.identification.physical_section import PhysicalRequest, fit_physical
+from stewartid.reports.identification.records import IdentificationReport, MethodReport
+from stewartid.reports.identification.text import data_rows, render_report
+from stewartid.validation.heldout import (
     DEFAULT_FOLDS,
     CrossValidation,
     Segment,
@@ -45,27 +63,9 @@ from stewartid.assessment.validation import (
     validation_entry,
     with_companion_friction,
 )
-from stewartid.assessment.verdict import Verdict, choose_trusted
-from stewartid.datasets.dataset import Dataset
-from stewartid.errors import ConfigError, StewartidError
-from stewartid.files import write_text_atomic
-from stewartid.identification import registry
-from stewartid.identification.consensus import combine_results
-from stewartid.identification.consistency import ConsistentEstimate, project_consistent
-from stewartid.identification.result import IdentificationResult
-from stewartid.model.linearization import nominal_matrices
-from stewartid.platform import Platform
-from stewartid.reporting.exports import ExportedModel, write_exports
-from stewartid.reporting.html import render_html
-from stewartid.reports.identification.figures import (
-    FigureDrawer,
-    data_figures,
-    physical_figures,
-    result_figures,
-)
-from stewartid.reports.identification.physical_section import PhysicalRequest, fit_physical
-from stewartid.reports.identification.records import IdentificationReport, MethodReport
-from stewartid.reports.identification.text import data_rows, render_report
+from stewartid.verdict.close_call import CONSENSUS, consensus_members, trust_consensus
+from stewartid.verdict.consensus import combine_results
+from stewartid.verdict.rule import Verdict, choose_trusted
 
 
 def consistent_result(result: IdentificationResult) -> tuple[IdentificationResult,
@@ -168,7 +168,7 @@ def same_segments(a: Sequence[Segment], b: Sequence[Segment]) -> bool:
 
 
 def consensus_run(members: Sequence[MethodReport], consistent: bool) -> MethodReport | None:
-    """The consensus of fitted methods (:func:`~stewartid.identification.consensus.combine_results`),
+    """The consensus of fitted methods (:func:`~stewartid.verdict.consensus.combine_results`),
     validated as :func:`run_method` validates a method: each fold's consensus of the members'
     fold fits predicts the held-out segments, the full consensus the validation records.
     None when the members were validated on differently prepared segments (their ``gravity``
@@ -201,9 +201,9 @@ def consensus_run(members: Sequence[MethodReport], consistent: bool) -> MethodRe
 
 def judge(runs: Sequence[MethodReport], consistent: bool = False
           ) -> tuple[list[MethodReport], Verdict]:
-    """The verdict on the methods' runs (:func:`~stewartid.assessment.verdict.choose_trusted`)
+    """The verdict on the methods' runs (:func:`~stewartid.verdict.rule.choose_trusted`)
     and, where it names a close call, the consensus of the close methods added to the runs
-    and trusted (:mod:`stewartid.assessment.close_call`).
+    and trusted (:mod:`stewartid.verdict.close_call`).
 
     Returns
     -------

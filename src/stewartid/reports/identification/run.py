@@ -16,7 +16,6 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from stewartid.assessment.validation import DEFAULT_FOLDS
 from stewartid.datasets.dataset import Dataset, expand_paths, read_datasets
 from stewartid.datasets.excitation import check_experiment_set
 from stewartid.datasets.log_format import load_log_format
@@ -36,6 +35,7 @@ from stewartid.model.linearization import nominal_matrices
 from stewartid.platform import Platform
 from stewartid.reports.identification.physical_section import PhysicalRequest
 from stewartid.reports.identification.records import IdentificationReport
+from stewartid.validation.heldout import DEFAULT_FOLDS
 
 #: ``identify --method`` value that runs every registered method.
 ALL_METHODS = "all"
@@ -204,7 +204,7 @@ def _fit_alone(datasets: list[Dataset], platform: Platform, method: str,
                ) -> IdentificationResult:
     """One method (or the physical model) without a report, made consistent on request."""
     if model is not None:
-        from stewartid.identification.physical_platform import identify_model
+        from stewartid.physical.identified_platform import identify_model
 
         return identify_model(datasets, platform, model, payload, consistent=consistent,
                               settings=dict(settings))
@@ -262,7 +262,7 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     model, payload, platform_out : optional
         ``"physical"``: the physical model instead of ``method``, in payload mode with
         ``payload``, its platform description written to ``platform_out``
-        (:func:`~stewartid.identification.physical_platform.identify_model`); with
+        (:func:`~stewartid.physical.identified_platform.identify_model`); with
         ``report``, the report of every compared method (as ``method="all"``) with the
         physical model's section, and its result (with their verdict) as the result. With
         ``method="all"`` and a report, the section is added too, unless the model cannot be
@@ -289,7 +289,7 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     _check_outputs(paths, (platform, columns), out, report, force, method, len(names) > 1,
                    folds)
     if model is not None:
-        from stewartid.identification.physical_platform import check_model_outputs
+        from stewartid.physical.identified_platform import check_model_outputs
 
         check_model_outputs(model, platform_out, {}, [*paths, *([platform] if platform else [])])
     if validate and report is None:
@@ -311,7 +311,7 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     meta = nominal_from_meta(paths)
 
     def check(found: IdentificationResult) -> None:
-        from stewartid.assessment.verdict import friction_immune, models_friction
+        from stewartid.verdict.rule import friction_immune, models_friction
 
         check_identified(found.M, found.B, description, found.method if report else None,
                          not (models_friction(found) or friction_immune(found)))
@@ -337,7 +337,7 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
                             payload, check)
     check(result)
     if model is not None and platform_out is not None:
-        from stewartid.identification.physical_platform import write_identified
+        from stewartid.physical.identified_platform import write_identified
 
         write_identified(description, result, platform_out, len(datasets))
     if delay_entry is not None:

@@ -1,6 +1,6 @@
 """The text of the identification report (:mod:`~stewartid.reports.identification.report`):
 data summary, which method to trust and why (the
-:class:`~stewartid.assessment.verdict.Verdict` in words), and ``report.md``.
+:class:`~stewartid.verdict.rule.Verdict` in words), and ``report.md``.
 
 Every statement is computed from the numbers of the run (no fixed verdicts): if a result
 changes, so does the sentence about it.
@@ -17,11 +17,11 @@ from stewartid.datasets.dataset import Dataset
 from stewartid.identification.consistency import consistency_metrics, is_consistent
 from stewartid.identification.wavelet.noise import white_noise_covariance
 from stewartid.platform import COORDINATES, Platform
-from stewartid.reporting.tables import ResultTable, to_markdown
 from stewartid.reports.identification.friction_text import friction_section
 from stewartid.reports.identification.physical_section import physical_lines
 from stewartid.reports.identification.records import IdentificationReport, MethodReport
 from stewartid.reports.identification.verdict_text import changed_text, verdict_lines
+from stewartid.reports.tables import ResultTable, to_markdown
 from stewartid.signals.differentiation import differentiate, estimate_frequency
 
 _UNITS = ("mm",) * 3 + ("mrad",) * 3

@@ -1,6 +1,6 @@
 """The identification report's verdict in words: what to know about one method's result
 (:func:`method_lines`), and for several which to trust and what set the others back
-(:func:`verdict_lines`, the :class:`~stewartid.assessment.verdict.Verdict` in sentences).
+(:func:`verdict_lines`, the :class:`~stewartid.verdict.rule.Verdict` in sentences).
 """
 
 from __future__ import annotations
@@ -10,10 +10,6 @@ from typing import Any
 
 import numpy as np
 
-from stewartid.assessment.close_call import CONSENSUS, combined_text
-from stewartid.assessment.validation import friction_signature
-from stewartid.assessment.verdict import CLOSE_FACTOR, Verdict, named_entries, worst_dof
-from stewartid.identification.accuracy import PRECISION_FACTOR, relative_std
 from stewartid.identification.consistency import consistency_metrics, is_consistent
 from stewartid.reports.identification.friction_text import (
     friction_law_lines,
@@ -22,6 +18,10 @@ from stewartid.reports.identification.friction_text import (
     third_harmonic_lines,
 )
 from stewartid.reports.identification.records import MethodReport
+from stewartid.validation.heldout import friction_signature
+from stewartid.verdict.accuracy import PRECISION_FACTOR, relative_std
+from stewartid.verdict.close_call import CONSENSUS, combined_text
+from stewartid.verdict.rule import CLOSE_FACTOR, Verdict, named_entries, worst_dof
 
 #: Held-out VAF (%) in the worst DOF above which a model "predicts closely", "adequately".
 CLOSE_VAF, ADEQUATE_VAF = 99.0, 95.0
@@ -160,7 +160,7 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
 
 def consensus_text(verdict: Verdict, best: MethodReport, names: dict[str, str]) -> str:
     """The verdict's first sentences when it trusts the consensus of a close call
-    (:mod:`stewartid.assessment.close_call`); ``names``: display name by registry name."""
+    (:mod:`stewartid.verdict.close_call`); ``names``: display name by registry name."""
     members = verdict.close
     standing = verdict.standings[best.name]
     agreement = best.result.diagnostics.get("consensus", {}).get("agreement", float("nan"))

@@ -1,0 +1,450 @@
+"""Predicted standard errors of the physical model's parameters from the information matrix.
+
+The physical estimator (:class:`~stewartid.physical.estimator.PhysicalIdentifier`)
+regresses the measured leg forces on the regressor's columns mapped to them,
+f = J_lq^-T X theta + e, with each leg's channel weighted by its residual variance. The force
+noise (white, ``force_noise`` of every leg, covariance S = Sigma_f per sample) is then that
+of the channels themselves. The estimator's covariance is the sandwich
+
+    Cov(theta) = A^-1 B A^-1,   A = sum_k X_k^T W X_k,   B = sum_k X_k^T W S_k W X_k,
+
+X_k the rows in leg forces and W = diag(1 / mean_k S_k,cc) its channel weights, summed over
+the logged samples (with legs alike, generalized least squares). The
+estimator filters both sides with a smooth kernel and keeps ``ROWS_PER_WINDOW`` rows per
+kernel window: the filtered noise is correlated over the window, and its sum over the kept
+rows is the sum of the filtered noise over every sample. For a regressor smooth on the
+kernel's scale the covariance is that of the unfiltered regression; the Coulomb columns'
+reversals are not, and the final prediction filters the regressor as the estimator does
+(:func:`kernel_filtered`; the search leaves it out). The
+regressor along the commanded motion (analytic q, q_dot, q_ddot; for the final prediction the
+motion the plant played, :func:`played_states`) is summed at ``rate_hz`` and scaled to the
+sample rate: the products of the columns vary on the scale of
+the motion's periods, far slower than :data:`INFORMATION_RATE`.
+
+The parameters judged are the moving body's ten (full mode) or the payload's ten (payload
+mode); the others (legs, friction, offsets) are estimated with them, so that the judged block
+of the covariance is the inverse of the Schur complement of the others' block in the
+information. The pose noise (leg-length noise through the kinematics) reaches the rows
+through the filtered rates and accelerations, high-pass: the search leaves it out (its
+payload's parameters take a tenth or less of their variance from it), the final prediction
+adds it (:mod:`stewartid.design.pose_noise`; most of the friction's variance at 2 Hz).
+
+A relative standard error is judged against a parameter's size, the same for the components
+of one vector or tensor so that the criterion does not depend on how the platform frame is
+turned: the mass against itself, each first moment against the first-moment vector's
+length (at least a tenth of the mass times the radius of gyration, for a centre of mass near
+the reference point), each entry of the inertia matrix, products included, against the mean
+of its diagonal. Judged by their own magnitudes, a first moment along a long lever arm and a
+product near zero would set the design's aim by the frame's orientation alone. Payload mode
+judges the payload's quantities instead (:mod:`stewartid.design.physical.payload_accuracy`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+import scipy.signal
+
+from stewartid.design.candidates import Design
+from stewartid.design.physical.payload_accuracy import (
+    REQUIRED_PAYLOAD_ACCURACY,
+    payload_criterion,
+    payload_std_errors,
+)
+from stewartid.design.pose_noise import pose_noise_scores
+from stewartid.model import regressor as reg
+from stewartid.physical.estimator import (
+    POSITIVE_PARAMETERS,
+    parameter_model,
+)
+from stewartid.physical.regression import leg_force_transforms
+from stewartid.platform import Platform
+from stewartid.signals.differentiation import default_window, estimate_frequency, kernel_taps
+from stewartid.simulation.sensors import SensorNoise
+
+#: Rate (Hz) the regressor is summed at along a commanded motion: at least ten samples per
+#: period of the fastest motion of the search (2.1 Hz).
+INFORMATION_RATE = 25.0
+
+
+@dataclasses.dataclass(frozen=True)
+class ParameterPrediction:
+    """Predicted standard errors of the physical model's parameters for one design.
+
+    Attributes
+    ----------
+    names : tuple of str
+        Every parameter the estimator fits (nuisance ones included).
+    nominal : ndarray, shape (p,)
+        Their values in the platform file.
+    std_errors : ndarray, shape (p,)
+        Predicted standard errors with every parameter estimated (the parameters' units).
+    expected_std_errors : ndarray, shape (p,)
+        The same once the parameters the estimator would fix (relative standard error above
+        its ``max_relative_error``) are fixed; NaN for those: what a fit will report, and
+        what the design criterion is taken of.
+    fixed : tuple of str
+        Those parameters.
+    expected_covariance : ndarray, shape (p, p)
+        The covariance ``expected_std_errors`` are of; NaN rows and columns for the fixed.
+    sizes : ndarray, shape (p,)
+        What a relative standard error is taken of; 0 for the nuisance parameters.
+    payload : bool
+        Payload mode.
+    accuracy : mapping of str to float
+        Payload mode: what :attr:`criterion` judges against (keys and units of
+        :data:`~stewartid.design.physical.payload_accuracy.REQUIRED_PAYLOAD_ACCURACY`).
+    """
+
+    names: tuple[str, ...]
+    nominal: np.ndarray
+    std_errors: np.ndarray
+    expected_std_errors: np.ndarray
+    fixed: tuple[str, ...]
+    expected_covariance: np.ndarray
+    sizes: np.ndarray
+    payload: bool
+    accuracy: Mapping[str, float] = dataclasses.field(
+        default_factory=lambda: dict(REQUIRED_PAYLOAD_ACCURACY))
+
+    @property
+    def judged(self) -> np.ndarray:
+        """Mask of the parameters the criterion is over (the moving body's or payload's)."""
+        return self.sizes > 0
+
+    @property
+    def relative_std(self) -> np.ndarray:
+        """Expected standard error (the estimator's fixing applied) relative to each judged
+        parameter's size (%); NaN for the others."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(self.judged, 100 * self.expected_std_errors / self.sizes, np.nan)
+
+    @property
+    def worst_relative_std(self) -> float:
+        """Largest relative standard error over the judged parameters (%)."""
+        return float(np.nanmax(self.relative_std))
+
+    @property
+    def worst_parameter(self) -> str:
+        """The judged parameter with the largest relative standard error."""
+        return self.names[int(np.nanargmax(self.relative_std))]
+
+    @property
+    def payload_std_errors(self) -> dict[str, float] | None:
+        """Payload mode: the payload's quantities' standard errors
+        (:func:`~stewartid.design.physical.payload_accuracy.payload_std_errors`); else None."""
+        if not self.payload:
+            return None
+        return payload_std_errors(self.names, self.nominal, self.expected_covariance)
+
+    @property
+    def criterion(self) -> float:
+        """What the design is judged by. Payload mode: the largest ratio of the payload's
+        quantities' standard errors to their required accuracy
+        (:func:`~stewartid.design.physical.payload_accuracy.payload_criterion`); full mode: the
+        worst relative standard error (%)."""
+        if self.payload:
+            return payload_criterion(self.payload_std_errors, self.accuracy)[0]
+        return self.worst_relative_std
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain values (JSON ready): per parameter its nominal value, predicted SE and
+        relative SE (%, None for nuisance parameters)."""
+        relative = self.relative_std
+        out = {"mode": "payload" if self.payload else "full", "criterion": self.criterion,
+                "worst_relative_std_percent": self.worst_relative_std,
+                "worst_parameter": self.worst_parameter, "fixed": list(self.fixed),
+                "parameters": {name: {"nominal": float(self.nominal[k]),
+                                      "std_error": float(self.std_errors[k]),
+                                      "expected_std_error": (
+                                          None if name in self.fixed
+                                          else float(self.expected_std_errors[k])),
+                                      "relative_std_percent": (float(relative[k])
+                                                               if self.judged[k] else None)}
+                               for k, name in enumerate(self.names)}}
+        if self.payload:
+            out["payload_std_errors"] = self.payload_std_errors
+            out["required_accuracy"] = dict(self.accuracy)
+        return out
+
+
+def parameter_sizes(names: tuple[str, ...], nominal: np.ndarray) -> np.ndarray:
+    """The size each parameter's relative standard error is taken of; 0 for the parameters
+    not judged.
+
+    The names are the estimator's (``m``, ``mc_x``, ..., or ``payload.m``, ...). Judged are
+    the moving body's ten (the payload's in payload mode): what Mt(q) is made of. The legs'
+    combinations are a small share of it and mostly beyond any excitation within the limits
+    (the estimator fixes them at the file's values where the data cannot tell them);
+    friction and offsets are nuisance parameters. The mass is judged against itself, every
+    first moment against the length of the first-moment vector (at least a tenth of the mass
+    times the radius of gyration about the reference point) and every entry of the inertia
+    matrix against the mean of its diagonal: sizes that turning the frame leaves alone.
+    """
+    values = dict(zip((n.removeprefix("payload.") for n in names), nominal, strict=True))
+    mass = abs(values.get("m", 0.0))
+    diagonal = np.mean([abs(values.get(f"I_{a}{a}", 0.0)) for a in "xyz"])
+    gyration = math.sqrt(1.5 * diagonal / mass) if mass > 0 else 0.0  # tr(I) / 2 m
+    moment = math.hypot(*(values.get(f"mc_{a}", 0.0) for a in "xyz"))
+    sizes = np.zeros(len(names))
+    for k, name in enumerate(names):
+        short = name.removeprefix("payload.")
+        if short not in reg.BODY_PARAMETERS:
+            continue
+        if short == "m":
+            sizes[k] = mass
+        elif short.startswith("mc_"):
+            sizes[k] = max(moment, 0.1 * mass * gyration)
+        else:
+            sizes[k] = diagonal
+    return sizes
+
+
+def force_noise_covariance(noise: SensorNoise, rows: int) -> np.ndarray:
+    """S = Sigma_f: the covariance of the leg forces' noise per sample, at every row.
+
+    Returns
+    -------
+    ndarray, shape (rows, 6, 6)
+        N^2.
+    """
+    sigma = np.broadcast_to(np.asarray(noise.force_noise, dtype=float), 6)
+    return np.broadcast_to(np.diag(sigma ** 2), (rows, 6, 6))
+
+
+def channel_weights(S: np.ndarray) -> np.ndarray:
+    """W: each leg channel weighted by its mean noise variance over the rows of ``S``
+    (K, 6, 6), as the estimator weights by its residual's. Shape (6,), 1/N^2."""
+    return 1.0 / np.mean(np.diagonal(S, axis1=1, axis2=2), axis=0)
+
+
+def sandwich_covariance(X: np.ndarray, S: np.ndarray, samples_per_row: float,
+                        noise_rows: np.ndarray | None = None,
+                        extra: np.ndarray | None = None) -> np.ndarray:
+    """The channel-weighted least-squares covariance A^-1 B A^-1 (module docstring).
+
+    Parameters
+    ----------
+    X : ndarray, shape (K, 6, p)
+        Regressor rows.
+    S : ndarray, shape (K, 6, 6)
+        Noise covariance of each row's channels.
+    samples_per_row : float
+        Logged samples each row stands for (sample rate / row rate).
+    noise_rows : ndarray, shape (K, 6, p), optional
+        The rows B is taken of, when not ``X``: for rows and noise filtered with a kernel
+        h, h * X (the filtered noise's correlation over the kernel, carried to the rows).
+    extra : ndarray, shape (p, p), optional
+        Another noise's share of B, in the same units (the pose noise's:
+        :func:`~stewartid.design.pose_noise.pose_noise_scores`).
+
+    Returns
+    -------
+    ndarray, shape (p, p)
+    """
+    weights = channel_weights(S)
+    Z = weights[None, :, None] * X  # W X
+    A = np.einsum("kcp,kcq->pq", X, Z, optimize=True)
+    if noise_rows is not None:
+        Z = weights[None, :, None] * noise_rows
+    B = np.einsum("kcp,kcd,kdq->pq", Z, S, Z, optimize=True)
+    if extra is not None:
+        B = B + extra
+    scale = np.sqrt(np.diag(A))
+    scale = np.where(scale > 0, scale, 1.0)
+    inverse = np.linalg.pinv(A / np.outer(scale, scale), rcond=1e-14) / np.outer(scale, scale)
+    return inverse @ B @ inverse / samples_per_row
+
+
+def record_rows(design: Design, rate_hz: float = INFORMATION_RATE) -> list[int]:
+    """Rows of each record in :func:`design_rows` at ``rate_hz``: its samples from 0 s to
+    its duration."""
+    return [int(math.floor(r.duration * rate_hz)) + 1 for r in design.records]
+
+
+def record_ends(design: Design, rate_hz: float = INFORMATION_RATE) -> np.ndarray:
+    """Each record's first row in :func:`design_rows` at ``rate_hz`` and, last, the total:
+    shape (records + 1,)."""
+    return np.cumsum([0, *record_rows(design, rate_hz)])
+
+
+def design_rows(platform: Platform, design: Design, rate_hz: float = INFORMATION_RATE
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The commanded motion of every record at ``rate_hz``, concatenated: q, q_dot, q_ddot,
+    each of shape (K, 6); :func:`record_rows` rows per record."""
+    parts = [playable.evaluate(np.arange(rows) / rate_hz) for playable, rows
+             in zip(design.playable(platform), record_rows(design, rate_hz), strict=True)]
+    return tuple(np.concatenate(x) for x in zip(*parts, strict=True))
+
+
+def played_states(records: list, design: Design, rate_hz: float
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The true motion of a design's records as the plant played them, at ``rate_hz``: q,
+    q_dot, q_ddot of shape (K, 6), :func:`record_rows` rows per record, as
+    :func:`design_rows` gives the commanded motion.
+
+    A plant tracks a fast record with errors of its own (a hydraulic one adds uncommanded
+    surge), and the information is in the motion the logs will hold: predicted along the
+    commanded motion, the payload's mass and the legs' offsets came out 1.3-1.7 times their
+    spread over 24 seeds on the plant.
+
+    Parameters
+    ----------
+    records : list of ExperimentRecord
+        The design played on the plant (:func:`~stewartid.design.prediction.plant_records`),
+        one per record of ``design``, from 0 s.
+    design : Design
+    rate_hz : float
+        Hz.
+    """
+    parts = []
+    for record, rows in zip(records, record_rows(design, rate_hz), strict=True):
+        t = np.arange(rows) / rate_hz
+        parts.append([np.stack([np.interp(t, record.t, x[:, j]) for j in range(6)], axis=1)
+                      for x in (record.q, record.q_dot, record.q_ddot)])
+    return tuple(np.concatenate(x) for x in zip(*parts, strict=True))
+
+
+def record_kernels(design: Design, rate_hz: float, q: np.ndarray) -> list[np.ndarray]:
+    """Each record's taps of the physical estimator's kernel at ``rate_hz`` (its window:
+    :data:`~stewartid.signals.differentiation.DEFAULT_WINDOW_PERIODS` periods of the
+    record's dominant frequency in ``q``, shape (K, 6), records one after the other)."""
+    ends = record_ends(design, rate_hz)
+    return [kernel_taps(rate_hz, default_window(estimate_frequency(q[a:b], rate_hz)))[0]
+            for a, b in zip(ends[:-1], ends[1:], strict=True)]
+
+
+def kernel_filtered(design: Design, rate_hz: float, q: np.ndarray, X: np.ndarray,
+                    taps: list[np.ndarray] | None = None
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The pose and the regressor of every record filtered with the physical estimator's
+    kernel (its window: :data:`~stewartid.signals.differentiation.DEFAULT_WINDOW_PERIODS`
+    periods of the record's dominant frequency), the records' ends dropped, as the
+    estimator's rows are.
+
+    The estimator regresses filtered rows h * X on filtered forces, whose noise h * e is
+    correlated over the kernel: its covariance is A^-1 B A^-1 with A of h * X and B of
+    h * h * X (in frequency, |H|^2 against |H|^4: for a sine the kernel's gain cancels, and
+    the body's parameters come out as from the unfiltered regressor). It matters for the
+    Coulomb columns, sign functions whose reversals the kernel smooths: predicted from the
+    unfiltered regressor, their levels came out 0.57-0.87 of their spread over 16 seeds
+    (0.92-1.20 on rigid-body data filtered).
+
+    Parameters
+    ----------
+    design : Design
+    rate_hz : float
+        Rate of ``q`` and ``X`` (Hz), records one after the other (:func:`design_rows`).
+    q : ndarray, shape (K, 6)
+    X : ndarray, shape (K, 6, p)
+    taps : list of ndarray, optional
+        Each record's kernel (:func:`record_kernels`), when already computed.
+
+    Returns
+    -------
+    q, X, noise_rows : ndarray
+        Filtered, shapes (K', 6), (K', 6, p) and (K', 6, p): the last filtered twice, what
+        the filtered noise's correlation makes of the rows (``noise_rows`` of
+        :func:`sandwich_covariance`).
+    """
+    ends = record_ends(design, rate_hz)
+    poses, rows, twice = [], [], []
+    taps = record_kernels(design, rate_hz, q) if taps is None else taps
+    for (a, b), h in zip(zip(ends[:-1], ends[1:], strict=True), taps, strict=True):
+        poses.append(scipy.signal.convolve(q[a:b], h[:, None], mode="valid"))
+        rows.append(scipy.signal.convolve(X[a:b], h[:, None, None], mode="valid"))
+        twice.append(scipy.signal.convolve(rows[-1], h[:, None, None], mode="same"))
+    return np.concatenate(poses), np.concatenate(rows), np.concatenate(twice)
+
+
+def predict_parameters(platform: Platform, design: Design, noise: SensorNoise,
+                       payload: bool = False, rate_hz: float = INFORMATION_RATE,
+                       max_relative_error: float = 0.3,
+                       states: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+                       rows: np.ndarray | None = None, filtered: bool = False
+                       ) -> ParameterPrediction:
+    """Predicted standard errors of the physical model's parameters for a design.
+
+    Parameters
+    ----------
+    platform : Platform
+        The description the design is for (with the expected payload in payload mode: it is
+        what the relative errors are taken of).
+    design : Design
+        Records of commanded motion (analytic q, q_dot, q_ddot).
+    noise : SensorNoise
+        ``force_noise`` (N) is used.
+    payload : bool
+        Payload mode (the payload's ten parameters, the platform file without its payload
+        known), else every base parameter.
+    rate_hz : float
+        Rate the regressor is summed at (Hz).
+    max_relative_error : float
+        The estimator's: a parameter positive by nature whose standard error exceeds this
+        fraction of its size is fixed at the file's value (the worst first, one at a time).
+    states : tuple of ndarray, optional
+        (q, q_dot, q_ddot) at ``rate_hz``: the commanded motion when already computed
+        (:func:`design_rows`), or the motion the plant played (:func:`played_states`).
+    rows : ndarray, shape (K, 6, N_STANDARD), optional
+        The standard regressor at ``states``, when already computed.
+    filtered : bool
+        Filter the regressor with the estimator's kernel first (:func:`kernel_filtered`):
+        what the Coulomb columns' reversals lose to it; and add the pose noise's share
+        (``length_noise``, :func:`~stewartid.design.pose_noise.pose_noise_scores`). Needs
+        ``rate_hz`` well above the kernel's taps per window (100 Hz or more).
+
+    Returns
+    -------
+    ParameterPrediction
+    """
+    names, _, selection, nominal, _ = parameter_model(platform, payload)
+    states = design_rows(platform, design, rate_hz) if states is None else states
+    q = states[0]
+    X = (reg.regressor(platform, *states) if rows is None else rows) @ selection.T
+    twice = taps = None
+    if filtered:
+        taps = record_kernels(design, rate_hz, q)
+        q, X, twice = kernel_filtered(design, rate_hz, q, X, taps)
+    to_legs = leg_force_transforms(platform, q)
+    X = np.einsum("kij,kjp->kip", to_legs, X, optimize=True)
+    if twice is not None:
+        twice = np.einsum("kij,kjp->kip", to_legs, twice, optimize=True)
+    S = force_noise_covariance(noise, len(q))
+    per_row = platform.sensors.sample_rate / rate_hz
+    extra = np.zeros((len(names),) * 2)
+    if filtered:
+        extra = pose_noise_scores(
+            platform, noise, rate_hz, states, record_ends(design, rate_hz),
+            taps, X, to_legs, channel_weights(S), reg.standard_parameters(platform))
+    # the estimator's own rule for what it fixes (PhysicalIdentifier's scales)
+    positive = np.isin(reg.PARAMETERS, POSITIVE_PARAMETERS)
+    size = np.maximum(np.abs(nominal), selection @ np.where(
+        positive, np.abs(reg.standard_parameters(platform)), 0.0))
+    fixable = selection @ positive > 0
+    free = np.ones(len(names), dtype=bool)
+    while True:
+        covariance = np.full((len(names),) * 2, np.nan)
+        covariance[np.ix_(free, free)] = sandwich_covariance(
+            X[:, :, free], S, per_row, None if twice is None else twice[:, :, free],
+            extra[np.ix_(free, free)])
+        std = np.sqrt(np.clip(np.diag(covariance), 0.0, None))
+        if free.all():
+            every = std.copy()
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.where(free & fixable & (size > 0), std / size, 0.0)
+        if not ratio.max() > max_relative_error:
+            break
+        free[int(np.argmax(ratio))] = False
+    return ParameterPrediction(tuple(names), np.asarray(nominal, dtype=float), every, std,
+                               tuple(n for n, f in zip(names, free, strict=True) if not f),
+                               covariance, parameter_sizes(tuple(names), nominal), payload)
+
+
+__all__ = ["INFORMATION_RATE", "ParameterPrediction", "channel_weights", "design_rows",
+           "force_noise_covariance", "kernel_filtered", "parameter_sizes", "played_states",
+           "predict_parameters", "record_ends", "record_kernels", "record_rows",
+           "sandwich_covariance"]

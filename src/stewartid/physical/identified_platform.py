@@ -1,0 +1,268 @@
+"""The platform description of an identified physical model: the TOML every command accepts,
+and the ``identify --model physical`` run behind the command line.
+
+Payload mode writes the platform file with the identified ``[payload]``. Full mode writes the
+identified moving body as the file's platform plus a ``[payload]`` that carries the
+difference (the only form a body with its centre of mass off the reference point and a full
+inertia matrix takes in the format), or, when the difference is no payload (a body lighter
+than the file's platform), as a platform carrying a light payload that holds the body's
+centre of mass offset and products of inertia; the legs' centres of mass and inertias from their
+identified first moments and inertias (the leg masses kept from the file: no motion tells
+them), and one viscous and one Coulomb level for all joint types (the format's), the mean of
+the identified ones.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stewartid.datasets.dataset import Dataset
+from stewartid.errors import ConfigError
+from stewartid.files import check_output_file, write_text_atomic
+from stewartid.model import regressor as reg
+from stewartid.physical.estimator import (
+    PhysicalIdentifier,
+    PhysicalResult,
+    known_platform,
+    payload_section,
+)
+from stewartid.platform import Platform
+from stewartid.platform.sections import inertia_matrix
+
+#: Values of ``identify --model``.
+MODELS = ("physical",)
+#: First line of a platform file ``identify --platform-out`` wrote: such a file is
+#: overwritten by the next run, any other refused.
+IDENTIFIED_HEADER = "# identified by stewartid identify --model physical from"
+
+
+def _standard_values(platform: Platform, result: PhysicalResult) -> np.ndarray:
+    """The standard parameters of a full-mode result: each base parameter less the
+    combinations it stands for, with the file's values for the parameters folded into it."""
+    base = reg.base_parameters(platform)
+    pi = reg.standard_parameters(platform)
+    values = pi.copy()
+    for name, column, row in zip(base.names, base.columns, base.combination, strict=True):
+        others = row.copy()
+        others[column] = 0.0
+        values[column] = result.parameters[name] - others @ pi
+    return values
+
+
+def _full_platform(platform: Platform, result: PhysicalResult) -> Platform:
+    """The description of a full-mode result (see the module docstring)."""
+    pi = _standard_values(platform, result)
+    value = dict(zip(reg.PARAMETERS, pi, strict=True))
+    own = reg.standard_parameters(known_platform(platform))
+    body = reg.parameter_index(reg.BODY_PARAMETERS)
+    difference = dict(zip((f"payload.{n}" for n in reg.BODY_PARAMETERS), pi[body] - own[body],
+                          strict=True))
+    i = platform.inertia
+    updates = _body_updates(platform, difference, pi[body])
+    legs: dict[str, Any] = {}
+    if i.upper_leg_mass > 0:
+        legs["inertia__upper_leg_com"] = value["md_u"] / i.upper_leg_mass
+    if i.lower_leg_mass > 0:
+        legs["inertia__lower_leg_com"] = value["md_l"] / i.lower_leg_mass
+    d_u = legs.get("inertia__upper_leg_com", i.upper_leg_com)
+    d_l = legs.get("inertia__lower_leg_com", i.lower_leg_com)
+    legs["inertia__upper_leg_inertia"] = (value["J_u"] + value["J_l"] - i.lower_leg_inertia
+                                          - i.upper_leg_mass * d_u ** 2
+                                          - i.lower_leg_mass * d_l ** 2)
+    gimbals = [value[f"viscous[{t}]"] for t in ("lower_gimbal", "upper_gimbal")]
+    updates["friction__gimbal_viscous"] = float(np.mean(gimbals))
+    updates["friction__coulomb"] = float(np.mean(
+        [value[f"coulomb[{t}]"] for t in reg.JOINT_TYPES]))
+    base = platform.replace(payload=None)
+    try:
+        return base.replace(**updates, **legs)
+    except ConfigError as exc:
+        described = base.replace(**updates)  # the body's and friction's errors raise here
+        warnings.warn(f"--platform-out: the identified leg parameters are no leg ({exc}); "
+                      "the file's leg values are written instead, so the file's Mt differs "
+                      "from the identified one by the legs' share.", stacklevel=2)
+        return described
+
+
+#: Share of the moving body's mass and principal inertias a carrier payload takes when the
+#: body is not the file's platform plus a payload (:func:`_body_updates`).
+CARRIER_SHARE = 0.01
+
+
+def _body_updates(platform: Platform, difference: dict[str, float], body: np.ndarray
+                  ) -> dict[str, Any]:
+    """The moving body (standard parameters ``body``, (10,)) as the file's platform plus a
+    ``[payload]`` of the difference; when that is no payload (a body lighter than the file's
+    platform, an inertia no mass has), as a platform that carries a light payload with the
+    body's centre of mass offset and products of inertia (CARRIER_SHARE of its mass and
+    principal inertias)."""
+    payload = {f"payload__{k}": v for k, v in payload_section(difference).items()}
+    try:
+        platform.replace(payload=None).replace(**payload)
+        return payload
+    except ConfigError:
+        pass
+    mass, first, inertia = body[0], body[1:4], inertia_matrix(body[[4, 5, 6, 7, 8, 9]])
+    carrier = CARRIER_SHARE * mass
+    c = first / carrier
+    spread = CARRIER_SHARE * np.diag(inertia)
+    shift = carrier * (c @ c * np.eye(3) - np.outer(c, c))
+    own = inertia - shift  # the body's inertia less the carrier's point mass
+    carried = own - np.diag(np.diag(own)) + np.diag(spread)
+    return {"inertia__platform_mass": float(mass - carrier),
+            "inertia__platform_inertia": [float(v) for v in np.diag(own) - spread],
+            "payload__mass": float(carrier), "payload__com": c.tolist(),
+            "payload__inertia": [float(carried[a, b]) for a, b in
+                                 ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))]}
+
+
+def identified_platform(platform: Platform, result: PhysicalResult) -> Platform:
+    """The platform description with the identified parameters.
+
+    Raises
+    ------
+    ConfigError
+        When they are no valid description (a negative mass or inertia, an inertia no mass
+        distribution has); the message names the section and key.
+    """
+    try:
+        if result.diagnostics.get("mode") == "payload":
+            section = result.diagnostics["payload"]
+            return platform.replace(payload=None).replace(
+                **{f"payload__{key}": value for key, value in section.items()})
+        return _full_platform(platform, result)
+    except ConfigError as exc:
+        raise ConfigError(f"the identified parameters are no valid platform description: "
+                          f"{exc}") from None
+
+
+def _is_identified(path: Path) -> bool:
+    """True for a platform file that ``identify --platform-out`` wrote (overwritten)."""
+    try:
+        return path.read_text(encoding="utf-8").startswith(IDENTIFIED_HEADER)
+    except (OSError, UnicodeDecodeError):
+        return False
+
+
+def check_model_options(model: str, platform_out: Path | None, forbidden: dict[str, bool]
+                        ) -> None:
+    """Refuse, before any computation, a model not known and options the physical model
+    does not take.
+
+    Parameters
+    ----------
+    model : str
+        The ``--model`` value.
+    platform_out : Path, optional
+        The ``--platform-out`` file.
+    forbidden : dict of str to bool
+        Options that do not apply, by flag, and whether each was given.
+    """
+    if model not in MODELS:
+        raise ConfigError(f"--model {model!r}: expected one of {', '.join(MODELS)}.")
+    given = [flag for flag, on in forbidden.items() if on]
+    if given:
+        raise ConfigError(f"{given[0]} does not apply to --model {model}; leave it out.")
+    if platform_out is not None and platform_out.suffix.lower() != ".toml":
+        raise ConfigError(f"--platform-out {str(platform_out)!r}: the platform description "
+                          "is TOML; give a .toml file name.")
+
+
+def model_method(model: str | None, method: str, payload: bool,
+                 platform_out: Path | None) -> str:
+    """The method ``identify`` runs: ``method`` without ``--model``, else the model's
+    estimator (``"physical"``).
+
+    Raises
+    ------
+    ConfigError
+        An unknown model, or ``--payload``/``--platform-out`` without ``--model``.
+    """
+    if model is None:
+        if payload or platform_out is not None:
+            raise ConfigError("--payload and --platform-out go with --model physical; add it.")
+        return method
+    if model not in MODELS:
+        raise ConfigError(f"--model {model!r}: expected one of {', '.join(MODELS)}.")
+    return model
+
+
+def check_model_outputs(model: str, platform_out: Path | None,
+                        refused: dict[str, bool] | None = None,
+                        inputs: Sequence[str | Path] = ()) -> None:
+    """Refuse, before any computation, what ``identify --model`` cannot do
+    (:func:`check_model_options`) and a ``platform_out`` that would replace an input or a
+    file ``--platform-out`` did not write.
+
+    Parameters
+    ----------
+    model : str
+    platform_out : Path, optional
+    refused : dict of str to bool, optional
+        Options of the command that do not apply, by flag, and whether each was given.
+    inputs : sequence of str or Path
+        Files the command reads, which ``platform_out`` must not be.
+    """
+    check_model_options(model, platform_out, refused or {})
+    if platform_out is not None:
+        check_output_file(platform_out, False, inputs, is_result=_is_identified,
+                          option="--platform-out")
+
+
+def write_identified(platform: Platform, result: PhysicalResult, platform_out: Path,
+                     experiments: int) -> Path:
+    """Write the platform description of ``result`` (:func:`identified_platform`) to
+    ``platform_out``, under the header that marks it as written by ``identify``; returns the
+    path."""
+    identified = identified_platform(platform, result)
+    return write_text_atomic(platform_out, f"{IDENTIFIED_HEADER} {experiments} experiments\n"
+                             + identified.to_toml())
+
+
+def identify_model(datasets: list[Dataset], platform: Platform, model: str = "physical",
+                   payload: bool = False, platform_out: Path | None = None,
+                   refused: dict[str, bool] | None = None,
+                   inputs: Sequence[str | Path] = (), consistent: bool = False,
+                   settings: dict[str, Any] | None = None) -> PhysicalResult:
+    """``stewartid identify --model physical`` without a report: fit, and write
+    ``platform_out``.
+
+    Parameters
+    ----------
+    datasets : list of Dataset
+    platform : Platform
+    model : str
+        ``"physical"``.
+    payload : bool
+        Payload mode (:class:`~stewartid.physical.estimator.PhysicalIdentifier`).
+    platform_out : Path, optional
+        Write the identified platform description here (TOML).
+    refused : dict of str to bool, optional
+        Options of the command that do not apply, by flag, and whether each was given.
+    inputs : sequence of str or Path
+        Files the command reads, which ``platform_out`` must not be.
+    consistent : bool
+        The physically consistent fit (the ``convex`` extra); ``platform_out`` then holds
+        the consistent parameters.
+    settings : dict, optional
+        Further estimator settings (e.g. ``{"gravity": False}``).
+
+    Returns
+    -------
+    PhysicalResult
+    """
+    check_model_outputs(model, platform_out, refused, inputs)
+    result = PhysicalIdentifier(**(settings or {}), payload=payload,
+                                consistent=consistent).fit(datasets, platform).result_
+    if platform_out is not None:
+        write_identified(platform, result, platform_out, len(datasets))
+    return result
+
+
+__all__ = ["IDENTIFIED_HEADER", "MODELS", "check_model_options", "check_model_outputs",
+           "identified_platform", "identify_model", "model_method", "write_identified"]

@@ -1,0 +1,131 @@
+"""Errors in variables for the physical model: the share of the normal equations that pose
+noise, carried into the regressor's rates and accelerations, adds.
+
+The physical model's regressor rows are evaluated at the measured pose and its Savitzky-Golay
+rate and acceleration, then filtered with the kernel h
+(:func:`~stewartid.physical.regression.filtered_regression`). White pose noise e (covariance
+Sigma per sample, estimated from the record by
+:func:`~stewartid.identification.wavelet.noise.white_noise_covariance`) enters a filtered row
+mostly through the terms linear in the acceleration and the rate,
+
+    delta Y(t) ~ sum_c A_c(q) (h * g2 * e_c)(t) + sum_c B_c(q) (h * g1 * e_c)(t),
+
+with A = d Y / d q_ddot (the inertia regressor), B = d Y / d q_dot at rest (the viscous
+columns) and g1, g2 the Savitzky-Golay derivative taps. Its expected outer product, summed
+over the rows kept, is what noise adds to X^T W X and what the least squares must subtract to
+be unbiased (attenuation bias; the same correction as the ``ls`` method's
+``noise_correction``). The composite filters h * g1 (odd) and h * g2 (even) give no cross term.
+Velocity products and the Coulomb signs are left out: their noise terms are of second order
+at the rates of an identification record.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stewartid.identification.preparation import Experiment
+from stewartid.identification.wavelet.noise import white_noise_covariance
+from stewartid.model import matrix_regressors
+from stewartid.model import regressor as reg
+from stewartid.platform import Platform
+from stewartid.signals.differentiation import (
+    differentiate,
+    kernel_taps,
+    savgol_coefficients,
+    window_samples,
+)
+from stewartid.signals.filtered_rows import kernel_filter_rows
+from stewartid.signals.sign_rates import coulomb_sign_rates
+
+
+def derivative_noise_gains(sample_rate: float, window: float, savgol_window: float,
+                           order: int) -> tuple[float, float]:
+    """Variance of h * g1 * e and h * g2 * e per unit variance of white e: the energies of
+    the composite taps of the kernel (support ``window`` s) and the Savitzky-Golay rate and
+    acceleration (``savgol_window`` s, ``order``). Units 1/s^2 and 1/s^4."""
+    h = kernel_taps(sample_rate, window)[0]
+    n = window_samples(savgol_window, sample_rate, order)
+    return tuple(float(np.sum(np.convolve(h, savgol_coefficients(n, order, d, 1 / sample_rate))
+                              ** 2)) for d in (1, 2))
+
+
+def measured_sign_rates(q: np.ndarray, sample_rate: float, window: float) -> np.ndarray:
+    """:func:`~stewartid.signals.sign_rates.coulomb_sign_rates` of a record whose pose noise
+    is not known yet: estimated against the pose smoothed as the physical model's regressor
+    is (order 5 over an eighth of the kernel), the rates (N, 6) returned alone."""
+    smooth = differentiate(q, sample_rate, window / 8, 5, (0,))[0]
+    return coulomb_sign_rates(q, sample_rate, window, white_noise_covariance(q, smooth))[0]
+
+
+#: Kept rows per evaluation of the noise's Jacobians in :func:`regressor_noise`.
+JACOBIAN_STRIDE = 5
+
+
+def _factor(covariance: np.ndarray) -> np.ndarray:
+    """L with L L^T = covariance (positive semidefinite; a noise-free record gives ~0)."""
+    values, vectors = np.linalg.eigh(covariance)
+    return vectors * np.sqrt(np.clip(values, 0.0, None))
+
+
+def regressor_noise(experiments: list[Experiment], windows: list[float], row_step: int,
+                    platform: Platform, savgol_fraction: float, order: int,
+                    pose_noise: list[np.ndarray],
+                    transforms: list[np.ndarray] | None = None, by_experiment: bool = False
+                    ) -> np.ndarray:
+    """Per channel, the sum over the kept rows of E[delta Y_i^T delta Y_i].
+
+    Parameters
+    ----------
+    experiments : list of Experiment
+    windows : list of float
+        Each experiment's kernel support (s).
+    row_step : int
+        The rows kept (every ``row_step``-th filtered row).
+    platform : Platform
+    savgol_fraction : float
+        The Savitzky-Golay window is ``window / savgol_fraction``.
+    order : int
+        Savitzky-Golay order.
+    pose_noise : list of ndarray, each shape (6, 6)
+        Each experiment's pose white-noise covariance per sample
+        (:attr:`~stewartid.physical.regression.Regression.pose_noise`).
+    transforms : list of ndarray, each shape (K_e, 6, 6), optional
+        Per experiment, a map applied to each kept row's channels (the leg forces'
+        :func:`~stewartid.physical.regression.leg_force_transforms`).
+    by_experiment : bool
+        Return each experiment's sum, not their total.
+
+    Returns
+    -------
+    ndarray, shape (6, N_STANDARD, N_STANDARD), or (E, 6, N_STANDARD, N_STANDARD)
+        In the standard parameters, by channel (of the generalized force, or of what
+        ``transforms`` maps it to).
+    """
+    terms = np.zeros((len(experiments), 6, reg.N_STANDARD, reg.N_STANDARD))
+    if transforms is None:
+        transforms = [None] * len(experiments)
+    for out, exp, window, sigma, transform in zip(terms, experiments, windows, pose_noise,
+                                                  transforms, strict=True):
+        rate = exp.sample_rate
+        gains = derivative_noise_gains(rate, window, window / savgol_fraction, order)
+        poses = kernel_filter_rows(exp.q, rate, window, row_step)
+        # the Jacobians vary on the kernel's scale: every JACOBIAN_STRIDE-th row stands for
+        # its neighbours (the sum scaled to the rows kept)
+        rows, poses = len(poses), poses[::JACOBIAN_STRIDE]
+        for jacobian, gain in ((matrix_regressors.viscous_regressor(platform, poses), gains[0]),
+                               (matrix_regressors.inertia_regressor(platform, poses), gains[1])):
+            if transform is not None:
+                jacobian = np.einsum("kji,kicp->kjcp", transform[::JACOBIAN_STRIDE], jacobian,
+                                     optimize=True)
+            # jacobian[k, i, c, :]: d Y_i / d (rate or acceleration of c) at row k; only
+            # its columns not zero at every row (4 viscous, the bodies' 14) add anything
+            used = np.flatnonzero(np.any(jacobian != 0.0, axis=(0, 1, 2)))
+            block = np.ix_(used, used)
+            factor = np.swapaxes(_factor(sigma * gain), 0, 1)
+            for i in range(6):  # (K d, p) per channel: one BLAS product each
+                flat = (factor @ jacobian[:, i][..., used]).reshape(-1, len(used))
+                out[i][block] += (flat.T @ flat) * (rows / len(poses))
+    return terms if by_experiment else terms.sum(axis=0)
+
+
+__all__ = ["JACOBIAN_STRIDE", "derivative_noise_gains", "measured_sign_rates", "regressor_noise"]

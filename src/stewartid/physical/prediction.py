@@ -1,0 +1,134 @@
+"""The identified physical model anywhere: Mt(q), Bt(q) at any pose with delta-method standard
+errors, and the generalized force it predicts along any motion by the full regressor.
+
+A result of :class:`~stewartid.physical.estimator.PhysicalIdentifier` holds its
+parameters p (base parameters in full mode, the payload's and the nuisance ones in payload
+mode). The regressor columns they multiply are a selection S of the standard columns, plus the
+known part o of the platform (payload mode: the platform and legs of the file), so that
+
+    J_lq^T f = Y(q, q_dot, q_ddot) (S^T p + o),   Mt(q) = A(q) (S^T p + o),
+
+with A(q) the inertia (or viscous) regressor (:func:`~stewartid.model.matrix_regressors.inertia_regressor`).
+Mt(q) is linear in p: its standard errors are sqrt(a^T C a) for each entry's row a = A(q) S^T
+and the parameters' covariance C (``PhysicalIdentifier.covariance_``); fixed parameters have
+zero variance.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from stewartid.errors import IdentificationError
+from stewartid.model import matrix_regressors
+from stewartid.physical.estimator import (
+    PhysicalResult,
+    _full_model,
+    _payload_model,
+    matrix_std_errors,
+)
+from stewartid.platform import Platform
+
+
+@dataclass(frozen=True)
+class ParameterMap:
+    """How a result's parameters enter the standard regressor columns.
+
+    Attributes
+    ----------
+    names : tuple of str
+        The result's parameters, in the order of its covariance.
+    values : ndarray, shape (p,)
+    selection : ndarray, shape (p, N_STANDARD)
+        Rows of the identity: the standard column each parameter multiplies.
+    offset : ndarray, shape (N_STANDARD,)
+        The known standard parameters (zero in full mode).
+    """
+
+    names: tuple[str, ...]
+    values: np.ndarray
+    selection: np.ndarray
+    offset: np.ndarray
+
+    @property
+    def standard(self) -> np.ndarray:
+        """S^T p + o, shape (N_STANDARD,): Y times it is the model's generalized force."""
+        return self.selection.T @ self.values + self.offset
+
+
+def parameter_map(platform: Platform, result: PhysicalResult) -> ParameterMap:
+    """The :class:`ParameterMap` of ``result`` on the platform it was fitted with.
+
+    Raises
+    ------
+    IdentificationError
+        When the result's parameters are not those of this platform's model (another platform
+        description, or another mode).
+    """
+    payload = result.diagnostics.get("mode") == "payload"
+    names, _, selection, _, offset = (_payload_model(platform) if payload
+                                      else _full_model(platform))
+    if tuple(names) != tuple(result.parameters):
+        raise IdentificationError("the physical result's parameters are not those of platform "
+                                  f"'{platform.name}'; give the platform it was fitted with.")
+    values = np.array([result.parameters[name] for name in names], dtype=float)
+    return ParameterMap(tuple(names), values, selection, offset)
+
+
+@dataclass(frozen=True)
+class PoseMatrices:
+    """Mt and Bt of the physical model at several poses.
+
+    Attributes
+    ----------
+    M, B : ndarray, shape (n, 6, 6)
+        kg, kg m, kg m^2 and N s/m, N s, N m s blocks.
+    std_errors_M, std_errors_B : ndarray, shape (n, 6, 6)
+        Delta-method standard errors (same units).
+    """
+
+    M: np.ndarray
+    B: np.ndarray
+    std_errors_M: np.ndarray
+    std_errors_B: np.ndarray
+
+
+def matrices_at(platform: Platform, result: PhysicalResult, covariance: np.ndarray,
+                poses: np.ndarray, mapping: ParameterMap | None = None) -> PoseMatrices:
+    """Mt(q) and Bt(q) of ``result`` at ``poses`` with their standard errors.
+
+    Parameters
+    ----------
+    platform : Platform
+        The description the result was fitted with.
+    result : PhysicalResult
+    covariance : ndarray, shape (p, p)
+        Of the result's parameters in their order (``PhysicalIdentifier.covariance_``).
+    poses : ndarray, shape (n, 6)
+        Absolute poses (m, rad).
+    mapping : ParameterMap, optional
+        :func:`parameter_map` of the result, if already at hand (it costs a base-parameter
+        decomposition).
+
+    Returns
+    -------
+    PoseMatrices
+    """
+    mapping = mapping or parameter_map(platform, result)
+    covariance = np.asarray(covariance, dtype=float)
+    if covariance.shape != (len(mapping.names),) * 2:
+        raise IdentificationError(f"covariance of shape {covariance.shape} for "
+                                  f"{len(mapping.names)} parameters.")
+    out: list[list[np.ndarray]] = [[], [], [], []]
+    for pose in np.atleast_2d(np.asarray(poses, dtype=float)):
+        for k, A in enumerate((matrix_regressors.inertia_regressor(platform, pose),
+                               matrix_regressors.viscous_regressor(platform, pose))):
+            out[k].append(A @ mapping.standard)
+        for k, std in enumerate(matrix_std_errors(platform, mapping.selection, covariance,
+                                                  pose)):
+            out[k + 2].append(std)
+    return PoseMatrices(*(np.array(x) for x in out))
+
+
+__all__ = ["ParameterMap", "PoseMatrices", "matrices_at", "parameter_map"]

@@ -1,0 +1,1 @@
+"""Validation of identified models on data the fit did not see."""

@@ -1,0 +1,445 @@
+"""Validation of an identified model on data it was not fitted on.
+
+The identified model predicts the measured generalized force
+
+    y = J_lq(q)^T f_a - G(q)  =  Mt q_ddot + Bt q_dot + Fc(q_dot) + c,
+
+with Fc the Coulomb friction where the method estimates it (levels per joint type: ``ls``,
+and ``wavelet`` with ``friction="shared"``) and nothing otherwise, so that friction a method
+does not model shows as unexplained force. c is a constant per channel (static-load residual,
+force-sensor offsets): no method identifies it as part of the model (Method A and B remove
+constants, ``ls`` fits one per experiment), so it is taken from each held-out segment's own
+mean; a constant does not change the VAF.
+
+Both sides are filtered with the same smooth zero-phase kernel h of 0.2 excitation periods
+(:func:`~stewartid.signals.differentiation.kernel_filter`): the velocity and acceleration are
+q * h' and q * h'' (no numerical differentiation), and y and the Coulomb regressors are
+filtered with h itself, so the filtered equation holds exactly and the comparison covers the
+excitation band, not sensor noise above it.
+
+Folds (:func:`cross_validate`): every experiment is cut into ``folds`` segments of equal
+length; fold k holds out segment k of every experiment and refits the method on the rest (each
+experiment's remaining one or two pieces as separate records). Holding out whole experiments
+would not work for the usual protocol, in which experiment k alone excites DOF k.
+
+Scores per DOF, pooled over every held-out segment (e = measured - predicted, both centred
+per segment):
+
+    VAF = 100 (1 - sum e^2 / sum y^2) %,   NRMSE = rms(e) / (max y - min y).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from stewartid.datasets.dataset import Dataset
+from stewartid.errors import DataError, StewartidError
+from stewartid.identification.result import IdentificationResult
+from stewartid.model.joints import FRICTION_TYPES
+from stewartid.platform import Platform
+
+#: Default number of time-segment folds.
+DEFAULT_FOLDS = 3
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One held-out piece of one experiment, filtered and ready for prediction.
+
+    Attributes
+    ----------
+    name : str
+        ``"exp1[0-4 s]"``.
+    experiment : int
+        Index of the experiment it comes from.
+    fold : int
+        The fold that holds it out.
+    t : ndarray, shape (n,)
+        Time (s) of the filtered samples.
+    force : ndarray, shape (n, 6)
+        Filtered measured generalized force y * h (N, N m).
+    q_dot, q_ddot : ndarray, shape (n, 6)
+        q * h' (m/s, rad/s) and q * h'' (m/s^2, rad/s^2).
+    coulomb : ndarray, shape (n, 3, 6)
+        Filtered generalized Coulomb force per unit level of each joint type (N or N m per
+        N m of level).
+    """
+
+    name: str
+    experiment: int
+    fold: int
+    t: np.ndarray
+    force: np.ndarray
+    q_dot: np.ndarray
+    q_ddot: np.ndarray
+    coulomb: np.ndarray
+
+
+@dataclass(frozen=True)
+class ValidationResult:
+    """Held-out prediction scores of one model.
+
+    Attributes
+    ----------
+    vaf_percent : ndarray, shape (6,)
+        Variance accounted for per DOF (%), 100 for a perfect prediction.
+    nrmse : ndarray, shape (6,)
+        RMS prediction error over the peak-to-peak range of the measured force, per DOF.
+    folds : int
+    measured, predicted : list of ndarray, each (n_k, 6)
+        Centred measured and predicted generalized force of every held-out segment (N, N m).
+    segments : list of Segment
+    """
+
+    vaf_percent: np.ndarray
+    nrmse: np.ndarray
+    folds: int
+    measured: list[np.ndarray]
+    predicted: list[np.ndarray]
+    segments: list[Segment]
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``validation`` object of ``result.json``: ``vaf_percent``, ``nrmse``, ``folds``."""
+        return {"vaf_percent": self.vaf_percent.tolist(), "nrmse": self.nrmse.tolist(),
+                "folds": int(self.folds)}
+
+
+@dataclass(frozen=True)
+class CrossValidation:
+    """The refits of a k-fold validation and the held-out segments they predict.
+
+    Attributes
+    ----------
+    folds : int
+    fold_results : list of IdentificationResult
+        The method refitted without fold k, for k = 0 ... folds - 1.
+    segments : list of Segment
+        Every segment of every experiment (each is held out by exactly one fold).
+    """
+
+    folds: int
+    fold_results: list[IdentificationResult]
+    segments: list[Segment]
+
+    def scores(self, adjust: Callable[[IdentificationResult], IdentificationResult]
+               | None = None) -> ValidationResult:
+        """VAF and NRMSE of the fold models on their held-out segments.
+
+        Parameters
+        ----------
+        adjust : callable, optional
+            Applied to every fold's result before it predicts (e.g. the physically
+            consistent projection), so its effect is validated the same way.
+        """
+        results = [r if adjust is None else adjust(r) for r in self.fold_results]
+        predicted = [predict(s, results[s.fold]) for s in self.segments]
+        return score(self.segments, predicted, self.folds)
+
+
+def coulomb_levels(result: IdentificationResult) -> np.ndarray | None:
+    """Coulomb level per joint type (N m) the method identified, None if it has none.
+
+    Returns
+    -------
+    ndarray, shape (3,), or None
+        In the order of :data:`FRICTION_TYPES`.
+    """
+    levels = result.diagnostics.get("coulomb")
+    if not isinstance(levels, dict) or result.diagnostics.get("friction_model") == "free":
+        return None
+    values = np.array([levels.get(name, np.nan) for name in FRICTION_TYPES], dtype=float)
+    return values if np.all(np.isfinite(values)) else None
+
+
+def prediction_levels(result: IdentificationResult) -> np.ndarray | None:
+    """Coulomb levels per joint type (N m) a result predicts with: its own
+    (:func:`coulomb_levels`), else those of the friction fit run alongside it for the
+    validation (``diagnostics["validation_coulomb"]``, see :func:`with_companion_friction`),
+    else None."""
+    levels = coulomb_levels(result)
+    if levels is not None:
+        return levels
+    companion = result.diagnostics.get("validation_coulomb")
+    if not isinstance(companion, dict):
+        return None
+    values = np.array([companion.get(name, np.nan) for name in FRICTION_TYPES], dtype=float)
+    return values if np.all(np.isfinite(values)) else None
+
+
+def with_companion_friction(result: IdentificationResult, companion: Callable[[], Any] | None,
+                            datasets: Sequence[Dataset], platform: Platform
+                            ) -> IdentificationResult:
+    """``result`` with the Coulomb levels of a friction-estimating fit of the same data
+    (``diagnostics["validation_coulomb"]``), when it predicts with none
+    (:func:`prediction_levels`; so a result that has them is returned as it is).
+
+    A method that leaves friction free (Method B's interval constants) is immune to it but
+    cannot predict it; without it, its held-out residual would be the friction it never
+    claimed to model. The companion (Method B with ``friction="uniform"``) estimates the
+    levels; Mt and Bt stay the method's own.
+    """
+    if companion is None or prediction_levels(result) is not None:
+        return result
+    try:
+        levels = companion().fit(list(datasets), platform).result_.diagnostics.get("coulomb")
+    except StewartidError:  # too little data for the companion: predict without friction
+        return result
+    if not isinstance(levels, dict):
+        return result
+    return dataclasses.replace(result, diagnostics={**result.diagnostics,
+                                                    "validation_coulomb": dict(levels)})
+
+
+def coulomb_estimate(result: IdentificationResult) -> tuple[np.ndarray, np.ndarray]:
+    """Coulomb level and standard error per joint type (N m), NaN where not estimated.
+
+    Returns
+    -------
+    levels, std_errors : ndarray, shape (3,)
+        In the order of :data:`FRICTION_TYPES`.
+    """
+    nan = np.full(len(FRICTION_TYPES), np.nan)
+    levels = coulomb_levels(result)
+    if levels is None:
+        return nan, nan
+    std = result.diagnostics.get("coulomb_std") or {}
+    return levels, np.array([std.get(k, np.nan) for k in FRICTION_TYPES], dtype=float)
+
+
+def prepare_segment(dataset: Dataset, platform: Platform, window: float, *, gravity: bool,
+                    experiment: int = 0, fold: int = 0,
+                    coulomb_smoothing: float = 1e-4, remainder: bool = False) -> Segment:
+    """Filtered force, motion and Coulomb regressors of one record.
+
+    Parameters
+    ----------
+    dataset : Dataset
+    platform : Platform
+    window : float
+        Kernel support (s), 0.2 excitation periods by convention.
+    gravity : bool
+        Subtract the model's G(q), as the identifier did.
+    experiment, fold : int
+        Labels stored in the segment.
+    coulomb_smoothing : float
+        Rate (rad/s) below which a joint's Coulomb sign is attenuated, as in ``ls``.
+    remainder : bool
+        Subtract the model's departure from its linearisation, as the identifier did
+        (:func:`~stewartid.identification.preparation.model_remainder`).
+
+    Returns
+    -------
+    Segment
+    """
+    from stewartid.identification.least_squares import coulomb_regressors
+    from stewartid.identification.preparation import prepare
+    from stewartid.physical.noise import measured_sign_rates
+    from stewartid.signals.differentiation import kernel_filter
+
+    record = prepare([dataset], platform, gravity=gravity, remainder=remainder)[0]
+    # the signs need rates at every sample, from the window the noise allows, as in ``ls``
+    q_dot_sign = measured_sign_rates(record.q, record.sample_rate, window)
+    unit = coulomb_regressors(record.joint_jacobians, q_dot_sign, coulomb_smoothing)
+    signals = np.concatenate([record.generalized_force, unit.reshape(len(unit), -1)], axis=1)
+    filtered = kernel_filter(signals, record.sample_rate, window)[0]
+    _, q_dot, q_ddot = kernel_filter(record.q, record.sample_rate, window, derivatives=2)
+    cut = (len(record.t) - len(q_dot)) // 2
+    return Segment(name=dataset.name, experiment=experiment, fold=fold,
+                   t=record.t[cut:cut + len(q_dot)], force=filtered[:, :6], q_dot=q_dot,
+                   q_ddot=q_ddot, coulomb=filtered[:, 6:].reshape(len(q_dot), 3, 6))
+
+
+def predict(segment: Segment, result: IdentificationResult) -> np.ndarray:
+    """Generalized force predicted by ``result`` on ``segment``, shape (n, 6) (N, N m),
+    before centring: Mt q_ddot + Bt q_dot (+ the Coulomb friction it identified, or that its
+    companion fit found, :func:`prediction_levels`)."""
+    out = segment.q_ddot @ np.asarray(result.M).T + segment.q_dot @ np.asarray(result.B).T
+    levels = prediction_levels(result)
+    if levels is not None:
+        out = out + np.einsum("k,nkc->nc", levels, segment.coulomb)
+    return out
+
+
+def score(segments: Sequence[Segment], predicted: Sequence[np.ndarray], folds: int
+          ) -> ValidationResult:
+    """VAF and NRMSE per DOF of predictions against the segments' measured force (see the
+    module docstring for the definitions)."""
+    measured = [s.force - s.force.mean(axis=0) for s in segments]
+    centred = [p - p.mean(axis=0) for p in predicted]
+    y = np.concatenate(measured)
+    error = y - np.concatenate(centred)
+    energy = np.sum(y ** 2, axis=0)
+    vaf = 100.0 * (1.0 - np.sum(error ** 2, axis=0) / np.where(energy > 0, energy, np.nan))
+    spread = y.max(axis=0) - y.min(axis=0)
+    nrmse = np.sqrt(np.mean(error ** 2, axis=0)) / np.where(spread > 0, spread, np.nan)
+    return ValidationResult(vaf_percent=vaf, nrmse=nrmse, folds=int(folds), measured=measured,
+                            predicted=centred, segments=list(segments))
+
+
+def fold_bounds(n: int, folds: int) -> np.ndarray:
+    """Sample boundaries of ``folds`` equal segments of a record of ``n`` samples, shape
+    (folds + 1,)."""
+    return np.round(np.linspace(0, n, folds + 1)).astype(int)
+
+
+def time_piece(dataset: Dataset, start: int, stop: int) -> Dataset:
+    t = dataset.t[start:stop]
+    return Dataset(t=t, pose=dataset.pose[start:stop], lengths=dataset.lengths[start:stop],
+                   forces=dataset.forces[start:stop],
+                   name=f"{dataset.name}[{t[0]:.4g}-{t[-1]:.4g} s]")
+
+
+def excitation_window(dataset: Dataset) -> float:
+    """Kernel support (s) for a record: 0.2 periods of its dominant excitation frequency."""
+    from stewartid.signals.differentiation import default_window, estimate_frequency
+
+    return default_window(estimate_frequency(dataset.pose, dataset.sample_rate))
+
+
+def held_out_segments(datasets: Sequence[Dataset], platform: Platform,
+                      folds: int = DEFAULT_FOLDS, gravity: bool = True,
+                      remainder: bool = False) -> list[Segment]:
+    """Every fold segment of every experiment, filtered (:func:`prepare_segment`); the same
+    for every method with the same ``gravity`` and ``remainder`` settings."""
+    segments = []
+    for e, dataset in enumerate(datasets):
+        edges, window = fold_bounds(len(dataset), folds), excitation_window(dataset)
+        for k in range(folds):
+            segments.append(prepare_segment(time_piece(dataset, edges[k], edges[k + 1]), platform,
+                                            window, gravity=gravity, experiment=e, fold=k,
+                                            remainder=remainder))
+    return segments
+
+
+def cross_validate(create: Callable[[], Any], datasets: Sequence[Dataset], platform: Platform,
+                   folds: int = DEFAULT_FOLDS, gravity: bool = True,
+                   segments: list[Segment] | None = None,
+                   companion: Callable[[], Any] | None = None) -> CrossValidation:
+    """Refit a method without each time segment and prepare the held-out segments.
+
+    Parameters
+    ----------
+    create : callable
+        Returns a new, unfitted identifier (e.g. ``lambda: create_identifier("wavelet")``).
+    datasets : sequence of Dataset
+        The experiments.
+    platform : Platform
+    folds : int
+        Segments per experiment, >= 2.
+    gravity : bool
+        Whether the method subtracts G(q) (its ``gravity`` setting).
+    segments : list of Segment, optional
+        The held-out segments if already prepared (:func:`held_out_segments` with the same
+        ``folds`` and ``gravity``).
+    companion : callable, optional
+        Returns a new friction-estimating identifier whose Coulomb levels each fold model
+        predicts with when it has none (:func:`with_companion_friction`).
+
+    Returns
+    -------
+    CrossValidation
+
+    Raises
+    ------
+    DataError
+        If ``folds`` < 2, or a refit fails because the remaining data are too short for the
+        method (the message names the fold and how to fix it).
+    """
+    if not (isinstance(folds, int | np.integer) and folds >= 2):
+        raise DataError(f"validation needs at least 2 folds; got {folds!r}.")
+    bounds = [fold_bounds(len(d), folds) for d in datasets]
+    fold_results = []
+    for k in range(folds):
+        training = []
+        for dataset, edges in zip(datasets, bounds, strict=True):
+            for start, stop in ((0, edges[k]), (edges[k + 1], len(dataset))):
+                if stop - start > 1:
+                    training.append(time_piece(dataset, start, stop))
+        try:
+            fold_results.append(with_companion_friction(
+                create().fit(training, platform).result_, companion, training, platform))
+        except StewartidError as exc:
+            raise DataError(f"validation fold {k + 1} of {folds} (segment {k + 1} of every "
+                            f"experiment held out) cannot be fitted: {exc} Record longer "
+                            "experiments or use fewer folds.") from exc
+    if segments is None:
+        segments = held_out_segments(datasets, platform, folds, gravity)
+    return CrossValidation(folds=int(folds), fold_results=fold_results, segments=segments)
+
+
+def record_segments(datasets: Sequence[Dataset], platform: Platform, gravity: bool = True,
+                    remainder: bool = False) -> list[Segment]:
+    """Validation records (motion the fit did not see), filtered as the held-out segments
+    are, each whole (:func:`prepare_segment`, labelled with fold 0)."""
+    return [prepare_segment(dataset, platform, excitation_window(dataset), gravity=gravity,
+                            experiment=k, remainder=remainder)
+            for k, dataset in enumerate(datasets)]
+
+
+def validate_on_records(result: IdentificationResult, segments: Sequence[Segment]
+                        ) -> ValidationResult:
+    """Scores of a model fitted on all experiments on validation records of another
+    excitation (:func:`record_segments`). Unlike held-out segments of the same sines, other
+    motion shows a wrong parameter that a friction term compensated on the fitted one.
+
+    Returns
+    -------
+    ValidationResult
+        With ``folds`` = 0 (no refit).
+    """
+    return score(segments, [predict(s, result) for s in segments], folds=0)
+
+
+def validation_entry(held_out: ValidationResult, records: ValidationResult | None = None
+                     ) -> dict[str, Any]:
+    """The ``validation`` object of ``result.json``: the held-out scores
+    (:meth:`ValidationResult.to_dict`) and, with validation records, their ``"records"``:
+    ``vaf_percent``, ``nrmse`` and ``names``."""
+    entry = held_out.to_dict()
+    if records is not None:
+        entry["records"] = {"vaf_percent": records.vaf_percent.tolist(),
+                            "nrmse": records.nrmse.tolist(),
+                            "names": [s.name for s in records.segments]}
+    return entry
+
+
+def friction_signature(validation: ValidationResult) -> float:
+    """Share of the held-out residual that has the shape of Coulomb joint friction.
+
+    The residuals of all six equations (each divided by the RMS of its measured force) are
+    fitted by least squares with the three Coulomb regressors (one level per joint type,
+    shared by the equations, centred per segment like the forces). 0: nothing of the
+    residual looks like friction; near 1: the residual is mostly friction the model lacks.
+    """
+    measured = np.concatenate(validation.measured)
+    scale = np.sqrt(np.mean(measured ** 2, axis=0))
+    scale = np.where(scale > 0, scale, 1.0)
+    residual = (measured - np.concatenate(validation.predicted)) / scale
+    regressors = np.concatenate([s.coulomb - s.coulomb.mean(axis=0)
+                                 for s in validation.segments]) / scale
+    design = np.transpose(regressors, (0, 2, 1)).reshape(-1, regressors.shape[1])
+    target = residual.reshape(-1)
+    energy = float(target @ target)
+    if energy == 0:
+        return 0.0
+    coefficients, *_ = np.linalg.lstsq(design, target, rcond=None)
+    left = target - design @ coefficients
+    return float(1.0 - left @ left / energy)
+
+
+def in_sample(segments: Sequence[Segment], result: IdentificationResult) -> ValidationResult:
+    """Scores and residuals of the model fitted on all data, on the same segments (the
+    residuals over time of the report)."""
+    return score(segments, [predict(s, result) for s in segments], folds=1)
+
+
+__all__ = ["DEFAULT_FOLDS", "CrossValidation", "Segment", "ValidationResult",
+           "coulomb_estimate", "coulomb_levels", "cross_validate", "excitation_window", "fold_bounds",
+           "friction_signature", "held_out_segments", "in_sample", "predict", "prediction_levels",
+           "prepare_segment", "record_segments", "score", "validate_on_records",
+           "validation_entry", "with_companion_friction"]
