@@ -16,9 +16,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from stewartid import compare_methods, write_report
 from stewartid.platform import load_platform
-from stewartid.reports.identification.report import write_identification_report
-from stewartid.reports.identification.run import methods_for
 from stewartid.simulation import simulate_experiments
 from stewartid.simulation.sensors import reference_noise
 
@@ -38,11 +37,12 @@ def main() -> None:
         # warm-up on a short copy: numba caches and imports, as a second command would have
         short = [d.__class__(t=d.t[:4000], pose=d.pose[:4000], lengths=d.lengths[:4000],
                              forces=d.forces[:4000], name=d.name) for d in data]
-        write_identification_report(short, platform, Path(folder) / "warm", folds=2)
+        comparison = compare_methods(short, platform, methods="wavelet", folds=2)
+        write_report(comparison, Path(folder) / "warm")
         start, cpu = time.perf_counter(), time.process_time()
-        report = write_identification_report(data, platform, Path(folder) / "report",
-                                             methods=methods_for(options.method),
-                                             consistent=options.consistent)
+        comparison = compare_methods(data, platform, methods=options.method,
+                                     consistent=options.consistent)
+        report = write_report(comparison, Path(folder) / "report")
         wall, cpu = time.perf_counter() - start, time.process_time() - cpu
     print(f"report ({options.method}{', consistent' if options.consistent else ''}): "
           f"{wall:.1f} s wall, {cpu:.1f} s CPU; trusted {report.trusted}")

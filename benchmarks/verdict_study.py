@@ -43,11 +43,11 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import noise_study  # noqa: E402  (a sibling script)
 
+from stewartid.comparison import judge, run_method  # noqa: E402
 from stewartid.identification import registry  # noqa: E402
 from stewartid.model.linearization import nominal_matrices  # noqa: E402
 from stewartid.platform import load_platform  # noqa: E402
 from stewartid.reference.published import PAPER_ENTRIES, relative_error_percent  # noqa: E402
-from stewartid.reports.identification.report import judge, run_method  # noqa: E402
 from stewartid.simulation import degrade  # noqa: E402
 from stewartid.simulation.sensors import reference_noise  # noqa: E402
 

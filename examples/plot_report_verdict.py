@@ -18,9 +18,8 @@ import tempfile
 import matplotlib.pyplot as plt
 import numpy as np
 
-from stewartid import load_platform
+from stewartid import compare_methods, load_platform, write_report
 from stewartid.identification.registry import registered_methods
-from stewartid.reports.identification.report import write_identification_report
 from stewartid.reports.identification.verdict_text import verdict_lines
 from stewartid.simulation import simulate_experiments
 from stewartid.simulation.sensors import reference_noise
@@ -29,8 +28,8 @@ paper = load_platform("paper")
 run = simulate_experiments(paper, coulomb=30.0, duration_s=4.0, noise=reference_noise(paper),
                            seed=1)
 print("registered:", ", ".join(spec.name for spec in registered_methods()))
-report = write_identification_report(run.datasets, paper, tempfile.mkdtemp(),
-                                     methods=("wavelet", "ls"), folds=2)
+comparison = compare_methods(run.datasets, paper, methods=("wavelet", "ls"), folds=2)
+report = write_report(comparison, tempfile.mkdtemp())
 print(f"trusted: {report.trusted}")
 print("\n".join(verdict_lines(report.verdict, report.runs)))
 

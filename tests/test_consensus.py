@@ -127,14 +127,14 @@ def test_a_close_call_trusts_the_consensus_and_says_why():
 def test_the_report_builds_and_trusts_the_consensus_of_a_close_call(tmp_path, paper):
     """A noisy 4 s log with 30 N m of Coulomb friction where Method B and least squares
     predict largest errors within 1.25x of each other."""
-    from stewartid.reports.identification.report import write_identification_report
+    from stewartid import compare_methods, write_report
     from stewartid.simulation import simulate_experiments
     from stewartid.simulation.sensors import reference_noise
 
     run = simulate_experiments(paper, coulomb=30.0, duration_s=4.0, noise=reference_noise(paper),
                                seed=3)
-    report = write_identification_report(run.datasets, paper, tmp_path, methods=("wavelet", "ls"),
-                                         folds=2)
+    comparison = compare_methods(run.datasets, paper, methods=("wavelet", "ls"), folds=2)
+    report = write_report(comparison, tmp_path)
     assert report.trusted == CONSENSUS and report.verdict.close == ("wavelet", "ls")
     document = json.loads((tmp_path / "result.json").read_text())
     assert document["method"] == CONSENSUS and document["verdict"]["trusted"] == CONSENSUS
@@ -160,8 +160,7 @@ def test_the_report_builds_and_trusts_the_consensus_of_a_close_call(tmp_path, pa
 def test_no_consensus_of_members_validated_on_differently_prepared_segments():
     """Members whose held-out forces differ (one subtracted gravity, the other not) cannot be
     validated as one model: no consensus is built, and the verdict stays with one method."""
-    from stewartid.reports.identification.records import MethodReport
-    from stewartid.reports.identification.report import consensus_run, same_segments
+    from stewartid.comparison import MethodFit, consensus_run, same_segments
     from stewartid.validation.heldout import CrossValidation, Segment
 
     rng = np.random.default_rng(2)
@@ -176,7 +175,7 @@ def test_no_consensus_of_members_validated_on_differently_prepared_segments():
     with_gravity, without = [segment(force)], [segment(force + 9.81)]
     assert same_segments(with_gravity, [segment(force.copy())])
     assert not same_segments(with_gravity, without)
-    members = [MethodReport(name, name, "k", result=_result(0.01), unconstrained=_result(0.01),
+    members = [MethodFit(name, name, "k", result=_result(0.01), unconstrained=_result(0.01),
                             cross_validation=CrossValidation(2, [_result(0.01)] * 2, segments))
                for name, segments in (("a", with_gravity), ("b", without))]
     assert consensus_run(members, consistent=False) is None

@@ -16,6 +16,7 @@ from typer.testing import CliRunner
 
 from linear_model_data import AMPLITUDES, make_experiment, random_matrices
 from roundoff import EPS
+from stewartid import compare_methods, write_report
 from stewartid.cli import app
 from stewartid.datasets.dataset import write_dataset
 from stewartid.errors import ConfigError
@@ -26,7 +27,6 @@ from stewartid.identification.consistency import (
 )
 from stewartid.reference.published import PAPER_ENTRIES, relative_error_percent
 from stewartid.reports.exports import read_matrix_csv
-from stewartid.reports.identification.report import write_identification_report
 
 SAMPLE_RATE = 200.0
 #: Force disturbance the model cannot explain: a sine at a frequency the motion lacks (N, N m).
@@ -52,9 +52,9 @@ def linear_data(paper):
 def linear_report(tmp_path_factory, linear_data, paper):
     data, M, B = linear_data
     folder = tmp_path_factory.mktemp("report")
-    report = write_identification_report(data, paper, folder, methods=("ls",),
-                                         settings={"coulomb": False}, folds=3,
-                                         nominal=(M, B), nominal_source="the generating model")
+    comparison = compare_methods(data, paper, methods=("ls",), settings={"coulomb": False},
+                                 folds=3, nominal=(M, B), nominal_source="the generating model")
+    report = write_report(comparison, folder)
     return report, folder
 
 
@@ -276,8 +276,8 @@ def test_report_on_the_independent_example(tmp_path, example_dir, example_platfo
     from stewartid.datasets.dataset import expand_paths, read_datasets
 
     data = read_datasets(expand_paths([example_dir]), example_platform)
-    report = write_identification_report(data, example_platform, tmp_path / "one",
-                                         consistent=True)
+    comparison = compare_methods(data, example_platform, methods="wavelet", consistent=True)
+    report = write_report(comparison, tmp_path / "one")
     run = report.runs[0]
     # noise-free data: the model predicts held-out force to better than 1 %
     assert np.all(run.validation.vaf_percent >= 99.0)
@@ -286,8 +286,8 @@ def test_report_on_the_independent_example(tmp_path, example_dir, example_platfo
     assert np.nanmax(change) <= 2.0
     assert np.linalg.eigvalsh(run.result.M).min() > 0
     assert np.linalg.eigvalsh(run.result.B).min() >= 0
-    compared = write_identification_report(data, example_platform, tmp_path / "all",
-                                           methods=("wavelet", "fourier", "ls"))
+    comparison = compare_methods(data, example_platform, methods=("wavelet", "fourier", "ls"))
+    compared = write_report(comparison, tmp_path / "all")
     text = (tmp_path / "all" / "report.md").read_text()
     assert [r.name for r in compared.runs] == ["wavelet", "fourier", "ls"]
     assert all(r.result is not None for r in compared.runs)
@@ -326,7 +326,7 @@ def test_report_on_own_noisy_plant(tmp_path, paper):
 
     run = simulate_experiments(paper, coulomb=5.0, duration_s=10.0,
                                noise=reference_noise(paper), seed=2)
-    report = write_identification_report(run.datasets, paper, tmp_path, methods=("wavelet",))
+    report = write_report(compare_methods(run.datasets, paper, methods=("wavelet",)), tmp_path)
     text = (tmp_path / "report.md").read_text()
     for section in ("## Data", "## Joint rates", "## Identified Mt and Bt", "## Residuals",
                     "## Validation on held-out data", "## Physical consistency", "## Friction"):
@@ -351,18 +351,18 @@ def test_validation_records_see_a_wrong_parameter(tmp_path, linear_data, paper):
     wrong = M.copy()
     wrong[0, 4] = wrong[4, 0] = M[0, 4] + 0.3 * np.sqrt(M[0, 0] * M[4, 4])
     records = [_validation_record(paper, M, B, "same"), _validation_record(paper, wrong, B, "wrong")]
-    report = write_identification_report(data, paper, tmp_path / "r", methods=("ls",),
-                                         settings={"coulomb": False}, folds=3,
-                                         records=records[:1])
+    comparison = compare_methods(data, paper, methods=("ls",), settings={"coulomb": False},
+                                 folds=3, validate=records[:1])
+    report = write_report(comparison, tmp_path / "r")
     run = report.runs[0]
     assert np.all(run.records.vaf_percent > 99.0), run.records.vaf_percent
     text = (tmp_path / "r" / "report.md").read_text()
     assert "## Validation on other records" in text
     document = json.loads((tmp_path / "r" / "result.json").read_text())
     assert len(document["validation"]["records"]["vaf_percent"]) == 6
-    other = write_identification_report(data, paper, tmp_path / "w", methods=("ls",),
-                                        settings={"coulomb": False}, folds=3,
-                                        records=records[1:])
+    comparison = compare_methods(data, paper, methods=("ls",), settings={"coulomb": False},
+                                 folds=3, validate=records[1:])
+    other = write_report(comparison, tmp_path / "w")
     worse = other.runs[0].records.vaf_percent
     assert min(worse[0], worse[4]) < 99.0 and min(worse[0], worse[4]) < min(
         run.records.vaf_percent[0], run.records.vaf_percent[4]) - 1.0

@@ -17,11 +17,11 @@ import pytest
 from typer.testing import CliRunner
 
 from stewartid.cli import app
+from stewartid.comparison import PhysicalRequest, fit_physical
 from stewartid.datasets.dataset import write_dataset
 from stewartid.model import regressor as reg
 from stewartid.model.linearization import nominal_matrices
 from stewartid.platform import load_platform
-from stewartid.reports.identification.physical_section import PhysicalRequest, fit_physical
 from test_physical_consistent import PAYLOAD, regressor_records
 
 #: White noise on each leg force (N): standard errors well above round-off.

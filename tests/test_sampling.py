@@ -131,11 +131,12 @@ def test_the_physical_model_widens_its_parameters_on_a_noise_free_plant_log():
 
 
 def test_the_report_says_which_results_the_sampling_limits(tmp_path, noise_free, paper):
-    from stewartid.reports.identification.report import write_identification_report
+    from stewartid import compare_methods, write_report
 
     data, M, B = noise_free
-    write_identification_report(data, paper, tmp_path, methods=("fourier", "ls"), folds=3,
-                                 nominal=(M, B), nominal_source="the generating model")
+    comparison = compare_methods(data, paper, methods=("fourier", "ls"), folds=3, nominal=(M, B),
+                                 nominal_source="the generating model")
+    write_report(comparison, tmp_path)
     text = (tmp_path / "report.md").read_text()
     line = next(line for line in text.splitlines() if "Limited by the log's sampling" in line)
     # least squares' residual is round-off there (flagged), Method A's errors do not scale

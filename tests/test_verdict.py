@@ -10,13 +10,15 @@ from stewartid.identification.result import IdentificationResult
 from stewartid.reference.published import PAPER_ENTRIES
 from stewartid.validation.heldout import Segment, ValidationResult
 from stewartid.verdict.accuracy import (
-    PRECISION_FACTOR,
     entry_relative_std,
     error_posterior,
     expected_worst_error,
     fold_correlation,
 )
+from stewartid.verdict.policy import DEFAULT_POLICY, VerdictPolicy, scored_entries
 from stewartid.verdict.rule import choose_trusted
+
+PRECISION_FACTOR = DEFAULT_POLICY.precision_factor
 
 
 def test_expected_worst_error_against_analytic_and_monte_carlo_values():
@@ -85,7 +87,7 @@ def test_a_tie_goes_to_the_better_held_out_prediction():
     verdict = choose_trusted({"ls": (_result(0.010), _validation(0.5)),
                               "wavelet": (_result(0.010, friction_model="free"),
                                           _validation(0.1))})
-    assert verdict.tied == ("ls", "wavelet") and verdict.trusted == "wavelet"
+    assert verdict.trusted == "wavelet"
 
 
 def test_immunity_to_the_friction_law_does_not_outweigh_a_smaller_predicted_error():
@@ -94,7 +96,7 @@ def test_immunity_to_the_friction_law_does_not_outweigh_a_smaller_predicted_erro
                               "wavelet": (_result(0.013, shift=0.013, friction_model="free"),
                                           _validation(0.1))})
     assert verdict.standings["wavelet"].friction_immune
-    assert verdict.tied == ("ls",) and verdict.trusted == "ls"
+    assert verdict.trusted == "ls"
 
 
 def test_entries_another_method_contradicts_are_named_uncertain():
@@ -302,3 +304,32 @@ def test_the_verdict_conditions_on_the_correlation_its_fold_fits_show():
     assert independent.standings["a"].error_correlation == {"b": 0.0, "c": 0.0}
     assert all(verdict.standings[n].expected_worst != independent.standings[n].expected_worst
                for n in "abc")
+
+
+def test_the_scored_entries_follow_the_platform():
+    """A symmetric platform scores the paper's 20 entries; an offset payload couples more."""
+    from stewartid import load_platform, nominal_matrices
+    from stewartid.reference.published import PAPER_ENTRIES
+
+    paper = load_platform("paper")
+    assert scored_entries(*nominal_matrices(paper)) == PAPER_ENTRIES
+    offset = paper.replace(payload__mass=2000.0, payload__com=(0.3, -0.2, 0.4),
+                           payload__inertia=(900.0, 800.0, 700.0, 0.0, 0.0, 0.0))
+    found = scored_entries(*nominal_matrices(offset))
+    assert set(PAPER_ENTRIES) < set(found)
+    M, _ = nominal_matrices(offset)
+    d = np.sqrt(np.diag(M))
+    for matrix, i, j in set(found) - set(PAPER_ENTRIES):
+        assert matrix == "M" and abs(M[i, j]) > 1e-2 * d[i] * d[j]
+
+
+def test_the_policy_sets_the_close_call():
+    """One threshold of the policy moves the verdict: a wider close factor names a close call
+    that the default does not."""
+    assessed = {"a": (_result(0.010), _validation(0.1)),
+                "b": (_result(0.030, shift=0.03), _validation(0.1))}
+    found = choose_trusted(assessed)
+    assert found.close == ("a",)
+    ratio = found.standings["b"].expected_worst / found.standings["a"].expected_worst
+    wide = choose_trusted(assessed, policy=VerdictPolicy(close_factor=1.01 * ratio))
+    assert wide.close == ("a", "b") and wide.policy.close_factor == 1.01 * ratio

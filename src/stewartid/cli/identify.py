@@ -93,8 +93,7 @@ def identify(
     known (platform description, or meta.json/truth.json beside the data) and write JSON."""
     import numpy as np
 
-    from stewartid.physical.identified_platform import model_method
-    from stewartid.reports.identification.run import FlagSetting, identify_files
+    from stewartid.cli.identify_run import FlagSetting, identify_files, model_method
     from stewartid.reports.terminal import print_comparison
 
     flags = {"--no-gravity": FlagSetting("gravity", not no_gravity, no_gravity),
@@ -116,7 +115,7 @@ def identify(
         else:
             typer.echo(f"force delay {entry['seconds'] * 1e3:.3f} ms, given; forces aligned")
     if found.delay_sensitivity is not None:
-        from stewartid.reports.identification.run import delay_note
+        from stewartid.cli.identify_run import delay_note
 
         typer.echo(f"note: {delay_note(found.delay_sensitivity)}")
     if found.report is not None:

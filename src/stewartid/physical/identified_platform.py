@@ -1,5 +1,4 @@
-"""The platform description of an identified physical model: the TOML every command accepts,
-and the ``identify --model physical`` run behind the command line.
+"""The platform description of an identified physical model: the TOML every command accepts.
 
 Payload mode writes the platform file with the identified ``[payload]``. Full mode writes the
 identified moving body as the file's platform plus a ``[payload]`` that carries the
@@ -15,18 +14,15 @@ the identified ones.
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from stewartid.datasets.dataset import Dataset
 from stewartid.errors import ConfigError
-from stewartid.files import check_output_file, write_text_atomic
+from stewartid.files import write_text_atomic
 from stewartid.model import regressor as reg
 from stewartid.physical.estimator import (
-    PhysicalIdentifier,
     PhysicalResult,
     known_platform,
     payload_section,
@@ -34,10 +30,7 @@ from stewartid.physical.estimator import (
 from stewartid.platform import Platform
 from stewartid.platform.sections import inertia_matrix
 
-#: Values of ``identify --model``.
-MODELS = ("physical",)
-#: First line of a platform file ``identify --platform-out`` wrote: such a file is
-#: overwritten by the next run, any other refused.
+#: The first line of a platform file ``identify --platform-out`` wrote.
 IDENTIFIED_HEADER = "# identified by stewartid identify --model physical from"
 
 
@@ -141,79 +134,6 @@ def identified_platform(platform: Platform, result: PhysicalResult) -> Platform:
                           f"{exc}") from None
 
 
-def _is_identified(path: Path) -> bool:
-    """True for a platform file that ``identify --platform-out`` wrote (overwritten)."""
-    try:
-        return path.read_text(encoding="utf-8").startswith(IDENTIFIED_HEADER)
-    except (OSError, UnicodeDecodeError):
-        return False
-
-
-def check_model_options(model: str, platform_out: Path | None, forbidden: dict[str, bool]
-                        ) -> None:
-    """Refuse, before any computation, a model not known and options the physical model
-    does not take.
-
-    Parameters
-    ----------
-    model : str
-        The ``--model`` value.
-    platform_out : Path, optional
-        The ``--platform-out`` file.
-    forbidden : dict of str to bool
-        Options that do not apply, by flag, and whether each was given.
-    """
-    if model not in MODELS:
-        raise ConfigError(f"--model {model!r}: expected one of {', '.join(MODELS)}.")
-    given = [flag for flag, on in forbidden.items() if on]
-    if given:
-        raise ConfigError(f"{given[0]} does not apply to --model {model}; leave it out.")
-    if platform_out is not None and platform_out.suffix.lower() != ".toml":
-        raise ConfigError(f"--platform-out {str(platform_out)!r}: the platform description "
-                          "is TOML; give a .toml file name.")
-
-
-def model_method(model: str | None, method: str, payload: bool,
-                 platform_out: Path | None) -> str:
-    """The method ``identify`` runs: ``method`` without ``--model``, else the model's
-    estimator (``"physical"``).
-
-    Raises
-    ------
-    ConfigError
-        An unknown model, or ``--payload``/``--platform-out`` without ``--model``.
-    """
-    if model is None:
-        if payload or platform_out is not None:
-            raise ConfigError("--payload and --platform-out go with --model physical; add it.")
-        return method
-    if model not in MODELS:
-        raise ConfigError(f"--model {model!r}: expected one of {', '.join(MODELS)}.")
-    return model
-
-
-def check_model_outputs(model: str, platform_out: Path | None,
-                        refused: dict[str, bool] | None = None,
-                        inputs: Sequence[str | Path] = ()) -> None:
-    """Refuse, before any computation, what ``identify --model`` cannot do
-    (:func:`check_model_options`) and a ``platform_out`` that would replace an input or a
-    file ``--platform-out`` did not write.
-
-    Parameters
-    ----------
-    model : str
-    platform_out : Path, optional
-    refused : dict of str to bool, optional
-        Options of the command that do not apply, by flag, and whether each was given.
-    inputs : sequence of str or Path
-        Files the command reads, which ``platform_out`` must not be.
-    """
-    check_model_options(model, platform_out, refused or {})
-    if platform_out is not None:
-        check_output_file(platform_out, False, inputs, is_result=_is_identified,
-                          option="--platform-out")
-
-
 def write_identified(platform: Platform, result: PhysicalResult, platform_out: Path,
                      experiments: int) -> Path:
     """Write the platform description of ``result`` (:func:`identified_platform`) to
@@ -224,45 +144,4 @@ def write_identified(platform: Platform, result: PhysicalResult, platform_out: P
                              + identified.to_toml())
 
 
-def identify_model(datasets: list[Dataset], platform: Platform, model: str = "physical",
-                   payload: bool = False, platform_out: Path | None = None,
-                   refused: dict[str, bool] | None = None,
-                   inputs: Sequence[str | Path] = (), consistent: bool = False,
-                   settings: dict[str, Any] | None = None) -> PhysicalResult:
-    """``stewartid identify --model physical`` without a report: fit, and write
-    ``platform_out``.
-
-    Parameters
-    ----------
-    datasets : list of Dataset
-    platform : Platform
-    model : str
-        ``"physical"``.
-    payload : bool
-        Payload mode (:class:`~stewartid.physical.estimator.PhysicalIdentifier`).
-    platform_out : Path, optional
-        Write the identified platform description here (TOML).
-    refused : dict of str to bool, optional
-        Options of the command that do not apply, by flag, and whether each was given.
-    inputs : sequence of str or Path
-        Files the command reads, which ``platform_out`` must not be.
-    consistent : bool
-        The physically consistent fit (the ``convex`` extra); ``platform_out`` then holds
-        the consistent parameters.
-    settings : dict, optional
-        Further estimator settings (e.g. ``{"gravity": False}``).
-
-    Returns
-    -------
-    PhysicalResult
-    """
-    check_model_outputs(model, platform_out, refused, inputs)
-    result = PhysicalIdentifier(**(settings or {}), payload=payload,
-                                consistent=consistent).fit(datasets, platform).result_
-    if platform_out is not None:
-        write_identified(platform, result, platform_out, len(datasets))
-    return result
-
-
-__all__ = ["IDENTIFIED_HEADER", "MODELS", "check_model_options", "check_model_outputs",
-           "identified_platform", "identify_model", "model_method", "write_identified"]
+__all__ = ["IDENTIFIED_HEADER", "identified_platform", "write_identified"]

@@ -30,11 +30,11 @@ from stewartid.validation.heldout import (
     DEFAULT_FOLDS,
     Segment,
     ValidationResult,
-    time_piece,
     cross_validate,
     excitation_window,
     fold_bounds,
     score,
+    time_piece,
 )
 
 

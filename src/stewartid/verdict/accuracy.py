@@ -11,7 +11,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from stewartid.identification.result import IdentificationResult
-from stewartid.reference.published import PAPER_ENTRIES
+from stewartid.reference.published import PAPER_ENTRIES, EntryKey
+from stewartid.verdict.policy import DEFAULT_POLICY
 
 
 def entry_estimate(result: IdentificationResult, matrix: str, i: int, j: int
@@ -22,11 +23,12 @@ def entry_estimate(result: IdentificationResult, matrix: str, i: int, j: int
     return float(result.B[i, j]), float(result.std_errors_B[i, j])
 
 
-def entry_relative_std(result: IdentificationResult) -> np.ndarray:
-    """Relative standard error of each of the paper's 20 entries (fractions), in the order
-    of :data:`~stewartid.reference.published.PAPER_ENTRIES`; infinite for a zero estimate."""
+def entry_relative_std(result: IdentificationResult,
+                       entries: Sequence[EntryKey] = PAPER_ENTRIES) -> np.ndarray:
+    """Relative standard error of each of ``entries`` (fractions), in their order; infinite
+    for a zero estimate."""
     out = []
-    for key in PAPER_ENTRIES:
+    for key in entries:
         value, std = entry_estimate(result, *key)
         out.append(std / abs(value) if value != 0 else np.inf)
     values = np.array(out, dtype=float)
@@ -76,12 +78,6 @@ def expected_worst_error(relative_std: np.ndarray, mean: np.ndarray | None = Non
     return float(np.trapezoid(1.0 - np.prod(within, axis=1), x[:, 0]))
 
 
-#: Other methods' estimates of an entry, pooled, at least this many times more precise than
-#: this method's measure its error there: their difference, to within a fifth of its own
-#: standard error (:func:`error_posterior` names such entries).
-PRECISION_FACTOR = 5.0
-
-
 def symmetric_members(result: IdentificationResult, matrix: str, i: int, j: int
                       ) -> list[tuple[float, float]]:
     """The distinct estimates (value, standard error) of entry (i, j) of ``matrix`` and of its
@@ -105,7 +101,8 @@ def pooled(estimates: Sequence[tuple[float, float]]) -> tuple[float, float]:
 
 
 def fold_correlation(results: Sequence[IdentificationResult],
-                     folds: Sequence[Sequence[IdentificationResult] | None]) -> np.ndarray:
+                     folds: Sequence[Sequence[IdentificationResult] | None],
+                     entries: Sequence[EntryKey] = PAPER_ENTRIES) -> np.ndarray:
     """Correlation of several methods' errors on the same data, from their fits of the same
     folds.
 
@@ -139,7 +136,7 @@ def fold_correlation(results: Sequence[IdentificationResult],
         if fits is None or len(fits) not in counts:
             continue
         departures = []
-        for matrix, i, j in PAPER_ENTRIES:
+        for matrix, i, j in entries:
             values = np.array([entry_estimate(fit, matrix, i, j)[0] for fit in fits])
             departures.append((values - values.mean()) / entry_estimate(result, matrix, i, j)[1])
         rows.append(np.concatenate(departures))
@@ -157,7 +154,9 @@ def fold_correlation(results: Sequence[IdentificationResult],
 
 
 def error_posterior(result: IdentificationResult, others: Sequence[IdentificationResult],
-                    correlation: np.ndarray | None = None
+                    correlation: np.ndarray | None = None,
+                    entries: Sequence[EntryKey] = PAPER_ENTRIES,
+                    precision_factor: float = DEFAULT_POLICY.precision_factor
                     ) -> tuple[np.ndarray, np.ndarray, list[int]]:
     """This result's error on each of the paper's 20 entries, given other estimates of the
     same quantities: the Gaussian posterior of its error conditioned on them.
@@ -198,13 +197,13 @@ def error_posterior(result: IdentificationResult, others: Sequence[Identificatio
         (0, :func:`entry_relative_std`) where nothing else estimates the entry.
     measured : list of int
         Indices of the entries the other estimates measure: pooled, their standard error is
-        at most s / :data:`PRECISION_FACTOR`.
+        at most s / ``precision_factor``.
     """
     links = np.eye(1 + len(others)) if correlation is None else np.asarray(correlation, float)
-    std = entry_relative_std(result)
+    std = entry_relative_std(result, entries)
     mean = np.zeros_like(std)
     measured = []
-    for k, (matrix, i, j) in enumerate(PAPER_ENTRIES):
+    for k, (matrix, i, j) in enumerate(entries):
         value, own = entry_estimate(result, matrix, i, j)
         if not (value != 0 and np.isfinite(value) and np.isfinite(own) and own > 0):
             continue
@@ -233,7 +232,7 @@ def error_posterior(result: IdentificationResult, others: Sequence[Identificatio
         differences = value - np.array([v for v, _, _ in estimates])
         mean[k] = float(weights @ differences) / abs(value)
         std[k] = np.sqrt(max(own ** 2 - float(with_d @ weights), 0.0)) / abs(value)
-        if PRECISION_FACTOR ** 2 * pooled([(v, s) for v, s, _ in estimates])[1] <= own ** 2:
+        if precision_factor ** 2 * pooled([(v, s) for v, s, _ in estimates])[1] <= own ** 2:
             measured.append(k)
     return mean, std, measured
 
@@ -244,6 +243,6 @@ def predicted_worst_error(result: IdentificationResult) -> float:
     return expected_worst_error(entry_relative_std(result))
 
 
-__all__ = ["PRECISION_FACTOR", "entry_estimate", "entry_relative_std", "error_posterior",
+__all__ = ["entry_estimate", "entry_relative_std", "error_posterior",
            "expected_worst_error", "fold_correlation", "pooled", "predicted_worst_error",
            "relative_std", "symmetric_members"]

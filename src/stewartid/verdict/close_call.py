@@ -1,26 +1,22 @@
 """The verdict's answer to a close call: trust the consensus of the close methods.
 
-Where :func:`~stewartid.verdict.rule.choose_trusted` finds several plausible methods
-whose standard errors predict largest errors within
-:data:`~stewartid.verdict.rule.CLOSE_FACTOR` of each other, which of them is the more
-accurate is decided by the noise (the one predicting the smaller error realised it in 60-72 %
-of such pairs). The report then builds their consensus
-(:func:`~stewartid.verdict.consensus.combine_results`, from the fits and folds it
-already has) and trusts it: on the verdict study's 100 noisy logs with a known truth, the
-trusted result was then within 1.5x of the most accurate method on 98, with the single
-method on 88 (``docs/benchmarks.md``, "Which method to trust").
+Where several plausible methods predict largest errors within the policy's ``close_factor``
+of each other, the noise decides which of them is the more accurate; their consensus
+(:func:`~stewartid.verdict.consensus.combine_results`) is trusted instead.
 """
 
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 
 import numpy as np
 
 from stewartid.identification.result import IdentificationResult
-from stewartid.reference.published import PAPER_ENTRIES
+from stewartid.reference.published import PAPER_ENTRIES, EntryKey
 from stewartid.validation.heldout import ValidationResult, friction_signature
 from stewartid.verdict.accuracy import entry_relative_std, expected_worst_error
+from stewartid.verdict.policy import entries_text
 from stewartid.verdict.rule import (
     Standing,
     Verdict,
@@ -42,23 +38,25 @@ def consensus_members(verdict: Verdict) -> tuple[str, ...]:
     return verdict.close if len(verdict.close) > 1 else ()
 
 
-def combined_entries(result: IdentificationResult) -> int:
-    """How many of the paper's 20 entries the consensus ``result`` averaged over two or more
-    members (the others are its reference member's)."""
+def combined_entries(result: IdentificationResult, entries: Sequence[EntryKey]) -> int:
+    """How many of ``entries`` the consensus ``result`` averaged over two or more members
+    (the others are its reference member's)."""
     found = result.diagnostics.get("consensus", {})
     used = {"M": np.asarray(found.get("used_M")), "B": np.asarray(found.get("used_B"))}
     if used["M"].ndim != 3 or used["B"].ndim != 3:
         return 0
-    return sum(int(used[matrix][:, i, j].sum() > 1) for matrix, i, j in PAPER_ENTRIES)
+    return sum(int(used[matrix][:, i, j].sum() > 1) for matrix, i, j in entries)
 
 
-def combined_text(result: IdentificationResult, reference: str) -> str:
-    """Which of the paper's 20 entries the consensus ``result`` averaged, for a sentence
-    (``reference``: how to name its reference member)."""
-    count = combined_entries(result)
-    if count == len(PAPER_ENTRIES):
-        return f"all {count} of the paper's entries"
-    return f"{count} of the paper's {len(PAPER_ENTRIES)} entries; {reference}'s elsewhere"
+def combined_text(result: IdentificationResult, reference: str,
+                  entries: Sequence[EntryKey]) -> str:
+    """Which of ``entries`` the consensus ``result`` averaged, for a sentence (``reference``:
+    how to name its reference member)."""
+    count = combined_entries(result, entries)
+    if count == len(entries):
+        return (f"all {count} of the paper's entries" if tuple(entries) == PAPER_ENTRIES
+                else f"all {count} scored entries")
+    return f"{count} of {entries_text(entries)}; {reference}'s elsewhere"
 
 
 def trust_consensus(verdict: Verdict, result: IdentificationResult,
@@ -85,13 +83,16 @@ def trust_consensus(verdict: Verdict, result: IdentificationResult,
         consensus's; every standing's unexplained force relative to the consensus's.
     """
     members = consensus_members(verdict)
+    entries = verdict.entries
     vaf, dof = worst_dof(validation)
-    worst, entry = worst_relative_std(result)
+    worst, entry = worst_relative_std(result, entries)
     unexplained = max(100 - vaf, 1e-12)
     standings = {CONSENSUS: Standing(
-        CONSENSUS, vaf, dof, 1.0, True, models_friction(result),
-        None, float("nan"), friction_signature(validation), worst, entry, False, False,
-        expected_worst_error(entry_relative_std(result)))}
+        name=CONSENSUS, worst_vaf_percent=vaf, worst_dof=dof, unexplained_ratio=1.0,
+        compared=True, models_friction=models_friction(result), friction_effect=None,
+        damping_excess=float("nan"), friction_share=friction_signature(validation),
+        worst_relative_std=worst, worst_entry=entry,
+        expected_worst=expected_worst_error(entry_relative_std(result, entries)))}
     standings.update({name: dataclasses.replace(
         standing, unexplained_ratio=standing.unexplained_percent / unexplained)
         for name, standing in verdict.standings.items()})
@@ -100,11 +101,11 @@ def trust_consensus(verdict: Verdict, result: IdentificationResult,
               "one's symmetric pairs pooled) are averaged, weighted by their inverse "
               "variances, where they agree within "
               f"{agreement:g} standard error of their difference "
-              f"({combined_text(result, members[0])}); its standard errors take "
+              f"({combined_text(result, members[0], entries)}); its standard errors take "
               "the members' errors as fully correlated, and predict a largest error of "
               f"{100 * standings[CONSENSUS].expected_worst:.3g} %; held-out VAF {vaf:.4g} % in "
               f"its worst DOF ({dof}).")
-    uncertain = uncertain_entries(result, compared)
+    uncertain = uncertain_entries(result, compared, entries, verdict.policy)
     reasons = [reason, *(r for r in verdict.reasons if not r.startswith("uncertain entries:"))]
     if uncertain:
         reasons.append(uncertain_sentence(uncertain))

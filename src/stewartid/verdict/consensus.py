@@ -1,36 +1,10 @@
-"""The consensus of several methods: their estimates of each entry averaged, weighted by
-their inverse variances, where they agree.
+"""The consensus of several methods: each member's symmetric pairs pooled, then their
+estimates of each entry averaged by inverse variance where they agree with the first member.
 
-When two methods predict the same accuracy on a log (the verdict's close call,
-:data:`~stewartid.verdict.rule.CLOSE_FACTOR`), the noise realisation decides which is
-the more accurate, and choosing one is a coin toss on every entry. Their precision-weighted
-mean hedges it. For each entry of Mt and Bt, with the first member's estimate v_0 +- s_0:
-
-- every member k whose estimate agrees with it, |v_k - v_0| <= ``agreement`` *
-  sqrt(s_k^2 + s_0^2), enters with weight w_k proportional to 1 / s_k^2;
-- a member that disagrees is left out of that entry: one of the two has a model error its
-  standard errors do not cover (least squares' friction law on three-sine logs), and a mean
-  would carry it.
-
-The members' errors are correlated: they fit the same record, and their z-scores correlated
-0.47-0.80 over the entries of noisy logs with a known truth (``docs/benchmarks.md``, "Which
-method to trust"). The standard error is therefore the bound for fully correlated members,
-sum_k w_k s_k, never below the mean's true one and at most the largest member's.
-
-Mt and Bt are symmetric, and a member that estimates the two entries of a pair (i, j), (j, i)
-apart (least squares: from different experiments' equations) holds two estimates of one
-quantity. Before the members are combined, each member's pair is pooled
-(:func:`pooled_pairs`): their inverse-variance mean, with the standard error for fully
-correlated estimates scaled by the pair's Birge ratio where the two disagree beyond their
-standard errors (the Particle Data Group's scale factor). A member that already gives both
-entries one estimate (Method B) is unchanged. The consensus is then symmetric.
-
-Measured on the verdict study's noisy logs (100 logs: our plant and MuJoCo, two platforms),
-with the consensus of the close methods trusted wherever the verdict named a close call, the
-trusted result was within 1.5x of the most accurate method on 98 with the pairs pooled (97
-without; the verdict's single method on 88); pooling lowered the trusted result's largest
-error on 32 of those logs and the 25 clean ones, and raised it on none
-(``docs/benchmarks.md``, "Which method to trust").
+A member that disagrees beyond ``agreement`` standard errors of the difference is left out of
+that entry (one of the two has a model error its standard errors do not cover). The members
+fit the same record and their errors correlate, so the standard error is the bound for fully
+correlated members, sum_k w_k s_k. ``docs/verdict.md`` gives the measurements behind it.
 """
 
 from __future__ import annotations
@@ -47,15 +21,14 @@ from stewartid.identification.base import BaseIdentifier
 from stewartid.identification.registry import create_identifier, method_spec, register_method
 from stewartid.identification.result import IdentificationResult
 from stewartid.platform import Platform
+from stewartid.verdict.policy import DEFAULT_POLICY
 
-#: Members agree on an entry within this many standard errors of their difference.
-AGREEMENT = 1.0
 #: The members of :class:`ConsensusIdentifier` by default: the paper's Method B and least
 #: squares, the two methods the verdict most often finds in a close call.
 DEFAULT_MEMBERS = ("wavelet", "ls")
 
 
-def combine_estimates(values: np.ndarray, std_errors: np.ndarray, agreement: float = AGREEMENT
+def combine_estimates(values: np.ndarray, std_errors: np.ndarray, agreement: float = DEFAULT_POLICY.agreement
                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Inverse-variance mean of the members that agree with the first one, entry by entry.
 
@@ -146,7 +119,7 @@ def friction_diagnostics(results: Sequence[IdentificationResult]) -> dict[str, A
 
 
 def combine_results(results: Sequence[IdentificationResult], names: Sequence[str],
-                    agreement: float = AGREEMENT) -> IdentificationResult:
+                    agreement: float = DEFAULT_POLICY.agreement) -> IdentificationResult:
     """The consensus of fitted results (:func:`combine_estimates` on Mt and Bt, each member's
     symmetric pairs pooled first by :func:`pooled_pairs`).
 
@@ -225,7 +198,8 @@ class ConsensusIdentifier(BaseIdentifier):
         "gravity": [BOOLEAN],
     }
 
-    def __init__(self, members: tuple[str, ...] = DEFAULT_MEMBERS, agreement: float = AGREEMENT,
+    def __init__(self, members: tuple[str, ...] = DEFAULT_MEMBERS,
+                 agreement: float = DEFAULT_POLICY.agreement,
                  gravity: bool = True):
         self.members = members
         self.agreement = agreement
@@ -254,5 +228,5 @@ class ConsensusIdentifier(BaseIdentifier):
         return result, {"members_": fitted}
 
 
-__all__ = ["AGREEMENT", "DEFAULT_MEMBERS", "ConsensusIdentifier", "combine_estimates",
+__all__ = ["DEFAULT_MEMBERS", "ConsensusIdentifier", "combine_estimates",
            "combine_results", "friction_diagnostics", "pooled_pairs"]

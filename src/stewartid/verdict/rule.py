@@ -1,48 +1,8 @@
 """Which of several identified models to trust on the same data, and why.
 
-:func:`choose_trusted` weighs what each method's result and held-out validation
-(:mod:`stewartid.validation.heldout`) show and returns the finding as data
-(:class:`Verdict`); the identification report puts it into words and ``result.json`` holds
-it (:meth:`Verdict.to_dict`).
-
-Rule, in order:
-
-1. **Applicable**: methods that refused the data (their assumptions fail: several sines for
-   Method A, no constant-direction interval for Method B) are out.
-2. **Physically plausible**: symmetric parts of Mt positive definite and of Bt positive
-   semidefinite (all methods, if none is).
-3. **Held-out prediction**: a method whose worst DOF leaves more than :data:`MISFIT_FACTOR`
-   times the least unexplained force, and more than :data:`MISFIT_FLOOR` %, misses something
-   the others model; it is ranked after the others. Held-out segments of the same excitation
-   cannot show a wrong parameter that a friction term compensates, so this is a gate, not the
-   ranking.
-4. **Honest uncertainty**: among the rest, the method with the smallest expected largest
-   relative error over the paper's 20 entries wins
-   (:func:`~stewartid.verdict.accuracy.expected_worst_error`, so one conservative
-   entry does not outweigh nineteen). Every method's standard errors carry its model error
-   where the data show it (:func:`~stewartid.identification.pairs.pair_calibration`; for
-   Method A the friction its third harmonic reveals), and each entry's error is conditioned
-   on the other plausible methods' estimates of it, their errors correlated as their fits of
-   the same folds show (:func:`~stewartid.verdict.accuracy.error_posterior`): the
-   less precise of two that disagree takes the larger share of the difference, and a
-   difference from estimates over :data:`~stewartid.verdict.accuracy.PRECISION_FACTOR`
-   times more precise measures the error. So a standard error widened for a model error a
-   precise fit shows absent is not held against a method, and a method several of its
-   standard errors from a more precise one is not trusted on them (Method B 9.4 % off on
-   Bt(6,6), predicted 4.3 % on its standard errors where least squares, 2.6 % off,
-   predicted 5.5 %; conditioned, 10.5 % and 3.7 %).
-5. **Ties** (within :data:`TIE_FACTOR`): the better held-out prediction. A method immune to
-   the friction law (Method B with free interval constants) is not preferred for it: with
-   every method's standard errors carrying its model error, the predicted accuracy already
-   says what the friction law costs, and on logs with a known truth the preference chose a
-   method up to twice as far off as the best (:doc:`/benchmarks`, "Which method to trust").
-6. **Close calls**: where other plausible methods predict largest errors within
-   :data:`CLOSE_FACTOR` of the trusted one's, the noise decides which is the more accurate;
-   the report then trusts their consensus (:mod:`stewartid.verdict.close_call`).
-
-Entries are *uncertain* when the trusted method's relative standard error exceeds
-:data:`UNCERTAIN_RELATIVE`, or when another plausible method's estimate differs from the
-trusted one's by more than :data:`DISAGREEMENT` combined standard errors.
+:func:`choose_trusted` returns the finding as data (:class:`Verdict`); the report puts it
+into words and ``result.json`` holds it (:meth:`Verdict.to_dict`). The rule, step by step, is
+in ``docs/verdict.md``; its thresholds are a :class:`~stewartid.verdict.policy.VerdictPolicy`.
 """
 
 from __future__ import annotations
@@ -57,47 +17,20 @@ import numpy as np
 from stewartid.identification.consistency import consistency_metrics
 from stewartid.identification.result import IdentificationResult
 from stewartid.platform import COORDINATES
-from stewartid.reference.published import PAPER_ENTRIES, entry_label
+from stewartid.reference.published import PAPER_ENTRIES, EntryKey, entry_label
 from stewartid.validation.heldout import (
     ValidationResult,
     coulomb_estimate,
     friction_signature,
 )
 from stewartid.verdict.accuracy import (
-    PRECISION_FACTOR,
     entry_estimate,
     entry_relative_std,
     error_posterior,
     expected_worst_error,
     fold_correlation,
 )
-
-#: Methods whose expected largest error is within this factor of the least are tied (the held-out
-#: prediction decides). Any tie wider than equality chose worse on logs with a known truth
-#: (35 logs: 30 within 1.5x of the best at 1, 29 at 1.02, 28 at 1.1, 27 at 1.2-1.5, 26 at 2
-#: with the friction-immune method first): a method whose errors predict a larger worst
-#: error was, more often than not, further off.
-TIE_FACTOR = 1.0
-#: Methods whose expected largest error is within this factor of the trusted one's are a
-#: close call: which is the more accurate is decided by the noise realisation, and the verdict
-#: says so. Measured over 220 pairs of methods on 100 noisy logs with a known truth (our plant
-#: and MuJoCo, two platforms): the one predicting the smaller largest error realised it in 60 %
-#: of the pairs within 1.1x, 72 % within 1.1-1.25x, 89 % within 1.25-1.5x (and was then within
-#: 1.5x of the other in all 27), 97 % beyond.
-CLOSE_FACTOR = 1.25
-#: A method leaving more than this factor times the least held-out unexplained force ...
-MISFIT_FACTOR = 4.0
-#: ... and more than this share (%) of the force in its worst DOF misses part of the physics.
-MISFIT_FLOOR = 1.0
-#: An entry's relative standard error above which the verdict names it uncertain.
-UNCERTAIN_RELATIVE = 0.10
-#: Two methods' estimates of an entry disagree beyond this many combined standard errors.
-DISAGREEMENT = 3.0
-#: A Coulomb level counts as present above this many standard errors.
-SIGNIFICANT = 3.0
-#: Mean relative excess of the Bt diagonal over the trusted method's above which a method
-#: without friction is said to read the friction as viscous damping.
-DAMPING_EXCESS = 0.05
+from stewartid.verdict.policy import DEFAULT_POLICY, VerdictPolicy, entries_text
 
 
 def worst_dof(validation: ValidationResult) -> tuple[float, str]:
@@ -107,47 +40,55 @@ def worst_dof(validation: ValidationResult) -> tuple[float, str]:
     return float(vaf[k]), COORDINATES[k]
 
 
-def worst_relative_std(result: IdentificationResult) -> tuple[float, str]:
-    """The largest relative standard error over the paper's 20 entries and the entry's label
+def worst_relative_std(result: IdentificationResult,
+                       entries: Sequence[EntryKey] = PAPER_ENTRIES) -> tuple[float, str]:
+    """The largest relative standard error over ``entries`` and the entry's label
     (``"Bt(5,1)"``)."""
-    values = entry_relative_std(result)
+    values = entry_relative_std(result, entries)
     k = int(np.argmax(values))
-    return float(values[k]), entry_label(PAPER_ENTRIES[k])
+    return float(values[k]), entry_label(entries[k])
 
 
-def named_entries(entries: Sequence[str]) -> str:
+def named_entries(entries: Sequence[str], scored: Sequence[EntryKey] = PAPER_ENTRIES) -> str:
     """Entry labels for a sentence: listed up to six, counted beyond."""
-    return ", ".join(entries) if len(entries) <= 6 else f"{len(entries)} of the paper's 20 entries"
+    if len(entries) <= 6:
+        return ", ".join(entries)
+    return f"{len(entries)} of {entries_text(scored)}"
 
 
 def uncertain_entries(trusted: IdentificationResult,
-                      others: Mapping[str, IdentificationResult]) -> list[dict]:
-    """The paper's entries the trusted result is unsure of, and why.
+                      others: Mapping[str, IdentificationResult],
+                      entries: Sequence[EntryKey] = PAPER_ENTRIES,
+                      policy: VerdictPolicy = DEFAULT_POLICY) -> list[dict]:
+    """The scored entries the trusted result is unsure of, and why.
 
     Parameters
     ----------
     trusted : IdentificationResult
     others : mapping of str to IdentificationResult
         The other plausible methods' results, by name.
+    entries : sequence of (str, int, int)
+        The scored entries.
+    policy : VerdictPolicy
 
     Returns
     -------
     list of dict
         ``{"entry": "Bt(5,1)", "relative_std": r, "disagrees_with": [names]}`` for every
-        entry whose relative standard error exceeds :data:`UNCERTAIN_RELATIVE` or whose
-        estimate another method contradicts beyond :data:`DISAGREEMENT` combined errors.
+        entry whose relative standard error exceeds ``policy.uncertain_relative`` or whose
+        estimate another method contradicts beyond ``policy.disagreement`` combined errors.
     """
     found = []
-    for k, (matrix, i, j) in enumerate(PAPER_ENTRIES):
+    for matrix, i, j in entries:
         value, std = entry_estimate(trusted, matrix, i, j)
         relative = std / abs(value) if value != 0 else np.inf
         against = []
         for name, other in others.items():
             v, s = entry_estimate(other, matrix, i, j)
-            if abs(v - value) > DISAGREEMENT * np.hypot(s, std):
+            if abs(v - value) > policy.disagreement * np.hypot(s, std):
                 against.append(name)
-        if relative > UNCERTAIN_RELATIVE or against:
-            found.append({"entry": entry_label(PAPER_ENTRIES[k]),
+        if relative > policy.uncertain_relative or against:
+            found.append({"entry": entry_label((matrix, i, j)),
                           "relative_std": float(relative), "disagrees_with": against})
     return found
 
@@ -176,10 +117,11 @@ def models_friction(result: IdentificationResult) -> bool:
     return bool(np.all(np.isfinite(coulomb_estimate(result)[0])))
 
 
-def finds_friction(result: IdentificationResult) -> bool:
-    """The method estimates a Coulomb level above :data:`SIGNIFICANT` standard errors."""
+def finds_friction(result: IdentificationResult,
+                   significant: float = DEFAULT_POLICY.significant) -> bool:
+    """The method estimates a Coulomb level above ``significant`` standard errors."""
     levels, std = coulomb_estimate(result)
-    return bool(np.any(np.isfinite(levels) & (levels > SIGNIFICANT * np.nan_to_num(std))))
+    return bool(np.any(np.isfinite(levels) & (levels > significant * np.nan_to_num(std))))
 
 
 @dataclass(frozen=True)
@@ -204,7 +146,7 @@ class Standing:
     friction_effect : {"damping", "residuals"} or None
         When a method finds Coulomb friction and this one (not the trusted) does not model
         it: its friction is read as viscous damping (Bt diagonal above the trusted method's
-        by more than :data:`DAMPING_EXCESS`) or stays in its residuals; else None.
+        by more than ``policy.damping_excess``) or stays in its residuals; else None.
     damping_excess : float
         Mean relative excess of its Bt diagonal over the trusted method's, where
         ``friction_effect`` is set (NaN elsewhere).
@@ -212,20 +154,20 @@ class Standing:
         Share of its held-out residual that has the shape of Coulomb friction
         (:func:`~stewartid.validation.heldout.friction_signature`).
     worst_relative_std : float
-        Its largest relative standard error over the paper's 20 entries (a fraction).
+        Its largest relative standard error over the scored entries (a fraction).
     worst_entry : str
         That entry (``"Bt(5,1)"``).
     misfit : bool
-        Its held-out prediction leaves more than :data:`MISFIT_FACTOR` times the least
-        unexplained force (and over :data:`MISFIT_FLOOR` %).
+        Its held-out prediction leaves more than ``policy.misfit_factor`` times the least
+        unexplained force (and over ``policy.misfit_floor_percent`` %).
     friction_immune : bool
         Its Mt and Bt do not rest on a friction law (:func:`friction_immune`).
     expected_worst : float
-        Its expected largest relative error over the paper's 20 entries (a fraction), its
+        Its expected largest relative error over the scored entries (a fraction), its
         errors conditioned on the others' (:func:`~stewartid.verdict.accuracy.error_posterior`).
     measured_entries : tuple of str
         Entries whose error the other plausible methods' estimates measure (over
-        :data:`~stewartid.verdict.accuracy.PRECISION_FACTOR` times more precise).
+        ``policy.precision_factor`` times more precise).
     error_correlation : dict of str to float
         Correlation of its errors with each other applicable method's, from their fits of the
         same folds (:func:`~stewartid.verdict.accuracy.fold_correlation`; 0 without).
@@ -263,11 +205,8 @@ class Verdict:
     trusted : str
         The method to trust.
     ranking : tuple of str
-        The applicable methods, trusted first, then the compared ones before the others,
-        each group by unexplained force.
-    tied : tuple of str
-        The compared methods within :data:`TIE_FACTOR` of the least worst relative standard
-        error (the held-out prediction decided between them).
+        The applicable methods, trusted first, then the plausible ones before the others,
+        each group by expected largest error.
     standings : dict of str to Standing
         Per applicable method, in the order given.
     friction_source : str or None
@@ -280,18 +219,24 @@ class Verdict:
         Why the trusted method was chosen and the others not, one sentence each.
     close : tuple of str
         The trusted method and the plausible ones whose expected largest error is within
-        :data:`CLOSE_FACTOR` of its own: on these data any of them may be the more accurate.
+        ``policy.close_factor`` of its own: on these data any of them may be the more
+        accurate.
+    entries : tuple of (str, int, int)
+        The entries the methods were judged on.
+    policy : VerdictPolicy
+        The thresholds the verdict was reached with.
     """
 
     trusted: str
     ranking: tuple[str, ...]
-    tied: tuple[str, ...]
     standings: dict[str, Standing]
     friction_source: str | None
     not_applicable: tuple[str, ...]
     uncertain: list[dict] = dataclasses.field(default_factory=list)
     reasons: list[str] = dataclasses.field(default_factory=list)
     close: tuple[str, ...] = ()
+    entries: tuple[EntryKey, ...] = PAPER_ENTRIES
+    policy: VerdictPolicy = DEFAULT_POLICY
 
     def to_dict(self) -> dict:
         """The ``verdict`` object of ``result.json``: ``trusted``, ``ranking`` (registry
@@ -317,9 +262,10 @@ class Verdict:
 
 
 def choose_trusted(assessed: Mapping[str, tuple[IdentificationResult, ValidationResult] | None],
-                   folds: Mapping[str, Sequence[IdentificationResult] | None] | None = None
-                   ) -> Verdict:
-    """Which method to trust on these data (see the module docstring for the rule).
+                   folds: Mapping[str, Sequence[IdentificationResult] | None] | None = None,
+                   entries: Sequence[EntryKey] = PAPER_ENTRIES,
+                   policy: VerdictPolicy = DEFAULT_POLICY) -> Verdict:
+    """Which method to trust on these data (``docs/verdict.md`` states the rule).
 
     Parameters
     ----------
@@ -329,35 +275,42 @@ def choose_trusted(assessed: Mapping[str, tuple[IdentificationResult, Validation
     folds : mapping, optional
         Method name -> its fits of the validation's (shared) folds, whence the correlation
         of the methods' errors (:func:`~stewartid.verdict.accuracy.fold_correlation`).
+    entries : sequence of (str, int, int)
+        The entries of Mt and Bt the methods are judged on
+        (:func:`~stewartid.verdict.policy.scored_entries`).
+    policy : VerdictPolicy
+        The thresholds.
 
     Returns
     -------
     Verdict
     """
+    entries = tuple(entries)
     ok = {name: pair for name, pair in assessed.items() if pair is not None}
     worst = {name: worst_dof(validation) for name, (_, validation) in ok.items()}
     unexplained = {name: 100.0 - vaf for name, (vaf, _) in worst.items()}
-    spread = {name: worst_relative_std(result) for name, (result, _) in ok.items()}
+    spread = {name: worst_relative_std(result, entries) for name, (result, _) in ok.items()}
     compared = [name for name, (result, _) in ok.items() if is_definite(result)] or list(ok)
     floor = min(unexplained[name] for name in compared)
-    misfit = {name: bool(unexplained[name] > max(MISFIT_FACTOR * floor, MISFIT_FLOOR))
+    misfit = {name: bool(unexplained[name] > max(policy.misfit_factor * floor,
+                                                 policy.misfit_floor_percent))
               for name in ok}
     candidates = [name for name in compared if not misfit[name]] or compared
     names = list(ok)
     links = fold_correlation([ok[name][0] for name in names],
-                             [(folds or {}).get(name) for name in names])
+                             [(folds or {}).get(name) for name in names], entries)
     checked = {}
     for name, (result, _) in ok.items():
         rows = [names.index(name)] + [names.index(o) for o in candidates if o != name]
         checked[name] = error_posterior(result, [ok[o][0] for o in candidates if o != name],
-                                        links[np.ix_(rows, rows)])
+                                        links[np.ix_(rows, rows)], entries,
+                                        policy.precision_factor)
     expected = {name: expected_worst_error(std, mean)
                 for name, (mean, std, _) in checked.items()}
-    least = min(expected[name] for name in candidates)
-    tied = [name for name in candidates if expected[name] <= TIE_FACTOR * least]
-    trusted = min(tied, key=lambda name: unexplained[name])
+    # an exact tie goes to the better held-out prediction
+    trusted = min(candidates, key=lambda name: (expected[name], unexplained[name]))
     friction_source = next((name for name, (result, _) in ok.items()
-                            if finds_friction(result)), None)
+                            if finds_friction(result, policy.significant)), None)
     reference_B = np.diag(ok[trusted][0].B)
     standings = {}
     for name, (result, validation) in ok.items():
@@ -365,51 +318,51 @@ def choose_trusted(assessed: Mapping[str, tuple[IdentificationResult, Validation
         excess, effect = float("nan"), None
         if friction_source is not None and not modelled and name != trusted:
             excess = float(np.mean(np.diag(result.B) / reference_B) - 1.0)
-            effect = "damping" if excess > DAMPING_EXCESS else "residuals"
+            effect = "damping" if excess > policy.damping_excess else "residuals"
         standings[name] = Standing(
-            name, worst[name][0], worst[name][1],
-            (100 - worst[name][0]) / max(100 - worst[trusted][0], 1e-12), name in compared,
-            modelled, effect, excess, friction_signature(validation),
-            spread[name][0], spread[name][1], misfit[name], friction_immune(result),
-            expected[name], tuple(entry_label(PAPER_ENTRIES[k]) for k in checked[name][2]),
-            {other: float(links[names.index(name), k]) for k, other in enumerate(names)
-             if other != name})
+            name=name, worst_vaf_percent=worst[name][0], worst_dof=worst[name][1],
+            unexplained_ratio=(100 - worst[name][0]) / max(100 - worst[trusted][0], 1e-12),
+            compared=name in compared, models_friction=modelled, friction_effect=effect,
+            damping_excess=excess, friction_share=friction_signature(validation),
+            worst_relative_std=spread[name][0], worst_entry=spread[name][1],
+            misfit=misfit[name], friction_immune=friction_immune(result),
+            expected_worst=expected[name],
+            measured_entries=tuple(entry_label(entries[k]) for k in checked[name][2]),
+            error_correlation={other: float(links[names.index(name), k])
+                               for k, other in enumerate(names) if other != name})
     others = sorted((name for name in ok if name != trusted),
                     key=lambda name: (name not in compared, misfit[name], expected[name]))
     uncertain = uncertain_entries(ok[trusted][0], {name: ok[name][0] for name in compared
-                                                   if name != trusted})
+                                                   if name != trusted}, entries, policy)
     not_applicable = tuple(name for name, pair in assessed.items() if pair is None)
     close = (trusted, *(name for name in others if name in candidates
-                        and expected[name] <= CLOSE_FACTOR * expected[trusted]))
-    return Verdict(trusted, (trusted, *others), tuple(tied), standings, friction_source,
-                   not_applicable, uncertain,
-                   _reasons(trusted, standings, tied, not_applicable, uncertain, close),
-                   close)
+                        and expected[name] <= policy.close_factor * expected[trusted]))
+    verdict = Verdict(trusted, (trusted, *others), standings, friction_source, not_applicable,
+                      uncertain, [], close, entries, policy)
+    return dataclasses.replace(verdict, reasons=_reasons(verdict))
 
 
-def _reasons(trusted: str, standings: Mapping[str, Standing], tied: list[str],
-             not_applicable: tuple[str, ...], uncertain: list[dict],
-             close: tuple[str, ...] = ()) -> list[str]:
+def _reasons(verdict: Verdict) -> list[str]:
     """One sentence per finding, for ``result.json`` (registry names, numbers)."""
+    trusted, standings, policy = verdict.trusted, verdict.standings, verdict.policy
+    close, scored = verdict.close, entries_text(verdict.entries)
     best = standings[trusted]
     reasons = [f"{trusted}: its standard errors, conditioned on the other methods' "
                "estimates, predict a largest error of "
-               f"{100 * best.expected_worst:.3g} % over the paper's 20 entries (largest "
+               f"{100 * best.expected_worst:.3g} % over {scored} (largest "
                f"standard error {100 * best.worst_relative_std:.3g} %, {best.worst_entry}), the "
                "least of the plausible methods that predict held-out data; held-out VAF "
                f"{best.worst_vaf_percent:.4g} % in its worst DOF ({best.worst_dof})."]
     for name, standing in standings.items():
         if standing.measured_entries:
-            reasons.append(f"{name}: the other methods' estimates, over {PRECISION_FACTOR:g}x "
-                           f"more precise, measure its errors of "
-                           f"{named_entries(standing.measured_entries)}; there its predicted "
-                           "largest error takes their difference, not its standard errors.")
-    if len(tied) > 1:
-        reasons.append(f"{', '.join(tied)} predict the same largest error (within "
-                       f"{TIE_FACTOR:g}x); the held-out prediction decided.")
+            reasons.append(f"{name}: the other methods' estimates, over "
+                           f"{policy.precision_factor:g}x more precise, measure its errors of "
+                           f"{named_entries(standing.measured_entries, verdict.entries)}; "
+                           "there its predicted largest error takes their difference, not its "
+                           "standard errors.")
     if len(close) > 1:
         reasons.append(f"close call: {', '.join(close)} predict largest errors within "
-                       f"{CLOSE_FACTOR:g}x of each other ("
+                       f"{policy.close_factor:g}x of each other ("
                        + ", ".join(f"{100 * standings[name].expected_worst:.3g} %"
                                    for name in close)
                        + "); on such data the noise decides which is the more accurate; "
@@ -422,15 +375,15 @@ def _reasons(trusted: str, standings: Mapping[str, Standing], tied: list[str],
                            "platform has.")
         elif standing.misfit:
             reasons.append(f"{name}: leaves {standing.unexplained_percent:.3g} % of the held-out "
-                           f"force unexplained in {standing.worst_dof}, over {MISFIT_FACTOR:g}x "
-                           "the least.")
+                           f"force unexplained in {standing.worst_dof}, over "
+                           f"{policy.misfit_factor:g}x the least.")
         else:
             reasons.append(f"{name}: predicted largest error "
                            f"{100 * standing.expected_worst:.3g} % (largest standard error "
                            f"{100 * standing.worst_relative_std:.3g} %, {standing.worst_entry}).")
-    reasons += [f"{name}: not applicable to these data." for name in not_applicable]
-    if uncertain:
-        reasons.append(uncertain_sentence(uncertain))
+    reasons += [f"{name}: not applicable to these data." for name in verdict.not_applicable]
+    if verdict.uncertain:
+        reasons.append(uncertain_sentence(verdict.uncertain))
     return reasons
 
 
@@ -443,7 +396,6 @@ def uncertain_sentence(uncertain: Sequence[dict]) -> str:
         for u in uncertain) + "."
 
 
-__all__ = ["CLOSE_FACTOR", "DAMPING_EXCESS", "DISAGREEMENT", "MISFIT_FACTOR", "MISFIT_FLOOR", "SIGNIFICANT",
-           "TIE_FACTOR", "UNCERTAIN_RELATIVE", "Standing", "Verdict", "choose_trusted",
-           "finds_friction", "friction_immune", "is_definite", "models_friction", "named_entries",
-           "uncertain_entries", "uncertain_sentence", "worst_dof", "worst_relative_std"]
+__all__ = ["Standing", "Verdict", "choose_trusted", "finds_friction", "friction_immune",
+           "is_definite", "models_friction", "named_entries", "uncertain_entries",
+           "uncertain_sentence", "worst_dof", "worst_relative_std"]

@@ -14,13 +14,13 @@ from typing import Any
 
 import numpy as np
 
+from stewartid.comparison import MethodFit, PhysicalSection
 from stewartid.datasets.dataset import Dataset
 from stewartid.identification.preparation import prepare
 from stewartid.identification.wavelet.intervals import joint_rates
 from stewartid.platform import Platform
 from stewartid.reports.drawing import ExperimentTrace, plot_excitation, plot_joint_rates
 from stewartid.reports.identification import method_figures as plots
-from stewartid.reports.identification.records import MethodReport, PhysicalSection
 from stewartid.reports.identification.text import used_intervals
 from stewartid.signals.differentiation import differentiate
 
@@ -59,7 +59,7 @@ def data_figures(drawer: FigureDrawer, datasets: Sequence[Dataset], platform: Pl
                [d.sample_rate for d in datasets], [row["frequency_hz"] for row in rows])
 
 
-def result_figures(drawer: FigureDrawer, runs: Sequence[MethodReport],
+def result_figures(drawer: FigureDrawer, runs: Sequence[MethodFit],
                    datasets: Sequence[Dataset], platform: Platform,
                    nominal: tuple[np.ndarray, np.ndarray], trusted: str,
                    rows: Sequence[dict[str, Any]]) -> None:

@@ -7,14 +7,14 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from stewartid.comparison import MethodFit
 from stewartid.identification.result import IdentificationResult
 from stewartid.model.joints import FRICTION_TYPES
 from stewartid.platform import Platform
-from stewartid.reports.identification.records import MethodReport
 from stewartid.validation.heldout import friction_signature
 
 
-def friction_text(run: MethodReport) -> str:
+def friction_text(run: MethodFit) -> str:
     """A method's Coulomb levels per joint type with their standard errors, for a sentence."""
     levels, std = run.coulomb
     return ", ".join(f"{name.replace('_', ' ')} {v:.3g} ± {s:.2g} N·m"
@@ -75,7 +75,7 @@ def third_harmonic_lines(result: IdentificationResult) -> list[str]:
                "its standard errors are the noise's.")]
 
 
-def friction_section(ok: Sequence[MethodReport], platform: Platform) -> list[str]:
+def friction_section(ok: Sequence[MethodFit], platform: Platform) -> list[str]:
     """The report's friction section: per method its Coulomb levels, or what its residual
     shows of the friction it does not estimate."""
     lines: list[str] = []

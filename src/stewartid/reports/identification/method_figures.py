@@ -14,10 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
+from stewartid.comparison import Workspace
 from stewartid.model.joints import FRICTION_TYPES
 from stewartid.platform import COORDINATES
 from stewartid.reports.drawing import new_figure, save_figure, styled, thinning_step
-from stewartid.reports.identification.records import Workspace
 from stewartid.validation.heldout import ValidationResult
 
 #: Display unit and scale of a displacement in each coordinate.

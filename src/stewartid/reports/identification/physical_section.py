@@ -1,186 +1,17 @@
-"""The physical model in the identification report: fitted beside the compared methods (not
-ranked by the verdict), its held-out prediction by the full nonlinear model
-(:mod:`stewartid.physical.validation`), Mt and Bt across the poses the data cover
-with their uncertainty (:func:`workspace`), and its parameters with the fixed ones named.
-"""
+"""The physical model's section of the identification report: its parameters with the fixed
+ones named, its held-out prediction and Mt, Bt across the poses the data cover."""
 
 from __future__ import annotations
 
-import dataclasses
-import time
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
-from typing import Any
+from collections.abc import Mapping
 
 import numpy as np
 
-from stewartid.datasets.dataset import Dataset
-from stewartid.errors import StewartidError
-from stewartid.model.linearization import nominal_matrices
-from stewartid.physical.estimator import PhysicalIdentifier, PhysicalResult
-from stewartid.physical.prediction import matrices_at, parameter_map
-from stewartid.physical.validation import (
-    cross_validate_physical,
-    validate_physical_on_records,
-)
-from stewartid.platform import COORDINATES, Platform
-from stewartid.reports.identification.records import PhysicalSection, Workspace
+from stewartid.comparison import PhysicalSection, Workspace
+from stewartid.physical.estimator import PhysicalResult
+from stewartid.platform import COORDINATES
 from stewartid.reports.tables import ResultTable, to_markdown
-from stewartid.validation.heldout import (
-    Segment,
-    held_out_segments,
-    record_segments,
-    validation_entry,
-)
 from stewartid.verdict.rule import worst_dof
-
-#: Poses per swept coordinate in :func:`workspace`.
-WORKSPACE_POINTS = 11
-#: Off-diagonal entries of Mt and of Bt shown beside the diagonal (the largest).
-SHOWN_COUPLINGS = 2
-#: Share of the parameters fixed at the file's values above which a report that did not ask
-#: for the physical model leaves its section out (one line says why).
-MOST_FIXED = 0.5
-
-
-@dataclass(frozen=True)
-class PhysicalRequest:
-    """What the report asks of the physical model.
-
-    Attributes
-    ----------
-    payload : bool
-        Payload mode (``identify --payload``).
-    consistent : bool
-        The physically consistent fit (``identify --model physical --consistent``).
-    required : bool
-        ``identify --model physical``: a model that cannot be applied is an error. Otherwise
-        (``identify --method all --report``) one line of the report says why it is not shown.
-    settings : dict
-        Further estimator settings (e.g. ``{"gravity": False}``).
-    """
-
-    payload: bool = False
-    consistent: bool = False
-    required: bool = False
-    settings: Mapping[str, Any] = dataclasses.field(default_factory=dict)
-
-
-def largest_couplings(matrix: np.ndarray, count: int = SHOWN_COUPLINGS
-                      ) -> list[tuple[int, int]]:
-    """The ``count`` off-diagonal entries (i < j) of a (6, 6) matrix largest relative to
-    sqrt(|m_ii m_jj|), those above 1e-6 of it."""
-    d = np.sqrt(np.abs(np.diag(matrix)))
-    scale = np.outer(d, d)
-    relative = np.abs(matrix) / np.where(scale > 0, scale, np.inf)
-    pairs = sorted(((i, j) for i in range(6) for j in range(i + 1, 6)),
-                   key=lambda e: -relative[e])
-    return [e for e in pairs[:count] if relative[e] > 1e-6]
-
-
-def workspace(platform: Platform, result: PhysicalResult, covariance: np.ndarray,
-              datasets: Sequence[Dataset], points: int = WORKSPACE_POINTS) -> Workspace:
-    """Mt and Bt of ``result`` (with standard errors) and of ``platform`` with each
-    coordinate swept over its measured range, the others at their mean.
-
-    Parameters
-    ----------
-    platform : Platform
-        The description the result was fitted with (its own Mt, Bt are the nominal curves).
-    result : PhysicalResult
-    covariance : ndarray, shape (p, p)
-        Of the result's parameters.
-    datasets : sequence of Dataset
-        The experiments whose poses set the range.
-    points : int
-        Poses per coordinate.
-
-    Returns
-    -------
-    Workspace
-    """
-    poses = np.concatenate([d.pose for d in datasets])
-    centre = poses.mean(axis=0)
-    grid = np.linspace(poses.min(axis=0), poses.max(axis=0), points).T
-    mapping = parameter_map(platform, result)
-    identified, nominal = [], []
-    for dof in range(6):
-        swept = np.tile(centre, (points, 1))
-        swept[:, dof] = grid[dof]
-        identified.append(matrices_at(platform, result, covariance, swept, mapping))
-        nominal.append([nominal_matrices(platform, q) for q in swept])
-    at_centre = matrices_at(platform, result, covariance, centre[None], mapping)
-    nominal_array = np.array(nominal)  # (6, P, 2, 6, 6)
-    return Workspace(centre, grid, identified, at_centre, nominal_array[:, :, 0],
-                     nominal_array[:, :, 1],
-                     {"M": largest_couplings(at_centre.M[0]),
-                      "B": largest_couplings(at_centre.B[0])})
-
-
-def fit_physical(datasets: Sequence[Dataset], platform: Platform, request: PhysicalRequest,
-                 folds: int, segments: dict[tuple[bool, bool], list[Segment]],
-                 records: Sequence[Dataset] = (),
-                 record_cache: dict[tuple[bool, bool], list[Segment]] | None = None
-                 ) -> PhysicalSection:
-    """Fit the physical model on all experiments, validate it on held-out segments (and on
-    ``records``) and compute its Mt, Bt across the workspace.
-
-    Parameters
-    ----------
-    datasets, platform, folds
-        As :func:`~stewartid.reports.identification.report.write_identification_report`.
-    request : PhysicalRequest
-    segments, record_cache : dict
-        Held-out segments and validation-record segments by (``gravity``, ``remainder``)
-        setting, shared with the compared methods (filled on first use).
-    records : sequence of Dataset
-        Validation records (``identify --validate``).
-
-    Returns
-    -------
-    PhysicalSection
-        With ``note`` instead of a result when the model cannot be applied or, unless
-        ``request.required``, the data fix more than ``MOST_FIXED`` of its parameters.
-
-    Raises
-    ------
-    StewartidError
-        With ``request.required``, when the model cannot be applied.
-    """
-    start = time.perf_counter()
-    options = {**request.settings, "payload": request.payload,
-               "consistent": request.consistent}
-    gravity = bool(options.get("gravity", True))
-    try:
-        estimator = PhysicalIdentifier(**options).fit(list(datasets), platform)
-        fixed, count = estimator.fixed_, len(estimator.parameters_)
-        if not request.required and len(fixed) > MOST_FIXED * count:
-            return PhysicalSection(seconds=time.perf_counter() - start, note=(
-                f"The physical model is not shown: these data fix {len(fixed)} of its {count} "
-                "parameters at the platform file's values (not identifiable from them); "
-                "`identify --model physical` fits and names the rest."))
-        terms = (gravity, False)  # the full model predicts the nonlinear terms itself
-        if terms not in segments:
-            segments[terms] = held_out_segments(datasets, platform, folds, *terms)
-        validation = cross_validate_physical(lambda: PhysicalIdentifier(**options), datasets,
-                                             platform, folds, segments[terms])
-        external = None
-        if records:
-            cache = {} if record_cache is None else record_cache
-            if terms not in cache:
-                cache[terms] = record_segments(records, platform, *terms)
-            external = validate_physical_on_records(estimator.result_, records,
-                                                    cache[terms], platform)
-        curves = workspace(platform, estimator.result_, estimator.covariance_, datasets)
-    except StewartidError as exc:
-        if request.required:
-            raise
-        return PhysicalSection(seconds=time.perf_counter() - start,
-                               note=f"The physical model is not shown: {exc}")
-    result = dataclasses.replace(estimator.result_,
-                                 validation=validation_entry(validation, external))
-    return PhysicalSection(result, estimator.covariance_, curves, validation, external,
-                           time.perf_counter() - start)
 
 
 def _value(value: float) -> str:
@@ -257,6 +88,4 @@ def _range_text(curves: Workspace | None) -> str:
     return f"Measured range (absolute pose): {spans}."
 
 
-__all__ = ["MOST_FIXED", "SHOWN_COUPLINGS", "WORKSPACE_POINTS", "PhysicalRequest",
-           "fit_physical", "largest_couplings", "parameter_table", "physical_lines",
-           "workspace"]
+__all__ = ["parameter_table", "physical_lines"]

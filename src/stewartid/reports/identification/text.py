@@ -9,20 +9,23 @@ changes, so does the sentence about it.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from stewartid.comparison import MethodFit
 from stewartid.datasets.dataset import Dataset
 from stewartid.identification.consistency import consistency_metrics, is_consistent
 from stewartid.identification.wavelet.noise import white_noise_covariance
 from stewartid.platform import COORDINATES, Platform
 from stewartid.reports.identification.friction_text import friction_section
 from stewartid.reports.identification.physical_section import physical_lines
-from stewartid.reports.identification.records import IdentificationReport, MethodReport
 from stewartid.reports.identification.verdict_text import changed_text, verdict_lines
 from stewartid.reports.tables import ResultTable, to_markdown
 from stewartid.signals.differentiation import differentiate, estimate_frequency
+
+if TYPE_CHECKING:
+    from stewartid.reports.identification.report import IdentificationReport
 
 _UNITS = ("mm",) * 3 + ("mrad",) * 3
 #: The physical model's row in the validation tables.
@@ -52,7 +55,7 @@ def data_rows(datasets: Sequence[Dataset], platform: Platform) -> list[dict[str,
     return rows
 
 
-def used_intervals(runs: Sequence[MethodReport], trusted: str, datasets: Sequence[Dataset]
+def used_intervals(runs: Sequence[MethodFit], trusted: str, datasets: Sequence[Dataset]
                    ) -> tuple[str, list[np.ndarray], list[np.ndarray | None]]:
     """Constant-direction intervals (M_k, 2) and (a, b) points (K_k, 2) per experiment, as
     the diagnostics record them, of the trusted method or else the first that uses them.
@@ -64,7 +67,7 @@ def used_intervals(runs: Sequence[MethodReport], trusted: str, datasets: Sequenc
     intervals, points : list
         Empty if no method uses intervals.
     """
-    def recorded(run: MethodReport) -> list[dict]:
+    def recorded(run: MethodFit) -> list[dict]:
         experiments = [] if run.result is None else run.result.diagnostics.get("experiments")
         experiments = experiments or []
         ok = len(experiments) == len(datasets) and all("intervals" in e for e in experiments)
@@ -243,7 +246,7 @@ def _records_section(report: IdentificationReport, records: Sequence[str]) -> li
         ("text",) + ("value",) * 6, rows)), ""]
 
 
-def _consistency_section(runs: Sequence[MethodReport]) -> list[str]:
+def _consistency_section(runs: Sequence[MethodFit]) -> list[str]:
     lines = ["## Physical consistency", "",
              "Mt must be symmetric positive definite and Bt symmetric positive semidefinite. "
              "Smallest eigenvalues are of the symmetric parts; asymmetry is the relative "

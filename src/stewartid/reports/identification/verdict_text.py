@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from stewartid.comparison import MethodFit
 from stewartid.identification.consistency import consistency_metrics, is_consistent
 from stewartid.reports.identification.friction_text import (
     friction_law_lines,
@@ -17,11 +18,11 @@ from stewartid.reports.identification.friction_text import (
     friction_text,
     third_harmonic_lines,
 )
-from stewartid.reports.identification.records import MethodReport
 from stewartid.validation.heldout import friction_signature
-from stewartid.verdict.accuracy import PRECISION_FACTOR, relative_std
+from stewartid.verdict.accuracy import relative_std
 from stewartid.verdict.close_call import CONSENSUS, combined_text
-from stewartid.verdict.rule import CLOSE_FACTOR, Verdict, named_entries, worst_dof
+from stewartid.verdict.policy import entries_text
+from stewartid.verdict.rule import Verdict, named_entries, worst_dof
 
 #: Held-out VAF (%) in the worst DOF above which a model "predicts closely", "adequately".
 CLOSE_VAF, ADEQUATE_VAF = 99.0, 95.0
@@ -44,7 +45,7 @@ def quality_text(vaf: float) -> str:
             "(see the residual spectrum and the friction section)")
 
 
-def method_lines(run: MethodReport) -> list[str]:
+def method_lines(run: MethodFit) -> list[str]:
     """What to know about one method's result, one Markdown sentence group each."""
     result = run.result
     vaf, dof = worst_dof(run.validation)
@@ -80,7 +81,7 @@ def method_lines(run: MethodReport) -> list[str]:
     return lines
 
 
-def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
+def verdict_lines(verdict: Verdict, runs: Sequence[MethodFit]) -> list[str]:
     """The verdict in plain language, Markdown sentences: for one applicable method what to
     know about it (:func:`method_lines`), for several which to trust and what set the others
     back."""
@@ -94,18 +95,19 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
              f"**Trust {best.display_name} on these data.** Of the physically plausible "
              "methods that predict held-out data, its standard errors, each entry's checked "
              "against the other methods' estimates, predict the smallest "
-             f"largest error over the paper's 20 entries: {100 * trusted.expected_worst:.3g} % "
+             f"largest error over {entries_text(verdict.entries)}: "
+             f"{100 * trusted.expected_worst:.3g} % "
              f"(largest standard error {100 * trusted.worst_relative_std:.3g} %, "
              f"{trusted.worst_entry}); they include the model error its symmetric pairs "
              "reveal. On held-out segments it leaves "
              f"{trusted.unexplained_percent:.3g} % of the force unexplained in its worst DOF "
-             f"({trusted.worst_dof})"
-             + (" (methods tied in uncertainty: the held-out prediction decides)."
-                if len(verdict.tied) > 1 else ".")]
-    measured = [f"{run.display_name}, {named_entries(standing.measured_entries)}"
+             f"({trusted.worst_dof})."]
+    measured = [f"{run.display_name}, "
+                f"{named_entries(standing.measured_entries, verdict.entries)}"
                 for run in ok if (standing := verdict.standings[run.name]).measured_entries]
     if measured:
-        lines.append(f"Where the other methods estimate an entry over {PRECISION_FACTOR:g}× "
+        lines.append("Where the other methods estimate an entry over "
+                     f"{verdict.policy.precision_factor:g}× "
                      "more precisely, the difference measures the error there and replaces "
                      "the standard error in these predictions (elsewhere a disagreement is "
                      "shared out by the methods' standard errors): "
@@ -113,7 +115,8 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
     if len(verdict.close) > 1 and best.name != CONSENSUS:
         lines.append(f"This is a close call: {' and '.join(names[n] for n in verdict.close)} "
                      "predict largest errors "
-                     f"within {CLOSE_FACTOR:g}× of each other, and on such data the noise "
+                     f"within {verdict.policy.close_factor:g}× of each other, and on such "
+                     "data the noise "
                      "decides which is the more accurate (on logs with a known truth the one "
                      "predicting less was the more accurate in six or seven of ten such "
                      "cases). Where their entries differ, both are in the tables below.")
@@ -158,7 +161,7 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodReport]) -> list[str]:
     return lines
 
 
-def consensus_text(verdict: Verdict, best: MethodReport, names: dict[str, str]) -> str:
+def consensus_text(verdict: Verdict, best: MethodFit, names: dict[str, str]) -> str:
     """The verdict's first sentences when it trusts the consensus of a close call
     (:mod:`stewartid.verdict.close_call`); ``names``: display name by registry name."""
     members = verdict.close
@@ -166,13 +169,16 @@ def consensus_text(verdict: Verdict, best: MethodReport, names: dict[str, str]) 
     agreement = best.result.diagnostics.get("consensus", {}).get("agreement", float("nan"))
     predicted = ", ".join(f"{100 * verdict.standings[n].expected_worst:.3g} %" for n in members)
     return (f"**Trust the consensus of {' and '.join(names[n] for n in members)} on these "
-            f"data.** Their standard errors predict largest errors within {CLOSE_FACTOR:g}× "
-            f"of each other over the paper's 20 entries ({predicted}): a close call, in which "
+            "data.** Their standard errors predict largest errors within "
+            f"{verdict.policy.close_factor:g}× "
+            f"of each other over {entries_text(verdict.entries)} ({predicted}): a close call, "
+            "in which "
             "the noise decides which is the more accurate (on logs with a known truth the one "
             "predicting less was the more accurate in six or seven of ten such cases). The "
             "consensus averages their estimates, weighted by their inverse variances, where "
             f"they agree within {agreement:g} standard error of their difference "
-            f"({combined_text(best.result, names[members[0]])}). Its standard errors take the "
+            f"({combined_text(best.result, names[members[0]], verdict.entries)}). Its "
+            "standard errors take the "
             "members' errors as fully correlated and "
             f"predict a largest error of {100 * standing.expected_worst:.3g} % (largest "
             f"standard error {100 * standing.worst_relative_std:.3g} %, "
@@ -181,7 +187,7 @@ def consensus_text(verdict: Verdict, best: MethodReport, names: dict[str, str]) 
             f"({standing.worst_dof}).")
 
 
-def sampling_lines(runs: Sequence[MethodReport]) -> list[str]:
+def sampling_lines(runs: Sequence[MethodFit]) -> list[str]:
     """A sentence naming the methods whose result the log's sampling limits, if any
     (:mod:`stewartid.identification.sampling`)."""
     limited = [(run.display_name, run.result.diagnostics["sampling"]) for run in runs

@@ -1,26 +1,33 @@
-"""One ``stewartid identify`` run: the experiments read, the method (or every method) fitted,
-the report and the result written.
+"""``stewartid identify`` behind its flags: the experiments read and aligned, the method (or
+every method: :func:`~stewartid.comparison.compare_methods`) fitted, the report
+(:func:`~stewartid.reports.identification.report.write_report`) and the result written.
 
-:func:`identify_files` is the whole command behind its flags; the command line only prints
-what it returns. Every output location is checked before anything is computed.
+Every output location and flag combination is checked before anything is computed.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import json
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, NamedTuple
 
 import numpy as np
 
-from stewartid.datasets.dataset import Dataset, expand_paths, read_datasets
+from stewartid.comparison import (
+    ALL_METHODS,
+    PhysicalRequest,
+    compare_methods,
+    consistent_result,
+    method_names,
+    plausibility_check,
+)
+from stewartid.datasets.dataset import expand_paths, read_datasets
 from stewartid.datasets.excitation import check_experiment_set
 from stewartid.datasets.log_format import load_log_format
 from stewartid.datasets.meta import nominal_from_meta, platform_for_data
-from stewartid.datasets.plausibility import check_identified
 from stewartid.errors import ConfigError
 from stewartid.files import check_output_file, check_output_folder
 from stewartid.identification import registry
@@ -32,13 +39,14 @@ from stewartid.identification.delay import (
 )
 from stewartid.identification.result import IdentificationResult, comparison_rows
 from stewartid.model.linearization import nominal_matrices
+from stewartid.physical.identified_platform import IDENTIFIED_HEADER, write_identified
 from stewartid.platform import Platform
-from stewartid.reports.identification.physical_section import PhysicalRequest
-from stewartid.reports.identification.records import IdentificationReport
+from stewartid.reports.identification.report import IdentificationReport, write_report
 from stewartid.validation.heldout import DEFAULT_FOLDS
 
-#: ``identify --method`` value that runs every registered method.
-ALL_METHODS = "all"
+#: Values of ``identify --model``.
+MODELS = ("physical",)
+
 #: Suffixes of data and description files, which a JSON result must not be named like.
 INPUT_SUFFIXES = (".csv", ".parquet", ".pq", ".toml")
 
@@ -105,23 +113,6 @@ class IdentifyRun:
         result = self.result
         return comparison_rows(result.M, result.B, self.nominal_M, self.nominal_B,
                                result.std_errors_M, result.std_errors_B)
-
-
-def methods_for(name: str) -> tuple[str, ...]:
-    """The methods ``identify --method NAME`` runs: every registered method compared by the
-    verdict (presets and the physical model aside,
-    :attr:`~stewartid.identification.registry.MethodSpec.compared`) for ``"all"``, else
-    ``(NAME,)``.
-
-    Raises
-    ------
-    ConfigError
-        For an unknown name (the message lists the registered ones).
-    """
-    if name == ALL_METHODS:
-        return tuple(spec.name for spec in registry.registered_methods()
-                     if spec.preset_of is None and spec.compared)
-    return (registry.method_spec(name).name,)
 
 
 def settings_for(methods: Sequence[str], method: str, flags: Mapping[str, FlagSetting]
@@ -198,21 +189,92 @@ def _physical_request(model: str | None, method: str, payload: bool, consistent:
                            settings={k: v for k, v in settings.items() if k in own})
 
 
-def _fit_alone(datasets: list[Dataset], platform: Platform, method: str,
-               settings: Mapping[str, Any], consistent: bool, model: str | None,
-               payload: bool, check: Callable[[IdentificationResult], None]
-               ) -> IdentificationResult:
+def _is_identified(path: Path) -> bool:
+    """True for a platform file that ``identify --platform-out`` wrote (overwritten)."""
+    try:
+        return path.read_text(encoding="utf-8").startswith(IDENTIFIED_HEADER)
+    except (OSError, UnicodeDecodeError):
+        return False
+
+
+def _check_model_options(model: str, platform_out: Path | None, forbidden: dict[str, bool]
+                        ) -> None:
+    """Refuse, before any computation, a model not known and options the physical model
+    does not take.
+
+    Parameters
+    ----------
+    model : str
+        The ``--model`` value.
+    platform_out : Path, optional
+        The ``--platform-out`` file.
+    forbidden : dict of str to bool
+        Options that do not apply, by flag, and whether each was given.
+    """
+    if model not in MODELS:
+        raise ConfigError(f"--model {model!r}: expected one of {', '.join(MODELS)}.")
+    given = [flag for flag, on in forbidden.items() if on]
+    if given:
+        raise ConfigError(f"{given[0]} does not apply to --model {model}; leave it out.")
+    if platform_out is not None and platform_out.suffix.lower() != ".toml":
+        raise ConfigError(f"--platform-out {str(platform_out)!r}: the platform description "
+                          "is TOML; give a .toml file name.")
+
+
+def model_method(model: str | None, method: str, payload: bool,
+                 platform_out: Path | None) -> str:
+    """The method ``identify`` runs: ``method`` without ``--model``, else the model's
+    estimator (``"physical"``).
+
+    Raises
+    ------
+    ConfigError
+        An unknown model, or ``--payload``/``--platform-out`` without ``--model``.
+    """
+    if model is None:
+        if payload or platform_out is not None:
+            raise ConfigError("--payload and --platform-out go with --model physical; add it.")
+        return method
+    if model not in MODELS:
+        raise ConfigError(f"--model {model!r}: expected one of {', '.join(MODELS)}.")
+    return model
+
+
+def _check_model_outputs(model: str, platform_out: Path | None,
+                        refused: dict[str, bool] | None = None,
+                        inputs: Sequence[str | Path] = ()) -> None:
+    """Refuse, before any computation, what ``identify --model`` cannot do
+    (:func:`check_model_options`) and a ``platform_out`` that would replace an input or a
+    file ``--platform-out`` did not write.
+
+    Parameters
+    ----------
+    model : str
+    platform_out : Path, optional
+    refused : dict of str to bool, optional
+        Options of the command that do not apply, by flag, and whether each was given.
+    inputs : sequence of str or Path
+        Files the command reads, which ``platform_out`` must not be.
+    """
+    _check_model_options(model, platform_out, refused or {})
+    if platform_out is not None:
+        check_output_file(platform_out, False, inputs, is_result=_is_identified,
+                          option="--platform-out")
+
+
+
+
+def _fit_alone(datasets: list, platform: Platform, method: str, settings: Mapping[str, Any],
+               consistent: bool, model: str | None, payload: bool) -> IdentificationResult:
     """One method (or the physical model) without a report, made consistent on request."""
     if model is not None:
-        from stewartid.physical.identified_platform import identify_model
+        from stewartid.physical.estimator import PhysicalIdentifier
 
-        return identify_model(datasets, platform, model, payload, consistent=consistent,
-                              settings=dict(settings))
+        return PhysicalIdentifier(**settings, payload=payload, consistent=consistent).fit(
+            datasets, platform).result_
     result = registry.create_identifier(method, **settings).fit(datasets, platform).result_
     if consistent:
-        from stewartid.reports.identification.report import consistent_result
-
-        check(result)
+        plausibility_check(platform)(result)
         result = consistent_result(result)[0]
     return result
 
@@ -226,72 +288,28 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
                    payload: bool = False, platform_out: Path | None = None) -> IdentifyRun:
     """Identify Mt and Bt from experiment files, as ``stewartid identify`` does.
 
-    Parameters
-    ----------
-    files : sequence of str or Path
-        Data files (CSV/Parquet, one experiment each) or folders of them.
-    method : str
-        A registered method or preset, or ``"all"`` (needs ``report``).
-    platform : str, optional
-        ``"paper"`` or a platform TOML file; by default the one a ``meta.json`` beside the
-        data names (:func:`~stewartid.datasets.meta.platform_for_data`).
-    flags : mapping of str to FlagSetting, optional
-        Settings by the flag that gives them (named in the messages).
-    columns : str, optional
-        Column mapping of the logs (:func:`~stewartid.datasets.log_format.load_log_format`).
-    out : Path, optional
-        Write the result as JSON (an earlier result is overwritten; another file only with
-        ``force``).
-    force : bool
-    report : Path, optional
-        Write the identification report into this folder
-        (:func:`~stewartid.reports.identification.report.write_identification_report`).
-    consistent : bool
-        Replace Mt, Bt by the nearest consistent pair (needs the ``convex`` extra); with
-        ``model``, the physical model's consistent fit instead (the compared methods of its
-        report stay unconstrained).
-    folds : int, optional
-        Validation folds of the report (default 3).
-    delay : float or 'auto', optional
-        Delay of the force channels relative to the motion (s, positive when the forces are
-        logged late): every method works on the forces aligned by it; ``"auto"`` estimates
-        it first (:func:`~stewartid.identification.delay.apply_delay`). None: as logged.
-    validate : sequence of str or Path
-        Validation records of another excitation (files or folders; needs ``report``): every
-        method predicts them, and the verdict judges the prediction on them.
-    model, payload, platform_out : optional
-        ``"physical"``: the physical model instead of ``method``, in payload mode with
-        ``payload``, its platform description written to ``platform_out``
-        (:func:`~stewartid.physical.identified_platform.identify_model`); with
-        ``report``, the report of every compared method (as ``method="all"``) with the
-        physical model's section, and its result (with their verdict) as the result. With
-        ``method="all"`` and a report, the section is added too, unless the model cannot be
-        applied (one line says why).
-
-    Returns
-    -------
-    IdentifyRun
+    The arguments are the command's options (``stewartid identify --help``); ``flags`` maps
+    each estimator flag to the setting it gives. With ``report``, the methods are compared
+    (:func:`~stewartid.comparison.compare_methods`) and the report written
+    (:func:`~stewartid.reports.identification.report.write_report`); with ``model``, the
+    physical model is fitted instead of ``method`` (beside every compared method in a report).
 
     Raises
     ------
     StewartidError
         Bad options or outputs (before any computation), unreadable data, an experiment given
-        twice or a DOF left unexcited
-        (:func:`~stewartid.datasets.excitation.check_experiment_set`), a method that
-        cannot be applied, or an implausible result
-        (:func:`~stewartid.datasets.plausibility.check_identified`).
+        twice or a DOF left unexcited, a method that cannot be applied, or an implausible
+        result.
     """
     delay = parse_delay(delay)
-    names = methods_for(method)
+    names = method_names(method)
     settings = settings_for(names, method, flags or {})
     paths = expand_paths(files)
     description = platform_for_data(paths, platform)
     _check_outputs(paths, (platform, columns), out, report, force, method, len(names) > 1,
                    folds)
     if model is not None:
-        from stewartid.physical.identified_platform import check_model_outputs
-
-        check_model_outputs(model, platform_out, {}, [*paths, *([platform] if platform else [])])
+        _check_model_outputs(model, platform_out, {}, [*paths, *([platform] if platform else [])])
     if validate and report is None:
         raise ConfigError("--validate compares the methods' predictions in a report; add "
                           "--report DIR.")
@@ -309,44 +327,43 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     if records and delay_entry is not None:
         records, _ = apply_delay(records, description, delay_entry["seconds"])
     meta = nominal_from_meta(paths)
-
-    def check(found: IdentificationResult) -> None:
-        from stewartid.verdict.rule import friction_immune, models_friction
-
-        check_identified(found.M, found.B, description, found.method if report else None,
-                         not (models_friction(found) or friction_immune(found)))
-
+    check = plausibility_check(description)
     if consistent:
         from stewartid.identification.consistency import require_cvxpy
 
         require_cvxpy()
+    fields: dict[str, Any] = {}
     written = None
     if report is not None:
-        from stewartid.reports.identification.report import write_identification_report
-
-        written = write_identification_report(
-            datasets, description, report, methods_for(ALL_METHODS) if model else names,
-            settings, consistent and model is None, DEFAULT_FOLDS if folds is None else folds,
-            None if meta is None else meta[:2], None if meta is None else meta[2],
-            [str(p) for p in paths], check, records,
-            [] if sensitivity is None else [delay_note(sensitivity)],
-            _physical_request(model, method, payload, consistent, settings))
-        result = written.main_result
+        comparison = compare_methods(
+            datasets, description, method_names(ALL_METHODS) if model else names, records,
+            DEFAULT_FOLDS if folds is None else folds, settings=settings,
+            consistent=consistent and model is None,
+            physical=_physical_request(model, method, payload, consistent, settings),
+            nominal=None if meta is None else meta[:2],
+            nominal_source=None if meta is None else meta[2])
+        check(comparison.result)
+        if delay_entry is not None:
+            fields["delay"] = delay_entry
+        if sensitivity is not None:
+            fields["diagnostics"] = {**comparison.result.diagnostics,
+                                     "delay_sensitivity": sensitivity}
+        if fields:
+            comparison = comparison.with_result(**fields)
+        written = write_report(comparison, report, sources=[str(p) for p in paths],
+                               notes=[] if sensitivity is None else [delay_note(sensitivity)])
+        result = comparison.result
     else:
         result = _fit_alone(datasets, description, method, settings, consistent, model,
-                            payload, check)
-    check(result)
+                            payload)
+        check(result)
+        if delay_entry is not None:
+            result = dataclasses.replace(result, delay=delay_entry)
+        if sensitivity is not None:
+            result = dataclasses.replace(result, diagnostics={**result.diagnostics,
+                                                              "delay_sensitivity": sensitivity})
     if model is not None and platform_out is not None:
-        from stewartid.physical.identified_platform import write_identified
-
         write_identified(description, result, platform_out, len(datasets))
-    if delay_entry is not None:
-        result = dataclasses.replace(result, delay=delay_entry)
-    if sensitivity is not None:
-        result = dataclasses.replace(result, diagnostics={**result.diagnostics,
-                                                          "delay_sensitivity": sensitivity})
-    if written is not None and (delay_entry is not None or sensitivity is not None):
-        result.to_json(Path(report) / "result.json")
     M_nominal, B_nominal = meta[:2] if meta is not None else nominal_matrices(description)
     source = meta[2] if meta is not None else f"platform '{description.name}' at neutral"
     if out is not None:
@@ -355,5 +372,5 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
                        source, delay_entry, sensitivity)
 
 
-__all__ = ["ALL_METHODS", "INPUT_SUFFIXES", "FlagSetting", "IdentifyRun", "delay_note", "identify_files",
-           "methods_for", "settings_for"]
+__all__ = ["FlagSetting", "IdentifyRun", "MODELS", "delay_note", "identify_files",
+           "model_method", "settings_for"]

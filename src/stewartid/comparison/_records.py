@@ -1,11 +1,10 @@
-"""What the identification report found: one :class:`MethodReport` per method, the physical
-model's :class:`PhysicalSection`, and the :class:`IdentificationReport` that holds them with
-the verdict and the files written."""
+"""What a comparison found: one :class:`MethodFit` per method and the physical model's
+:class:`PhysicalSection`."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
-from pathlib import Path
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -20,12 +19,11 @@ from stewartid.validation.heldout import (
     ValidationResult,
     coulomb_estimate,
 )
-from stewartid.verdict.rule import Verdict
 
 
 @dataclass(frozen=True)
-class MethodReport:
-    """One method applied to the experiments, with everything the report says about it.
+class MethodFit:
+    """One method fitted to the experiments and validated on held-out data.
 
     Attributes
     ----------
@@ -51,6 +49,8 @@ class MethodReport:
         Why the method could not be applied.
     cross_validation : CrossValidation or None
         The fold fits ``validation`` scores (a consensus of close methods is built from them).
+    estimator : BaseIdentifier or None
+        The fitted estimator (None for the consensus of close methods, built from results).
     """
 
     name: str
@@ -67,6 +67,7 @@ class MethodReport:
     error: str | None = None
     exception: StewartidError | None = field(default=None, repr=False, compare=False)
     cross_validation: CrossValidation | None = field(default=None, repr=False, compare=False)
+    estimator: Any = field(default=None, repr=False, compare=False)
 
     @property
     def coulomb(self) -> tuple[np.ndarray, np.ndarray]:
@@ -147,48 +148,4 @@ class PhysicalSection:
     note: str | None = None
 
 
-@dataclass(frozen=True)
-class IdentificationReport:
-    """What :func:`~stewartid.reports.identification.report.write_identification_report`
-    found and wrote.
-
-    Attributes
-    ----------
-    runs : list of MethodReport
-    verdict : Verdict
-        Which method to trust and why (:mod:`stewartid.verdict.rule`).
-    directory : Path
-    files : list of Path
-    physical : PhysicalSection or None
-        The physical model's section, when asked for.
-    physical_primary : bool
-        ``identify --model physical``: ``result.json`` holds the physical model's result.
-    """
-
-    runs: list[MethodReport]
-    verdict: Verdict
-    directory: Path
-    files: list[Path] = field(default_factory=list)
-    physical: PhysicalSection | None = None
-    physical_primary: bool = False
-
-    @property
-    def trusted(self) -> str:
-        """Name of the method the report trusts (the only one for a single method)."""
-        return self.verdict.trusted
-
-    @property
-    def result(self) -> IdentificationResult:
-        """The trusted method's result (with ``validation``)."""
-        return next(run.result for run in self.runs if run.name == self.trusted)
-
-    @property
-    def main_result(self) -> IdentificationResult:
-        """What ``result.json`` holds: with ``physical_primary``, the physical model's result
-        with the compared methods' ``verdict``; else the trusted method's (:attr:`result`)."""
-        if self.physical_primary and self.physical is not None and self.physical.result:
-            return replace(self.physical.result, verdict=self.verdict.to_dict())
-        return self.result
-
-
-__all__ = ["IdentificationReport", "MethodReport", "PhysicalSection", "Workspace"]
+__all__ = ["MethodFit", "PhysicalSection", "Workspace"]

@@ -1,0 +1,30 @@
+"""Every method fitted to the same experiments, validated on held-out data and judged:
+:func:`compare_methods` returns a :class:`Comparison`, which the identification report renders
+(:func:`stewartid.write_report`)."""
+
+from stewartid.comparison._compare import (
+    ALL_METHODS,
+    Comparison,
+    compare_methods,
+    method_names,
+    plausibility_check,
+)
+from stewartid.comparison._physical import (
+    PhysicalRequest,
+    fit_physical,
+    largest_couplings,
+    workspace,
+)
+from stewartid.comparison._records import MethodFit, PhysicalSection, Workspace
+from stewartid.comparison._runs import (
+    consensus_run,
+    consistent_result,
+    judge,
+    run_method,
+    same_segments,
+)
+
+__all__ = ["ALL_METHODS", "Comparison", "MethodFit", "PhysicalRequest", "PhysicalSection",
+           "Workspace", "compare_methods", "consensus_run", "consistent_result", "fit_physical",
+           "judge", "largest_couplings", "method_names", "plausibility_check", "run_method",
+           "same_segments", "workspace"]

@@ -1,0 +1,279 @@
+"""Every method fitted to the same experiments, validated on held-out data and judged: the
+:class:`Comparison` behind ``identify --method all``, computed without writing a file."""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stewartid.comparison._physical import PhysicalRequest, fit_physical
+from stewartid.comparison._records import MethodFit, PhysicalSection
+from stewartid.comparison._runs import judge, run_method
+from stewartid.datasets.dataset import Dataset
+from stewartid.datasets.plausibility import check_identified
+from stewartid.errors import ConfigError
+from stewartid.identification import registry
+from stewartid.identification.result import IdentificationResult
+from stewartid.model.linearization import nominal_matrices
+from stewartid.platform import Platform, load_platform
+from stewartid.validation.heldout import DEFAULT_FOLDS, Segment, ValidationResult
+from stewartid.verdict.policy import (
+    DEFAULT_POLICY,
+    VerdictPolicy,
+    parse_entries,
+    scored_entries,
+)
+from stewartid.verdict.rule import Verdict, friction_immune, models_friction
+
+#: ``methods`` value that compares every registered method.
+ALL_METHODS = "all"
+
+
+def method_names(methods: str | Sequence[str]) -> tuple[str, ...]:
+    """The registered methods ``methods`` names: every method the verdict compares for
+    ``"all"`` (presets and the physical model aside), else the names themselves.
+
+    Raises
+    ------
+    ConfigError
+        For an unknown name (the message lists the registered ones).
+    """
+    if isinstance(methods, str):
+        if methods == ALL_METHODS:
+            return tuple(spec.name for spec in registry.registered_methods()
+                         if spec.preset_of is None and spec.compared)
+        methods = (methods,)
+    return tuple(registry.method_spec(name).name for name in methods)
+
+
+def plausibility_check(platform: Platform) -> Callable[[IdentificationResult], None]:
+    """The physical check of a method's result against the platform description
+    (:func:`~stewartid.datasets.plausibility.check_identified`), naming the method: a
+    result that fails it is reported as the method not applying."""
+
+    def check(result: IdentificationResult) -> None:
+        check_identified(result.M, result.B, platform, result.method,
+                         not (models_friction(result) or friction_immune(result)))
+
+    return check
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """Every method's fit, validation and the verdict on which to trust.
+
+    Attributes
+    ----------
+    runs : tuple of MethodFit
+        One per method, in the order asked, the consensus of close methods last when the
+        verdict built it.
+    verdict : Verdict
+    platform : Platform
+    experiments : tuple of Dataset
+    records : tuple of Dataset
+        Validation records of another excitation, predicted and not fitted.
+    folds : int
+        Time segments per experiment of the held-out validation.
+    nominal_M, nominal_B : ndarray, shape (6, 6)
+        The reference matrices the report compares with.
+    nominal_source : str
+        Where they come from.
+    physical : PhysicalSection or None
+        The physical model beside the compared methods, when asked for.
+    physical_primary : bool
+        The physical model was asked for by itself: :attr:`result` is its result.
+    seconds : float
+        Wall time of the fits, validations and verdict.
+    """
+
+    runs: tuple[MethodFit, ...]
+    verdict: Verdict
+    platform: Platform
+    experiments: tuple[Dataset, ...]
+    records: tuple[Dataset, ...]
+    folds: int
+    nominal_M: np.ndarray
+    nominal_B: np.ndarray
+    nominal_source: str
+    physical: PhysicalSection | None = None
+    physical_primary: bool = False
+    seconds: float = 0.0
+
+    @property
+    def trusted(self) -> str:
+        """Registry name of the method to trust (the only one for a single method)."""
+        return self.verdict.trusted
+
+    @property
+    def ranking(self) -> tuple[str, ...]:
+        """The applicable methods, best first."""
+        return self.verdict.ranking
+
+    @property
+    def reasons(self) -> list[str]:
+        """Why the trusted method was chosen, one sentence each."""
+        return list(self.verdict.reasons)
+
+    @property
+    def uncertain_entries(self) -> list[dict]:
+        """The scored entries the trusted result is unsure of, and why."""
+        return list(self.verdict.uncertain)
+
+    @property
+    def estimators(self) -> dict[str, Any]:
+        """Fitted estimator by method name (methods that refused the data left out)."""
+        return {run.name: run.estimator for run in self.runs if run.estimator is not None}
+
+    @property
+    def validation(self) -> dict[str, ValidationResult]:
+        """Held-out validation (or the validation records' prediction) by method name."""
+        return {run.name: run.evidence for run in self.runs if run.evidence is not None}
+
+    @property
+    def trusted_result(self) -> IdentificationResult:
+        """The trusted method's result, with its ``validation`` (and ``verdict`` when several
+        methods were compared)."""
+        return next(run.result for run in self.runs if run.name == self.trusted)
+
+    @property
+    def result(self) -> IdentificationResult:
+        """What ``result.json`` holds: the physical model's result with the compared methods'
+        verdict when it was asked for by itself, else :attr:`trusted_result`."""
+        if self.physical_primary and self.physical is not None and self.physical.result:
+            return dataclasses.replace(self.physical.result, verdict=self.verdict.to_dict())
+        return self.trusted_result
+
+    @property
+    def M(self) -> np.ndarray:
+        """The trusted inertia matrix Mt, shape (6, 6) (kg, kg m, kg m^2)."""
+        return self.trusted_result.M
+
+    @property
+    def B(self) -> np.ndarray:
+        """The trusted viscous matrix Bt, shape (6, 6) (N s/m, N m s/rad)."""
+        return self.trusted_result.B
+
+    @property
+    def std_errors(self) -> dict[str, np.ndarray]:
+        """The trusted matrices' standard errors, ``{"M": (6, 6), "B": (6, 6)}``."""
+        result = self.trusted_result
+        return {"M": result.std_errors_M, "B": result.std_errors_B}
+
+    def with_result(self, **fields: Any) -> Comparison:
+        """A copy whose :attr:`result` has ``fields`` replaced (e.g. the ``delay`` the data
+        were aligned by)."""
+        if self.physical_primary and self.physical is not None and self.physical.result:
+            physical = dataclasses.replace(
+                self.physical, result=dataclasses.replace(self.physical.result, **fields))
+            return dataclasses.replace(self, physical=physical)
+        runs = tuple(dataclasses.replace(run, result=dataclasses.replace(run.result, **fields))
+                     if run.name == self.trusted else run for run in self.runs)
+        return dataclasses.replace(self, runs=runs)
+
+
+def _experiments(experiments: Sequence[Dataset | str | Path], platform: Platform
+                 ) -> list[Dataset]:
+    from stewartid.datasets.dataset import read_datasets
+
+    return [item if isinstance(item, Dataset) else read_datasets([item], platform)[0]
+            for item in experiments]
+
+
+def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platform | str | Path,
+                    methods: str | Sequence[str] = ALL_METHODS,
+                    validate: Sequence[Dataset | str | Path] | None = None,
+                    folds: int = DEFAULT_FOLDS, *, settings: Mapping[str, Any] | None = None,
+                    consistent: bool = False, physical: PhysicalRequest | None = None,
+                    nominal: tuple[np.ndarray, np.ndarray] | None = None,
+                    nominal_source: str | None = None,
+                    check: bool | Callable[[IdentificationResult], None] = True,
+                    entries: Sequence[str] | None = None,
+                    policy: VerdictPolicy = DEFAULT_POLICY) -> Comparison:
+    """Fit every method to the same experiments, validate each on held-out time segments and
+    say which to trust; writes no file.
+
+    Parameters
+    ----------
+    experiments : sequence of Dataset (or data files)
+        Together they must excite every DOF.
+    platform : Platform, or ``"paper"`` or a TOML file
+    methods : str or sequence of str
+        ``"all"`` (every method the verdict compares), a registered name or several.
+    validate : sequence of Dataset (or data files), optional
+        Records of another excitation, not fitted: every method predicts them and the verdict
+        judges the prediction on them instead of on held-out segments.
+    folds : int
+        Time segments per experiment for the held-out validation (>= 2).
+    settings : mapping, optional
+        Settings given to every method that has them (e.g. ``{"gravity": False}``).
+    consistent : bool
+        Replace every method's Mt, Bt by the nearest physically consistent pair (needs the
+        ``convex`` extra) and validate those.
+    physical : PhysicalRequest, optional
+        Fit the physical model beside the compared methods (not ranked by the verdict); with
+        ``physical.required``, :attr:`Comparison.result` is its result.
+    nominal : (M, B), optional
+        Reference matrices for the report; the platform description's at neutral by default.
+    nominal_source : str, optional
+        Where ``nominal`` comes from.
+    check : bool or callable
+        Check each result against the platform description (:func:`plausibility_check`,
+        default) or with a callable that raises a StewartidError; a result that fails is
+        reported as the method not applying.
+    entries : sequence of str, optional
+        The entries the verdict judges the methods on, as labels (``"Mt(1,5)"``); by default
+        every entry the platform's nominal matrices (with its payload) make non-negligible
+        (:func:`~stewartid.verdict.policy.scored_entries`).
+    policy : VerdictPolicy
+        The verdict's thresholds.
+
+    Returns
+    -------
+    Comparison
+
+    Raises
+    ------
+    StewartidError
+        Bad settings, or no method could be applied (the first method's message).
+    """
+    started = time.perf_counter()
+    if not isinstance(platform, Platform):
+        platform = load_platform(platform)
+    if not (isinstance(folds, int | np.integer) and folds >= 2):
+        raise ConfigError(f"the validation needs at least 2 folds; got {folds!r}.")
+    datasets = _experiments(experiments, platform)
+    records = _experiments(validate or (), platform)
+    names = method_names(methods)
+    if nominal is None:
+        nominal = nominal_matrices(platform)
+        nominal_source = nominal_source or (f"platform description '{platform.name}' at the "
+                                            "neutral pose")
+    checker = plausibility_check(platform) if check is True else (check or None)
+    segments: dict[tuple[bool, bool], list[Segment]] = {}
+    record_cache: dict[tuple[bool, bool], list[Segment]] = {}
+    runs = [run_method(name, settings or {}, datasets, platform, folds, consistent, segments,
+                       checker, records, record_cache) for name in dict.fromkeys(names)]
+    if all(run.result is None for run in runs):
+        raise runs[0].exception
+    scored = (parse_entries(entries) if entries is not None
+              else scored_entries(*nominal_matrices(platform)))
+    runs, verdict = judge(runs, consistent, scored, policy)
+    section = None if physical is None else fit_physical(
+        datasets, platform, physical, folds, segments, records, record_cache)
+    if len(runs) > 1:
+        runs = [dataclasses.replace(run, result=dataclasses.replace(
+            run.result, verdict=verdict.to_dict())) if run.name == verdict.trusted else run
+            for run in runs]
+    return Comparison(tuple(runs), verdict, platform, tuple(datasets), tuple(records), folds,
+                      nominal[0], nominal[1], nominal_source or "", section,
+                      physical is not None and physical.required,
+                      time.perf_counter() - started)
+
+
+__all__ = ["ALL_METHODS", "Comparison", "compare_methods", "method_names", "plausibility_check"]

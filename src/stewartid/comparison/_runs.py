@@ -1,0 +1,204 @@
+"""Each method fitted, validated on held-out segments and judged: the steps of
+:func:`~stewartid.comparison.compare_methods`."""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from stewartid.comparison._records import MethodFit
+from stewartid.datasets.dataset import Dataset
+from stewartid.errors import StewartidError
+from stewartid.identification import registry
+from stewartid.identification.consistency import ConsistentEstimate, project_consistent
+from stewartid.identification.result import IdentificationResult
+from stewartid.platform import Platform
+from stewartid.reference.published import PAPER_ENTRIES, EntryKey
+from stewartid.validation.heldout import (
+    CrossValidation,
+    Segment,
+    cross_validate,
+    held_out_segments,
+    in_sample,
+    record_segments,
+    validate_on_records,
+    validation_entry,
+    with_companion_friction,
+)
+from stewartid.verdict.close_call import CONSENSUS, consensus_members, trust_consensus
+from stewartid.verdict.consensus import combine_results
+from stewartid.verdict.policy import DEFAULT_POLICY, VerdictPolicy
+from stewartid.verdict.rule import Verdict, choose_trusted
+
+
+def consistent_result(result: IdentificationResult) -> tuple[IdentificationResult,
+                                                              ConsistentEstimate]:
+    """``result`` with M and B replaced by the nearest consistent pair (needs the ``convex``
+    extra), and the projection; the unconstrained matrices and the change are kept in the
+    diagnostics."""
+    projection = project_consistent(result.M, result.B, result.std_errors_M,
+                                    result.std_errors_B)
+    diagnostics = {**result.diagnostics, "consistent_fit": {
+        **projection.to_dict(), "unconstrained_M": result.M, "unconstrained_B": result.B}}
+    return dataclasses.replace(result, M=projection.M, B=projection.B,
+                               diagnostics=diagnostics), projection
+
+
+def _project(result: IdentificationResult) -> IdentificationResult:
+    return consistent_result(result)[0]
+
+
+def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Dataset],
+               platform: Platform, folds: int, consistent: bool,
+               segments: dict[tuple[bool, bool], list[Segment]],
+               check: Callable[[IdentificationResult], None] | None = None,
+               records: Sequence[Dataset] = (),
+               record_cache: dict[tuple[bool, bool], list[Segment]] | None = None
+               ) -> MethodFit:
+    """Fit, validate and check one method; a method that cannot be applied to these data
+    (a :class:`~stewartid.errors.StewartidError`) is reported with its message.
+
+    Parameters
+    ----------
+    name : str
+        Registered method or preset.
+    settings : mapping
+        Settings for it (those it does not have are ignored).
+    datasets, platform, folds, consistent
+        As :func:`~stewartid.comparison.compare_methods`.
+    segments : dict
+        Held-out segments by (``gravity``, ``remainder``) setting, filled on first use and
+        shared between methods.
+    check : callable, optional
+        Raises a StewartidError for an implausible result (the method is then reported as
+        not applicable).
+    records : sequence of Dataset
+        Validation records of another excitation (``identify --validate``), predicted by the
+        full fit.
+    record_cache : dict, optional
+        Their filtered segments by (``gravity``, ``remainder``) setting, filled on first use.
+    """
+    spec = registry.method_spec(name)
+    accepted = spec.estimator_class.param_names()
+    own = {k: v for k, v in settings.items() if k in accepted}
+    start = time.perf_counter()
+    try:
+        estimator = registry.create_identifier(name, **own).fit(list(datasets), platform)
+        if check is not None:
+            check(estimator.result_)
+        params = estimator.get_params()
+        # the measured side of the prediction with the model terms the method removed
+        terms = (bool(params.get("gravity", True)), bool(params.get("remainder", False)))
+        if terms not in segments:
+            segments[terms] = held_out_segments(datasets, platform, folds, *terms)
+        # the folds and the companion predict: their standard errors are never read
+        companion = None
+        if "friction" in accepted:
+            def companion():
+                return registry.estimates_only(name, **{**own, "friction": "uniform"})
+        folds_fit = cross_validate(lambda: registry.estimates_only(name, **own), datasets,
+                                   platform, folds, terms[0], segments[terms], companion)
+    except StewartidError as exc:
+        return MethodFit(name, spec.display_name, spec.color, error=str(exc),
+                            exception=exc, seconds=time.perf_counter() - start)
+    unconstrained = with_companion_friction(estimator.result_, companion, datasets, platform)
+    validation = folds_fit.scores()
+    result, projection, before = unconstrained, None, None
+    if consistent:
+        result, projection = consistent_result(unconstrained)
+        before, validation = validation, folds_fit.scores(_project)
+    external = None
+    if records:
+        cache = {} if record_cache is None else record_cache
+        if terms not in cache:
+            cache[terms] = record_segments(records, platform, *terms)
+        # ``result`` holds the companion's levels: the consistent one keeps the diagnostics
+        external = validate_on_records(result, cache[terms])
+    result = dataclasses.replace(result, validation=validation_entry(validation, external))
+    return MethodFit(name, spec.display_name, spec.color, result=result,
+                        unconstrained=unconstrained, validation=validation,
+                        validation_unconstrained=before,
+                        in_sample=in_sample(segments[terms], result), projection=projection,
+                        records=external, seconds=time.perf_counter() - start,
+                        cross_validation=folds_fit, estimator=estimator)
+
+
+def same_segments(a: Sequence[Segment], b: Sequence[Segment]) -> bool:
+    """Whether two methods' held-out segments are the same pieces, prepared alike (the same
+    ``gravity`` setting gives the same measured force)."""
+    return a is b or (len(a) == len(b) and all(
+        x.name == y.name and np.array_equal(x.force, y.force) for x, y in zip(a, b, strict=True)))
+
+
+def consensus_run(members: Sequence[MethodFit], consistent: bool,
+                  agreement: float = DEFAULT_POLICY.agreement) -> MethodFit | None:
+    """The consensus of fitted methods (:func:`~stewartid.verdict.consensus.combine_results`),
+    validated as :func:`run_method` validates a method: each fold's consensus of the members'
+    fold fits predicts the held-out segments, the full consensus the validation records.
+    None when the members were validated on differently prepared segments (their ``gravity``
+    settings differ)."""
+    start = time.perf_counter()
+    names = [run.name for run in members]
+    folds = [run.cross_validation for run in members]
+    if any(f is None or not same_segments(f.segments, folds[0].segments) for f in folds):
+        return None
+    unconstrained = combine_results([run.unconstrained for run in members], names,
+                                    agreement)
+    fitted = CrossValidation(folds[0].folds, [
+        combine_results([f.fold_results[k] for f in folds], names, agreement)
+        for k in range(folds[0].folds)], folds[0].segments)
+    validation = fitted.scores()
+    result, projection, before = unconstrained, None, None
+    if consistent:
+        result, projection = consistent_result(unconstrained)
+        before, validation = validation, fitted.scores(_project)
+    records = members[0].records
+    external = None if records is None else validate_on_records(result, records.segments)
+    result = dataclasses.replace(result, validation=validation_entry(validation, external))
+    spec = registry.method_spec(CONSENSUS)
+    return MethodFit(CONSENSUS, spec.display_name, spec.color, result=result,
+                        unconstrained=unconstrained, validation=validation,
+                        validation_unconstrained=before,
+                        in_sample=in_sample(fitted.segments, result), projection=projection,
+                        records=external, seconds=time.perf_counter() - start,
+                        cross_validation=fitted)
+
+
+def judge(runs: Sequence[MethodFit], consistent: bool = False,
+          entries: Sequence[EntryKey] = PAPER_ENTRIES, policy: VerdictPolicy = DEFAULT_POLICY
+          ) -> tuple[list[MethodFit], Verdict]:
+    """The verdict on the methods' runs (:func:`~stewartid.verdict.rule.choose_trusted`, on
+    ``entries`` with ``policy``) and, where it names a close call, the consensus of the close
+    methods added to the runs and trusted (:mod:`stewartid.verdict.close_call`).
+
+    Returns
+    -------
+    runs : list of MethodFit
+        ``runs``, with the consensus's last when it was built.
+    verdict : Verdict
+    """
+    runs = list(runs)
+    verdict = choose_trusted({run.name: None if run.result is None else
+                              (run.result, run.evidence) for run in runs},
+                             {run.name: None if run.cross_validation is None else
+                              run.cross_validation.fold_results for run in runs},
+                             entries, policy)
+    by_name = {run.name: run for run in runs}
+    members = consensus_members(verdict)
+    if not members or CONSENSUS in by_name:
+        return runs, verdict
+    consensus = consensus_run([by_name[name] for name in members], consistent,
+                              policy.agreement)
+    if consensus is None:
+        return runs, verdict
+    compared = {name: by_name[name].result for name, standing in verdict.standings.items()
+                if standing.compared}
+    return [*runs, consensus], trust_consensus(verdict, consensus.result, consensus.evidence,
+                                               compared)
+
+
+__all__ = ["consensus_run", "consistent_result", "judge", "run_method", "same_segments"]
