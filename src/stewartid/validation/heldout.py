@@ -1,31 +1,9 @@
 """Validation of an identified model on data it was not fitted on.
 
-The identified model predicts the measured generalized force
-
-    y = J_lq(q)^T f_a - G(q)  =  Mt q_ddot + Bt q_dot + Fc(q_dot) + c,
-
-with Fc the Coulomb friction where the method estimates it (levels per joint type: ``ls``,
-and ``wavelet`` with ``friction="shared"``) and nothing otherwise, so that friction a method
-does not model shows as unexplained force. c is a constant per channel (static-load residual,
-force-sensor offsets): no method identifies it as part of the model (Method A and B remove
-constants, ``ls`` fits one per experiment), so it is taken from each held-out segment's own
-mean; a constant does not change the VAF.
-
-Both sides are filtered with the same smooth zero-phase kernel h of 0.2 excitation periods
-(:func:`~stewartid.signals.differentiation.kernel_filter`): the velocity and acceleration are
-q * h' and q * h'' (no numerical differentiation), and y and the Coulomb regressors are
-filtered with h itself, so the filtered equation holds exactly and the comparison covers the
-excitation band, not sensor noise above it.
-
-Folds (:func:`cross_validate`): every experiment is cut into ``folds`` segments of equal
-length; fold k holds out segment k of every experiment and refits the method on the rest (each
-experiment's remaining one or two pieces as separate records). Holding out whole experiments
-would not work for the usual protocol, in which experiment k alone excites DOF k.
-
-Scores per DOF, pooled over every held-out segment (e = measured - predicted, both centred
-per segment):
-
-    VAF = 100 (1 - sum e^2 / sum y^2) %,   NRMSE = rms(e) / (max y - min y).
+The model predicts y = J_lq(q)^T f_a - G(q) = Mt q_ddot + Bt q_dot + Fc(q_dot) + c, with c
+taken from each segment's mean. Both sides are filtered with the same zero-phase kernel h
+(:func:`~stewartid.signals.differentiation.kernel_filter`). Scores per DOF, pooled over
+held-out segments: VAF = 100 (1 - sum e^2 / sum y^2) %, NRMSE = rms(e) / (max y - min y).
 """
 
 from __future__ import annotations
@@ -157,10 +135,11 @@ def coulomb_levels(result: IdentificationResult) -> np.ndarray | None:
 
 
 def prediction_levels(result: IdentificationResult) -> np.ndarray | None:
-    """Coulomb levels per joint type (N m) a result predicts with: its own
-    (:func:`coulomb_levels`), else those of the friction fit run alongside it for the
-    validation (``diagnostics["validation_coulomb"]``, see :func:`with_companion_friction`),
-    else None."""
+    """Coulomb levels per joint type (N m) a result predicts with.
+
+    Its own (:func:`coulomb_levels`), else those of its companion friction fit
+    (``diagnostics["validation_coulomb"]``, :func:`with_companion_friction`), else None.
+    """
     levels = coulomb_levels(result)
     if levels is not None:
         return levels
@@ -174,14 +153,11 @@ def prediction_levels(result: IdentificationResult) -> np.ndarray | None:
 def with_companion_friction(result: IdentificationResult, companion: Callable[[], Any] | None,
                             datasets: Sequence[Dataset], platform: Platform
                             ) -> IdentificationResult:
-    """``result`` with the Coulomb levels of a friction-estimating fit of the same data
-    (``diagnostics["validation_coulomb"]``), when it predicts with none
-    (:func:`prediction_levels`; so a result that has them is returned as it is).
+    """``result`` with the Coulomb levels of a friction-estimating fit of the same data.
 
-    A method that leaves friction free (Method B's interval constants) is immune to it but
-    cannot predict it; without it, its held-out residual would be the friction it never
-    claimed to model. The companion (Method B with ``friction="uniform"``) estimates the
-    levels; Mt and Bt stay the method's own.
+    A method that leaves friction free cannot predict it, so its held-out residual would be
+    friction it never claimed to model. The levels go to ``diagnostics["validation_coulomb"]``;
+    Mt and Bt stay the method's own. A result that has levels is returned as it is.
     """
     if companion is None or prediction_levels(result) is not None:
         return result
@@ -221,15 +197,15 @@ def prepare_segment(dataset: Dataset, platform: Platform, window: float, *, grav
     dataset : Dataset
     platform : Platform
     window : float
-        Kernel support (s), 0.2 excitation periods by convention.
+        Kernel support (s).
     gravity : bool
         Subtract the model's G(q), as the identifier did.
     experiment, fold : int
         Labels stored in the segment.
     coulomb_smoothing : float
-        Rate (rad/s) below which a joint's Coulomb sign is attenuated, as in ``ls``.
+        Rate (rad/s) below which a joint's Coulomb sign is attenuated.
     remainder : bool
-        Subtract the model's departure from its linearisation, as the identifier did
+        Subtract the model's departure from its linearisation
         (:func:`~stewartid.identification.preparation.model_remainder`).
 
     Returns
@@ -242,7 +218,7 @@ def prepare_segment(dataset: Dataset, platform: Platform, window: float, *, grav
     from stewartid.signals.differentiation import kernel_filter
 
     record = prepare([dataset], platform, gravity=gravity, remainder=remainder)[0]
-    # the signs need rates at every sample, from the window the noise allows, as in ``ls``
+    # the signs need rates at every sample, from the window the noise allows
     q_dot_sign = measured_sign_rates(record.q, record.sample_rate, window)
     unit = coulomb_regressors(record.joint_jacobians, q_dot_sign, coulomb_smoothing)
     signals = np.concatenate([record.generalized_force, unit.reshape(len(unit), -1)], axis=1)
@@ -255,9 +231,10 @@ def prepare_segment(dataset: Dataset, platform: Platform, window: float, *, grav
 
 
 def predict(segment: Segment, result: IdentificationResult) -> np.ndarray:
-    """Generalized force predicted by ``result`` on ``segment``, shape (n, 6) (N, N m),
-    before centring: Mt q_ddot + Bt q_dot (+ the Coulomb friction it identified, or that its
-    companion fit found, :func:`prediction_levels`)."""
+    """Generalized force predicted by ``result`` on ``segment``, shape (n, 6) (N, N m), not centred.
+
+    Mt q_ddot + Bt q_dot, plus the Coulomb friction of :func:`prediction_levels` when there is one.
+    """
     out = segment.q_ddot @ np.asarray(result.M).T + segment.q_dot @ np.asarray(result.B).T
     levels = prediction_levels(result)
     if levels is not None:
@@ -267,8 +244,7 @@ def predict(segment: Segment, result: IdentificationResult) -> np.ndarray:
 
 def score(segments: Sequence[Segment], predicted: Sequence[np.ndarray], folds: int
           ) -> ValidationResult:
-    """VAF and NRMSE per DOF of predictions against the segments' measured force (see the
-    module docstring for the definitions)."""
+    """VAF and NRMSE per DOF of predictions against the segments' measured force (module docstring)."""
     measured = [s.force - s.force.mean(axis=0) for s in segments]
     centred = [p - p.mean(axis=0) for p in predicted]
     y = np.concatenate(measured)
@@ -282,12 +258,12 @@ def score(segments: Sequence[Segment], predicted: Sequence[np.ndarray], folds: i
 
 
 def fold_bounds(n: int, folds: int) -> np.ndarray:
-    """Sample boundaries of ``folds`` equal segments of a record of ``n`` samples, shape
-    (folds + 1,)."""
+    """Sample boundaries of ``folds`` equal segments of ``n`` samples, shape (folds + 1,)."""
     return np.round(np.linspace(0, n, folds + 1)).astype(int)
 
 
 def time_piece(dataset: Dataset, start: int, stop: int) -> Dataset:
+    """Samples ``start:stop`` of a record, named after their time span."""
     t = dataset.t[start:stop]
     return Dataset(t=t, pose=dataset.pose[start:stop], lengths=dataset.lengths[start:stop],
                    forces=dataset.forces[start:stop],
@@ -304,8 +280,10 @@ def excitation_window(dataset: Dataset) -> float:
 def held_out_segments(datasets: Sequence[Dataset], platform: Platform,
                       folds: int = DEFAULT_FOLDS, gravity: bool = True,
                       remainder: bool = False) -> list[Segment]:
-    """Every fold segment of every experiment, filtered (:func:`prepare_segment`); the same
-    for every method with the same ``gravity`` and ``remainder`` settings."""
+    """Every fold segment of every experiment, filtered (:func:`prepare_segment`).
+
+    The same for every method with the same ``gravity`` and ``remainder`` settings.
+    """
     segments = []
     for e, dataset in enumerate(datasets):
         edges, window = fold_bounds(len(dataset), folds), excitation_window(dataset)
@@ -327,7 +305,6 @@ def cross_validate(create: Callable[[], Any], datasets: Sequence[Dataset], platf
     create : callable
         Returns a new, unfitted identifier (e.g. ``lambda: create_identifier("wavelet")``).
     datasets : sequence of Dataset
-        The experiments.
     platform : Platform
     folds : int
         Segments per experiment, >= 2.
@@ -374,8 +351,7 @@ def cross_validate(create: Callable[[], Any], datasets: Sequence[Dataset], platf
 
 def record_segments(datasets: Sequence[Dataset], platform: Platform, gravity: bool = True,
                     remainder: bool = False) -> list[Segment]:
-    """Validation records (motion the fit did not see), filtered as the held-out segments
-    are, each whole (:func:`prepare_segment`, labelled with fold 0)."""
+    """Validation records, each whole, filtered as held-out segments are (fold 0)."""
     return [prepare_segment(dataset, platform, excitation_window(dataset), gravity=gravity,
                             experiment=k, remainder=remainder)
             for k, dataset in enumerate(datasets)]
@@ -383,9 +359,9 @@ def record_segments(datasets: Sequence[Dataset], platform: Platform, gravity: bo
 
 def validate_on_records(result: IdentificationResult, segments: Sequence[Segment]
                         ) -> ValidationResult:
-    """Scores of a model fitted on all experiments on validation records of another
-    excitation (:func:`record_segments`). Unlike held-out segments of the same sines, other
-    motion shows a wrong parameter that a friction term compensated on the fitted one.
+    """Scores of a model fitted on all experiments on validation records of another excitation.
+
+    Other motion shows a wrong parameter that a friction term compensated on the fitted one.
 
     Returns
     -------
@@ -397,9 +373,11 @@ def validate_on_records(result: IdentificationResult, segments: Sequence[Segment
 
 def validation_entry(held_out: ValidationResult, records: ValidationResult | None = None
                      ) -> dict[str, Any]:
-    """The ``validation`` object of ``result.json``: the held-out scores
-    (:meth:`ValidationResult.to_dict`) and, with validation records, their ``"records"``:
-    ``vaf_percent``, ``nrmse`` and ``names``."""
+    """The ``validation`` object of ``result.json``.
+
+    The held-out scores (:meth:`ValidationResult.to_dict`) and, with validation records, their
+    ``"records"``: ``vaf_percent``, ``nrmse`` and ``names``.
+    """
     entry = held_out.to_dict()
     if records is not None:
         entry["records"] = {"vaf_percent": records.vaf_percent.tolist(),
@@ -411,10 +389,9 @@ def validation_entry(held_out: ValidationResult, records: ValidationResult | Non
 def friction_signature(validation: ValidationResult) -> float:
     """Share of the held-out residual that has the shape of Coulomb joint friction.
 
-    The residuals of all six equations (each divided by the RMS of its measured force) are
-    fitted by least squares with the three Coulomb regressors (one level per joint type,
-    shared by the equations, centred per segment like the forces). 0: nothing of the
-    residual looks like friction; near 1: the residual is mostly friction the model lacks.
+    The residuals of the six equations, each scaled by the RMS of its measured force, are
+    least-squares fitted with the three Coulomb regressors (one level per joint type). 0: nothing
+    looks like friction; near 1: the residual is mostly friction the model lacks.
     """
     measured = np.concatenate(validation.measured)
     scale = np.sqrt(np.mean(measured ** 2, axis=0))
@@ -433,8 +410,7 @@ def friction_signature(validation: ValidationResult) -> float:
 
 
 def in_sample(segments: Sequence[Segment], result: IdentificationResult) -> ValidationResult:
-    """Scores and residuals of the model fitted on all data, on the same segments (the
-    residuals over time of the report)."""
+    """Scores and residuals of the model fitted on all data, on the same segments."""
     return score(segments, [predict(s, result) for s in segments], folds=1)
 
 
