@@ -1,12 +1,7 @@
 """The estimator base class every identifier derives from (scikit-learn estimator contract).
 
-``__init__`` of a subclass stores its settings only, and the class declares their
-constraints next to it in ``_parameter_constraints`` (the vocabulary of
-:mod:`stewartid.fields`); :meth:`BaseIdentifier.fit` validates settings and data, calls the
-subclass's ``_fit`` and sets every learned attribute (names ending in ``_``) in one place;
-reading one before ``fit`` raises :class:`~stewartid.errors.NotFittedError`.
-``get_params``/``set_params`` follow scikit-learn, so ``sklearn.base.clone`` works on every
-identifier.
+A subclass's ``__init__`` stores its settings, constrained in ``_parameter_constraints``;
+:meth:`BaseIdentifier.fit` validates them and sets every learned attribute (names ending in ``_``).
 """
 
 from __future__ import annotations
@@ -34,9 +29,8 @@ class BaseIdentifier:
     ``M_``, ``B_`` : ndarray (6, 6)
         Identified inertial and viscous matrices (paper frame).
     ``std_errors_`` : dict with ``"M"`` and ``"B"`` : ndarray (6, 6)
-        Standard errors from the residuals; with the setting ``sampling_check`` (every
-        built-in method's), widened where the log's sampling rather than its noise limits
-        the estimate (:mod:`stewartid.identification.sampling`).
+        Standard errors, widened where the log's sampling limits the estimate when
+        ``sampling_check`` is set (:mod:`stewartid.identification.sampling`).
     ``condition_number_`` : float
         Condition number of the (equilibrated) regression.
     ``result_`` : IdentificationResult
@@ -59,8 +53,7 @@ class BaseIdentifier:
         return [name for name in signature.parameters if name != "self"]
 
     def get_params(self, deep: bool = True) -> dict[str, Any]:
-        """Settings given to ``__init__`` (``deep`` is accepted for scikit-learn; identifiers
-        hold no nested estimators)."""
+        """Settings given to ``__init__`` (``deep`` is accepted for scikit-learn)."""
         return {name: getattr(self, name) for name in self.param_names()}
 
     def set_params(self, **params: Any) -> BaseIdentifier:
@@ -91,8 +84,7 @@ class BaseIdentifier:
         raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     def _validate_params(self) -> None:
-        """Check the settings against ``_parameter_constraints``; a subclass with rules across
-        settings extends this after calling it.
+        """Check the settings against ``_parameter_constraints``.
 
         Raises
         ------
@@ -109,8 +101,7 @@ class BaseIdentifier:
         datasets : Dataset, path, or sequence of them
             The experiments (several files = several experiments).
         platform : Platform, 'paper' or TOML path
-            Platform description of the measured hexapod: geometry for the Jacobians, leg
-            masses for G(q). Required: there is no default platform.
+            The measured hexapod (geometry, leg masses); required.
 
         Returns
         -------
@@ -140,9 +131,10 @@ class BaseIdentifier:
     def _check_sampling(self, datasets: list[Dataset], platform: Platform,
                         result: IdentificationResult, learned: dict[str, Any]
                         ) -> tuple[IdentificationResult, dict[str, Any]]:
-        """``_fit``'s result and learned attributes with the standard errors widened where
-        the log's sampling limits them (:func:`~stewartid.identification.sampling.check_sampling`);
-        a method whose learned attributes hold errors too extends this."""
+        """``_fit``'s result and learned attributes, standard errors widened where sampling limits them.
+
+        See :func:`~stewartid.identification.sampling.check_sampling`.
+        """
         return check_sampling(lambda part: self._fit(part, platform)[0], datasets,
                               result), learned
 

@@ -1,25 +1,14 @@
 """Cramér-Rao bounds on Mt and Bt: the best any unbiased estimator can do with a motion.
 
-For the linearised model y = Mt q_ddot + Bt q_dot + c + J_lq^T e, with the motion known
-exactly and white leg-force noise e (standard deviation sigma per leg), the Fisher
-information of vec([Mt Bt]) is
+For y = Mt q_ddot + Bt q_dot + c + J_lq^T e, with white leg-force noise e (sigma per leg),
+the Fisher information of vec([Mt Bt]) is
 
     I = sum_t C_t^-1 (x) x_t x_t^T,      C_t = J_lq(q_t)^T diag(sigma^2) J_lq(q_t),
     x_t = [q_ddot_t, q_dot_t],
 
-less what the nuisance constants c take (the Schur complement over them). Two nuisance
-structures:
-
-* ``friction="known"``: the Coulomb force is known (subtracted exactly), one constant per
-  record remains (what the gravity model leaves): the bound of the oracle;
-* ``friction="immune"``: a free constant per constant-direction interval (every joint
-  keeps its direction), which is all a Coulomb-invariant estimator (Method B with free
-  interval constants) may assume: inside an interval the mean viscous force cannot be
-  told from the constant, and only the within-interval variation of q_dot informs Bt.
-
-Pose noise, which the real estimators also face, only adds to these bounds, so they are
-lower bounds for noisy logs: an accuracy target below them cannot be met by any unbiased
-estimator on that motion, whatever its cleverness; only a different excitation helps.
+with the nuisance constants c profiled out (Schur complement): one per record
+(``friction="known"``) or one per constant-direction interval (``friction="immune"``, the
+Coulomb-invariant case). Pose noise only adds, so these are lower bounds for noisy logs.
 
 References
 ----------
@@ -76,9 +65,10 @@ class InformationBound:
 
 def _profiled_information(q_dot: np.ndarray, q_ddot: np.ndarray, precision: np.ndarray,
                           labels: np.ndarray) -> tuple[np.ndarray, int]:
-    """Fisher information of the 72 [Mt Bt] unknowns with one free 6-vector constant per
-    label >= 0 profiled out; samples labelled -1 are not used. Returns (72, 72) and the
-    number of constants."""
+    """Fisher information of [Mt Bt] with one free 6-vector constant per label >= 0 profiled out.
+
+    Samples labelled -1 are not used. Returns the (72, 72) information and the number of constants.
+    """
     keep = labels >= 0
     x = np.hstack([q_ddot, q_dot])[keep]                                # (n, 12)
     p, lab = precision[keep], labels[keep]

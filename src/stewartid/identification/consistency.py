@@ -1,39 +1,20 @@
 """Physical consistency of identified Mt and Bt, and the nearest consistent pair.
 
-Physics: Mt is the inertia matrix of the linearised platform, symmetric positive definite
-(kinetic energy q_dot^T Mt q_dot / 2 > 0 for every motion); Bt comes from viscous joint
-friction, symmetric positive semidefinite (dissipated power q_dot^T Bt q_dot >= 0). An
-unconstrained least-squares estimate need not be either: noise, friction the method does not
-model, or weakly excited directions leave asymmetric parts and, at worst, negative
-eigenvalues that make a model-based controller or simulator unstable.
-
-:func:`consistency_metrics` measures both (the ``consistency`` object of ``result.json``);
-:func:`project_consistent` solves the constrained problem
+Mt must be symmetric positive definite and Bt symmetric positive semidefinite; an
+unconstrained estimate need not be. :func:`project_consistent` solves
 
     minimise   sum_ij ((M_ij - M^_ij) / s^M_ij)^2 + sum_ij ((B_ij - B^_ij) / s^B_ij)^2
     subject to M = M^T,  M - delta I positive semidefinite,  B = B^T positive semidefinite,
 
-with M^, B^ the unconstrained estimate and s its standard errors: the projection of the
-estimate onto the consistent set in the metric of its own uncertainty (the Mahalanobis
-distance with the estimate's covariance taken diagonal). Compared with imposing the
-constraints inside each method's regression, it works the same way for every method, needs
-only the result (matrices and standard errors), keeps the method's own treatment of friction
-and noise, and moves well-determined entries little and poorly determined ones more. The
-diagonal weighting is what the result files carry; the cross-covariances between entries of
-one equation are not kept by every method. For a symmetric pair the solution without active
-eigenvalue constraints is the inverse-variance weighted mean of the two entries, i.e. what a
-symmetric fit of the same data would give. ``delta`` (a millionth of the mean diagonal of
-|M^|) makes the inequality on Mt strict without affecting any estimate that is already
-positive definite.
-
-The problem is a small semidefinite program (two 6x6 matrix variables) solved with cvxpy
-(Clarabel, else SCS), an optional dependency: ``pip install "stewartid[convex]"``.
+with M^, B^ the estimate and s its standard errors: the projection in the metric of the
+estimate's own uncertainty, the same for every method. Needs cvxpy
+(``pip install "stewartid[convex]"``).
 
 References
 ----------
 Traversaro, S., Brossette, S., Escande, A., Nori, F. "Identification of fully physical
 consistent inertial parameters using optimization on manifolds." IROS 2016, 5446-5451;
-arXiv:1610.08703 (why estimates must be projected onto the physically consistent set).
+arXiv:1610.08703.
 """
 
 from __future__ import annotations
@@ -50,16 +31,17 @@ STRICT_FRACTION = 1e-6
 
 
 def asymmetry(matrix: np.ndarray) -> float:
-    """Relative Frobenius norm of the antisymmetric part, ||(A - A^T) / 2|| / ||A|| (0 for a
-    symmetric matrix, 1 for an antisymmetric one; NaN for a zero matrix)."""
+    """Relative Frobenius norm of the antisymmetric part, ||(A - A^T) / 2|| / ||A||.
+
+    0 for a symmetric matrix, 1 for an antisymmetric one, NaN for a zero matrix.
+    """
     matrix = np.asarray(matrix, dtype=float)
     norm = np.linalg.norm(matrix)
     return float(np.linalg.norm(matrix - matrix.T) / 2 / norm) if norm > 0 else float("nan")
 
 
 def min_eigenvalue(matrix: np.ndarray) -> float:
-    """Smallest eigenvalue of the symmetric part (A + A^T) / 2 (the one the quadratic forms
-    q_dot^T A q_dot see), in the matrix's units; NaN if an entry is not finite."""
+    """Smallest eigenvalue of the symmetric part (A + A^T) / 2; NaN if an entry is not finite."""
     matrix = np.asarray(matrix, dtype=float)
     if not np.all(np.isfinite(matrix)):
         return float("nan")
@@ -85,8 +67,10 @@ def consistency_metrics(M: np.ndarray, B: np.ndarray) -> dict[str, float]:
 
 
 def is_consistent(M: np.ndarray, B: np.ndarray, tolerance: float = 1e-9) -> bool:
-    """True if M is symmetric positive definite and B symmetric positive semidefinite, up to
-    ``tolerance`` relative to each matrix's largest entry."""
+    """True if M is symmetric positive definite and B symmetric positive semidefinite.
+
+    ``tolerance`` is relative to each matrix's largest entry.
+    """
     metrics = consistency_metrics(M, B)
     scale_M, scale_B = np.abs(M).max(), max(np.abs(B).max(), 1e-300)
     return bool(metrics["M_asymmetry"] <= tolerance and metrics["B_asymmetry"] <= tolerance
@@ -130,8 +114,7 @@ class ConsistentEstimate:
 
 
 def _weights(std: np.ndarray, estimate: np.ndarray) -> np.ndarray:
-    """1 / standard error, with unusable errors (0, NaN) replaced by the matrix's median
-    error (or a tiny fraction of its scale) so that no entry is free or infinitely stiff."""
+    """1 / standard error; unusable errors (0, NaN) take the median error so no entry is free."""
     std = np.asarray(std, dtype=float)
     usable = np.isfinite(std) & (std > 0)
     scale = float(np.abs(estimate).max()) or 1.0
@@ -162,8 +145,7 @@ def default_solver() -> str:
 
 
 def solve_convex(problem: Any, solver: str | None, hint: str) -> tuple[str, str]:
-    """Solve a cvxpy problem of a consistent fit; "optimal_inaccurate" counts as solved and is
-    returned in the status, not warned about.
+    """Solve a cvxpy problem of a consistent fit; "optimal_inaccurate" counts as solved.
 
     Parameters
     ----------
@@ -180,7 +162,7 @@ def solve_convex(problem: Any, solver: str | None, hint: str) -> tuple[str, str]
     Raises
     ------
     IdentificationError
-        The solver fails or finds no solution (one line, naming the solver and status).
+        The solver fails or finds no solution.
     """
     import warnings
 

@@ -1,27 +1,9 @@
 """Delay of the force channels relative to the motion, estimated from the logged experiments.
 
-With the forces logged tau seconds late, f_logged(t) = f(t - tau), the generalized force the
-identifiers see is y_logged(t) ~ y(t) - tau y_dot(t), and the equation of motion becomes
-
-    y_logged = Mt q_ddot + Bt q_dot + Fc(t) + c - tau y_dot_logged          (first order).
-
-Under a sine of angular frequency w the delay term is tau w^2 Mt q_dot: the apparent Bt is
-Bt + tau w^2 Mt (plus tau K from the static load, :func:`delay_bias_per_ms`), which no fit
-can tell from damping at one frequency. Across several
-frequencies per DOF the two separate (viscous force grows with w, the delay term with w^2),
-and tau, shared by every channel and experiment, is fitted jointly with Mt, Bt, the Coulomb
-levels per joint type and an offset per channel and experiment.
-
-The fit is in weak form: every signal is filtered with one smooth compact kernel h
-(:func:`~stewartid.signals.differentiation.kernel_filter`), so q_dot = q * h', q_ddot = q * h''
-and y_dot = y * h' come without differentiating any measured signal; for a symmetric kernel
-the noise of y * h' is uncorrelated with that of y * h at the same instant (sum h h' = 0), so
-the force noise in the delay regressor does not correlate with the target's. A second pass on
-the experiments aligned by the first estimate (exact shift,
-:func:`~stewartid.datasets.alignment.align_forces`) removes the bias of the first-order
-expansion (of order tau^2 w) and the attenuation the noise of y * h' gives the first
-estimate; the standard error is that of the last pass, from a sandwich covariance robust to
-residuals correlated in time and across channels (:func:`shared_least_squares`).
+A delay tau biases Bt by tau w^2 Mt at one frequency; across two or more frequencies per DOF
+it separates from damping. tau is fitted jointly with Mt, Bt, Coulomb levels and offsets in
+weak form (every signal filtered with one smooth kernel, so no measured signal is
+differentiated), then refitted on the aligned experiments.
 
 References
 ----------
@@ -101,13 +83,10 @@ class DelayEstimate:
 
 def delay_bias_per_ms(platform: Platform | np.ndarray, frequencies_hz: Sequence[float],
                       stiffness: np.ndarray | None = None) -> np.ndarray:
-    """The bias a delay of 1 ms puts on the Bt diagonal under single sines:
-    Delta Bt(i, i) = tau (w_i^2 Mt(i, i) + K(i, i)).
+    """The bias a delay of 1 ms puts on the Bt diagonal under single sines.
 
-    With the forces logged tau late, y_logged(t) = J(q(t))^T f(t - tau) - G(q(t)) ~
-    y(t) - tau y_dot(t) + tau K q_dot(t): under a sine of angular frequency w, -tau Mt q_dddot
-    = tau w^2 Mt q_dot, and the static leg load turned by the pose change over tau adds
-    tau K q_dot, with K = d y / d q (the geometric and gravity stiffness).
+    Delta Bt(i, i) = tau (w_i^2 Mt(i, i) + K(i, i)), with K = d y / d q the geometric and
+    gravity stiffness.
 
     Parameters
     ----------
@@ -116,7 +95,7 @@ def delay_bias_per_ms(platform: Platform | np.ndarray, frequencies_hz: Sequence[
     frequencies_hz : sequence of 6 float
         Each DOF's excitation frequency (Hz).
     stiffness : ndarray, shape (6, 6), optional
-        K = d y / d q at the mean pose and leg forces
+        K at the mean pose and leg forces
         (:func:`~stewartid.identification.preparation.generalized_force_sensitivity`);
         without it the inertial term alone.
 
@@ -148,9 +127,8 @@ def single_frequency_bias(datasets: Sequence[Dataset], platform: Platform,
     -------
     dict or None
         None when every DOF moves at two or more frequencies; else ``{"dofs": [names],
-        "frequencies_hz": [6], "bt_diagonal_per_ms": [6]}``, the bias on the Bt diagonal per
-        millisecond of delay (:func:`delay_bias_per_ms`, at each DOF's frequency refined in
-        the experiment that moves it most; NaN for a DOF that does not move).
+        "frequencies_hz": [6], "bt_diagonal_per_ms": [6]}`` (:func:`delay_bias_per_ms`;
+        NaN for a DOF that does not move).
     """
     lines = excitation_lines(datasets) if lines is None else lines
     single = [k for k, f in enumerate(lines) if len(f) < 2]
@@ -182,9 +160,8 @@ def check_delay_identifiable(datasets: Sequence[Dataset], platform: Platform
     Raises
     ------
     IdentificationError
-        One line: the DOFs with a single frequency, that delay and damping cannot be told
-        apart there, and the bias on the Bt diagonal per millisecond of delay
-        (:func:`single_frequency_bias`).
+        Naming the DOFs with a single frequency and the bias on the Bt diagonal per
+        millisecond of delay (:func:`single_frequency_bias`).
     """
     lines = excitation_lines(datasets)
     found = single_frequency_bias(datasets, platform, lines)
@@ -201,8 +178,11 @@ def check_delay_identifiable(datasets: Sequence[Dataset], platform: Platform
 
 def _filtered_rows(dataset: Dataset, platform: Platform, window: float
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Weak-form rows of one experiment: q_ddot, q_dot (N', 6), y (N', 6), Coulomb
-    regressors (N', 3, 6) and the delay regressor -y_dot (N', 6), all filtered with h."""
+    """Weak-form rows of one experiment, all filtered with the kernel.
+
+    Returns q_ddot, q_dot (N', 6), y (N', 6) and the shared regressors (N', 4, 6): the three
+    Coulomb ones and the delay regressor -y_dot.
+    """
     experiment = prepare_experiment(dataset, platform, gravity=True, joints=True)
     rate = experiment.sample_rate
     # the Coulomb signs need rates at every sample; they only decide signs
@@ -219,15 +199,11 @@ def _filtered_rows(dataset: Dataset, platform: Platform, window: float
 
 def shared_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray,
                          groups: np.ndarray, lags: int) -> tuple[np.ndarray, np.ndarray]:
-    """The shared coefficients c of y(k) = theta phi(k) + sum_s c_s S_s(k), with standard
-    errors robust to residuals correlated in time and across channels.
+    """Shared coefficients c of y(k) = theta phi(k) + sum_s c_s S_s(k), with robust standard errors.
 
-    The per-channel coefficients theta are partialled out (Frisch-Waugh); the channels are
-    weighted by their residual variance from a first, unweighted pass. The covariance is the
-    sandwich A^-1 Omega A^-1 with the Newey-West (Bartlett) long-run covariance Omega of the
-    scores g(k) = sum_i w_i S~_i(k) e_i(k), summed over the channels at each row (the six
-    generalized forces share the six leg-force noises) and over the experiments
-    (independent groups).
+    theta is partialled out (Frisch-Waugh); channels are weighted by their residual variance;
+    the covariance is a sandwich with a Newey-West (Bartlett) long-run covariance of the
+    scores summed over channels, experiments being independent groups.
 
     Parameters
     ----------
@@ -288,8 +264,7 @@ def fit_delay(datasets: Sequence[Dataset], platform: Platform, window: float,
     window : float
         Kernel support (s).
     decimate : int
-        Keep every ``decimate``-th filtered row (the filtered signals are smooth over the
-        window).
+        Keep every ``decimate``-th filtered row.
 
     Returns
     -------
@@ -316,21 +291,19 @@ def fit_delay(datasets: Sequence[Dataset], platform: Platform, window: float,
 
 def estimate_delay(datasets: Sequence[Dataset], platform: Platform, window: float | None = None,
                    iterations: int = 1) -> DelayEstimate:
-    """Estimate the delay of the force channels relative to the motion, with its standard
-    error.
+    """Estimate the delay of the force channels relative to the motion, with its standard error.
 
     Parameters
     ----------
     datasets : sequence of Dataset
         The experiments, logged with one acquisition chain (one delay for all).
     platform : Platform
-        Description of the measured hexapod (Jacobians, gravity, joint axes).
+        Description of the measured hexapod.
     window : float, optional
         Kernel support of the weak form (s); by default :data:`WINDOW_PERIODS` periods of
         the highest excitation line.
     iterations : int
-        Refits on the experiments aligned by the estimate so far (1 removes the bias of the
-        first-order expansion at a few ms; 0 keeps the first pass).
+        Refits on the experiments aligned by the estimate so far (0 keeps the first pass).
 
     Returns
     -------
