@@ -1,7 +1,6 @@
 """Brent's bounded minimisation of a scalar function (:func:`minimize_bounded`), step for step
-as ``scipy.optimize.minimize_scalar(method="bounded")``, whose import would cost more than the
-searches it serves (the refinement of an excitation frequency,
-:func:`~stewartid.signals.differentiation.estimate_frequency`)."""
+as ``scipy.optimize.minimize_scalar(method="bounded")``, without importing scipy.optimize.
+"""
 
 from __future__ import annotations
 
@@ -14,9 +13,7 @@ def minimize_bounded(cost: Callable[[float], float], lower: float, upper: float,
     """Minimiser of a scalar function on [lower, upper] by Brent's bounded method.
 
     Golden-section steps safeguarded by parabolic interpolation (Forsythe, Malcolm & Moler,
-    *Computer Methods for Mathematical Computations*, 1977, procedure ``fmin``), step for
-    step as ``scipy.optimize.minimize_scalar(method="bounded")``, whose import would cost
-    more than the search itself.
+    *Computer Methods for Mathematical Computations*, 1977, procedure ``fmin``).
 
     Parameters
     ----------

@@ -1,20 +1,8 @@
 """Noise-aware differentiation of measured motion, and excitation-frequency estimation.
 
-Velocities and accelerations come from a Savitzky-Golay filter: a polynomial of order
-``order`` fitted by least squares in a sliding window of ``window`` seconds, differentiated
-analytically (Savitzky & Golay 1964, doi:10.1021/ac60214a047).
-
-Choice of window and order. For a sine of frequency f the filter returns the derivative
-scaled by a gain H_d(f) that tends to 1 as the window shrinks, while the white-noise gain grows
-like window^-(d + 1/2). With order 5 and a window of 0.2 periods of the highest excitation
-frequency (the default, :func:`default_window`), the relative amplitude error at f is
-1e-6 for the velocity and 2e-4 for the acceleration, and at 1 kHz and 0.5 Hz the noise on the
-acceleration is about 29 (1/s^2) times the position noise per sample, which averages out over
-whole periods. Shorter windows trade noise for bias; ``window`` is a setting of every
-identifier that differentiates.
-
-The first and last half-window are fitted by the end polynomials (``mode="interp"``); they
-are noisier, so identifiers drop them (:func:`trim`).
+Velocities and accelerations come from a Savitzky-Golay filter (Savitzky & Golay 1964,
+doi:10.1021/ac60214a047), by default over 0.2 periods of the highest excitation frequency
+(:func:`default_window`).
 """
 
 from __future__ import annotations
@@ -53,6 +41,9 @@ def differentiate(x: np.ndarray, sample_rate: float, window: float,
                   ) -> tuple[np.ndarray, ...]:
     """Smoothed signal and its first two time derivatives by Savitzky-Golay filtering.
 
+    The first and last half-window come from the end polynomials (``mode="interp"``); they are
+    noisier, so identifiers drop them (:func:`trim`).
+
     Parameters
     ----------
     x : ndarray, shape (N,) or (N, m)
@@ -60,12 +51,11 @@ def differentiate(x: np.ndarray, sample_rate: float, window: float,
     sample_rate : float
         Hz.
     window : float
-        Window length (s); see the module docstring for the choice.
+        Window length (s).
     order : int
         Polynomial order (>= 3 for an acceleration).
     derivatives : sequence of int
-        The estimates returned: 0 (smoothed), 1, 2; one transform of x for all of them and
-        one inverse transform each, so that asking for fewer costs less.
+        The estimates returned: 0 (smoothed), 1, 2; asking for fewer costs less.
 
     Returns
     -------
@@ -109,11 +99,9 @@ def differentiate(x: np.ndarray, sample_rate: float, window: float,
 def savgol_coefficients(n: int, order: int, deriv: int = 0, delta: float = 1.0) -> np.ndarray:
     """Convolution taps of the Savitzky-Golay estimate of the ``deriv``-th derivative.
 
-    The least-squares polynomial of degree ``order`` through ``n`` (odd) samples, its
-    ``deriv``-th derivative at the centre sample: ``scipy.signal.savgol_coeffs(n, order,
-    deriv, delta, use="conv")`` without importing scipy.signal (about a second), and exact to
-    round-off for any window (the sample offsets are scaled to [-1, 1] first; unscaled, as in
-    scipy 1.17, the taps of a 1001-sample, order-5 acceleration filter are 67 % wrong).
+    As ``scipy.signal.savgol_coeffs(n, order, deriv, delta, use="conv")``, without importing
+    scipy.signal, and exact to round-off for long windows (the sample offsets are scaled to
+    [-1, 1] first).
 
     Parameters
     ----------
@@ -129,11 +117,9 @@ def savgol_coefficients(n: int, order: int, deriv: int = 0, delta: float = 1.0) 
     Returns
     -------
     ndarray, shape (n,)
-        Taps for ``np.convolve`` (reversed in time: ``taps[::-1]`` are the dot-product
-        weights of the samples from oldest to newest).
+        Taps for ``np.convolve`` (``taps[::-1]`` weight the samples from oldest to newest).
     """
-    # offsets scaled to [-1, 1]: the raw Vandermonde matrix has a condition number of about
-    # (n/2)^order, and its least-squares taps lose every digit for windows of 1000 samples
+    # offsets scaled to [-1, 1]: the raw Vandermonde matrix's condition number is about (n/2)^order
     half = max(n // 2, 1)
     offsets = np.arange(n // 2, n // 2 - n, -1, dtype=float) / half
     vandermonde = offsets ** np.arange(order + 1).reshape(-1, 1)
@@ -159,15 +145,14 @@ def convolve_valid(x: np.ndarray, kernels: Sequence[np.ndarray],
     """Convolve the columns of ``x`` with each kernel along axis 0, "valid" part only.
 
     Overlap-save FFT convolution: one forward transform of ``x`` serves every kernel, and
-    ``x`` is processed in blocks of about ``block_bytes`` so that the scratch memory stays
-    bounded for records of any length.
+    blocks of about ``block_bytes`` bound the scratch memory.
 
     Parameters
     ----------
     x : ndarray, shape (N, ...)
         Time on axis 0.
     kernels : sequence of ndarray, each of shape (L,)
-        Same odd or even length L <= N.
+        Same length L <= N.
     block_bytes : int
         Approximate size of the blocks of ``x`` transformed at once.
 
@@ -204,9 +189,8 @@ def savgol_gain(frequency_hz: float, sample_rate: float, window: float,
                 order: int = DEFAULT_ORDER, deriv: int = 0) -> float:
     """Gain of the Savitzky-Golay estimate of the ``deriv``-th derivative of a sine.
 
-    The filter is symmetric, so for x = sin(w t) its derivative estimate is exactly
-    gain * d^k/dt^k sin(w t) (no phase error); dividing harmonic coefficients by this gain
-    removes the filter's amplitude bias at that frequency.
+    The filter is symmetric, so for x = sin(w t) the estimate is exactly gain * d^k/dt^k x;
+    dividing harmonic coefficients by it removes the filter's amplitude bias.
     """
     n = window_samples(window, sample_rate, order)
     coefficients = savgol_coefficients(n, order, deriv, 1.0 / sample_rate)[::-1]
@@ -224,13 +208,10 @@ def kernel_filter(x: np.ndarray, sample_rate: float, window: float, derivatives:
                   exponent: int = KERNEL_EXPONENT) -> list[np.ndarray]:
     """Convolve with a smooth compact kernel h and, optionally, its derivatives.
 
-    (x * h)(t) = integral x(t - tau) h(tau) dtau with h(tau) = c (1 - (2 tau / W)^2)^p on
-    |tau| < W/2 (unit integral). Because h and its first p - 1 derivatives vanish at the ends,
-    d/dt (x * h) = x * h' and d^2/dt^2 (x * h) = x * h'' exactly: filtering a linear
-    equation of motion with h gives an equation in filtered signals whose velocity and
-    acceleration come from the measured positions without numerical differentiation, and in
-    which every other term (forces, Coulomb signs) is filtered identically, so the filter
-    introduces no bias (the modulating-function idea).
+    h(tau) = c (1 - (2 tau / W)^2)^p on |tau| < W/2 (unit integral). h and its first p - 1
+    derivatives vanish at the ends, so d/dt (x * h) = x * h' and d^2/dt^2 (x * h) = x * h''
+    exactly: velocity and acceleration come from the positions without numerical
+    differentiation, and every other term is filtered identically (modulating functions).
 
     Parameters
     ----------
@@ -307,8 +288,7 @@ def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -
     """Frequency (Hz) of the dominant sine in ``x``.
 
     The largest peak of the Hann-windowed, zero-padded spectrum of the channel with the largest
-    relative variation, refined by fitting a sine by nonlinear least squares around it (the
-    refinement is what makes whole-period windows exact enough for Method A).
+    relative variation, refined by a least-squares sine fit around it.
 
     Parameters
     ----------
@@ -316,9 +296,8 @@ def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -
     sample_rate : float
         Hz.
     refine : bool
-        Zero-pad eight-fold and refine the peak by a sine fit; False: the plain spectrum's
-        peak, within half a bin (1 / (2 T) Hz for a record of T s), ten times cheaper, for
-        settings such as a filter window that need the frequency only roughly.
+        Zero-pad eight-fold and refine by a sine fit; False: the plain spectrum's peak, within
+        half a bin (1 / (2 T) Hz for a record of T s), for settings that need it only roughly.
 
     Returns
     -------
@@ -338,8 +317,7 @@ def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -
         raise DataError("the motion is constant; no excitation frequency can be found.")
     n = len(x)
     nfft = 1 << int(np.ceil(np.log2(8 * n if refine else n)))
-    # each channel's transform on contiguous samples (time last): a third faster than along
-    # the columns, the same numbers
+    # each channel's transform on contiguous samples (time last): faster, the same numbers
     windowed = np.ascontiguousarray((centered * np.hanning(n)[:, None]).T)
     relative = np.abs(np.fft.rfft(windowed, nfft, axis=1)[:, 1:])
     # compare channels by spectral peak relative to the channel's own scale: units differ
@@ -355,9 +333,8 @@ def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -
 
 def _refine_frequency(x: np.ndarray, sample_rate: float, frequency: float) -> float:
     """The frequency near ``frequency`` of the sine (with a constant and a trend) that fits
-    ``x`` best by least squares on [sin, cos, 1, t]: the residual by projections on an
-    orthonormal basis of those columns (Gram-Schmidt, each projection repeated once), the
-    constant and the trend's share computed once, not at every step."""
+    ``x`` best by least squares on [sin, cos, 1, t], by projections on an orthonormal basis.
+    """
     t = np.arange(len(x)) / sample_rate
     basis = np.empty((4, len(x)))  # orthonormal rows: the constant and trend, then the sine's
     basis[:2] = np.linalg.qr(np.column_stack([np.ones_like(t), t]))[0].T

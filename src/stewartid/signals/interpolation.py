@@ -13,11 +13,8 @@ ONE_SIDED_SLOPE = np.array([-25.0, 48.0, -36.0, 16.0, -3.0]) / 12.0
 def spline_at(t: np.ndarray, values: np.ndarray, times: np.ndarray) -> np.ndarray:
     """The sampled signal at ``times``, by a cubic spline through its samples.
 
-    The spline's end slopes are the five-point one-sided differences of the samples (error
-    h^4 |x^(5)| / 5). That keeps the classical error bound of the complete spline, (5/384)
-    h^4 max|x''''| for a period h, up to the ends of the record (plus h^5 max|x^(5)| / 5 from
-    the end slopes); scipy's default not-a-knot ends exceed it near the ends (2.2 times,
-    measured). At the sample times the spline gives the samples (to round-off).
+    The end slopes are five-point one-sided differences, which keep the complete spline's error
+    bound (5/384) h^4 max|x''''| up to the ends of the record (Hall & Meyer 1976).
 
     Parameters
     ----------
@@ -38,7 +35,7 @@ def spline_at(t: np.ndarray, values: np.ndarray, times: np.ndarray) -> np.ndarra
     C. A. Hall, W. W. Meyer, Optimal error bounds for cubic spline interpolation, J. Approx.
     Theory 16 (1976) 105-122, doi:10.1016/0021-9045(76)90040-X.
     """
-    # scipy.interpolate costs 0.1 s to import, on the command line only with --delay
+    # scipy.interpolate imported here: the command line needs it only with --delay
     from scipy.interpolate import CubicSpline
 
     t = np.asarray(t, dtype=float)
@@ -62,10 +59,8 @@ SECOND_SLOPE = np.array([-3.0, -10.0, 18.0, -6.0, 1.0]) / 12.0
 def hermite_uniform(values: np.ndarray, step: int, n: int) -> np.ndarray:
     """A signal known every ``step``-th sample, at every sample: piecewise cubic Hermite.
 
-    The slope at each knot is the five-point difference of the knot values (central inside,
-    one-sided at the ends), so the error is (1/384) h^4 max|d4x| plus O(h^5 max|d5x|), h =
-    ``step`` samples: the order of a cubic spline's, without its linear system (nor
-    scipy.interpolate's import, 0.6 s on the command line).
+    Knot slopes are five-point differences of the knot values (central inside, one-sided at the
+    ends): a cubic spline's error order without its linear system.
 
     Parameters
     ----------

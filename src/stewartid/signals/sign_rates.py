@@ -1,11 +1,8 @@
 """The pose rates Coulomb friction's signs are taken from: the shortest Savitzky-Golay window
 the noise allows.
 
-Every method that models Coulomb friction at the joints (least squares, Method B's soft signs,
-the physical model, the validation's prediction) needs the sign of each joint's rate at every
-sample. A rig's friction puts a kink in the rate at each reversal, which a window rounds off
-(a joint barely moving, a gimbal's revolute axis, reverses inside the rounding); noise makes
-the sign chatter around each reversal through a short one.
+A window rounds off the kink friction puts in the rate at each reversal; noise through a
+short window makes the sign chatter around it.
 """
 
 from __future__ import annotations
@@ -15,12 +12,8 @@ import numpy as np
 from stewartid.signals.differentiation import differentiate, savgol_coefficients, window_samples
 
 #: Savitzky-Golay order and candidate windows (fractions of the kernel's) of the rates the
-#: Coulomb signs are taken from, shortest first. The short ones are for quiet records: the
-#: plant's friction puts a kink in the rate at each reversal, which a window rounds off, and
-#: a joint barely moving (a gimbal's revolute axis) reverses inside the rounding. On the
-#: paper's noise-free sines at 30 N m least squares' translation-rotation couplings were
-#: 0.128 % off (18 standard errors) with an eighth of the kernel, 0.037 / 0.0067 / 0.0008 %
-#: with a sixteenth / 32nd / 64th.
+#: Coulomb signs are taken from, shortest first; the short ones keep the reversals of quiet
+#: records where the motion has them.
 SIGN_ORDER, SIGN_FRACTIONS = 3, (1 / 64, 1 / 32, 1 / 16, 1 / 8, 1 / 4, 1 / 2, 1)
 #: Largest noise of the sign's rate relative to the rate's RMS (on the most moved DOF): a
 #: sine's sign is then uncertain for about (2 / pi) x this fraction of the time.
@@ -32,14 +25,8 @@ def coulomb_sign_rates(q: np.ndarray, sample_rate: float, window: float,
                        ) -> tuple[np.ndarray, float]:
     """The pose rates the Coulomb signs are taken from, and their Savitzky-Golay window (s).
 
-    A short window keeps the switches where the motion has them (a rig's reversals are not
-    pure sines: stiction, servo dynamics; on noise-free logs of our plant a window of half
-    the kernel put the legs' first moments 11 standard errors off); noise, through a short
-    window, makes the sign chatter around each reversal and biases the friction and what
-    correlates with it (the moving body's first moment 4 standard errors off on the paper's
-    sines with the reference noise). The shortest of :data:`SIGN_FRACTIONS` whose rate noise
-    (from the pose noise estimated on the record) is within ``noise_limit`` of the rate's RMS
-    is taken; the whole kernel when none is.
+    The shortest of :data:`SIGN_FRACTIONS` whose rate noise (from the pose noise) is within
+    ``noise_limit`` of the rate's RMS; the whole kernel when none is.
 
     Parameters
     ----------

@@ -1,23 +1,13 @@
 """Mother wavelets and the continuous wavelet transform at chosen (scale, shift) points.
 
-The transform follows Zhang (2020), Section 3:
-
-    W_psi f (a, b) = (1 / a) * integral f(t) psi((t - b) / a) dt,
-
-with scale ``a`` > 0 and shift ``b`` in seconds. Only the (a, b) points an identification
-needs are evaluated, as a sparse matrix of sampled wavelets applied to the signals (no general
-CWT). Each mother wavelet provides its first and second integrals and its first two
-derivatives analytically, so that integration by parts moves derivatives between the signal
-and the wavelet:
+W_psi f (a, b) = (1 / a) integral f(t) psi((t - b) / a) dt (Zhang 2020, Section 3), evaluated
+only at the (a, b) points an identification needs, as a sparse matrix of sampled wavelets.
+Each wavelet has analytic integrals and derivatives, so integration by parts moves
+derivatives between signal and wavelet:
 
     W_psi f'  (a, b) = -(1 / a)   W_psi' f  (a, b)
     W_psi f'' (a, b) =  (1 / a^2) W_psi'' f (a, b)
     W_psi F   (a, b) = -a         W_psi1 f  (a, b)        (F' = f, psi1' = psi)
-
-valid whenever the wavelet and its integrals vanish at the ends of the integration range
-(exactly for the compactly supported wavelets, to the truncation level for the Gaussian ones).
-Vanishing moments of order 0 and 1 make the transform of a constant and of a straight line
-zero, which is what removes gravity and Coulomb friction inside a constant-direction interval.
 
 References
 ----------
@@ -104,11 +94,7 @@ class MotherWavelet(ABC):
 
     def moments(self, derivative: int, degree: int) -> np.ndarray:
         """Moments m_j = integral psi^(derivative)(x) x^j dx, j = 0..degree, of the ideal
-        (untruncated) wavelet.
-
-        Gauss-Legendre quadrature with 256 nodes over the support (compact wavelets, exact
-        for their polynomials) or over +-12 scales (Gaussian family, where the integrand is
-        below 1e-28 at the ends).
+        (untruncated) wavelet, by Gauss-Legendre quadrature.
 
         Returns
         -------
@@ -132,11 +118,7 @@ class MotherWavelet(ABC):
 class MexicanHat(MotherWavelet):
     """Mexican hat psi(t) = (1 - t^2) exp(-t^2 / 2), the paper's example wavelet.
 
-    Its first integral is psi1(t) = t exp(-t^2 / 2) (Zhang 2020, Section 3) and its second
-    integral -exp(-t^2 / 2); moments of order 0 and 1 vanish on the whole line. Not compactly
-    supported: it is truncated at +-``truncation`` scales, where psi, psi1 and psi2 are of the
-    order of exp(-truncation^2 / 2) (3.7e-6 at 5).
-
+    psi1(t) = t exp(-t^2 / 2), psi2(t) = -exp(-t^2 / 2); truncated at +-``truncation`` scales.
     Unnormalised (psi(0) = 1); PyWavelets' ``'mexh'`` is this function times
     2 / (sqrt(3) pi^(1/4)).
 
@@ -178,22 +160,10 @@ class MexicanHat(MotherWavelet):
 class PolynomialWavelet(MotherWavelet):
     """Compactly supported wavelet psi = g'' with g(x) = (1 - x^2)^p on [-1, 1].
 
-    The modulating-function (weak-form) wavelet: zero outside [-1, 1], a polynomial inside.
-    Its integrals are psi1 = g' and psi2 = g, so moments of order 0 and 1 vanish exactly
-    (integral of g'' = [g'] = 0, integral of x g'' = [x g' - g] = 0), and psi, its integrals
-    and its derivatives up to order p - 3 vanish at +-1: the wavelet can span a whole
-    constant-direction interval with no truncation error, and with p >= 5 the derivatives
-    psi' and psi'' used to move differentiation onto the wavelet are continuous.
-
-    With ``odd=True`` the wavelet is the odd companion psi = g''' (integrals g'' and g'),
-    whose moments of order 0, 1 and 2 vanish. An even wavelet centred in a half period of a
-    sine hardly sees the (antisymmetric) acceleration and strongly sees the (symmetric)
-    velocity; the odd one does the opposite. Its psi'' = g^(5) has only p - 5 continuous
-    derivatives at +-1, so the sampled transform needs p >= 8 (or the moment correction of
-    :func:`transform_matrix`) to be accurate. Measured on whole constant-direction
-    intervals under leg-length noise, it does not raise the acceleration regressor's
-    signal-to-noise ratio over the even wavelet (both are limited by the vanishing moments).
-
+    The modulating-function (weak-form) wavelet: psi1 = g', psi2 = g, moments of order 0 and 1
+    vanish exactly, and it spans a whole constant-direction interval without truncation error.
+    With ``odd=True`` it is psi = g''' (integrals g'', g'), moments 0 to 2 vanishing; its psi''
+    needs p >= 8 (or the moment correction of :func:`transform_matrix`) to be sampled accurately.
     Normalised to unit L2 norm on [-1, 1].
 
     Parameters
@@ -270,21 +240,10 @@ def transform_matrix(t: np.ndarray, scales: np.ndarray, shifts: np.ndarray,
     """Sparse matrix W with (W @ f)[k] = W_psi f (scales[k], shifts[k]) for samples f of t.
 
     Row k holds (1 / a_k) psi^(derivative)((t - b_k) / a_k) times trapezoid weights, on the
-    samples inside the wavelet's support only.
-
-    Moment correction (``exact_degree``). The trapezoid rule integrates a sampled wavelet
-    against a polynomial only approximately: its error depends on where the samples fall
-    relative to the support ends and grows with the wavelet's polynomial degree and with
-    roughness at the ends (psi'' of the odd companion of order p has only p - 5 continuous
-    derivatives there). Because a measured pose inside an interval is mostly a large local
-    offset and trend, those small errors in the discrete moments of psi'' are multiplied by
-    the offset and by 1 / a^2 and swamp the acceleration. With ``exact_degree = m`` each row
-    gets the smallest (least-norm) change that makes it integrate 1, x, ..., x^m
-    (x = (t - b) / a) exactly, i.e. reproduce the wavelet's analytic moments
-    (:meth:`MotherWavelet.moments`): constants and trends then vanish to rounding, and the
-    integration-by-parts identities hold exactly for polynomials up to degree m, whatever the
-    sampling. The change is of the order of the quadrature error, so the noise gain of the
-    rows is unchanged. Rows with fewer than m + 2 samples are left as they are.
+    samples inside the wavelet's support. With ``exact_degree = m`` each row gets the least-norm
+    change that makes it integrate 1, x, ..., x^m exactly (the analytic
+    :meth:`MotherWavelet.moments`), so offsets and trends vanish to rounding whatever the
+    sampling; rows with fewer than m + 2 samples are left as they are.
 
     Parameters
     ----------
@@ -296,8 +255,7 @@ def transform_matrix(t: np.ndarray, scales: np.ndarray, shifts: np.ndarray,
     derivative : int
         Evaluate psi2, psi1, psi, psi' or psi'' (see :data:`DERIVATIVE_ORDERS`).
     exact_degree : int or None
-        Correct every row so that polynomials up to this degree are integrated exactly
-        (see above); None: plain trapezoid weights.
+        Highest degree of the polynomials integrated exactly; None: plain trapezoid weights.
 
     Returns
     -------
@@ -324,7 +282,7 @@ def transform_matrix(t: np.ndarray, scales: np.ndarray, shifts: np.ndarray,
     if exact_degree is not None and exact_degree >= 0 and len(values):
         values = _correct_moments(values, x, rows, counts, indptr,
                                   wavelet.moments(derivative, int(exact_degree)))
-    from scipy.sparse import csr_matrix  # 0.3 s to import, for the methods that build one
+    from scipy.sparse import csr_matrix  # slow to import: only for the methods that build one
 
     return csr_matrix((values, cols, indptr), shape=(len(a), len(t)))
 
@@ -337,8 +295,7 @@ def _correct_moments(values: np.ndarray, x: np.ndarray, rows: np.ndarray, counts
     all rows at once with segment sums.
     """
     m = len(target)
-    # x^0 .. x^(2m-2) by repeated products: float powers through pow() cost several times
-    # the rest of the correction
+    # x^0 .. x^(2m-2) by repeated products: float powers through pow() are slow
     rows_of_powers = np.empty((2 * m - 1, len(x)))
     rows_of_powers[0] = 1.0
     for j in range(1, 2 * m - 1):
@@ -382,8 +339,7 @@ def wavelet_transform(signal: np.ndarray, t: np.ndarray, scales: np.ndarray,
     Returns
     -------
     ndarray, shape (K,) or (K, C)
-        W f (a_k, b_k) in u (the 1/a normalisation makes the transform of f = 1 equal to the
-        wavelet's integral, zero).
+        W f (a_k, b_k) in u.
     """
     matrix = transform_matrix(t, scales, shifts, make_wavelet(wavelet), derivative,
                               exact_degree)
