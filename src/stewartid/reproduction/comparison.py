@@ -1,8 +1,7 @@
 """Identification results of a reproduction, in the form its tables, figures and report use.
 
-A :class:`ComparisonResults` holds one :class:`MethodRun` per (method, Coulomb level), the
-nominal matrices of the simulated plant and the paper's published values; everything the
-report says is computed from it, so the same object can be rebuilt from ``results.json``.
+Everything the report says is computed from a :class:`ComparisonResults`, so it can be
+rebuilt from ``results.json``.
 """
 
 from __future__ import annotations
@@ -49,8 +48,11 @@ class MethodRun:
 
     @property
     def diagnostics(self) -> dict[str, Any]:
-        """The run's ``diagnostics`` in ``results.json``: condition number, RMS residual per
-        equation, the method's settings and its own diagnostics (``details``), JSON-able."""
+        """The run's ``diagnostics`` in ``results.json``, JSON-able.
+
+        Condition number, RMS residual per equation, the method's settings and its own diagnostics
+        (``details``).
+        """
         result = self.result
         return {"condition_number": float(result.condition_number),
                 "residual_rms": np.asarray(result.residual_rms, dtype=float).tolist(),

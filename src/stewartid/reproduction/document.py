@@ -1,8 +1,5 @@
-"""``results.json`` of a reproduction: everything of a run as one JSON document, and back.
-
-Written through :func:`stewartid.files.write_json_atomic` (non-finite numbers as ``null``);
-:func:`load_results` rebuilds the :class:`~stewartid.reproduction.comparison.ComparisonResults`
-the tables, figures and report are made from.
+"""``results.json`` of a reproduction: every result of a run as one JSON document, and back
+(:func:`load_results`).
 """
 
 from __future__ import annotations
@@ -32,8 +29,11 @@ LEGACY_METHOD_NAMES = {"least_squares": "ls", "wavelet_paper": "wavelet-paper"}
 
 
 def run_record(results: ComparisonResults, run: MethodRun) -> dict[str, Any]:
-    """One identification of a run as a JSON-ready dict: matrices, standard errors, ε per
-    entry, the largest, the paper's values where published, time and diagnostics."""
+    """One identification of a run as a JSON-ready dict.
+
+    Matrices, standard errors, ε per entry and the largest, the paper's values where published,
+    time and diagnostics.
+    """
     eps = results.eps_all(run)
     worst = max(eps, key=eps.__getitem__)
     published = {}

@@ -1,10 +1,5 @@
-"""The figures only a reproduction draws: the force budget and the scalogram of the traced
-experiment, and the errors of every method beside the paper's.
-
-Drawn like every figure of the package (:mod:`stewartid.reports.drawing`); every function
-returns the written paths (PNG and SVG). The signal figures take an
-:class:`~stewartid.reports.drawing.ExperimentTrace`, the comparison figures a
-:class:`~stewartid.reproduction.comparison.ComparisonResults`.
+"""The figures only a reproduction draws: the force budget and scalogram of the traced
+experiment, and every method's errors beside the paper's. Each returns the written paths.
 """
 
 from __future__ import annotations
@@ -88,12 +83,11 @@ def plot_scalogram(t: np.ndarray, signal: np.ndarray, points: np.ndarray,
     points : ndarray, shape (K, 2)
         (a, b) pairs used (s, s).
     wavelet : str or MotherWavelet
-        The mother wavelet (see :func:`stewartid.signals.wavelets.make_wavelet`).
+        See :func:`stewartid.signals.wavelets.make_wavelet`.
     intervals : ndarray, shape (M, 2), optional
         Constant-direction intervals, drawn as bars under the map.
     max_rate_hz : float
-        The signal is decimated to at most this rate for the map (the map is smooth at the
-        scales shown); the (a, b) points are not affected.
+        The signal is decimated to at most this rate for the map only.
     """
     from stewartid.signals.wavelets import make_wavelet, wavelet_transform
 

@@ -1,13 +1,8 @@
 """The noisy case of a reproduction: every method on the highest Coulomb level with the
-reference sensor noise.
+reference sensor noise (:func:`~stewartid.simulation.sensors.reference_noise`).
 
-The paper shows its methods on noise-free simulations only; a real hexapod's log always
-carries sensor noise. This case simulates the six experiments once more at the highest
-Coulomb level with the reference noise (:func:`~stewartid.simulation.sensors.reference_noise`:
-20 µm on the leg lengths, the pose from their forward kinematics, 0.5 % of the static leg
-force on the forces), identifies with every method, and reports a table, a figure and one
-summary line: the largest error per method and how many of the 20 entries lie within three
-of the method's own standard errors (honest standard errors put about 99 % there).
+The paper shows noise-free simulations only; a real log always carries sensor noise. The case
+reports a table, a figure and one summary line.
 """
 
 from __future__ import annotations
@@ -71,9 +66,11 @@ def noisy_results(runs: Sequence[MethodRun], clean: ComparisonResults) -> Compar
 
 
 def noisy_document(results: ComparisonResults) -> dict:
-    """JSON-ready record of the noisy case (``results.json`` key ``noise_case``): the runs as
-    in the rest of ``results.json`` (:func:`~stewartid.reproduction.document.run_record`),
-    each with ``within_3_std``."""
+    """JSON-ready record of the noisy case (``results.json`` key ``noise_case``).
+
+    The runs as :func:`~stewartid.reproduction.document.run_record` writes them, each with
+    ``within_3_std``.
+    """
     level = max(results.coulomb_levels)
     runs = [{**run_record(results, run), "within_3_std": within_three_std(results, run)}
             for run in (results.run(m, level) for m in results.methods) if run is not None]

@@ -1,6 +1,4 @@
-"""The figures of a reproduction, submitted to the worker pool in report order with their
-captions (drawn by :mod:`stewartid.reports.drawing` and
-:mod:`stewartid.reproduction.figures`)."""
+"""The figures of a reproduction, submitted to the worker pool in report order with their captions."""
 
 from __future__ import annotations
 
@@ -41,8 +39,7 @@ class FigureQueue:
         self.submitted.append((future, FigureEntry(f"figures/{stem}.png", caption)))
 
     def finish(self) -> tuple[list[FigureEntry], list[Path]]:
-        """Wait for every figure: their report entries in submission order, and the files
-        written."""
+        """Wait for every figure; return their report entries in submission order and the files written."""
         files: list[Path] = []
         for future, _ in self.submitted:
             files += future.result()

@@ -1,9 +1,6 @@
 """The report of a reproduction: ``report.md`` and a self-contained ``report.html``.
 
-The report states what was run, an automatic summary computed from the results (largest
-error per method and case, set against the paper's), every table and every figure. The
-summary's statements are derived from the numbers, never fixed text: if a result changes,
-so does the sentence about it.
+The summary's sentences are derived from the numbers, never fixed text.
 """
 
 from __future__ import annotations
@@ -89,7 +86,8 @@ def wavelet_summary(results: ComparisonResults) -> list[str]:
 
 def fourier_summary(results: ComparisonResults) -> list[str]:
     """Sentences on Method A: its errors by group with and without Coulomb friction, and
-    whether they show the paper's pattern (diagonal Mt accurate, Bt and couplings biased)."""
+    whether they show the paper's pattern (diagonal Mt accurate, Bt and couplings biased).
+    """
     lines = []
     for level in results.coulomb_levels:
         run = results.run("fourier", level)

@@ -1,18 +1,7 @@
 """Regenerate the paper's Section 5 comparison: simulate, identify, tabulate, plot, report.
 
-:func:`run_reproduce` runs every registered method (:mod:`stewartid.identification.registry`)
-at every Coulomb level on this package's plant simulator and writes into one folder:
-
-- ``results.json``: every identified matrix, standard error and ε, the nominal matrices, the
-  settings, the seed, the package version and the run time
-  (:mod:`~stewartid.reproduction.document`);
-- ``tables/``: the paper's Tables 3-6 with the published values beside ours, a comparison of
-  all methods per Coulomb level and a summary, as Markdown and CSV;
-- ``figures/``: PNG and SVG figures;
-- ``report.md`` and ``report.html``.
-
-Simulations and identifications run in parallel worker processes
-(:class:`concurrent.futures.ProcessPoolExecutor`); every file is written atomically.
+:func:`run_reproduce` writes ``results.json``, ``tables/``, ``figures/``, ``report.md`` and
+``report.html`` into one folder, running simulations and fits in worker processes.
 
 References
 ----------
@@ -64,9 +53,10 @@ def simulate_one(platform: Platform, experiment: int, frequency_hz: float, durat
                  ) -> tuple[Any, Any, list[float]]:
     """Simulate experiment ``experiment`` (0-5) of the paper's six on ``platform``.
 
-    The noise generator is :func:`~stewartid.simulation.experiments.noise_generator`'s, as in
-    :func:`~stewartid.simulation.simulate_experiments`, so a run split into one task per
-    experiment gives the same data as one call simulating all six.
+    The noise generator is the one of :func:`~stewartid.simulation.simulate_experiments`, so one
+    task per experiment gives the same data as one call for all six. ``noise_scale`` > 0 measures
+    with that multiple of :func:`~stewartid.simulation.sensors.reference_noise` instead of the
+    platform's ``[sensors]`` errors.
 
     Returns
     -------
@@ -76,10 +66,6 @@ def simulate_one(platform: Platform, experiment: int, frequency_hz: float, durat
         True signals, only when ``keep_record`` (they are large).
     tracking_error : list of float
         RMS leg-length tracking error per leg (m).
-
-    ``noise_scale`` > 0 measures with that multiple of the reference sensor noise
-    (:func:`~stewartid.simulation.sensors.reference_noise`) instead of the platform's
-    ``[sensors]`` errors.
     """
     from stewartid.simulation import SensorNoise, paper_experiments, simulate_experiment
     from stewartid.simulation.experiments import noise_generator
@@ -142,8 +128,7 @@ def _progress(enabled: bool) -> Iterator[Any]:
 
 
 def _collect(futures: Sequence[Future], progress: Any, task: Any) -> list[Any]:
-    """Results of ``futures`` in submission order, advancing ``task`` as each completes;
-    the first failure is raised at once."""
+    """Results of ``futures`` in submission order, advancing ``task``; the first failure is raised."""
     from concurrent.futures import as_completed
 
     for future in as_completed(futures):
@@ -157,11 +142,6 @@ def run_reproduce(out: str | Path = "results/reproduce", quick: bool = False,
                   progress: bool = False, settings: ReproduceSettings | None = None
                   ) -> ReproduceOutput:
     """Run the paper's comparison and write results, tables, figures and the report.
-
-    Stages: simulate the six experiments at every Coulomb level (one task per experiment),
-    identify with every method at every level (one task each), draw the figures (one task
-    each; the signal figures while the identifications run), then write the tables,
-    ``results.json`` and the report.
 
     Parameters
     ----------

@@ -1,11 +1,7 @@
-"""What a reproduction of the paper's comparison runs: validated settings and the result
-object.
+"""What a reproduction of the paper's comparison runs: validated settings and the result object.
 
-The paper (Zhang 2020) compares two identification methods on a simulated hydraulic Stewart
-platform: Method A (Fourier, Tian et al.) with viscous friction only (Table 3), Methods A and
-B with 5 N·m of Coulomb friction per joint axis (Tables 4, 5) and Method B with 30 N·m
-(Table 6). A reproduction runs every registered method and preset at every Coulomb level
-(0, 5, 30 N·m) on this package's plant simulator.
+Every registered method and preset runs at every Coulomb level of the paper (0, 5, 30 N·m)
+on this package's plant simulator.
 
 References
 ----------
@@ -31,16 +27,17 @@ from stewartid.reproduction.comparison import ComparisonResults
 COULOMB_LEVELS = (0.0, 5.0, 30.0)
 #: Excitation frequency of the paper's experiments (Hz).
 FREQUENCY_HZ = 0.5
-#: Record length per experiment (s): full run and ``--quick``. The full run holds 7 periods
-#: at 0.5 Hz after the 2 s fade-in; the quick one 2, enough for every method to run.
+#: Record length per experiment (s): full run and ``--quick`` (the shortest every method runs on).
 FULL_DURATION_S = 20.0
 QUICK_DURATION_S = 6.0
 
 
 
 def default_methods() -> tuple[str, ...]:
-    """Every registered method and preset that the comparisons run
-    (:attr:`~stewartid.identification.registry.MethodSpec.compared`), in registry order."""
+    """Every registered method and preset the comparisons run, in registry order.
+
+    See :attr:`~stewartid.identification.registry.MethodSpec.compared`.
+    """
     from stewartid.identification.registry import registered_methods
 
     return tuple(spec.name for spec in registered_methods() if spec.compared)
@@ -68,8 +65,8 @@ class ReproduceSettings:
         Registered method names (:mod:`stewartid.identification.registry`); every
         registered method and preset by default.
     seed : int
-        Seed of the simulator's noise; the same seed at every level, so that the levels
-        differ only by their friction.
+        Seed of the simulator's noise, the same at every level so that levels differ only by
+        their friction.
     jobs : int
         Worker processes (1: everything in this process).
     platform : str

@@ -1,9 +1,7 @@
 """The tables of a reproduction: the paper's Tables 3-6 with ours beside the published values,
-every method per Coulomb level and the largest error per method (built as
-:class:`~stewartid.reports.tables.ResultTable`, written as Markdown and CSV).
+every method per Coulomb level and the largest error per method.
 
-ε is the relative absolute error in percent against the nominal value of the simulated plant;
-the paper's ε column is reprinted as published.
+ε is the relative absolute error (%) against the nominal value of the simulated plant.
 """
 
 from __future__ import annotations
@@ -21,9 +19,8 @@ def _entry_cells(key: EntryKey) -> list[Cell]:
 def paper_table(results: ComparisonResults, number: int) -> ResultTable:
     """The paper's Table ``number`` (3-6) with our identified values and ε beside its own.
 
-    Rows are the entries the paper's table reports; for each of its methods the columns are
-    our identified value and ε, then the paper's; the nominal columns close the row (ours,
-    computed from the platform description, and the paper's printed one).
+    Per paper method: our value and ε, then the paper's; the row ends with our nominal value
+    and the paper's printed one.
     """
     published = results.published.table(number)
     letters = paper_methods()
@@ -63,7 +60,8 @@ def paper_table(results: ComparisonResults, number: int) -> ResultTable:
 
 def comparison_table(results: ComparisonResults, coulomb: float) -> ResultTable:
     """Every method at one Coulomb level: identified value and ε per entry, with the paper's
-    values for the methods it reports at that level."""
+    values for the methods it reports at that level.
+    """
     columns = ["Parameter", "Unit", "Nominal"]
     kinds = ["text", "text", "value"]
     runs = [r for r in (results.run(m, coulomb) for m in results.methods) if r is not None]

@@ -1,5 +1,6 @@
-"""The physics behind the signal figures of a reproduction: the model's force components
-along a simulated experiment, and the commanded poses."""
+"""The model's force components along a simulated experiment, and the commanded poses, for the
+signal figures of a reproduction.
+"""
 
 from __future__ import annotations
 
@@ -15,11 +16,9 @@ def experiment_trace(platform: Platform, dataset: Any, excited: int, frequency_h
                      reference: np.ndarray | None = None, record: Any = None):
     """Everything the signal figures need from one simulated experiment.
 
-    The force components are the model's terms along the motion: with the simulator's true
-    record, at its true pose, velocity and acceleration; without it, at the measured pose
-    differentiated by Savitzky-Golay filtering (as an identifier would). The actuators'
-    generalized force is always the measured one, so the figure shows how far the model's
-    terms explain it.
+    The force components are the model's terms along the motion: at the simulator's true pose,
+    velocity and acceleration when ``record`` is given, else at the measured pose differentiated
+    as an identifier would. The actuators' generalized force is always the measured one.
 
     Parameters
     ----------
