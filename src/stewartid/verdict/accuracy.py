@@ -1,8 +1,5 @@
-"""What a result's standard errors predict about its accuracy over the paper's 20 entries.
-
-Used to choose between fits of the same data (Method B's friction model, the verdict between
-methods): the one whose calibrated standard errors predict the smaller largest error.
-"""
+"""What a result's standard errors predict about its accuracy over a set of entries of Mt
+and Bt, alone or conditioned on other methods' estimates of the same data."""
 
 from __future__ import annotations
 
@@ -106,11 +103,9 @@ def fold_correlation(results: Sequence[IdentificationResult],
     """Correlation of several methods' errors on the same data, from their fits of the same
     folds.
 
-    Methods that fit the same record share its noise, and their errors correlate (least
-    squares and Method B at 0.70 over the entries of noisy logs with a known truth, Method A
-    and Method B at 0.04). A fold's estimate departs from the folds' mean by the noise of
-    the data it was given; standardised by the method's standard error, the departures of
-    two methods on the same folds over the paper's 20 entries correlate as their errors do.
+    A fold's estimate departs from the folds' mean by the noise of the data it was given;
+    standardised by the method's standard error, two methods' departures on the same folds
+    correlate as their errors do.
 
     Parameters
     ----------
@@ -118,6 +113,8 @@ def fold_correlation(results: Sequence[IdentificationResult],
         The methods' fits of all the data (their standard errors scale the departures).
     folds : sequence of (sequence of IdentificationResult or None)
         Each method's fits of the same folds, in the same order (None: not available).
+    entries : sequence of (str, int, int)
+        The entries compared.
 
     Returns
     -------
@@ -158,27 +155,14 @@ def error_posterior(result: IdentificationResult, others: Sequence[Identificatio
                     entries: Sequence[EntryKey] = PAPER_ENTRIES,
                     precision_factor: float = DEFAULT_POLICY.precision_factor
                     ) -> tuple[np.ndarray, np.ndarray, list[int]]:
-    """This result's error on each of the paper's 20 entries, given other estimates of the
-    same quantities: the Gaussian posterior of its error conditioned on them.
+    """This result's error on each of ``entries``, given other estimates of the same
+    quantities: the Gaussian posterior of its error conditioned on them.
 
-    Mt and Bt are symmetric, so entry (i, j) is estimated by every other fit of the same data
-    (its members (i, j) and (j, i), pooled by inverse variance where they differ: they come
-    from different experiments' equations) and by this result's own partner (j, i) where it
-    differs from (i, j). With the errors Gaussian and unbiased, at their standard errors and
-    correlated between methods as ``correlation`` says, this result's error e given its
-    differences d from those estimates is Gaussian with mean c' V^-1 d and variance
-    s^2 - c' V^-1 c (c = Cov(e, d), V = Cov(d)). For independent errors this is, with the
-    others pooled into p +- s_p and g = s^2 / (s^2 + s_p^2): mean g (v - p), variance
-    g s_p^2.
-
-    Averaged over d the error's scale is s, as its standard error says; on one data set the
-    differences place it. Where the others are far more precise (s_p << s) the error is the
-    difference, known to within s_p: a standard error widened for a model error (a symmetric
-    pair whose members disagree, a log limited by its sampling) is replaced by what the more
-    precise fits measure. Where they are far less precise it is this result's own N(0, s^2).
-    Two alike that disagree are blamed for half each, and the noise decides (the verdict's
-    close call). Errors correlated with the others' are shared with them, so agreeing with
-    them shows less than it would for independent errors.
+    Entry (i, j) is estimated by every other fit (its members (i, j) and (j, i) pooled) and by
+    this result's own partner (j, i) where that differs. With Gaussian, unbiased errors at their
+    standard errors, correlated between methods as ``correlation`` says, the error e given the
+    differences d is Gaussian with mean c' V^-1 d and variance s^2 - c' V^-1 c
+    (c = Cov(e, d), V = Cov(d)).
 
     Parameters
     ----------
@@ -188,13 +172,16 @@ def error_posterior(result: IdentificationResult, others: Sequence[Identificatio
     correlation : ndarray, shape (1 + len(others), 1 + len(others)), optional
         Correlation of the methods' errors, ``result`` first (:func:`fold_correlation`);
         independent by default. A result's own partner is taken as independent of all.
+    entries : sequence of (str, int, int)
+        The entries judged.
+    precision_factor : float
+        Other estimates this many times more precise measure the error.
 
     Returns
     -------
-    mean, std : ndarray, shape (20,)
+    mean, std : ndarray, shape (len(entries),)
         The error's posterior mean and standard deviation relative to the estimate
-        (fractions), in the order of :data:`~stewartid.reference.published.PAPER_ENTRIES`;
-        (0, :func:`entry_relative_std`) where nothing else estimates the entry.
+        (fractions); (0, :func:`entry_relative_std`) where nothing else estimates the entry.
     measured : list of int
         Indices of the entries the other estimates measure: pooled, their standard error is
         at most s / ``precision_factor``.
@@ -238,7 +225,7 @@ def error_posterior(result: IdentificationResult, others: Sequence[Identificatio
 
 
 def predicted_worst_error(result: IdentificationResult) -> float:
-    """The largest relative error over the paper's 20 entries that the result's standard
+    """The largest relative error over the paper's 20 entries that the result's own standard
     errors predict (:func:`expected_worst_error` of :func:`entry_relative_std`, a fraction)."""
     return expected_worst_error(entry_relative_std(result))
 
