@@ -1,12 +1,7 @@
 """Studies: Monte Carlo runs and parameter sweeps of simulation and identification.
 
-A study file (:mod:`~stewartid.studies.spec`) names the fixed settings and a grid; every
-(grid point, seed) becomes a task (:mod:`~stewartid.studies.grid`) that simulates the six
-experiments and identifies them with every method (:mod:`~stewartid.studies.task`). The
-tasks run on dask.distributed (:mod:`~stewartid.studies.runner`), their rows are stored as a
-partitioned Parquet data set (:mod:`~stewartid.studies.results`), and a report with figures
-sums them up (:mod:`~stewartid.studies.report`). ``stewartid study FILE --out DIR`` runs it
-all; dask comes with the ``[dask]`` extra.
+``stewartid study FILE --out DIR`` runs every (grid point, seed) of a study file on
+dask.distributed (the ``[dask]`` extra) and reports the errors of every method.
 """
 
 from stewartid.studies.grid import StudyTask, expand_grid

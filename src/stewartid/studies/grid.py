@@ -1,9 +1,7 @@
 """Expansion of a study into tasks: one per (grid point, seed).
 
-A task simulates the six experiments once and identifies them with every method of the study,
-so the methods are compared on the same data. Its key is a hash of every parameter value and
-the seed: the same point gives the same key in every run, which is what lets a resumed run
-skip the finished tasks and lets the results be deduplicated.
+A task identifies one simulation with every method, so the methods meet the same data. Its
+key hashes the parameters and the seed, so that a resumed run skips finished tasks.
 """
 
 from __future__ import annotations
@@ -49,8 +47,7 @@ class StudyTask:
 def expand_grid(spec: StudySpec) -> list[StudyTask]:
     """Every task of ``spec``: the Cartesian product of the grid, times the seeds.
 
-    The seed is the outer loop, so a run stopped half-way has covered the whole grid with its
-    first seeds rather than half of the grid with all of them.
+    The seed is the outer loop, so a run stopped half-way has covered the whole grid.
 
     Returns
     -------

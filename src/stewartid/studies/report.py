@@ -1,12 +1,5 @@
 """The report of a study: error against each swept parameter, per method, median and spread
 over the seeds, with the table behind every figure and sentences computed from the numbers.
-
-For every parameter swept over two or more values (Coulomb friction and the noise scale first)
-one figure ``figures/error_vs_<parameter>`` shows, per method, the median over the seeds of
-the largest relative error of Mt (left) and of Bt (right), the interquartile range shaded
-darker and the full range lighter; one row of panels per combination of the other swept
-parameters. ``tables/error_vs_<parameter>.md``/``.csv`` hold the numbers drawn;
-``report.md`` and a self-contained ``report.html`` put it together.
 """
 
 from __future__ import annotations

@@ -1,13 +1,9 @@
 """The results of a study: one row per (grid point, seed, method), stored as a partitioned
 Parquet data set.
 
-``DIR/results.parquet/`` is a folder holding one file ``part-<task key>.parquet`` per
-finished task (one row per method), each written atomically (a temporary file renamed into
-place; readers and pyarrow ignore the temporary files, whose names start with a dot). A task
-that finishes twice (a worker lost after the result came back, a rerun) replaces its own file,
-so no row is ever duplicated, and a run killed at any moment leaves only whole files.
-``pandas.read_parquet(DIR / "results.parquet")`` reads the data set; :func:`read_results`
-does so and also drops duplicate (task, method) rows, should files have been copied in.
+``DIR/results.parquet/`` holds one atomically written file ``part-<task key>.parquet`` per
+finished task, so a task finishing twice replaces its own rows and a killed run leaves only
+whole files.
 
 Columns
 -------
@@ -33,8 +29,7 @@ run_time_s : float
 simulation_time_s : float
     Wall time of the task's simulation, shared by its methods (s).
 task_cpu_time_s : float
-    CPU time of the whole task, simulation and every identification (s); unlike the wall
-    times it does not grow when other processes compete for the cores.
+    CPU time of the whole task (s).
 failure : str
     Why the simulation or the identification failed (a StewartidError), null otherwise.
 worker : str

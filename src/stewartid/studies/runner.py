@@ -1,20 +1,7 @@
 """Running a study on dask.distributed: resumable, fault tolerant, with a progress bar.
 
-:func:`run_study` submits one task per (grid point, seed) that is not yet in the output
-folder's data set, to a fresh :class:`distributed.LocalCluster` (one single-threaded worker
-process per core by default) or to an existing cluster by its scheduler address. The client
-stores each task's rows as soon as it finishes (:func:`~stewartid.studies.results.write_part`,
-atomic), so:
-
-- a worker killed mid-task costs only that task, which the scheduler runs again on another
-  worker (and ``retries`` more times if it raises); its rows are stored once;
-- a run interrupted at any moment keeps every finished task, and ``resume=True`` computes
-  only the missing ones;
-- workers need no shared file system: only the client writes.
-
-Output folder: ``study.json`` (the validated study), ``results.parquet/`` (the rows),
-``failed.json`` (tasks that crashed, if any), ``report.md``/``report.html``, ``figures/`` and
-``tables/`` (:mod:`stewartid.studies.report`).
+Only the client writes, each task's rows as soon as it finishes, so a lost worker costs one
+task, an interrupted run keeps every finished task, and workers need no shared file system.
 """
 
 from __future__ import annotations
@@ -131,9 +118,10 @@ def _check_folder(spec: StudySpec, directory: Path, resume: bool) -> None:
 
 @contextmanager
 def connect(scheduler: str | None = None, workers: int | None = None) -> Iterator[Any]:
-    """A :class:`distributed.Client`: of the cluster at ``scheduler``, or of a new
-    LocalCluster of ``workers`` single-threaded processes (one per core by default), closed on
-    exit.
+    """A :class:`distributed.Client` of the cluster at ``scheduler``, or of a new LocalCluster.
+
+    The LocalCluster has ``workers`` single-threaded processes (one per core by default) and is
+    closed on exit.
 
     Raises
     ------
@@ -159,9 +147,8 @@ def connect(scheduler: str | None = None, workers: int | None = None) -> Iterato
     count = (os.cpu_count() or 1) if workers is None else workers
     if count < 1:
         raise ConfigError(f"--workers must be >= 1; got {workers!r}.")
-    # one BLAS thread per worker, as in every process pool of the package (stewartid.parallel);
-    # quiet workers: at shutdown their heartbeats to the closing scheduler log errors, and a
-    # task's own failure reaches the client through its future anyway
+    # one BLAS thread per worker; quiet workers: their shutdown heartbeats log spurious errors,
+    # and a task's failure reaches the client through its future
     with LocalCluster(n_workers=count, threads_per_worker=1, processes=True,
                       dashboard_address=None, silence_logs=logging.CRITICAL,
                       env=dict(WORKER_THREADS)) as cluster, Client(cluster) as client:

@@ -1,8 +1,5 @@
-"""What one study task computes, on whichever worker runs it: one simulation of the six
-experiments and its identification by every method, as result rows.
-
-The function is module-level and takes only picklable values, so dask (or any executor) can
-ship it to another process or machine; it writes nothing, the client stores the rows.
+"""What one study task computes on a worker: one simulation of the six experiments and its
+identification by every method, as result rows. Picklable and writes nothing.
 """
 
 from __future__ import annotations
@@ -73,10 +70,9 @@ def run_task(task: StudyTask, platform: Platform, methods: Sequence[str],
              actuator: str | None = None) -> list[dict[str, Any]]:
     """Simulate the six experiments at ``task``'s point and identify them with each method.
 
-    A :class:`~stewartid.errors.StewartidError` of the simulation (a leg leaving its stroke,
-    a frequency above Nyquist) or of one identification (too few equations) is a result of
-    the study: it gives rows with NaN errors and the message in ``failure``. Any other
-    exception is a bug and propagates (the task then counts as failed).
+    A :class:`~stewartid.errors.StewartidError` of the simulation or of one identification is a
+    result of the study: rows with NaN errors and the message in ``failure``. Any other
+    exception is a bug and propagates.
 
     Parameters
     ----------
@@ -128,8 +124,7 @@ def run_task(task: StudyTask, platform: Platform, methods: Sequence[str],
                                    nominal_M, nominal_B), "failure": None}
         row["run_time_s"] = time.perf_counter() - start
         rows.append({**common, "method": method, **row, "simulation_time_s": simulation_time})
-    # the task runs in one thread (one-thread BLAS): its CPU time, unlike its wall time, does
-    # not grow when other processes compete for the cores
+    # one-thread CPU time does not grow when other processes compete for the cores
     cpu_time = time.thread_time() - cpu_start
     return [{**row, "task_cpu_time_s": cpu_time} for row in rows]
 
