@@ -1,33 +1,10 @@
 """Method A: first-harmonic Fourier identification (Tian et al.), as compared in Zhang (2020).
 
-Each experiment excites the platform with a sine of frequency f (one DOF at a time in the
-classical protocol, any combination here). Over a whole period the first-harmonic
-coefficients
-
-    x_c = (2/N) sum x(t) cos(w t),   x_s = (2/N) sum x(t) sin(w t),   w = 2 pi f,
-
-of the linear model y = Mt q_ddot + Bt q_dot + G0 + Fc turn it into algebraic equations
-
-    y_c = Mt qdd_c + Bt qd_c,   y_s = Mt qdd_s + Bt qd_s
-
-in all six channels: constants (static load, offsets) drop out because the period is whole.
-With one single-DOF experiment per DOF this gives column k of Mt and Bt from experiment k;
-stacking the equations of every period of every experiment gives a least-squares problem for
-the 72 unknowns whose period-to-period scatter yields the standard errors.
-
-Coulomb friction is the method's weakness: a square wave of level Fc in phase with the
-velocity has the first harmonic (4/pi) Fc sin(w t + phase of velocity), which is
-indistinguishable from viscous friction and lands in Bt as (4/pi) Fc / (w A). The same
-square wave has a third harmonic of a third of that amplitude, which no linear term explains:
-where the force the linear model leaves shows it above the noise
-(:func:`~stewartid.identification.harmonics.third_harmonic`), the standard errors carry it
-(:func:`~stewartid.identification.harmonics.friction_bias_bound`), so that the entries friction
-biases are reported with the uncertainty the data show, not the noise's alone.
-
-With two or more excitation frequencies a stiffness matrix K can be identified alongside
-(``stiffness=True``): y = Mt q_ddot + Bt q_dot + K (q - q0), with the harmonic coefficients
-of each frequency as separate equations (at a single frequency K q = -K q_ddot / w^2 is
-indistinguishable from inertia).
+Over whole periods of a sine of angular frequency w the first-harmonic coefficients turn
+y = Mt q_ddot + Bt q_dot + G0 + Fc into y_c = Mt qdd_c + Bt qd_c, y_s = Mt qdd_s + Bt qd_s
+(constants drop out); stacking every period of every experiment gives a least-squares
+problem for the 72 unknowns. Coulomb friction lands in Bt; its third harmonic widens the
+standard errors (:mod:`~stewartid.identification.harmonics`).
 
 References
 ----------
@@ -71,22 +48,18 @@ from stewartid.signals.differentiation import (
     trim,
 )
 
-#: A harmonic of a fitted frequency passes below this amplitude relative to the largest line:
-#: a servo tracking a sine distorts it by a few per cent, and harmonics do not disturb the
-#: first-harmonic equations over whole periods (they are orthogonal to it); a line this large
-#: is a second sine of the excitation.
+#: Amplitude, relative to the largest line, below which a harmonic of a fitted frequency is
+#: taken as the servo's distortion; above it, as a second sine of the excitation.
 HARMONIC_FRACTION = 0.2
 
 
 def check_single_sine(name: str, pose: np.ndarray, sample_rate: float, platform: Platform,
                       frequencies_hz: Sequence[float], given: bool = False) -> None:
-    """Refuse an experiment whose motion is not one sine at the fitted frequency (or at the
-    given ones).
+    """Refuse an experiment whose motion is not one sine at the fitted (or given) frequencies.
 
-    The spectral lines of the motion (:func:`~stewartid.datasets.excitation.spectral_lines`
-    of its leg-length change) reaching :data:`~stewartid.datasets.excitation.LINE_FRACTION`
-    of the largest must sit at ``frequencies_hz``, or at their harmonics below
-    :data:`HARMONIC_FRACTION`.
+    Every spectral line of the leg-length motion reaching
+    :data:`~stewartid.datasets.excitation.LINE_FRACTION` of the largest must sit at
+    ``frequencies_hz``, or at a harmonic of them below :data:`HARMONIC_FRACTION`.
 
     Parameters
     ----------
@@ -143,30 +116,27 @@ class FourierIdentifier(BaseIdentifier):
     Parameters
     ----------
     frequency_hz : float or sequence of float, optional
-        Excitation frequency (Hz), or several. Detected from each experiment's motion when
-        not given (the dominant sine).
+        Excitation frequency (Hz), or several; detected per experiment (the dominant sine)
+        when not given.
     window : float, optional
         Savitzky-Golay window (s) for q_dot, q_ddot; 0.2 periods of the highest frequency by
-        default (see :mod:`stewartid.signals.differentiation`).
+        default.
     order : int
         Savitzky-Golay polynomial order.
     gravity : bool
-        Subtract the model's pose-dependent gravity term G(q) (recommended; without it the
-        legs' gravity stiffness biases Mt by -K_G / w^2).
+        Subtract the model's pose-dependent gravity term G(q).
     remainder : bool
         Subtract the model's departure from its linearisation along the measured motion
-        first (:func:`~stewartid.identification.preparation.model_remainder`).
+        (:func:`~stewartid.identification.preparation.model_remainder`).
     sampling_check : bool
-        Refit at a half, a third and a quarter of the log's rate where the residual is not
-        noise, and add the estimate's change to the standard errors
+        Widen the standard errors where the log's sampling limits the estimate
         (:mod:`~stewartid.identification.sampling`).
     stiffness : bool
         Identify a stiffness matrix K as well (needs two or more frequencies).
     symmetric : bool
         Impose Mt = Mt^T and Bt = Bt^T.
     periods_per_segment : int
-        Whole periods of the lowest frequency per equation block; every block of every
-        experiment contributes two equations per frequency and channel.
+        Whole periods of the lowest frequency per equation block.
 
     Attributes
     ----------
@@ -226,9 +196,7 @@ class FourierIdentifier(BaseIdentifier):
         experiments = prepare(datasets, platform, gravity=self.gravity, remainder=self.remainder)
         rows_motion, rows_force, used, rows, third_blocks = [], [], [], [], []
         for exp in experiments:
-            # detected on the leg-length motion, where every DOF counts in one unit: on the
-            # pose, a DOF that the excited one drags along at twice the frequency can have
-            # the sharper peak relative to its own spread
+            # on the leg-length motion every DOF counts in one unit
             freqs = self._given_frequencies() or [
                 estimate_frequency(leg_space_motion(exp.q, platform), exp.sample_rate)]
             check_single_sine(exp.name, exp.q, exp.sample_rate, platform, freqs,

@@ -1,10 +1,7 @@
-"""Harmonic coefficients over whole periods, and what the force's third harmonic says about
-the Coulomb friction that Method A (:mod:`stewartid.identification.fourier`) reads as viscous.
+"""Harmonic coefficients over whole periods, and the Coulomb bias the force's third harmonic shows.
 
-A Coulomb force switching with the velocity of a sine is a square wave: its first harmonic,
-(4/pi) Fc, lands in Bt; its third, a third of that, is left unexplained by any linear term.
-Where the force the fitted linear model leaves shows such a third harmonic above its noise,
-:func:`friction_bias_bound` turns it into the bias of every first-harmonic estimate.
+A Coulomb force switching with a sine's velocity is a square wave: its first harmonic lands
+in Method A's Bt, its third is left unexplained by any linear term.
 """
 
 from __future__ import annotations
@@ -21,10 +18,8 @@ def harmonic_coefficients(x: np.ndarray, t: np.ndarray, frequencies_hz: Sequence
                           ) -> np.ndarray:
     """In-phase and quadrature coefficients of ``x`` at ``frequencies_hz`` over a segment.
 
-    Least-squares fit of x(t) = c0 + sum_f [x_c cos(2 pi f t) + x_s sin(2 pi f t)]. Over a
-    whole number of periods of a single frequency this equals the Fourier coefficients
-    (2/N) sum x cos, (2/N) sum x sin exactly (the columns are orthogonal); for several
-    frequencies it removes the residual leakage between them.
+    Least-squares fit of x(t) = c0 + sum_f [x_c cos(2 pi f t) + x_s sin(2 pi f t)]; over whole
+    periods of one frequency these are the Fourier coefficients.
 
     Parameters
     ----------
@@ -49,8 +44,10 @@ def harmonic_coefficients(x: np.ndarray, t: np.ndarray, frequencies_hz: Sequence
 
 def motion_gains(frequencies_hz: Sequence[float], sample_rate: float, window: float,
                  order: int) -> np.ndarray:
-    """Savitzky-Golay gain of q_ddot, q_dot and q at each frequency (the filter has zero
-    phase, so dividing the harmonic coefficients by it removes its amplitude bias exactly).
+    """Savitzky-Golay gain of q_ddot, q_dot and q at each frequency.
+
+    The filter has zero phase, so dividing the harmonic coefficients by it removes its
+    amplitude bias exactly.
 
     Returns
     -------
@@ -67,8 +64,9 @@ def motion_gains(frequencies_hz: Sequence[float], sample_rate: float, window: fl
 def third_harmonic_blocks(signals: np.ndarray, t: np.ndarray, slices: Sequence[slice],
                           frequency_hz: float, sample_rate: float, window: float, order: int
                           ) -> np.ndarray:
-    """(cos, sin) coefficients at 3 f of q_ddot, q_dot, q - q0 (corrected for the
-    differentiator's gain at 3 f) and the generalized force, per whole-period block.
+    """(cos, sin) coefficients at 3 f of the motion and the generalized force, per block.
+
+    The motion's coefficients are corrected for the differentiator's gain at 3 f.
 
     Parameters
     ----------
@@ -100,12 +98,9 @@ def friction_bias_bound(pinv: np.ndarray, rows: Sequence[np.ndarray],
                         third: Sequence[np.ndarray]) -> np.ndarray:
     """Bias of the first-harmonic estimates that the force's third harmonic implies.
 
-    A Coulomb force switching with the velocity of a sine is a square wave whose first
-    harmonic is :data:`SQUARE_WAVE_RATIO` times its third; of unknown phase relative to the
-    motion, it enters an experiment's first-harmonic equations as an error of that amplitude
-    in each channel. Propagated through the least-squares solution (the same error in every
-    block of the experiment) and summed in quadrature over experiments (their switching
-    phases are independent).
+    A square wave's first harmonic is :data:`SQUARE_WAVE_RATIO` times its third, of unknown
+    phase; it is propagated through the least-squares solution and summed in quadrature over
+    experiments.
 
     Parameters
     ----------
@@ -130,9 +125,7 @@ def friction_bias_bound(pinv: np.ndarray, rows: Sequence[np.ndarray],
 
 
 #: Significance level of the test for friction in the third harmonic that the linear model
-#: leaves. Below its point the data do not show friction; reading the noise's own third
-#: harmonic (about 1.25 times a coefficient's noise) as friction would inflate every error bar
-#: about fourfold.
+#: leaves (so that the noise's own third harmonic is not read as friction).
 THIRD_HARMONIC_LEVEL = 0.01
 
 
@@ -140,17 +133,10 @@ def third_harmonic(coefficients: Sequence[np.ndarray | None], noise_covariance: 
                    ) -> tuple[list[np.ndarray], float, float]:
     """Third-harmonic amplitude per experiment and force channel that the data show as friction.
 
-    The coefficients are those of the force the fitted linear model leaves at three times the
-    excitation frequency (a servo's distortion of the sine puts a third harmonic in the
-    motion, which the model explains), averaged over each experiment's whole-period blocks.
-    Their noise is that of the first-harmonic equations' residuals (the same force noise, one
-    block per equation), with its correlation across channels (the legs' noise through the
-    same Jacobian). Coulomb friction is one property of the joints, present in every
-    experiment, so the data are tested as a whole: the sum over experiments of the Mahalanobis
-    norm of the mean coefficients is chi-squared with 12 degrees of freedom per experiment
-    without friction. If it exceeds the point of :data:`THIRD_HARMONIC_LEVEL`, every channel
-    keeps its amplitude, noise included (friction the data cannot rule out); if not, all are
-    zero.
+    The mean residual coefficients at 3 f are tested as a whole: the sum over experiments of
+    their Mahalanobis norm is chi-squared with 12 degrees of freedom per experiment without
+    friction. Above the point of :data:`THIRD_HARMONIC_LEVEL` every channel keeps its
+    amplitude; below it all are zero.
 
     Parameters
     ----------
@@ -196,8 +182,7 @@ def residual_third_harmonic(blocks: np.ndarray, theta: np.ndarray) -> np.ndarray
     Parameters
     ----------
     blocks : ndarray, shape (blocks, 2, 24)
-        (cos, sin) coefficients at 3 f of q_ddot, q_dot, q - q0 (each corrected for the
-        differentiator's gain at 3 f) and the generalized force, per block.
+        As :func:`third_harmonic_blocks` returns.
     theta : ndarray, shape (6, p)
         Fitted parameters: Mt, Bt (and K) side by side, p = 12 or 18.
 

@@ -1,33 +1,13 @@
 """Time-domain least squares with Coulomb friction: the inverse-dynamics model of robotics.
 
-At every sample (after differentiation and trimming of the filter's edges),
+At every sample
 
     y(t) = Mt q_ddot + Bt q_dot + c_e + sum_types Fc_type S_type(t),
     S_type(t) = sum_legs sum_{axes of the type} J_j(q)^T sign(J_j(q) q_dot),
 
-with y = J_lq^T f_a - G(q), c_e a constant per channel and experiment (residual static load,
-force-sensor offsets), J_j the joint-rate Jacobian of joint axis j at the measured pose, and
-one Coulomb level per joint type (lower gimbal, upper gimbal, revolute). The 72 entries of Mt
-and Bt, the offsets and the three Coulomb levels are solved together by
-:func:`~stewartid.identification.solvers.solve_least_squares`, each standard error the
-larger of the sandwich of the rows' scores with their autocovariances summed over the
-filter's support (:func:`~stewartid.identification.long_run.long_run_covariance`) and the
-residual's variance times its autocorrelation time.
-
-By default (``differentiation="kernel"``) both sides of the equation are filtered with one
-smooth compact kernel h (:func:`~stewartid.signals.differentiation.kernel_filter`): velocity and
-acceleration become q * h' and q * h'' (no numerical differentiation), and y, the offsets and
-the Coulomb regressors are filtered with h itself, so the equation holds exactly in the
-filtered signals, including across the friction switches where a differentiating filter
-would smear the jump of the acceleration. ``differentiation="savgol"`` uses
-Savitzky-Golay derivatives at each sample instead (the textbook variant).
-
-sign() is regularised over s = ``coulomb_smoothing`` (rad/s), so that joints that barely move
-(rates at the noise level of the differentiated signal) do not contribute random full-size
-signs. How it is regularised (the friction's shape near a reversal) is the rig's, and one log
-rarely shows it: by default the fit is made with both shapes of
-:mod:`~stewartid.identification.friction_shape` and averaged by their Akaike weights, the
-spread between the two in the standard errors.
+with c_e a constant per channel and experiment and one Coulomb level per joint type. By
+default both sides are filtered with one smooth kernel, so no signal is differentiated
+numerically and the equation holds exactly in the filtered signals.
 
 References
 ----------
@@ -72,9 +52,11 @@ from stewartid.signals.differentiation import (
 
 
 def pose_noise_gram(q: np.ndarray, sample_rate: float, window: float) -> np.ndarray:
-    """Covariance (12, 12) of the noise one row [q * h'', q * h'] carries: the pose's white
-    noise Sigma (estimated from the record) times the energy of the kernel's second and first
-    derivative taps (their cross term vanishes: h'' is even, h' odd)."""
+    """Covariance (12, 12) of the pose noise one row [q * h'', q * h'] carries.
+
+    The pose's white noise covariance, estimated from the record, times the energy of the
+    kernel's second and first derivative taps (h'' is even and h' odd, so no cross term).
+    """
     from stewartid.identification.wavelet.noise import white_noise_covariance
 
     smooth = differentiate(q, sample_rate, window)[0]
@@ -113,10 +95,11 @@ def coulomb_regressors(joint_jacobians: np.ndarray, q_dot: np.ndarray, smoothing
 
 
 class _Rows(NamedTuple):
-    """One experiment's rows of the regression (:meth:`LeastSquaresIdentifier._experiment_rows`):
-    their times (s), the kernel's support (s), the force, velocity and acceleration, (K, 6)
-    each, per Coulomb shape the regressors (K, 3, 6), and the rows' pose-noise covariance
-    (12, 12) or None."""
+    """One experiment's rows of the regression.
+
+    Times (s), the kernel's support (s), force, velocity and acceleration (K, 6), per Coulomb
+    shape the regressors (K, 3, 6), and the rows' pose-noise covariance (12, 12) or None.
+    """
 
     t: np.ndarray
     window: float
@@ -140,19 +123,17 @@ class LeastSquaresIdentifier(BaseIdentifier):
     Parameters
     ----------
     window : float, optional
-        Savitzky-Golay window (s); 0.2 periods of the dominant excitation frequency of each
-        experiment by default.
+        Filter window (s); 0.2 periods of each experiment's dominant excitation frequency by
+        default.
     order : int
         Savitzky-Golay polynomial order.
     gravity : bool
         Subtract the model's gravity term G(q).
     remainder : bool
         Fit the force less the model's nonlinear remainder
-        (:func:`~stewartid.identification.preparation.model_remainder`): the linearisation's
-        Mt and Bt at any amplitude.
+        (:func:`~stewartid.identification.preparation.model_remainder`).
     sampling_check : bool
-        Refit at a half, a third and a quarter of the log's rate where the residual is not
-        noise, and add the estimate's change to the standard errors
+        Widen the standard errors where the log's sampling limits the estimate
         (:mod:`~stewartid.identification.sampling`).
     coulomb : bool
         Include the three Coulomb regressors.
@@ -160,22 +141,18 @@ class LeastSquaresIdentifier(BaseIdentifier):
         Rate (rad/s) below which a joint's Coulomb sign is attenuated.
     coulomb_shape : {'average', 'algebraic', 'erf'}
         The sign's shape over ``coulomb_smoothing``
-        (:data:`~stewartid.identification.friction_shape.COULOMB_SHAPES`), or the average of
-        fits with each, weighted by their likelihoods (default).
+        (:data:`~stewartid.identification.friction_shape.COULOMB_SHAPES`), or the
+        Akaike-weighted average of fits with each (default).
     symmetric : bool
         Impose Mt = Mt^T and Bt = Bt^T.
     differentiation : {'kernel', 'savgol'}
         Filter both sides with a smooth kernel (default) or differentiate with
         Savitzky-Golay.
     decimate : int
-        Use every ``decimate``-th sample (the differentiated signals are smooth over the
-        filter window, so little information is lost; saves time on long records).
+        Use every ``decimate``-th sample (the filtered signals are smooth over the window).
     noise_correction : bool
-        With ``differentiation="kernel"``: remove the bias that pose noise, carried into
-        q_dot and q_ddot by the kernel's derivatives, puts on Mt and Bt (errors in
-        variables): the pose-noise covariance is estimated from each record
-        (:func:`~stewartid.identification.wavelet.noise.white_noise_covariance`) and its
-        share of the normal equations subtracted.
+        With ``differentiation="kernel"``: remove the errors-in-variables bias that pose noise
+        puts on Mt and Bt, from the noise covariance estimated in each record.
 
     Attributes
     ----------
@@ -220,8 +197,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
     }
 
     def _experiment_rows(self, exp: Experiment, shapes: tuple[str, ...]) -> _Rows:
-        """One prepared experiment's rows: the force, the filtered or differentiated motion
-        and, per shape, the Coulomb regressors."""
+        """One prepared experiment's rows: force, filtered motion and, per shape, Coulomb regressors."""
         window = self.window or default_window(estimate_frequency(exp.q, exp.sample_rate))
         if self.differentiation == "savgol":
             _, qd, qdd = differentiate(exp.q, exp.sample_rate, window, self.order)
@@ -232,9 +208,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
             return _Rows(exp.t[sl], window, exp.generalized_force[sl], qd[sl], qdd[sl], coulomb,
                          None)
         # the Coulomb signs need the rates at every sample, from a window the noise allows
-        # (the physical model's rule): a quarter of the kernel, as before, made the signs
-        # chatter under the reference noise on three-sine logs (rotational Bt 3-7 % and 4.3
-        # standard errors off; 86 % within 3)
+        # (the physical model's rule), so that they do not chatter
         qd_sign = measured_sign_rates(exp.q, exp.sample_rate, window)
         units = [coulomb_regressors(exp.joint_jacobians, qd_sign, self.coulomb_smoothing, shape)
                  for shape in shapes]
@@ -259,7 +233,6 @@ class LeastSquaresIdentifier(BaseIdentifier):
         n_exp = len(experiments)
         shapes = (() if not self.coulomb else COULOMB_SHAPES if self.coulomb_shape == "average"
                   else (self.coulomb_shape,))
-        # per shape, the Coulomb regressors of every experiment
         shared: list[list[np.ndarray]] = [[] for _ in shapes]
         phis, ys, used, noise, segments = [], [], [], [], []
         for e, exp in enumerate(experiments):

@@ -1,12 +1,5 @@
-"""Covariance of an estimate from correlated residuals: the long-run covariance of its
-scores, and the more cautious of two covariances.
-
-An estimate solving sum_k s_k(theta) = 0 has, to first order, the covariance
-A^-1 B A^-1 with A the Jacobian of the summed scores and B the covariance of their sum.
-Filtered signals make the rows' residuals correlated over the filter's support, so B sums
-the scores' autocovariances over those lags (:func:`long_run_covariance`); model error
-correlated with the motion over a whole record is seen by the scores summed per record
-(:func:`record_sandwich`).
+"""Covariance of an estimate from correlated residuals: sandwiches A^-1 B A^-1 whose B is the
+long-run covariance of the rows' scores or their sum per record, and the more cautious of two.
 """
 
 from __future__ import annotations
@@ -18,8 +11,9 @@ import scipy.ndimage
 
 
 def with_variances(covariance: np.ndarray, variances: np.ndarray) -> np.ndarray:
-    """``covariance`` with its variances replaced by ``variances``, its correlations kept
-    (a variance of zero takes its new value with no correlation).
+    """``covariance`` with its variances replaced by ``variances``, its correlations kept.
+
+    A variance of zero takes its new value with no correlation.
 
     Parameters
     ----------
@@ -39,9 +33,7 @@ def with_variances(covariance: np.ndarray, variances: np.ndarray) -> np.ndarray:
 
 
 def with_larger_variances(covariance: np.ndarray, other: np.ndarray) -> np.ndarray:
-    """``covariance`` with each variance raised to ``other``'s where that is larger, its
-    correlations kept: the more cautious of two standard errors, each honest under its own
-    assumption about the residual.
+    """``covariance`` with each variance raised to ``other``'s where larger, correlations kept.
 
     Parameters
     ----------
@@ -56,17 +48,11 @@ def with_larger_variances(covariance: np.ndarray, other: np.ndarray) -> np.ndarr
 
 def long_run_covariance(scores: np.ndarray, segments: Sequence[tuple[int, int]],
                         stride: int = 1, psd: bool = True) -> np.ndarray:
-    """Sum of the autocovariances of a series of score vectors over every lag up to each
-    record's correlation length: the covariance of their sum, for a sandwich A^-1 B A^-1.
+    """Covariance of the sum of a series of score vectors, for a sandwich A^-1 B A^-1.
 
-    Filtered white noise is correlated over the filter's support only, so the sum truncated
-    there (uniform weights, no lag crossing two records) is unbiased; it is computed as
-    sum_k s_k w_k^T with w_k the sum of s over the lags within reach of k (one cumulative
-    sum), symmetrized, and negative eigenvalues, which only its sampling error can give, are
-    set to zero. Unlike an autocorrelation time summed up to its first non-positive value, it
-    keeps the negative lobes a high-pass residual has (pose noise through differentiated
-    rates and accelerations) and the correlation of a residual with the regressors (model
-    error), both of which change the estimate's variance.
+    The scores' autocovariances summed with uniform weights over every lag below each record's
+    correlation length (filtered white noise is correlated over the filter's support only), no
+    lag crossing two records.
 
     Parameters
     ----------
@@ -76,12 +62,11 @@ def long_run_covariance(scores: np.ndarray, segments: Sequence[tuple[int, int]],
         Rows of each record (summing to K) and its correlation length L (rows): rows L or
         more apart are uncorrelated.
     stride : int
-        Take the outer products s_k w_k^T at every ``stride``-th row only, times ``stride``
-        (the windowed sums still over every row): for scores that vary slowly against the
-        row spacing (filtered signals kept at every sample), a small share of the cost.
+        Take the outer products at every ``stride``-th row only, times ``stride`` (cheaper for
+        slowly varying scores).
     psd : bool
-        Set the negative eigenvalues to zero (a covariance); else the symmetrized sum as it
-        is, whose diagonal stays unbiased where the clipping is not (:func:`nearest_psd`).
+        Set the negative eigenvalues to zero (:func:`nearest_psd`); else the symmetrized sum,
+        whose diagonal stays unbiased.
 
     Returns
     -------
@@ -105,13 +90,10 @@ def long_run_covariance(scores: np.ndarray, segments: Sequence[tuple[int, int]],
 def filtered_noise_covariance(X: np.ndarray, weights: np.ndarray,
                               segments: Sequence[tuple[int, int]],
                               noises: Sequence[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
-    """B = Cov(sum_k s_k) for scores s_k = sum_c w_c X_kc e_kc whose e is a known noise: white
-    per sample with covariance S across the channels, then filtered, so that
-    Cov(e_k, e_j) = S rho(|k - j|) over the rows of one record and 0 across records.
+    """B = Cov(sum_k s_k) for scores s_k = sum_c w_c X_kc e_kc whose e is a known filtered noise.
 
-    Unlike :func:`long_run_covariance` it estimates nothing from the residual, so it does not
-    scatter from one realisation to the next; it counts only this noise (a lower bound of
-    the residual's when the others are independent of it).
+    Cov(e_k, e_j) = S rho(|k - j|) over the rows of one record and 0 across records. It
+    estimates nothing from the residual, so it does not scatter between realisations.
 
     Parameters
     ----------
@@ -144,12 +126,8 @@ def filtered_noise_covariance(X: np.ndarray, weights: np.ndarray,
 def nearest_psd(matrix: np.ndarray) -> np.ndarray:
     """A symmetric matrix with its negative eigenvalues set to zero.
 
-    Where a long-run sum's true value is the small remainder of large positive and negative
-    autocovariances (pose noise through differentiated rates and accelerations, high-pass),
-    its sampling error gives eigenvalues of either sign, and zeroing the negative ones raises
-    the diagonal: on a 2 Hz payload design dominated by pose noise the physical fit's
-    variances came out 6.2 times the square of their spread over 12 seeds clipped, 1.00
-    times unclipped (medians over the parameters).
+    Clipping raises the diagonal of a long-run sum whose value is a small remainder of large
+    autocovariances of either sign.
     """
     values, vectors = np.linalg.eigh(matrix)
     return (vectors * np.clip(values, 0.0, None)) @ vectors.T
@@ -158,10 +136,9 @@ def nearest_psd(matrix: np.ndarray) -> np.ndarray:
 def score_sandwich(inverse: np.ndarray, scores: np.ndarray,
                    segments: Sequence[tuple[int, int]], basis: np.ndarray | None = None,
                    psd: bool | str = True) -> np.ndarray:
-    """The covariance A^-1 B A^-1 of an estimate from its rows' scores: B their
-    :func:`long_run_covariance`, the outer products taken a sixteenth of the shortest
-    correlation length apart (filtered rows vary slowly; every row when the rows are already
-    that sparse).
+    """The covariance A^-1 B A^-1 of an estimate, B the :func:`long_run_covariance` of its rows' scores.
+
+    The outer products are taken a sixteenth of the shortest correlation length apart.
 
     Parameters
     ----------
@@ -175,10 +152,8 @@ def score_sandwich(inverse: np.ndarray, scores: np.ndarray,
     basis : ndarray, shape (n, m), optional
         Maps the solved unknowns to the scores' (B becomes basis^T B basis).
     psd : bool or "variances"
-        B with its negative eigenvalues set to zero (:func:`long_run_covariance`), or not;
-        ``"variances"``: the correlations of the first and the variances of the second
-        (the first's where negative), which stay unbiased where the clipping raises them
-        (:func:`nearest_psd`).
+        B with its negative eigenvalues set to zero, or not; ``"variances"``: the correlations
+        of the clipped B and the variances of the unclipped one (the clipped where negative).
 
     Returns
     -------
@@ -202,17 +177,11 @@ def score_sandwich(inverse: np.ndarray, scores: np.ndarray,
 def record_sandwich(inverse: np.ndarray, scores: np.ndarray,
                     segments: Sequence[tuple[int, int]], expected: np.ndarray | None = None
                     ) -> np.ndarray:
-    """The covariance A^-1 B A^-1 with the records as independent clusters: B the sum over
-    the records of the outer product of their summed scores, times R / (R - 1) for R records.
+    """The covariance A^-1 B A^-1 with the records as independent clusters.
 
-    Model error (a friction law or a sensor lag the model does not have) leaves a residual
-    correlated with the motion over a whole record, beyond any filter's support; its share
-    in the estimate is A^-1 times the summed scores, which the residual's short-lag
-    autocovariances do not see. Summed per record, the part that differs between records
-    shows (the part common to all is what the fit removed: the scores of all records sum to
-    zero, or, for an estimate corrected for errors in variables, to the correction: each
-    record's own share of it is taken out when ``expected`` is given, else the total shared
-    out by rows). Under noise alone B is unbiased, with R - 1 degrees of freedom.
+    B is the sum over the R records of the outer product of their summed scores (less each
+    record's expected sum), times R / (R - 1). It sees model error correlated with the motion
+    over a whole record, which short-lag autocovariances do not.
 
     Parameters
     ----------
@@ -222,7 +191,7 @@ def record_sandwich(inverse: np.ndarray, scores: np.ndarray,
         Rows of each record (summing to K) and its correlation length (unused here).
     expected : ndarray, shape (R, m), optional
         Each record's expected summed score under noise alone (its errors-in-variables
-        correction, which depends on its own motion and filter; summing to the total).
+        correction); by default the total shared out by rows.
 
     Returns
     -------
