@@ -17,10 +17,6 @@ import numpy as np
 def symmetric_pair_scores(matrix: np.ndarray, std: np.ndarray) -> np.ndarray:
     """|a_ij - a_ji| / sqrt(s_ij^2 + s_ji^2) of every off-diagonal pair (i < j), row-major.
 
-    The two members of a pair come from different equations and, in the usual protocol,
-    different experiments; as estimates of one entry of a symmetric matrix their difference
-    tests the standard errors.
-
     Returns
     -------
     ndarray, shape (n (n - 1) / 2,)
@@ -43,22 +39,10 @@ def pair_calibration(scores: np.ndarray, clip: bool = False) -> dict[str, Any]:
     """How far the symmetric pairs' scatter exceeds their standard errors.
 
     The Birge ratio sqrt(mean z^2) of the pair scores z (:func:`symmetric_pair_scores`) is
-    about 1 when the standard errors are honest; above 1, model error (friction a model
-    lacks, unmodelled dynamics) that the residual-based errors do not show. The factor that
-    multiplies every standard error is that ratio, at least 1 (the scatter of 15 pairs cannot
-    show that errors are too large). The mean of z^2, not a robust scale (median |z| / 0.6745,
-    also reported): measured on logs with friction the model lacks, the bias spreads over
-    many entries, the diagonal's included, and a robust scale left a third of them beyond 3
-    errors.
-
-    With ``clip``, for a fit immune to the friction law (Method B's free interval
-    constants), the ratio is taken over the pairs within :data:`PAIR_DISAGREEMENT` times it,
-    a fixed point reached from the robust scale up. Such a fit's model error sits in the
-    equations that see idle joints' friction (a rotational row under translational
-    excitation), so it shows in a few pairs, whose members' errors take it individually
-    (:func:`select_symmetric_pairs`), and not in the diagonal: on a noise-free log of an
-    independent simulator two pairs at 48-56 errors, among thirteen within 0.1, made every
-    error 16-20 times its realised error.
+    about 1 when the standard errors are honest; the factor for every standard error is that
+    ratio, at least 1. With ``clip`` (a fit immune to the friction law, whose model error shows
+    in a few pairs) the ratio is taken over the pairs within :data:`PAIR_DISAGREEMENT` times
+    it, a fixed point reached from the robust scale up.
 
     Parameters
     ----------
@@ -100,10 +84,9 @@ def calibrate_by_pairs(M: np.ndarray, B: np.ndarray, std_M: np.ndarray,
                        std_B: np.ndarray) -> dict[str, dict[str, Any]]:
     """Calibrate the standard errors of Mt and Bt, in place, by their symmetric pairs.
 
-    Each matrix's errors are multiplied by its pairs' factor (:func:`pair_calibration`);
-    then both members of a pair that still disagree beyond :data:`PAIR_DISAGREEMENT` get at
-    least half their difference (which of the two is biased the data cannot tell; if one is
-    right, the other is within two such errors).
+    Each matrix's errors are multiplied by its pairs' factor (:func:`pair_calibration`); both
+    members of a pair still disagreeing beyond :data:`PAIR_DISAGREEMENT` then get at least half
+    their difference (the data cannot tell which one is biased).
 
     Parameters
     ----------
@@ -134,30 +117,24 @@ def select_symmetric_pairs(matrix: np.ndarray, std: np.ndarray,
                            preferred_rows: tuple[int, ...] = (0, 1, 2),
                            disagreement: float = PAIR_DISAGREEMENT, pool: bool = False
                            ) -> list[dict]:
-    """For every off-diagonal pair, copy the better estimate (or, with ``pool``, the
-    inverse-variance mean of two that agree) onto both entries.
+    """Copy the better estimate of every off-diagonal pair (or the pooled mean) onto both entries.
 
-    Normally the estimate with the smaller standard error is kept. When the two estimates
-    differ by more than ``disagreement`` combined standard errors, at least one carries a
-    model error that its standard error does not show; then the member in one of
-    ``preferred_rows`` is kept if exactly one is (the translational equations: under
-    translational excitation the rotational equations see the lever-arm-amplified friction
-    of joints that barely move, measured as a 2.8 % bias of Mt(5,1) at 5 N m), and the kept
-    standard error is raised to |difference| / ``disagreement``, so that the reported
-    uncertainty covers the disagreement.
+    The member with the smaller standard error is kept. On a disagreement beyond
+    ``disagreement`` the member in ``preferred_rows`` is kept if exactly one is, and the kept
+    error is raised to |difference| / ``disagreement`` so that it covers the disagreement.
 
     Parameters
     ----------
     matrix, std : ndarray, shape (n, n)
         Estimates and their standard errors; modified in place.
     preferred_rows : tuple of int
-        0-based rows whose equations are trusted first on a significant disagreement.
+        0-based rows whose equations are trusted first on a significant disagreement (the
+        translational ones: the rotational equations see idle joints' friction).
     disagreement : float
         Threshold of |a - b| / sqrt(s_a^2 + s_b^2).
     pool : bool
-        Two members within ``disagreement`` are both estimates of the one entry of a
-        symmetric matrix: take their inverse-variance mean, standard error
-        (s_a^-2 + s_b^-2)^(-1/2), recorded as ``"pooled": True``.
+        Replace two members within ``disagreement`` by their inverse-variance mean, standard
+        error (s_a^-2 + s_b^-2)^(-1/2), recorded as ``"pooled": True``.
 
     Returns
     -------
@@ -192,12 +169,12 @@ def select_symmetric_pairs(matrix: np.ndarray, std: np.ndarray,
 def combine_pairs(M: np.ndarray, B: np.ndarray, std_M: np.ndarray, std_B: np.ndarray,
                   symmetric: bool = False, pair_selection: str = "pooled", clip: bool = False
                   ) -> tuple[dict, dict]:
-    """Method B's symmetric pairs, in place: the better-determined member
-    (``pair_selection`` "pooled" or "std_error", :func:`select_symmetric_pairs`; "none"
-    keeps both), the standard errors then multiplied by the pairs' calibration factor
-    (:func:`pair_calibration`, with ``clip`` for a fit immune to the friction law, judged on
-    the residual-based errors: an inflated error would pool a biased member); or with
-    ``symmetric`` the inverse-variance mean of both.
+    """Method B's symmetric pairs, in place, and their calibration.
+
+    The better-determined member (``pair_selection`` "pooled" or "std_error",
+    :func:`select_symmetric_pairs`; "none" keeps both), then the standard errors multiplied by
+    the pairs' calibration factor (:func:`pair_calibration`, judged on the residual-based
+    errors); or with ``symmetric`` the inverse-variance mean of both.
 
     Returns
     -------

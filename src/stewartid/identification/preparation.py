@@ -1,14 +1,6 @@
-"""Data preparation shared by every identifier: experiments with every model term the
-identifiers need (leg and joint-axis Jacobians, gravity, the generalized force and its
-sensitivity to the pose), computed once at every measured pose.
-
-The identified model is the paper's linearised equation of motion (Zhang 2020, Eq. 5),
-
-    Mt q_ddot + Bt q_dot + G(q) + Fc(q_dot) = J_lq(q)^T f_a,
-
-with J_lq evaluated at every *measured* pose and, by default, the pose-dependent gravity term
-G(q) of the platform description subtracted from the measured generalized force, so that
-the identifiers see y = J_lq^T f_a - G(q) = Mt q_ddot + Bt q_dot + Fc + (small offsets).
+"""Data preparation shared by every identifier: each experiment's model terms (Jacobians,
+gravity, the generalized force y = J_lq^T f_a - G(q) and its sensitivity to the pose),
+computed once at every measured pose (Zhang 2020, Eq. 5).
 
 References
 ----------
@@ -59,16 +51,15 @@ class Experiment:
     gravity : ndarray, shape (N, 6)
         G(q) of the platform description (N, N m), whether or not it was subtracted.
     force_sensitivity : ndarray, shape (6, 6)
-        K = d y / d q at the mean pose and mean leg forces (N/m, N m/rad ...): how pose
-        noise enters the generalized force (:func:`generalized_force_sensitivity`).
+        K = d y / d q at the mean pose and mean leg forces
+        (:func:`generalized_force_sensitivity`).
     sample_rate : float
         Hz.
     platform : Platform
         The description the terms were computed from.
     joint_jacobians : ndarray, shape (N, 6, 5, 6)
-        Joint-axis rate Jacobians at every measured pose (rad/s per unit q_dot), axes
-        lower 1, lower 2, upper 1, upper 2, revolute; computed on first use (1.4 kB a
-        sample, and not every method needs them) unless :func:`prepare` was asked for them.
+        Joint-axis rate Jacobians (rad/s per unit q_dot), axes lower 1, lower 2, upper 1,
+        upper 2, revolute; computed on first use unless :func:`prepare` was asked for them.
     """
 
     name: str
@@ -128,9 +119,7 @@ def generalized_force_sensitivity(platform: Platform, q: np.ndarray, forces: np.
                                   gravity: bool = True, step: float = 1e-6) -> np.ndarray:
     """K = d(J_lq(q)^T f - G(q)) / dq at the mean pose and mean leg forces.
 
-    Pose noise enters the generalized force through the Jacobian (the static leg load times
-    the change of the leg directions) and through G(q); K maps it there, so that an
-    errors-in-variables correction can account for noise shared by regressors and targets.
+    K maps pose noise into the generalized force, for errors-in-variables corrections.
 
     Parameters
     ----------
@@ -171,19 +160,14 @@ def prepare_experiment(dataset: Dataset, platform: Platform, gravity: bool = Tru
     platform : Platform
         Platform description (geometry for J_lq; leg masses for G(q)).
     gravity : bool
-        Subtract the model's pose-dependent gravity term G(q) from J_lq^T f_a. Without it the
-        legs' gravity stiffness biases Mt by about -K_G / omega^2 (about -3 % on Mt(4,4) of
-        the paper's platform at 0.5 Hz).
+        Subtract the model's pose-dependent gravity term G(q) from J_lq^T f_a (else the
+        legs' gravity stiffness biases Mt).
     joints : bool
-        Compute the joint-axis Jacobians now, in the same pass over the leg geometry as
-        J_lq and G(q), rather than on first use (1.4 kB a sample, and not every method needs
-        them).
+        Compute the joint-axis Jacobians now, in the same pass as J_lq and G(q), rather than
+        on first use.
     remainder : bool
-        Also subtract what the model's inertial and viscous terms add to their linearisation
-        at the neutral pose (:func:`~stewartid.model.linearization.linearisation_remainder`),
-        at the measured pose with its Savitzky-Golay rates and accelerations: the linear
-        model then holds at any amplitude (the paper's sines at ten times their amplitude,
-        noise-free: Bt(3,3) 1.5 % off without it, 0.004 % with it).
+        Also subtract the model's departure from its linearisation (:func:`model_remainder`),
+        so that the linear model holds at any amplitude.
 
     Returns
     -------
@@ -209,17 +193,9 @@ def model_remainder(platform: Platform, q: np.ndarray, sample_rate: float) -> np
     """The model's departure from its linearisation along a measured motion (N, 6).
 
     :func:`~stewartid.model.linearization.linearisation_remainder` at the measured pose q
-    (N, 6) with Savitzky-Golay rates and accelerations: order 5 over a tenth of the dominant
-    period. The acceleration's gain is then within 1e-4 of one up to twice the dominant
-    frequency and 0.7 % low at five times it, on a term a few per cent of the inertial force;
-    the noise the differentiation puts into the forces is 32 times smaller than over a
-    fortieth of the period (the physical model's regressor window), and it showed: the
-    design's Monte Carlo spread of Method B grew by up to 30 % with that window. The model
-    is evaluated every :data:`REMAINDER_STEPS`-th of the window and interpolated between by
-    cubic Hermite polynomials (:func:`~stewartid.signals.interpolation.hermite_uniform`; the
-    smoothed signals vary on the window's scale: the error is below 1e-5 of the remainder at
-    three times the dominant frequency), which takes its cost from 0.17 s to 0.01 s per
-    20 000 samples.
+    (N, 6) with Savitzky-Golay rates and accelerations (order 5 over a tenth of the dominant
+    period), evaluated every :data:`REMAINDER_STEPS`-th of the window and interpolated by cubic
+    Hermite polynomials (:func:`~stewartid.signals.interpolation.hermite_uniform`).
     """
     # the window needs the frequency only roughly: the spectrum's peak without refinement
     window = default_window(estimate_frequency(q, sample_rate, refine=False)) / REMAINDER_FRACTION
@@ -252,7 +228,7 @@ def prepare(datasets: Sequence[Dataset], platform: Platform, gravity: bool = Tru
     ----------
     datasets : sequence of Dataset
     platform : Platform
-    gravity, joints : bool
+    gravity, joints, remainder : bool
         As in :func:`prepare_experiment`.
 
     Returns
