@@ -1,26 +1,15 @@
 """Leg-length servo controller: PID with anti-windup, gravity feed-forward, inner force loop.
 
-Each leg has a PID on its length error e = l_cmd - l (m), whose output is the force demand
+Each leg's force demand, clamped to the cylinder's force range, is
 
     f_d = f_ff + K_p e + K_i z + K_d (l_cmd' - l'),      z' = e  (unless winding up),
 
-clamped to the force range of the cylinder. ``f_ff`` is the optional gravity feed-forward,
-the leg forces that hold the commanded pose at rest: J_lq(q_cmd)^-T G(q_cmd). Anti-windup
-by conditional integration: z stops integrating while f_d is saturated and e would push it
-further. The controller is continuous-time (an analogue-equivalent servo amplifier), which
-keeps the closed loop an ODE that a fixed-step integrator resolves to its stated order.
-
-In ``ideal`` actuator mode the clamped demand is the leg force. In ``hydraulic`` mode an
-inner loop drives the servo-valve in proportion to the force error: u = k_f (f_d - f),
-with f from the chamber pressures, saturated to [-1, 1] (full opening).
-
-The inner loop is an integrator (valve flow -> chamber pressure) in series with the
-second-order spool, so its gain k_f is bounded by the spool's phase lag. For the paper's
-platform with the default hydraulics the loop linearised at rest
-(:func:`stewartid.simulation.stability.closed_loop_poles`) is stable up to k_f = 1.9e-5 1/N;
-at the default 1e-5 1/N its least-damped pair (about 44 Hz) has damping 0.19, a gain margin
-of about 1.9. Beyond the limit a 64 Hz mode in sway and roll grows into a limit cycle of
-several kN, which :func:`~stewartid.simulation.stability.require_stable` refuses to simulate.
+with e = l_cmd - l (m) and f_ff = J_lq(q_cmd)^-T G(q_cmd) the optional gravity feed-forward;
+z stops integrating while f_d is saturated and e would push it further. The controller is
+continuous-time, so the closed loop stays an ODE. In ``ideal`` actuator mode the demand is
+the leg force; in ``hydraulic`` mode an inner loop opens the valve by u = k_f (f_d - f),
+saturated to [-1, 1], and :func:`~stewartid.simulation.stability.require_stable` refuses
+gains k_f that make the loop unstable.
 """
 
 from __future__ import annotations

@@ -1,12 +1,8 @@
 """Excitation trajectories of the platform pose: sines, multi-sines and a smooth fade-in.
 
-A trajectory is a sum of sines on the pose coordinates, added to a base pose (the neutral
-pose by default) and multiplied by a fade-in window, so that pose, velocity and acceleration
-all start at the base pose / zero and the plant is not shocked at t = 0. Everything is
-analytic: :meth:`Excitation.evaluate` returns q, q_dot and q_ddot exactly.
-
-The paper's set (Zhang 2020, Section 4): six experiments, experiment k excites DOF k alone
-with a sine at 0.5 Hz; see :func:`paper_experiments` for the default amplitudes and why.
+A trajectory is a base pose plus a sum of sines times a fade-in window, so that the plant
+starts at rest; :meth:`Excitation.evaluate` returns q, q_dot and q_ddot analytically. The
+paper's set (Zhang 2020, Section 4) is :func:`paper_experiments`.
 """
 
 from __future__ import annotations
@@ -21,12 +17,8 @@ from stewartid.errors import ConfigError
 from stewartid.platform import COORDINATES, Platform
 
 #: Default sine amplitudes of the paper's experiments: 20 mm in translation, 10 mrad in
-#: rotation. Small enough that the motion is linear (M(q) changes by < 1 % over the
-#: motion) and far inside the 1 m stroke; large enough that at 0.5 Hz the inertial forces
-#: (e.g. 14 224 kg x 0.02 m x (pi rad/s)^2 = 2.8 kN along x, 50 214 kg m^2 x 0.01 rad x pi^2
-#: = 5.0 kN m about x) and viscous forces (4140 N s/m x 0.063 m/s = 260 N along x) dominate
-#: the generalized Coulomb force of 5 N m per joint axis (about 30 N along x, 75 N m about
-#: x), as in the paper's experiments.
+#: rotation; small enough for the linearised model, large enough that inertial and viscous
+#: forces dominate Coulomb friction.
 DEFAULT_AMPLITUDES = (0.02, 0.02, 0.02, 0.01, 0.01, 0.01)
 #: Default fade-in duration (s): one period at the paper's 0.5 Hz.
 DEFAULT_FADE_IN = 2.0
@@ -193,7 +185,7 @@ def paper_experiments(platform: Platform, frequency_hz: float = 0.5,
     frequency_hz : float
         Sine frequency (Hz); 0.5 in the paper.
     amplitudes : sequence of 6 float
-        Per DOF (m, m, m, rad, rad, rad); see :data:`DEFAULT_AMPLITUDES` for the reasoning.
+        Per DOF (m, m, m, rad, rad, rad).
     fade_in : float
         Fade-in duration (s).
 

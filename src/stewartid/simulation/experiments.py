@@ -37,7 +37,7 @@ from stewartid.simulation.hydraulics import hydraulic_parameters
 from stewartid.simulation.sensors import SensorNoise, measure_legs, measured_pose
 from stewartid.simulation.stability import initial_state, loop_poles, require_stable
 
-#: Default integration step (s); see ``plant.py`` for its justification.
+#: Default integration step (s).
 DEFAULT_STEP = 5e-4
 
 
@@ -203,8 +203,8 @@ def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: 
                             states[:, plant.S_PB:plant.S_PB + 6]], axis=-1),
         spools=states[:, plant.S_XV:plant.S_XV + 6])
     measured_lengths, measured_forces = measure_legs(lengths, forces, noise, rng, t)
-    # Newton started at the true pose: the same solution as from the commanded one (tracking
-    # errors of millimetres), in one or two iterations instead of four
+    # Newton started at the true pose: the same solution as from the commanded one, in fewer
+    # iterations
     pose = measured_pose(platform, measured_lengths, record.q)
     dataset = Dataset(t=t, pose=pose, lengths=measured_lengths, forces=measured_forces,
                       name=excitation.name)

@@ -1,25 +1,19 @@
 """Hydraulic leg actuators: servo-valve, orifice flows, chamber pressures, actuator force.
 
-Per leg (all six legs alike, parameters from the ``[hydraulics]`` section):
+Per leg (all six alike, parameters from the ``[hydraulics]`` section):
 
 * Servo-valve spool, second order: x_v'' = w_v^2 (u - x_v) - 2 zeta_v w_v x_v', with u the
   valve command (fraction of full opening, saturated to [-1, 1]).
 * Critically lapped four-edge valve with turbulent orifices:
   x_v >= 0: Q_A = K x_v phi(p_s - p_A), Q_B = -K x_v phi(p_B - p_r);
   x_v < 0:  Q_A = K x_v phi(p_A - p_r), Q_B = -K x_v phi(p_s - p_B),
-  K = Q_rated / sqrt(dp_rated / 2). phi(dp) = dp / (dp^2 + p_t^2)^(1/4) is sign(dp)
-  sqrt(|dp|) for |dp| >> p_t and laminar (linear) below the transition pressure p_t, which
-  keeps the flow law differentiable where a chamber pressure crosses p_s or p_r.
+  K = Q_rated / sqrt(dp_rated / 2), phi(dp) = dp / (dp^2 + p_t^2)^(1/4): sign(dp) sqrt(|dp|)
+  above the transition pressure p_t, laminar below it (differentiable everywhere).
 * Chambers with compressible oil and stroke-dependent volumes, internal leakage C_i:
   p_A' = beta / V_A (Q_A - A_A x' - C_i (p_A - p_B)),
   p_B' = beta / V_B (Q_B + A_B x' + C_i (p_A - p_B)),
-  V_A = V_0 + A_A (S/2 + x), V_B = V_0 + A_B (S/2 - x); x = leg length - mid-stroke length
-  (the neutral leg length).
+  V_A = V_0 + A_A (S/2 + x), V_B = V_0 + A_B (S/2 - x); x = leg length - neutral leg length.
 * Actuator force along the leg (N, positive extends): f = p_A A_A - p_B A_B.
-
-The hydraulic natural frequency of a leg of effective mass m is
-w_h = sqrt(beta (A_A^2 / V_A + A_B^2 / V_B) / m) (:func:`hydraulic_natural_frequency`); it
-and the valve bandwidth set the integration step of the plant (see ``plant.py``).
 
 References
 ----------
@@ -126,12 +120,9 @@ def force_limits(hydraulics: Hydraulics) -> tuple[float, float]:
 def static_state(hp: np.ndarray, force: float, length: float) -> tuple[float, float, float]:
     """Spool position and chamber pressures that hold ``force`` at rest.
 
-    At rest the valve only feeds the leakage: Q_A = C_i (p_A - p_B) = -Q_B. Both metering
-    edges pass the same flow through the same opening, so they see the same pressure drop
-    (the regularised orifice law is strictly monotonic): p_s - p_A = p_B - p_r for x_v >= 0
-    and p_A - p_r = p_s - p_B for x_v < 0, i.e. p_A + p_B = p_s + p_r in both cases. With
-    p_A A_A - p_B A_B = force this gives the pressures in closed form, and the spool
-    position follows from the leakage flow.
+    At rest the valve only feeds the leakage, and both metering edges see the same pressure
+    drop, so p_A + p_B = p_s + p_r; with p_A A_A - p_B A_B = force the pressures follow in
+    closed form, the spool position from the leakage flow.
 
     Parameters
     ----------
@@ -140,8 +131,8 @@ def static_state(hp: np.ndarray, force: float, length: float) -> tuple[float, fl
     force : float
         N, positive extends.
     length : float
-        Leg length (m); the equilibrium does not depend on it (no flow into the chambers
-        at rest), it is kept for a uniform per-leg signature.
+        Leg length (m); unused (no flow into the chambers at rest), kept for a uniform per-leg
+        signature.
 
     Returns
     -------

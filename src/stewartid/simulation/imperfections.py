@@ -1,20 +1,7 @@
 """Imperfections of a real rig's sensor channels: delay, coloured noise, mains hum, drift.
 
-Pure functions on sampled signals (time on axis 0, one column per channel) that
-:func:`stewartid.simulation.sensors.measure_legs` combines into the sensor model of the
-simulator and of :func:`stewartid.simulation.sensors.degrade`:
-
-- :func:`delay_signal`: a channel logged ``delay`` seconds after the motion, by cubic-spline
-  interpolation of the sampled true signal (the plant records its states at the samples
-  only); on the paper platform at 1 kHz, Coulomb 30 N m, three sines on each DOF, a
-  half-sample delay of the leg forces differs from the forces the integrator gives at those
-  instants by 8e-4 N RMS and 0.074 N at worst (friction reversals), against leg forces of
-  about 30 kN and 9e-3 N for halving the integration step (``docs/benchmarks.md``);
-- :func:`lowpass_noise`: white noise through a causal Butterworth low-pass filter, as an
-  anti-aliasing filter colours a transducer's noise, scaled to the requested standard
-  deviation;
-- :func:`mains_hum`: a sinusoid at the mains frequency with a random phase per channel;
-- :func:`random_walk`: a slow drift of each channel from zero at the start of the record.
+Pure functions on sampled signals (time on axis 0, one column per channel), combined by
+:func:`stewartid.simulation.sensors.measure_legs` into the simulator's sensor model.
 """
 
 from __future__ import annotations
@@ -32,11 +19,9 @@ SETTLED = 1e-10
 def delay_signal(t: np.ndarray, values: np.ndarray, delay_s: float) -> np.ndarray:
     """The signal ``delay_s`` seconds later: out(t) = values(t - delay_s).
 
-    The sampled signal is interpolated by :func:`~stewartid.signals.interpolation.spline_at`
-    (within its error bound up to the ends of the record): for a sine of frequency f and
-    amplitude A, 5/384 A (2 pi f h)^4, 1e-10 A at 1.5 Hz and 1 kHz. A delay of a whole number
-    of samples returns the samples shifted (to round-off). Before the first sample the
-    signal is its first value (the rig at rest before the record started).
+    Interpolated by :func:`~stewartid.signals.interpolation.spline_at`; a whole number of samples
+    shifts the samples (to round-off). Before the first sample the signal is its first value
+    (the rig at rest before the record started).
 
     Parameters
     ----------
@@ -93,12 +78,10 @@ def lowpass_noise(rng: np.random.Generator, n_samples: int, std: float | np.ndar
                   channels: int = 6) -> np.ndarray:
     """Stationary low-pass (coloured) Gaussian noise of a given standard deviation.
 
-    White noise runs through the causal filter of :func:`lowpass_sections` (as a transducer's
-    noise through an anti-aliasing filter), started :func:`warm_up_length` samples before the
-    record so that it is stationary from the first sample, and is divided by the filter's
-    noise gain sqrt(sum h[k]^2) (h: impulse response), so that its standard deviation is
-    ``std`` and its power spectrum is ``std^2 |H(f)|^2 / sum h[k]^2``: flat below the cutoff,
-    half (-3 dB) at it.
+    White noise through the causal filter of :func:`lowpass_sections` (as a transducer's noise
+    through an anti-aliasing filter), started :func:`warm_up_length` samples early so that it is
+    stationary from the first sample, and scaled by the filter's noise gain to standard
+    deviation ``std``.
 
     Parameters
     ----------
@@ -154,9 +137,8 @@ def random_walk(n_samples: int, std: float, rng: np.random.Generator,
                 channels: int = 6) -> np.ndarray:
     """A slow drift per channel: a Gaussian random walk from zero at the first sample.
 
-    The sampled Brownian motion of standard deviation ``std`` at the last sample, so
-    ``std * sqrt(k / (n_samples - 1))`` at sample k: a sensor zeroed when the record starts
-    that wanders off over it.
+    Standard deviation ``std * sqrt(k / (n_samples - 1))`` at sample k: a sensor zeroed when the
+    record starts that wanders off over it.
 
     Parameters
     ----------

@@ -5,25 +5,11 @@ State vector y (42 values): q (6), q_dot (6), PID integrators z (6, m s), valve 
 ``ideal`` actuator mode the valve and pressure states are frozen and the leg forces are the
 controller's demands.
 
-Integration: classical fixed-step Runge-Kutta (RK4) inside one numba loop; the commanded
-leg lengths, their rates and the gravity feed-forward are tabulated beforehand on the
-half-step grid that RK4 samples. Step choice: the fastest dynamics of the hydraulic loop are
-the spool (80 Hz, w_v = 503 rad/s, damping 0.7), the inner force loop and the hydraulic
-resonance of the legs (15-25 Hz); the closed loop's fastest pole on the paper's platform is
-at |lambda| = 406 rad/s (:func:`stewartid.simulation.stability.closed_loop_poles`, Coulomb
-0-30 N m). RK4 is stable for |lambda h| < 2.78 and accurate to O((lambda h)^4). The default
-step of 0.5 ms (|lambda h| = 0.2) is 14x inside the stability limit; halving it (the
-step-halving test, ``tests/test_simulation.py``) changes the recorded pose by 2e-10 m and the
-leg forces by 0.02 N (Coulomb 0-30 N m), far below any sensor resolution. The regularised
-Coulomb friction adds a damping Fc / s per joint axis near zero rate (s = 1e-4 rad/s: 5e4
-N m s/rad at Fc = 5 N m, about ten times the viscous gimbal friction), which the poles above
-include (they are taken at rest, where that damping is largest).
-
-Friction: viscous on the four gimbal axes of each leg, Coulomb on all five rotational axes,
-regularised as Fc w / sqrt(w^2 + s^2) (:func:`stewartid.model.kernels.joint_friction_torque`). Within
-|w| < s a joint behaves as a very stiff viscous damper: it sticks (creeps at a rate below
-s, 1e-4 rad/s) until the applied torque exceeds Fc, then slips with the full Coulomb torque
-opposing the motion, so the stick-slip transitions are resolved without event detection.
+Integration: fixed-step RK4 inside one numba loop, the commands tabulated beforehand on the
+half-step grid RK4 samples; the default step lies well inside RK4's stability limit for the
+loop's fastest pole (:func:`stewartid.simulation.stability.closed_loop_poles`). Joint
+friction is regularised (:func:`stewartid.model.kernels.joint_friction_torque`), so a joint
+sticks and slips without event detection.
 """
 
 from __future__ import annotations

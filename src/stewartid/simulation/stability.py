@@ -1,15 +1,8 @@
 """Closed-loop equilibrium at rest and the poles of the loop linearised about it.
 
-A servo whose linearised loop has a pole in the right half-plane does not track its command:
-any disturbance (here, the excitation itself) grows into a limit cycle bounded only by the
-valve and orifice non-linearities. Such a plant produces data that no linear rigid-body model
-explains (leg forces of tens of kN at the loop's natural frequency), so every experiment is
-checked before it is integrated (:func:`require_stable`).
-
-The poles come from the state matrix of the compiled right-hand side
-(:func:`stewartid.simulation.plant.linearize`, central differences) at the equilibrium of
-:func:`initial_state`; they are nearly independent of the pose over the excitation range, so
-the start pose is representative.
+An unstable servo loop grows into a limit cycle no rigid-body model explains, so every
+experiment is checked before it is integrated (:func:`require_stable`), from the state matrix
+of :func:`stewartid.simulation.plant.linearize` at the equilibrium of :func:`initial_state`.
 """
 
 from __future__ import annotations
@@ -23,8 +16,8 @@ from stewartid.simulation import plant
 from stewartid.simulation.controller import command_tables, controller_parameters
 from stewartid.simulation.hydraulics import hydraulic_parameters, static_state
 
-#: Largest growth rate (1/s) accepted as numerically zero: an e-fold in 1000 s, far longer
-#: than any record, and well above the finite-difference error of the frozen states.
+#: Largest growth rate (1/s) accepted as numerically zero: an e-fold in 1000 s, longer than
+#: any record.
 GROWTH_TOLERANCE = 1e-3
 
 
