@@ -39,6 +39,11 @@ def method_names(methods: str | Sequence[str]) -> tuple[str, ...]:
     """The registered methods ``methods`` names: every method the verdict compares for
     ``"all"`` (presets and the physical model aside), else the names themselves.
 
+    Returns
+    -------
+    tuple of str
+        Registry names.
+
     Raises
     ------
     ConfigError
@@ -55,7 +60,7 @@ def method_names(methods: str | Sequence[str]) -> tuple[str, ...]:
 def plausibility_check(platform: Platform) -> Callable[[IdentificationResult], None]:
     """The physical check of a method's result against the platform description
     (:func:`~stewartid.datasets.plausibility.check_identified`), naming the method: a
-    result that fails it is reported as the method not applying."""
+    result that fails it counts as the method not applying."""
 
     def check(result: IdentificationResult) -> None:
         check_identified(result.M, result.B, platform, result.method,
@@ -81,7 +86,7 @@ class Comparison:
     folds : int
         Time segments per experiment of the held-out validation.
     nominal_M, nominal_B : ndarray, shape (6, 6)
-        The reference matrices the report compares with.
+        The reference matrices the results are compared with.
     nominal_source : str
         Where they come from.
     physical : PhysicalSection or None
@@ -219,13 +224,14 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
         Fit the physical model beside the compared methods (not ranked by the verdict); with
         ``physical.required``, :attr:`Comparison.result` is its result.
     nominal : (M, B), optional
-        Reference matrices for the report; the platform description's at neutral by default.
+        Reference matrices, shape (6, 6) each, the results are compared with; the platform
+        description's at neutral by default.
     nominal_source : str, optional
         Where ``nominal`` comes from.
     check : bool or callable
         Check each result against the platform description (:func:`plausibility_check`,
-        default) or with a callable that raises a StewartidError; a result that fails is
-        reported as the method not applying.
+        default) or with a callable that raises a StewartidError; a result that fails counts
+        as the method not applying.
     entries : sequence of str, optional
         The entries the verdict judges the methods on, as labels (``"Mt(1,5)"``); by default
         every entry the platform's nominal matrices (with its payload) make non-negligible

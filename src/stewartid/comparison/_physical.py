@@ -34,14 +34,14 @@ from stewartid.validation.heldout import (
 WORKSPACE_POINTS = 11
 #: Off-diagonal entries of Mt and of Bt shown beside the diagonal (the largest).
 SHOWN_COUPLINGS = 2
-#: Share of the parameters fixed at the file's values above which a report that did not ask
-#: for the physical model leaves its section out (one line says why).
+#: Share of the parameters fixed at the file's values above which a comparison that does not
+#: require the physical model leaves it out (the section's ``note`` says why).
 MOST_FIXED = 0.5
 
 
 @dataclass(frozen=True)
 class PhysicalRequest:
-    """What the report asks of the physical model.
+    """What a comparison asks of the physical model.
 
     Attributes
     ----------
@@ -51,7 +51,7 @@ class PhysicalRequest:
         The physically consistent fit (``identify --model physical --consistent``).
     required : bool
         ``identify --model physical``: a model that cannot be applied is an error. Otherwise
-        (``identify --method all --report``) one line of the report says why it is not shown.
+        (``identify --method all --report``) the section's ``note`` says why it is not shown.
     settings : dict
         Further estimator settings (e.g. ``{"gravity": False}``).
     """
@@ -64,8 +64,14 @@ class PhysicalRequest:
 
 def largest_couplings(matrix: np.ndarray, count: int = SHOWN_COUPLINGS
                       ) -> list[tuple[int, int]]:
-    """The ``count`` off-diagonal entries (i < j) of a (6, 6) matrix largest relative to
-    sqrt(|m_ii m_jj|), those above 1e-6 of it."""
+    """The off-diagonal entries (i < j) of a (6, 6) matrix largest relative to
+    sqrt(|m_ii m_jj|): the couplings worth showing beside the diagonal.
+
+    Returns
+    -------
+    list of (int, int)
+        At most ``count`` index pairs, largest first, each above 1e-6 of its scale.
+    """
     d = np.sqrt(np.abs(np.diag(matrix)))
     scale = np.outer(d, d)
     relative = np.abs(matrix) / np.where(scale > 0, scale, np.inf)
@@ -124,7 +130,7 @@ def fit_physical(datasets: Sequence[Dataset], platform: Platform, request: Physi
     Parameters
     ----------
     datasets, platform, folds
-        As :func:`~stewartid.reports.identification.report.write_identification_report`.
+        As :func:`~stewartid.comparison.compare_methods`.
     request : PhysicalRequest
     segments, record_cache : dict
         Held-out segments and validation-record segments by (``gravity``, ``remainder``)

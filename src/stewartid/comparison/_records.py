@@ -30,7 +30,7 @@ class MethodFit:
     name, display_name, color : str
         From the registry.
     result : IdentificationResult or None
-        The reported result (the consistent one with ``consistent=True``), with
+        The result the verdict judges (the consistent one with ``consistent=True``), with
         ``validation`` set; None if the method could not be applied.
     unconstrained : IdentificationResult or None
         The method's own estimate.
@@ -44,9 +44,11 @@ class MethodFit:
     records : ValidationResult or None
         The full fit's prediction of the validation records (``identify --validate``).
     seconds : float
-        Fit and validation time.
+        Fit and validation time (s).
     error : str or None
         Why the method could not be applied.
+    exception : StewartidError or None
+        The error itself, raised again when no method could be applied.
     cross_validation : CrossValidation or None
         The fold fits ``validation`` scores (a consensus of close methods is built from them).
     estimator : BaseIdentifier or None
@@ -119,7 +121,7 @@ class Workspace:
 
 @dataclass(frozen=True)
 class PhysicalSection:
-    """The physical model in the identification report (not ranked by the verdict).
+    """The physical model beside the compared methods (not ranked by the verdict).
 
     Attributes
     ----------
@@ -133,10 +135,10 @@ class PhysicalSection:
     records : ValidationResult or None
         Its prediction of the validation records (``identify --validate``).
     seconds : float
-        Fit, validation and curves.
+        Time of the fit, validation and workspace curves (s).
     note : str or None
-        Why the section is not shown (the model cannot be applied, or the data fix most of
-        its parameters).
+        Why the model is not shown (it cannot be applied, or the data fix most of its
+        parameters).
     """
 
     result: PhysicalResult | None = None

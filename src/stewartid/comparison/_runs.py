@@ -37,9 +37,16 @@ from stewartid.verdict.rule import Verdict, choose_trusted
 
 def consistent_result(result: IdentificationResult) -> tuple[IdentificationResult,
                                                               ConsistentEstimate]:
-    """``result`` with M and B replaced by the nearest consistent pair (needs the ``convex``
-    extra), and the projection; the unconstrained matrices and the change are kept in the
-    diagnostics."""
+    """Replace a result's M and B by the nearest physically consistent pair (needs the
+    ``convex`` extra).
+
+    Returns
+    -------
+    result : IdentificationResult
+        ``result`` with the consistent M and B; ``diagnostics["consistent_fit"]`` keeps the
+        unconstrained matrices and the change.
+    projection : ConsistentEstimate
+    """
     projection = project_consistent(result.M, result.B, result.std_errors_M,
                                     result.std_errors_B)
     diagnostics = {**result.diagnostics, "consistent_fit": {
@@ -59,8 +66,7 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
                records: Sequence[Dataset] = (),
                record_cache: dict[tuple[bool, bool], list[Segment]] | None = None
                ) -> MethodFit:
-    """Fit, validate and check one method; a method that cannot be applied to these data
-    (a :class:`~stewartid.errors.StewartidError`) is reported with its message.
+    """Fit, validate and check one method of the comparison.
 
     Parameters
     ----------
@@ -74,13 +80,19 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
         Held-out segments by (``gravity``, ``remainder``) setting, filled on first use and
         shared between methods.
     check : callable, optional
-        Raises a StewartidError for an implausible result (the method is then reported as
-        not applicable).
+        Raises a StewartidError for an implausible result (the method then counts as not
+        applicable).
     records : sequence of Dataset
         Validation records of another excitation (``identify --validate``), predicted by the
         full fit.
     record_cache : dict, optional
         Their filtered segments by (``gravity``, ``remainder``) setting, filled on first use.
+
+    Returns
+    -------
+    MethodFit
+        With ``error`` and ``exception`` instead of a result when the method cannot be
+        applied to these data (a :class:`~stewartid.errors.StewartidError`).
     """
     spec = registry.method_spec(name)
     accepted = spec.estimator_class.param_names()
@@ -128,8 +140,8 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
 
 
 def same_segments(a: Sequence[Segment], b: Sequence[Segment]) -> bool:
-    """Whether two methods' held-out segments are the same pieces, prepared alike (the same
-    ``gravity`` setting gives the same measured force)."""
+    """Whether two methods' held-out segments are the same pieces, prepared alike: the same
+    ``gravity`` setting gives the same measured force."""
     return a is b or (len(a) == len(b) and all(
         x.name == y.name and np.array_equal(x.force, y.force) for x, y in zip(a, b, strict=True)))
 
@@ -139,8 +151,22 @@ def consensus_run(members: Sequence[MethodFit], consistent: bool,
     """The consensus of fitted methods (:func:`~stewartid.verdict.consensus.combine_results`),
     validated as :func:`run_method` validates a method: each fold's consensus of the members'
     fold fits predicts the held-out segments, the full consensus the validation records.
-    None when the members were validated on differently prepared segments (their ``gravity``
-    settings differ)."""
+
+    Parameters
+    ----------
+    members : sequence of MethodFit
+        The close methods, each with its fold fits (``cross_validation``).
+    consistent : bool
+        As :func:`~stewartid.comparison.compare_methods`.
+    agreement : float
+        As :func:`~stewartid.verdict.consensus.combine_results`.
+
+    Returns
+    -------
+    MethodFit or None
+        None when the members were validated on differently prepared segments (their
+        ``gravity`` settings differ).
+    """
     start = time.perf_counter()
     names = [run.name for run in members]
     folds = [run.cross_validation for run in members]
@@ -171,9 +197,20 @@ def consensus_run(members: Sequence[MethodFit], consistent: bool,
 def judge(runs: Sequence[MethodFit], consistent: bool = False,
           entries: Sequence[EntryKey] = PAPER_ENTRIES, policy: VerdictPolicy = DEFAULT_POLICY
           ) -> tuple[list[MethodFit], Verdict]:
-    """The verdict on the methods' runs (:func:`~stewartid.verdict.rule.choose_trusted`, on
-    ``entries`` with ``policy``) and, where it names a close call, the consensus of the close
-    methods added to the runs and trusted (:mod:`stewartid.verdict.close_call`).
+    """The verdict on the methods' runs (:func:`~stewartid.verdict.rule.choose_trusted`) and,
+    where it names a close call, the consensus of the close methods added to the runs and
+    trusted (:mod:`stewartid.verdict.close_call`).
+
+    Parameters
+    ----------
+    runs : sequence of MethodFit
+        From :func:`run_method`.
+    consistent : bool
+        As :func:`~stewartid.comparison.compare_methods`, for the consensus.
+    entries : sequence of EntryKey
+        The entries the verdict judges the methods on.
+    policy : VerdictPolicy
+        The verdict's thresholds.
 
     Returns
     -------
