@@ -1,16 +1,8 @@
-"""The one list of identification methods.
+"""The one list of identification methods, read by the command line, reproduction and reports.
 
-A method registers itself once, in its own module, with the class decorator
-:func:`register_method` (name, display name, the paper's letter, reference, description,
-colour, and named presets such as ``wavelet-paper``). The command line (``identify --method``,
-``stewartid methods``), ``reproduce``, the reports (labels, colours, the paper's columns) and
-the benchmarks read it from here.
-
-Adding a method is one new file: put a module in ``stewartid/identification/`` whose
-estimator class (a :class:`~stewartid.identification.base.BaseIdentifier`) carries
-``@register_method(...)``. Discovery imports the built-in methods' modules
-(:data:`BUILTIN_MODULES`, in their order) and then every other module of the
-``stewartid.identification`` package, alphabetically. Presets come after every method.
+A method registers itself in its own module with the class decorator :func:`register_method`.
+Discovery imports :data:`BUILTIN_MODULES` in order, then every other module of
+``stewartid.identification`` alphabetically; presets come after every method.
 
 Example
 -------
@@ -49,8 +41,8 @@ class MethodSpec:
     display_name : str
         Label in tables, figures and reports, e.g. ``"Method A (Fourier)"``.
     letter : str or None
-        The paper's letter for the method (``"A"``, ``"B"``), None if the paper does not
-        report it; the published columns are matched by this letter.
+        The paper's letter for the method (``"A"``, ``"B"``), matching its published columns;
+        None if the paper does not report it.
     reference : str
         Citation (with DOI where there is one).
     description : str
@@ -65,10 +57,7 @@ class MethodSpec:
         Name of the method this preset configures, None for a method.
     compared : bool
         Run by ``identify --method all`` (and so judged by its verdict) and by the
-        reproduction. False for a method whose standard errors are not yet calibrated on the
-        logs the verdict is measured on (the physical model: ``docs/benchmarks.md``, "Which
-        method to trust"), and for the consensus, which the report builds from the compared
-        methods' fits where its verdict names a close call; each runs by name.
+        reproduction; False for a method that runs by name only.
     """
 
     name: str
@@ -204,8 +193,7 @@ def method_spec(name: str) -> MethodSpec:
 
 
 def create_identifier(name: str, **settings: Any) -> Any:
-    """A new estimator for method or preset ``name``: the preset's settings, updated by
-    ``settings``.
+    """A new estimator for method or preset ``name``: the preset's settings updated by ``settings``.
 
     Raises
     ------
@@ -223,10 +211,11 @@ def create_identifier(name: str, **settings: Any) -> Any:
 
 
 def estimates_only(name: str, **settings: Any) -> Any:
-    """:func:`create_identifier` for a use that reads the estimates and never their standard
-    errors (Monte Carlo runs, cross-validation folds): without the sampling check
-    (:mod:`~stewartid.identification.sampling`), which costs a fit at half the rate, unless
-    ``settings`` ask for it."""
+    """:func:`create_identifier` for a use that never reads the standard errors.
+
+    Turns the sampling check (:mod:`~stewartid.identification.sampling`) off unless
+    ``settings`` ask for it, since it costs extra fits.
+    """
     if "sampling_check" in method_spec(name).estimator_class.param_names():
         settings = {"sampling_check": False, **settings}
     return create_identifier(name, **settings)

@@ -1,6 +1,7 @@
 """The result of an identification: matrices, standard errors, settings, diagnostics, its
 JSON file (``result.json``), and the comparison table in the layout of the paper (Zhang 2020,
-Tables 3-6)."""
+Tables 3-6).
+"""
 
 from __future__ import annotations
 
@@ -67,8 +68,7 @@ class IdentificationResult:
     verdict: dict[str, Any] | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """A JSON-ready dict; ``M`` and ``B`` at the top level; non-finite numbers are None
-        (see :mod:`stewartid.files`)."""
+        """A JSON-ready dict; non-finite numbers are None (see :mod:`stewartid.files`)."""
         from stewartid.identification.consistency import consistency_metrics
 
         document = {
@@ -140,8 +140,7 @@ class IdentificationResult:
 def comparison_rows(M: np.ndarray, B: np.ndarray, M_nominal: np.ndarray,
                     B_nominal: np.ndarray, std_M: np.ndarray | None = None,
                     std_B: np.ndarray | None = None) -> list[dict[str, Any]]:
-    """The rows of :func:`comparison_table` as dicts, without pandas (the command line prints
-    them)."""
+    """The rows of :func:`comparison_table` as dicts, without pandas."""
     identified = {"M": np.asarray(M), "B": np.asarray(B)}
     nominal = {"M": np.asarray(M_nominal, dtype=float), "B": np.asarray(B_nominal, dtype=float)}
     std = {"M": std_M if std_M is not None else np.full((6, 6), np.nan),
@@ -162,8 +161,7 @@ def comparison_rows(M: np.ndarray, B: np.ndarray, M_nominal: np.ndarray,
 def comparison_table(M: np.ndarray, B: np.ndarray, M_nominal: np.ndarray,
                      B_nominal: np.ndarray, std_M: np.ndarray | None = None,
                      std_B: np.ndarray | None = None):
-    """Table of the paper's 20 entries; see
-    :meth:`IdentificationResult.comparison_table`."""
+    """Table of the paper's 20 entries; see :meth:`IdentificationResult.comparison_table`."""
     import pandas as pd
 
     return pd.DataFrame(comparison_rows(M, B, M_nominal, B_nominal, std_M, std_B))

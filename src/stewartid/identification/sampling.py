@@ -1,28 +1,10 @@
 """Whether a result is limited by its log's sampling rather than by its noise.
 
-A method's standard errors come from its residual, and describe the error of the estimate when
-that residual is noise. On a log with little or no noise the residual is what the sampling
-leaves (the simulator's integration step, the differentiation at the log's rate, a
-zero-order hold): deterministic, repeated with the motion, and no residual-based standard
-error sees it. On our plant's noise-free logs the estimates are 1e-7 to 1e-5 relative off at
-7 to 46 of their standard errors (``docs/benchmarks.md``, "Which method to trust").
-
-The check fits the log again at half its sample rate (every second sample). The result is
-limited by the sampling, not the noise, when either
-
-- the standard errors grow faster than noise makes them: noise gives standard errors larger
-  by about sqrt(2) at half the rate (half the samples of twice the filtered variance in each
-  window), an error of the sampling of order p gives 2**p; the median ratio over the
-  diagonals of Mt and Bt is compared with :data:`RATIO_LIMIT`; or
-- the estimate moves by more than noise can move it: a diagonal entry changes by more than
-  :data:`SHIFT_LIMIT` of its half-rate standard errors (a residual at round-off, as on logs
-  of the identified model itself, where the standard errors are 1e-9 relative).
-
-Then the log is also fitted at a third and a quarter of its rate, and each entry's largest
-change over the three thinned fits is added to its standard error in quadrature: an
-empirical bound of what the sampling does to the estimate, conservative (a coarser rate errs
-more). On the 13 noise-free logs of the verdict study every entry of every method is then
-within 3 standard errors (largest 2.74), where 7 to 46 were before.
+Residual-based standard errors miss what the sampling leaves (integration step,
+differentiation at the log's rate). The log is fitted again at half its rate; when the
+standard errors grow faster than noise makes them (:data:`RATIO_LIMIT`) or the estimate moves
+more than noise can (:data:`SHIFT_LIMIT`), it is also fitted at a third and a quarter of its
+rate, and each entry's largest change is added to its standard error in quadrature.
 """
 
 from __future__ import annotations
@@ -43,14 +25,11 @@ FACTORS = (2, 3, 4)
 
 #: Median ratio of the standard errors at half the rate to those at the full rate above which
 #: the residual counts as the sampling's (noise: about sqrt(2); a sampling error of order p:
-#: 2**p). Measured with the reference noise, 65 logs of two platforms: 0.9-1.93; their
-#: noise-free versions: 2.7-44.
+#: 2**p).
 RATIO_LIMIT = 2.5
 
 #: Largest change of a diagonal entry at half the rate, in its half-rate standard errors,
-#: that noise explains. Measured with noise: at most 2.8 on the 65 logs at 1 kHz, 5.7 for
-#: Method B at 200 Hz (whose half rate is coarse for its wavelets); on noise-free logs of the
-#: linear model itself, whose residual is round-off: 15 to 1e8.
+#: that noise explains.
 SHIFT_LIMIT = 10.0
 
 
@@ -75,8 +54,7 @@ def thinned(dataset: Dataset, factor: int) -> Dataset:
 
 
 def _diagonals(result: IdentificationResult) -> tuple[np.ndarray, np.ndarray]:
-    """The diagonals of Mt and Bt and their standard errors, shape (12,) each (the
-    off-diagonal entries a method does not estimate carry round-off)."""
+    """The diagonals of Mt and Bt and their standard errors, shape (12,) each."""
     return (np.concatenate([np.diag(result.M), np.diag(result.B)]),
             np.concatenate([np.diag(result.std_errors_M), np.diag(result.std_errors_B)]))
 

@@ -26,8 +26,8 @@ class LeastSquaresSolution:
     Attributes
     ----------
     theta : ndarray, shape (6, p)
-        Coefficients: y_i = sum_j theta[i, j] phi_j (+ shared terms). The first six columns
-        are Mt, the next six Bt when the regressors are ordered [q_ddot, q_dot, ...].
+        Coefficients: y_i = sum_j theta[i, j] phi_j (+ shared terms); Mt then Bt first when
+        the regressors are ordered [q_ddot, q_dot, ...].
     theta_std : ndarray, shape (6, p)
         Standard errors of ``theta``.
     shared : ndarray, shape (s,)
@@ -41,8 +41,7 @@ class LeastSquaresSolution:
         Rows per channel.
     effective_equations : ndarray, shape (6,)
         Independent rows per channel: ``n_equations`` over the residual's autocorrelation
-        time (``n_equations`` without ``autocorrelated``); the sample size of the Gaussian
-        log-likelihood by which fits of other regressors on the same rows are compared.
+        time; the sample size for comparing fits on the same rows by likelihood.
     """
 
     theta: np.ndarray
@@ -77,8 +76,7 @@ def check_rank(normal: np.ndarray, names: Sequence[str], max_condition: float) -
     Returns
     -------
     float
-        The condition number of the equilibrated regression (square root of that of the
-        equilibrated normal matrix).
+        The condition number of the equilibrated regression.
 
     Raises
     ------
@@ -150,16 +148,10 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
                         ) -> LeastSquaresSolution:
     """Least squares for y(k) = theta phi(k) + sum_s c_s S_s(k), with standard errors.
 
-    Every channel i of ``y`` shares the regressor rows ``phi``; the shared terms S_s are
-    6-vectors per row multiplied by one scalar c_s common to all channels (a Coulomb level
-    mapped through Jacobians, for instance). Channels have different units (N and N m) and
-    noise levels, so the solve is weighted by each channel's residual variance from a first,
-    equally weighted pass (feasible generalized least squares); with ``symmetric`` the
-    weighting is what couples the channels, without it the coefficients of theta equal the
-    per-channel ordinary least squares.
-
-    The normal equations are assembled from p x p Gram blocks, so memory does not grow with
-    the number of rows beyond the inputs; columns are equilibrated before solving.
+    Every channel of ``y`` shares the rows ``phi``; each shared term S_s is a 6-vector per row
+    with one scalar c_s common to all channels. The solve is weighted by each channel's
+    residual variance from a first, equally weighted pass (feasible generalized least squares),
+    since channels differ in units and noise.
 
     Parameters
     ----------
@@ -175,28 +167,17 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
     regressor_names, shared_names : sequence of str, optional
         Used in error messages, e.g. ``"q_ddot[rx]"``.
     max_condition : float
-        Largest acceptable condition number of the equilibrated regression; above it the
-        problem counts as rank deficient and an IdentificationError names the regressors.
+        Largest acceptable condition number of the equilibrated regression.
     autocorrelated : bool
-        The rows are consecutive samples of a time series whose residuals are correlated
-        (filtered signals): inflate each channel's variance by its integrated
-        autocorrelation time tau = 1 + 2 sum_k rho_k (summed while rho_k > 0), i.e. count
-        K / tau independent equations. Without it the standard errors assume white residuals.
+        The residuals are correlated in time (filtered signals): inflate each channel's
+        variance by its integrated autocorrelation time (:func:`integrated_autocorrelation`).
     regressor_noise : ndarray, shape (p, p), optional
-        The sum over rows of the covariance of the noise the regressor rows carry (pose noise
-        through the filters that make q_dot and q_ddot): subtracted from phi^T phi, it
-        removes the attenuation bias that noise in the regressors puts on the estimate
-        (errors in variables; the noise is taken independent of the targets' noise).
+        Sum over rows of the covariance of the regressors' noise, subtracted from phi^T phi
+        to remove the errors-in-variables attenuation.
     segments : sequence of (int, int), optional
-        The rows as consecutive records: each one's number of rows and its correlation
-        length (rows beyond which its noise is uncorrelated: the filter's support). Given,
-        the covariance is also the sandwich of the unknowns' scores
-        (:func:`~stewartid.identification.long_run.score_sandwich`) and each variance
-        the larger of the two
-        (:func:`~stewartid.identification.long_run.with_larger_variances`): the sandwich
-        counts the residual where the regressors are (a high-pass residual adds little),
-        the autocorrelation time counts correlation beyond the filter's support (model
-        error, periodic with the motion).
+        The rows as consecutive records: each one's number of rows and its correlation length
+        (rows). Given, each variance is the larger of the above and the score sandwich
+        (:func:`~stewartid.identification.long_run.score_sandwich`).
 
     Returns
     -------
@@ -289,9 +270,10 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
 
 
 def _row_scores(phi: np.ndarray, S: np.ndarray, weighted: np.ndarray) -> np.ndarray:
-    """Per row, the gradient of its weighted squared residual in the full unknowns: channel
-    i's coefficients w_i phi_k r_ki, the shared ones sum_i w_i S_ksi r_ki; ``weighted`` is
-    r / sigma^2, shape (K, 6)."""
+    """Per row, the gradient of its weighted squared residual in the full unknowns, shape (K, 6 p + s).
+
+    ``weighted`` is r / sigma^2, shape (K, 6).
+    """
     K, p = phi.shape
     per_channel = (phi[:, None, :] * weighted[:, :, None]).reshape(K, 6 * p)
     return np.concatenate([per_channel, np.einsum("ksi,ki->ks", S, weighted)], axis=1)
@@ -300,8 +282,7 @@ def _row_scores(phi: np.ndarray, S: np.ndarray, weighted: np.ndarray) -> np.ndar
 def integrated_autocorrelation(x: np.ndarray, max_lag: int | None = None) -> float:
     """Integrated autocorrelation time tau = 1 + 2 sum_{k>=1} rho_k of a series (samples).
 
-    The sum stops at the first non-positive autocorrelation (initial positive sequence), so
-    white noise gives tau close to 1 and a signal smoothed over w samples about w.
+    The sum stops at the first non-positive autocorrelation (initial positive sequence).
     """
     x = np.asarray(x, dtype=float) - np.mean(x)
     n = len(x)
@@ -334,17 +315,11 @@ def bias_compensated_least_squares(phi: np.ndarray, target: np.ndarray, cluster:
                                    ) -> tuple[np.ndarray, np.ndarray]:
     """Errors-in-variables least squares with cluster-robust standard errors.
 
-    With measured regressors X = X0 + E and targets Y = Y0 + E_y, ordinary least squares
-    is biased towards zero by E[E^T E] (attenuation) and shifted by E[E^T E_y]. With the
-    noise second moments known per row, the bias-compensated estimator (Stoica &
-    Soderstrom 1982, "Bias correction in least-squares identification")
-
         theta_i = (X^T X - sum_k C_k)^-1 (X^T y_i - sum_k D_k[:, i])
 
-    is consistent. Its covariance is the sandwich A^-1 (sum_c s_c s_c^T) A^-1 with the
-    mean-zero estimating-equation scores of each cluster
-    s_c = X_c^T (y_c - X_c theta) + C_c theta - D_c, clusters being the intervals (their
-    equations share samples; intervals do not overlap, so clusters are independent).
+    with C_k, D_k the known noise second moments of each row (Stoica and Soderstrom 1982, "Bias
+    correction in least-squares identification"). The covariance is the sandwich over
+    independent clusters (intervals) of the estimating-equation scores.
 
     Parameters
     ----------
