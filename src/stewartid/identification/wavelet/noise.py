@@ -1,14 +1,5 @@
-"""Measurement noise estimated from the data, and how it propagates into the wavelet
-equations of Method B.
-
-- :func:`white_noise_covariance`: covariance of white noise per sample (pose, forces);
-- :func:`joint_rate_noise`: the noise it causes on the Savitzky-Golay joint rates (for the
-  hysteresis thresholds of the interval detection);
-- :func:`estimate_noise`: both, for one prepared experiment (the noise-model step of
-  Method B).
-
-How pose noise enters the generalized force, for the errors-in-variables correction, is a
-model term: :func:`~stewartid.identification.preparation.generalized_force_sensitivity`.
+"""Measurement noise estimated from the data (pose, forces) and the noise it puts on the joint
+rates: the noise-model step of Method B.
 """
 
 from __future__ import annotations
@@ -29,20 +20,15 @@ from stewartid.signals.differentiation import (
 def white_noise_covariance(q: np.ndarray, smooth: np.ndarray | None = None) -> np.ndarray:
     """Covariance of white measurement noise on a smooth signal, from second differences.
 
-    For a smooth signal, q[n+1] - 2 q[n] + q[n-1] is the noise e[n+1] - 2 e[n] + e[n-1]
-    (covariance 6 Sigma for white noise) plus q_ddot dt^2. The latter is removed by taking
-    the differences of q minus a smoothed copy (a low-pass smoother leaves the noise's second
-    differences almost untouched), so noise-free data give a covariance near zero. The pose
-    of a hexapod is the forward kinematics of the measured leg lengths, so its noise is
-    correlated across the six coordinates; the full covariance is returned.
+    The second differences of q minus a smoothed copy are the noise's, of covariance 6 Sigma
+    for white noise; noise-free data give a covariance near zero.
 
     Parameters
     ----------
     q : ndarray, shape (N, m)
         Measured signals, e.g. poses (m, rad) or generalized forces (N, N m).
     smooth : ndarray, shape (N, m), optional
-        A low-pass smoothed copy of ``q`` (e.g. the Savitzky-Golay output); None: raw
-        second differences.
+        A low-pass smoothed copy of ``q``; None: raw second differences.
 
     Returns
     -------
@@ -60,10 +46,8 @@ def joint_rate_noise(covariance: np.ndarray, sample_rate: float, window: float,
                      order: int = DEFAULT_ORDER) -> np.ndarray:
     """Standard deviation of each Savitzky-Golay joint rate caused by pose noise.
 
-    The velocity filter is a linear combination of samples with coefficients c, so white
-    pose noise of covariance Sigma gives q_dot noise of covariance |c|^2 Sigma, and the joint
-    rates J q_dot the standard deviations |c| sqrt(diag(J Sigma J^T)) (Jacobians averaged over
-    the record; the motion is small).
+    |c| sqrt(diag(J Sigma J^T)), with c the velocity filter's coefficients and J the Jacobians
+    averaged over the record.
 
     Parameters
     ----------
@@ -116,9 +100,7 @@ class NoiseModel(NamedTuple):
 
 
 def estimate_noise(experiment: Experiment, window: float) -> NoiseModel:
-    """The noise model of one prepared experiment: pose and generalized force smoothed with
-    a Savitzky-Golay window, the white noise each holds around its smoothed copy, and what
-    the pose noise puts on the joint rates (from the Jacobians the experiment holds).
+    """The noise model of one prepared experiment.
 
     Parameters
     ----------

@@ -1,11 +1,7 @@
 """Method B's equations at chosen (scale, shift) points: the paper's wavelet transform.
 
-Inside every constant-direction interval, for every fraction s of ``scale_fractions`` the
-scale is a = s T / (2 h) (T the interval length, h the wavelet's half-width in scales), and
-``shifts_per_scale`` shifts spread over the positions that keep the support inside the
-interval (:func:`~stewartid.identification.wavelet.intervals.wavelet_points`). Each (a, b) gives the
-equation [Mt Bt] [W_psi q_ddot ; W_psi q_dot](a, b) = W_psi y (a, b), with the derivatives
-obtained as ``variant`` says (see :mod:`.wavelet`).
+Each (a, b) point inside an interval gives
+[Mt Bt] [W_psi q_ddot ; W_psi q_dot](a, b) = W_psi y (a, b).
 """
 
 from __future__ import annotations
@@ -37,8 +33,11 @@ def point_equations(experiment: Experiment, found: Detection,
     wavelets : sequence of MotherWavelet
         Every wavelet is applied at every (a, b) point.
     scale_fractions : tuple of float
+        Scales as fractions of the interval length
+        (:func:`~stewartid.identification.wavelet.intervals.wavelet_points`).
     shifts_per_scale : int
     variant : {"position", "paper", "derivative"}
+        How the transformed derivatives are obtained.
 
     Returns
     -------
@@ -70,16 +69,13 @@ def point_equations(experiment: Experiment, found: Detection,
         w0 = matrix(0)
         targets.append(w0 @ experiment.generalized_force)
         if variant == "position":
-            # constants vanish analytically (and, with the moment correction, to
-            # rounding); removing the mean also keeps the Mexican hat's truncation error
-            # proportional to the motion, not the offset
+            # removing the mean keeps the Mexican hat's truncation error proportional to
+            # the motion, not the offset
             from scipy import sparse  # only this path builds sparse matrices
 
             w2 = sparse.diags(1.0 / scales ** 2) @ matrix(2)
             w1 = sparse.diags(-1.0 / scales) @ matrix(1)
             w_acc, w_vel = w2 @ qc, w1 @ qc
-            # inner products of the rows acting on q (acc, vel) and on y (target): the
-            # covariances of the transformed white pose noise
             operators = (w2, w1, w0)
             products.append(np.stack([
                 np.stack([np.asarray(u.multiply(v).sum(axis=1)).ravel()

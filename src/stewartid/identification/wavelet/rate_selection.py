@@ -1,12 +1,5 @@
-"""Which Coulomb regressors Method B's rows carry: the soft sign's transition rate, the fits
-at every candidate averaged by how well each explains the rows, and (every interval
-constant free) whether the Coulomb levels are kept at all.
-
-The invariant rows remove each interval's constant, but the Coulomb force is not constant
-inside an interval when the pose changes its map J_j(q)^T or an idle joint (left out of the
-detection) reverses: both grow with the motion's amplitude. The rows then gain the
-Coulomb levels' regressors (:attr:`.weak_form.IntervalEquations.coulomb_rows`), at each
-candidate transition rate of :data:`.weak_form.SOFT_SIGN_RATES`.
+"""Which Coulomb regressors Method B's rows carry: fits at every candidate soft-sign transition
+rate averaged by how well each explains the rows, and whether the Coulomb levels are kept.
 """
 
 from __future__ import annotations
@@ -25,8 +18,10 @@ VARIATION_TEST_LEVEL = 0.01
 
 
 def residual_cost(solution: WeakFormSolution) -> float:
-    """The sum over channels of the log of the force-side noise variance: minus twice the
-    profile log-likelihood of Gaussian rows, per row."""
+    """Sum over channels of the log force-side noise variance.
+
+    Minus twice the profile log-likelihood of Gaussian rows, per row.
+    """
     return float(np.sum(np.log(solution.noise_std ** 2)))
 
 
@@ -34,22 +29,16 @@ def averaged_over_rates(solve: Callable[[int], WeakFormSolution], rates: Sequenc
                         ) -> tuple[WeakFormSolution, float]:
     """``solve(index)`` at every transition rate, averaged over the rates with Akaike weights.
 
-    The candidates have the same unknowns, so each one's weight is exp(-D_k / 2), normalised,
-    with D_k = n (c_k - min c) its excess of minus twice the profile log-likelihood (n rows
-    per channel, c = :func:`residual_cost`). Where the data tell the rates apart (a large
-    Coulomb force) one candidate takes the weight; where they do not, choosing the least
-    residual picks among fits that trade the Coulomb levels for Bt, and the choice's
-    variance is missing from the chosen fit's standard errors (the heavy platform of
-    ``docs/benchmarks.md`` at 5 N m: Bt 3-4 standard errors off on one seed in eight). The
-    average carries it: mean sum_k w_k theta_k, standard error
-    sqrt(sum_k w_k (s_k^2 + (theta_k - mean)^2)) (Burnham and Anderson 2002, sec. 6.3).
+    Each weight is exp(-D_k / 2), normalised, with D_k = n (c_k - min c) (n rows per channel,
+    c = :func:`residual_cost`); the mean is sum_k w_k theta_k with standard error
+    sqrt(sum_k w_k (s_k^2 + (theta_k - mean)^2)) (Burnham and Anderson 2002, sec. 6.3), which
+    carries the uncertainty of the choice of rate.
 
     Returns
     -------
     solution : WeakFormSolution
-        [Mt Bt] and the Coulomb levels averaged, with their standard errors; the rest (the
-        noise, hence :func:`residual_cost`) of the candidate of least residual;
-        ``rate_weights`` each rate's weight.
+        [Mt Bt] and the Coulomb levels averaged, with their standard errors; the rest of the
+        candidate of least residual; ``rate_weights`` each rate's weight.
     rate : float
         The transition rate of greatest weight (rad/s).
     """
@@ -78,18 +67,11 @@ def averaged_over_rates(solve: Callable[[int], WeakFormSolution], rates: Sequenc
 def solve_weak_form_over_rates(equations: Sequence[IntervalEquations], n_experiments: int,
                                shared_friction: bool = True, **settings
                                ) -> tuple[WeakFormSolution, float | None]:
-    """:func:`solve_weak_form` with the invariant rows' Coulomb regressors at every soft-sign
-    transition rate of the equations' ``coulomb_rows``, averaged over the rates
-    (:func:`averaged_over_rates`); with ``shared_friction`` the solution without them.
+    """:func:`solve_weak_form` with the rows' Coulomb regressors, averaged over transition rates.
 
-    With every constant free (not ``shared_friction``) the levels are extra unknowns, kept
-    only when a likelihood-ratio test at :data:`VARIATION_TEST_LEVEL` says they explain the
-    rows (chi-square with n_types degrees of freedom; 11.3 for three levels); else the
-    solution without them. Paper platform, 30 N m, reference noise, 8 seeds: the paper's
-    sines gave 2.2-9.5 (keeping the levels anyway cost 35 % in the median largest error),
-    the same sines at ten times their amplitude 13-118 (without the levels Mt(4,2) was
-    3.5 % and 4.7 standard errors off). Levels more than 3 standard errors below zero, which
-    no friction has, also leave them out: the structure does not describe the plant.
+    With ``shared_friction`` the solution without them. Otherwise the levels are kept only when
+    a likelihood-ratio test at :data:`VARIATION_TEST_LEVEL` says they explain the rows and no
+    level is more than 3 standard errors below zero (which no friction has).
 
     Returns
     -------
@@ -98,7 +80,7 @@ def solve_weak_form_over_rates(equations: Sequence[IntervalEquations], n_experim
         The transition rate of greatest weight (rad/s, from
         :data:`.weak_form.SOFT_SIGN_RATES`); None when the levels were left out.
     """
-    if shared_friction:  # the mean rows carry the levels; their benchmarks are without these
+    if shared_friction:  # the mean rows carry the levels
         return solve_weak_form(equations, n_experiments, True, **settings), None
     shared: dict = {}
     plain = solve_weak_form(equations, n_experiments, False, shared=shared, **settings)
@@ -107,9 +89,8 @@ def solve_weak_form_over_rates(equations: Sequence[IntervalEquations], n_experim
                                       variation=True, shared=shared, **settings),
         SOFT_SIGN_RATES[:len(equations[0].coulomb_rows)])
     rows = plain.n_equations
-    # likelihood ratio of the levels (with the rate picked among the candidates), and levels
-    # a friction can have: a level 3 standard errors below zero says the plant's friction
-    # does not follow the structure (MuJoCo's frictionloss on the example data: -8.9)
+    # likelihood ratio of the levels, and levels a friction can have: one 3 standard errors
+    # below zero says the plant's friction does not follow the structure
     gain = rows * (residual_cost(plain) - residual_cost(best))
     explains = gain > chdtri(len(best.coulomb), VARIATION_TEST_LEVEL)
     if explains and np.all(best.coulomb > -3.0 * best.coulomb_std):
