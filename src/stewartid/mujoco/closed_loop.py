@@ -1,13 +1,9 @@
 """An experiment played on the MuJoCo model: the plant's leg servo on ideal force actuators,
 logged like a rig's record.
 
-The independent engine as a source of logs: the same command as
-:func:`stewartid.simulation.simulate_experiment`, MuJoCo's own integration of the 42-joint
-mechanism closed by welds (:mod:`~stewartid.mujoco.model`), and a record in the package's
-:class:`~stewartid.datasets.dataset.Dataset` (pose, leg lengths, actuator forces) that every
-identifier reads. What differs from our plant is what would differ on another simulator: the
-rigid-body algorithms, the Cardan chains' axes, MuJoCo's friction constraints instead of our
-regularised Coulomb law, its integrator, and no hydraulics (the actuators are ideal).
+The same command as :func:`stewartid.simulation.simulate_experiment`, integrated by an
+independent engine (its own rigid-body algorithms, Cardan axes, friction constraints and
+integrator; no hydraulics), recorded as a :class:`~stewartid.datasets.dataset.Dataset`.
 """
 
 from __future__ import annotations
@@ -46,24 +42,14 @@ def simulate_mujoco(platform: Platform, excitation: Commanded, duration: float, 
     """Play ``excitation`` on the MuJoCo model and record it at the sensors' rate.
 
     The legs are ideal force actuators under the PD part of the plant's leg-length servo with
-    its gravity feed-forward (:func:`~stewartid.mujoco.state.add_leg_servo`; MuJoCo would need
-    an extra state per leg for the integral term, which is left out whatever
-    ``[controller] integral_gain`` says). Every sample is
-    MuJoCo's exact state: the platform's pose, the slides' leg lengths and the actuator
-    forces (the forces a load cell would read then). No sensor errors: add them with
-    :func:`stewartid.simulation.degrade`.
+    its gravity feed-forward (:func:`~stewartid.mujoco.state.add_leg_servo`; the integral term
+    would need an extra state per leg and is left out). Every sample is MuJoCo's exact state:
+    the platform's pose, the slides' leg lengths and the actuator forces; no sensor errors (add
+    them with :func:`stewartid.simulation.degrade`).
 
-    The command is evaluated at every stage of the integrator, through MuJoCo's control
-    callback (set for the run, the previous one restored after), from a table at half steps.
-    That callback is global to the process: run one simulation per process at a time (worker
-    processes, not threads).
-
-    Held over each step instead, as ``ctrl`` is by default, RK4 integrates the stiff servo
-    with an error that acts like a damper along the legs, K_p K_d step^2 / (12 m) for a mass
-    m on the servo: on the paper platform 21 N s/m at 0.5 ms and 5.3 N s/m at 0.25 ms, where
-    it raised the heave damping Bt(3,3) found on noise-free logs by 0.94 %; at 0.5 ms it put
-    2.5 N rms between the recorded forces and the recorded motion.
-    Evaluated at every stage, that gap is 2e-4 N rms at 0.5 ms (forces up to 44 kN).
+    The command is evaluated at every stage of the integrator through MuJoCo's control callback
+    (a command held over each step acts like a damper along the legs). That callback is global
+    to the process: run one simulation per process at a time (worker processes, not threads).
 
     Parameters
     ----------

@@ -1,10 +1,7 @@
-"""Experiments played on the MuJoCo model, with sensor errors, as ``stewartid simulate``
-writes the plant's (``--engine mujoco``).
-
-A second engine for every check a user runs on our plant: the paper's six sine experiments or
-any command files (a design's), each played by
-:func:`~stewartid.mujoco.closed_loop.simulate_mujoco` and then measured by the same sensor
-model (:func:`~stewartid.simulation.sensors.degrade`, the noise stream of experiment k of
+"""Experiments played on the MuJoCo model with sensor errors (``--engine mujoco`` of the
+``simulate`` command): each played by :func:`~stewartid.mujoco.closed_loop.simulate_mujoco`,
+then measured by the plant's sensor
+model (:func:`~stewartid.simulation.sensors.degrade`, the noise stream of
 :func:`~stewartid.simulation.experiments.noise_generator`).
 """
 

@@ -1,75 +1,48 @@
 """The platform as a MuJoCo model: an independent engine for the same mechanism.
 
 :func:`build_mjcf` writes MJCF for a :class:`~stewartid.platform.Platform`;
-:func:`load_model` compiles it. The helpers below move poses, rates and forces between
-our coordinates and MuJoCo's, so the two engines can be compared term by term (tests) and
-timed on the same load (``benchmarks/bench_plant_vs_mujoco.py``). MuJoCo is an optional
-dependency, imported only when a function needs it: ``pip install "stewartid[mujoco]"``.
+:func:`load_model` compiles it. The helpers move poses, rates and forces between our
+coordinates and MuJoCo's, so the two engines can be compared term by term. MuJoCo is
+imported only when a function needs it: ``pip install "stewartid[mujoco]"``.
 
 Frames
 ------
-MuJoCo's world is the paper frame turned half a turn about x (z up, so its viewer shows the
-platform upright and its default gravity (0, 0, -9.81) is the paper's +9.81 along z down)::
+MuJoCo's world is the paper frame turned half a turn about x (z up)::
 
     p_mujoco = T p_paper,   T = diag(1, -1, -1)   (a proper rotation, R_x(pi)).
 
-Bodies follow the same rule: the platform body's local frame is T applied to the paper's
-platform frame, so its world orientation is T R T. For a pose q = [x, y, z, rx, ry, rz],
-the MuJoCo image has position T [x, y, z] and roll-pitch-yaw (rx, -ry, -rz); generalized
-forces and rates transform with the same diag(1, -1, -1, 1, -1, -1) (the matrix
-``T_M_T`` of ``MODEL.md``, used there to compare the z-up and z-down mass matrices).
+The platform body's world orientation is T R T: pose q = [x, y, z, rx, ry, rz] has position
+T [x, y, z] and roll-pitch-yaw (rx, -ry, -rz); generalized forces and rates transform with
+diag(1, -1, -1, 1, -1, -1).
 
 Mechanism
 ---------
 Each leg is an open chain from the base, closed on the platform by a weld:
 
 * ``leg<k>_cylinder`` at the base joint B: hinges ``leg<k>_lower1`` (axis e1) then
-  ``leg<k>_lower2`` (axis e2, carried by the first), a Cardan joint. Mass, centre of mass
-  B + d_l u and transverse inertia of the lower part.
+  ``leg<k>_lower2`` (axis e2), a Cardan joint; the lower part's mass, centre of mass
+  B + d_l u and transverse inertia.
 * ``leg<k>_rod``: slide ``leg<k>_slide`` along the leg (qpos = l - l_0, l_0 the neutral
   leg length), driven by the ideal force actuator ``leg<k>`` (``<motor>``, N, positive
-  extends). Mass, centre of mass A - d_u u and transverse inertia of the upper part.
+  extends); the upper part's mass, centre of mass A - d_u u and transverse inertia.
 * ``leg<k>_end`` at the upper joint A: hinges ``leg<k>_upper1`` (e1), ``leg<k>_upper2``
-  (e2), a second Cardan joint, then ``leg<k>_revolute`` about the leg; welded to the
-  platform (6 constraint rows).
+  (e2), then ``leg<k>_revolute`` about the leg; welded to the platform.
 
-The platform is a free body at the reference point (its centre of mass). A ``[payload]`` is
-a body ``payload`` fixed in it (no joint), with its own mass, centre of mass and full inertia:
-MuJoCo composes the two bodies itself. The axes are the
-orthonormal leg frame of ``docs/conventions.md`` (e1 = unit(z x u), e2 = u x e1, u) at the
-neutral pose, which is every joint's zero. Away from it the Cardan axes move with the
-bodies that carry them while our model re-evaluates e1, e2 from the current leg direction:
-the axes agree at the gimbal's zero and differ by an angle of the order of the gimbal
-deflection. Masses, gravity and the leg Jacobian do not depend on the choice of axes; the
-joint friction does. The lower pair's total dissipation is invariant to first order (any
-orthonormal pair across the leg), but the upper chain's three hinges stop being orthogonal
-(upper 1 and the revolute axis tilt by the upper 2 angle), so a revolute rate leaks into the
-damped gimbal rates at first order: the viscous matrix V^T D V differs from our Bt by about
-0.2-0.4 times the largest gimbal angle (relative to its largest entry; about 0.3 % at 10 mrad).
+The platform is a free body at the reference point; a ``[payload]`` is a body fixed in it.
+The axes are the leg frame of ``docs/conventions.md`` at the neutral pose, every joint's
+zero; away from it the Cardan axes move with their bodies while our model re-evaluates e1,
+e2, so the joint friction (not the masses, gravity or leg Jacobian) differs at the order of
+the gimbal deflection.
 
-Friction: joint damping ``gimbal_viscous`` on the four gimbal hinges, none on the revolute
-or the slide; Coulomb ``coulomb`` as MuJoCo ``frictionloss`` on all five hinges (MuJoCo
-resolves it as a constraint, not regularised as our ``Fc w / sqrt(w^2 + s^2)``). A friction
-row is soft like any constraint: its regulariser is (1 - d)/d times the row's inverse
-effective mass, so at MuJoCo's default impedance (0.9-0.95) the upper hinges, which carry only
-the light end bodies, passed 1-2 N m of a 30 N m friction at 0.05 rad/s, while the lower
-gimbals, which carry the cylinders, passed all of it. The friction rows therefore take the
-welds' time constant and impedance (``solreffriction``, ``solimpfriction``): every hinge then
-passes its full level once it slides.
+Friction: damping ``gimbal_viscous`` on the four gimbal hinges; Coulomb ``coulomb`` as
+``frictionloss`` on all five hinges, a constraint rather than our regularised law. The
+friction rows take the welds' time constant and impedance, since at MuJoCo's default
+softness the hinges of the light end bodies would not pass their full friction.
 
-Closure stiffness: MuJoCo's equality constraints are soft. With time constant tau and
-impedance d a weld row obeys r'' = -b r' - k r + (1 - d)/d A_ii lambda (k ~ 1/tau^2, A_ii the
-row's inverse effective mass, lambda its force), so its violation under load is of order
-(1 - d) tau^2 A_ii lambda. At the defaults (tau = 2 timestep, d = 0.9999) a 2 s closed-loop
-run at 0.5 ms keeps the position rows within 5e-8 m and the rotational rows within 6e-6 rad.
-
-Masses the chain needs: MuJoCo requires mass and inertia on every moving body, so each
-``end`` body carries ``END_MASS_FRACTION`` of the platform's mass (isotropic inertia of a
-0.3 m sphere; the rotational rows' compliance scales with 1/A_ii, hence not smaller), taken
-from the platform body, whose mass, centre of mass and inertia are reduced so that the
-platform and the six ends together have exactly the description's mass and inertia. Leg
-parts get a token inertia about the leg axis (1e-9 of the transverse one) where our model has
-none: the lower Cardan joint lets a leg spin only at second order in its deflection.
+Masses: MuJoCo requires mass and inertia on every moving body, so each ``end`` body carries
+``END_MASS_FRACTION`` of the platform's mass, taken from the platform body so that the
+platform and the six ends together have the description's mass and inertia. Leg parts get a
+token inertia about the leg axis, where our model has none.
 """
 
 from __future__ import annotations
@@ -89,13 +62,12 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
 T = np.diag([1.0, -1.0, -1.0])
 #: Share of the platform's mass carried by each leg's end body (see the module docstring).
 END_MASS_FRACTION = 1e-4
-#: Radius (m) of the sphere whose inertia the end bodies carry: large enough that the
-#: welds' rotational rows, whose compliance scales with 1/inertia, stay below 1e-5 rad.
+#: Radius (m) of the sphere whose inertia the end bodies carry: the welds' rotational rows'
+#: compliance scales with 1/inertia.
 END_RADIUS = 0.3
 #: Integrators accepted by :func:`build_mjcf` (MuJoCo's names).
 INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast")
-#: MuJoCo's default time step here (s): with RK4, the welds' error is then 1.1e-7 m against our
-#: plant in closed loop without friction, below the reference length noise (20 um).
+#: MuJoCo's default time step here (s).
 DEFAULT_TIMESTEP = 5e-4
 
 
@@ -193,14 +165,12 @@ def build_mjcf(platform: Platform, *, integrator: str = "RK4",
     timestep : float
         Integration step (s).
     constraint_timeconst : float, optional
-        Time constant of the weld constraints that close the legs on the platform (s);
-        ``2 * timestep`` by default, the smallest MuJoCo recommends for stability.
+        Time constant of the welds that close the legs on the platform (s); ``2 * timestep``
+        by default, the smallest MuJoCo recommends for stability.
     constraint_impedance : float
-        Impedance d of the welds, in (0, 1): the share of the constraint the solver enforces
-        rigidly; closer to 1 is stiffer.
+        Impedance d of the welds, in (0, 1); closer to 1 is stiffer.
     coulomb : bool
-        Model the Coulomb friction as ``frictionloss`` on the five hinges of each leg
-        (adds up to 30 constraint rows when ``[friction] coulomb`` > 0).
+        Model the Coulomb friction as ``frictionloss`` on the five hinges of each leg.
 
     Returns
     -------
@@ -215,9 +185,8 @@ def build_mjcf(platform: Platform, *, integrator: str = "RK4",
     if not 0.0 < constraint_impedance < 1.0:
         raise ValueError(f"constraint_impedance must lie in (0, 1); got {constraint_impedance!r}.")
     friction = platform.friction.coulomb if coulomb else 0.0
-    # the friction rows as stiff as the welds: at MuJoCo's default softness a row's
-    # regulariser scales with the joint's inverse inertia, and the light end bodies' hinges
-    # would pass 1-2 N m of a 30 N m friction (see the module docstring)
+    # the friction rows as stiff as the welds: at MuJoCo's default softness the light end
+    # bodies' hinges would not pass their full friction
     imp = f"{constraint_impedance:.17g}"
     frictionloss = (f' frictionloss="{friction:.17g}" solreffriction="{tau:.17g} 1" '
                     f'solimpfriction="{imp} {imp} 0.001 0.5 2"') if friction > 0 else ""
@@ -285,9 +254,8 @@ def _leg_lines(platform: Platform, k: int, frame: np.ndarray, frictionloss: str,
     i = platform.inertia
     damping = platform.friction.gimbal_viscous
     l0 = platform.neutral_leg_length
-    # MuJoCo refuses a zero principal inertia; our leg parts have none about the leg axis,
-    # about which the Cardan joints let them turn only at second order in the deflection,
-    # so a token value changes nothing measurable (1e-9 of the transverse inertia).
+    # MuJoCo refuses a zero principal inertia; the Cardan joints let a leg turn about its axis
+    # only at second order in the deflection, so a token value stands for our none.
     axial = f"{max(1e-9 * max(i.lower_leg_inertia, i.upper_leg_inertia), 1e-10):.3g}"
     lower_t = max(i.lower_leg_inertia, 1e-10)
     upper_t = max(i.upper_leg_inertia, 1e-10)

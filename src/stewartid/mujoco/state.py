@@ -160,10 +160,9 @@ def equality_jacobian(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
 def closure_map(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
     """Map S from the platform's free-joint velocity to all joint velocities.
 
-    The welds' Jacobian J_c (36 x nv) splits into platform and leg columns; velocities that
-    keep the chains closed satisfy J_c,p v_p + J_c,l v_l = 0, so v_l = -J_c,l^-1 J_c,p v_p.
-    Forces J_c^T lambda of the welds do no work along S (J_c S = 0), which is why S^T
-    projects MuJoCo's joint-space equations onto the platform's six coordinates.
+    Velocities that keep the chains closed satisfy J_c,p v_p + J_c,l v_l = 0 (J_c the welds'
+    Jacobian), so v_l = -J_c,l^-1 J_c,p v_p; the welds do no work along S, so S^T projects
+    MuJoCo's joint-space equations onto the platform's six coordinates.
 
     Returns
     -------
@@ -291,12 +290,10 @@ def leg_lengths(platform: Platform, model: mujoco.MjModel, data: mujoco.MjData) 
 def add_leg_servo(platform: Platform, model: mujoco.MjModel) -> None:
     """Give the six leg motors the PD part of the plant's leg-length servo, in place.
 
-    The plant's controller (``stewartid.simulation.controller``, integral gain aside) demands
-    f = f_ff + K_p (l_cmd - l) + K_d (l_cmd' - l'). The terms in l and l' become the motors'
-    affine bias (K_p, K_d from ``[controller]``), which MuJoCo evaluates at every stage of
-    its integrator, as our continuous-time controller is; the command terms come through
-    ``ctrl`` (:func:`servo_controls`). The actuators stay ideal force sources: with zero
-    gains they are the plain ``<motor>`` of :func:`build_mjcf`.
+    The terms in l and l' of f = f_ff + K_p (l_cmd - l) + K_d (l_cmd' - l') become the motors'
+    affine bias, evaluated at every integrator stage; the command terms come through ``ctrl``
+    (:func:`servo_controls`). With zero gains the motors are the plain ``<motor>`` of
+    :func:`build_mjcf`.
     """
     mj = require_mujoco()
     c = platform.controller
