@@ -1,3 +1,3 @@
-"""The rigid-body ("physical") model identified from the logs: payload and platform masses,
-first moments and inertias, friction per joint type and sensor offsets, valid over the
-workspace; Mt and Bt at any pose follow from them."""
+"""The rigid-body ("physical") model identified from the logs: masses, first moments,
+inertias, friction per joint type and sensor offsets, from which Mt and Bt follow at any pose.
+"""

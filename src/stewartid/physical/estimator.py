@@ -1,38 +1,11 @@
 """The physical model: weighted least squares on the base parameters of the regressor, and the
 paper's Mt, Bt at the neutral pose from the identified parameters.
 
-The measured generalized force is linear in the physical parameters
-(:mod:`stewartid.model.regressor`), J_lq^T f = Y(q, q_dot, q_ddot) pi. The regressor is
-evaluated at every sample (rates and accelerations by Savitzky-Golay, the Coulomb signs from
-the same rates) and both sides are filtered with the smooth kernel h of
-:func:`~stewartid.signals.differentiation.kernel_filter`: the filtered equation holds exactly
-because it is linear in pi, and h takes the differentiation's noise down to its band. The
-filtered signals are band-limited by h: the regression keeps
-:data:`~stewartid.physical.regression.ROWS_PER_WINDOW` rows per kernel
-window, which moves the estimates by a small fraction of their standard errors at a fraction
-of the cost.
-
-Two modes:
-
-- full (default): every base parameter (:func:`~stewartid.model.regressor.base_parameters`);
-- payload (``payload=True``): the platform file is known but for its payload; the known
-  platform and legs are subtracted and the residual regressed on the moving body's ten columns
-  (the payload's mass, first moment and inertia about the reference point), with the joint
-  and actuator friction and the sensor offsets as nuisance parameters.
-
-Where the data cannot tell a parameter (the scaled regression's condition number, or a
-relative standard error above ``max_relative_error``), it is fixed at the platform file's
-value, named in ``diagnostics["fixed"]`` and the rest fitted. Mt and Bt are linear in the
-parameters (:func:`~stewartid.model.matrix_regressors.inertia_regressor`,
-:func:`~stewartid.model.matrix_regressors.viscous_regressor`), their standard errors by the delta
-method from the parameters' covariance (each variance the larger of the sandwich of the
-rows' scores over the filters' correlation length and that of the scores summed per record,
-:func:`~stewartid.physical.parameter_fit.score_covariance`). The rows are mapped to the leg forces
-(:func:`~stewartid.physical.regression.leg_force_transforms`) and each leg
-weighted by its residual variance: generalized least squares for the legs' force noise.
-With ``consistent=True`` the estimate is replaced by the physically consistent parameters
-nearest to it in the metric of its covariance
-(:func:`~stewartid.physical.parameter_fit.nearest_consistent`).
+J_lq^T f = Y(q, q_dot, q_ddot) pi is linear in the physical parameters
+(:mod:`stewartid.model.regressor`); both sides are filtered with the kernel h
+(:mod:`~stewartid.physical.regression`). Full mode fits every base parameter; payload mode
+fits the payload on top of the known platform, with friction and sensor offsets as nuisance
+parameters. Parameters the data cannot tell are fixed at the platform file's values.
 """
 
 from __future__ import annotations
@@ -149,27 +122,24 @@ class PhysicalIdentifier(BaseIdentifier):
     coulomb_smoothing : float
         Rate (rad/s) below which a joint's Coulomb sign is attenuated.
     decimate : int, optional
-        Use every ``decimate``-th filtered row; None (default): ``ROWS_PER_WINDOW`` rows per
-        kernel window (:func:`~stewartid.physical.regression.row_step`).
+        Use every ``decimate``-th filtered row; None: ``ROWS_PER_WINDOW`` rows per kernel window
+        (:func:`~stewartid.physical.regression.row_step`).
     max_condition : float
         Largest condition number of the scaled regression before a parameter is fixed.
     max_relative_error : float
         Largest relative standard error of a positive parameter before it is fixed.
     consistent : bool
         Replace the estimate by the physically consistent parameters nearest to it in the
-        metric of its covariance (:func:`~stewartid.physical.parameter_fit.nearest_consistent`):
-        the moving body's (payload mode: the payload's) pseudo-inertia positive semidefinite,
-        its mass positive, friction coefficients nonnegative; how far each parameter moved,
-        in standard errors, in ``diagnostics["consistent"]``. Needs the ``convex`` extra.
+        metric of its covariance (:func:`~stewartid.physical.parameter_fit.nearest_consistent`);
+        how far each moved, in standard errors, in ``diagnostics["consistent"]``. Needs the
+        ``convex`` extra.
     noise_correction : bool
-        Remove the bias that pose noise, carried into the regressor's rates and
-        accelerations, puts on the estimate (errors in variables,
-        :func:`~stewartid.physical.noise.regressor_noise`).
+        Remove the bias that pose noise in the regressor's rates and accelerations puts on the
+        estimate (:func:`~stewartid.physical.noise.regressor_noise`).
     sampling_check : bool
         Refit at a half, a third and a quarter of the log's rate where the residual is not
         noise, and add each free parameter's change to its variance
-        (:mod:`~stewartid.identification.sampling`); Mt, Bt and Mt(q) follow by the delta
-        method.
+        (:mod:`~stewartid.identification.sampling`).
 
     Attributes
     ----------
@@ -261,8 +231,9 @@ class PhysicalIdentifier(BaseIdentifier):
     def _check_sampling(self, datasets: list[Dataset], platform: Platform,
                         result: IdentificationResult, learned: dict
                         ) -> tuple[IdentificationResult, dict]:
-        """The sampling check on the parameters: each free parameter's largest change over
-        the thinned (unconstrained) fits joins its variance, where it was free in them too."""
+        """The sampling check on the parameters: each free parameter's largest change over the
+        thinned, unconstrained fits joins its variance.
+        """
         quick = type(self)(**{**self.get_params(), "consistent": False,
                               "sampling_check": False})
         summary, fits = thinned_fits(lambda part: quick._fit(part, platform)[0], datasets,
@@ -290,9 +261,10 @@ class PhysicalIdentifier(BaseIdentifier):
 
 
 def correlation_segments(data, experiments: list) -> list[tuple[int, int]]:
-    """Per experiment its filtered rows and the lag (rows) beyond which their noise is
-    uncorrelated: the support of the kernel convolved with the Savitzky-Golay taps (window
-    and an eighth of it), the farthest two rows sharing a noise sample."""
+    """Per experiment, its filtered rows and the lag (rows) beyond which their noise is uncorrelated.
+
+    The lag is the support of the kernel convolved with the Savitzky-Golay taps.
+    """
     return [(e["samples"], math.ceil((1 + 1 / SAVGOL_FRACTION) * e["window_s"]
                                      * exp.sample_rate / e["row_step"]) + 1)
             for e, exp in zip(data.experiments, experiments, strict=True)]
@@ -300,8 +272,7 @@ def correlation_segments(data, experiments: list) -> list[tuple[int, int]]:
 
 @functools.lru_cache(maxsize=4)
 def _base_parameters(platform: Platform) -> reg.BaseParameters:
-    """:func:`~stewartid.model.regressor.base_parameters`, once per platform description: a
-    report fits the model several times (folds) and predicts with it (read only)."""
+    """:func:`~stewartid.model.regressor.base_parameters`, cached per platform description."""
     return reg.base_parameters(platform)
 
 
@@ -333,8 +304,7 @@ def parameter_model(platform: Platform, payload: bool = False) -> tuple:
 
 
 def _full_model(platform: Platform):
-    """(names, combination strings, selection (p, N_STANDARD) of the columns regressed on,
-    nominal values (p,), known standard parameters (N_STANDARD,)) of the base parameters."""
+    """The tuple of :func:`parameter_model` for every base parameter."""
     base = _base_parameters(platform)
     pi = reg.standard_parameters(platform)
     return (base.names, dict(zip(base.names, base.combinations, strict=True)),
@@ -343,8 +313,9 @@ def _full_model(platform: Platform):
 
 
 def _payload_model(platform: Platform):
-    """The same for payload mode: the payload's ten parameters (the moving body's columns)
-    and the nuisance ones; the known platform and legs as the offset."""
+    """The tuple of :func:`parameter_model` for payload mode; the known platform and legs as the
+    offset.
+    """
     known = reg.standard_parameters(known_platform(platform))
     loaded = reg.standard_parameters(platform)
     body = reg.parameter_index(reg.BODY_PARAMETERS)
@@ -363,9 +334,9 @@ def _payload_model(platform: Platform):
 
 
 def _bodies(platform: Platform, model, payload: bool) -> list[Body]:
-    """The rigid body of the consistent fit: the payload (payload mode) or the moving body,
-    whose base parameters hold the legs' upper parts (six point masses) at the file's
-    values."""
+    """The rigid body of the consistent fit: the payload (payload mode) or the moving body, the
+    legs' upper parts held at the file's values.
+    """
     names, _, selection, nominal, _ = model
     body = reg.parameter_index(reg.BODY_PARAMETERS)
     if not np.all(selection[:, body].any(axis=0)):
@@ -384,7 +355,8 @@ def _bodies(platform: Platform, model, payload: bool) -> list[Body]:
 def _result(estimator: PhysicalIdentifier, platform: Platform, model, solution: Solution,
             data: Regression, projection: ConsistentParameters | None = None) -> PhysicalResult:
     """Mt, Bt at neutral with their delta-method standard errors (of the unconstrained
-    estimate), and the parameters (the consistent ones when ``projection`` is given)."""
+    estimate), and the parameters (the consistent ones when ``projection`` is given).
+    """
     names, combinations, selection, _, offset = model
     values = solution.values if projection is None else projection.values
     matrices = [A @ (selection.T @ values + offset)
@@ -422,9 +394,11 @@ def _result(estimator: PhysicalIdentifier, platform: Platform, model, solution: 
 
 def matrix_std_errors(platform: Platform, selection: np.ndarray, covariance: np.ndarray,
                       pose: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Delta-method standard errors, (6, 6) each, of Mt and Bt at ``pose`` (absolute, m and
-    rad; neutral by default) from the covariance (p, p) of the parameters that ``selection``
-    (p, N_STANDARD) places among the standard ones."""
+    """Delta-method standard errors, (6, 6) each, of Mt and Bt at ``pose``.
+
+    ``pose`` is absolute (m, rad), neutral by default; ``covariance`` (p, p) is of the parameters
+    that ``selection`` (p, N_STANDARD) places among the standard ones.
+    """
     out = []
     for A in (matrix_regressors.inertia_regressor(platform, pose),
               matrix_regressors.viscous_regressor(platform, pose)):
@@ -436,8 +410,9 @@ def matrix_std_errors(platform: Platform, selection: np.ndarray, covariance: np.
 
 def payload_section(parameters: dict[str, float]) -> dict[str, Any]:
     """The ``[payload]`` keys (mass, com, inertia about the centre of mass) of the payload's
-    identified mass, first moment and inertia about the reference point (a mass of zero or
-    less gives the centre of mass at the reference point)."""
+    identified parameters about the reference point; a mass of zero or less puts the centre of mass
+    at the reference point.
+    """
     body = np.array([parameters[f"payload.{n}"] for n in reg.BODY_PARAMETERS])
     if not body[0] > 0:
         return {"mass": float(body[0]), "com": [0.0] * 3, "inertia": body[4:].tolist()}

@@ -1,14 +1,9 @@
 """The platform description of an identified physical model: the TOML every command accepts.
 
-Payload mode writes the platform file with the identified ``[payload]``. Full mode writes the
-identified moving body as the file's platform plus a ``[payload]`` that carries the
-difference (the only form a body with its centre of mass off the reference point and a full
-inertia matrix takes in the format), or, when the difference is no payload (a body lighter
-than the file's platform), as a platform carrying a light payload that holds the body's
-centre of mass offset and products of inertia; the legs' centres of mass and inertias from their
-identified first moments and inertias (the leg masses kept from the file: no motion tells
-them), and one viscous and one Coulomb level for all joint types (the format's), the mean of
-the identified ones.
+Payload mode writes the identified ``[payload]``. Full mode writes the moving body as the
+file's platform plus a ``[payload]`` of the difference (or a light carrier payload when the
+difference is no payload), the legs from their identified moments (masses kept from the file)
+and the mean of the identified friction levels.
 """
 
 from __future__ import annotations
@@ -89,11 +84,12 @@ CARRIER_SHARE = 0.01
 
 def _body_updates(platform: Platform, difference: dict[str, float], body: np.ndarray
                   ) -> dict[str, Any]:
-    """The moving body (standard parameters ``body``, (10,)) as the file's platform plus a
-    ``[payload]`` of the difference; when that is no payload (a body lighter than the file's
-    platform, an inertia no mass has), as a platform that carries a light payload with the
-    body's centre of mass offset and products of inertia (CARRIER_SHARE of its mass and
-    principal inertias)."""
+    """The moving body (standard parameters ``body``, (10,)) as platform and payload keys.
+
+    The file's platform plus a ``[payload]`` of the difference; when that is no payload, a
+    platform carrying a light payload (CARRIER_SHARE of its mass and principal inertias) that holds
+    the centre of mass offset and products of inertia.
+    """
     payload = {f"payload__{k}": v for k, v in payload_section(difference).items()}
     try:
         platform.replace(payload=None).replace(**payload)
@@ -136,9 +132,10 @@ def identified_platform(platform: Platform, result: PhysicalResult) -> Platform:
 
 def write_identified(platform: Platform, result: PhysicalResult, platform_out: Path,
                      experiments: int) -> Path:
-    """Write the platform description of ``result`` (:func:`identified_platform`) to
-    ``platform_out``, under the header that marks it as written by ``identify``; returns the
-    path."""
+    """Write the platform description of ``result`` to ``platform_out``; return the path.
+
+    The file starts with the header that marks it as written by ``identify``.
+    """
     identified = identified_platform(platform, result)
     return write_text_atomic(platform_out, f"{IDENTIFIED_HEADER} {experiments} experiments\n"
                              + identified.to_toml())

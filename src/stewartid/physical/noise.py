@@ -1,22 +1,12 @@
 """Errors in variables for the physical model: the share of the normal equations that pose
 noise, carried into the regressor's rates and accelerations, adds.
 
-The physical model's regressor rows are evaluated at the measured pose and its Savitzky-Golay
-rate and acceleration, then filtered with the kernel h
-(:func:`~stewartid.physical.regression.filtered_regression`). White pose noise e (covariance
-Sigma per sample, estimated from the record by
-:func:`~stewartid.identification.wavelet.noise.white_noise_covariance`) enters a filtered row
-mostly through the terms linear in the acceleration and the rate,
+To first order a filtered row's noise is
 
     delta Y(t) ~ sum_c A_c(q) (h * g2 * e_c)(t) + sum_c B_c(q) (h * g1 * e_c)(t),
 
-with A = d Y / d q_ddot (the inertia regressor), B = d Y / d q_dot at rest (the viscous
-columns) and g1, g2 the Savitzky-Golay derivative taps. Its expected outer product, summed
-over the rows kept, is what noise adds to X^T W X and what the least squares must subtract to
-be unbiased (attenuation bias; the same correction as the ``ls`` method's
-``noise_correction``). The composite filters h * g1 (odd) and h * g2 (even) give no cross term.
-Velocity products and the Coulomb signs are left out: their noise terms are of second order
-at the rates of an identification record.
+with A = d Y / d q_ddot, B = d Y / d q_dot at rest and g1, g2 the Savitzky-Golay derivative
+taps; its expected outer product is what the least squares subtract to be unbiased.
 """
 
 from __future__ import annotations
@@ -40,9 +30,11 @@ from stewartid.signals.sign_rates import coulomb_sign_rates
 
 def derivative_noise_gains(sample_rate: float, window: float, savgol_window: float,
                            order: int) -> tuple[float, float]:
-    """Variance of h * g1 * e and h * g2 * e per unit variance of white e: the energies of
-    the composite taps of the kernel (support ``window`` s) and the Savitzky-Golay rate and
-    acceleration (``savgol_window`` s, ``order``). Units 1/s^2 and 1/s^4."""
+    """Variance of h * g1 * e and h * g2 * e per unit variance of white e.
+
+    The energies of the kernel (support ``window`` s) convolved with the Savitzky-Golay rate and
+    acceleration taps (``savgol_window`` s, ``order``). Units 1/s^2 and 1/s^4.
+    """
     h = kernel_taps(sample_rate, window)[0]
     n = window_samples(savgol_window, sample_rate, order)
     return tuple(float(np.sum(np.convolve(h, savgol_coefficients(n, order, d, 1 / sample_rate))
@@ -50,9 +42,11 @@ def derivative_noise_gains(sample_rate: float, window: float, savgol_window: flo
 
 
 def measured_sign_rates(q: np.ndarray, sample_rate: float, window: float) -> np.ndarray:
-    """:func:`~stewartid.signals.sign_rates.coulomb_sign_rates` of a record whose pose noise
-    is not known yet: estimated against the pose smoothed as the physical model's regressor
-    is (order 5 over an eighth of the kernel), the rates (N, 6) returned alone."""
+    """Coulomb sign rates, shape (N, 6), of a record whose pose noise is not known yet.
+
+    :func:`~stewartid.signals.sign_rates.coulomb_sign_rates` with the noise estimated against the
+    pose smoothed as the physical model's regressor is (order 5 over an eighth of the kernel).
+    """
     smooth = differentiate(q, sample_rate, window / 8, 5, (0,))[0]
     return coulomb_sign_rates(q, sample_rate, window, white_noise_covariance(q, smooth))[0]
 
@@ -110,7 +104,7 @@ def regressor_noise(experiments: list[Experiment], windows: list[float], row_ste
         gains = derivative_noise_gains(rate, window, window / savgol_fraction, order)
         poses = kernel_filter_rows(exp.q, rate, window, row_step)
         # the Jacobians vary on the kernel's scale: every JACOBIAN_STRIDE-th row stands for
-        # its neighbours (the sum scaled to the rows kept)
+        # its neighbours
         rows, poses = len(poses), poses[::JACOBIAN_STRIDE]
         for jacobian, gain in ((matrix_regressors.viscous_regressor(platform, poses), gains[0]),
                                (matrix_regressors.inertia_regressor(platform, poses), gains[1])):
@@ -118,7 +112,7 @@ def regressor_noise(experiments: list[Experiment], windows: list[float], row_ste
                 jacobian = np.einsum("kji,kicp->kjcp", transform[::JACOBIAN_STRIDE], jacobian,
                                      optimize=True)
             # jacobian[k, i, c, :]: d Y_i / d (rate or acceleration of c) at row k; only
-            # its columns not zero at every row (4 viscous, the bodies' 14) add anything
+            # columns not zero at every row add anything
             used = np.flatnonzero(np.any(jacobian != 0.0, axis=(0, 1, 2)))
             block = np.ix_(used, used)
             factor = np.swapaxes(_factor(sigma * gain), 0, 1)

@@ -2,39 +2,17 @@
 values, and the physically consistent parameters nearest to them: the solvers of
 :mod:`stewartid.physical.estimator`.
 
-Channels are weighted by their residual variance (feasible generalized least squares). Each
-standard error is the larger of the sandwich of the rows' scores summed over the filters'
-correlation length (:func:`~stewartid.identification.long_run.long_run_covariance`) and that
-of the scores summed per record
-(:func:`~stewartid.identification.long_run.record_sandwich`), each record's own
-errors-in-variables correction taken out of its scores: it differs between records with
-their motion and filter, and shared out by rows as one total it read as model error (on a
-2 Hz payload design the mass's standard error 6 times its spread over seeds, the leg
-offsets' 4-7 times). The long-run sandwich's variances are those of its sum of
-autocovariances as it is, its correlations those of the sum made positive semidefinite: under
-pose noise that sum is the small remainder of large positive and negative autocovariances,
-and zeroing its negative eigenvalues, as a covariance needs, had raised the fits' standard
-errors to 1.23 times their spread over 12 seeds at the reference noise on a 2 Hz payload
-design (2.5 times with the pose noise alone; 1.02 and 1.52 now, a variance whose estimate
-came out negative taking the clipped one). The residual's variance times its
-autocorrelation time, which the least squares also take, is not among them here: the
-pose noise reaches this residual through the differentiated accelerations, high-pass, and
-that time counts it as if it were slow (the fits' errors 1.3 times the information-matrix
-prediction on the reference multisine, 4 times at 2 Hz), while the per-record sums see the model error
-correlated with the motion that it was kept for.
-
-:func:`nearest_consistent` projects the estimate onto the physically consistent set in the
-metric of its covariance,
+:func:`nearest_consistent` solves
 
     minimise (p - p^)^T Sigma^-1 (p - p^)  subject to  J(body) >= 0,  m(body) > 0,  f >= 0,
 
-over the estimated parameters (the fixed ones keep their values): every rigid body's
-pseudo-inertia matrix J (:func:`~stewartid.model.regressor.pseudo_inertia`, of its standard
-parameters, affine in p) positive semidefinite, its mass positive and the friction
-coefficients nonnegative (Wensing, Kim, Slotine, "Linear matrix inequalities for physically
-consistent inertial parameter identification", IEEE RA-L 3(1), 2017). Where the unconstrained
-estimate is consistent it is its own projection. A small semidefinite program, solved with
-cvxpy (the ``convex`` extra).
+with J the pseudo-inertia (:func:`~stewartid.model.regressor.pseudo_inertia`), as a small
+semidefinite program in cvxpy (the ``convex`` extra).
+
+References
+----------
+Wensing, P. M., Kim, S., Slotine, J.-J. E. "Linear matrix inequalities for physically
+consistent inertial parameter identification." IEEE RA-L 3(1) (2017).
 """
 
 from __future__ import annotations
@@ -93,11 +71,13 @@ class Solution:
 
 
 def _weighted_fit(gram, cross, weights, free, fixed_values):
-    """Equilibrated weighted least squares from the per-channel Gram matrices ``gram``
-    (6, p, p) and ``cross`` (6, p) = X_c^T y_c, the parameters outside ``free`` held at
-    ``fixed_values``: the estimates of the free ones, the inverse of their normal matrix (in
-    the original units), the singular values of the scaled regression relative to the
-    largest and its right singular vectors (rows)."""
+    """Equilibrated weighted least squares from per-channel Gram matrices.
+
+    ``gram`` (6, p, p) and ``cross`` (6, p) = X_c^T y_c; parameters outside ``free`` held at
+    ``fixed_values``. Returns the free estimates, the inverse of their normal matrix (original
+    units), the scaled regression's singular values relative to the largest and its right
+    singular vectors (rows).
+    """
     N = np.einsum("c,cpq->pq", weights, gram)
     b = np.einsum("c,cp->p", weights, cross) - N[:, ~free] @ fixed_values[~free]
     N, b = N[np.ix_(free, free)], b[free]
@@ -119,15 +99,12 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
                      segments: list[tuple[int, int]] | None = None,
                      measured_noise: list[tuple[np.ndarray, np.ndarray]] | None = None
                      ) -> Solution:
-    """Weighted least squares for y = X theta with residual-autocorrelation-consistent
-    standard errors, fixing at ``nominal`` what the data cannot tell.
+    """Weighted least squares for y = X theta, fixing at ``nominal`` what the data cannot tell.
 
-    Channels are weighted by their residual variance from a first, RMS-weighted pass
-    (feasible generalized least squares). A parameter is fixed when the column-equilibrated
-    regression's condition number exceeds ``max_condition`` (the one weighing most in the
-    weakest direction, repeatedly) or, for a parameter whose value is positive by nature,
-    when its standard error exceeds ``max_relative_error`` of its size (the larger of its
-    estimate and its scale).
+    Channels are weighted by their residual variance from a first, RMS-weighted pass. A parameter
+    is fixed when the equilibrated regression's condition number exceeds ``max_condition`` (the
+    one weighing most in the weakest direction) or, if positive by nature, when its standard
+    error exceeds ``max_relative_error`` of its size.
 
     Parameters
     ----------
@@ -137,25 +114,20 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
     nominal : ndarray, shape (p,)
         The values a fixed parameter keeps (the platform file's).
     scales : ndarray, shape (p,), optional
-        The size of each parameter positive by nature (a mass, an inertia: the moving
-        body's, for a payload's), zero for the others, which no relative error applies to.
+        The size of each parameter positive by nature, zero for the others.
     max_condition, max_relative_error : float
     regressor_noise : ndarray, shape (6, p, p) or (R, 6, p, p), optional
-        Per channel, the expected share of X^T X that noise in the regressor rows adds
-        (errors in variables): subtracted, so that the estimate is free of the attenuation
-        bias it causes. With a first axis, per record (R = ``len(segments)``): each
-        record's share is then also what noise alone leaves in its summed scores.
+        Per channel (and per record, R = ``len(segments)``), the expected share of X^T X that
+        noise in the regressor rows adds; subtracted to remove the attenuation bias.
     target_noise : ndarray, shape (6, p) or (R, 6, p), optional
-        Per channel, the expected share of X^T y that the same noise adds (when y holds
-        regressor columns too, as a known part moved to the left-hand side): subtracted.
+        The same for X^T y; subtracted.
     segments : list of (int, int), optional
         Per record, its number of rows and the lag (rows) beyond which its noise is
-        uncorrelated (the filter's support). Given, the covariance is that of the
-        parameters' scores (:func:`score_covariance`); without, the inverse normal matrix
-        scaled by the residual's variance and autocorrelation time per channel.
+        uncorrelated. Given, the covariance is :func:`score_covariance`; without, the inverse
+        normal matrix scaled by the residual's variance and autocorrelation time.
     measured_noise : list of (ndarray, ndarray), optional
-        With ``segments``: per record, a noise of the rows measured apart from the fit,
-        which the standard errors do not fall below (:func:`score_covariance`).
+        With ``segments``: per record, a noise of the rows measured apart from the fit, a floor
+        of the standard errors (:func:`score_covariance`).
 
     Returns
     -------
@@ -225,9 +197,8 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
 
 @dataclass(frozen=True)
 class Body:
-    """A rigid body of the consistent fit: its ten standard parameters (m, m c, inertia about
-    the reference point, :data:`~stewartid.model.regressor.BODY_PARAMETERS`) are
-    ``mapping @ p + offset`` for the fitted parameters p.
+    """A rigid body of the consistent fit: its ten standard parameters
+    (:data:`~stewartid.model.regressor.BODY_PARAMETERS`) are ``mapping @ p + offset``.
 
     Attributes
     ----------
@@ -265,9 +236,7 @@ class ConsistentParameters:
     solver : str
         The cvxpy solver, or ``"none"`` when the estimate was consistent already.
     status : str
-        The solver's status: ``"optimal"``, or ``"optimal_inaccurate"`` when it stopped
-        just short of its tolerances (a solution with several zero eigenvalues of a
-        pseudo-inertia, e.g. a point mass), or ``"consistent already"``.
+        ``"optimal"``, ``"optimal_inaccurate"`` or ``"consistent already"``.
     """
 
     values: np.ndarray
@@ -283,17 +252,12 @@ def score_covariance(inverse: np.ndarray, X: np.ndarray, residual: np.ndarray,
                      expected: np.ndarray | None = None,
                      measured_noise: list[tuple[np.ndarray, np.ndarray]] | None = None
                      ) -> np.ndarray:
-    """N^-1 B N^-1, B the long-run covariance of the scores s_k = sum_c w_c X_kc r_kc
-    (:func:`~stewartid.identification.long_run.score_sandwich`, its variances from B as it
-    is, its correlations from B made positive semidefinite), each variance raised to
-    that of the scores summed per record where larger (model error correlated with the
-    motion over a record: :func:`~stewartid.identification.long_run.record_sandwich`).
+    """N^-1 B N^-1, B the long-run covariance of the scores s_k = sum_c w_c X_kc r_kc.
 
-    The residual of filtered rows is correlated over the filter's support, and where pose
-    noise reaches it through differentiated rates and accelerations it is high-pass: its
-    autocorrelation has negative lobes, which an autocorrelation time summed up to its first
-    non-positive value leaves out, overstating the variance (the payload's mass 1.5 times
-    its spread over 24 seeds).
+    B is :func:`~stewartid.identification.long_run.score_sandwich` (variances as estimated,
+    correlations made positive semidefinite), each variance raised to that of the scores summed
+    per record where larger (:func:`~stewartid.identification.long_run.record_sandwich`), then to
+    the floor of the measured noise.
 
     Parameters
     ----------
@@ -306,18 +270,13 @@ def score_covariance(inverse: np.ndarray, X: np.ndarray, residual: np.ndarray,
     segments : list of (int, int)
         Rows of each record (summing to K) and its correlation length in rows.
     expected : ndarray, shape (R, p), optional
-        Each record's expected summed score under noise alone (an errors-in-variables
-        correction's per record); without, the scores' total shared out by rows. Taken out
-        of the record sums and, spread evenly over the record's rows, of the scores: the
-        correction's mean is no fluctuation.
+        Each record's expected summed score under noise alone; without, the scores' total
+        shared out by rows. Taken out of the scores: a correction's mean is no fluctuation.
     measured_noise : list of (ndarray, ndarray), optional
-        Per record, a noise of the rows measured apart from the fit (the force sensors',
-        white, filtered): its covariance S per sample and the filter's autocorrelation at
-        row lags (:func:`~stewartid.identification.long_run.filtered_noise_covariance`).
-        Each variance is raised to its share where larger: the sums above scatter from one
-        log to the next (their variances are estimated from the residual's products over
-        the lags, and a high-pass residual leaves a small sum of large terms), and on one
-        log in 24 they put a parameter's standard error at a third of its spread.
+        Per record, a noise of the rows measured apart from the fit: its covariance per
+        sample and the filter's autocorrelation at row lags
+        (:func:`~stewartid.identification.long_run.filtered_noise_covariance`); each variance is
+        raised to its share where larger.
 
     Returns
     -------
@@ -399,9 +358,9 @@ def nearest_consistent(values: np.ndarray, covariance: np.ndarray, bodies: list[
 
 
 def _projection(values, std, correlation, solved, bodies, bounded, solver):
-    """The changes z (standard errors) of the parameters ``solved`` minimising z^T C^-1 z,
-    C their ``correlation``, subject to the constraints of :func:`nearest_consistent`; and
-    the solver's status."""
+    """The changes z (standard errors) of the parameters ``solved`` minimising z^T C^-1 z under
+    the constraints of :func:`nearest_consistent`, C their ``correlation``; and the solver's status.
+    """
     cp = require_cvxpy()
     eigenvalues, vectors = np.linalg.eigh(correlation)
     eigenvalues = np.maximum(eigenvalues, eigenvalues[-1] * 1e-15)

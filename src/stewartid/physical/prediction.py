@@ -1,17 +1,9 @@
-"""The identified physical model anywhere: Mt(q), Bt(q) at any pose with delta-method standard
-errors, and the generalized force it predicts along any motion by the full regressor.
+"""The identified physical model anywhere: Mt(q), Bt(q) at any pose with delta-method
+standard errors.
 
-A result of :class:`~stewartid.physical.estimator.PhysicalIdentifier` holds its
-parameters p (base parameters in full mode, the payload's and the nuisance ones in payload
-mode). The regressor columns they multiply are a selection S of the standard columns, plus the
-known part o of the platform (payload mode: the platform and legs of the file), so that
-
-    J_lq^T f = Y(q, q_dot, q_ddot) (S^T p + o),   Mt(q) = A(q) (S^T p + o),
-
-with A(q) the inertia (or viscous) regressor (:func:`~stewartid.model.matrix_regressors.inertia_regressor`).
-Mt(q) is linear in p: its standard errors are sqrt(a^T C a) for each entry's row a = A(q) S^T
-and the parameters' covariance C (``PhysicalIdentifier.covariance_``); fixed parameters have
-zero variance.
+With the parameters p selecting standard columns S and the known part o,
+J_lq^T f = Y(q, q_dot, q_ddot) (S^T p + o) and Mt(q) = A(q) (S^T p + o); each entry's standard
+error is sqrt(a^T C a) with a = A(q) S^T its row and C the parameters' covariance.
 """
 
 from __future__ import annotations

@@ -55,9 +55,11 @@ class Regression:
     force_noise: list[np.ndarray]
 
     def measured_force_noise(self) -> list[tuple[np.ndarray, np.ndarray]]:
-        """Per experiment, the leg forces' noise as the rows carry it: its covariance per
-        sample and the kernel's autocorrelation at lags of 0, 1, ... rows (the filtered
-        rows' noise, for :func:`~stewartid.identification.long_run.filtered_noise_covariance`)."""
+        """Per experiment, the leg forces' noise as the rows carry it.
+
+        Its covariance per sample and the kernel's autocorrelation at lags of 0, 1, ... rows, for
+        :func:`~stewartid.identification.long_run.filtered_noise_covariance`.
+        """
         out = []
         for S, e in zip(self.force_noise, self.experiments, strict=True):
             h = kernel_taps(e["sample_rate"], e["window_s"])[0]
@@ -67,20 +69,16 @@ class Regression:
 
 
 #: Savitzky-Golay order and window (a fraction of the kernel's) of the rates and accelerations
-#: the regressor is evaluated at: order 5 over an eighth of the kernel keeps the gain of the
-#: acceleration within 1e-4 of one wherever the kernel passes the signal (order 3 over a
-#: quarter: 2 % low at 1 Hz for a 0.67 s kernel, which biased the inertias), and the kernel
-#: takes the differentiation's noise down to its own band.
+#: the regressor is evaluated at: flat gain wherever the kernel passes the signal.
 SAVGOL_ORDER, SAVGOL_FRACTION = 5, 8
 
-#: Filtered rows kept per kernel window when the row step is automatic: the filtered signals
-#: vary on the scale of the window, so denser rows add round-off-level information only.
+#: Filtered rows kept per kernel window when the row step is automatic (the filtered signals
+#: vary on the scale of the window).
 ROWS_PER_WINDOW = 20
 
 
 def row_step(window: float, sample_rate: float) -> int:
-    """The automatic row step of :func:`filtered_regression`: ``ROWS_PER_WINDOW`` rows per
-    kernel window (``window`` s at ``sample_rate`` Hz), at least 1."""
+    """Automatic row step: ``ROWS_PER_WINDOW`` rows per kernel window (``window`` s), at least 1."""
     return max(1, int(window * sample_rate) // ROWS_PER_WINDOW)
 
 
@@ -90,13 +88,9 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
                         coulomb_smoothing: float = 1e-4) -> Regression:
     """The regressor and the generalized force of every experiment, filtered with h.
 
-    The regressor is evaluated at every sample, from the pose and its Savitzky-Golay rates
-    and accelerations (order :data:`SAVGOL_ORDER`, window 1/:data:`SAVGOL_FRACTION` of the
-    kernel's), and filtered with h like the force. The equation J_lq^T f = Y pi is linear in
-    pi, so the filtered one holds exactly, whatever the motion's amplitude; a regressor
-    evaluated at the filtered pose, rate and acceleration instead is off by the kernel's
-    smoothing of its nonlinear terms (md_u, J_u 7 standard errors off at four times the
-    paper's amplitudes).
+    The regressor is evaluated at every sample from the pose and its Savitzky-Golay rates and
+    accelerations, then filtered like the force. The equation J_lq^T f = Y pi is linear in pi,
+    so the filtered one holds exactly whatever the motion's amplitude.
 
     Parameters
     ----------
@@ -109,9 +103,7 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
         Savitzky-Golay order of the rates, accelerations and Coulomb signs.
     decimate : int, optional
         Keep every ``decimate``-th filtered row; None: the smallest :func:`row_step` of the
-        experiments' windows, the same for all so that each keeps its share of the rows (the
-        filtered signals are band-limited by the kernel: the rows between add little, and
-        the estimates move by a small fraction of their standard errors).
+        experiments' windows, the same for all.
     gravity : bool
         Include the gravity columns.
     coulomb_smoothing : float
@@ -127,8 +119,7 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
     # one step for every experiment: each keeps its share of the rows, as without decimation
     step = decimate or min(row_step(w, exp.sample_rate)
                            for w, exp in zip(windows, experiments, strict=True))
-    # one buffer for every experiment's signals (time last: the regressor's rows and the
-    # kernel's sums on contiguous rows), its memory touched once
+    # one buffer for every experiment's signals, time last for contiguous kernel sums
     width = 2 + reg.N_STANDARD  # force, regressor columns, pose
     buffer = np.empty(6 * width * max(len(exp.q) for exp in experiments))
     for exp, w in zip(experiments, windows, strict=True):
@@ -162,11 +153,8 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
 def leg_force_transforms(platform: Platform, poses: np.ndarray) -> np.ndarray:
     """J_lq^-T at every row's pose: the map from a row's generalized force to the leg forces.
 
-    The force sensors' noise is white and alike in every leg, so in leg forces a filtered
-    row's noise has equal, uncorrelated channels (the Jacobian varies little over a kernel
-    window) and weighting each channel by its residual variance is generalized least
-    squares; the generalized-force channels mix the legs' noise by J_lq^T, which per-channel
-    weights cannot undo (on all-DOF multisines, standard errors up to 43 % larger).
+    In leg forces a filtered row's noise has equal, uncorrelated channels, so weighting each
+    channel by its residual variance is generalized least squares.
 
     Parameters
     ----------

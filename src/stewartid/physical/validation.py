@@ -1,14 +1,8 @@
 """Held-out prediction of the physical model by its full nonlinear model, scored as every
 other method's (:mod:`stewartid.validation.heldout`).
 
-Mt and Bt at one pose predict the other methods' held-out force. The physical model predicts
-J_lq^T f = Y(q, q_dot, q_ddot) p at the measured poses, with its gravity, Coulomb friction and
-sensor offsets: the regressor filtered as the fit filters it
-(:func:`~stewartid.physical.regression.filtered_regression`, every row, the segment's own
-kernel), so the error e = (J_lq^T f) * h - (Y p) * h. The segments' measured force is the
-same filtered J_lq^T f less the model's G(q) filtered; the prediction of it is that force less
-e, so VAF and NRMSE are those of the same measured signal as the other methods', one constant
-per segment removed as for them.
+The model predicts J_lq^T f = Y(q, q_dot, q_ddot) p at the measured poses, with gravity,
+Coulomb friction and sensor offsets, the regressor filtered as the fit filters it.
 """
 
 from __future__ import annotations
@@ -55,8 +49,7 @@ def predict_physical(segment: Segment, dataset: Dataset, platform: Platform,
     window : float
         The kernel support (s) the segment was filtered with.
     standard : ndarray, shape (N_STANDARD,), optional
-        The result's :attr:`~stewartid.physical.prediction.ParameterMap.standard`
-        if already at hand (it costs a base-parameter decomposition).
+        The result's :attr:`~stewartid.physical.prediction.ParameterMap.standard`, if at hand.
     """
     settings = result.settings
     experiments = prepare([dataset], platform, gravity=False)
@@ -75,9 +68,7 @@ def predict_physical(segment: Segment, dataset: Dataset, platform: Platform,
 def cross_validate_physical(create: Callable[[], Any], datasets: Sequence[Dataset],
                             platform: Platform, folds: int = DEFAULT_FOLDS,
                             segments: list[Segment] | None = None) -> ValidationResult:
-    """Held-out scores of the physical model: refitted without each time segment
-    (:func:`~stewartid.validation.heldout.cross_validate`), each segment predicted by
-    :func:`predict_physical`.
+    """Held-out scores of the physical model, each time segment predicted by the fit without it.
 
     Parameters
     ----------
