@@ -1,14 +1,5 @@
-"""Method B's friction treatments: the equations and solve of each, and on one sine per
-experiment the choice between the free interval constants and the Coulomb law of each joint
-type.
-
-On one sine per experiment neither wins everywhere. The free constants give away the motion
-inside each interval, and Bt pays for it; the law keeps it, and reads friction it lacks as
-damping. Our plant, paper platform, reference noise, 4 seeds: the law's largest error over
-the paper's 20 entries 1.9-9.0 % where the free constants give 2.5-7.7 % (median 2.7 against
-7.0 %; Bt(3,3) at 9-12 % relative standard error for the free constants). The independent
-example without noise, whose friction is not the law's: the free constants 0.016 %, the law
-2.7 %. Both fits' errors are honest, so the data decide (:func:`choose_friction_fit`).
+"""Method B's friction treatments (free interval constants, Coulomb law per joint type): the
+equations and solve of each, and the choice between them on one sine per experiment.
 """
 
 from __future__ import annotations
@@ -39,8 +30,11 @@ WINDOW_LENGTH = 2.0
 
 
 def friction_models(setting: str, datasets: Sequence[Dataset]) -> tuple[str, ...]:
-    """The friction models to fit: ``setting``; for "auto" both "free" and "coulomb" when
-    every experiment is one sine (:func:`.detection.sine_share`), else "coulomb"."""
+    """The friction models to fit for ``setting``.
+
+    For "auto": both "free" and "coulomb" when every experiment is one sine
+    (:func:`.detection.sine_share`), else "coulomb".
+    """
     if setting != "auto":
         return (setting,)
     single = all(sine_share(d.lengths, 1.0 / float(d.t[1] - d.t[0])) >= SINGLE_SINE_SHARE
@@ -50,10 +44,11 @@ def friction_models(setting: str, datasets: Sequence[Dataset]) -> tuple[str, ...
 
 def model_equations(model: str, experiment: Experiment, found: Detection, order: int,
                     functions: int, k: int) -> list:
-    """The weak-form equations of experiment ``k`` under friction model ``model``: windows
-    across reversals with each joint type's Coulomb rows for "coulomb"
-    (:func:`.windows.window_equations`), else the constant-direction intervals
-    (:func:`.weak_form.experiment_equations`)."""
+    """The weak-form equations of experiment ``k`` under friction model ``model``.
+
+    Windows with Coulomb rows for "coulomb" (:func:`.windows.window_equations`), else the
+    constant-direction intervals (:func:`.weak_form.experiment_equations`).
+    """
     if model == "coulomb":
         return window_equations(experiment, found, order, functions, k, False, WINDOW_LENGTH)
     return experiment_equations(experiment, found, order, functions, k, model)
@@ -61,9 +56,10 @@ def model_equations(model: str, experiment: Experiment, found: Detection, order:
 
 def solve_model(model: str, equations: list, infos: list[dict], motion: list[np.ndarray],
                 noise: dict) -> tuple[WeakFormSolution, float]:
-    """Solve one friction model's equations over the soft-sign rates
-    (:func:`.windows.solve_windows_over_rates`, :func:`.rate_selection.solve_weak_form_over_rates`);
-    the intervals' coverage of every DOF checked first. Returns the solution and its rate."""
+    """Solve one friction model's equations over the soft-sign rates; returns the solution and its rate.
+
+    The intervals' coverage of every DOF is checked first.
+    """
     if not equations:
         raise_no_interval(infos)
     if model == "coulomb":
@@ -76,9 +72,9 @@ def solve_model(model: str, equations: list, infos: list[dict], motion: list[np.
 def solve_models(models: Sequence[str], equations: Mapping[str, list], infos: list[dict],
                  motion: list[np.ndarray], noise: dict
                  ) -> tuple[dict[str, tuple[WeakFormSolution, float]], dict[str, str]]:
-    """:func:`solve_model` of every friction model. One the data refuse (no interval, a DOF
-    no interval covers, a singular system) is left out and its reason returned, for another
-    may still fit; when every model is refused, the first refusal is raised.
+    """:func:`solve_model` of every friction model; a refused one is left out with its reason.
+
+    Raises the first refusal when every model is refused.
 
     Returns
     -------
@@ -103,9 +99,8 @@ def choose_friction_fit(results: Mapping[str, IdentificationResult],
                         solutions: Mapping[str, WeakFormSolution]) -> tuple[str, dict]:
     """Which fit to keep, and the diagnostics that say why.
 
-    One fit is kept as it is. Of "free" and "coulomb", the law's is kept unless its
-    standard errors predict the larger worst error
-    (:func:`~stewartid.verdict.accuracy.predicted_worst_error`) or
+    Of "free" and "coulomb", the one whose standard errors predict the smaller worst error
+    (:func:`~stewartid.verdict.accuracy.predicted_worst_error`), unless
     :func:`friction_law_test` rejects the law.
 
     Parameters
@@ -113,8 +108,7 @@ def choose_friction_fit(results: Mapping[str, IdentificationResult],
     results : mapping
         Friction model -> its result.
     solutions : mapping
-        Friction model -> its solve, before the symmetric pairs are combined (its
-        residual-based standard errors).
+        Friction model -> its solve, before the symmetric pairs are combined.
 
     Returns
     -------
@@ -143,16 +137,10 @@ def friction_law_test(free: np.ndarray, free_std: np.ndarray, law: np.ndarray,
                       law_std: np.ndarray) -> dict:
     """Does the fit with a friction law depart from the fit immune to it?
 
-    A specification test in Hausman's spirit on the diagonals of Mt and Bt. The free
-    interval constants estimate them whatever the friction law (each DOF's own excitation;
-    their couplings carry the idle joints' friction, :mod:`stewartid.identification.pairs`);
-    the Coulomb law's rows estimate them more precisely if the law holds, and where it does
-    not, read the friction it lacks as damping. Each diagonal entry's difference is scored in
-    the residual-based standard errors of the two fits (before any allowance for model
-    error, which is what is tested), combined as sqrt(s_free^2 + s_law^2): larger than the
-    difference's when the two are positively correlated, so the test errs towards keeping
-    the law. The largest of the 12 scores is compared with the two-sided normal point at
-    :data:`FRICTION_LAW_LEVEL` shared over them.
+    A Hausman-style specification test on the diagonals of Mt and Bt: each difference is
+    scored in sqrt(s_free^2 + s_law^2) of the residual-based standard errors, and the largest of
+    the 12 scores compared with the two-sided normal point at :data:`FRICTION_LAW_LEVEL`
+    shared over them (Bonferroni).
 
     Parameters
     ----------

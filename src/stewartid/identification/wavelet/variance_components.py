@@ -1,13 +1,6 @@
-"""Variance components of the weak-form rows of Method B.
-
-- :func:`pose_covariance`: the covariance the white pose noise puts into each interval's
-  rows of one channel, Q_rs = sum_ab (c_a Sigma c_b) <phi_r^(a), phi_s^(b)> (see
-  :mod:`~stewartid.identification.wavelet.gls`), with :func:`pose_coefficients` the c_a;
-- :func:`noise_bias`: the expected noise parts of the weighted normal equations, which
-  :func:`compensate` subtracts (the errors-in-variables solve);
-- :func:`chi2_excess` and :func:`excess_variance`: the variance residuals hold beyond what
-  the noise explains (model error, the scatter of the interval constants), matched in
-  weighted chi-square; :func:`row_noise` the force-side noise of every interval from them.
+"""Variance components of Method B's weak-form rows: the covariance the pose noise puts into
+them, its bias on the normal equations, and the variance residuals hold beyond the noise
+(matched in weighted chi-square, Paule and Mandel 1982).
 
 References
 ----------
@@ -30,6 +23,8 @@ def pose_covariance(gram: np.ndarray, sigma: np.ndarray, coefficients: np.ndarra
                     ) -> np.ndarray:
     """The row covariance the pose noise causes in one channel, per interval.
 
+    Q_rs = sum_ab (c_a Sigma c_b) <phi_r^(a), phi_s^(b)>.
+
     Parameters
     ----------
     gram : ndarray, shape (n, 3, 3, R, R)
@@ -37,8 +32,8 @@ def pose_covariance(gram: np.ndarray, sigma: np.ndarray, coefficients: np.ndarra
     sigma : ndarray, shape (n, 6, 6)
         Pose noise per sample of each interval's experiment (m^2, m rad, rad^2).
     coefficients : ndarray, shape (n, 3, 6)
-        What multiplies <phi^(a), n> in the channel's residual, a = 0 (the target's
-        sensitivity k_i), 1 (b_i) and 2 (-m_i) (:func:`pose_coefficients`).
+        c_a, what multiplies <phi^(a), n> in the channel's residual
+        (:func:`pose_coefficients`).
 
     Returns
     -------
@@ -51,9 +46,9 @@ def pose_covariance(gram: np.ndarray, sigma: np.ndarray, coefficients: np.ndarra
 
 def noise_bias(weights: np.ndarray, gram: np.ndarray, sigma: np.ndarray,
                sensitivity: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Expected noise parts of sum X^T W X (12, 12) and of sum X^T W y (12,) over intervals
-    for one channel, the regressors' noise being [<phi'', n>, -<phi', n>] and the target's
-    <phi, k_i n>.
+    """Expected noise parts of sum X^T W X and sum X^T W y over intervals, for one channel.
+
+    The regressors' noise is [<phi'', n>, -<phi', n>], the target's <phi, k_i n>.
 
     Parameters
     ----------
@@ -81,10 +76,11 @@ def noise_bias(weights: np.ndarray, gram: np.ndarray, sigma: np.ndarray,
 def compensate(normal: np.ndarray, rhs: np.ndarray, weights: np.ndarray, gram: np.ndarray,
                sigma: np.ndarray, sensitivity: np.ndarray
                ) -> tuple[np.ndarray, np.ndarray, bool]:
-    """One channel's [Mt Bt] block of the normal equations less its expected noise part
-    (:func:`noise_bias`), and whether it was; the block unchanged when
-    the noise is so large that the correction leaves no information (not positive
-    definite)."""
+    """One channel's normal equations less their expected noise part (:func:`noise_bias`).
+
+    Returns the block, its right-hand side and whether it was corrected; unchanged when the
+    correction would leave it not positive definite.
+    """
     bias, bias_rhs = noise_bias(weights, gram, sigma, sensitivity)
     try:
         np.linalg.cholesky(normal - bias)
@@ -94,18 +90,21 @@ def compensate(normal: np.ndarray, rhs: np.ndarray, weights: np.ndarray, gram: n
 
 
 def pose_coefficients(sensitivity: np.ndarray, theta_i: np.ndarray) -> np.ndarray:
-    """(n, 3, 6) coefficients of :func:`pose_covariance` for channel row theta_i = [m, b]
-    (12,), sensitivity (n, 6) the channel's k_i per interval."""
+    """(n, 3, 6) coefficients of :func:`pose_covariance` for channel row theta_i = [m, b] (12,).
+
+    Rows k_i (``sensitivity``, (n, 6)), b and -m.
+    """
     n = len(sensitivity)
     return np.stack([sensitivity, np.broadcast_to(theta_i[6:], (n, 6)),
                      np.broadcast_to(-theta_i[:6], (n, 6))], axis=1)
 
 
 def chi2_excess(variances: np.ndarray, squares: np.ndarray, dof: float) -> float:
-    """e >= 0 with sum_k squares_k / (variances_k + e) = dof (0 when the left side is already
-    at most dof at e = 0): the variance that residuals of expected variances ``variances``
-    hold beyond them, matched in weighted chi-square (the Paule-Mandel estimator of
-    random-effects meta-analysis). Both arrays of any one shape, variances >= 0."""
+    """e >= 0 with sum_k squares_k / (variances_k + e) = dof (Paule-Mandel).
+
+    0 when the left side is already at most dof at e = 0. Both arrays of any one shape,
+    variances >= 0.
+    """
     lam = np.maximum(variances, 0.0)
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):  # noise-free rows
         if np.sum(np.where(squares > 0, squares / lam, 0.0)) <= dof:
@@ -118,21 +117,22 @@ def chi2_excess(variances: np.ndarray, squares: np.ndarray, dof: float) -> float
 
 
 def excess_variance(covariance: np.ndarray, residual: np.ndarray, dof: int) -> float:
-    """e >= 0 with sum_n r_n^T (V_n + e I)^-1 r_n = dof: the white variance per row the
-    residuals (n, R) hold beyond their expected covariance V (n, R, R), model error.
+    """e >= 0 with sum_n r_n^T (V_n + e I)^-1 r_n = dof: the white variance per row beyond V.
 
-    Weighted, because the pose part of V is orders of magnitude larger on the narrow test
-    functions than on the wide ones: the plain moment (sum |r|^2 - tr V) / (n R) is then the
-    difference of two numbers whose randomness alone exceeds the force noise."""
+    Residuals r (n, R), expected covariance V (n, R, R). Weighted, since V varies by orders of
+    magnitude across the test functions.
+    """
     lam, vectors = np.linalg.eigh(covariance)
     return chi2_excess(lam, np.einsum("nrk,nr->nk", vectors, residual) ** 2, dof)
 
 
 def row_noise(stacked: StackedEquations, designs: Sequence[np.ndarray],
               targets: Sequence[np.ndarray], z: np.ndarray) -> np.ndarray:
-    """Force-side noise s (n, 6) per interval (or window) and channel: the white part
-    measured from the data plus the chi-square excess of the invariant rows' residuals at
-    the unknowns z over what the noise explains."""
+    """Force-side noise variance (n, 6) per interval (or window) and channel.
+
+    The white part measured from the data plus the chi-square excess of the rows' residuals
+    at the unknowns z.
+    """
     n, k_rows = stacked.regressors.shape[:2]
     gram = stacked.gram[..., :k_rows, :k_rows]
     floor = 1e-24 * np.maximum(np.mean(stacked.targets.reshape(-1, 6) ** 2, axis=0), 1e-300)

@@ -1,26 +1,13 @@
 """Method B on windows that span joint reversals: the Coulomb structure integrated.
 
-When joints reverse every few tens of milliseconds (several frequencies per DOF, all DOFs
-moving at once) the constant-direction intervals are too short to hold the test functions,
-or so short that a free constant per interval takes what Bt does (on a short interval
-Bt q_dot is nearly constant). With the friction's Coulomb structure,
-
-    c(t) = sum_types F_type W_type(t),   W_type(t) = sum_{legs, axes of the type}
-           sign(w_axis(t)) J_axis(q(t))    (6,),
-
-the interval is no longer needed: the record is cut into windows of any length, and every
-test function's row gains the Coulomb regressors <phi, W_type>,
+Where constant-direction intervals are too short, every test function's row of a window
+gains the Coulomb regressors <phi, W_type>,
 
     Mt <phi'', q> - Bt <phi', q> + sum_types F_type <phi, W_type> = <phi, y>,
 
-the zero-mean test functions still removing each window's constant (what the gravity model
-leaves). The joint directions come from the smoothed joint rates, w / sqrt(w^2 + s^2) with
-s^2 = sigma^2 + r^2: sigma the rate's noise level, so a reversal inside the noise band is
-weighed as uncertain, and r the friction's own transition rate (a regularised or Stribeck
-friction is not a sign): the fits at every rate of :data:`SOFT_SIGN_RATES`, averaged by
-how well each explains the rows (:func:`solve_windows_over_rates`). The solve is
-:func:`~stewartid.identification.wavelet.gls.fit_jointly`'s generalized least squares, pose
-noise weighted and its bias removed, the Coulomb levels shared by the channels.
+with W_type = sum_{legs, axes of the type} sign(w_axis) J_axis(q), the sign softened by the
+rate's noise and a transition rate; fits at every rate of :data:`SOFT_SIGN_RATES` are
+averaged (:func:`solve_windows_over_rates`).
 """
 
 from __future__ import annotations
@@ -52,9 +39,11 @@ from stewartid.identification.wavelet.weak_form import (
 
 
 class WindowEquations(NamedTuple):
-    """Weak-form equations of one window: the interval equations (mean row unused) and
-    ``coulomb`` (n_rates, K, n_types, 6), <phi_k, W_type> of every row for every transition
-    rate (s^(1/2) per N m of level)."""
+    """Weak-form equations of one window.
+
+    ``rows`` the interval equations (mean row unused); ``coulomb`` (n_rates, K, n_types, 6),
+    <phi_k, W_type> of every row for every transition rate (s^(1/2) per N m of level).
+    """
 
     rows: IntervalEquations
     coulomb: np.ndarray
@@ -133,12 +122,12 @@ def solve_windows(equations: Sequence[WindowEquations], iterations: int = 3,
                   force_sensitivity: np.ndarray | None = None,
                   force_variance: np.ndarray | None = None, rate_index: int = 0
                   ) -> WeakFormSolution:
-    """[Mt Bt] and the Coulomb levels from window equations: generalized least squares over
-    all channels (the levels are shared), reweighted ``iterations`` times with the
-    force-side noise re-estimated from the residuals, the pose-noise bias removed.
+    """[Mt Bt] and the Coulomb levels from window equations by iterated generalized least squares.
 
-    Parameters as :func:`~stewartid.identification.wavelet.gls.solve_weak_form`;
-    ``rate_index`` picks the soft sign's transition rate among the equations' rates.
+    The levels are shared by the channels; the force-side noise is re-estimated from the
+    residuals ``iterations`` times and the pose-noise bias removed. Parameters as
+    :func:`~stewartid.identification.wavelet.gls.solve_weak_form`; ``rate_index`` picks the
+    soft sign's transition rate.
 
     Returns
     -------
@@ -176,9 +165,10 @@ def solve_windows(equations: Sequence[WindowEquations], iterations: int = 3,
 def solve_windows_over_rates(equations: Sequence[WindowEquations],
                              rates: Sequence[float] = SOFT_SIGN_RATES, **settings
                              ) -> tuple[WeakFormSolution, float]:
-    """:func:`solve_windows` at every transition rate of the soft sign, averaged over the rates
-    (:func:`.rate_selection.averaged_over_rates`), and the rate of greatest weight (rad/s).
-    ``settings`` go to :func:`solve_windows`."""
+    """:func:`solve_windows` averaged over the soft sign's transition rates, and the rate of greatest weight.
+
+    See :func:`.rate_selection.averaged_over_rates`; ``settings`` go to :func:`solve_windows`.
+    """
     return averaged_over_rates(
         lambda index: solve_windows(equations, rate_index=index, **settings), rates)
 
