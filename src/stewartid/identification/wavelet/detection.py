@@ -1,10 +1,7 @@
 """Constant-direction intervals of one measured experiment: the interval step of Method B.
 
-The smoothed pose rates of the noise model (:mod:`.noise`) are mapped to the rates of the 30
-joint axes and the 6 actuators with the Jacobians the prepared experiment holds, and cut
-where any active joint reverses (:mod:`.intervals`); a reversal inside a rate's noise band
-stays outside every interval. :func:`excitation_scales` sets the smoothing window and the
-interval margin from the excitation frequency estimated from the data.
+The smoothed pose rates are mapped to the joint and actuator rates and cut where an active
+joint reverses beyond its noise band (:mod:`.intervals`).
 """
 
 from __future__ import annotations
@@ -41,9 +38,8 @@ class Detection(NamedTuple):
     q_dot, q_ddot : ndarray, shape (N, 6)
         Savitzky-Golay derivatives of the pose.
     sign_rates : ndarray, shape (N, 6, 5)
-        Joint-axis rates the Coulomb signs are taken from (rad/s): the shortest window the
-        noise allows (:func:`~stewartid.signals.sign_rates.coulomb_sign_rates`), which keeps
-        each reversal where the friction's kink puts it.
+        Joint-axis rates the Coulomb signs are taken from (rad/s), over the shortest window
+        the noise allows (:func:`~stewartid.signals.sign_rates.coulomb_sign_rates`).
     sign_rate_noise : ndarray, shape (6, 5)
         Their noise levels (rad/s).
     """
@@ -59,10 +55,8 @@ class Detection(NamedTuple):
 
 
 #: Largest noise of the Coulomb signs' rates relative to their RMS
-#: (:func:`~stewartid.signals.sign_rates.coulomb_sign_rates`): a quarter of least squares'.
-#: Method B's Coulomb levels are kept only where a likelihood-ratio test wants them, and
-#: chatter in the soft signs cost it that test on ten-times-amplitude logs (one seed of four
-#: at 0.2 %: 0.48 -> 3.5 %).
+#: (:func:`~stewartid.signals.sign_rates.coulomb_sign_rates`), low so that the soft signs
+#: do not chatter.
 SIGN_NOISE_LIMIT = 0.0005
 #: Joints whose rate RMS is below this multiple of its noise level count as idle.
 IDLE_NOISE_RATIO = 2.0
@@ -72,8 +66,10 @@ COVERAGE_FRACTION = 0.1
 
 
 def raise_no_interval(infos: Sequence[dict]) -> None:
-    """Raise the error for data without a single usable interval (``infos`` of
-    :func:`detect_intervals`), naming the longest found and what was needed."""
+    """Raise the error for data without a usable interval, naming the longest found and the need.
+
+    ``infos`` as :func:`detect_intervals` returns them.
+    """
     longest = max(info["longest_interval"] for info in infos)
     needed = min(info["shortest_usable"] for info in infos)
     raise IdentificationError(
@@ -85,8 +81,7 @@ def raise_no_interval(infos: Sequence[dict]) -> None:
 
 
 def check_coverage(names: Sequence[str], motion: np.ndarray, counts: Sequence[int]) -> None:
-    """Warn for every experiment without a usable interval; raise when those left out were
-    the only ones to move a DOF (its entries would rest on noise, with small standard errors).
+    """Warn for every experiment without a usable interval; raise if they alone moved a DOF.
 
     Parameters
     ----------
@@ -121,11 +116,9 @@ SINGLE_SINE_SHARE = 0.9
 
 
 def sine_share(lengths: np.ndarray, sample_rate: float) -> float:
-    """Share of the leg-length variance a single sine at the dominant frequency (with an
-    offset and a drift per leg) explains, over the legs that move.
+    """Share of the leg-length variance one sine at the dominant frequency explains.
 
-    Leg lengths, not the pose: they share one unit, and a single sine of the pose is a single
-    sine of every leg length (to first order in the amplitude).
+    With an offset and a drift per leg, over the legs that move; leg lengths share one unit.
 
     Parameters
     ----------
@@ -137,8 +130,7 @@ def sine_share(lengths: np.ndarray, sample_rate: float) -> float:
     Returns
     -------
     float
-        In [0, 1]: near 1 for one sine per experiment (the paper's protocol), well below
-        for several frequencies or DOFs moving at different frequencies.
+        In [0, 1]: near 1 for one sine per experiment (the paper's protocol).
     """
     frequency = estimate_frequency(lengths, sample_rate)
     t = np.arange(len(lengths)) / sample_rate
@@ -208,10 +200,8 @@ def detect_intervals(experiment: Experiment, noise: NoiseModel, *, margin: float
     t, period, rate_noise = experiment.t, experiment.period, noise.rate_noise
     rates = joint_rates(experiment.platform, experiment.q, noise.q_dot,
                         experiment.joint_jacobians, experiment.leg_jacobian)
-    # a joint whose rate is no larger than its noise has no direction to keep, whatever its
-    # share of the largest rate (pure heave with 20 um pose noise leaves three axes per leg at
-    # 1.0x their noise and 1 % of the largest rate; on some seeds they broke every interval)
-    # (an infinite threshold leaves them out; their rates still give the friction pattern)
+    # a joint whose rate is no larger than its noise has no direction to keep; an infinite
+    # threshold leaves it out (its rates still give the friction pattern)
     idle = np.sqrt(np.mean(np.square(rates), axis=0)) < IDLE_NOISE_RATIO * rate_noise
     found = constant_direction_intervals(t, rates, margin=margin, ignore_below=ignore_below,
                                          hysteresis=np.where(idle, np.inf,
@@ -219,7 +209,6 @@ def detect_intervals(experiment: Experiment, noise: NoiseModel, *, margin: float
     lengths = found[:, 1] - found[:, 0]
     shortest = (min_interval if min_interval is not None
                 else 0.5 * float(np.median(lengths)) if len(lengths) else 0.0)
-    # the smallest support must cover min_support_samples samples
     needed = min_support_samples * period / smallest
     intervals = found[lengths >= max(shortest, needed)]
     info = {"name": experiment.name, "intervals_found": int(len(found)),
@@ -237,9 +226,7 @@ def detect_intervals(experiment: Experiment, noise: NoiseModel, *, margin: float
 
 
 def _sign_rates(experiment: Experiment, noise: NoiseModel) -> dict:
-    """``sign_rates`` and ``sign_rate_noise`` of :class:`Detection`: the joint rates of the
-    pose rates over the shortest window (a fraction of the noise model's) the pose noise
-    allows, and their noise levels."""
+    """``sign_rates`` and ``sign_rate_noise`` of :class:`Detection`."""
     q_dot, window = coulomb_sign_rates(experiment.q, experiment.sample_rate, noise.window,
                                        noise.pose_covariance, SIGN_NOISE_LIMIT)
     jacobians = experiment.joint_jacobians

@@ -1,22 +1,9 @@
 """Constant-direction intervals: time spans in which no joint reverses.
 
-Zhang (2020, Section 3) calls a time interval in which the velocity of every joint keeps its
-sign a *constant direction space*. Inside it each joint's Coulomb friction is a constant
-(up to the slow change of the joint Jacobians with the pose), so a wavelet with vanishing
-moments of order 0 and 1 removes it together with gravity.
-
-The joints of a 6-6 platform with two-part legs are, per leg, five rotational axes (two at the
-lower gimbal, two at the upper gimbal, the revolute about the leg; order of
-:data:`stewartid.model.joints.JOINT_AXES`) and the actuator. :func:`joint_rates` returns their
-rates from a pose/velocity history, :func:`constant_direction_intervals` the intervals, and
-:func:`check_intervals` tells whether a trajectory design yields enough of them, and
-:func:`wavelet_points` places the wavelets' (a, b) points inside them.
-
-Joints that barely move deserve care: a rate whose amplitude is a tiny fraction of the
-others' crosses zero at odd times (noise, second-order motion), which would cut every interval
-into pieces. ``ignore_below`` leaves such joints out; their friction then may switch inside an
-interval, but it is small where the rate is small only if the joint is truly idle, so the
-default keeps every joint and the option is documented as a trade-off.
+Zhang (2020, Section 3) calls them *constant direction spaces*: inside one each joint's
+Coulomb friction is nearly constant, so a wavelet with vanishing moments of order 0 and 1
+removes it together with gravity. The joints are, per leg, the five rotational axes of
+:data:`stewartid.model.joints.JOINT_AXES` and the actuator.
 
 References
 ----------
@@ -89,10 +76,9 @@ def joint_rates(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
 def active_joints(rates: np.ndarray, ignore_below: float = 0.0) -> np.ndarray:
     """Mask of the joints whose rate amplitude is not negligible.
 
-    A joint is ignored when the RMS of its rate is below ``ignore_below`` times the largest
-    RMS among joints of the same kind (rotational axes in rad/s compared with each other,
-    actuators in m/s with each other; the 30 + 6 layout of :func:`joint_rates` is assumed when
-    there are 36 columns, otherwise all columns are one kind).
+    A joint is ignored when its rate RMS is below ``ignore_below`` times the largest RMS among
+    joints of its kind (rotational axes, actuators: the 30 + 6 layout of :func:`joint_rates`
+    when there are 36 columns, else one kind).
 
     Parameters
     ----------
@@ -129,28 +115,23 @@ def constant_direction_intervals(t: np.ndarray, rates: np.ndarray, margin: float
     rates : ndarray, shape (N, J)
         Joint rates, e.g. from :func:`joint_rates`; any units, only signs matter.
     margin : float
-        Time (s) cut from both ends of every interval, so that a friction reversal that lags
-        the zero crossing of the measured rate (stiction, filtering, sensor noise) stays
-        outside.
+        Time (s) cut from both ends of every interval, so that a friction reversal lagging
+        the measured zero crossing stays outside.
     min_duration : float
         Intervals shorter than this (s, after the margins) are dropped.
     ignore_below : float
         Leave out joints whose rate RMS is below this fraction of the largest of their kind
         (see :func:`active_joints`).
     hysteresis : float or ndarray, shape (J,)
-        Rate thresholds (units of ``rates``) for noisy measurements: a joint's direction
-        counts as known only while |rate| exceeds its threshold, and a reversal is confirmed
-        when the rate passes the opposite threshold. The interval before a reversal ends at
-        the last sample where the old direction was still confirmed, the next one starts at
-        the confirmation, so the unknown crossing time stays outside both. Joints that never
-        exceed their threshold are left out. 0 (default): plain signs.
+        Rate thresholds (units of ``rates``): a joint's direction counts as known only while
+        |rate| exceeds its threshold, so the unknown crossing time stays outside both
+        neighbouring intervals. Joints that never exceed it are left out. 0: plain signs.
 
     Returns
     -------
     ndarray, shape (M, 2)
-        [start, stop] times (s) of the intervals, in time order. A rate that touches zero
-        without changing sign does not end an interval. The first and last runs are kept: a record that
-        starts or ends mid-interval still gives a usable, shorter, interval.
+        [start, stop] times (s) of the intervals, in time order; the first and last runs of
+        the record are kept.
     """
     t = np.asarray(t, dtype=float)
     rates = np.asarray(rates, dtype=float)
@@ -213,7 +194,7 @@ class IntervalCheck(NamedTuple):
     coverage : float
         Fraction of the record covered by such intervals.
     message : str
-        One line that says what was found and, when not ok, what to change.
+        What was found and, when not ok, what to change.
     """
 
     ok: bool
