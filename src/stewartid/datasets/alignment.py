@@ -1,20 +1,9 @@
 """Time alignment of the force channels with the motion channels.
 
-On a real rig the forces and the motion are often acquired by separate cards, and the
-position transducers are filtered: the force channels reach the log a few milliseconds after
-(or before) the motion they belong to. With the forces logged ``delay`` seconds late,
-
-    f_logged(t) = f(t - delay),
-
-the aligned forces are f(t) = f_logged(t + delay), read between the samples by a cubic
-spline through the logged forces. The samples at which t + delay falls outside the record
-are dropped (never extrapolated): a positive delay shortens the end of the record, a
-negative one its start. The interpolation error of a not-a-knot cubic spline on a sine of
-frequency f sampled at rate fs is at most about (2 pi f / fs)^4 / 384 of its amplitude
-(3e-10 at 1.5 Hz and 1 kHz); white force noise between the samples is slightly attenuated
-and coloured by the interpolation.
-
-The delay itself is estimated by :func:`stewartid.identification.delay.estimate_delay`.
+Forces logged ``delay`` seconds late, f_logged(t) = f(t - delay), are aligned as
+f(t) = f_logged(t + delay), read between the samples by a cubic spline; samples whose
+t + delay falls outside the record are dropped, never extrapolated. The delay is estimated by
+:func:`stewartid.identification.delay.estimate_delay`.
 """
 
 from __future__ import annotations

@@ -8,9 +8,8 @@ import numpy as np
 def median(values: np.ndarray) -> float:
     """``np.median(values)`` over all elements, equal to the last bit.
 
-    Without ``np.median``'s NaN check, whose first call still imports numpy.ma in numpy 2.4
-    (16 ms, which the ``fourier`` and ``ls`` command lines save); NaN anywhere gives NaN as
-    there.
+    Without ``np.median``'s NaN check, whose first call imports numpy.ma (the command line's
+    start-up cost); NaN anywhere gives NaN as there.
 
     Parameters
     ----------

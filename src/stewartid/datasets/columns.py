@@ -1,16 +1,10 @@
 """The one reader of data files: CSV and Parquet tables into NumPy columns, with pyarrow.
 
-Logs are parsed by ``pyarrow.csv`` (delimiter, decimal mark and preamble lines as given) or
-``pyarrow.parquet`` and handed on as a dict of column name to array: float64 for numeric
-columns (a missing value is NaN), object arrays of the values as read otherwise, so that a
-message can quote a bad value. Arrow rounds each decimal correctly to the nearest double, as
-the pandas reader does for the shortest decimals that :func:`~stewartid.datasets.dataset.
-write_dataset` writes, and the package does not import pandas to read data: importing it costs
-a command-line ``identify`` about 0.4 s.
-
-Column names are cleaned as pandas' ``read_csv(skipinitialspace=True)`` cleans them:
-surrounding spaces and quotes removed, an empty name read as ``Unnamed: k`` and a repeated one
-as ``name.1``, ``name.2`` ...
+A table is a dict of column name to array: float64 for numeric columns (NaN where missing),
+the values as read otherwise, so that a message can quote a bad value. Pandas is not
+imported to read data (a command line's start-up cost). Column names are cleaned as pandas'
+``read_csv(skipinitialspace=True)`` cleans them: spaces and quotes stripped, an empty name
+read as ``Unnamed: k``, a repeated one as ``name.1``, ``name.2`` ...
 """
 
 from __future__ import annotations
@@ -67,7 +61,7 @@ def read_parquet_columns(path: str, where: str) -> Columns:
     DataError
         The file is not Parquet.
     """
-    from pyarrow import parquet  # 0.08 s to import, which a command line reading CSV saves
+    from pyarrow import parquet  # here: a command line reading CSV never needs it
 
     try:
         table = parquet.read_table(path)
@@ -94,7 +88,7 @@ def _values(column: pa.ChunkedArray) -> np.ndarray:
     if not (pa.types.is_floating(kind) or pa.types.is_integer(kind)):
         return np.array(column.to_pylist(), dtype=object)
     # read from the buffers: Array.to_numpy would import pandas, and cast or fill_null
-    # pyarrow.compute (0.1 s of every command line that reads a log)
+    # pyarrow.compute
     code = "f" if pa.types.is_floating(kind) else "i" if pa.types.is_signed_integer(kind) else "u"
     dtype = np.dtype(f"<{code}{kind.bit_width // 8}")
     return np.concatenate([_chunk_values(chunk, dtype) for chunk in column.chunks]

@@ -1,23 +1,12 @@
 """Measured experiments in the interchange format: reading, validation, writing.
 
-One table per experiment (CSV or Parquet) with the columns
+One table per experiment (CSV or Parquet) with the columns ``t, x, y, z, rx, ry, rz,
+l1..l6, f1..f6``: time (s), pose of the reference point in the paper frame (m, rad; z down),
+leg lengths (m), actuator forces along the legs (N, positive extends). Either the pose or the
+leg lengths may be missing: kinematics fill them in from the platform description.
 
-    t, x, y, z, rx, ry, rz, l1..l6, f1..f6
-
-time (s); pose of the reference point in the paper frame (m, rad; absolute, z down); leg
-lengths (m); actuator forces along the legs (N, positive extends the leg). Either the pose or
-the leg lengths may be missing: forward or inverse kinematics fill them in from the platform
-description. Several files are several experiments.
-
-Validation happens here, at the boundary, so that identification code can trust its input:
-required columns, finite values, strictly increasing time, a uniform sample period, at least
-:data:`MIN_SAMPLES` samples, and a sample rate in :data:`SAMPLE_RATE_RANGE_HZ` (a time column
-in ms or µs read as seconds falls outside). Every identification method here assumes a fixed
-sample period: time stamps that jitter around a uniform sample clock (every sample within
-half a period of its slot, none skipped) are timing noise of the logger and are replaced by
-the least-squares uniform clock; any other non-uniform time base is resampled onto a uniform
-grid (linear interpolation at the median sample period). Both with a :class:`~stewartid.errors.DataWarning`.
-With a platform description, the data are checked against it (:mod:`stewartid.datasets.plausibility`).
+Validation happens here, at the boundary, so that identification code can trust its input;
+a jittery or non-uniform time base is made uniform with a :class:`~stewartid.errors.DataWarning`.
 Logs in other layouts or units are read through a :class:`~stewartid.datasets.log_format.LogFormat`
 (``docs/logs.md``).
 """
@@ -119,7 +108,7 @@ class Dataset:
 
     def to_frame(self) -> pd.DataFrame:
         """The experiment as a table with the interchange columns."""
-        import pandas as pd  # 0.4 s to import, which reading and writing data never need
+        import pandas as pd  # slow to import: reading and writing data never need it
 
         data = np.column_stack([self.t, self.pose, self.lengths, self.forces])
         return pd.DataFrame(data, columns=list(COLUMNS))
@@ -273,9 +262,8 @@ def dataset_from_frame(frame: Mapping[str, np.ndarray] | pd.DataFrame,
 
 
 def _forward_kinematics_tracked(platform: Platform, lengths: np.ndarray, solve) -> np.ndarray:
-    # Start every sample at the neutral pose but refine from the previous solution in blocks:
-    # consecutive samples are close, so Newton converges in a couple of iterations even for
-    # large excursions that would stall from neutral.
+    # refined from the previous block's solution: consecutive samples are close, so Newton
+    # converges even for large excursions that would stall from neutral
     pose = np.empty_like(lengths)
     block = 2048
     start = platform.neutral_pose
@@ -382,11 +370,10 @@ def write_dataset(dataset: Dataset, path: str | Path, format: str | None = None)
     table = pa.table(dict(zip(COLUMNS, data, strict=True)))
     buffer = pa.BufferOutputStream()
     if kind == "csv":
-        # Arrow writes the shortest decimal that reads back to the same double: the round
-        # trip is bit-exact, at a tenth of the time of printf-style formatting
+        # Arrow writes the shortest decimal that reads back to the same double: a bit-exact round trip
         pyarrow.csv.write_csv(table, buffer, pyarrow.csv.WriteOptions(quoting_style="none"))
     else:
-        from pyarrow import parquet  # 0.08 s to import, which writing CSV files saves
+        from pyarrow import parquet  # here: writing CSV files never needs it
 
         parquet.write_table(table, buffer)
     return write_bytes_atomic(path, buffer.getvalue().to_pybytes())

@@ -1,10 +1,7 @@
 """An experiment given twice: the same file under two spellings, or two files with the same
-numbers.
-
-Counted twice, an experiment weighs its DOF double, and the one it displaced is often
-missing: with the paper's protocol (experiment k excites DOF k) that DOF is then moved only
-by coupling and its column of Mt and Bt comes out wrong by orders of magnitude, without any
-rank warning. Both checks run before anything is fitted.
+numbers. Counted twice, an experiment weighs its DOF double and hides the one it displaced,
+which then comes out wrong without any rank warning; both checks run before anything is
+fitted.
 """
 
 from __future__ import annotations

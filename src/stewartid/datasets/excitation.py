@@ -1,15 +1,7 @@
-"""What the motion of a set of experiments allows an identification to see.
-
-Two questions about the logged pose, asked before anything is fitted:
-
-- which sines a record holds (:func:`spectral_lines`): Method A assumes one per experiment;
-- whether every DOF moves on its own somewhere in the set (:func:`excitation_per_dof`,
-  :func:`check_excitation`): column k of Mt and Bt is seen only through the part of the
-  velocity and acceleration of DOF k that the other DOFs' do not explain.
-
-Both look at the motion in one unit for all six DOFs: the leg-length change it causes at the
-neutral pose, dl = J_lq(q0) (q - mean q) (m), so that a rotation counts as much as the
-translation that moves the legs as far.
+"""What the motion of a set of experiments allows an identification to see: which sines a
+record holds (:func:`spectral_lines`) and whether every DOF moves on its own somewhere in the
+set (:func:`excitation_per_dof`, :func:`check_excitation`). Both measure the motion as the
+leg-length change it causes at the neutral pose, dl = J_lq(q0) (q - mean q) (m).
 """
 
 from __future__ import annotations
@@ -26,24 +18,19 @@ from stewartid.model.kinematics import compute_leg_terms
 from stewartid.platform import COORDINATES, Platform
 from stewartid.signals.differentiation import default_window, differentiate, trim
 
-#: A spectral line counts when its amplitude reaches this fraction of the largest line's. The
-#: Hann window's highest sidelobe is 2.7 % of its line (-31.5 dB), and the single sines of our
-#: plant and of an independent simulator show nothing else above 2.8 %; 5 % of the amplitude
-#: is 0.25 % of the power, small against the Coulomb bias Method A carries anyway.
+#: A spectral line counts when its amplitude reaches this fraction of the largest line's:
+#: above the Hann window's highest sidelobe (2.7 % of its line).
 LINE_FRACTION = 0.05
 #: Within this many frequency bins (1 / record length) of a larger peak, a peak below
-#: SIDELOBE_FRACTION of it is taken for a sidelobe: the Hann window's first sidelobes peak 2.3
-#: to 2.4 bins from their line at 2.7 % of it (SIDELOBE_FRACTION allows three times that, for
-#: a line whose amplitude varies); its main lobe spans 2 bins either side.
+#: SIDELOBE_FRACTION of it is taken for a sidelobe (the Hann window's first sidelobes lie
+#: 2.3 to 2.4 bins from their line).
 SIDELOBE_BINS = 2.6
 SIDELOBE_FRACTION = 0.08
 #: A line needs this many periods in the record; slower content is drift or a fade-in.
 MIN_LINE_PERIODS = 2.0
 #: Smallest share of a DOF's velocity and acceleration left unexplained by the other DOFs',
-#: relative to the best-excited DOF's. The standard errors of column k of Mt and Bt scale with
-#: its inverse: at 1 % they are a hundred times those of the best column. A DOF moved only by
-#: coupling from the others' experiments measures 0.005 % to 0.15 % on our plant and an
-#: independent simulator; a single experiment moving all six DOFs at once 7 % or more.
+#: relative to the best-excited DOF's (the standard errors of its column of Mt and Bt scale
+#: with the inverse): below it, a DOF counts as moved only by coupling.
 MIN_RELATIVE_EXCITATION = 0.01
 #: Rows per experiment used by the excitation measure (an evenly strided subset).
 CHECK_SAMPLES = 4000
@@ -199,15 +186,11 @@ def _regressors(dataset: Dataset, scales: np.ndarray, platform: Platform) -> np.
 def excitation_per_dof(datasets: Sequence[Dataset], platform: Platform) -> np.ndarray:
     """How well each DOF is excited on its own over a set of experiments.
 
-    The twelve regressors (velocity and acceleration of each DOF: Savitzky-Golay derivatives
-    of the pose in the leg-length unit of :func:`dof_scales`, stacked over the experiments),
-    each divided by the largest norm among the regressors of its kind, are orthogonalised
-    greedily, the largest remaining part first (Gram-Schmidt with column pivoting): a
-    regressor's measure is the norm of the part the ones taken before it do not explain. A
-    DOF moved only by coupling thus comes last with the sliver of its own motion, and does
-    not discredit the DOF it follows. Per DOF the smaller of its two. The standard error of
-    an entry of column k of Mt or Bt is the noise divided by that part, so the measure is the
-    inverse of how much worse column k is determined than the best-excited one.
+    The twelve regressors (Savitzky-Golay velocity and acceleration of each DOF in the
+    leg-length unit of :func:`dof_scales`, stacked over the experiments), each scaled by the
+    largest norm of its kind, are orthogonalised greedily (Gram-Schmidt with column pivoting);
+    a regressor's measure is the norm of the part the ones before it do not explain, and a DOF's
+    the smaller of its two. The standard errors of column k of Mt and Bt scale with its inverse.
 
     Parameters
     ----------
@@ -298,9 +281,8 @@ def excitation_lines(datasets: Sequence[Dataset], threshold: float = LINE_THRESH
                      ) -> tuple[tuple[float, ...], ...]:
     """The distinct excitation frequencies of each DOF over all experiments.
 
-    A line counts when its amplitude is at least ``threshold`` times the DOF's largest line
-    over the experiments (a position spectrum: sensor noise, white in the pose, stays far
-    below it, where a velocity spectrum would raise it with frequency); lines within
+    A line counts when its amplitude (in the position spectrum, where white noise stays low) is
+    at least ``threshold`` times the DOF's largest line over the experiments; lines within
     :data:`LINE_MERGE_BINS` frequency resolutions of each other are one.
 
     Parameters
@@ -317,8 +299,7 @@ def excitation_lines(datasets: Sequence[Dataset], threshold: float = LINE_THRESH
     found = []
     for dof in range(6):
         # a line below the threshold of its own record's largest is below the threshold of
-        # the DOF's largest: the records need report no more (a noisy spectrum has thousands
-        # of maxima, each checked against the others as a sidelobe)
+        # the DOF's largest: the records need report no more
         records = [spectral_lines(d.pose[:, dof], d.sample_rate, fraction=threshold)
                    for d in datasets]
         largest = max((r.largest for r in records), default=0.0)

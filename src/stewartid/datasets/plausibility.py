@@ -1,18 +1,11 @@
 """Physical consistency of measured data with the platform description.
 
-A log with a unit, a frame, a leg numbering or a platform file wrong is still a table of
-finite numbers, and an identification on it runs to the end with a wrong answer. These checks
-compare the data with what the platform description implies, where the two meet:
-
-- leg lengths near the neutral leg length, positions near the neutral pose, angles small;
-- logged leg lengths against the inverse kinematics of the logged pose (both present);
-- static balance: the mean actuator forces against the weight of the platform and legs;
-- the identified Mt, Bt against the nominal ones of the platform description.
-
-Each failure is a :class:`~stewartid.errors.DataError` naming the likely cause and the fix;
-a mismatch a user may mean (a payload missing from the platform file, a constant leg-length
-calibration offset, an identified matrix a little off) is a
-:class:`~stewartid.errors.DataWarning`. The thresholds below are the documented factors.
+A log with a wrong unit, frame, leg numbering or platform file is still a table of finite
+numbers, and an identification on it runs to a wrong answer. These checks compare the data
+with what the description implies (leg lengths and pose near neutral, lengths against the
+inverse kinematics of the pose, mean forces against the weight, identified Mt, Bt against the
+nominal ones): a :class:`~stewartid.errors.DataError` naming the likely cause and the fix, or
+a :class:`~stewartid.errors.DataWarning` for a mismatch a user may mean.
 """
 
 from __future__ import annotations
