@@ -1,46 +1,13 @@
 """Method B: wavelet transform on constant-direction intervals (Zhang 2020).
 
-In a constant-direction interval (no joint reverses, :mod:`.intervals`) the Coulomb friction
-of every joint is constant, and so is what remains of gravity after the pose-dependent G(q)
-has been subtracted. The linearised equation of motion
-
-    Mt q_ddot + Bt q_dot + c = y,        y = J_lq(q)^T f_a - G(q),   c constant,
-
-transformed with a wavelet psi whose moments of order 0 and 1 vanish and whose support lies
-inside the interval, loses the constant:
+Inside an interval where no joint reverses, Coulomb friction and what gravity leaves are a
+constant c in Mt q_ddot + Bt q_dot + c = y; a wavelet psi with vanishing moments of order 0
+and 1 removes it:
 
     [Mt Bt] [W_psi q_ddot ; W_psi q_dot](a, b) = W_psi y (a, b).
 
-Stacking the equations of many (a, b) points from all intervals of all experiments gives a
-least-squares problem for the 72 entries of Mt and Bt.
-
-Variants (``variant``):
-
-``"position"`` (default)
-    No numerical differentiation: integration by parts moves both derivatives onto the
-    wavelet, W_psi q_ddot = W_psi'' q / a^2 and W_psi q_dot = -W_psi' q / a.
-``"paper"``
-    Zhang's equations: W_psi q_ddot and W_psi q_dot = -a W_psi1 q_ddot, with the
-    acceleration from a Savitzky-Golay differentiator (``differentiation_window``).
-``"derivative"``
-    W_psi q_ddot and W_psi q_dot with both signals from the Savitzky-Golay differentiator.
-
-Wavelets (``wavelet``): ``"polynomial"`` (default), psi = g'' with g = (1 - x^2)^p on [-1, 1],
-compactly supported, so the largest scale spans a whole interval (the modulating-function
-idea); ``"mexican_hat"``, the paper's Gaussian wavelet, truncated at +-``truncation`` scales
-(a tenth of the interval at the default 5); the polynomial one is the more accurate.
-
-Default (``test_functions=8``): per interval a family of orthonormalised zero-mean test
-functions spanning the whole interval, the weak form of :mod:`.weak_form`, solved by
-generalized least squares with the force and pose noise estimated from the data and the pose
-noise's bias removed (:mod:`.gls`), standard errors cluster-robust over intervals;
-``test_functions=None`` uses (a, b) points (:mod:`.point_equations`), as the paper does.
-
-Couplings (the paper's Mt(2,4) case): an entry and its transpose come from different
-equations (Mt(5,1) from pitch under surge, Mt(1,5) from surge under pitch), the rotational
-ones the sensitive; ``pair_selection`` combines them
-(:func:`~stewartid.identification.pairs.select_symmetric_pairs`), ``symmetric=True``
-imposes symmetry in the solve instead.
+By default each interval carries a family of zero-mean test functions (:mod:`.weak_form`)
+solved by generalized least squares (:mod:`.gls`).
 
 References
 ----------
@@ -114,82 +81,71 @@ class WaveletIdentifier(BaseIdentifier):
     Parameters
     ----------
     wavelet : {"polynomial", "mexican_hat"}
-        Mother wavelet (see the module docstring).
+        Mother wavelet: psi = g'' with g = (1 - x^2)^p on [-1, 1] (compact support), or the
+        paper's Mexican hat truncated at +-``truncation`` scales.
     wavelet_order : int
         Exponent p of the polynomial wavelet, 5..20.
     truncation : float
         Half-width (scales) at which the Mexican hat is cut.
     variant : {"position", "paper", "derivative"}
-        How W q_ddot and W q_dot are obtained (see the module docstring).
+        How W q_ddot and W q_dot are obtained: "position" moves both derivatives onto the
+        wavelet (W psi'' q / a^2, -W psi' q / a); "paper" uses a Savitzky-Golay q_ddot and
+        W q_dot = -a W_psi1 q_ddot; "derivative" Savitzky-Golay q_ddot and q_dot.
     test_functions : int or None
         Number K of orthonormalised zero-mean test functions per interval, 1..12
-        (:mod:`~stewartid.identification.wavelet.weak_form`; default 8). None: the wavelet transform
-        at (a, b) points set by ``scale_fractions`` and ``shifts_per_scale``, as in the paper.
+        (:mod:`~stewartid.identification.wavelet.weak_form`). None: the wavelet transform at
+        (a, b) points set by ``scale_fractions`` and ``shifts_per_scale``, as in the paper.
         Needs the polynomial wavelet and the position variant.
     friction : {"auto", "free", "shared", "uniform", "coulomb"}
-        With ``test_functions``: "coulomb", windows of
-        :data:`.friction_models.WINDOW_LENGTH` s across joint reversals, every row with the
-        Coulomb force of each joint type (:mod:`.windows`; several frequencies per DOF, all
-        DOFs at once: plant, paper platform, 30 N m, noise-free, 2.2 / 0.39 % on three-sine /
-        all-DOF logs, "free" 17 / 1343 %). "auto" (default): "coulomb"; on one sine per
-        experiment both it and "free", the data choosing (:mod:`.friction_models`). "free"
-        leaves every interval constant free (the paper's invariance to any friction law),
-        the Coulomb levels kept only where the force inside the intervals needs them
-        (:mod:`.rate_selection`); "shared" models the constants as an offset per experiment
-        plus the Coulomb level of each joint type, with a scatter estimated from the data
-        (``coulomb_``): more precise Bt under noise, biased where the plant's friction
-        departs from that structure; "uniform" one level for every axis.
+        With ``test_functions``: "coulomb", windows of :data:`.friction_models.WINDOW_LENGTH`
+        s across joint reversals with each joint type's Coulomb force (:mod:`.windows`);
+        "free", every interval constant free (invariant to any friction law; Coulomb levels
+        kept only where the rows need them, :mod:`.rate_selection`); "shared", an offset per
+        experiment plus the Coulomb level of each joint type; "uniform", one level for every
+        axis. "auto": "coulomb", or on one sine per experiment both it and "free", the data
+        choosing (:mod:`.friction_models`).
     scale_fractions : tuple of float
         Wavelet support as fractions of each interval's length, each in (0, 1].
     shifts_per_scale : int
         Shifts per scale and interval.
     margin : float or None
-        Time (s) cut from both ends of every constant-direction interval. None (default):
-        :data:`MARGIN_PERIODS` periods of the estimated excitation frequency (0.03 s at
-        0.5 Hz): idle joints' friction reverses late, but longer intervals inform more
-        (paper platform, 30 N m: noise-free 0.23 / 0.37 % at 0.1 / 0.03 s; reference
-        noise, Bt diagonal 19 / 11 % worst of 8 seeds).
+        Time (s) cut from both ends of every constant-direction interval. None:
+        :data:`MARGIN_PERIODS` periods of the estimated excitation frequency.
     ignore_below : float
         Joints whose rate RMS is below this fraction of the largest of their kind are left
-        out of the interval detection (they barely move, and their sign flips at odd times).
+        out of the interval detection.
     min_interval : float or None
         Shortest usable interval (s); None: half the median interval of each experiment.
     min_support_samples : int
-        Fewest samples the smallest wavelet's support may cover; intervals too short for it
-        are dropped.
+        Fewest samples the smallest wavelet's support may cover.
     differentiation_window : float or None
         Savitzky-Golay window (s) for the joint rates of the interval detection and, in the
-        ``"paper"`` and ``"derivative"`` variants, for q_dot and q_ddot. None (default): a
-        fifth of the period of the experiment's dominant frequency, estimated from the data,
-        which keeps measurement noise out of the joint rates without moving their zeros.
+        ``"paper"`` and ``"derivative"`` variants, for q_dot and q_ddot. None: a fifth of the
+        period of the experiment's dominant frequency.
     hysteresis : float
         A joint's direction counts as known only while its rate exceeds this many times the
-        rate's noise level (estimated from the data,
-        :func:`~stewartid.identification.wavelet.noise.joint_rate_noise`); reversals inside the
-        noise band are kept out of every interval (see
-        :func:`~stewartid.identification.wavelet.intervals.constant_direction_intervals`).
+        rate's noise level (:func:`~stewartid.identification.wavelet.noise.joint_rate_noise`).
     odd_companion : bool
         ``test_functions=None``: also use the polynomial wavelet's odd companion g'''
         (:class:`~stewartid.signals.wavelets.PolynomialWavelet`; ``wavelet_order`` >= 8).
     noise_correction : bool
         Position variant: weight by and remove the pose noise's contribution to the normal
-        equations (errors in variables, noise estimated from the data; :mod:`.gls`,
+        equations (errors in variables; :mod:`.gls`,
         :func:`~stewartid.identification.solvers.bias_compensated_least_squares`).
     symmetric : bool
         Impose Mt = Mt^T and Bt = Bt^T in the solve.
     pair_selection : {"pooled", "std_error", "none"}
-        Symmetric pairs (not with ``symmetric``): "pooled" (default) the inverse-variance mean
-        of members within 3 standard errors, else the translational one; "std_error" the
-        better-determined member.
+        Symmetric pairs (not with ``symmetric``): "pooled" the inverse-variance mean of
+        members within 3 standard errors, else the translational one; "std_error" the
+        better-determined member
+        (:func:`~stewartid.identification.pairs.select_symmetric_pairs`).
     gravity : bool
         Subtract the model's pose-dependent gravity G(q) before identification.
     remainder : bool
         Subtract the model's departure from its linearisation along the measured motion
-        (:func:`~stewartid.identification.preparation.model_remainder`): the linearisation's
-        matrices at any amplitude.
+        (:func:`~stewartid.identification.preparation.model_remainder`).
     sampling_check : bool
-        Refit at a half, a third and a quarter of the log's rate where the residual is not
-        noise, and add the estimate's change to the standard errors
+        Widen the standard errors where the log's sampling limits the estimate
         (:mod:`~stewartid.identification.sampling`).
 
     Attributes
@@ -289,13 +245,12 @@ class WaveletIdentifier(BaseIdentifier):
 
     def _fit_weak_form(self, datasets: list[Dataset], platform: Platform,
                        wavelet: MotherWavelet) -> tuple[IdentificationResult, dict]:
-        """The default path: orthonormal test-function families per interval
-        (:mod:`~stewartid.identification.wavelet.weak_form`), the steps of the data path in
-        :mod:`stewartid.identification.wavelet`. One experiment at a time, its arrays
-        dropped once its equations are formed, so that long logs fit in memory.
+        """The default path: test-function families per interval, one experiment at a time.
 
-        With ``friction="auto"`` on one sine per experiment both friction treatments are
-        formed from the same prepared experiments and solved, one kept (:mod:`.friction_models`)."""
+        Each experiment's arrays are dropped once its equations are formed, so that long logs fit
+        in memory; with several friction models each is solved and one kept
+        (:mod:`.friction_models`).
+        """
         models = friction_models(self.friction, datasets)
         infos, sensitivities, motion = [], [], []
         equations: dict[str, list] = {model: [] for model in models}
@@ -356,9 +311,10 @@ class WaveletIdentifier(BaseIdentifier):
         return result, {"coulomb_": levels, "coulomb_std_": levels_std}
 
     def _point_equations(self, experiment: Experiment, wavelet: MotherWavelet):
-        """Wavelet equations of one prepared experiment at (a, b) points
-        (``test_functions=None``), with the covariances of the pose noise they carry: per
-        row E[e_x e_x^T] (12, 12) and E[e_x e_y^T] (12, 6), zero without noise correction."""
+        """Wavelet equations of one prepared experiment at (a, b) points, with their pose-noise covariances.
+
+        Per row E[e_x e_x^T] (12, 12) and E[e_x e_y^T] (12, 6), zero without noise correction.
+        """
         found = self._noise_and_intervals(experiment, min(self.scale_fractions))
         wavelets = [wavelet]
         if self.odd_companion and isinstance(wavelet, PolynomialWavelet):
@@ -378,9 +334,10 @@ class WaveletIdentifier(BaseIdentifier):
 
     def _combine_pairs(self, M: np.ndarray, B: np.ndarray, std_M: np.ndarray,
                        std_B: np.ndarray, clip: bool = False) -> dict:
-        """Symmetric pairs, in place (:func:`~stewartid.identification.pairs.combine_pairs`;
-        ``clip`` for the free interval constants); the calibration kept for the
-        diagnostics."""
+        """Symmetric pairs, in place (:func:`~stewartid.identification.pairs.combine_pairs`).
+
+        ``clip`` for the free interval constants; the calibration is kept for the diagnostics.
+        """
         chosen, self.pair_calibration_ = combine_pairs(
             M, B, std_M, std_B, bool(self.symmetric), self.pair_selection, clip)
         return chosen

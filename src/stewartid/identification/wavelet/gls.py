@@ -1,39 +1,15 @@
 """Generalized least squares for the weak-form equations, with pose noise propagated.
 
-The rows of one interval, <phi_r, y> = Mt <phi_r'', q> - Bt <phi_r', q> (+ the constant for
-the mean row), carry two kinds of noise:
+The rows of an interval carry white force-side noise (variance s_i per row of channel i)
+and pose noise n (covariance Sigma per sample) entering both regressors and target; channel
+i's rows then have covariance s_i I + Q with
 
-- the force side (leg-force noise through J^T, what the gravity model leaves): white on the
-  samples, so of variance s_i per row of channel i (the rows are orthonormal on the samples);
-- the pose noise n (white, covariance Sigma per sample), which enters every regressor and,
-  through y = J(q)^T f - G(q), the target (k_i n, k_i the row of K = dy/dq). Channel i's
-  residual then holds sum_a c_a . <phi_r^(a), n> with c_0 = k_i, c_1 = b_i, c_2 = -m_i
-  (m_i, b_i the rows of Mt and Bt), of covariance between rows r and s
+    Q_rs = sum_ab (c_a Sigma c_b) <phi_r^(a), phi_s^(b)>,   c_0 = k_i, c_1 = b_i, c_2 = -m_i.
 
-      Q_rs = sum_ab (c_a Sigma c_b) <phi_r^(a), phi_s^(b)>
-
-  (the ``noise_gram`` of :class:`~stewartid.identification.wavelet.weak_form.IntervalEquations`).
-
-The second derivative makes the pose noise the larger part on the narrow test functions: on
-the example data set with 20 µm leg-length noise it is 3-40x the force noise, growing with
-the function's order. Equal weights then spend the narrow functions' noise on Mt, and the
-noise in the regressors attenuates Mt by its share of their power (0.1-0.35 % on the Mt
-diagonal there, measured as a bias over seeds). Both are removed as in WENDy: each
-interval's rows are weighted by the inverse of their covariance s_i I + Q (iteratively, since Q
-depends on the estimate), and the expected noise parts of the weighted normal equations,
-sum_rs W_rs <phi_r^(a), phi_s^(b)> Sigma per block (and the targets' share through K), are
-subtracted (the bias-compensated, errors-in-variables normal equations).
-
-Sigma comes from the data (:func:`~stewartid.identification.wavelet.noise.white_noise_covariance`
-per experiment), and so does the white force noise of each experiment (the same estimator on
-the generalized force); s_i is that white part plus, when the weighted residuals hold more
-than noise explains (model error), the excess that brings their chi-square to its degrees of
-freedom. The white part must be measured, not left to the moments: with 20 µm pose noise the
-pose part is 99.9 % of the residual power on the narrow test functions, the moments'
-difference of two large numbers came out negative on most channels, and the widest
-functions, where the force noise is the larger part, were then weighted as if noise-free
-(weighted residuals 8-34 times their expected size, standard errors up to 45 times the
-spread over seeds).
+As in WENDy, each interval's rows are weighted by the inverse of that covariance
+(iteratively, Q depending on the estimate) and the expected noise parts of the weighted
+normal equations are subtracted (errors in variables). Sigma and the white force noise are
+measured from the data (:mod:`.noise`).
 
 References
 ----------
@@ -117,8 +93,10 @@ class WeakFormSolution:
 
 def _weighted_normal(design: np.ndarray, weights: np.ndarray, target: np.ndarray
                      ) -> tuple[np.ndarray, np.ndarray]:
-    """sum_n D_n^T W_n D_n and sum_n D_n^T W_n t_n for designs (n, R, u), weights (n, R, R)
-    and targets (n, R), as two matrix products."""
+    """sum_n D_n^T W_n D_n and sum_n D_n^T W_n t_n.
+
+    For designs (n, R, u), weights (n, R, R) and targets (n, R).
+    """
     weighted = weights @ design                                         # (n, R, u)
     flat = design.reshape(-1, design.shape[-1])
     return (flat.T @ weighted.reshape(flat.shape),
@@ -127,16 +105,12 @@ def _weighted_normal(design: np.ndarray, weights: np.ndarray, target: np.ndarray
 
 def channel_systems(stacked: StackedEquations, n_experiments: int, shared_friction: bool,
                     variation: bool = False) -> tuple[list[np.ndarray], list[np.ndarray]]:
-    """Design (n, R, u) and targets (n, R) of each of the 6 channels over all u unknowns:
-    [Mt Bt] row-major, then (shared friction) an offset per experiment and channel, then the
-    Coulomb levels (shared friction, or ``variation``); R = K invariant rows, plus the mean
-    row with shared friction.
+    """Design (n, R, u) and targets (n, R) of each of the 6 channels over all u unknowns.
 
-    With ``variation`` the invariant rows carry the Coulomb levels too: the pose's change
-    inside an interval changes the generalized Coulomb force the interval constant holds
-    (J_j(q)^T mapped with fixed joint directions), and at large motions that change follows
-    the motion itself (paper platform, the paper's sines at ten times their amplitude,
-    30 N m: Mt(4,2) 3.5 % off, noise-free, with the constants alone; < 0.01 % with it).
+    Unknowns: [Mt Bt] row-major, then (shared friction) an offset per experiment and channel,
+    then the Coulomb levels (shared friction, or ``variation``). R = K invariant rows, plus the
+    mean row with shared friction. With ``variation`` the invariant rows carry the Coulomb
+    levels too: the generalized Coulomb force changes with the pose inside an interval.
     """
     x, y, owner = stacked.regressors, stacked.targets, stacked.owner
     n, k_rows = x.shape[:2]
@@ -164,9 +138,12 @@ def channel_systems(stacked: StackedEquations, n_experiments: int, shared_fricti
 
 def channel_covariance(stacked: StackedEquations, gram: np.ndarray, noise: np.ndarray,
                        i: int, theta_i: np.ndarray, scatter: float | None) -> np.ndarray:
-    """Covariance (n, R, R) of channel i's rows: the force-side noise ``noise`` (n,) per
-    row, the pose noise at the estimate theta_i (12,) and, with shared friction
-    (``scatter`` not None), the interval constants' scatter tau on the mean row."""
+    """Covariance (n, R, R) of channel i's rows.
+
+    The force-side noise ``noise`` (n,) per row, the pose noise at the estimate theta_i (12,)
+    and, with shared friction (``scatter`` not None), the interval constants' scatter on the
+    mean row.
+    """
     rows = gram.shape[-1]
     v = noise[:, None, None] * np.eye(rows) + pose_covariance(
         gram, stacked.sigma, pose_coefficients(stacked.sensitivity[:, i], theta_i))
@@ -176,9 +153,11 @@ def channel_covariance(stacked: StackedEquations, gram: np.ndarray, noise: np.nd
 
 
 class InvariantFit(NamedTuple):
-    """Result of :func:`fit_invariant_rows`: theta (6, 12), the force-side noise s (n, 6)
-    per interval and channel, and the share of each channel's residual power the pose
-    noise explains (6,)."""
+    """Result of :func:`fit_invariant_rows`.
+
+    theta (6, 12), the force-side noise variance (n, 6) per interval and channel, and the share
+    of each channel's residual power the pose noise explains (6,).
+    """
 
     theta: np.ndarray
     noise: np.ndarray
@@ -186,14 +165,15 @@ class InvariantFit(NamedTuple):
 
 
 def fit_invariant_rows(stacked: StackedEquations, iterations: int) -> InvariantFit:
-    """Each channel from the invariant rows alone (the estimate the scatter of the interval
-    constants is measured with), reweighted ``iterations`` times with the row covariance
-    s_i I + Q, s_i the white force noise plus the chi-square excess of the residuals."""
+    """Each channel from the invariant rows alone, reweighted ``iterations`` times.
+
+    The row covariance is s_i I + Q, s_i the white force noise plus the chi-square excess of
+    the residuals; this estimate is the one the interval constants' scatter is measured with.
+    """
     x, y = stacked.regressors, stacked.targets
     n, k_rows = x.shape[:2]
     sigma, sensitivity, white = stacked.sigma, stacked.sensitivity, stacked.white
     gram = stacked.gram[..., :k_rows, :k_rows]
-    # start: each channel's invariant rows, force-side weights only
     theta = np.linalg.lstsq(x.reshape(-1, 12), y.reshape(-1, 6), rcond=None)[0].T
     # floor: noise-free data must not give infinite weights
     floor = 1e-24 * np.maximum(np.mean(y.reshape(-1, 6) ** 2, axis=0), 1e-300)
@@ -217,11 +197,10 @@ def fit_invariant_rows(stacked: StackedEquations, iterations: int) -> InvariantF
 
 def constant_scatter(stacked: StackedEquations, designs: Sequence[np.ndarray],
                      invariant: InvariantFit) -> np.ndarray:
-    """tau (6,): the scatter of the interval constants around the friction structure, per
-    channel (N, N m).
+    """tau (6,): the scatter of the interval constants around the friction structure (N, N m).
 
-    Measured with the invariant estimate: a joint fit would bend Bt to hide a structure that
-    does not hold, and so report a scatter too small to notice it.
+    Measured with the invariant estimate, since a joint fit would bend Bt to hide a structure
+    that does not hold.
     """
     theta, n = invariant.theta, len(stacked.owner)
     gram = stacked.gram
@@ -235,11 +214,8 @@ def constant_scatter(stacked: StackedEquations, designs: Sequence[np.ndarray],
     fitted = np.linalg.lstsq(scaled.reshape(-1, n_nuisance),
                              (base / np.sqrt(variance)).ravel(), rcond=None)[0]
     mean_residual = base - nuisance_design @ fitted
-    # tau^2 per channel with sum_k r_k^2 / (v_k + tau^2 w_k^2) = dof, i.e. the chi-square
-    # excess of r_k / w_k over v_k / w_k. Not the plain moment sum(r^2 - v) / sum(w^2):
-    # the intervals' noise variances v differ 100-fold, the moment was ruled by the
-    # noisiest, came out zero on half the seeds and 20x the typical value on others,
-    # and the estimates of Bt followed it (kurtosis 4-9 over seeds, twice the spread)
+    # tau^2 per channel with sum_k r_k^2 / (v_k + tau^2 w_k^2) = dof, weighted because the
+    # intervals' noise variances v differ widely
     dof = n - n_nuisance / 6
     weight = stacked.weights
     return np.sqrt([chi2_excess(variance[:, i] / weight ** 2,
@@ -274,10 +250,11 @@ class JointFit(NamedTuple):
 def fit_jointly(stacked: StackedEquations, designs: Sequence[np.ndarray],
                 targets: Sequence[np.ndarray], invariant: InvariantFit,
                 scatter: np.ndarray | None, iterations: int) -> JointFit:
-    """All channels at once (the Coulomb levels are shared by the channels), each interval's
-    rows weighted by the inverse of their covariance, the noise bias of every channel's
-    [Mt Bt] block removed; reweighted ``iterations`` times with shared friction
-    (``scatter`` not None), once without."""
+    """All channels at once, rows weighted by the inverse of their covariance, noise bias removed.
+
+    The Coulomb levels are shared by the channels; reweighted ``iterations`` times with shared
+    friction (``scatter`` not None), once without.
+    """
     n_unknowns = designs[0].shape[-1]
     rows = designs[0].shape[1]
     gram = stacked.gram[..., :rows, :rows]
@@ -316,10 +293,11 @@ def fit_jointly(stacked: StackedEquations, designs: Sequence[np.ndarray],
 
 def standard_errors(designs: Sequence[np.ndarray], targets: Sequence[np.ndarray],
                     fit: JointFit) -> np.ndarray:
-    """Standard errors (u,) of all unknowns: the larger of the model's (GLS with the
-    compensated normal matrix) and a cluster-robust sandwich over intervals (model errors
-    such as a friction reversal inside an interval show in the spread between intervals,
-    not in the noise level)."""
+    """Standard errors (u,) of all unknowns: the larger of the GLS one and a cluster-robust one.
+
+    The sandwich is over intervals, so model errors that show in the spread between intervals
+    are counted.
+    """
     n, n_unknowns = len(designs[0]), len(fit.z)
     scores = np.zeros((n, n_unknowns))
     squares, n_rows = 0.0, 0
@@ -329,8 +307,7 @@ def standard_errors(designs: Sequence[np.ndarray], targets: Sequence[np.ndarray]
         scores += (weighted[:, None, :] @ designs[i])[:, 0, :]
         squares += float(np.sum(residual * weighted))
         n_rows += residual.size
-    # the equilibrated normal matrix is well conditioned (checked above): an inverse, not
-    # pinv's SVD of the 111 x 111 shared-friction system
+    # the equilibrated normal matrix is well conditioned (checked above): an inverse
     outer = np.outer(fit.scale, fit.scale)
     bread = np.linalg.inv(fit.normal / outer) / outer
     model_cov = bread * max(squares / max(n_rows - n_unknowns, 1), 1e-300)
@@ -346,8 +323,7 @@ def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
                     force_sensitivity: np.ndarray | None = None,
                     force_variance: np.ndarray | None = None, rate_index: int = 0,
                     variation: bool = False, shared: dict | None = None) -> WeakFormSolution:
-    """Generalized least squares for [Mt Bt] (and the friction structure), pose noise
-    propagated and its bias compensated (module docstring).
+    """Generalized least squares for [Mt Bt] (and the friction structure), pose noise compensated.
 
     Parameters
     ----------
@@ -364,15 +340,13 @@ def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
         Rank check of the invariant regression (names the DOF never excited).
     pose_covariance : ndarray, shape (n_experiments, 6, 6), optional
         White pose-noise covariance per sample of each experiment (m^2, m rad, rad^2);
-        None: noise-free poses (weights from the force side only).
+        None: noise-free poses.
     force_sensitivity : ndarray, shape (n_experiments, 6, 6), optional
         K = d(J^T f - G) / dq of each experiment
-        (:attr:`~stewartid.identification.preparation.Experiment.force_sensitivity`): the
-        pose noise the targets share with the regressors. None: zero.
+        (:attr:`~stewartid.identification.preparation.Experiment.force_sensitivity`); None: zero.
     force_variance : ndarray, shape (n_experiments, 6), optional
         White noise variance per sample of each experiment's generalized force (N^2,
-        N^2 m^2), e.g. :func:`~stewartid.identification.wavelet.noise.white_noise_covariance`
-        of it; None: zero (the force noise then comes from the residuals alone).
+        N^2 m^2); None: zero (the force noise then comes from the residuals alone).
     rate_index : int
         Soft-sign transition rate of the invariant rows' Coulomb regressors (an index into
         each interval's ``coulomb_rows``).
@@ -380,9 +354,8 @@ def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
         Give the invariant rows the Coulomb levels (:func:`channel_systems`); the force-side
         noise is then re-measured from the joint fit's residuals and the fit repeated.
     shared : dict, optional
-        Work that does not depend on ``rate_index`` or ``variation`` (the rank check and
-        :func:`fit_invariant_rows`), kept here by the first call and reused by the next ones
-        on the same equations.
+        Cache of the work independent of ``rate_index`` and ``variation`` (rank check,
+        :func:`fit_invariant_rows`), filled by the first call and reused on the same equations.
 
     Returns
     -------
@@ -392,11 +365,9 @@ def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
 
     Notes
     -----
-    The steps, each a function of this module: :func:`stack_equations` (the intervals'
-    equations and noise levels as arrays), :func:`channel_systems` (each channel's design),
-    :func:`fit_invariant_rows` (the invariant rows alone, reweighted, with the force-side
-    noise), :func:`constant_scatter` (shared friction: the interval constants' scatter),
-    :func:`fit_jointly` (all rows and channels) and :func:`standard_errors`.
+    The steps: :func:`stack_equations`, :func:`channel_systems`, :func:`fit_invariant_rows`,
+    :func:`constant_scatter` (shared friction), :func:`fit_jointly` and
+    :func:`standard_errors`.
     """
     stacked = stack_equations(equations, pose_covariance, force_sensitivity, force_variance,
                               rate_index)
