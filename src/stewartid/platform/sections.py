@@ -1,12 +1,9 @@
 """The sections of a platform description: one frozen dataclass per TOML table.
 
-Each field is declared once, with its unit, description, constraint (sign and physical
-range, in the field's SI unit) and default (:func:`stewartid.fields.spec`); a section checks
-every field when built (:class:`stewartid.fields.Section`). The physical ranges are wide on
-purpose: they catch factors of a thousand (a file in millimetres, a mass in grams, a pressure
-in bar), not unusual designs. :mod:`stewartid.platform.description` assembles the sections
-into a :class:`~stewartid.platform.Platform`; the format is documented in
-``docs/platform-format.md``.
+Each field is declared once with its unit, description, constraint and default
+(:func:`stewartid.fields.spec`) and checked when the section is built. The physical ranges
+are wide on purpose: they catch factors of a thousand (millimetres, grams, bar), not unusual
+designs. The format is documented in ``docs/platform-format.md``.
 """
 
 from __future__ import annotations
@@ -168,10 +165,8 @@ class Hydraulics(Section):
     """Hydraulic actuators of the legs: servo-valve, cylinder and oil (same for all six legs).
 
     Defaults size a flight-simulator class hexapod of about 14 t: a 21 MPa supply, 100/70 mm
-    cylinders with 1 m stroke (mid-stroke at the neutral pose; about 165 kN extending force
-    against a static load near 31 kN per leg), 200 L/min servo-valves of 80 Hz bandwidth and
-    an effective bulk modulus of 1.2 GPa (oil with some hose compliance). With these values
-    the hydraulic natural frequency of a leg is about 15-25 Hz.
+    cylinders with 1 m stroke (mid-stroke at the neutral pose), 200 L/min servo-valves of 80 Hz
+    bandwidth and an effective bulk modulus of 1.2 GPa.
     """
 
     section = "hydraulics"
@@ -230,11 +225,8 @@ class Hydraulics(Section):
 class Controller(Section):
     """Leg-length servo: PID on each leg length giving a force demand, plus an inner force loop.
 
-    The PID output is the force demand of the leg (N). In ``ideal`` actuator mode it is
-    applied exactly; in ``hydraulic`` mode an inner loop opens the valve in proportion to the
-    force error (force from the chamber pressures). Defaults give a position bandwidth of
-    about 5 Hz per leg for the paper's platform, so that the 0.5 Hz excitation is tracked to
-    about 1 % of its amplitude.
+    The PID output is the force demand of the leg (N): applied exactly in ``ideal`` actuator
+    mode; in ``hydraulic`` mode an inner loop opens the valve in proportion to the force error.
     """
 
     section = "controller"
