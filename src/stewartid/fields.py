@@ -1,20 +1,11 @@
 """One vocabulary of constraints for every value the package takes from outside.
 
-A constraint says which values a setting accepts and is declared once, beside what it
-constrains, in the manner of scikit-learn's ``_parameter_constraints``:
-
-- a field of a platform section: :func:`spec` (unit, description, constraint, default);
-- a hyper-parameter of an identifier: ``_parameter_constraints`` next to its ``__init__``;
-- a parameter of a study point: a :class:`FieldSpec` in the study's parameter table;
-- a command-line flag: the constraint given to :func:`check` beside the flag.
-
-A setting is valid if it satisfies one of its constraints (``None`` in the list allows None).
-Every refusal has one form, scikit-learn's: *"The 'order' parameter of FourierIdentifier
-must be an integer >= 3. Got 2 instead."*, *"[inertia] platform_mass must be > 0 (kg). Got
--1.0 instead."*, *"--budget must be > 0. Got -5.0 instead."* A number may also carry a
-physical range, wide enough for any hexapod from a desktop positioner to a large shaking
-table: a value outside it is almost always a unit mistake (a file in millimetres, a mass in
-grams) and is refused with a hint to check its unit.
+A constraint is declared once, beside what it constrains, in the manner of scikit-learn's
+``_parameter_constraints``: a platform section's field (:func:`spec`), an identifier's
+hyper-parameter, a study parameter (:class:`FieldSpec`), a command-line flag (:func:`check`).
+A setting is valid if it satisfies one of its constraints (``None`` allows None). Every
+refusal reads *"{subject} must be {expected}. Got {value!r} instead."*; a number outside its
+physical range (wide enough for any hexapod) is refused as a probable unit mistake.
 """
 
 from __future__ import annotations

@@ -1,29 +1,16 @@
 """The one process-pool policy of the package: how independent tasks run on several cores.
 
-Every parallel stage (``simulate``'s experiments, a design's noise realisations,
-``reproduce``'s simulations, identifications and figures) runs through
-:func:`process_pool` or :func:`run_in_order`, so they share one policy:
+Every parallel stage runs through :func:`process_pool` or :func:`run_in_order`:
 
 - **start method "fork"** where the system has it, "spawn" elsewhere: a forked worker starts
-  with the modules and the compiled kernels of this process, while a spawned one imports the
-  package and compiles the kernels generated at run time again (measured: ``simulate`` of
-  6 x 12 s on two workers 5.3 s forked, 14.3 s spawned). The package starts no threads of
-  its own (numba without ``parallel``), and OpenBLAS re-creates its threads after a fork.
-  Callers that load kernels lazily warm them here first when :data:`WORKERS_INHERIT`.
-- **one BLAS thread per task**, set with threadpoolctl by the worker's initializer (the
-  parent's environment is left alone), and around the tasks when one worker runs them here:
-  the parallelism is across processes, multithreaded BLAS in every worker only
-  oversubscribes the cores (two two-thread workers on two cores double the identification
-  time), and a product summed by one thread or by two can differ in the last bit, so the
-  thread count is the same for any worker count. Workers that another library starts
-  (dask's LocalCluster) get the same limit through :data:`WORKER_THREADS` in their
-  environment.
-- **worker count**: ``os.cpu_count()`` by default, never more than there are tasks; one
-  worker runs the tasks in this process, without a pool.
-- **results in task order**, whatever order the workers finish in; every task carries its
-  own seed, so the results do not depend on the worker count.
-- **progress** as ``progress(done, total, index)`` after each finished task, ``index`` being
-  the position of that task.
+  with this process's modules and compiled kernels (:data:`WORKERS_INHERIT`);
+- **one BLAS thread per task**: the parallelism is across processes, and a fixed thread
+  count keeps the results bitwise the same for any worker count (:data:`WORKER_THREADS` for
+  workers another library starts);
+- **worker count** ``os.cpu_count()`` by default, at most one per task; one worker runs the
+  tasks in this process, without a pool;
+- **results in task order**, each task carrying its own seed;
+- **progress** as ``progress(done, total, index)`` after each finished task.
 """
 
 from __future__ import annotations
