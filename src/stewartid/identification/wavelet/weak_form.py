@@ -1,39 +1,14 @@
-"""Weak-form equations on constant-direction intervals, and their noise-aware solution.
+"""Weak-form equations on constant-direction intervals: the default rows of Method B.
 
-The default Method B. Inside a constant-direction interval the equation of motion is
-
-    Mt q_ddot + Bt q_dot + c_m = y,        y = J_lq(q)^T f_a - G(q),
-
-with c_m the interval's constant (Coulomb friction of the moving joints, what the gravity
-model leaves over). Multiplying by a test function phi that vanishes with its first
-derivative at the interval's ends and integrating by parts moves both derivatives onto phi,
+A test function phi vanishing with its first derivative at the interval's ends moves both
+derivatives of Mt q_ddot + Bt q_dot + c_m = y onto itself,
 
     Mt <phi'', q> - Bt <phi', q> + c_m <phi, 1> = <phi, y>,
 
-so no signal is differentiated numerically (the modulating-function, or weak, form; the
-paper's wavelet transform is the special case of one dilated and shifted wavelet).
-
-Test functions, per interval of half-length L and centre c, x = (t - c) / L:
-
-- a family of ``size`` zero-mean functions phi_k = d/dt [(1 - x^2)^p x^k], k = 0..size-1,
-  orthonormalised on the samples (so that white force noise stays white and equally
-  weighted, as in WENDy), which remove c_m exactly: these rows are Coulomb-invariant;
-- one mean row, the bump (1 - x^2)^p orthogonalised against the family, which keeps c_m.
-
-The mean rows say what the interval constants hold. With ``shared_friction`` the constant is
-modelled as c_m = o_e + sum_types F_type W_m,type + delta_m: an offset per experiment, the
-Coulomb level of each joint type (lower gimbal, upper gimbal, revolute) mapped through the
-joint Jacobians with the interval's joint directions, and a random deviation delta_m of
-variance tau^2 per channel estimated from the data (idle joints, a friction law other than
-Coulomb's). Inside one interval the mean viscous force cannot be told from the constant; the
-friction structure across intervals and experiments gives that information back, and tau^2
-decides how much it is trusted: a plant whose friction does not fit the structure gets a
-large tau^2 and the estimate falls back on the invariant rows alone.
-
-The solve (:mod:`~stewartid.identification.wavelet.gls`) is generalized least squares
-over all channels at once (the Coulomb levels are shared by the channels), each interval's
-rows weighted by their covariance: the force noise, and the pose noise the test functions'
-derivatives carry into the regressors, whose bias it also compensates.
+so no signal is differentiated numerically. Per interval, a family of orthonormal zero-mean
+test functions (Coulomb-invariant rows) and one mean row, which keeps c_m; with shared
+friction c_m = o_e + sum_types F_type W_m,type + delta_m, with delta_m of variance tau^2
+estimated from the data.
 
 References
 ----------
@@ -86,6 +61,10 @@ def test_family(t: np.ndarray, start: float, stop: float, order: int, size: int,
                 ) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
     """The test functions of one span, sampled and scaled for quadrature.
 
+    With x = (t - c) / L on the span of centre c and half-length L, phi_k = d/dt [(1 - x^2)^p
+    x^k], k < ``size``, orthonormalised on the samples; the mean row is the bump (1 - x^2)^p
+    orthogonalised against them.
+
     Parameters
     ----------
     t : ndarray, shape (n,)
@@ -109,7 +88,6 @@ def test_family(t: np.ndarray, start: float, stop: float, order: int, size: int,
     half, centre = 0.5 * (stop - start), 0.5 * (start + stop)
     x = (t - centre) / half
     vander = polynomial.polyvander(x, _family_coefficients(order, size)[0].shape[0] - 1)
-    # rows: test functions and their time derivatives, times the quadrature step
     g0, g1, g2, g3 = (vander @ c * (h / half ** d)
                       for d, c in enumerate(_family_coefficients(order, size)))
     phi0, phi1, phi2 = g1[:, 1:].T, g2[:, 1:].T, g3[:, 1:].T
@@ -131,8 +109,7 @@ class IntervalEquations:
     Attributes
     ----------
     regressors : ndarray, shape (K, 12)
-        Invariant rows: [<phi_k'', q>, -<phi_k', q>] (m s^-1, rad s^-1 times s^0 ...: the
-        units of q_ddot and q_dot times seconds).
+        Invariant rows: [<phi_k'', q>, -<phi_k', q>] (units of q_ddot and q_dot times s).
     targets : ndarray, shape (K, 6)
         <phi_k, y> (N s, N m s).
     mean_regressors : ndarray, shape (12,)
@@ -145,16 +122,14 @@ class IntervalEquations:
         <g, W_type>: generalized Coulomb force per unit level of each joint type, with the
         interval's joint directions.
     coulomb_rows : ndarray, shape (n_rates, K, n_types, 6), or (n_rates, K, 1, 6), or None
-        <phi_k, W_type(t)> at each soft-sign transition rate of :func:`coulomb_patterns`:
-        what the invariant rows see of the Coulomb force when it is not constant inside the
-        interval (the pose changes its map J_j(q)^T; idle joints reverse). Formed with every
-        constant free only, the one model that fits them (:mod:`.rate_selection`).
+        <phi_k, W_type(t)> at each soft-sign transition rate of :func:`coulomb_patterns`: the
+        Coulomb force's change inside the interval seen by the invariant rows (every constant
+        free only).
     experiment : int
         Index of the experiment the interval belongs to.
     noise_gram : ndarray, shape (3, 3, K + 1, K + 1)
-        Gram matrices <phi^(a), phi^(b)> of the rows' test functions and their first and
-        second derivatives (a, b = 0, 1, 2), invariant rows then the mean row: what white
-        pose noise puts into the rows (:mod:`~stewartid.identification.wavelet.gls`).
+        Gram matrices <phi^(a), phi^(b)> (a, b = 0, 1, 2) of the invariant rows then the mean
+        row: what white pose noise puts into the rows.
     """
 
     regressors: np.ndarray
@@ -186,13 +161,11 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
         Generalized force J^T f - G(q) (N, N m).
     joint_jacobians : ndarray, shape (N, 6, 5, 6), or None
         Joint-axis rate Jacobians (rad/s per unit q_dot). None: no friction structure
-        (``coulomb`` zero; the mean row is then unused).
+        (``coulomb`` zero).
     joint_rates : ndarray, shape (N, 6, 5)
-        Smoothed joint-axis rates (rad/s); only their mean over the interval is used, for the
-        joint directions.
+        Smoothed joint-axis rates (rad/s); their mean over the interval gives the directions.
     rate_noise : ndarray, shape (6, 5)
-        Noise level of those rates (rad/s): a joint whose mean rate is within it counts as
-        idle (its direction weighs |mean| / noise).
+        Noise level of those rates (rad/s): a direction weighs |mean| / noise when within it.
     interval : (start, stop)
         s.
     order : int
@@ -218,8 +191,7 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
         return None
     (phi0, phi1, phi2), (bump0, bump1, bump2) = test_family(t[sel], start, stop, order, size,
                                                             float(t[1] - t[0]))
-    # constants and straight lines vanish against phi'' and phi', so the offset only costs
-    # rounding; removing the mean keeps it from being amplified
+    # removing the mean keeps the offset's rounding from being amplified
     qc = q[sel] - q[sel].mean(axis=0)
     ys = y[sel]
     mean_rate = joint_rates[sel].mean(axis=0)
@@ -244,31 +216,32 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
 
 
 #: Candidate transition rates r (rad/s) of the Coulomb soft sign (:func:`coulomb_patterns`).
-#: No rate between 0 and 1e-4: on records of an exact sign sampled at 500 Hz, 3e-5 fitted the
-#: sampling error of the switches better than 0 and moved the rotational Bt diagonal by 3 %.
+#: No rate between 0 and 1e-4, where one would fit the sampling error of an exact sign.
 SOFT_SIGN_RATES = (0.0, 1e-4, 3e-4, 1e-3, 3e-3)
 
 
 def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: bool,
                      rate: float | Sequence[float] = 0.0) -> np.ndarray:
-    """W_type(t) at every sample, shape (N, n_types, 6) (or (N, 1, 6) with ``uniform``):
-    the generalized force of a unit Coulomb torque on every axis of a joint type, opposing
-    the axis's rate over the shortest window the noise allows (``found.sign_rates``), as the
-    soft sign w / sqrt(w^2 + sigma^2 + r^2) over the rate's noise level sigma and the
-    friction's transition ``rate`` r, rad/s (a regularised or Stribeck friction is not a
-    sign). A sequence of rates gives shape (n_rates, N, n_types, 6)."""
+    """W_type(t) at every sample: generalized force of a unit Coulomb torque on each axis of a type.
+
+    Each axis's torque opposes its rate (``found.sign_rates``) as the soft sign
+    w / sqrt(w^2 + sigma^2 + r^2), sigma the rate's noise level and r the friction's transition
+    ``rate`` (rad/s). Shape (N, n_types, 6), or (N, 1, 6) with ``uniform``; a sequence of
+    rates adds a leading axis (n_rates,).
+    """
     rates, noise = found.sign_rates, found.sign_rate_noise
     out = []
     for r in np.atleast_1d(np.asarray(rate, dtype=float)):
         direction = rates / np.sqrt(rates ** 2 + noise ** 2 + r ** 2)          # (N, 6, 5)
-        # per axis over the legs, then the axes summed by type: one einsum on whole arrays
         out.append(_by_type(np.einsum("nla,nlac->nac", direction, joint_jacobians), uniform))
     return np.stack(out) if np.ndim(rate) else out[0]
 
 
 def _by_type(pattern: np.ndarray, uniform: bool) -> np.ndarray:
-    """Generalized Coulomb force per unit level (n, n_types, 6), or (n, 1, 6) with
-    ``uniform``, from the per-axis pattern (n, 5, 6)."""
+    """Generalized Coulomb force per unit level (n, n_types, 6), or (n, 1, 6) with ``uniform``.
+
+    From the per-axis pattern (n, 5, 6).
+    """
     by_type = np.stack([pattern[:, list(axes)].sum(axis=1) for axes in JOINT_TYPES.values()],
                        axis=1)
     return by_type.sum(axis=1, keepdims=True) if uniform else by_type
@@ -277,8 +250,7 @@ def _by_type(pattern: np.ndarray, uniform: bool) -> np.ndarray:
 def experiment_equations(experiment: Experiment, found: Detection, order: int, size: int,
                          index: int, friction: str,
                          rates: Sequence[float] = SOFT_SIGN_RATES) -> list[IntervalEquations]:
-    """The equations step of Method B: the weak-form equations of every usable interval of
-    one experiment.
+    """The equations step of Method B: the weak-form equations of every usable interval.
 
     Parameters
     ----------
@@ -396,8 +368,7 @@ def stack_equations(equations: Sequence[IntervalEquations],
 
 def _per_interval(values: np.ndarray | None, owner: np.ndarray, shape: tuple[int, ...]
                   ) -> np.ndarray:
-    """Per-experiment ``values`` (n_experiments, *shape) at every interval (n, *shape), from
-    the intervals' experiments ``owner``; zeros for None."""
+    """Per-experiment ``values`` (n_experiments, *shape) at every interval (n, *shape); zeros for None."""
     if values is None:
         return np.zeros((len(owner), *shape))
     return np.asarray(values, dtype=float)[owner]
