@@ -1,13 +1,7 @@
-"""The figures' common parts: style, drawing and saving (PNG and SVG), and the signal figures
-of an experiment that several reports show.
-
-Signal figures take :class:`ExperimentTrace` objects (one experiment, with the model's terms
-already evaluated where a figure needs them). Every plotting function returns the written
-paths. The figures are :class:`matplotlib.figure.Figure` objects drawn inside
-``matplotlib.rc_context(STYLE)``: no pyplot, no backend selection and no change to the
-caller's matplotlib settings. matplotlib is imported inside the functions so that importing
-this module is cheap.
-"""
+"""The figures' common parts: style, saving (PNG and SVG) and the signal figures of an
+experiment that several reports show. Figures are :class:`matplotlib.figure.Figure` objects
+drawn inside ``rc_context(STYLE)``: no pyplot, the caller's settings untouched; matplotlib is
+imported inside the functions so that importing this module is cheap."""
 
 from __future__ import annotations
 
@@ -92,8 +86,22 @@ def save_figure(figure: Any, directory: str | Path, stem: str, dpi: int = 120,
                 tight: bool = True) -> list[Path]:
     """Write ``figure`` as ``stem.png`` and ``stem.svg`` in ``directory`` (atomic).
 
-    ``tight=False`` keeps the figure's own margins and saves one layout pass per file (about
-    half the drawing time) for figures laid out with fixed margins.
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+    directory : str or Path
+    stem : str
+        File name without suffix.
+    dpi : int
+        Resolution of the PNG (dots per inch).
+    tight : bool
+        Crop to the drawn content; False keeps the fixed margins of a figure laid out with
+        them and saves a layout pass per file.
+
+    Returns
+    -------
+    list of Path
+        The PNG and the SVG file.
     """
     directory = Path(directory)
     paths = []
@@ -108,8 +116,8 @@ def save_figure(figure: Any, directory: str | Path, stem: str, dpi: int = 120,
 
 
 def thinning_step(t: np.ndarray, max_points: int = 4000) -> slice:
-    """Sample step that keeps at most about ``max_points`` points of a line: the figures show
-    0.5 Hz motion, and thinner lines keep the SVG files small and fast to write."""
+    """Sample step that keeps at most about ``max_points`` points of a line: enough for the
+    slow motion the figures show, and the SVG files stay small and fast to write."""
     return slice(None, None, max(1, int(np.ceil(len(t) / max_points))))
 
 
@@ -125,7 +133,7 @@ def _shade_intervals(axis: Any, intervals: np.ndarray | None, label: bool) -> No
 def plot_excitation(traces: Sequence[ExperimentTrace], directory: str | Path,
                     stem: str = "excitation") -> list[Path]:
     """Commanded and measured motion of the excited coordinate in each experiment, with the
-    tracking error, one panel per experiment."""
+    tracking error, one panel per experiment; returns the written paths."""
     count = len(traces)
     columns = min(3, count)
     rows = int(np.ceil(count / columns))
@@ -166,7 +174,13 @@ def plot_excitation(traces: Sequence[ExperimentTrace], directory: str | Path,
 def plot_joint_rates(trace: ExperimentTrace, directory: str | Path,
                      stem: str = "joint_velocities") -> list[Path]:
     """Rates of the 30 rotational joint axes and the 6 actuators of one experiment, with the
-    constant-direction intervals shaded."""
+    constant-direction intervals shaded; returns the written paths.
+
+    Raises
+    ------
+    ValueError
+        If ``trace`` has no joint rates.
+    """
     if trace.joint_rates is None:
         raise ValueError(f"trace {trace.name!r} has no joint rates to plot")
     figure = new_figure(figsize=(9, 6), layout="constrained")

@@ -40,6 +40,7 @@ class ExportedModel:
     coulomb : ndarray, shape (3,)
         Coulomb level per joint type (N m), NaN where not estimated.
     coulomb_std : ndarray, shape (3,)
+        Their standard errors (N m).
     """
 
     name: str
@@ -66,7 +67,20 @@ def read_matrix_csv(path: str | Path) -> np.ndarray:
 
 def write_exports(models: Sequence[ExportedModel], directory: str | Path,
                   trusted: str) -> list[Path]:
-    """Write the CSV files and ``identification.mat`` of every model; return the paths."""
+    """Write the CSV files and ``identification.mat`` of every model.
+
+    Parameters
+    ----------
+    models : sequence of ExportedModel
+    directory : str or Path
+    trusted : str
+        Registered name of the trusted method, stored as ``trusted``.
+
+    Returns
+    -------
+    list of Path
+        The CSV files, then the MAT file.
+    """
     from scipy.io import savemat
 
     directory = Path(directory)

@@ -29,6 +29,13 @@ def render_html(markdown_text: str, base: str | Path, title: str = "stewartid re
     markdown_text : str
     base : str or Path
         Folder the Markdown's relative image paths refer to.
+    title : str
+        The page's ``<title>``.
+
+    Returns
+    -------
+    str
+        The HTML document.
     """
     from markdown_it import MarkdownIt
 

@@ -1,9 +1,5 @@
-"""Tables of every report, as Markdown and CSV.
-
-Each table is built once as a :class:`ResultTable` (column names and rows of numbers or text)
-and written both ways: CSV keeps full precision, Markdown rounds for reading (values to one
-decimal, ε in percent to two, published numbers as printed).
-"""
+"""Tables of every report, each built once as a :class:`ResultTable` and written as CSV (full
+precision) and as Markdown (rounded for reading)."""
 
 from __future__ import annotations
 
@@ -50,7 +46,9 @@ class ResultTable:
 
 
 def format_cell(value: Cell, kind: str) -> str:
-    """Markdown text of a cell: values to 1 decimal with thousands separators, ε to 2."""
+    """Markdown text of a cell by its column's ``kind``: values to 1 decimal with thousands
+    separators, ε to 2, published numbers as printed; "—" for no value, "n/a" for a
+    non-finite one."""
     if value is None:
         return "—"
     if isinstance(value, str):

@@ -1,10 +1,6 @@
-"""The figures of the identification report (:mod:`~stewartid.reports.identification.report`),
-in report order.
-
-The drawing itself is :mod:`~stewartid.reports.identification.method_figures` and
-:mod:`stewartid.reports.drawing`; this module decides what is drawn, with which data and
-caption.
-"""
+"""The figures of the identification report in report order: what is drawn, with which data
+and caption (the drawing itself is :mod:`~stewartid.reports.identification.method_figures`
+and :mod:`stewartid.reports.drawing`)."""
 
 from __future__ import annotations
 
@@ -26,11 +22,17 @@ from stewartid.signals.differentiation import differentiate
 
 
 class FigureDrawer:
-    """Draws the figures into one folder and keeps their captions in report order.
+    """Draws the figures into one folder, in this process (a worker process would pay its
+    own imports and slow the fits beside it), and keeps their captions in report order.
 
-    Drawing in worker processes while the methods are fitted was measured on the 2-core
-    machine (docs/benchmarks.md): each worker pays its own imports, and under load the extra
-    process slows the fits more than it saves, so the figures are drawn here.
+    Attributes
+    ----------
+    folder : Path
+        Where the figures are written.
+    entries : dict of str to (str, str)
+        Relative PNG path and caption by figure key, in report order.
+    files : list of Path
+        Every file written.
     """
 
     def __init__(self, folder: Path):

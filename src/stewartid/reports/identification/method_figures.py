@@ -1,11 +1,6 @@
-"""Figures of an identification report on measured data, each written as PNG and SVG.
-
-Drawn like every figure of the package (:mod:`stewartid.reports.drawing`): a
-:class:`matplotlib.figure.Figure` inside ``rc_context(STYLE)``, no pyplot, lines thinned to a
-few thousand points, saved by :func:`~stewartid.reports.drawing.save_figure`. Every
-function returns the written paths. The layouts are regular grids with fixed margins rather
-than matplotlib's constrained layout, which would triple the drawing time of a report.
-"""
+"""The plots of the identification report, each written as PNG and SVG, drawn as
+:mod:`stewartid.reports.drawing` draws; every function returns the written paths. Layouts are
+grids with fixed margins: matplotlib's constrained layout is far slower to draw."""
 
 from __future__ import annotations
 
@@ -38,9 +33,9 @@ def _grid(figure, count: int, columns: int = 3, top: float = 0.9, **options):
 
 
 def _log_floor(axis, values: np.ndarray, decades: float | None = 5.0) -> None:
-    """Show ``decades`` decades below the largest value (None: all; the numerical floor of a
-    noise-free record is not the interesting part) with plain tick labels (``0.001``: mathtext powers of
-    ten take most of a log axis's drawing time)."""
+    """Limit a log axis to ``decades`` decades below its largest value (None: no limit), so
+    that the numerical floor of a noise-free record does not take the panel, and label it with
+    plain numbers (``0.001``), much faster to draw than mathtext powers of ten."""
     from matplotlib.ticker import FuncFormatter, NullLocator
 
     top = float(np.nanmax(values)) if np.size(values) else 1.0
@@ -189,7 +184,15 @@ def _concatenated(validation: ValidationResult, values: Sequence[np.ndarray]):
 def plot_residuals(validation: ValidationResult, frequencies_hz: Sequence[float],
                    directory: str | Path, stem: str = "residuals") -> list[Path]:
     """Residual of every equation over time (all experiments end to end) and its amplitude
-    spectrum, with the excitation frequencies and their harmonics marked."""
+    spectrum, with the excitation frequencies and their harmonics marked.
+
+    Parameters
+    ----------
+    validation : ValidationResult
+        Measured and predicted force on the segments (the full fit's, in sample).
+    frequencies_hz : sequence of float
+        Excitation frequency of each experiment (Hz).
+    """
     residual = [m - p for m, p in zip(validation.measured, validation.predicted, strict=True)]
     t, values = _concatenated(validation, residual)
     figure = new_figure(figsize=(13, 12))
@@ -269,7 +272,14 @@ def plot_validation(validations: Mapping[str, ValidationResult], colours: Mappin
 @styled
 def plot_unexplained(vaf: Mapping[str, np.ndarray], colours: Mapping[str, str],
                      directory: str | Path, stem: str = "methods") -> list[Path]:
-    """Held-out unexplained force, 100 − VAF (%), per DOF and method (log scale)."""
+    """Held-out unexplained force, 100 − VAF (%), per DOF and method (log scale).
+
+    Parameters
+    ----------
+    vaf : mapping of label to ndarray, shape (6,)
+        Held-out VAF per DOF (%).
+    colours : mapping of label to colour
+    """
     figure = new_figure(figsize=(9, 4))
     axis = figure.subplots(gridspec_kw={"left": 0.1, "right": 0.98, "bottom": 0.1,
                                         "top": 0.9})
@@ -304,6 +314,7 @@ def plot_friction(levels: Mapping[str, tuple[np.ndarray, np.ndarray]],
     Parameters
     ----------
     levels : mapping of label to (levels, standard errors), each ndarray (3,) (N m)
+    colours : mapping of label to colour
     nominal : float or None
         The platform description's Coulomb level (N m per joint axis), drawn as a line.
     """
@@ -336,7 +347,13 @@ def plot_workspace(curves: Workspace, directory: str | Path, stem: str = "worksp
     """Mt and Bt across the measured poses: one column per swept coordinate, the diagonal
     entries and the largest couplings as their change from the identified value at the mean
     pose (% of the diagonal's scale), a band of ±2 standard errors, the platform description
-    dashed."""
+    dashed.
+
+    Parameters
+    ----------
+    curves : Workspace
+        From :func:`~stewartid.comparison.workspace`.
+    """
     figure = new_figure(figsize=(15, 6.5))
     axes = figure.subplots(2, 6, squeeze=False, gridspec_kw={
         "left": 0.05, "right": 0.86, "bottom": 0.1, "top": 0.9, "hspace": 0.4,

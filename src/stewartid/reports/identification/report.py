@@ -42,18 +42,22 @@ class IdentificationReport:
 
     @property
     def runs(self) -> tuple[MethodFit, ...]:
+        """Every method's fit, the consensus of close methods last when the verdict built it."""
         return self.comparison.runs
 
     @property
     def verdict(self) -> Verdict:
+        """Which method to trust, and why."""
         return self.comparison.verdict
 
     @property
     def physical(self) -> PhysicalSection | None:
+        """The physical model beside the compared methods, when asked for."""
         return self.comparison.physical
 
     @property
     def physical_primary(self) -> bool:
+        """The physical model was asked for by itself: ``result.json`` holds its result."""
         return self.comparison.physical_primary
 
     @property
@@ -91,6 +95,7 @@ def write_report(comparison: Comparison, directory: str | Path, *, sources: Sequ
     Returns
     -------
     IdentificationReport
+        The comparison and every file written.
     """
     started = time.perf_counter()
     directory = Path(directory)

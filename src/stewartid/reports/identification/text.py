@@ -1,10 +1,6 @@
-"""The text of the identification report (:mod:`~stewartid.reports.identification.report`):
-data summary, which method to trust and why (the
-:class:`~stewartid.verdict.rule.Verdict` in words), and ``report.md``.
-
-Every statement is computed from the numbers of the run (no fixed verdicts): if a result
-changes, so does the sentence about it.
-"""
+"""The text of the identification report: data summary, every section of ``report.md``.
+Every statement is computed from the run's numbers, so a sentence changes with the result it
+describes."""
 
 from __future__ import annotations
 
@@ -33,9 +29,17 @@ _UNRANKED = "Physical model (full model; not ranked)"
 
 
 def data_rows(datasets: Sequence[Dataset], platform: Platform) -> list[dict[str, Any]]:
-    """Per experiment: samples, duration (s), sample rate (Hz), dominant frequency (Hz), the
-    most excited coordinate (rotations weighted by the upper joint radius), its amplitude
-    (mm or mrad) and the noise estimated from the data: pose (um, urad) and leg forces (N)."""
+    """Summary of each experiment for the data table and the figures.
+
+    Returns
+    -------
+    list of dict
+        Per experiment: ``name``, ``samples``, ``duration_s``, ``sample_rate_hz``,
+        ``frequency_hz`` (dominant), ``excited`` (index of the most excited coordinate,
+        rotations weighted by the upper joint radius), ``amplitude`` (its half range, mm or
+        mrad), and the noise estimated from the data: ``pose_noise`` (m, rad) and
+        ``force_noise`` (leg forces, N), shape (6,) each.
+    """
     rows = []
     lever = np.array([1.0] * 3 + [platform.geometry.upper_radius] * 3)
     for d in datasets:
@@ -57,15 +61,18 @@ def data_rows(datasets: Sequence[Dataset], platform: Platform) -> list[dict[str,
 
 def used_intervals(runs: Sequence[MethodFit], trusted: str, datasets: Sequence[Dataset]
                    ) -> tuple[str, list[np.ndarray], list[np.ndarray | None]]:
-    """Constant-direction intervals (M_k, 2) and (a, b) points (K_k, 2) per experiment, as
-    the diagnostics record them, of the trusted method or else the first that uses them.
+    """The constant-direction intervals and (a, b) points per experiment, as the diagnostics
+    record them, of the trusted method or else the first that uses them.
 
     Returns
     -------
     display_name : str
         Of the method they come from ("" if no method uses intervals).
-    intervals, points : list
-        Empty if no method uses intervals.
+    intervals : list of ndarray, shape (M_k, 2)
+        [start, stop] (s); empty if no method uses intervals.
+    points : list of ndarray, shape (K_k, 2), or None
+        (a, b) pairs (s, s), None for an experiment without them; empty if no method uses
+        intervals.
     """
     def recorded(run: MethodFit) -> list[dict]:
         experiments = [] if run.result is None else run.result.diagnostics.get("experiments")
@@ -134,9 +141,37 @@ def render_report(report: IdentificationReport, datasets: Sequence[Dataset],
                   figures: Mapping[str, tuple[str, str]], sources: Sequence[str], folds: int,
                   seconds: float, records: Sequence[str] = (), notes: Sequence[str] = ()
                   ) -> str:
-    """``report.md``: every section, figures referenced by relative path; ``records`` names
-    the validation records (``identify --validate``), ``notes`` are sentences for the
-    summary (e.g. what a force delay would do to Bt)."""
+    """The text of ``report.md``, figures referenced by relative path.
+
+    Parameters
+    ----------
+    report : IdentificationReport
+    datasets : sequence of Dataset
+        The experiments fitted.
+    platform : Platform
+    nominal : (ndarray, ndarray)
+        Reference Mt and Bt, shape (6, 6) each.
+    nominal_source : str
+        Where they come from.
+    rows : sequence of dict
+        From :func:`data_rows`.
+    figures : mapping of str to (str, str)
+        Relative PNG path and caption by figure key.
+    sources : sequence of str
+        The data files.
+    folds : int
+        Time segments per experiment of the held-out validation.
+    seconds : float
+        Wall time of the comparison and the report (s).
+    records : sequence of str
+        Names of the validation records (``identify --validate``).
+    notes : sequence of str
+        Sentences for the summary (e.g. what a force delay would do to Bt).
+
+    Returns
+    -------
+    str
+    """
     from stewartid import __version__
 
     best = next(run for run in report.runs if run.name == report.trusted)
