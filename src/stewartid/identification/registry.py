@@ -4,8 +4,8 @@ A method registers itself in its own module with the class decorator :func:`regi
 Discovery imports :data:`BUILTIN_MODULES` in order, then every other module of
 ``stewartid.identification`` alphabetically; presets come after every method.
 
-Example
--------
+Examples
+--------
 >>> from stewartid.identification.registry import create_identifier, method_spec
 >>> method_spec("ls").display_name
 'Time-domain least squares'
