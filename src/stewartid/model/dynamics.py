@@ -4,19 +4,16 @@ Equation of motion in the paper's frame and coordinates (z down, q = [x y z rx r
 
     M(q) q_ddot + h(q, q_dot) + G(q) + F(q, q_dot) = J_lq(q)^T f_a
 
-M is the mass matrix of the moving body (platform and payload as one rigid body, its centre
-of mass anywhere and its inertia matrix full) and the legs, h the velocity-product (Coriolis
-and centrifugal) forces, G gravity (g = 9.81 m/s^2 along +z), F joint friction (viscous on the
-four gimbal axes, Coulomb on all five rotational axes of each leg), f_a the actuator forces
-(N, positive extends the leg). Body equations are Newton-Euler per body, projected with the
-velocity Jacobians (Kane's method), compiled with numba in :mod:`stewartid.model.compiled`.
+M the mass matrix of the moving body (platform and payload) and the legs, h the
+velocity-product forces, G gravity (along +z), F joint friction (viscous on the four gimbal
+axes, Coulomb on all five rotational axes of each leg), f_a the actuator forces (N, positive
+extends). Newton-Euler per body projected with the velocity Jacobians (Kane's method),
+compiled in :mod:`stewartid.model.compiled`.
 
-Coulomb regularisation: a joint's Coulomb torque is Fc * w / sqrt(w^2 + s^2), w the joint
-rate, s = ``coulomb_smoothing`` (rad/s, default 1e-4): exact sign(w) for |w| >> s, smooth and
-odd through zero so an ODE solver can step over reversals. The plant simulator offers a
-stick-slip aware alternative.
-
-All functions take q, q_dot, q_ddot of shape (6,) or (N, 6) and return matching shapes.
+A joint's Coulomb torque is regularised as Fc * w / sqrt(w^2 + s^2), w the joint rate,
+s = ``coulomb_smoothing`` (rad/s): sign(w) for |w| >> s, smooth through zero for an ODE
+solver. All functions take q, q_dot, q_ddot of shape (6,) or (N, 6) and return matching
+shapes.
 """
 
 from __future__ import annotations

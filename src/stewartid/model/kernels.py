@@ -1,40 +1,25 @@
 """Per-sample kernels of the platform model, in plain Python: the one definition.
 
-:mod:`stewartid.model.compiled` compiles every function here with numba; run as they are, they
-give the same numbers for a handful of samples in a process that has not started numba's
-code generator (importing numba and loading the cached machine code cost about 0.5 s).
-The kernels call each other by their global names, which the compiled copies resolve to
-the compiled kernels. Only what numba compiles belongs here.
-
-One kernel, :func:`model_terms`, evaluates every pose-dependent term of the model at one
-sample, so the simulator pays for the leg geometry once per right-hand-side call. The batched
-functions of :mod:`stewartid.model.dynamics` loop over samples in compiled code around it; the
-pose-only terms (leg lengths, J_lq, G, joint Jacobians) that kinematics, command tables and
-identification need are computed by :mod:`stewartid.model.leg_terms` in numpy from the same
-per-sample geometry functions below (:func:`leg_vector`, :func:`twist_column`,
-:func:`leg_rate`, :func:`leg_angular_rate`, :func:`joint_rate_column`,
-:func:`centre_of_mass_rates`, :func:`leg_gravity`, :func:`body_gravity`,
-:func:`euler_columns`): pure arithmetic on their arguments, which are floats here and arrays
-of samples there, so both give the same numbers to the last bit.
+:mod:`stewartid.model.compiled` compiles every function here with numba; run as they are,
+they give the same numbers without starting numba. The kernels call each other by their
+global names, which the compiled copies resolve to the compiled kernels. :func:`model_terms`
+evaluates every pose-dependent term at one sample; the per-sample geometry functions are also
+applied to arrays of samples by :mod:`stewartid.model.leg_terms`, so both give the same
+numbers to the last bit. Only what numba compiles belongs here.
 
 Coordinates: q = [x, y, z, rx, ry, rz] (m, rad; R = Rz(rz) Ry(ry) Rx(rx)), q_dot its time
-derivative (Euler-angle rates). Internally the body equations are written in the twist
-nu = [v, omega] (world frame, at the reference point) and mapped to q with
-nu = T(q) q_dot, T = blockdiag(I, E(q)).
+derivative; the body equations are written in the twist nu = [v, omega] (world frame, at the
+reference point) and mapped to q with nu = T(q) q_dot, T = blockdiag(I, E(q)).
 
-Moving body: the platform with its payload, one rigid body of mass m, centre of mass c_body
-(platform frame, from the reference point) and inertia matrix I_body about the reference
-point, packed by :meth:`stewartid.platform.Platform.parameters`; without a payload c_body = 0
-and I_body is diagonal.
+Bodies: the moving body (platform and payload) of mass m, centre of mass c_body and inertia
+I_body about the reference point (platform frame); per leg a lower part turning about the
+lower gimbal point B (centre of mass B + d_l u) and an upper part that also slides with the
+stroke (centre of mass A - d_u u), neither with inertia about the leg's axis.
 
-Leg bodies (per leg, zero inertia about the leg's own axis):
-lower part turns about the lower gimbal point B with the leg, centre of mass at B + d_l u;
-upper part turns with the leg and slides with the stroke, centre of mass at A - d_u u.
-
-Joint axes per leg, in the order [lower 1, lower 2, upper 1, upper 2, revolute]: an
-orthonormal leg frame e1 = unit(z x u) (horizontal), e2 = u x e1, u; gimbal rates are the
-components of the leg's angular velocity (lower) and of the platform's angular velocity
-relative to the leg (upper) on e1 and e2, the revolute rate is the relative rate about u.
+Joint axes per leg, in the order [lower 1, lower 2, upper 1, upper 2, revolute]: the leg
+frame e1 = unit(z x u), e2 = u x e1, u; gimbal rates are the components on e1, e2 of the
+leg's angular velocity (lower) and of the platform's relative to the leg (upper), the
+revolute rate the relative rate about u.
 """
 
 from __future__ import annotations
@@ -189,6 +174,9 @@ def euler_rate_map_derivative_product(ry: float, rz: float, rates: np.ndarray) -
 def model_terms(params, upper, base, q, qd, M, h, G, J_leg, J_joint, lengths):
     """Evaluate every model term at one sample, in q coordinates (written into the outputs).
 
+    Scalar loops and a few scratch arrays: the simulator calls it four times per step, where
+    small-matrix BLAS calls and temporaries would dominate the cost.
+
     Parameters
     ----------
     params : (N_PARAMETERS,) packed parameters (:mod:`stewartid.model.parameters`).
@@ -201,12 +189,6 @@ def model_terms(params, upper, base, q, qd, M, h, G, J_leg, J_joint, lengths):
     J_leg : (6, 6) out, leg-length rates = J_leg qd.
     J_joint : (6, 5, 6) out, joint axis rates = J_joint[leg] qd.
     lengths : (6,) out, leg lengths (m).
-
-    Notes
-    -----
-    Written with scalar loops and a handful of scratch arrays: the simulator calls it four
-    times per integration step, and small-matrix products (BLAS calls) and temporaries
-    would dominate its cost.
     """
     cx, sx, cy, sy, cz, sz = trigonometry(q)
     R = rotation_entries(cx, sx, cy, sy, cz, sz)

@@ -1,22 +1,13 @@
 """Pose-only terms of the platform model, batched over samples in numpy.
 
-The leg lengths, the leg Jacobian J_lq, the gravity forces G(q) and the joint-axis Jacobians
-at every sample: what the command tables, forward kinematics and the identifiers need, without
-the mass matrix and velocity products of :func:`stewartid.model.kernels.model_terms` (the
-simulator's compiled kernel, which evaluates the same leg geometry at one state).
-
-Numpy, not numba: in a fresh process, starting numba and loading its cached kernels costs
-0.5-1 s, more than these terms take for the 6 x 20 s at 1 kHz of an identification. The
-terms are the kernels' own per-sample geometry functions (:func:`~stewartid.model.kernels.leg_vector`,
-:func:`~stewartid.model.kernels.joint_rate_column`, ...) applied to arrays of samples: one
-definition, the same numbers to the last bit (``tests/test_dynamics.py``). Where the kernel
-passes 0.0 and 1.0 for the structural zeros and ones of J_A = [I, -[r]x], this module passes
-:data:`ZERO` and :data:`ONE`, which drop out of sums and products without a whole-array
-operation.
-
-Coordinates and joint axes as in :mod:`stewartid.model.kernels`: q = [x, y, z, rx, ry, rz] (m, rad),
-R = Rz Ry Rx, twist nu = [v, omega] mapped to q rates by E(q); leg frame e1 = unit(z x u),
-e2 = u x e1; joint axes [lower 1, lower 2, upper 1, upper 2, revolute].
+Leg lengths, J_lq, G(q) and the joint-axis Jacobians: what command tables, forward kinematics
+and the identifiers need, without the mass matrix and velocity products of
+:func:`stewartid.model.kernels.model_terms`. Numpy, not numba, to spare a process numba's
+start; the terms are the kernels' own per-sample geometry functions applied to arrays, so
+they give the same numbers to the last bit. Where a kernel passes 0.0 and 1.0 for the
+structural zeros and ones of J_A = [I, -[r]x], this module passes :data:`ZERO` and
+:data:`ONE`, which drop out without a whole-array operation. Coordinates and joint axes as
+in :mod:`stewartid.model.kernels`.
 """
 
 from __future__ import annotations
@@ -65,7 +56,7 @@ class LegTerms(NamedTuple):
 
 
 #: Samples per block: each block's arrays stay in the processor's cache while the outputs,
-#: interleaved per sample, are written (writing whole columns of them costs 3x the arithmetic).
+#: interleaved per sample, are written.
 BLOCK = 2048
 
 
@@ -232,8 +223,8 @@ def _joint_jacobians(u, columns, length, E, out):
     frame = leg_frame(*u)
     by_column = [joint_rate_column(c, frame, *u, *leg_angular_rate(*u, *b, length))
                  for c, b in enumerate(columns)]
-    # gathered contiguously, then interleaved per sample in one copy (5x faster than
-    # writing each (axis, column) entry across the samples)
+    # gathered contiguously, then interleaved per sample in one copy (faster than writing each
+    # (axis, column) entry across the samples)
     gathered = np.empty((N_JOINTS, 6, *length.shape))
     for j in range(N_JOINTS):
         row = [rates[j] for rates in by_column]

@@ -84,11 +84,9 @@ def linearisation_remainder(platform: Platform, q: np.ndarray, q_dot: np.ndarray
     """What the inertial and viscous terms of the model add to their linearisation at ``pose``.
 
     r = [M(q) - Mt] q_ddot + h(q, q_dot) + [Bt(q) - Bt] q_dot, with (Mt, Bt) =
-    :func:`nominal_matrices` at ``pose``: the equation of motion less gravity and Coulomb
-    friction is Mt q_ddot + Bt q_dot + r. It grows with the motion (the change of M(q) and
-    Bt(q) over the poses reached, the velocity products), so subtracting it from measured
-    forces leaves the linearised model exact at any amplitude, to the extent the platform
-    description's mass distribution is right.
+    :func:`nominal_matrices` at ``pose``, so that the equation of motion less gravity and Coulomb
+    friction is Mt q_ddot + Bt q_dot + r: subtracted from measured forces, it keeps the
+    linearised model exact at any amplitude.
 
     Parameters
     ----------

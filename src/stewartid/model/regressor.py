@@ -1,36 +1,13 @@
-"""The regressor of the platform model: the generalized force linear in its physical parameters.
-
-The measured generalized force is linear in the standard parameters pi (:data:`PARAMETERS`),
+"""The regressor of the platform model: the generalized force linear in its physical parameters,
 
     J_lq(q)^T f_meas = Y(q, q_dot, q_ddot) pi,
 
-with Y of shape (6, P) per sample (q coordinates, as :class:`~stewartid.model.dynamics.ModelTerms`).
-Every body's Newton-Euler force is linear in its mass, first moment and inertia, and the
-generalized force is the sum of each body's velocity Jacobian transposed times it (Kane):
-
-- the moving body (platform and payload): mass m, first moment m c (platform frame, from the
-  reference point) and inertia about the reference point (platform frame): 10 parameters;
-- the legs (six identical, zero inertia about their own axis): the lower part turns about its
-  fixed gimbal point, so it enters through its first moment m_l d_l (gravity) and its
-  transverse inertia about the gimbal point J_l = I_l + m_l d_l^2 only; the upper part through
-  its mass m_u, first moment m_u d_u about the upper gimbal point and J_u = I_u + m_u d_u^2;
-- joint friction per joint type (:data:`~stewartid.model.joints.FRICTION_TYPES`): a viscous
-  coefficient and a Coulomb level (the model's viscous friction is on the gimbal axes only, so
-  the revolute's viscous coefficient is nominally zero);
-- friction along each actuator, viscous and Coulomb (not part of the plant model: nominally
-  zero);
-- an offset per leg force sensor: f_meas = f + offset (``[sensors] force_bias`` nominally).
-
-Not all of them can be told apart by any motion: the upper parts' mass acts as point masses at
-the upper joints, a combination of the moving body's columns, and J_u and J_l have the same
-column. :func:`base_parameters` finds the identifiable combinations numerically: the regressor
-stacked over random states, QR with column pivoting for the rank, and the columns kept in the
-order of :data:`PARAMETERS` (the moving body first), each dependent column folded into the
-kept ones it is a combination of.
-
-Coordinates as in :mod:`stewartid.model.kernels`: q = [x, y, z, rx, ry, rz] (m, rad), R = Rz Ry Rx,
-z down, gravity g along +z; the body equations in the twist [v, omega] at the reference point,
-mapped to q with T = blockdiag(I, E(q)).
+with Y of shape (6, P) per sample and pi the standard parameters (:data:`PARAMETERS`): the
+moving body's mass, first moment and inertia; the legs' upper-part mass, first moments and
+transverse inertias about the gimbal points; viscous and Coulomb friction per joint type and
+along the actuators; an offset per force sensor. Some are not separable by any motion;
+:func:`base_parameters` finds the identifiable combinations numerically. Coordinates as in
+:mod:`stewartid.model.kernels`.
 """
 
 from __future__ import annotations
@@ -277,10 +254,10 @@ def base_parameters(platform: Platform, samples: int = 100, seed: int = 0,
                     tolerance: float = 1e-8) -> BaseParameters:
     """The base parameters of the regressor, found numerically.
 
-    The regressor is stacked over ``samples`` random states (:func:`random_states`), its
-    columns scaled to unit norm; QR with column pivoting gives its rank. The columns are then
-    kept in the order of :data:`PARAMETERS` when independent of those kept before (the
-    moving body's first), and every other column is written as a combination of the kept.
+    The regressor stacked over ``samples`` random states (:func:`random_states`), columns scaled
+    to unit norm, gives its rank by QR with column pivoting; columns are kept in the order of
+    :data:`PARAMETERS` when independent of those kept before, and every other column is written
+    as a combination of the kept.
 
     Parameters
     ----------

@@ -1,30 +1,11 @@
 """The regressor's columns at many samples in numpy, every leg quantity computed once a sample
 (:func:`regressor_columns`, behind :func:`stewartid.model.regressor.regressor`).
 
-Time is last: a body quantity is a row of N samples, a leg quantity an array (6, N) (legs,
-samples), and a vector a tuple of its three components, so that every operation is on whole
-contiguous rows and the sums over the legs are sums of six rows. Every leg term of the
-regressor is the wrench at the reference point of a vector x at the upper joint,
-sum over the legs of [x, r x x] (r = R a, the upper joint from the reference point): the legs'
-inertial and gravity terms, and the joint and actuator friction, whose Jacobians need not be
-formed. In the leg frame e1, e2, u of :func:`~stewartid.model.kernels.leg_frame`
-(orthonormal, e1 x e2 = u) the leg's angular velocity is w = u x v_A / l (v_A the upper
-joint's velocity, l the leg length), so the joint rates are
-
-    lower gimbal: e1 . w = -e2 . v_A / l,  e2 . w = e1 . v_A / l;
-    upper gimbal: e . (omega - w);  revolute: u . (omega - w) = u . omega;
-
-and weights lambda of the five axes of a leg (their rates, or Coulomb signs) give the
-generalized force sum_a lambda_a J_a^T as
-
-- lower gimbal: the wrench of (lambda_2 e1 - lambda_1 e2) / l (the lower rates are e . w, and
-  e . (u x b) / l = b . (e x u) / l for the joint velocity b of a twist);
-- upper gimbal: the pure moment lambda_3 e1 + lambda_4 e2 and the wrench of
-  (lambda_3 e2 - lambda_4 e1) / l;
-- revolute: the pure moment lambda_5 u.
-
-The rotational rows are mapped from the twist [v, omega] to q coordinates by E(q)^T at the
-end, for every column at once. Coordinates as in :mod:`stewartid.model.kernels`.
+Time is last: a body quantity is a row of N samples, a leg quantity an array (6, N), a vector
+a tuple of its three components, so that every operation is on whole contiguous rows. Every
+leg term is the wrench [x, r x x] at the reference point of a vector x at the upper joint,
+summed over the legs, so the joint and actuator Jacobians need not be formed. Coordinates as
+in :mod:`stewartid.model.kernels`.
 """
 
 from __future__ import annotations
