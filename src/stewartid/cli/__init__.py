@@ -1,9 +1,7 @@
-"""Command-line interface: ``stewartid COMMAND ...``.
-
-:mod:`~stewartid.cli.application` holds the application and its error policy; one module per
-command: :mod:`~stewartid.cli.nominal`, :mod:`~stewartid.cli.simulate`,
-:mod:`~stewartid.cli.identify`, :mod:`~stewartid.cli.reproduce`, :mod:`~stewartid.cli.methods`.
-"""
+"""Command-line interface: ``stewartid COMMAND ...``. :mod:`~stewartid.cli.application` holds
+the application and its error policy; one module per command (``nominal``, ``simulate``,
+``identify`` with :mod:`~stewartid.cli.identify_run`, ``reproduce``, ``methods``, ``study``,
+``design``)."""
 
 from stewartid.cli.application import app, main
 

@@ -1,12 +1,7 @@
-"""The ``stewartid`` command-line application: the typer app, its error policy and its
-commands (one module per command in :mod:`stewartid.cli`; heavy imports happen inside them).
-
-Error policy: a :class:`~stewartid.errors.StewartidError` (bad input, failed numerics) or an
-OSError (a user's file cannot be read or written) becomes one line ``error: ...`` on stderr
-and exit code 2, and so does a usage error (a mistyped option or option value). Anything else
-is a bug and propagates with its traceback. ``--debug`` shows the traceback of the expected
-errors too. Warnings are printed as one line ``warning: ...`` each, without source lines.
-"""
+"""The ``stewartid`` application: the typer app, its commands (one module per command in
+:mod:`stewartid.cli`) and its error policy: an expected error (bad input, failed numerics, an
+unreadable file, a usage error) is one line ``error: ...`` on stderr and exit code 2; anything
+else is a bug and propagates with its traceback; ``--debug`` shows every traceback."""
 
 from __future__ import annotations
 
@@ -66,6 +61,7 @@ class PlainHelpCommand(TyperCommand):
     terminal, so a line break in the source never breaks a sentence."""
 
     def collect_usage_pieces(self, ctx: Any) -> list[str]:
+        """The usage line after the command: the options placeholder, then each argument."""
         pieces = [self.options_metavar] if self.options_metavar else []
         for parameter in self.get_params(ctx):
             if parameter.param_type_name == "argument":
@@ -138,7 +134,8 @@ def _show_warning(message: Warning | str, category: type[Warning], *args: Any,
 
 def clean_errors(command: Callable[..., Any]) -> Callable[..., Any]:
     """Decorator: StewartidError and OSError become one error line and exit code 2 (unless
-    ``--debug``); every other exception propagates."""
+    ``--debug``); every other exception propagates. Warnings are one line ``warning: ...``
+    each, without source lines."""
 
     @functools.wraps(command)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
@@ -179,9 +176,9 @@ _register()
 def main(argv: list[str] | None = None) -> None:
     """Console-script entry point.
 
-    BLAS runs on one thread: the commands' linear algebra is on small matrices, where extra
-    BLAS threads only synchronise, and on a busy machine their spinning costs 20-40 % of the
-    identification time (worker processes get the same limit).
+    BLAS runs on one thread (worker processes get the same limit): the commands' linear
+    algebra is on small matrices, where extra BLAS threads only synchronise and, on a busy
+    machine, spin.
     """
     from threadpoolctl import threadpool_limits
 

@@ -73,8 +73,7 @@ def design(
     is smallest against the accuracy its group needs (Mt diagonal 0.5 %, Bt diagonal 2 %,
     couplings 8 %), written as command files (pose and leg lengths) with a report against
     the paper's set."""
-    # design, simulation and rich.progress load in 0.5 s; every command's module is imported
-    # when the command line starts, so they are imported when this one runs
+    # imported when this command runs: every command's module is imported at start-up
     from numbers import Real
 
     from rich.progress import Progress

@@ -1,9 +1,6 @@
 """``stewartid identify`` behind its flags: the experiments read and aligned, the method (or
-every method: :func:`~stewartid.comparison.compare_methods`) fitted, the report
-(:func:`~stewartid.reports.identification.report.write_report`) and the result written.
-
-Every output location and flag combination is checked before anything is computed.
-"""
+every method: :func:`~stewartid.comparison.compare_methods`) fitted, the report and the result
+written. Every output location and flag combination is checked before anything is computed."""
 
 from __future__ import annotations
 
@@ -244,7 +241,7 @@ def _check_model_outputs(model: str, platform_out: Path | None,
                         refused: dict[str, bool] | None = None,
                         inputs: Sequence[str | Path] = ()) -> None:
     """Refuse, before any computation, what ``identify --model`` cannot do
-    (:func:`check_model_options`) and a ``platform_out`` that would replace an input or a
+    (``_check_model_options``) and a ``platform_out`` that would replace an input or a
     file ``--platform-out`` did not write.
 
     Parameters
@@ -293,6 +290,11 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     (:func:`~stewartid.comparison.compare_methods`) and the report written
     (:func:`~stewartid.reports.identification.report.write_report`); with ``model``, the
     physical model is fitted instead of ``method`` (beside every compared method in a report).
+
+    Returns
+    -------
+    IdentifyRun
+        The result, the report and the reference matrices.
 
     Raises
     ------

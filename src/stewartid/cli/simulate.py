@@ -115,8 +115,7 @@ def simulate(
 ) -> None:
     """Simulate the six experiments (experiment k excites DOF k) on the hydraulic plant, or
     with ``--engine mujoco`` on MuJoCo's model of the platform."""
-    # simulation, design and rich.progress load in 0.4-0.5 s; every command's module is
-    # imported when the command line starts, so they are imported when this one runs
+    # imported when this command runs: every command's module is imported at start-up
     from rich.progress import Progress
 
     from stewartid.fields import Options, check, nonnegative, positive
