@@ -1,21 +1,13 @@
 """Excitation designs: records of one sine along a fixed pose direction, with level schedules.
 
-A designed record moves the platform along one direction of pose space (one DOF, or a
-combination such as surge with pitch) as
+A designed record moves the platform along direction d of pose space as
 
     q(t) = q0 + d * a(t) * sin(2 pi f t),
 
-with d the direction (unit amplitude per DOF, m or rad), f the frequency and a(t) an
-amplitude envelope: a quintic fade-in to the first level, a hold, a one-period quintic ramp
-to the next level, ..., and a quintic fade-out to rest. Because every pose rate is the
-scalar a(t) sin' times d, every leg and every joint reverses at the same instants: the
-constant-direction intervals are the half-periods, whatever the direction. Two levels make
-two speeds in one record; their intervals share the joint-direction pattern but not the
-viscous force, which is what lets Method B with ``friction="shared"`` separate viscous from
-Coulomb friction.
-
-A :class:`Design` is a list of such records plus the platform's neutral pose; the paper's
-set (:func:`paper_design`) is six single-level records, record k on DOF k.
+with a(t) a quintic fade-in, holds at each level joined by one-period ramps, and a fade-out.
+Every leg and joint then reverses at the same instants, so the constant-direction intervals
+are the half-periods; two levels give two speeds with one joint-direction pattern, which lets
+Method B with ``friction="shared"`` separate viscous from Coulomb friction.
 """
 
 from __future__ import annotations
@@ -40,8 +32,9 @@ def quintic_ramp(s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def fade_envelope(t: np.ndarray, fade: float, duration: float
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Quintic fade-in over ``fade`` s times quintic fade-out ending at ``duration`` s, and
-    its first two time derivatives (1/s, 1/s^2), each of the shape of ``t``."""
+    """Quintic fade-in over ``fade`` s times quintic fade-out ending at ``duration`` s, and its
+    first two time derivatives (1/s, 1/s^2), each of the shape of ``t``.
+    """
     rise, d_rise, dd_rise = quintic_ramp(t / fade)
     fall, d_fall, dd_fall = quintic_ramp((duration - t) / fade)
     k = 1.0 / fade
@@ -226,8 +219,7 @@ def paper_design(frequency_hz: float = 0.5, duration_s: float = 20.0,
                  amplitudes: Sequence[float] = DEFAULT_AMPLITUDES) -> Design:
     """The paper's set: six records, record k a single-level sine on DOF k.
 
-    The record length is ``duration_s`` rounded to whole periods (fade-in and fade-out of
-    one period each included).
+    The record length is ``duration_s`` rounded to whole periods, the one-period fades included.
     """
     periods = max(1, round(duration_s * frequency_hz) - 2)
     return Design(tuple(
@@ -277,9 +269,11 @@ def scheduled_design(amplitudes: Sequence[float], frequency_hz: float | Sequence
 
 
 def schedule_label(schedules: Sequence, unit: str = "") -> str:
-    """A short text for one schedule (or value) per record: '1/0.5' when all six are equal,
-    else runs of equal ones, 'x and y 0.75 Hz, z 0.5 Hz, rotations 0.75 Hz'; ``unit`` follows
-    every value."""
+    """A short text for one schedule (or value) per record.
+
+    '1/0.5' when all six are equal, else runs of equal ones ('x and y 0.75 Hz, z 0.5 Hz,
+    rotations 0.75 Hz'); ``unit`` follows every value.
+    """
     tail = f" {unit}" if unit else ""
     names = ["/".join(f"{v:g}" for v in np.atleast_1d(s)) + tail for s in schedules]
     if len(set(names)) == 1:

@@ -1,13 +1,9 @@
 """Command files of a design, and playing any excitation file on the plant.
 
-A command file is a CSV table of one record at the motion controller's rate: ``t`` (s), the
-pose ``x, y, z, rx, ry, rz`` (m, rad; absolute, paper frame, as in data files) and the leg
-lengths ``l1..l6`` (m, inverse kinematics of the pose). The record fades in from rest at the
-neutral pose and fades out to it (every designed record does). :func:`read_excitation`
-reads such a file, or one a user wrote with the pose or the leg lengths alone, into a
-:class:`TabulatedExcitation` that the plant plays like an analytic excitation: a cubic spline
-of the pose (of the forward kinematics of the lengths when the pose is missing) gives q, q_dot
-and q_ddot between the samples.
+A command file is a CSV table of one record at the controller's rate: ``t`` (s), the pose
+``x, y, z, rx, ry, rz`` (m, rad; absolute, paper frame) and the leg lengths ``l1..l6`` (m).
+:func:`read_excitation` reads such a file, or one with the pose or the lengths alone, into a
+:class:`TabulatedExcitation` the plant plays through a cubic spline.
 """
 
 from __future__ import annotations
@@ -106,8 +102,9 @@ class TabulatedExcitation:
         return float(self.t[-1] - self.t[0])
 
     def evaluate(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Pose, velocity and acceleration at ``t`` (s), each (N, 6); held at the last
-        sample after the end of the table."""
+        """Pose, velocity and acceleration at ``t`` (s), each (N, 6); held at the last sample after
+        the end of the table.
+        """
         spline = CubicSpline(self.t, self.pose, axis=0, bc_type="clamped")
         inside = np.clip(np.asarray(t, dtype=float), self.t[0], self.t[-1])
         return spline(inside), spline(inside, 1), spline(inside, 2)

@@ -1,14 +1,8 @@
 """Operating limits of a hexapod and how much of them a motion uses.
 
-The ``[limits]`` section of a platform description (:class:`stewartid.platform.Limits`) may
-leave keys out; :func:`resolve_limits` fills them from the model: the stroke ends from
-``[hydraulics] stroke`` centred on the neutral leg length, the leg velocity from the rated
-valve flow through the piston area, the force from the smaller stall force of the cylinder.
-
-:func:`limit_use` turns a motion (pose, leg lengths, rates, accelerations, forces) into the
-fraction of every limit used at every sample: 1 is the limit itself. It serves both the
-design (on commanded trajectories and model forces) and the check of a simulation (on the
-plant's true states).
+:func:`resolve_limits` fills the keys a ``[limits]`` section leaves out from the model;
+:func:`limit_use` gives the fraction of every limit used at every sample (1 = the limit), for
+designed trajectories and simulated plants alike.
 """
 
 from __future__ import annotations
@@ -60,7 +54,11 @@ class OperatingLimits:
 
 
 def resolve_limits(platform: Platform) -> OperatingLimits:
-    """The platform's limits with every default derived from its other sections.
+    """The platform's limits, every missing one derived from its other sections.
+
+    The stroke ends from ``[hydraulics] stroke`` centred on the neutral leg length, the leg
+    velocity from the rated valve flow through the piston area, the force from the smaller stall
+    force of the cylinder.
 
     Raises
     ------
@@ -219,8 +217,7 @@ def record_limit_use(platform: Platform, record) -> LimitUse:
     ----------
     platform : Platform
     record : stewartid.simulation.ExperimentRecord
-        True signals; the leg accelerations are the central differences of the true leg
-        rates.
+        True signals; the leg accelerations are central differences of the true leg rates.
     """
     accelerations = np.gradient(record.length_rates, record.t, axis=0)
     return limit_use(platform, resolve_limits(platform), record.t, record.q, record.lengths,

@@ -1,24 +1,12 @@
 """Records that move every DOF at once: a few sines per DOF, faded in and out.
 
-The physical model's parameters are seen only through motion that spans the workspace (large
-rotations for the inertia tensor, translations with rotations for the first moments, joint
-rates of several speeds for viscous against Coulomb friction). A :class:`MultisineRecord`
-moves DOF d as
+DOF d of a :class:`MultisineRecord` moves as
 
     q_d(t) = q0_d + a(t) * sum_h A[d, h] sin(2 pi F[d, h] t + phi[d, h]),
 
-with a(t) a quintic fade-in and fade-out (:func:`~stewartid.design.candidates.quintic_ramp`),
-so that the record starts and ends at rest at the neutral pose; pose, rate and acceleration
-are analytic. It has the interface of a designed record (``duration``, ``max_frequency``,
-``evaluate_offsets``, ``scaled``, ``to_dict``), so a :class:`~stewartid.design.candidates.Design`
-holds it, the plant plays it and :func:`~stewartid.design.export.write_commands` exports it.
-
-:func:`multisine_design` is the family the physical design searches (a Fourier series per DOF,
-as BIRDy's and FIGAROH's excitations): record k moves DOF d at the frequencies of a pool
-rotated by k, so that across the records every DOF meets every frequency and no two DOFs
-share one in the same record's first harmonic. :func:`all_dofs_multisine` is the reference
-it is judged against: one sine per DOF at the paper's amplitudes (the physical model's study
-data).
+with a(t) a quintic fade-in and fade-out, so that it starts and ends at rest. The physical
+model's parameters are seen only through motion that spans the workspace; a record has the
+interface of a designed record, so designs hold it and the plant plays it.
 """
 
 from __future__ import annotations
@@ -34,8 +22,7 @@ from stewartid.errors import ConfigError
 from stewartid.simulation.excitation import DEFAULT_AMPLITUDES
 
 #: Frequencies (Hz) of the reference all-DOFs multisine: record k moves DOF d at
-#: ``REFERENCE_HZ[(d + k) % 6]``; whole periods in 20 s, within a factor 3.5 of each other
-#: so that the estimator's kernel, set by the dominant one, passes them all.
+#: ``REFERENCE_HZ[(d + k) % 6]``; close enough that the estimator's kernel passes them all.
 REFERENCE_HZ = (0.3, 0.45, 0.6, 0.75, 0.9, 1.05)
 #: Fade-in and fade-out of every multisine record (s).
 MULTISINE_FADE = 2.0
@@ -137,7 +124,8 @@ def multisine_design(budget_s: float, amplitudes: Sequence[float], speed: float 
                      share: float = 0.0, seed: int = 0, label: str | None = None,
                      record_length: float = RECORD_LENGTH, fade: float = MULTISINE_FADE
                      ) -> Design:
-    """The physical design's family: records of every DOF at once, the pool rotated by record.
+    """The physical design's family: records of every DOF at once, the frequency pool rotated
+    by record so that every DOF meets every frequency and no two DOFs share one in a record.
 
     Parameters
     ----------
@@ -151,7 +139,7 @@ def multisine_design(budget_s: float, amplitudes: Sequence[float], speed: float 
         Fraction of each DOF's amplitude at a second frequency, the pool's entry three places
         on (0: one sine per DOF).
     seed : int
-        Seed of the phases (uniform, fixed by it: the design is reproducible).
+        Seed of the phases (uniform; the design is reproducible).
     label : str, optional
     record_length, fade : float
         Longest record, and each record's fade-in and fade-out (s).
@@ -178,9 +166,9 @@ def multisine_design(budget_s: float, amplitudes: Sequence[float], speed: float 
 
 
 def all_dofs_multisine(budget_s: float, scale: float = 1.0, slower: float = 1.0) -> Design:
-    """The reference: record k moves DOF d at ``REFERENCE_HZ[(d + k) % 6] / slower`` with
-    ``scale`` times the paper's amplitude, phase ``0.5 d + k`` rad (the physical model's study
-    data)."""
+    """The reference design: record k moves DOF d at ``REFERENCE_HZ[(d + k) % 6] / slower``
+    with ``scale`` times the paper's amplitude, phase ``0.5 d + k`` rad.
+    """
     records = []
     for k, length in enumerate(record_lengths(budget_s)):
         index = (np.arange(6) + k) % 6

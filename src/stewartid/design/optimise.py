@@ -1,31 +1,10 @@
 """Choosing a design: amplitudes at the limits of the plant, a small grid judged at full length.
 
-The family (:func:`~stewartid.design.candidates.scheduled_design`): six single-DOF records,
-one frequency for surge and sway, one for heave, one for the three rotations
-(:data:`FREQUENCY_GROUPS`), each record with a level schedule, the budget split equally. For
-each combination of the grid:
-
-1. the amplitude of each DOF is the largest whose commanded motion uses at most ``max_use``
-   of every limit (:func:`largest_amplitudes`), capped by ``cap`` (the pose dependence of
-   M(q) and of the Jacobians grows with the motion);
-2. the candidate is played on the closed-loop plant, and any record whose true states use
-   more than ``max_use`` of a limit is scaled down and played again
-   (:func:`within_plant_limits`): the plant's force and velocity exceed the commanded
-   motion's by up to 15 % of the limit (valve dynamics, tracking, friction);
-3. its accuracy is predicted at full length: for Method B with its interval constants tied
-   to the friction (the design's estimator) the standard errors from the information matrix
-   of its weak-form equations and the bias of one noise-free fit
-   (:func:`~stewartid.design.weak_information.information_prediction`, about 3 s), for
-   other methods a Monte Carlo of ``screening_seeds`` noise realisations. Short screening
-   records scaled by 1 / sqrt(time) mis-ranked candidates: the bias (once, with Method B
-   before its errors-in-variables correction, as large as the standard error on the Bt
-   diagonal) does not shrink with time.
-
-The criterion is the largest ratio, over the 20 entries of the paper's tables, of the
-predicted |bias| + 2 SE to the accuracy the entry's group requires (``required``: by
-default 0.5 % for the Mt diagonal, 2 % for the Bt diagonal, 8 % for the couplings). The
-best candidate is then checked by a Monte Carlo of ``seeds`` realisations (its bias, the
-noise's shift of the mean included, and the spread beside the information matrix's).
+Each candidate of the grid (:func:`~stewartid.design.candidates.scheduled_design`, one
+frequency per group of :data:`FREQUENCY_GROUPS`) gets the largest amplitudes within
+``max_use`` of every limit, is scaled down where the plant's true states exceed it, and is
+predicted at full length, since the bias does not shrink with time as the standard error
+does. The best by :func:`required_score` is then checked by a Monte Carlo.
 """
 
 from __future__ import annotations
@@ -53,20 +32,12 @@ from stewartid.reference.published import PAPER_ENTRIES
 from stewartid.simulation.excitation import DEFAULT_AMPLITUDES
 from stewartid.simulation.sensors import SensorNoise
 
-#: Records that share a frequency: surge and sway, heave, the rotations. Heave moves all
-#: legs alike: it reaches the leg-velocity limit at the smallest amplitude, and on the paper
-#: platform its Bt entry needed longer intervals than the others.
+#: Records that share a frequency: surge and sway, heave (all legs alike), the rotations.
 FREQUENCY_GROUPS = ((0, 1), (2,), (3, 4, 5))
-#: Frequencies tried (Hz) for each of :data:`FREQUENCY_GROUPS`. On the paper platform
-#: rotations at 1 Hz scored worse than at 0.75 Hz with every translation frequency, and surge
-#: and sway at 0.5 Hz doubled the spread of the Mt(2,4) coupling (to 3.3 %, more than half
-#: the paper's set's worst standard error).
+#: Frequencies tried (Hz) for each of :data:`FREQUENCY_GROUPS`.
 DEFAULT_FREQUENCIES = ((0.75,), (0.5, 0.75), (0.75,))
 #: Level schedules tried, relative to the largest amplitude: one for every record, or six.
-#: Two levels give intervals of two speeds with one joint-direction pattern, which Method B
-#: with shared friction constants uses to tell viscous from Coulomb friction; a low second
-#: level (0.3) separates the speeds more than 0.5 and, on the paper platform, lowered both
-#: the standard error and the noise's shift of the Bt diagonal.
+#: Two well separated levels let Method B tell viscous from Coulomb friction.
 DEFAULT_SCHEDULES = ((1.0, 0.3),)
 #: Largest amplitudes, as multiples of the paper's (20 mm, 10 mrad) per DOF: beyond them the
 #: pose dependence of M(q) and of the joint Jacobians shows in the noise-free estimate.
@@ -85,7 +56,8 @@ def entry_group(key: tuple[str, int, int]) -> str:
 
 def commanded_use(platform: Platform, record: DesignedRecord) -> LimitUse:
     """Limit use of a record played exactly: inverse kinematics for the legs, the rigid-body
-    model with the platform's friction for the forces."""
+    model with the platform's friction for the forces.
+    """
     rate = platform.sensors.sample_rate
     t = np.arange(int(record.duration * rate) + 1) / rate
     dq, q_dot, q_ddot = record.evaluate_offsets(t)
@@ -100,13 +72,11 @@ def commanded_use(platform: Platform, record: DesignedRecord) -> LimitUse:
 
 def largest_root(g: Callable[[float], float], low: float, high: float, tolerance: float
                  ) -> float:
-    """The largest x in [low, high] with g(x) <= 0, to within ``tolerance``, for g increasing
-    with g(high) > 0; 0 when g(low) > 0 already.
+    """The largest x in [low, high] with g(x) <= 0, to within ``tolerance``.
 
-    Regula falsi with the Illinois modification (the value at an end that stays twice in a
-    row halved), each point kept a quarter of ``tolerance`` inside the bracket: a limit's
-    use grows almost linearly with the amplitude, so it needs about 8 evaluations of g where
-    bisection needs 20.
+    For g increasing with g(high) > 0; 0 when g(low) > 0 already. Regula falsi with the Illinois
+    modification, each point kept a quarter of ``tolerance`` inside the bracket: a limit's use is
+    nearly linear in the amplitude, so it needs far fewer evaluations than bisection.
     """
     g_low, g_high = g(low), g(high)
     if g_low > 0:
@@ -130,8 +100,8 @@ def largest_root(g: Callable[[float], float], low: float, high: float, tolerance
 def largest_amplitudes(platform: Platform, frequency_hz: float | Sequence[float],
                        max_use: float = 0.7,
                        cap: float | Sequence[float] = DEFAULT_AMPLITUDE_CAP) -> np.ndarray:
-    """Per DOF, the largest sine amplitude whose commanded motion stays within ``max_use``
-    of every limit.
+    """Per DOF, the largest sine amplitude whose commanded motion stays within ``max_use`` of
+    every limit.
 
     Parameters
     ----------
@@ -175,15 +145,15 @@ def within_plant_limits(platform: Platform, design: Design, max_use: float,
                         rounds: int = 4, workers: int | None = None
                         ) -> tuple[Design, list, list[LimitUse]]:
     """Play a design on the plant and scale down the records whose true states use more than
-    ``max_use`` of a limit, until none does (the records played over ``workers`` processes,
-    every core by default).
+    ``max_use`` of a limit, until none does.
+
+    The records are played over ``workers`` processes, every core by default.
 
     Returns
     -------
     design : Design
-        With the amplitudes of the offending records scaled (by max_use / peak use per
-        round: exact for the velocity, which is proportional to the amplitude, short for the
-        force, which carries the static load, hence several rounds).
+        With the offending records scaled by max_use / peak use per round (several rounds,
+        since the force carries the static load).
     records : list of ExperimentRecord
         The design's true signals on the plant (no sensor noise).
     uses : list of LimitUse
@@ -213,8 +183,7 @@ def within_plant_limits(platform: Platform, design: Design, max_use: float,
 def within_plant_limits_all(platform: Platform, designs: Sequence[Design], max_use: float,
                             workers: int | None = None
                             ) -> list[tuple[Design, list, tuple[LimitUse, ...]]]:
-    """:func:`within_plant_limits` of several designs, each distinct record played once (the
-    candidates of a grid share most of theirs), the records over ``workers`` processes.
+    """:func:`within_plant_limits` of several designs, each distinct record played once.
 
     Returns
     -------
@@ -236,7 +205,8 @@ def within_plant_limits_all(platform: Platform, designs: Sequence[Design], max_u
 def required_score(prediction: Prediction,
                    required: Mapping[str, float] = REQUIRED_ACCURACY) -> float:
     """The design criterion: the largest (|bias| + 2 SE) / required accuracy over the 20
-    entries (-); below 1, every entry is expected within its group's accuracy."""
+    entries (-); below 1, every entry is expected within its group's accuracy.
+    """
     need = np.array([required[entry_group(k)] for k in PAPER_ENTRIES])
     return float(np.max((prediction.relative_bias + 2 * prediction.relative_std) / need))
 
@@ -291,8 +261,7 @@ def optimise_design(platform: Platform, budget_s: float, noise: SensorNoise,
         Noise realisations per candidate of methods without an information-matrix
         prediction (:func:`~stewartid.design.weak_information.has_information`).
     seeds : int
-        Noise realisations of the best candidate's Monte Carlo (its check, with an
-        information-matrix prediction; else its prediction), >= 2.
+        Noise realisations of the best candidate's Monte Carlo, >= 2.
     source : {"plant", "model"}
         Noise-free data of the predictions (:func:`~stewartid.design.prediction.predict_accuracy`).
     required : mapping

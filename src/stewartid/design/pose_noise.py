@@ -1,32 +1,12 @@
 """The pose noise's share of the physical model's predicted parameter covariance.
 
-The estimator's rows are the regressor at the measured pose and its Savitzky-Golay rate and
-acceleration, filtered with the kernel h and mapped to the leg forces. White pose noise e
-(leg-length noise through the kinematics, covariance Sigma_q = J_lq^-1 Sigma_l J_lq^-T per
-sample) enters a row's model force Y theta mostly through the acceleration and the rate,
-
-    n_j = D_a(j) (g2 * e)_j + D_v(j) (g1 * e)_j,    D_a = M(q),  D_v = d(Y theta)/d q_dot,
-
-g1, g2 the derivative taps, and the residual of filtered row k is -T_k (h * n)_k. The scores'
-share is sum_k Z_k (h * n)_k with Z_k = X_k^T W T_k, which is sum_j U_j n_j for U = h * Z
-(the kernel is symmetric), and, with P = U D_a and Q = U D_v,
-
-    sum_i [ sum_j P_j g2(j - i) + Q_j g1(j - i) ] e_i  =  sum_i [ P''(t_i) - Q'(t_i) ] e_i,
-
-the taps being exact derivatives on P and Q, which vary on the kernel's scale. Its
-covariance, sum_i G_i Sigma_q G_i^T with G = P'' - Q', adds to the force noise's B of the
-sandwich A^-1 B A^-1 (:func:`~stewartid.design.physical.information.sandwich_covariance`). For a
-slowly varying column the high-pass noise cancels (the mass through gravity); what is left
-is seen through how fast the motion's rows change, so the friction and the leg offsets take
-most of it and more at higher frequencies. On the 2 Hz payload design of our plant (8 seeds
-with the leg-length noise alone) the prediction gives 1.67 / 1.23 N m for the lower gimbals'
-and revolute joints' Coulomb levels against a spread of 1.94 / 1.31, 72 against 70 N m s/rad
-for the lower gimbals' viscous coefficient, 1.0 against 1.1 kg for the payload's mass.
-
-Left out: the pose itself (no derivative gain), and the Coulomb signs, whose rates are taken
-where their noise is within 0.2 % of the rate's RMS
-(:data:`~stewartid.signals.sign_rates.SIGN_NOISE`): the reversals they shift by 0.1 ms or so
-gave standard errors a tenth or less of this share's there (a hundredth of its variance).
+White pose noise e reaches a row's model force through the differentiated rate and
+acceleration, n_j = D_a(j) (g2 * e)_j + D_v(j) (g1 * e)_j with D_a = M(q) and
+D_v = d(Y theta)/d q_dot. Its share of the scores is sum_i G_i e_i with G = P'' - Q',
+P = U D_a, Q = U D_v and U the kernel-filtered scores' weights; its covariance
+sum_i G_i Sigma_q G_i^T adds to B of the sandwich
+(:func:`~stewartid.design.physical.information.sandwich_covariance`). The Coulomb signs are
+left out.
 """
 
 from __future__ import annotations

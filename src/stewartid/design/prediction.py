@@ -1,41 +1,12 @@
 """Predicted accuracy of a design: the standard error of every Mt and Bt entry, before any test.
 
-How: the design's records are turned into noise-free data, the chosen estimator is fitted to
-it once without noise (its deviation from the nominal matrices is the design's noise-free
-bias: the non-linearity of the larger motion, friction the estimator does not model,
-tracking) and then to ``seeds`` copies with the sensor noise added, and the spread of those
-estimates about their mean is the predicted standard error (the shift of the mean from the
-noise-free estimate, which the pose noise in the regressors causes, is counted in the bias;
-it is comparable to the standard error on the Mt diagonal). The noise-free data come from
-
-* ``source="plant"`` (the default): the records played once on the closed-loop hydraulic
-  plant without sensor noise (:func:`stewartid.design.export.simulate_excitations`); the
-  noise is then drawn exactly as ``simulate`` draws it (:func:`measure_legs`), and the pose
-  is the first Newton step of forward kinematics from the true pose (J_lq^-1 at the true
-  poses computed once; within 2e-9 m of ``simulate``'s converged forward kinematics for
-  20 um of length noise, 0.04 s per realisation of 6 x 20 s instead of 1.3 s). The plant's
-  motion is not the commanded one (tracking error, servo and valve dynamics, friction the
-  controller fights), and the estimator's spread on it is 2-10 times the spread on model
-  data for some entries;
-* ``source="model"``: the commanded motion taken as tracked exactly, with the actuator forces
-  of the nonlinear rigid-body model (:func:`stewartid.model.dynamics.inverse_dynamics`) and the
-  pose noise to first order. Fast, for screening and tests, but optimistic.
-
-Why a Monte Carlo over the estimator: Method B's default (reweighted weak form, interval
-detection with noise-dependent hysteresis, shared friction constants whose scatter is
-estimated from the data, the choice of the better member of every symmetric pair) is not
-one linear map of the noise; running the estimator itself predicts what it will do,
-whatever its settings. For the design's estimator the first-order covariance of its
-equations (:mod:`~stewartid.design.weak_information`) agrees with 120 realisations of it
-within 15 % on the 120 s design of the paper platform and ranks the candidates; this Monte
-Carlo checks the pick and predicts the other methods. A standard error estimated from K seeds has a relative
-uncertainty of about 1 / sqrt(2 K): 25 % at 8 seeds, 16 % at 20, 6.5 % at 120.
-Compared with an observed spread over 20 seeds (itself 16 % uncertain), a prediction from
-120 seeds lands within 30 % of it for about 9 entries in 10 when the estimates are close to
-Gaussian, as Method B's are since its interval-constant scatter is matched in weighted
-chi-square (:mod:`~stewartid.identification.wavelet.gls`). The realisations are spread
-over processes (``workers``); each draws from its own stream, so the count does not change
-the result."""
+The chosen estimator is fitted once to the design's noise-free data (its deviation from the
+nominal matrices is the noise-free bias) and then to ``seeds`` noisy copies; the spread of those
+estimates is the predicted standard error, the shift of their mean joins the bias. Running
+the estimator itself predicts what it will do, whatever its settings. The noise-free data come
+from the closed-loop plant (``source="plant"``) or from the rigid-body model with perfect
+tracking (``source="model"``: fast, optimistic).
+"""
 
 from __future__ import annotations
 
@@ -92,8 +63,8 @@ def add_noise(platform: Platform, dataset: Dataset, noise: SensorNoise,
         Standard deviations (m, N); biases and resolutions are not modelled here.
     rng : numpy.random.Generator
     inverse_jacobian : ndarray, shape (N, 6, 6), optional
-        J_lq^-1 at the noise-free poses (:func:`inverse_leg_jacobians`; computed when not
-        given, worth keeping when many copies are drawn).
+        J_lq^-1 at the noise-free poses (:func:`inverse_leg_jacobians`), worth keeping when many
+        copies are drawn.
 
     Returns
     -------
@@ -124,15 +95,12 @@ class Prediction:
     nominal_M, nominal_B : ndarray, shape (6, 6)
         Nominal Mt, Bt at the neutral pose (kg..., N s/m...).
     bias_M, bias_B : ndarray, shape (6, 6)
-        Mean estimate over the seeds minus nominal (same units): the noise-free bias plus the
-        shift the noise causes (uncertain by std / sqrt(seeds)); without seeds, the expected
+        Mean estimate over the seeds minus nominal (same units); without seeds, the expected
         estimate of the information matrix's fit minus nominal.
     noise_free_bias_M, noise_free_bias_B : ndarray, shape (6, 6), or None
-        Noise-free estimate minus nominal (same units); None when not fitted (an
-        information-matrix prediction without its Monte Carlo check).
+        Noise-free estimate minus nominal (same units); None when not fitted.
     std_M, std_B : ndarray, shape (6, 6)
-        Predicted standard errors (same units): standard deviation of the estimates over the
-        seeds.
+        Predicted standard errors (same units).
     seeds : int
         Noise realisations of the Monte Carlo (0: none, the bias is the noise-free one).
     method : str
@@ -173,8 +141,9 @@ class Prediction:
 
     @property
     def relative_noise_free_bias(self) -> np.ndarray | None:
-        """|noise-free bias| of the paper's 20 entries, % of nominal; shape (20,); None
-        without a noise-free fit."""
+        """|noise-free bias| of the paper's 20 entries, % of nominal; shape (20,); None without a
+        noise-free fit.
+        """
         return None if self.noise_free_bias_M is None else self._entries("noise_free_bias")
 
     @property
@@ -217,11 +186,8 @@ class Prediction:
 
 
 #: Settings of the estimator a design is made for, per method (the rest: its defaults).
-#: Method B with the interval constants tied to one Coulomb level for every joint axis, so
-#: that intervals of different speeds separate viscous from Coulomb friction (three levels,
-#: one per joint type, drift apart on some noise seeds: 95, 28 and -21 N m for 30 N m, and
-#: Bt with them; with every constant free, the default, the Bt diagonal of the 120 s design
-#: scatters 2.7-11 times more).
+#: Method B with one Coulomb level for every joint axis, so that intervals of different speeds
+#: separate viscous from Coulomb friction.
 DESIGN_SETTINGS = {"wavelet": {"friction": "uniform"}}
 
 
@@ -265,11 +231,9 @@ def measured_plant_datasets(platform: Platform, records: list, noise: SensorNois
     generators : list of numpy.random.Generator
         One per record.
     inverse_jacobians : list of ndarray, shape (N, 6, 6), optional
-        J_lq^-1 at each record's true poses (:func:`inverse_leg_jacobians`): the pose is
-        then the true pose plus J_lq^-1 (measured - true lengths), the first Newton step of
-        forward kinematics from the true pose (within 2e-9 m of it for 20 um of length
-        noise; 0.04 s instead of 1.3 s for 6 x 20 s). None: forward kinematics, as
-        ``simulate``.
+        J_lq^-1 at each record's true poses (:func:`inverse_leg_jacobians`): the pose is then
+        the first Newton step of forward kinematics from the true pose. None: forward
+        kinematics, as ``simulate``.
 
     Returns
     -------
@@ -290,9 +254,10 @@ def measured_plant_datasets(platform: Platform, records: list, noise: SensorNois
 
 
 def plant_records(platform: Platform, design: Design, workers: int | None = None) -> list:
-    """The design played once on the plant without sensor noise: the true signals of every
-    record (:class:`~stewartid.simulation.experiments.ExperimentRecord`), the records spread
-    over ``workers`` processes (every core by default; each is played from rest alone)."""
+    """The design played once on the plant without sensor noise: the true signals of every record.
+
+    The records are played over ``workers`` processes (every core by default), each from rest.
+    """
     return run_in_order(_play, design.playable(platform), workers, shared=platform)
 
 
@@ -305,7 +270,7 @@ def predict_accuracy(platform: Platform, design: Design, noise: SensorNoise,
                      source: str = "plant", records: list | None = None,
                      workers: int | None = None,
                      progress: Callable[[int, int], None] | None = None) -> Prediction:
-    """Predicted bias and standard errors of Mt and Bt for a design (see the module docstring).
+    """Predicted bias and standard errors of Mt and Bt for a design (module docstring).
 
     Parameters
     ----------
@@ -326,9 +291,8 @@ def predict_accuracy(platform: Platform, design: Design, noise: SensorNoise,
     records : list of ExperimentRecord, optional
         The design already played on the plant (:func:`plant_records`), ``source="plant"``.
     workers : int, optional
-        Processes the realisations are spread over; None: every available core when there
-        are at least :data:`PARALLEL_SEEDS` realisations, else 1. Each realisation draws
-        from its own stream, so the result does not depend on the count.
+        Processes the realisations are spread over; None: every available core from
+        :data:`PARALLEL_SEEDS` realisations on, else 1. The result does not depend on it.
     progress : callable, optional
         Called with (done, total) after each realisation.
 
@@ -356,8 +320,7 @@ def predict_accuracy(platform: Platform, design: Design, noise: SensorNoise,
     fits = runs.estimates(range(int(seeds)), workers, progress)         # (seeds, 2, 6, 6)
     settings = estimator.get_params()
     label = method + ("" if method != "wavelet" else f" (friction={settings['friction']})")
-    # the noise also shifts the mean (pose noise in the regressors): that shift belongs to
-    # the bias, the spread about the mean is the standard error
+    # the noise's shift of the mean belongs to the bias, the spread about it to the SE
     mean, std = fits.mean(axis=0), fits.std(axis=0, ddof=1)
     return Prediction(
         nominal_M=M0, nominal_B=B0, bias_M=mean[0] - M0, bias_B=mean[1] - B0,
@@ -366,7 +329,7 @@ def predict_accuracy(platform: Platform, design: Design, noise: SensorNoise,
 
 
 #: Realisations from which a prediction is spread over processes (fewer: not worth starting
-#: them, about 2 s each).
+#: them).
 PARALLEL_SEEDS = 16
 
 
@@ -410,7 +373,9 @@ class NoiseRuns:
     def fit(self, ks: Sequence[int], progress: Callable[[int, int], None] | None = None
             ) -> np.ndarray:
         """``[M_, B_]`` of the estimator on realisations ``ks``; shape (len(ks), 2, 6, 6).
-        ``progress(done, total)`` after each."""
+
+        ``progress(done, total)`` is called after each.
+        """
         estimator = _monte_carlo_estimator(self.method)
         out = np.empty((len(ks), 2, 6, 6))
         for i, k in enumerate(ks):
@@ -422,9 +387,11 @@ class NoiseRuns:
 
     def estimates(self, ks: Sequence[int], workers: int | None = None,
                   progress: Callable[[int, int], None] | None = None) -> np.ndarray:
-        """:meth:`fit` over ``workers`` processes (every core from :data:`PARALLEL_SEEDS`
-        realisations on, else 1), in the order of ``ks``; the noise-free data go to each
-        worker once, a task carries only its realisation's number."""
+        """:meth:`fit` over ``workers`` processes, in the order of ``ks``.
+
+        Every core from :data:`PARALLEL_SEEDS` realisations on, else 1; the noise-free data go to
+        each worker once.
+        """
         ks = [int(k) for k in ks]
         if workers is None:
             workers = None if len(ks) >= PARALLEL_SEEDS else 1

@@ -1,7 +1,5 @@
-"""The design report: limit use over time, interval lengths, predicted accuracy vs the paper's set.
-
-Figures are matplotlib PNG + SVG (:func:`stewartid.reports.drawing.save_figure`), the text is
-Markdown, rendered to a self-contained HTML page by :func:`stewartid.reports.html.render_html`.
+"""The design report: limit use over time, interval lengths, predicted accuracy against the
+paper's set, as Markdown and a self-contained HTML page.
 """
 
 from __future__ import annotations
@@ -152,8 +150,8 @@ def identify_command(method: str, run: str = "RUN") -> str:
 def validation_commands(method: str, coulomb: float, folder: str = "DIR", run: str = "RUN"
                         ) -> list[str]:
     """The commands that play the design's validation record on the plant and identify with
-    it held out (``identify --validate``): the report then judges every model on motion it
-    did not see."""
+    it held out (``identify --validate``).
+    """
     record = shlex.quote(f"{folder}/validation/validation.csv")
     return [f"stewartid simulate --platform PLATFORM --coulomb {coulomb:g} --excitation "
             f"{record} --noise --seed 1 --out {run}_validation",

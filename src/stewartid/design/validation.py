@@ -1,13 +1,8 @@
 """The short validation record a design is checked with: every DOF at once, at frequencies
 of its own, within the platform's limits.
 
-A fitted model is validated on motion it did not see (``stewartid identify --validate``):
-segments of the fitted sines cannot show a wrong coupling that a friction term compensated,
-motion along other directions at other frequencies can. The record moves all six DOFs
-together, DOF k at :data:`VALIDATION_HZ` [k] (no two frequencies in a ratio of small
-integers, so that no DOF's harmonic falls on another's line), with a quintic fade-in and
-fade-out, its amplitudes scaled until the commanded motion uses :data:`VALIDATION_USE` of the
-most used limit (:func:`~stewartid.design.optimise.commanded_use`).
+Motion along other directions at other frequencies shows a wrong coupling that a friction term
+compensated on the fitted sines (``stewartid identify --validate``).
 """
 
 from __future__ import annotations
@@ -25,7 +20,7 @@ from stewartid.platform import COORDINATES, Platform
 from stewartid.simulation.excitation import DEFAULT_AMPLITUDES
 
 #: Frequency of each DOF in the validation record (Hz): within the paper's band, pairwise
-#: ratios far from small-integer ones.
+#: ratios far from small-integer ones so that no harmonic falls on another DOF's line.
 VALIDATION_HZ = (0.37, 0.53, 0.71, 0.89, 1.13, 1.31)
 #: Share of the most used limit the commanded validation motion reaches.
 VALIDATION_USE = 0.5
@@ -91,8 +86,7 @@ def validation_record(platform: Platform, duration_s: float = VALIDATION_DURATIO
     """The validation record of a platform: the paper's amplitudes scaled until the
     commanded motion uses ``max_use`` of its most used limit.
 
-    Limit use grows linearly with the amplitudes but for the static part of the leg forces,
-    so three rescalings settle it to well within a per cent.
+    Limit use is nearly linear in the amplitudes, so a few rescalings settle it.
     """
     from stewartid.design.optimise import commanded_use
 

@@ -1,41 +1,14 @@
 """Predicted standard errors of Method B's Mt and Bt from the information of its weak-form
 equations, without a Monte Carlo.
 
-The design's estimator (:func:`~stewartid.design.prediction.default_estimator`, Method B
-with one Coulomb level, ``friction="uniform"``) solves the weak-form equations of every
-constant-direction interval (:mod:`~stewartid.identification.wavelet.weak_form`) by
-generalized least squares over all channels, each interval's rows weighted by the inverse of
-their assumed covariance V (force noise, the pose noise the test functions' derivatives
-carry, the model error the residuals show, and the interval constants' scatter tau on the
-mean row). To first order in the noise its error is
-
-    dz = N^-1 sum_n D_n^T W_n e_n,      N = sum_n D_n^T W_n D_n,
-
-with D_n the noise-free design of interval n, W_n = V_n^-1 (per channel) and e_n the noise
-of its rows, so that
+To first order the generalized least squares of the design's estimator errs by
+dz = N^-1 sum_n D_n^T W_n e_n, N = sum_n D_n^T W_n D_n, so that
 
     Cov(z) = N^-1 (sum_n D_n^T W_n C_n W_n D_n) N^-1,
 
-C_n the true noise covariance of the rows of all six channels: the force noise through the
-leg Jacobian, S = J_lq^T Sigma_f J_lq, and the pose noise (leg-length noise through J_lq^-1)
-in the regressors and, through K = dy/dq, in the targets, correlated across channels. The
-model error (the residuals' excess, tau) shapes the weights but not C: it is the same in
-every realisation, and belongs to the bias.
-
-Everything is computed on the design's noise-free data (the records played once on the
-plant) with the noise model known instead of estimated: the smoothing window, interval
-margin and hysteresis thresholds as the estimator sets them, the rate noise of the
-hysteresis from the known pose noise, so that the intervals are those a noisy fit finds
-(their ends jitter by a few samples in a noisy fit). The same weighted fit of the noise-free
-equations, z = N^-1 sum_n D_n^T W_n t_n, is the mean of the noisy fits to first order (the
-errors-in-variables correction removes the noise's shift): the expected estimate, whose
-error is the design's bias. The symmetric pairs are then pooled as the estimator pools them
-(inverse-variance mean of both members), with their covariance.
-
-What this leaves out, and the Monte Carlo check of the final design
-(:func:`~stewartid.design.prediction.predict_accuracy`) measures: the randomness of the
-weights and of tau (estimated from the data in a fit), the jitter of the interval ends, and
-the shift of the mean beyond first order.
+with D_n the noise-free design of interval n, W_n its weights and C_n the true covariance of
+its rows' force and pose noise. Everything is computed on the design's noise-free data with
+the noise model known; the Monte Carlo check measures what first order leaves out.
 """
 
 from __future__ import annotations
@@ -88,8 +61,8 @@ from stewartid.simulation.sensors import SensorNoise
 
 
 def known_noise(experiment: Experiment, noise: SensorNoise) -> tuple[np.ndarray, np.ndarray]:
-    """The pose noise per sample and the generalized force's noise per sample of one
-    noise-free experiment, from the sensor noise (white on lengths and forces).
+    """The pose noise and the generalized force's noise per sample of one noise-free experiment,
+    from the sensor noise (white on lengths and forces).
 
     Returns
     -------
@@ -108,8 +81,7 @@ def known_noise(experiment: Experiment, noise: SensorNoise) -> tuple[np.ndarray,
 
 def expected_detection(experiment: Experiment, pose: np.ndarray, force: np.ndarray,
                        settings: dict) -> Detection:
-    """The intervals Method B finds in a noisy copy of a noise-free experiment: its
-    smoothing window and margin, the hysteresis of the known pose noise.
+    """The intervals Method B finds in a noisy copy of a noise-free experiment.
 
     Parameters
     ----------
@@ -137,8 +109,8 @@ def expected_detection(experiment: Experiment, pose: np.ndarray, force: np.ndarr
 
 def expected_equations(platform: Platform, datasets: list[Dataset], noise: SensorNoise,
                        settings: dict) -> tuple[StackedEquations, np.ndarray]:
-    """The weak-form equations of noise-free data, as the estimator would form them from a
-    noisy copy, with the known noise of each experiment.
+    """The weak-form equations of noise-free data, as the estimator forms them from a noisy
+    copy, with the known noise of each experiment.
 
     Returns
     -------
@@ -165,9 +137,7 @@ def expected_equations(platform: Platform, datasets: list[Dataset], noise: Senso
 
 def expected_scatter(stacked: StackedEquations, designs: list[np.ndarray], theta: np.ndarray,
                      variance: np.ndarray) -> np.ndarray:
-    """tau (6,) the estimator's chi-square match would give on average: the residuals of the
-    noise-free mean rows (model error) plus the noise's variance, against that variance
-    (N, N m).
+    """tau (6,) the estimator's chi-square match gives on average (N, N m).
 
     Parameters
     ----------
@@ -203,7 +173,7 @@ def information_covariance(stacked: StackedEquations, force: np.ndarray, theta: 
     theta : ndarray, shape (6, 12)
         [Mt Bt] the pose noise's coefficients are taken at.
     model_error : ndarray, shape (n, 6)
-        Variance per row the estimator adds for model error (its residuals' excess).
+        Variance per row the estimator adds for model error.
     scatter : ndarray, shape (6,)
         tau per channel.
 
@@ -211,8 +181,7 @@ def information_covariance(stacked: StackedEquations, force: np.ndarray, theta: 
     -------
     z : ndarray, shape (u,)
         The fit of the noise-free equations with the weights of the noise: the mean of the
-        noisy fits to first order (the errors-in-variables correction removes the noise's
-        shift).
+        noisy fits to first order.
     covariance : ndarray, shape (u, u)
         [Mt Bt] row-major, then the offsets and the Coulomb level.
     """
@@ -249,9 +218,9 @@ def information_covariance(stacked: StackedEquations, force: np.ndarray, theta: 
 
 
 def pooled(z: np.ndarray, covariance: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Mt, Bt and their standard errors (6, 6) each once the estimator has pooled every
-    symmetric pair (the inverse-variance mean of both members, their correlation kept),
-    from [Mt Bt] row-major (the 72 first unknowns) and their covariance.
+    """Mt, Bt and their standard errors once every symmetric pair is pooled as the estimator
+    pools it (inverse-variance mean, correlation kept), from [Mt Bt] row-major (the first 72
+    unknowns) and their covariance.
 
     Returns
     -------
@@ -279,8 +248,7 @@ def pooled(z: np.ndarray, covariance: np.ndarray) -> tuple[np.ndarray, ...]:
 
 def information_estimate(platform: Platform, datasets: list[Dataset], noise: SensorNoise,
                          settings: dict) -> tuple[np.ndarray, ...]:
-    """Method B's expected Mt and Bt and their standard errors on noisy copies of noise-free
-    data (module docstring).
+    """Method B's expected Mt and Bt and their standard errors on noisy copies of noise-free data.
 
     Parameters
     ----------
@@ -315,9 +283,10 @@ def information_estimate(platform: Platform, datasets: list[Dataset], noise: Sen
 
 
 def has_information(method: str) -> bool:
-    """Whether the design's estimator for ``method`` has a prediction from the information
-    matrix (Method B with its interval constants tied to the friction structure); the others
-    are predicted by the Monte Carlo alone."""
+    """Whether the design's estimator for ``method`` has an information-matrix prediction
+    (Method B with its interval constants tied to the friction); the others have the Monte Carlo
+    alone.
+    """
     return method == "wavelet" and DESIGN_SETTINGS.get(method, {}).get("friction") in (
         "shared", "uniform")
 
@@ -340,10 +309,9 @@ def information_prediction(platform: Platform, design: Design, noise: SensorNois
     method : str
         Registered method with :func:`has_information`.
     check_seeds : int
-        0: the bias is the estimator's noise-free error (one fit). >= 2: a Monte Carlo of as
-        many noise realisations (:func:`~stewartid.design.prediction.predict_accuracy`)
-        gives the bias (mean estimate minus nominal, the noise's shift included) and its
-        spread, kept beside the standard errors as their check.
+        0: the bias is the expected estimate's. >= 2: a Monte Carlo of as many realisations
+        (:func:`~stewartid.design.prediction.predict_accuracy`) gives the bias and its spread,
+        kept beside the standard errors as their check.
     seed : int
         Seed of the Monte Carlo's first realisation.
     source : {"plant", "model"}
@@ -381,24 +349,23 @@ def information_prediction(platform: Platform, design: Design, noise: SensorNois
     M0, B0 = nominal_matrices(platform)
     label = f"{method} (friction={estimator.friction}), {source} data, information matrix"
     # no noise-free fit: on noise-free data the estimator's weights and intervals are not
-    # those of a noisy fit (0.92 % off on a Bt diagonal entry where the mean of 24 noisy
-    # fits and the expected estimate were 0.003 % off)
+    # those of a noisy fit
     prediction = Prediction(nominal_M=M0, nominal_B=B0, bias_M=M - M0, bias_B=B - B0,
                             noise_free_bias_M=None, noise_free_bias_B=None, std_M=std_M,
                             std_B=std_B, seeds=0, method=label)
     if not check_seeds:
         return prediction
-    # the check's realisations over every core: each is a fit of about 1.5 s
     return checked_prediction(prediction, predict_accuracy(
         platform, design, noise, method, check_seeds, seed, source, records,
         worker_count(workers, check_seeds), progress))
 
 
 def checked_prediction(prediction: Prediction, monte_carlo: Prediction) -> Prediction:
-    """An information-matrix prediction with the Monte Carlo of the same design as its check:
-    the standard errors stay the information matrix's (the Monte Carlo's spread, uncertain
-    by about 1 / sqrt(2 seeds), is kept beside them), the bias becomes the Monte Carlo's
-    (mean estimate minus nominal: what the first-order expected estimate leaves out)."""
+    """An information-matrix prediction checked by the Monte Carlo of the same design.
+
+    The standard errors stay the information matrix's, with the Monte Carlo's spread beside them;
+    the bias becomes the Monte Carlo's, which holds what first order leaves out.
+    """
     return dataclasses.replace(monte_carlo, std_M=prediction.std_M, std_B=prediction.std_B,
                                monte_carlo_std_M=monte_carlo.std_M,
                                monte_carlo_std_B=monte_carlo.std_B,

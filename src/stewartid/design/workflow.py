@@ -40,7 +40,7 @@ from stewartid.platform import Platform
 from stewartid.simulation.sensors import SensorNoise
 
 #: Noise realisations of the Monte Carlo that checks the chosen design's information-matrix
-#: prediction (its spread is uncertain by about 1 / sqrt(2 x 8) = 25 %).
+#: prediction.
 CHECK_SEEDS = 8
 
 
@@ -99,7 +99,7 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
         Noise-free data of the predictions: the design played on the plant, or the
         rigid-body model with perfect tracking (faster, optimistic).
     quick : bool
-        One candidate (1 Hz, levels 1/0.5) and no screening (for tests).
+        One candidate and no screening (for tests).
     force : bool
         Overwrite an earlier design in ``out``.
     workers : int, optional

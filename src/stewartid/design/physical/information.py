@@ -1,42 +1,13 @@
 """Predicted standard errors of the physical model's parameters from the information matrix.
 
-The physical estimator (:class:`~stewartid.physical.estimator.PhysicalIdentifier`)
-regresses the measured leg forces on the regressor's columns mapped to them,
-f = J_lq^-T X theta + e, with each leg's channel weighted by its residual variance. The force
-noise (white, ``force_noise`` of every leg, covariance S = Sigma_f per sample) is then that
-of the channels themselves. The estimator's covariance is the sandwich
+The physical estimator regresses the leg forces on the regressor's columns mapped to them,
+each leg weighted by its noise variance; its covariance is the sandwich
 
     Cov(theta) = A^-1 B A^-1,   A = sum_k X_k^T W X_k,   B = sum_k X_k^T W S_k W X_k,
 
-X_k the rows in leg forces and W = diag(1 / mean_k S_k,cc) its channel weights, summed over
-the logged samples (with legs alike, generalized least squares). The
-estimator filters both sides with a smooth kernel and keeps ``ROWS_PER_WINDOW`` rows per
-kernel window: the filtered noise is correlated over the window, and its sum over the kept
-rows is the sum of the filtered noise over every sample. For a regressor smooth on the
-kernel's scale the covariance is that of the unfiltered regression; the Coulomb columns'
-reversals are not, and the final prediction filters the regressor as the estimator does
-(:func:`kernel_filtered`; the search leaves it out). The
-regressor along the commanded motion (analytic q, q_dot, q_ddot; for the final prediction the
-motion the plant played, :func:`played_states`) is summed at ``rate_hz`` and scaled to the
-sample rate: the products of the columns vary on the scale of
-the motion's periods, far slower than :data:`INFORMATION_RATE`.
-
-The parameters judged are the moving body's ten (full mode) or the payload's ten (payload
-mode); the others (legs, friction, offsets) are estimated with them, so that the judged block
-of the covariance is the inverse of the Schur complement of the others' block in the
-information. The pose noise (leg-length noise through the kinematics) reaches the rows
-through the filtered rates and accelerations, high-pass: the search leaves it out (its
-payload's parameters take a tenth or less of their variance from it), the final prediction
-adds it (:mod:`stewartid.design.pose_noise`; most of the friction's variance at 2 Hz).
-
-A relative standard error is judged against a parameter's size, the same for the components
-of one vector or tensor so that the criterion does not depend on how the platform frame is
-turned: the mass against itself, each first moment against the first-moment vector's
-length (at least a tenth of the mass times the radius of gyration, for a centre of mass near
-the reference point), each entry of the inertia matrix, products included, against the mean
-of its diagonal. Judged by their own magnitudes, a first moment along a long lever arm and a
-product near zero would set the design's aim by the frame's orientation alone. Payload mode
-judges the payload's quantities instead (:mod:`stewartid.design.physical.payload_accuracy`).
+summed over the logged samples. The judged parameters (the moving body's or the payload's
+ten) are estimated with the others, and their relative standard errors are taken of sizes
+that turning the frame leaves alone (:func:`parameter_sizes`).
 """
 
 from __future__ import annotations
@@ -67,7 +38,7 @@ from stewartid.signals.differentiation import default_window, estimate_frequency
 from stewartid.simulation.sensors import SensorNoise
 
 #: Rate (Hz) the regressor is summed at along a commanded motion: at least ten samples per
-#: period of the fastest motion of the search (2.1 Hz).
+#: period of the fastest motion of the search.
 INFORMATION_RATE = 25.0
 
 
@@ -84,9 +55,8 @@ class ParameterPrediction:
     std_errors : ndarray, shape (p,)
         Predicted standard errors with every parameter estimated (the parameters' units).
     expected_std_errors : ndarray, shape (p,)
-        The same once the parameters the estimator would fix (relative standard error above
-        its ``max_relative_error``) are fixed; NaN for those: what a fit will report, and
-        what the design criterion is taken of.
+        The same once the parameters the estimator would fix are fixed (NaN for those): what a
+        fit will report, and what the design criterion is taken of.
     fixed : tuple of str
         Those parameters.
     expected_covariance : ndarray, shape (p, p)
@@ -118,8 +88,7 @@ class ParameterPrediction:
 
     @property
     def relative_std(self) -> np.ndarray:
-        """Expected standard error (the estimator's fixing applied) relative to each judged
-        parameter's size (%); NaN for the others."""
+        """Expected standard error relative to each judged parameter's size (%); NaN for the others."""
         with np.errstate(divide="ignore", invalid="ignore"):
             return np.where(self.judged, 100 * self.expected_std_errors / self.sizes, np.nan)
 
@@ -136,24 +105,28 @@ class ParameterPrediction:
     @property
     def payload_std_errors(self) -> dict[str, float] | None:
         """Payload mode: the payload's quantities' standard errors
-        (:func:`~stewartid.design.physical.payload_accuracy.payload_std_errors`); else None."""
+        (:func:`~stewartid.design.physical.payload_accuracy.payload_std_errors`); else None.
+        """
         if not self.payload:
             return None
         return payload_std_errors(self.names, self.nominal, self.expected_covariance)
 
     @property
     def criterion(self) -> float:
-        """What the design is judged by. Payload mode: the largest ratio of the payload's
-        quantities' standard errors to their required accuracy
-        (:func:`~stewartid.design.physical.payload_accuracy.payload_criterion`); full mode: the
-        worst relative standard error (%)."""
+        """What the design is judged by.
+
+        Payload mode: the largest ratio of the payload's quantities' standard errors to their
+        required accuracy (:func:`~stewartid.design.physical.payload_accuracy.payload_criterion`);
+        full mode: the worst relative standard error (%).
+        """
         if self.payload:
             return payload_criterion(self.payload_std_errors, self.accuracy)[0]
         return self.worst_relative_std
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain values (JSON ready): per parameter its nominal value, predicted SE and
-        relative SE (%, None for nuisance parameters)."""
+        """Plain values (JSON ready): per parameter its nominal value, predicted SE and relative SE
+        (%, None for nuisance parameters).
+        """
         relative = self.relative_std
         out = {"mode": "payload" if self.payload else "full", "criterion": self.criterion,
                 "worst_relative_std_percent": self.worst_relative_std,
@@ -173,17 +146,12 @@ class ParameterPrediction:
 
 
 def parameter_sizes(names: tuple[str, ...], nominal: np.ndarray) -> np.ndarray:
-    """The size each parameter's relative standard error is taken of; 0 for the parameters
-    not judged.
+    """The size each parameter's relative standard error is taken of; 0 for those not judged.
 
-    The names are the estimator's (``m``, ``mc_x``, ..., or ``payload.m``, ...). Judged are
-    the moving body's ten (the payload's in payload mode): what Mt(q) is made of. The legs'
-    combinations are a small share of it and mostly beyond any excitation within the limits
-    (the estimator fixes them at the file's values where the data cannot tell them);
-    friction and offsets are nuisance parameters. The mass is judged against itself, every
-    first moment against the length of the first-moment vector (at least a tenth of the mass
-    times the radius of gyration about the reference point) and every entry of the inertia
-    matrix against the mean of its diagonal: sizes that turning the frame leaves alone.
+    Judged are the moving body's ten (the payload's in payload mode): the mass against itself,
+    every first moment against the first-moment vector's length (at least a tenth of the mass
+    times the radius of gyration), every inertia entry against the mean of the diagonal. These
+    sizes do not depend on how the frame is turned.
     """
     values = dict(zip((n.removeprefix("payload.") for n in names), nominal, strict=True))
     mass = abs(values.get("m", 0.0))
@@ -217,8 +185,9 @@ def force_noise_covariance(noise: SensorNoise, rows: int) -> np.ndarray:
 
 
 def channel_weights(S: np.ndarray) -> np.ndarray:
-    """W: each leg channel weighted by its mean noise variance over the rows of ``S``
-    (K, 6, 6), as the estimator weights by its residual's. Shape (6,), 1/N^2."""
+    """W: each leg channel weighted by its mean noise variance over the rows of ``S`` (K, 6, 6),
+    as the estimator weights by its residual's. Shape (6,), 1/N^2.
+    """
     return 1.0 / np.mean(np.diagonal(S, axis1=1, axis2=2), axis=0)
 
 
@@ -236,11 +205,10 @@ def sandwich_covariance(X: np.ndarray, S: np.ndarray, samples_per_row: float,
     samples_per_row : float
         Logged samples each row stands for (sample rate / row rate).
     noise_rows : ndarray, shape (K, 6, p), optional
-        The rows B is taken of, when not ``X``: for rows and noise filtered with a kernel
-        h, h * X (the filtered noise's correlation over the kernel, carried to the rows).
+        The rows B is taken of, when not ``X`` (h * X for kernel-filtered rows).
     extra : ndarray, shape (p, p), optional
-        Another noise's share of B, in the same units (the pose noise's:
-        :func:`~stewartid.design.pose_noise.pose_noise_scores`).
+        Another noise's share of B, in the same units
+        (:func:`~stewartid.design.pose_noise.pose_noise_scores`).
 
     Returns
     -------
@@ -261,21 +229,22 @@ def sandwich_covariance(X: np.ndarray, S: np.ndarray, samples_per_row: float,
 
 
 def record_rows(design: Design, rate_hz: float = INFORMATION_RATE) -> list[int]:
-    """Rows of each record in :func:`design_rows` at ``rate_hz``: its samples from 0 s to
-    its duration."""
+    """Rows of each record in :func:`design_rows` at ``rate_hz``: its samples from 0 s to its duration."""
     return [int(math.floor(r.duration * rate_hz)) + 1 for r in design.records]
 
 
 def record_ends(design: Design, rate_hz: float = INFORMATION_RATE) -> np.ndarray:
-    """Each record's first row in :func:`design_rows` at ``rate_hz`` and, last, the total:
-    shape (records + 1,)."""
+    """Each record's first row in :func:`design_rows` at ``rate_hz`` and, last, the total; shape
+    (records + 1,).
+    """
     return np.cumsum([0, *record_rows(design, rate_hz)])
 
 
 def design_rows(platform: Platform, design: Design, rate_hz: float = INFORMATION_RATE
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The commanded motion of every record at ``rate_hz``, concatenated: q, q_dot, q_ddot,
-    each of shape (K, 6); :func:`record_rows` rows per record."""
+    """The commanded motion of every record at ``rate_hz``, concatenated: q, q_dot, q_ddot, each
+    (K, 6); :func:`record_rows` rows per record.
+    """
     parts = [playable.evaluate(np.arange(rows) / rate_hz) for playable, rows
              in zip(design.playable(platform), record_rows(design, rate_hz), strict=True)]
     return tuple(np.concatenate(x) for x in zip(*parts, strict=True))
@@ -283,14 +252,10 @@ def design_rows(platform: Platform, design: Design, rate_hz: float = INFORMATION
 
 def played_states(records: list, design: Design, rate_hz: float
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The true motion of a design's records as the plant played them, at ``rate_hz``: q,
-    q_dot, q_ddot of shape (K, 6), :func:`record_rows` rows per record, as
-    :func:`design_rows` gives the commanded motion.
+    """The true motion of a design's records as the plant played them, at ``rate_hz``.
 
-    A plant tracks a fast record with errors of its own (a hydraulic one adds uncommanded
-    surge), and the information is in the motion the logs will hold: predicted along the
-    commanded motion, the payload's mass and the legs' offsets came out 1.3-1.7 times their
-    spread over 24 seeds on the plant.
+    q, q_dot, q_ddot of shape (K, 6), as :func:`design_rows` gives the commanded motion: the
+    information is in the motion the logs will hold, tracking errors included.
 
     Parameters
     ----------
@@ -310,9 +275,11 @@ def played_states(records: list, design: Design, rate_hz: float
 
 
 def record_kernels(design: Design, rate_hz: float, q: np.ndarray) -> list[np.ndarray]:
-    """Each record's taps of the physical estimator's kernel at ``rate_hz`` (its window:
-    :data:`~stewartid.signals.differentiation.DEFAULT_WINDOW_PERIODS` periods of the
-    record's dominant frequency in ``q``, shape (K, 6), records one after the other)."""
+    """Each record's taps of the physical estimator's kernel at ``rate_hz``.
+
+    The window is :data:`~stewartid.signals.differentiation.DEFAULT_WINDOW_PERIODS` periods of
+    the record's dominant frequency in ``q`` (K, 6), records one after the other.
+    """
     ends = record_ends(design, rate_hz)
     return [kernel_taps(rate_hz, default_window(estimate_frequency(q[a:b], rate_hz)))[0]
             for a, b in zip(ends[:-1], ends[1:], strict=True)]
@@ -321,18 +288,11 @@ def record_kernels(design: Design, rate_hz: float, q: np.ndarray) -> list[np.nda
 def kernel_filtered(design: Design, rate_hz: float, q: np.ndarray, X: np.ndarray,
                     taps: list[np.ndarray] | None = None
                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The pose and the regressor of every record filtered with the physical estimator's
-    kernel (its window: :data:`~stewartid.signals.differentiation.DEFAULT_WINDOW_PERIODS`
-    periods of the record's dominant frequency), the records' ends dropped, as the
-    estimator's rows are.
+    """The pose and the regressor of every record filtered with the physical estimator's kernel,
+    the records' ends dropped, as the estimator's rows are.
 
-    The estimator regresses filtered rows h * X on filtered forces, whose noise h * e is
-    correlated over the kernel: its covariance is A^-1 B A^-1 with A of h * X and B of
-    h * h * X (in frequency, |H|^2 against |H|^4: for a sine the kernel's gain cancels, and
-    the body's parameters come out as from the unfiltered regressor). It matters for the
-    Coulomb columns, sign functions whose reversals the kernel smooths: predicted from the
-    unfiltered regressor, their levels came out 0.57-0.87 of their spread over 16 seeds
-    (0.92-1.20 on rigid-body data filtered).
+    The filtered noise is correlated over the kernel, so B is of h * h * X; this matters for the
+    Coulomb columns, whose reversals the kernel smooths.
 
     Parameters
     ----------
@@ -347,9 +307,8 @@ def kernel_filtered(design: Design, rate_hz: float, q: np.ndarray, X: np.ndarray
     Returns
     -------
     q, X, noise_rows : ndarray
-        Filtered, shapes (K', 6), (K', 6, p) and (K', 6, p): the last filtered twice, what
-        the filtered noise's correlation makes of the rows (``noise_rows`` of
-        :func:`sandwich_covariance`).
+        Filtered, shapes (K', 6), (K', 6, p) and (K', 6, p); the last filtered twice
+        (``noise_rows`` of :func:`sandwich_covariance`).
     """
     ends = record_ends(design, rate_hz)
     poses, rows, twice = [], [], []
@@ -372,30 +331,28 @@ def predict_parameters(platform: Platform, design: Design, noise: SensorNoise,
     Parameters
     ----------
     platform : Platform
-        The description the design is for (with the expected payload in payload mode: it is
-        what the relative errors are taken of).
+        The description the design is for (with the expected payload in payload mode).
     design : Design
-        Records of commanded motion (analytic q, q_dot, q_ddot).
+        Records of commanded motion.
     noise : SensorNoise
-        ``force_noise`` (N) is used.
+        ``force_noise`` (N); with ``filtered``, ``length_noise`` (m) too.
     payload : bool
-        Payload mode (the payload's ten parameters, the platform file without its payload
-        known), else every base parameter.
+        Payload mode (the payload's ten parameters on the known platform), else every base
+        parameter.
     rate_hz : float
         Rate the regressor is summed at (Hz).
     max_relative_error : float
         The estimator's: a parameter positive by nature whose standard error exceeds this
-        fraction of its size is fixed at the file's value (the worst first, one at a time).
+        fraction of its size is fixed (the worst first, one at a time).
     states : tuple of ndarray, optional
-        (q, q_dot, q_ddot) at ``rate_hz``: the commanded motion when already computed
-        (:func:`design_rows`), or the motion the plant played (:func:`played_states`).
+        (q, q_dot, q_ddot) at ``rate_hz``: the commanded motion (:func:`design_rows`) or the
+        motion the plant played (:func:`played_states`).
     rows : ndarray, shape (K, 6, N_STANDARD), optional
         The standard regressor at ``states``, when already computed.
     filtered : bool
-        Filter the regressor with the estimator's kernel first (:func:`kernel_filtered`):
-        what the Coulomb columns' reversals lose to it; and add the pose noise's share
-        (``length_noise``, :func:`~stewartid.design.pose_noise.pose_noise_scores`). Needs
-        ``rate_hz`` well above the kernel's taps per window (100 Hz or more).
+        Filter the regressor with the estimator's kernel (:func:`kernel_filtered`) and add the
+        pose noise's share (:func:`~stewartid.design.pose_noise.pose_noise_scores`). Needs
+        ``rate_hz`` of 100 Hz or more.
 
     Returns
     -------

@@ -1,28 +1,10 @@
 """What payload mode's design aims at: the payload's mass, centre of mass and inertia about
 it, each within the accuracy it is needed to.
 
-A payload is wanted as the platform file's ``[payload]`` holds it: mass, centre of mass and
-inertia about the centre of mass (:func:`~stewartid.physical.estimator.payload_section`),
-not as the ten parameters about the reference point the estimator fits. Those three are
-needed to different accuracies (:data:`REQUIRED_PAYLOAD_ACCURACY`): the mass is most of the
-translational Mt, and a relative error of the inertia moves only the rotational block.
-Judged on equal relative terms, as full mode judges the moving body's ten, the design spent
-the motion on the inertia: on the paper platform with a 2 t payload the mass's predicted
-standard error along the commanded motion was 0.122 %, the inertia's 0.18 %, and on a
-simulator that tracked the command the worst mass of 8 seeds came out 0.20-0.25 %.
-
-The standard errors of the three follow from the parameters' covariance to first order
-(:func:`payload_jacobian` of
-:func:`~stewartid.model.regressor.about_centre_of_mass`).
-
-The search holds each of the three within its accuracy in :data:`ACCURACY_COVERAGE` of
-runs (:func:`held_share`; the centre of mass's error as a distance in three directions,
-:func:`distance_quantile`) and, within that, sharpens every one of the ten parameters
-(:func:`payload_objective`). Minimising the largest share of accuracy alone left a flat
-direction the search wandered along: on the paper platform with a 2 t payload it reached
-0.385 of the accuracy (the centre of mass) with the ten's worst relative standard error at
-0.67 of the all-DOFs multisine's; held within the accuracy in 95 % of runs and sharpened,
-0.38 and 0.49.
+A payload is wanted as ``[payload]`` holds it (:func:`~stewartid.physical.estimator.payload_section`),
+not as the ten parameters about the reference point the estimator fits, and its three
+quantities are needed to different accuracies. Their standard errors follow from the
+parameters' covariance to first order (:func:`payload_jacobian`).
 """
 
 from __future__ import annotations
@@ -37,10 +19,8 @@ from stewartid.errors import ConfigError
 from stewartid.model import regressor as reg
 
 #: Accuracy each payload quantity is needed to by default (``design --accuracy`` sets
-#: others): the mass relative to itself, the centre of mass as a distance (m; its standard
-#: error along its least certain direction in :func:`payload_criterion`), every entry of
-#: the inertia about the centre of mass relative to the mean of its diagonal. The design
-#: holds one run's error within it in :data:`ACCURACY_COVERAGE` of runs (:func:`held_share`).
+#: others): the mass relative to itself, the centre of mass as a distance (m), every entry of
+#: the inertia about the centre of mass relative to the mean of its diagonal.
 REQUIRED_PAYLOAD_ACCURACY = {"mass": 0.002, "com": 0.002, "inertia": 0.02}
 #: Share of runs whose error payload mode's design holds within the required accuracy
 #: (:func:`held_share`).
@@ -80,8 +60,8 @@ def payload_jacobian(parameters: np.ndarray) -> np.ndarray:
 
 def payload_std_errors(names: tuple[str, ...], nominal: np.ndarray, covariance: np.ndarray
                        ) -> dict[str, float]:
-    """Predicted standard errors of the payload's quantities, each in the unit its accuracy
-    is needed in (:data:`REQUIRED_PAYLOAD_ACCURACY`).
+    """Predicted standard errors of the payload's quantities, each in the unit its accuracy is
+    needed in (:data:`REQUIRED_PAYLOAD_ACCURACY`).
 
     Parameters
     ----------
@@ -96,11 +76,11 @@ def payload_std_errors(names: tuple[str, ...], nominal: np.ndarray, covariance: 
     Returns
     -------
     dict
-        ``mass``: relative to the mass; ``com``: the centre of mass's standard error along
-        its least certain direction (m); ``inertia``: the largest of the inertia's six
-        entries about the centre of mass relative to the mean of its diagonal;
-        ``com_distance``: the distance from the true centre of mass within which a run's
-        lies in :data:`ACCURACY_COVERAGE` of runs (m, :func:`distance_quantile`).
+        ``mass``: relative to the mass; ``com``: the centre of mass's standard error along its
+        least certain direction (m); ``inertia``: the largest of the six inertia entries about
+        the centre of mass relative to the mean of its diagonal; ``com_distance``: the distance
+        a run's centre of mass error stays within in :data:`ACCURACY_COVERAGE` of runs (m,
+        :func:`distance_quantile`).
     """
     index = [names.index(f"payload.{n}") for n in reg.BODY_PARAMETERS]
     values = np.asarray(nominal, dtype=float)[index]
@@ -118,9 +98,9 @@ def payload_std_errors(names: tuple[str, ...], nominal: np.ndarray, covariance: 
 
 def payload_criterion(std_errors: Mapping[str, float],
                       accuracy: Mapping[str, float] | None = None) -> tuple[float, str]:
-    """The largest ratio of a payload quantity's standard error to the accuracy it is needed
-    to (``accuracy``, default :data:`REQUIRED_PAYLOAD_ACCURACY`), and the quantity (below 1
-    every one is expected within its accuracy at one standard error)."""
+    """The largest ratio of a payload quantity's standard error to the accuracy it is needed to,
+    and the quantity (below 1 every one is within its accuracy at one standard error).
+    """
     accuracy = REQUIRED_PAYLOAD_ACCURACY if accuracy is None else accuracy
     ratios = {k: std_errors[k] / accuracy[k] for k in REQUIRED_PAYLOAD_ACCURACY}
     worst = max(ratios, key=ratios.__getitem__)
@@ -128,10 +108,9 @@ def payload_criterion(std_errors: Mapping[str, float],
 
 
 def distance_quantile(variances: np.ndarray, coverage: float) -> float:
-    """The distance a Gaussian error with these variances along its principal directions
-    stays within in ``coverage`` of draws, by Satterthwaite's scaled chi-square (the sum of
-    weighted chi-squares matched in mean and variance; within 1 % of a Monte Carlo for the
-    centres of mass here).
+    """The distance a Gaussian error with these variances along its principal directions stays
+    within in ``coverage`` of draws, by Satterthwaite's scaled chi-square (matched in mean and
+    variance).
 
     Parameters
     ----------
@@ -155,12 +134,11 @@ def distance_quantile(variances: np.ndarray, coverage: float) -> float:
 
 def held_share(std_errors: Mapping[str, float],
                accuracy: Mapping[str, float] | None = None) -> tuple[float, str]:
-    """The largest ratio of a payload quantity's error in :data:`ACCURACY_COVERAGE` of runs
-    to the accuracy it is needed to, and the quantity: at most 1, every one is within its
-    accuracy in that share of runs. The mass and each inertia entry are one number (1.96
-    standard errors); the centre of mass's error is a distance in three directions
-    (``com_distance``): 2 standard errors of the least certain one, as a first version
-    held it, left the largest distance of 8 runs at 1.5-2.1 mm of 2."""
+    """The largest ratio of a payload quantity's error in :data:`ACCURACY_COVERAGE` of runs to its
+    required accuracy, and the quantity; at most 1, every one is within its accuracy in that
+    share of runs. The mass and inertia errors are one number each; the centre of mass's is a
+    distance in three directions (``com_distance``).
+    """
     accuracy = REQUIRED_PAYLOAD_ACCURACY if accuracy is None else accuracy
     z = math.sqrt(special.chdtri(1, 1 - ACCURACY_COVERAGE))
     shares = {"mass": z * std_errors["mass"] / accuracy["mass"],
@@ -172,9 +150,10 @@ def held_share(std_errors: Mapping[str, float],
 
 def payload_objective(worst_relative_std: float, std_errors: Mapping[str, float],
                       accuracy: Mapping[str, float] | None = None) -> float:
-    """What payload mode's search minimises: the ten parameters' worst relative standard
-    error, times :func:`held_share` ^10 where that exceeds 1: a constraint the search may
-    cross only to where a few percent beyond it would halve the worst error."""
+    """What payload mode's search minimises: the ten parameters' worst relative standard error,
+    times :func:`held_share` ^10 where that exceeds 1, a constraint the search crosses only for a
+    large gain.
+    """
     return worst_relative_std * max(1.0, held_share(std_errors, accuracy)[0]) ** 10
 
 

@@ -1,14 +1,9 @@
-"""The physical design's pick against the plant: played, refined where the plant allows
-less of it than its commanded motion at the limits, and predicted along the motion it played.
+"""The physical design's pick against the plant: played, refined where the plant allows less
+of it than its commanded motion at the limits, and predicted along the motion it played.
 
-The search (:mod:`stewartid.design.physical.search`) judges candidates by their commanded
-motion. The plant's servo does not follow it exactly: at 2 Hz on the paper platform with a
-2 t payload it adds surge acceleration of 1 m/s^2 where 0.03 is commanded and uses up to
-0.87 of the force limit where the command used 0.69, so a record may keep as little as 0.64
-of its amplitudes. :func:`played_pick` plays the pick, refines the search against the
-plant's scales with its predictions corrected by the played pick's
-(:func:`search_correction`), and keeps the best of the picks by the worse of their final
-predictions along the plant's motion and along the command.
+The plant's servo does not follow the command exactly, so a record may keep only part of its
+amplitudes; :func:`played_pick` keeps the best pick by the worse of its final predictions
+along the plant's motion and along the command.
 """
 
 from __future__ import annotations
@@ -72,16 +67,13 @@ def played_pick(platform: Platform, best: PhysicalCandidate, budget_s: float,
                 evaluations: int = PLANT_EVALUATIONS,
                 progress: Callable[[str], None] | None = None,
                 accuracy: Mapping[str, float] | None = None) -> PlayedPick:
-    """The search's pick played on the plant (records over ``max_use`` scaled down) and
-    predicted as the final design is, along the motion the plant played
-    (:func:`~stewartid.design.physical.information.played_states`); where the plant allowed less of
-    a record than its commanded motion at the limits
-    (:func:`~stewartid.design.physical.search.plant_scales`: its tracking adds motion at the
-    higher frequencies), the search refined against that
-    (:func:`~stewartid.design.physical.search.refine_for_plant`, its predictions corrected
-    by :func:`search_correction` of the last pick) and its pick played too, for up to
-    :data:`~stewartid.design.physical.search.PLANT_ROUNDS` rounds, the best of the picks
-    kept.
+    """The search's pick played on the plant and predicted as the final design is.
+
+    Where the plant allowed less of a record than its commanded motion at the limits
+    (:func:`~stewartid.design.physical.search.plant_scales`), the search is refined against that
+    (:func:`~stewartid.design.physical.search.refine_for_plant`, corrected by
+    :func:`search_correction`) and its pick played too, for up to
+    :data:`~stewartid.design.physical.search.PLANT_ROUNDS` rounds.
 
     Returns
     -------
@@ -120,14 +112,13 @@ def _played(platform: Platform, pick: PhysicalCandidate, noise: SensorNoise, pay
 
 def search_correction(platform: Platform, played: PlayedPick, noise: SensorNoise,
                       payload: bool) -> dict[str, float]:
-    """How much the final prediction of a played pick (:func:`_played`: along the plant's
-    motion and along the command, filtered, the worse of the two) exceeds the search's
-    prediction of the same records (commanded, unfiltered), per payload quantity and for
-    the worst relative standard error (``"worst"``): what
+    """How much a played pick's final prediction (the worse of plant and command, filtered)
+    exceeds the search's prediction of the same records (commanded, unfiltered).
+
+    Per payload quantity and for the worst relative standard error (``"worst"``): what
     :func:`~stewartid.design.physical.search.refine_for_plant` multiplies its candidates'
-    predictions by. On the paper platform with a 2 t payload (payload mode) the plant's
-    servo moved the centre of mass's standard error 1.11-1.13 times, the ten's worst 1.04
-    times and the mass's 1.01 times."""
+    predictions by.
+    """
     search = predict_parameters(platform, played.design, noise, payload)
     final = (played.prediction, played.commanded)
     correction = {"worst": max(p.worst_relative_std for p in final) / search.worst_relative_std}

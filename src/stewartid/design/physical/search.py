@@ -1,17 +1,12 @@
-"""Choosing the physical design: all-DOF multisines at the limits, the worst predicted
-relative standard error minimised (payload mode: with the payload's quantities held within
-their required accuracy in 95 % of runs, :func:`design_objective`).
+"""Choosing the physical design: all-DOF multisines at the limits, :func:`design_objective`
+minimised.
 
-The family (:func:`~stewartid.design.multisine.multisine_design`) has eight parameters: the
-share of each DOF in the motion (six, as log-weights on the paper's amplitudes), the speed of
-the frequency pool and the share of each DOF's amplitude at its second frequency. For each
-candidate every record's amplitudes are scaled until its commanded motion uses ``max_use`` of
-its most used limit (:func:`scale_to_limits`: leg strokes, rates, accelerations and forces,
-gimbal angles), and :func:`design_objective` is taken of the
-predicted covariance (:func:`~stewartid.design.physical.information.predict_parameters`: the
-information matrix, a fraction of a second). Random candidates first (a fixed seed), then
-Nelder-Mead from the best, each within a fixed number of evaluations: the design does not
-depend on the machine's speed.
+The family (:func:`~stewartid.design.multisine.multisine_design`) has eight parameters: six
+DOF log-weights on the paper's amplitudes, the log speed of the frequency pool and the
+second-frequency share. Each candidate is scaled to the limits (:func:`scale_to_limits`) and
+judged by its information-matrix prediction. Random candidates (fixed seed), then
+Nelder-Mead, each within a fixed number of evaluations, so that the design does not depend on
+the machine's speed.
 """
 
 from __future__ import annotations
@@ -45,21 +40,12 @@ from stewartid.simulation.sensors import SensorNoise
 WEIGHT_BOUNDS = (-2.5, 2.5)
 SPEED_BOUNDS = (0.5, 1.0)
 SHARE_BOUNDS = (0.0, 0.6)
-#: The speed's bounds in payload mode. Faster motion at the same leg speeds (smaller
-#: amplitudes) raises the accelerations the payload's inertia is seen through; the pose
-#: noise it brings into the filtered rates and accelerations, which the search's prediction
-#: leaves out (the final one adds it), falls mostly on the friction (a nuisance there). In
-#: full mode the friction is among the results: at twice the speed its Coulomb levels'
-#: spread over seeds was 2-4 times their prediction, so full mode keeps to the reference
-#: band.
+#: The speed's bounds in payload mode: faster motion shows the payload's inertia better, and
+#: the pose noise it brings falls mostly on the friction, a nuisance there but a result in
+#: full mode.
 PAYLOAD_SPEED_BOUNDS = (0.5, 2.0)
-#: Payload mode's longest record and fade (s). Its lowest frequency is 0.15 Hz or more, so
-#: a second's quintic fade adds little to the rates, and 30 s records fade a fifteenth of
-#: the time where 20 s records with 2 s fades fade a fifth: on the paper platform with a
-#: 2 t payload the ten's worst relative standard error came out 0.172 % (0.184 %; 20 s and
-#: 1 s: 0.189 %; 40 s and 1 s: 0.164 %, its centre of mass 11 % less certain). Full mode
-#: keeps the reference's 20 s and 2 s: with 30 s and 1 s its ten gained 1.5 %, and its
-#: friction, a result there, lost 34 % (lower gimbals' Coulomb level 4.6 % against 3.4 %).
+#: Payload mode's longest record and fade (s): less of the time spent fading. Full mode keeps
+#: the reference's, which serve its friction better.
 PAYLOAD_RECORD = (30.0, 1.0)
 #: Candidates evaluated at random, then by Nelder-Mead from the best.
 RANDOM_CANDIDATES = 12
@@ -69,14 +55,14 @@ LOCAL_EVALUATIONS = 48
 PLANT_EVALUATIONS = 24
 PLANT_TOLERANCE = 0.02
 #: Rounds of :func:`refine_for_plant` at most: a refined pick played on the plant may need
-#: its records scaled again (by 0.88-0.95 on the paper platform with a 2 t payload).
+#: its records scaled again.
 PLANT_ROUNDS = 2
 
 
 def commanded_limit_use(platform: Platform, design: Design, rate_hz: float = INFORMATION_RATE
                         ) -> tuple[LimitUse, tuple[np.ndarray, np.ndarray, np.ndarray]]:
-    """Limit use of a design's commanded motion at ``rate_hz``, the forces those of the
-    platform's rigid-body model (J_lq^-T Y pi), and the states it was taken at.
+    """Limit use of a design's commanded motion at ``rate_hz``, the forces those of the rigid-body
+    model (J_lq^-T Y pi), and the states it was taken at.
 
     Returns
     -------
@@ -100,8 +86,9 @@ def commanded_limit_use(platform: Platform, design: Design, rate_hz: float = INF
 
 def record_peaks(design: Design, use: LimitUse, rate_hz: float = INFORMATION_RATE
                  ) -> np.ndarray:
-    """Largest use of any limit in each record of a design, from the use of all records one
-    after the other at ``rate_hz`` (:func:`commanded_limit_use`); shape (records,)."""
+    """Largest use of any limit in each record, from the use of all records one after the other
+    at ``rate_hz`` (:func:`commanded_limit_use`); shape (records,).
+    """
     edges = record_ends(design, rate_hz)
     return np.array([use.use[a:b].max() for a, b in zip(edges[:-1], edges[1:], strict=True)])
 
@@ -109,15 +96,11 @@ def record_peaks(design: Design, use: LimitUse, rate_hz: float = INFORMATION_RAT
 def scale_to_limits(platform: Platform, design: Design, max_use: float | np.ndarray,
                     rate_hz: float = INFORMATION_RATE, rounds: int = 4
                     ) -> tuple[Design, LimitUse, tuple]:
-    """Scale each record's amplitudes until its commanded motion uses ``max_use`` of its
-    most used limit (within 2 %; one value for all records, or one per record).
+    """Scale each record's amplitudes until its commanded motion uses ``max_use`` of its most
+    used limit (within 2 %; one value for all records, or one per record).
 
-    Each record on its own: records of one family move the DOFs at different frequencies,
-    so the one that reaches a rate limit first would otherwise hold the others below
-    theirs (on the paper platform with a 2 t payload, the rotations' records at a third to
-    a half of the leg-speed limit when the translations' reached it). Limit use grows about
-    linearly with the amplitudes (but for the static leg forces and the geometry), so a few
-    rescalings settle it.
+    Each record on its own, so that the one reaching a limit first does not hold the others below
+    theirs.
 
     Returns
     -------
@@ -167,13 +150,14 @@ class PhysicalCandidate:
 
 def design_objective(prediction: ParameterPrediction,
                      correction: Mapping[str, float] | None = None) -> float:
-    """What the search minimises: full mode the criterion (the worst relative standard error,
-    :attr:`~stewartid.design.physical.information.ParameterPrediction.criterion`); payload mode the
-    ten parameters' worst relative standard error with the payload's quantities held within
-    their accuracy in :data:`~stewartid.design.physical.payload_accuracy.ACCURACY_COVERAGE` of runs
-    (:func:`~stewartid.design.physical.payload_accuracy.payload_objective`). ``correction``
-    (:func:`~stewartid.design.physical.refine.search_correction`) multiplies the worst relative
-    standard error (``"worst"``) and each payload quantity's."""
+    """What the search minimises.
+
+    Full mode: the criterion (the worst relative standard error). Payload mode: the ten
+    parameters' worst relative standard error with the payload's quantities held within their
+    accuracy (:func:`~stewartid.design.physical.payload_accuracy.payload_objective`).
+    ``correction`` (:func:`~stewartid.design.physical.refine.search_correction`) multiplies the
+    worst relative standard error (``"worst"``) and each payload quantity's.
+    """
     factor = correction or {}
     if not prediction.payload:
         return prediction.criterion * factor.get("worst", 1.0)
@@ -201,16 +185,19 @@ def _bounds(payload: bool) -> tuple[np.ndarray, np.ndarray]:
 
 def speed_bounds(payload: bool) -> tuple[float, float]:
     """The search's bounds on the frequency pool's speed (:data:`SPEED_BOUNDS`, or
-    :data:`PAYLOAD_SPEED_BOUNDS` in payload mode)."""
+    :data:`PAYLOAD_SPEED_BOUNDS` in payload mode).
+    """
     return PAYLOAD_SPEED_BOUNDS if payload else SPEED_BOUNDS
 
 
 def candidate(platform: Platform, budget_s: float, noise: SensorNoise, payload: bool,
               parameters: np.ndarray, max_use: float, scales: np.ndarray | None = None,
               accuracy: Mapping[str, float] | None = None) -> PhysicalCandidate:
-    """One member of the family at the limits, with its prediction; with ``scales``
-    (:func:`plant_scales`), each record's amplitudes then times its own; ``accuracy``: what
-    payload mode judges against (:func:`judged_against`)."""
+    """One member of the family at the limits, with its prediction.
+
+    With ``scales`` (:func:`plant_scales`) each record's amplitudes are then multiplied by its
+    own; ``accuracy`` is what payload mode judges against (:func:`judged_against`).
+    """
     weights, speed, share = parameters[:6], parameters[6], parameters[7]
     amplitudes = np.exp(np.clip(weights, *WEIGHT_BOUNDS)) * np.asarray(DEFAULT_AMPLITUDES)
     record_length, fade = PAYLOAD_RECORD if payload else (RECORD_LENGTH, MULTISINE_FADE)
@@ -231,19 +218,18 @@ def candidate(platform: Platform, budget_s: float, noise: SensorNoise, payload: 
 
 def judged_against(prediction: ParameterPrediction, accuracy: Mapping[str, float] | None
                    ) -> ParameterPrediction:
-    """``prediction`` with payload mode's criterion taken against ``accuracy`` (keys and
-    units of :data:`~stewartid.design.physical.payload_accuracy.REQUIRED_PAYLOAD_ACCURACY`; None:
-    those)."""
+    """``prediction`` with payload mode's criterion taken against ``accuracy`` (keys and units of
+    :data:`~stewartid.design.physical.payload_accuracy.REQUIRED_PAYLOAD_ACCURACY`; None: those).
+    """
     return prediction if accuracy is None else dataclasses.replace(prediction,
                                                                    accuracy=dict(accuracy))
 
 
 def plant_scales(design: Design, played: Design) -> np.ndarray:
-    """Per record, the factor its amplitudes were scaled by to keep the plant's states
-    within the limits (``played``, of :func:`~stewartid.design.optimise.within_plant_limits`,
-    against ``design``): what the plant's tracking (lag, the servo's coupling at the higher
-    frequencies) takes from motion the rigid-body model of the command allows.
-    Shape (records,), at most 1."""
+    """Per record, the factor its amplitudes were scaled by to keep the plant's states within the
+    limits (``played`` against ``design``): what the plant's tracking takes from the commanded
+    motion. Shape (records,), at most 1.
+    """
     return np.array([np.linalg.norm(b.amplitudes) / np.linalg.norm(a.amplitudes)
                      for a, b in zip(design.records, played.records, strict=True)])
 
@@ -253,16 +239,12 @@ def refine_for_plant(platform: Platform, budget_s: float, noise: SensorNoise, pa
                      evaluations: int = PLANT_EVALUATIONS,
                      accuracy: Mapping[str, float] | None = None,
                      correction: Mapping[str, float] | None = None) -> PhysicalCandidate:
-    """Nelder-Mead again from ``start``, every candidate's record k, at ``max_use`` of its
-    commanded limits, scaled by the plant's scale of the played pick's record k
-    (:func:`plant_scales`): the motion judged as the plant will allow it. Record k of the
-    family keeps its order of frequencies from one candidate to the next, so its scale
-    carries over to the neighbours.
+    """Nelder-Mead again from ``start``, each candidate's record k scaled by the played pick's
+    plant scale of record k (:func:`plant_scales`): the motion judged as the plant will allow it.
 
-    ``correction`` (:func:`~stewartid.design.physical.refine.search_correction`) carries
-    the played pick's final prediction over to its neighbours: the plant's servo adds motion
-    of its own, which moves the standard errors by quantity (the centre of mass's 1.11-1.13
-    times, the mass's 1.01 on the paper platform with a 2 t payload).
+    Record k keeps its order of frequencies across candidates, so its scale carries over to the
+    neighbours; ``correction`` (:func:`~stewartid.design.physical.refine.search_correction`)
+    carries the played pick's final prediction over likewise.
 
     Returns
     -------

@@ -1,14 +1,5 @@
 """``stewartid design --model physical`` end to end: search, play on the plant, predict, check
-by a small Monte Carlo, export, report.
-
-Output folder layout (as ``stewartid design``)::
-
-    design.json           the design, the predicted SE of every parameter beside the
-                          all-DOFs multisine's, the Monte Carlo check, the limits, the commands
-    commands/exp*.csv     pose and leg-length commands at the controller rate
-    validation/validation.csv  every DOF at once at frequencies of its own
-    figures/limit_use.*   limit use over time on the plant's simulated states
-    report.md, report.html
+by a small Monte Carlo, export, report; the output folder is laid out as ``stewartid design``'s.
 """
 
 from __future__ import annotations
@@ -89,14 +80,10 @@ def physical_identify_command(payload: bool, run: str = "RUN") -> str:
 
 def monte_carlo_check(platform: Platform, records: list, noise: SensorNoise,
                       prediction: ParameterPrediction, seeds: int) -> dict[str, Any]:
-    """Fit the physical model to ``seeds`` noisy copies of the design played on the plant,
-    and compare with the prediction.
+    """Fit the physical model to ``seeds`` noisy copies of the design played on the plant, and
+    compare with the prediction.
 
-    Per parameter: the standard error the fits report (mean over seeds) and the predicted
-    one; their ratio's median and the share within 30 % are the check (a spread over a few
-    seeds is itself uncertain by 1 / sqrt(2 (seeds - 1)); the fits' own standard errors are
-    not). The platform description is the truth of the plant, so the errors in standard
-    errors are shown too.
+    The platform description is the plant's truth, so each fit's errors are known too.
 
     Returns
     -------
@@ -181,11 +168,10 @@ def run_physical_design(platform: Platform, budget_s: float, noise: SensorNoise,
     search : dict, optional
         ``random_candidates`` and ``local_evaluations`` of
         :func:`~stewartid.design.physical.search.search_design` and ``plant_evaluations``
-        of :func:`played_pick` (tests: fewer).
+        of :func:`played_pick`.
     accuracy : mapping, optional
         Payload mode: the accuracy each payload quantity is needed to (keys and units of
-        :data:`~stewartid.design.physical.payload_accuracy.REQUIRED_PAYLOAD_ACCURACY`, its values by
-        default).
+        :data:`~stewartid.design.physical.payload_accuracy.REQUIRED_PAYLOAD_ACCURACY`).
 
     Returns
     -------
@@ -249,8 +235,9 @@ def render_physical_markdown(design: Design, prediction: ParameterPrediction,
                              peaks: list[dict[str, float]], settings: dict,
                              commands: dict[str, str],
                              commanded: ParameterPrediction | None = None) -> str:
-    """The report text of a physical design (``commanded``: its prediction along the
-    commanded motion, beside the one along the plant's)."""
+    """The report text of a physical design (``commanded``: its prediction along the commanded
+    motion, beside the one along the plant's).
+    """
     lines = ["# Excitation design for the physical model", "",
              f"{design.label}; {design.duration:.1f} s of motion.", "", "## Settings", ""]
     lines += [f"- {key}: {value}" for key, value in settings.items()]
@@ -297,9 +284,11 @@ def render_physical_markdown(design: Design, prediction: ParameterPrediction,
 
 
 def criterion_summary(prediction: ParameterPrediction, baseline: ParameterPrediction) -> str:
-    """The design's criterion beside the all-DOFs multisine's, in a sentence (payload mode:
-    the payload's quantities against their required accuracy, then the ten parameters'
-    worst relative standard error)."""
+    """The design's criterion beside the all-DOFs multisine's, in a sentence.
+
+    Payload mode: the payload's quantities against their required accuracy, then the ten
+    parameters' worst relative standard error.
+    """
     worst = (f"worst relative standard error of the "
              f"{'payload' if prediction.payload else 'moving body'}'s ten parameters "
              f"{prediction.worst_relative_std:.3g} % ({prediction.worst_parameter}; the "
