@@ -17,13 +17,10 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from stewartid import load_platform
-from stewartid.datasets.dataset import read_dataset
-from stewartid.datasets.log_format import load_log_format
-from stewartid.simulation import simulate_experiments
+import stewartid as sid
 
-paper = load_platform("paper")
-truth = simulate_experiments(paper, coulomb=5.0, duration_s=3.0).datasets[2]  # heave
+paper = sid.load_platform("paper")
+truth = sid.simulate_experiments(paper, coulomb=5.0, duration_s=3.0).datasets[2]  # heave
 
 # %%
 # The controller's file, as it would come off the machine.
@@ -40,8 +37,8 @@ print("\n".join(lines[:3]))
 # %%
 # The mapping, inline as ``--columns`` takes it (a TOML file says the same). The delimiter
 # and the decimal comma are detected.
-mapping = load_log_format("t=Time [ms]:ms, l1..l6=Leg{k} [mm]:mm, f1..f6=Load{k} [kN]:kN")
-read = read_dataset(log, paper, log_format=mapping)
+mapping = "t=Time [ms]:ms, l1..l6=Leg{k} [mm]:mm, f1..f6=Load{k} [kN]:kN"
+(read,) = sid.read_experiments(log, paper, columns=mapping)
 print(f"largest pose difference to the simulated truth: "
       f"{np.abs(read.pose - truth.pose)[:, :3].max() * 1e6:.2f} um, "
       f"{np.abs(read.pose - truth.pose)[:, 3:].max() * 1e6:.2f} urad")

@@ -15,8 +15,7 @@ import tempfile
 import matplotlib.pyplot as plt
 from distributed import Client, LocalCluster
 
-from stewartid.studies import run_study
-from stewartid.studies.spec import parse_study
+from stewartid.studies import parse_study, run_study
 
 spec = parse_study({
     "study": {"platform": "paper", "methods": ["wavelet", "ls"], "duration": 4.0,

@@ -13,32 +13,50 @@ noise, so one computation per motion gives every noise level (``docs/accuracy-bo
 import matplotlib.pyplot as plt
 import numpy as np
 
-from stewartid import load_platform
-from stewartid.design.candidates import paper_design
+import stewartid as sid
 from stewartid.identification.bounds import information_bound
-from stewartid.model.linearization import nominal_matrices
-from stewartid.simulation.sensors import static_leg_force
 
-paper = load_platform("paper")
-_, nominal_B = nominal_matrices(paper)
+paper = sid.load_platform("paper")
+_, nominal_B = sid.nominal_matrices(paper)
 #: The motions are sampled at 200 Hz for speed; white noise logged at the plant's 1 kHz
 #: carries 5 times the information, so every bound below is divided by sqrt(5).
 AT_1KHZ = 1 / np.sqrt(5)
+#: The paper's sine amplitude per DOF (m, m, m, rad, rad, rad).
+AMPLITUDES = (0.02, 0.02, 0.02, 0.01, 0.01, 0.01)
 
 
-def sine_motions(duration_s, rate_hz=200.0):
-    """The paper's excitation played exactly (record k a 0.5 Hz sine on DOF k, with a
-    one-period fade-in and fade-out), as (t, q, q_dot, q_ddot) per record."""
-    records = paper_design(duration_s=duration_s).playable(paper)
-    return [(t, *record.evaluate(t)) for record in records
-            for t in [np.arange(0.0, record.record.duration, 1 / rate_hz)]]
+def ramp(s):
+    """Quintic smoothstep on s in [0, 1] and its first two derivatives in s."""
+    s = np.clip(s, 0.0, 1.0)
+    return s ** 3 * (10 - 15 * s + 6 * s ** 2), 30 * s ** 2 * (1 - s) ** 2, 60 * s * (1 - s) * (1 - 2 * s)
+
+
+def sine_motions(duration_s, rate_hz=200.0, frequency_hz=0.5):
+    """The paper's excitation played exactly: record k a 0.5 Hz sine on DOF k about the
+    neutral pose, faded in and out over one period each, as (t, q, q_dot, q_ddot) per record
+    (``duration_s`` whole periods)."""
+    t = np.arange(0.0, duration_s, 1 / rate_hz)
+    fade, omega = 1 / frequency_hz, 2 * np.pi * frequency_hz
+    rise, d_rise, dd_rise = ramp(t / fade)
+    fall, d_fall, dd_fall = ramp((duration_s - t) / fade)
+    a = rise * fall  # the envelope and its time derivatives
+    da = (d_rise * fall - rise * d_fall) / fade
+    dda = (dd_rise * fall - 2 * d_rise * d_fall + rise * dd_fall) / fade ** 2
+    sin, cos = np.sin(omega * t), np.cos(omega * t)
+    shapes = (a * sin, da * sin + a * omega * cos,
+              dda * sin + 2 * da * omega * cos - a * omega ** 2 * sin)
+    motions = []
+    for k in range(6):
+        q, q_dot, q_ddot = (np.outer(x, AMPLITUDES[k] * np.eye(6)[k]) for x in shapes)
+        motions.append((t, q + paper.neutral_pose, q_dot, q_ddot))
+    return motions
 
 
 # %%
 # The reference noise: 0.5 % of the static leg force. On the paper's 6 x 20 s of sines the
 # Bt diagonal cannot be known better than this, whatever the estimator (the table of
 # ``docs/accuracy-bounds.md`` gives nearly the same numbers for the plant's records).
-sigma = 0.005 * static_leg_force(paper)
+sigma = sid.reference_noise(paper).force_noise
 print(f"reference force noise {sigma:.1f} N per leg")
 motions = sine_motions(20.0)
 bounds = {friction: information_bound(paper, motions, sigma, friction)
@@ -55,7 +73,7 @@ fig, axes = plt.subplots(1, 2, figsize=(9, 3.5))
 for friction, bound in bounds.items():
     heave = bound.std[2, 8] / abs(nominal_B[2, 2]) * 100 * AT_1KHZ
     axes[0].plot(noise, heave * noise / sigma, "o-", label=friction)
-lengths = [5.0, 10.0, 20.0, 40.0]
+lengths = [6.0, 10.0, 20.0, 40.0]
 for friction in ("known", "immune"):
     heave = [information_bound(paper, sine_motions(length), sigma, friction).std[2, 8]
              / abs(nominal_B[2, 2]) * 100 * AT_1KHZ for length in lengths]

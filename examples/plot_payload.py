@@ -14,24 +14,43 @@ every degree of freedom at once, each at its own frequency, with the reference s
 import matplotlib.pyplot as plt
 import numpy as np
 
-from stewartid import load_platform
-from stewartid.identification.registry import create_identifier
-from stewartid.model import regressor as reg
-from stewartid.physical.estimator import PAYLOAD_PARAMETERS, payload_section
+import stewartid as sid
 from stewartid.simulation import DEFAULT_AMPLITUDES, Sine, multisine_excitation, simulate_experiment
-from stewartid.simulation.sensors import reference_noise
 
-bare = load_platform("paper")
+bare = sid.load_platform("paper")
 cabin = {"mass": 2000.0, "com": [-0.20, 0.30, -0.50],
          "inertia": [1800.0, 2200.0, 2600.0, -120.0, 80.0, 160.0]}
 loaded = bare.replace(**{f"payload__{key}": value for key, value in cabin.items()})
+#: Ixx, Iyy, Izz, Ixy, Ixz, Iyz: entries (row, column) of the 3 x 3 inertia matrix.
+ENTRIES = ([0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2])
+
+
+def parallel_axis(mass, c):
+    """What moving the inertia from the centre of mass ``c`` to the reference point adds,
+    m (c.c 1 - c c^T), as Ixx, Iyy, Izz, Ixy, Ixz, Iyz (the parallel-axis theorem)."""
+    return (mass * (c @ c * np.eye(3) - np.outer(c, c)))[ENTRIES]
+
+
+def about_reference(mass, com, inertia):
+    """The ten parameters (m, first moment m c, inertia about the reference point) of the
+    ``[payload]`` keys."""
+    c = np.asarray(com)
+    return np.concatenate([[mass], mass * c, np.asarray(inertia) + parallel_axis(mass, c)])
+
+
+def keys(body):
+    """The ``[payload]`` keys of the ten parameters, flat: mass, com (3), inertia about the
+    centre of mass (6)."""
+    m, c = body[0], body[1:4] / body[0]
+    return np.concatenate([[m], c, body[4:] - parallel_axis(m, c)])
+
 
 # %%
 # The plant carries the payload. Record k moves degree of freedom d at frequency
 # ``hz[(d + k) % 6]``, so that every record excites translation and rotation together and
 # the six records differ; 2 s fade in, then 4 s of full motion.
 hz = (0.3, 0.45, 0.6, 0.75, 0.9, 1.05)
-noise = reference_noise(loaded)
+noise = sid.reference_noise(loaded)
 datasets = []
 for k in range(6):
     sines = [Sine(d, 0.7 * DEFAULT_AMPLITUDES[d], hz[(d + k) % 6], 0.5 * d + k)
@@ -46,22 +65,15 @@ print(f"6 records of {datasets[0].t[-1]:.1f} s, force noise {noise.force_noise:.
 # mass, first moment and inertia about the reference point less the platform's own; the
 # ``[payload]`` keys (mass, centre of mass, inertia about it) follow from them, their standard
 # errors by the delta method (a central difference of the map, which is smooth for m > 0).
-fitted = create_identifier("physical", payload=True).fit(datasets, bare)
-body = reg.parameter_index(reg.BODY_PARAMETERS)
-truth = reg.standard_parameters(loaded)[body] - reg.standard_parameters(bare)[body]
-found = np.array([fitted.parameters_[name] for name in PAYLOAD_PARAMETERS])
-error = np.array([fitted.parameter_std_errors_[name] for name in PAYLOAD_PARAMETERS])
+fitted = sid.create_identifier("physical", payload=True).fit(datasets, bare)
+names = [name for name in fitted.parameters_ if name.startswith("payload.")]
+truth = about_reference(**cabin)
+found = np.array([fitted.parameters_[name] for name in names])
+error = np.array([fitted.parameter_std_errors_[name] for name in names])
 print("fixed (not excited):", list(fitted.fixed_) or "none")
 print(f"{'parameter':14s} {'true':>10s} {'identified':>11s} {'std error':>10s}")
-for name, t, v, s in zip(PAYLOAD_PARAMETERS, truth, found, error, strict=True):
+for name, t, v, s in zip(names, truth, found, error, strict=True):
     print(f"{name:14s} {t:10.2f} {v:11.2f} {s:10.2f}")
-
-
-def keys(values):
-    """The ``[payload]`` keys of the ten parameters, flat: mass, com (3), inertia (6)."""
-    section = payload_section(dict(zip(PAYLOAD_PARAMETERS, values, strict=True)))
-    return np.array([section["mass"], *section["com"], *section["inertia"]])
-
 
 covariance = fitted.covariance_[:10, :10]  # the payload's parameters come first
 steps = 1e-6 * np.maximum(np.abs(found), 1.0)

@@ -13,21 +13,18 @@ standard errors.
 import matplotlib.pyplot as plt
 import numpy as np
 
-from stewartid import load_platform
-from stewartid.identification.registry import create_identifier
-from stewartid.model.linearization import nominal_matrices
-from stewartid.simulation import simulate_experiments
+import stewartid as sid
 
-paper = load_platform("paper")
-nominal_M, nominal_B = nominal_matrices(paper)
-run = simulate_experiments(paper, coulomb=5.0, duration_s=4.0)
+paper = sid.load_platform("paper")
+nominal_M, nominal_B = sid.nominal_matrices(paper)
+run = sid.simulate_experiments(paper, coulomb=5.0, duration_s=4.0)
 print(f"{len(run.datasets)} experiments of {run.datasets[0].t[-1]:.1f} s "
       f"at {run.datasets[0].sample_rate:.0f} Hz")
 
 # %%
 # Every registered method is built by name and fitted the same way (the scikit-learn
 # contract: ``fit`` returns the estimator, learned attributes end in ``_``).
-estimators = {name: create_identifier(name).fit(run.datasets, paper)
+estimators = {name: sid.create_identifier(name).fit(run.datasets, paper)
               for name in ("wavelet", "ls")}
 for name, estimator in estimators.items():
     error = np.abs(np.diag(estimator.B_) / np.diag(nominal_B) - 1) * 100
