@@ -171,12 +171,25 @@ def test_identify_estimates_the_delay(tmp_path, late_files):
     assert delay["seconds"] == pytest.approx(1e-3, abs=1e-6)
 
 
-def test_identify_without_the_flag_writes_no_delay(tmp_path, late_files):
+def test_identify_estimates_and_applies_the_delay_by_default(tmp_path, late_files):
+    """Without the flag, a delay the motion identifies and noise cannot explain is removed."""
     out = tmp_path / "result.json"
     result = CliRunner().invoke(app, ["identify", "--method", "ls", "--platform", "paper",
                                       "--out", str(out), *map(str, late_files)])
     assert result.exit_code == 0, result.output
-    assert "delay" not in json.loads(out.read_text())
+    delay = json.loads(out.read_text())["delay"]
+    assert delay["source"] == "estimated" and delay["applied"] is True
+    assert delay["seconds"] == pytest.approx(1e-3, abs=1e-6)
+    assert "forces aligned" in result.output
+
+
+def test_identify_with_a_zero_delay_uses_the_forces_as_logged(tmp_path, late_files):
+    out = tmp_path / "result.json"
+    result = CliRunner().invoke(app, ["identify", "--method", "ls", "--platform", "paper",
+                                      "--delay", "0", "--out", str(out), *map(str, late_files)])
+    assert result.exit_code == 0, result.output
+    delay = json.loads(out.read_text())["delay"]
+    assert delay["source"] == "given" and delay["seconds"] == 0.0
 
 
 @pytest.mark.parametrize("value, message", [("2ms", "--delay must be a number of seconds"),

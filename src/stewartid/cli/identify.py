@@ -68,9 +68,11 @@ def identify(
     delay: Annotated[str | None, typer.Option(
         "--delay", metavar="SECONDS|auto",
         help="Delay of the force channels behind the motion, in seconds (0.002 for 2 ms; "
-             "negative when the forces lead): every method works on the forces aligned by it. "
-             "'auto' estimates it first (needs two or more frequencies per DOF) and prints it "
-             "with its standard error (docs/logs.md).")] = None,
+             "negative when the forces lead; 0: as logged): every method works on the forces "
+             "aligned by it. By default it is estimated where the motion tells it from damping "
+             "(two or more frequencies per DOF) and applied when beyond two standard errors "
+             "of zero; 'auto' estimates and applies it, and refuses one-frequency motion "
+             "(docs/logs.md).")] = None,
     validate: Annotated[list[Path] | None, typer.Option(
         "--validate", metavar="FILE",
         help="--report: a record of another excitation (e.g. the validation record of "
@@ -109,13 +111,17 @@ def identify(
                            payload=payload, platform_out=platform_out)
     if found.delay is not None:
         entry = found.delay
-        if entry["source"] == "estimated":
-            typer.echo(f"force delay {entry['seconds'] * 1e3:.3f} ms (standard error "
-                       f"{entry['std_error'] * 1e3:.3f} ms), estimated; forces aligned")
-        else:
+        if entry["source"] == "given":
             typer.echo(f"force delay {entry['seconds'] * 1e3:.3f} ms, given; forces aligned")
+        elif entry["seconds"] is None:
+            typer.echo(f"force delay not estimated: {entry.get('reason', '')}")
+        else:
+            typer.echo(f"force delay {entry['seconds'] * 1e3:.3f} ms (standard error "
+                       f"{entry['std_error'] * 1e3:.3f} ms), estimated; "
+                       + ("forces aligned" if entry["applied"] else
+                          "within noise of zero, forces used as logged"))
     if found.delay_sensitivity is not None:
-        from stewartid.cli.identify_run import delay_note
+        from stewartid.comparison import delay_note
 
         typer.echo(f"note: {delay_note(found.delay_sensitivity)}")
     if found.report is not None:

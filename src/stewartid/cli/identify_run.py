@@ -16,8 +16,10 @@ import numpy as np
 from stewartid.comparison import (
     ALL_METHODS,
     PhysicalRequest,
+    align_experiments,
     compare_methods,
     consistent_result,
+    delay_note,
     method_names,
     plausibility_check,
 )
@@ -29,10 +31,7 @@ from stewartid.errors import ConfigError
 from stewartid.files import check_output_file, check_output_folder
 from stewartid.identification import registry
 from stewartid.identification.delay import (
-    apply_delay,
-    describe_bias,
     parse_delay,
-    single_frequency_bias,
 )
 from stewartid.identification.result import IdentificationResult, comparison_rows
 from stewartid.model.linearization import nominal_matrices
@@ -163,15 +162,6 @@ def _check_outputs(paths: Sequence[Path], inputs: Sequence[str | Path | None],
                           "--report DIR.")
     elif folds is not None:
         raise ConfigError("--folds sets the report's validation; add --report DIR.")
-
-
-def delay_note(sensitivity: Mapping[str, Any]) -> str:
-    """One sentence: where a force delay passes for damping and its bias on Bt per
-    millisecond (:func:`~stewartid.identification.delay.single_frequency_bias`)."""
-    return (f"{', '.join(sensitivity['dofs'])} moved at one frequency only, where a delay of "
-            "the force channels behind the motion passes for damping: each ms of delay adds "
-            f"{describe_bias(sensitivity)} to Bt. Give a known delay (--delay SECONDS), or "
-            "excite two or more frequencies per DOF and estimate it (--delay auto).")
 
 
 def _physical_request(model: str | None, method: str, payload: bool, consistent: bool,
@@ -323,18 +313,13 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     log_format = load_log_format(columns) if columns is not None else None
     datasets = read_datasets(paths, description, log_format)
     check_experiment_set(datasets, description)
-    datasets, delay_entry = apply_delay(datasets, description, delay)
-    sensitivity = single_frequency_bias(datasets, description) if delay is None else None
     records = read_datasets(records_paths, description, log_format) if records_paths else []
-    if records and delay_entry is not None:
-        records, _ = apply_delay(records, description, delay_entry["seconds"])
     meta = nominal_from_meta(paths)
     check = plausibility_check(description)
     if consistent:
         from stewartid.identification.consistency import require_cvxpy
 
         require_cvxpy()
-    fields: dict[str, Any] = {}
     written = None
     if report is not None:
         comparison = compare_methods(
@@ -343,21 +328,16 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
             consistent=consistent and model is None,
             physical=_physical_request(model, method, payload, consistent, settings),
             nominal=None if meta is None else meta[:2],
-            nominal_source=None if meta is None else meta[2])
+            nominal_source=None if meta is None else meta[2], delay=delay)
         check(comparison.result)
-        if delay_entry is not None:
-            fields["delay"] = delay_entry
-        if sensitivity is not None:
-            fields["diagnostics"] = {**comparison.result.diagnostics,
-                                     "delay_sensitivity": sensitivity}
-        if fields:
-            comparison = comparison.with_result(**fields)
-        written = write_report(comparison, report, sources=[str(p) for p in paths],
-                               notes=[] if sensitivity is None else [delay_note(sensitivity)])
-        result = comparison.result
+        written = write_report(comparison, report, sources=[str(p) for p in paths])
+        result, delay_entry = comparison.result, comparison.delay
+        sensitivity = comparison.delay_sensitivity
     else:
-        result = _fit_alone(datasets, description, method, settings, consistent, model,
-                            payload)
+        alignment = align_experiments(datasets, description, delay)
+        delay_entry, sensitivity = alignment.entry, alignment.sensitivity
+        result = _fit_alone(alignment.experiments, description, method, settings, consistent,
+                            model, payload)
         check(result)
         if delay_entry is not None:
             result = dataclasses.replace(result, delay=delay_entry)
@@ -374,5 +354,5 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
                        source, delay_entry, sensitivity)
 
 
-__all__ = ["FlagSetting", "IdentifyRun", "MODELS", "delay_note", "identify_files",
+__all__ = ["FlagSetting", "IdentifyRun", "MODELS", "identify_files",
            "model_method", "settings_for"]

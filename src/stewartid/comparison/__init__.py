@@ -9,6 +9,12 @@ from stewartid.comparison._compare import (
     method_names,
     plausibility_check,
 )
+from stewartid.comparison._delay import (
+    DELAY_SIGNIFICANCE,
+    Alignment,
+    align_experiments,
+    delay_note,
+)
 from stewartid.comparison._physical import (
     PhysicalRequest,
     fit_physical,
@@ -24,7 +30,8 @@ from stewartid.comparison._runs import (
     same_segments,
 )
 
-__all__ = ["ALL_METHODS", "Comparison", "MethodFit", "PhysicalRequest", "PhysicalSection",
-           "Workspace", "compare_methods", "consensus_run", "consistent_result", "fit_physical",
-           "judge", "largest_couplings", "method_names", "plausibility_check", "run_method",
+__all__ = ["ALL_METHODS", "DELAY_SIGNIFICANCE", "Alignment", "Comparison", "MethodFit", "PhysicalRequest",
+           "PhysicalSection", "Workspace", "align_experiments", "compare_methods",
+           "consensus_run", "consistent_result", "delay_note", "fit_physical", "judge",
+           "largest_couplings", "method_names", "plausibility_check", "run_method",
            "same_segments", "workspace"]

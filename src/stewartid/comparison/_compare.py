@@ -12,9 +12,11 @@ from typing import Any
 
 import numpy as np
 
+from stewartid.comparison._delay import align_experiments, delay_note
 from stewartid.comparison._physical import PhysicalRequest, fit_physical
 from stewartid.comparison._records import MethodFit, PhysicalSection
 from stewartid.comparison._runs import judge, run_method
+from stewartid.datasets.alignment import align_forces
 from stewartid.datasets.dataset import Dataset
 from stewartid.datasets.plausibility import check_identified
 from stewartid.errors import ConfigError
@@ -95,6 +97,13 @@ class Comparison:
         The physical model was asked for by itself: :attr:`result` is its result.
     seconds : float
         Wall time of the fits, validations and verdict.
+    delay : dict or None
+        The ``"delay"`` entry of ``result.json``: the force delay the experiments were aligned
+        by, or estimated and found within noise of zero.
+    delay_sensitivity : dict or None
+        Where the motion cannot tell a force delay from damping, the Bt bias per ms of delay.
+    notes : tuple of str
+        Sentences for the report's summary.
     """
 
     runs: tuple[MethodFit, ...]
@@ -109,6 +118,9 @@ class Comparison:
     physical: PhysicalSection | None = None
     physical_primary: bool = False
     seconds: float = 0.0
+    delay: dict[str, Any] | None = None
+    delay_sensitivity: dict[str, Any] | None = None
+    notes: tuple[str, ...] = ()
 
     @property
     def trusted(self) -> str:
@@ -199,7 +211,8 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
                     nominal_source: str | None = None,
                     check: bool | Callable[[IdentificationResult], None] = True,
                     entries: Sequence[str] | None = None,
-                    policy: VerdictPolicy = DEFAULT_POLICY) -> Comparison:
+                    policy: VerdictPolicy = DEFAULT_POLICY,
+                    delay: str | float | None = None) -> Comparison:
     """Fit every method to the same experiments, validate each on held-out time segments and
     say which to trust; writes no file.
 
@@ -238,6 +251,10 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
         (:func:`~stewartid.verdict.policy.scored_entries`).
     policy : VerdictPolicy
         The verdict's thresholds.
+    delay : float, ``"auto"`` or None
+        The force channels' delay behind the motion (s; 0: as logged); by default estimated
+        where the motion tells it from damping and applied when beyond noise
+        (:func:`~stewartid.comparison.align_experiments`).
 
     Returns
     -------
@@ -253,8 +270,11 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
         platform = load_platform(platform)
     if not (isinstance(folds, int | np.integer) and folds >= 2):
         raise ConfigError(f"the validation needs at least 2 folds; got {folds!r}.")
-    datasets = _experiments(experiments, platform)
+    alignment = align_experiments(_experiments(experiments, platform), platform, delay)
+    datasets = alignment.experiments
     records = _experiments(validate or (), platform)
+    if records and alignment.entry is not None and alignment.entry["applied"]:
+        records = align_forces(records, alignment.entry["seconds"])
     names = method_names(methods)
     if nominal is None:
         nominal = nominal_matrices(platform)
@@ -276,10 +296,18 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
         runs = [dataclasses.replace(run, result=dataclasses.replace(
             run.result, verdict=verdict.to_dict())) if run.name == verdict.trusted else run
             for run in runs]
-    return Comparison(tuple(runs), verdict, platform, tuple(datasets), tuple(records), folds,
-                      nominal[0], nominal[1], nominal_source or "", section,
-                      physical is not None and physical.required,
-                      time.perf_counter() - started)
+    comparison = Comparison(
+        tuple(runs), verdict, platform, tuple(datasets), tuple(records), folds, nominal[0],
+        nominal[1], nominal_source or "", section, physical is not None and physical.required,
+        time.perf_counter() - started, alignment.entry, alignment.sensitivity,
+        () if alignment.sensitivity is None else (delay_note(alignment.sensitivity),))
+    fields: dict[str, Any] = {}
+    if alignment.entry is not None:
+        fields["delay"] = alignment.entry
+    if alignment.sensitivity is not None:
+        fields["diagnostics"] = {**comparison.result.diagnostics,
+                                 "delay_sensitivity": alignment.sensitivity}
+    return comparison.with_result(**fields) if fields else comparison
 
 
 __all__ = ["ALL_METHODS", "Comparison", "compare_methods", "method_names", "plausibility_check"]

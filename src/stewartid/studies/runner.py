@@ -23,6 +23,7 @@ from stewartid.errors import ConfigError, OutputExistsError
 from stewartid.files import write_json_atomic
 from stewartid.parallel import WORKER_THREADS
 from stewartid.studies.grid import StudyTask, expand_grid
+from stewartid.studies.lock import study_lock
 from stewartid.studies.report import write_study_report
 from stewartid.studies.results import RESULTS_NAME, finished_tasks, read_results, write_part
 from stewartid.studies.spec import StudySpec
@@ -222,11 +223,23 @@ def run_study(spec: StudySpec, out: str | Path, *, scheduler: str | None = None,
     OutputExistsError
         If ``out`` holds a study and not ``resume``.
     ConfigError
-        If ``resume`` meets a study with other fixed settings, or dask is unavailable.
+        If ``resume`` meets a study with other fixed settings, dask is unavailable, or
+        another run is writing ``out`` (:func:`~stewartid.studies.lock.study_lock`).
     """
     start = time.perf_counter()
     directory = Path(out)
     _check_folder(spec, directory, resume)
+    with study_lock(directory):
+        # again under the lock: another run may have started this folder meanwhile
+        _check_folder(spec, directory, resume)
+        return _run_locked(spec, directory, start, scheduler, workers, retries, client,
+                           progress, report)
+
+
+def _run_locked(spec: StudySpec, directory: Path, start: float, scheduler: str | None,
+                workers: int | None, retries: int, client: Any,
+                progress: bool | ProgressCallback, report: bool) -> StudyRun:
+    """:func:`run_study`'s work, with the folder's lock held."""
     tasks = expand_grid(spec)
     stored = finished_tasks(directory)
     todo = [task for task in tasks if task.key not in stored]
