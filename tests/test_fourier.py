@@ -283,3 +283,18 @@ def test_a_third_harmonic_in_a_noise_free_channel_counts_as_friction():
     quiet = np.zeros((8, 2, 6))
     amplitudes, statistic, threshold = third_harmonic([quiet], covariance)
     assert statistic < threshold and not np.any(amplitudes[0])
+
+
+def test_a_record_shorter_than_a_period_is_refused_naming_both(paper, truth):
+    """0.1 s of a 0.5 Hz sine: the message names the record length and the 2 s period."""
+    M, B = truth
+    data = [make_experiment(paper, M, B, k, frequency_hz=0.5, periods=0.05, sample_rate=1000.0)
+            for k in range(6)]
+    with pytest.raises(IdentificationError) as found:
+        FourierIdentifier().fit(data, paper)
+    message = str(found.value)
+    assert "lasts 0.1 s" in message and "about 2 s" in message and "spectral" not in message
+    # a whole period passes the check
+    whole = [make_experiment(paper, M, B, k, frequency_hz=0.5, periods=4, sample_rate=200.0)
+             for k in range(6)]
+    FourierIdentifier().fit(whole, paper)

@@ -53,6 +53,55 @@ from stewartid.signals.differentiation import (
 HARMONIC_FRACTION = 0.2
 
 
+def check_whole_period(name: str, motion: np.ndarray, sample_rate: float) -> None:
+    """Refuse a record shorter than one period of its motion, naming both.
+
+    The period is that of the sine c + a cos(w t) + b sin(w t) fitted to the leg-space motion
+    of the largest excursion, over w from 1/100 of the record's own frequency up to it.
+
+    Parameters
+    ----------
+    name : str
+        Experiment named in the message.
+    motion : ndarray, shape (N, 6)
+        Leg-space motion (m), mean removed.
+    sample_rate : float
+        Hz.
+
+    Raises
+    ------
+    IdentificationError
+        When no leg's motion crosses its mean twice (no whole oscillation).
+    """
+    column = motion[:, int(np.argmax(np.ptp(motion, axis=0)))]
+    centred = column - column.mean()
+    crossings = int(np.count_nonzero(np.diff(np.signbit(centred))))
+    if crossings >= 2:
+        return
+    from scipy.optimize import minimize_scalar
+
+    length = len(column) / sample_rate
+    t = np.arange(len(column)) / sample_rate
+
+    def cost(w: float) -> float:
+        basis = np.column_stack([np.ones_like(t), np.cos(w * t), np.sin(w * t)])
+        residual = column - basis @ np.linalg.lstsq(basis, column, rcond=None)[0]
+        return float(residual @ residual)
+
+    grid = 2 * np.pi / length * np.geomspace(0.01, 1.0, 200)
+    k = int(np.argmin([cost(w) for w in grid]))
+    found = minimize_scalar(cost, bounds=(grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]),
+                            method="bounded")
+    period = 2 * np.pi / float(found.x)
+    fitted = found.fun <= 1e-4 * float(centred @ centred) and 0 < k < len(grid) - 1
+    needs = (f"one period of its motion, about {period:.2g} s (a sine fits it)" if fitted
+             else "one period of its motion")
+    raise IdentificationError(
+        f"{name}: the record lasts {length:.3g} s, shorter than {needs}: Method A fits the "
+        "first harmonic over whole periods of the excitation; record at least one period, "
+        "or use Method B or least squares (--method wavelet or ls).")
+
+
 def check_single_sine(name: str, pose: np.ndarray, sample_rate: float, platform: Platform,
                       frequencies_hz: Sequence[float], given: bool = False) -> None:
     """Refuse an experiment whose motion is not one sine at the fitted (or given) frequencies.
@@ -197,8 +246,9 @@ class FourierIdentifier(BaseIdentifier):
         rows_motion, rows_force, used, rows, third_blocks = [], [], [], [], []
         for exp in experiments:
             # on the leg-length motion every DOF counts in one unit
-            freqs = self._given_frequencies() or [
-                estimate_frequency(leg_space_motion(exp.q, platform), exp.sample_rate)]
+            motion = leg_space_motion(exp.q, platform)
+            check_whole_period(exp.name, motion, exp.sample_rate)
+            freqs = self._given_frequencies() or [estimate_frequency(motion, exp.sample_rate)]
             check_single_sine(exp.name, exp.q, exp.sample_rate, platform, freqs,
                               given=self.frequency_hz is not None)
             window = self.window or default_window(max(freqs))
@@ -268,4 +318,4 @@ class FourierIdentifier(BaseIdentifier):
             "stiffness_": stiffness, "frequencies_": [u["frequencies_hz"] for u in used]}
 
 
-__all__ = ["HARMONIC_FRACTION", "FourierIdentifier", "check_single_sine"]
+__all__ = ["HARMONIC_FRACTION", "FourierIdentifier", "check_single_sine", "check_whole_period"]
