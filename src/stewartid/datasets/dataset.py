@@ -181,7 +181,8 @@ def _resample(t: np.ndarray, columns: dict[str, np.ndarray], where: str
 
 def dataset_from_frame(frame: Mapping[str, np.ndarray] | pd.DataFrame,
                        platform: Platform | None = None, name: str = "exp",
-                       where: str | None = None) -> Dataset:
+                       where: str | None = None,
+                       carried: tuple[float, float] = checks.CARRIED_WEIGHT) -> Dataset:
     """Validate a table in the interchange format and build a :class:`Dataset`.
 
     Parameters
@@ -196,6 +197,8 @@ def dataset_from_frame(frame: Mapping[str, np.ndarray] | pd.DataFrame,
         Experiment label.
     where : str, optional
         Source named in error messages (file path); ``name`` by default.
+    carried : (float, float)
+        The weight the forces may carry, in multiples of the file's.
 
     Raises
     ------
@@ -257,7 +260,7 @@ def dataset_from_frame(frame: Mapping[str, np.ndarray] | pd.DataFrame,
             lengths = leg_lengths(platform, pose)
     if platform is not None:
         checks.check_dataset(pose, lengths, forces, platform, where,
-                             both_logged=has_pose and has_lengths)
+                             both_logged=has_pose and has_lengths, carried=carried)
     return Dataset(t=t, pose=pose, lengths=lengths, forces=forces, name=name)
 
 
@@ -275,7 +278,8 @@ def _forward_kinematics_tracked(platform: Platform, lengths: np.ndarray, solve) 
 
 
 def read_dataset(path: str | Path, platform: Platform | None = None,
-                 format: str | None = None, log_format: LogFormat | None = None) -> Dataset:
+                 format: str | None = None, log_format: LogFormat | None = None,
+                 carried: tuple[float, float] = checks.CARRIED_WEIGHT) -> Dataset:
     """Read and validate one experiment from a CSV or Parquet file.
 
     Parameters
@@ -291,6 +295,9 @@ def read_dataset(path: str | Path, platform: Platform | None = None,
         Overrides the file suffix.
     log_format : LogFormat, optional
         Column mapping with units (:mod:`stewartid.datasets.log_format`).
+    carried : (float, float)
+        The weight the forces may carry, in multiples of the file's
+        (:func:`~stewartid.datasets.plausibility.check_static_balance`).
 
     Returns
     -------
@@ -307,7 +314,8 @@ def read_dataset(path: str | Path, platform: Platform | None = None,
     if not path.is_file():
         raise DataError(f"{path}: no such data file.")
     frame = read_table(path, kind, log_format)
-    return dataset_from_frame(frame, platform, name=path.stem, where=str(path))
+    return dataset_from_frame(frame, platform, name=path.stem, where=str(path),
+                              carried=carried)
 
 
 def expand_paths(paths: Iterable[str | Path]) -> list[Path]:
@@ -326,9 +334,10 @@ def expand_paths(paths: Iterable[str | Path]) -> list[Path]:
 
 def read_datasets(paths: str | Path | Sequence[str | Path],
                   platform: Platform | None = None,
-                  log_format: LogFormat | None = None) -> list[Dataset]:
+                  log_format: LogFormat | None = None,
+                  carried: tuple[float, float] = checks.CARRIED_WEIGHT) -> list[Dataset]:
     """Read several experiments (one file each; a directory means all data files in it),
-    with the ``platform`` and ``log_format`` of :func:`read_dataset`.
+    with the ``platform``, ``log_format`` and ``carried`` of :func:`read_dataset`.
 
     Returns
     -------
@@ -341,7 +350,8 @@ def read_datasets(paths: str | Path | Sequence[str | Path],
     if not files:
         raise DataError("no data files given; pass one or more .csv/.parquet files.")
     check_distinct_paths(files)
-    datasets = [read_dataset(f, platform, log_format=log_format) for f in files]
+    datasets = [read_dataset(f, platform, log_format=log_format, carried=carried)
+                for f in files]
     check_distinct_experiments(datasets, [str(f) for f in files])
     return datasets
 

@@ -35,9 +35,14 @@ IK_EXCURSION_FRACTION = 0.1
 #: neutral leg length it is an error (strokes logged instead of gimbal-to-gimbal lengths).
 MAX_LENGTH_OFFSET = 0.05
 #: Static balance: relative deviation of the mean vertical force from the weight that gives
-#: a warning, and one that gives an error.
+#: a warning, and one below the weight that gives an error.
 BALANCE_WARNING = 0.05
 BALANCE_ERROR = 0.2
+#: The weight the forces may carry, in multiples of the file's: by default (a payload not in
+#: the file warns), and when the data identify the rigid-body model, whose payload the
+#: weight is evidence of.
+CARRIED_WEIGHT = (1.0 - BALANCE_ERROR, 5.0)
+PHYSICAL_CARRIED_WEIGHT = (0.5, 5.0)
 #: A single leg's mean force may differ from its static share by this fraction.
 LEG_BALANCE_ERROR = 0.5
 #: Identified diagonal of Mt or Bt beyond this factor of the nominal one: a warning.
@@ -220,7 +225,7 @@ def _leg_order(pose: np.ndarray, lengths: np.ndarray, platform: Platform, fits) 
 
 
 def check_static_balance(pose: np.ndarray, forces: np.ndarray, platform: Platform,
-                         where: str) -> None:
+                         where: str, carried: tuple[float, float] = CARRIED_WEIGHT) -> None:
     """The mean actuator forces must carry the weight the platform description implies.
 
     Over a record of whole excitation periods the inertial and viscous forces average out,
@@ -234,17 +239,21 @@ def check_static_balance(pose: np.ndarray, forces: np.ndarray, platform: Platfor
         Actuator forces along the legs (N, positive extends).
     platform : Platform
     where : str
+    carried : (float, float)
+        The weight the forces may carry, in multiples of the file's
+        (:data:`PHYSICAL_CARRIED_WEIGHT` when they identify the payload).
 
     Raises
     ------
     DataError
         Forces near zero, in kN, of the opposite sign, a single dead channel, or a weight
-        more than :data:`BALANCE_ERROR` off (wrong platform file).
+        outside ``carried`` (wrong platform file).
 
     Warns
     -----
     DataWarning
-        A weight off by more than :data:`BALANCE_WARNING` (a payload not in the file?).
+        Unless the range is the physical model's, a weight off by more than
+        :data:`BALANCE_WARNING` (a payload not in the file?).
     """
     pose, forces = _subsample(pose, forces)
     # the pose-only leg terms that preparation uses too: no mass matrix, no compiled kernel
@@ -261,21 +270,28 @@ def check_static_balance(pose: np.ndarray, forces: np.ndarray, platform: Platfor
     if abs(ratio + 1.0) <= BALANCE_ERROR:
         raise DataError(f"{what}; positive must extend the leg: map f1..f6 with scale = -1 "
                         "(docs/logs.md).")
-    if abs(ratio - 1.0) > BALANCE_ERROR:
+    if not carried[0] <= ratio <= carried[1]:
         raise DataError(f"{what}; wrong platform file (--platform) or force unit (N)?")
     static = np.linalg.solve(np.transpose(leg_jacobian, (0, 2, 1)), gravity[..., None])[..., 0]
-    shares = forces.mean(axis=0) / static.mean(axis=0)
+    shares = forces.mean(axis=0) / static.mean(axis=0) / ratio
     leg = int(np.argmax(np.abs(shares - 1.0)))
     if abs(shares[leg] - 1.0) > LEG_BALANCE_ERROR:
         raise DataError(f"{where}: column f{leg + 1} carries {shares[leg]:.3g} times its static "
                         "load, the other legs about their share; check that channel "
                         "(unplugged, unit, sign).")
-    if abs(ratio - 1.0) > BALANCE_WARNING:
+    if carried == PHYSICAL_CARRIED_WEIGHT:
+        return
+    if ratio > 1.0 + BALANCE_WARNING:
+        _warn(f"{what}: a payload missing from the platform file? `stewartid identify --model "
+              "physical --payload` identifies it (docs/physical-model.md), or add its "
+              "[payload] section.")
+    elif abs(ratio - 1.0) > BALANCE_WARNING:
         _warn(f"{what}: a payload missing from the platform file (its [payload] section)?")
 
 
 def check_dataset(pose: np.ndarray, lengths: np.ndarray, forces: np.ndarray,
-                  platform: Platform, where: str, both_logged: bool) -> None:
+                  platform: Platform, where: str, both_logged: bool,
+                  carried: tuple[float, float] = CARRIED_WEIGHT) -> None:
     """The consistency checks that need pose, lengths and forces together.
 
     Parameters
@@ -286,10 +302,12 @@ def check_dataset(pose: np.ndarray, lengths: np.ndarray, forces: np.ndarray,
     where : str
     both_logged : bool
         True when the log held both the pose and the leg lengths (then they must agree).
+    carried : (float, float)
+        As :func:`check_static_balance`.
     """
     if both_logged:
         check_inverse_kinematics(pose, lengths, platform, where)
-    check_static_balance(pose, forces, platform, where)
+    check_static_balance(pose, forces, platform, where, carried)
 
 
 def check_identified(M: np.ndarray, B: np.ndarray, platform: Platform,
@@ -342,5 +360,5 @@ def check_identified(M: np.ndarray, B: np.ndarray, platform: Platform,
                 _warn(f"{entry}; {hint}.")
 
 
-__all__ = ["check_dataset", "check_identified", "check_inverse_kinematics",
-           "check_leg_lengths", "check_pose", "check_static_balance"]
+__all__ = ["CARRIED_WEIGHT", "PHYSICAL_CARRIED_WEIGHT", "check_dataset", "check_identified",
+           "check_inverse_kinematics", "check_leg_lengths", "check_pose", "check_static_balance"]
