@@ -9,7 +9,7 @@ i's rows then have covariance s_i I + Q with
 As in WENDy, each interval's rows are weighted by the inverse of that covariance
 (iteratively, Q depending on the estimate) and the expected noise parts of the weighted
 normal equations are subtracted (errors in variables). Sigma and the white force noise are
-measured from the data (:mod:`.noise`).
+measured from the data (:mod:`~stewartid.identification.wavelet.noise`).
 
 References
 ----------
@@ -95,12 +95,20 @@ def _weighted_normal(design: np.ndarray, weights: np.ndarray, target: np.ndarray
                      ) -> tuple[np.ndarray, np.ndarray]:
     """sum_n D_n^T W_n D_n and sum_n D_n^T W_n t_n.
 
-    For designs (n, R, u), weights (n, R, R) and targets (n, R).
+    For designs (n, R, u), weights (n, R, R) and targets (n, R). A channel's design is zero
+    outside its own unknowns and the shared ones: only the columns used are multiplied.
     """
-    weighted = weights @ design                                         # (n, R, u)
-    flat = design.reshape(-1, design.shape[-1])
-    return (flat.T @ weighted.reshape(flat.shape),
-            weighted.reshape(flat.shape).T @ target.ravel())
+    used = np.flatnonzero(np.any(design, axis=(0, 1)))
+    sub = design[..., used] if used.size < design.shape[-1] else design
+    weighted = (weights @ sub).reshape(-1, sub.shape[-1])               # (n R, k)
+    flat = sub.reshape(weighted.shape)
+    if sub is design:
+        return flat.T @ weighted, weighted.T @ target.ravel()
+    normal = np.zeros((design.shape[-1], design.shape[-1]))
+    rhs = np.zeros(design.shape[-1])
+    normal[np.ix_(used, used)] = flat.T @ weighted
+    rhs[used] = weighted.T @ target.ravel()
+    return normal, rhs
 
 
 def channel_systems(stacked: StackedEquations, n_experiments: int, shared_friction: bool,
