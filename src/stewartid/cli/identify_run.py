@@ -39,6 +39,7 @@ from stewartid.physical.identified_platform import IDENTIFIED_HEADER, write_iden
 from stewartid.platform import Platform
 from stewartid.reports.identification.report import IdentificationReport, write_report
 from stewartid.validation.heldout import DEFAULT_FOLDS
+from stewartid.verdict.policy import scored_entries
 
 #: Values of ``identify --model``.
 MODELS = ("physical",)
@@ -104,11 +105,13 @@ class IdentifyRun:
     delay_sensitivity: dict[str, Any] | None = None
 
     def comparison(self) -> list[dict[str, Any]]:
-        """The paper's 20 entries, identified against nominal
+        """The scored entries (:func:`~stewartid.verdict.policy.scored_entries` of the
+        platform), identified against nominal
         (:func:`~stewartid.identification.result.comparison_rows`)."""
         result = self.result
         return comparison_rows(result.M, result.B, self.nominal_M, self.nominal_B,
-                               result.std_errors_M, result.std_errors_B)
+                               result.std_errors_M, result.std_errors_B,
+                               scored_entries(*nominal_matrices(self.platform)))
 
 
 def settings_for(methods: Sequence[str], method: str, flags: Mapping[str, FlagSetting]

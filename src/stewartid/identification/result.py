@@ -6,6 +6,7 @@ Tables 3-6).
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -13,7 +14,12 @@ from typing import Any
 import numpy as np
 
 from stewartid.files import to_jsonable, write_json_atomic
-from stewartid.reference.published import PAPER_ENTRIES, entry_label, relative_error_percent
+from stewartid.reference.published import (
+    PAPER_ENTRIES,
+    EntryKey,
+    entry_label,
+    relative_error_percent,
+)
 
 
 @dataclass(frozen=True)
@@ -139,14 +145,16 @@ class IdentificationResult:
 
 def comparison_rows(M: np.ndarray, B: np.ndarray, M_nominal: np.ndarray,
                     B_nominal: np.ndarray, std_M: np.ndarray | None = None,
-                    std_B: np.ndarray | None = None) -> list[dict[str, Any]]:
-    """The rows of :func:`comparison_table` as dicts, without pandas."""
+                    std_B: np.ndarray | None = None,
+                    entries: Sequence[EntryKey] = PAPER_ENTRIES) -> list[dict[str, Any]]:
+    """The rows of :func:`comparison_table` as dicts, without pandas, for ``entries`` (the
+    paper's 20 by default)."""
     identified = {"M": np.asarray(M), "B": np.asarray(B)}
     nominal = {"M": np.asarray(M_nominal, dtype=float), "B": np.asarray(B_nominal, dtype=float)}
     std = {"M": std_M if std_M is not None else np.full((6, 6), np.nan),
            "B": std_B if std_B is not None else np.full((6, 6), np.nan)}
     rows = []
-    for key in PAPER_ENTRIES:
+    for key in entries:
         matrix, row, col = key
         value = float(identified[matrix][row, col])
         ref = float(nominal[matrix][row, col])
