@@ -71,7 +71,7 @@ def plausibility_check(platform: Platform) -> Callable[[IdentificationResult], N
     return check
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Comparison:
     """Every method's fit, validation and the verdict on which to trust.
 
@@ -181,6 +181,11 @@ class Comparison:
         """The trusted matrices' standard errors, ``{"M": (6, 6), "B": (6, 6)}``."""
         result = self.trusted_result
         return {"M": result.std_errors_M, "B": result.std_errors_B}
+
+    def __repr__(self) -> str:
+        return (f"Comparison(trusted={self.trusted!r}, ranking={self.ranking!r}, "
+                f"experiments={len(self.experiments)}, folds={self.folds}, "
+                f"uncertain_entries={[u['entry'] for u in self.uncertain_entries]!r})")
 
     def with_result(self, **fields: Any) -> Comparison:
         """A copy whose :attr:`result` has ``fields`` replaced (e.g. the ``delay`` the data
