@@ -1,0 +1,62 @@
+"""The top-level API: a script that imports only ``stewartid`` gets the verdict without
+writing a file, and its report is the command line's."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from stewartid.cli import app
+from typer.testing import CliRunner
+
+SCRIPT = """
+import stewartid as sid
+platform = sid.load_platform(LOGS + "/platform.toml")
+experiments = sid.read_experiments(LOGS, platform)
+comparison = sid.compare_methods(experiments, platform, methods=("fourier", "ls"))
+assert comparison.trusted in ("fourier", "ls", "consensus"), comparison.trusted
+assert comparison.M.shape == comparison.B.shape == (6, 6)
+assert set(comparison.std_errors) == {"M", "B"}
+assert comparison.reasons and all(isinstance(r, str) for r in comparison.reasons)
+assert set(comparison.estimators) == {"fourier", "ls"}
+print(repr(comparison))
+"""
+
+
+@pytest.mark.slow
+def test_a_script_gets_the_verdict_and_writes_no_file(tmp_path, example_dir):
+    work, temporary = tmp_path / "work", tmp_path / "tmp"
+    work.mkdir()
+    temporary.mkdir()
+    code = f"LOGS = {str(example_dir)!r}\n" + SCRIPT
+    environment = {**os.environ, "TMPDIR": str(temporary), "MPLCONFIGDIR": str(temporary)}
+    found = subprocess.run([sys.executable, "-c", code], cwd=work, env=environment,
+                           capture_output=True, text=True)
+    assert found.returncode == 0, found.stderr
+    assert found.stdout.startswith("Comparison(trusted=")
+    assert list(work.iterdir()) == [] and list(temporary.iterdir()) == []
+
+
+@pytest.mark.slow
+def test_write_report_gives_the_command_lines_report(tmp_path, example_dir, example_platform):
+    import stewartid as sid
+
+    experiments = sid.read_experiments(example_dir, example_platform)
+    comparison = sid.compare_methods(experiments, example_platform, methods="ls",
+                                     nominal_source="ignored")
+    written = sid.write_report(comparison, tmp_path / "python")
+    assert (tmp_path / "python" / "report.html").is_file() and written.trusted == "ls"
+    result = CliRunner().invoke(app, ["identify", "--method", "ls", "--platform",
+                                      str(example_dir / "platform.toml"), "--report",
+                                      str(tmp_path / "cli"), str(example_dir)])
+    assert result.exit_code == 0, result.output
+    ours = json.loads((tmp_path / "python" / "result.json").read_text())
+    theirs = json.loads((tmp_path / "cli" / "result.json").read_text())
+    assert ours == theirs
+    assert sorted(p.name for p in (tmp_path / "python").glob("*.csv")) == sorted(
+        p.name for p in (tmp_path / "cli").glob("*.csv"))
