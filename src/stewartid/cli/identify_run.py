@@ -1,6 +1,6 @@
-"""``stewartid identify`` behind its flags: the experiments read and aligned, the method (or
-every method: :func:`~stewartid.comparison.compare_methods`) fitted, the report and the result
-written. Every output location and flag combination is checked before anything is computed."""
+"""``stewartid identify`` behind its flags: experiments read and aligned, the method(s) fitted,
+report and result written; every output and flag combination checked before any computation.
+"""
 
 from __future__ import annotations
 
@@ -56,9 +56,8 @@ class FlagSetting(NamedTuple):
     name : str
         The setting (``"gravity"``, ``"frequency_hz"``, ...).
     value : object
-        Its value from the flag.
     given : bool
-        The flag was given (a setting given for a method without it is an error).
+        The flag was given (an error for a method without the setting).
     """
 
     name: str
@@ -75,23 +74,16 @@ class IdentifyRun:
     result : IdentificationResult
         The trusted (or only) method's result.
     report : IdentificationReport or None
-        With a report folder.
     platform : Platform
     experiments : int
-        Number of experiments identified.
     nominal_M, nominal_B : ndarray, shape (6, 6)
-        The reference matrices: from a ``meta.json``/``truth.json`` beside the data, else the
-        platform description's at the neutral pose.
+        Reference: a ``meta.json``/``truth.json`` beside the data, else the platform at neutral.
     nominal_source : str
-        Where they come from.
     delay : dict or None
-        The force delay the data were aligned by (the ``"delay"`` entry of the result), or
-        None when they were used as logged.
+        The force delay the data were aligned by; None when used as logged.
     delay_sensitivity : dict or None
-        With the data used as logged and a DOF moved at one frequency only, where a force
-        delay would pass for damping and its bias on the Bt diagonal per millisecond
-        (:func:`~stewartid.identification.delay.single_frequency_bias`; the result's
-        ``diagnostics["delay_sensitivity"]``); else None.
+        Bias a force delay would put on the Bt diagonal per ms, for single-frequency DOFs
+        (:func:`~stewartid.identification.delay.single_frequency_bias`).
     """
 
     result: IdentificationResult
@@ -105,9 +97,7 @@ class IdentifyRun:
     delay_sensitivity: dict[str, Any] | None = None
 
     def comparison(self) -> list[dict[str, Any]]:
-        """The scored entries (:func:`~stewartid.verdict.policy.scored_entries` of the
-        platform), identified against nominal
-        (:func:`~stewartid.identification.result.comparison_rows`)."""
+        """The platform's scored entries, identified against nominal."""
         result = self.result
         return comparison_rows(result.M, result.B, self.nominal_M, self.nominal_B,
                                result.std_errors_M, result.std_errors_B,
@@ -116,8 +106,7 @@ class IdentifyRun:
 
 def settings_for(methods: Sequence[str], method: str, flags: Mapping[str, FlagSetting]
                  ) -> dict[str, Any]:
-    """The settings the flags give the methods: those any of them has (``friction`` only when
-    given, so that a method's own default stays).
+    """The settings the flags give the methods (``friction`` only when given).
 
     Raises
     ------
@@ -136,7 +125,7 @@ def settings_for(methods: Sequence[str], method: str, flags: Mapping[str, FlagSe
 
 
 def _is_result(path: Path) -> bool:
-    """True for a JSON file that ``identify --out`` wrote (overwritten without --force)."""
+    """True for a JSON file that ``identify --out`` wrote."""
     try:
         document = json.loads(path.read_text())
     except (OSError, ValueError):
@@ -147,8 +136,7 @@ def _is_result(path: Path) -> bool:
 def _check_outputs(paths: Sequence[Path], inputs: Sequence[str | Path | None],
                    out: Path | None, report: Path | None, force: bool, method: str,
                    several: bool, folds: int | None) -> None:
-    """Refuse, before any computation, outputs that would overwrite the inputs or earlier
-    work, and options that need a report folder without one."""
+    """Refuse outputs that would overwrite inputs or earlier work, and report-only options."""
     if out is not None:
         named = [*paths, *(p for p in inputs if p and Path(p).is_file())]
         check_output_file(out, force, named, is_result=_is_result)
@@ -169,8 +157,7 @@ def _check_outputs(paths: Sequence[Path], inputs: Sequence[str | Path | None],
 
 def _physical_request(model: str | None, method: str, payload: bool, consistent: bool,
                       settings: Mapping[str, Any]) -> PhysicalRequest | None:
-    """The report's physical section: asked for with ``--model physical``, shown beside the
-    comparison of ``--method all`` when the model fits the data; none otherwise."""
+    """The report's physical section, or None when neither ``--model`` nor ``--method all``."""
     if model is None and method != ALL_METHODS:
         return None
     own = registry.method_spec("physical").estimator_class.param_names()
@@ -180,7 +167,7 @@ def _physical_request(model: str | None, method: str, payload: bool, consistent:
 
 
 def _is_identified(path: Path) -> bool:
-    """True for a platform file that ``identify --platform-out`` wrote (overwritten)."""
+    """True for a platform file that ``identify --platform-out`` wrote."""
     try:
         return path.read_text(encoding="utf-8").startswith(IDENTIFIED_HEADER)
     except (OSError, UnicodeDecodeError):
@@ -189,18 +176,7 @@ def _is_identified(path: Path) -> bool:
 
 def _check_model_options(model: str, platform_out: Path | None, forbidden: dict[str, bool]
                         ) -> None:
-    """Refuse, before any computation, a model not known and options the physical model
-    does not take.
-
-    Parameters
-    ----------
-    model : str
-        The ``--model`` value.
-    platform_out : Path, optional
-        The ``--platform-out`` file.
-    forbidden : dict of str to bool
-        Options that do not apply, by flag, and whether each was given.
-    """
+    """Refuse an unknown model and the options (``forbidden``: flag -> given) it does not take."""
     if model not in MODELS:
         raise ConfigError(f"--model {model!r}: expected one of {', '.join(MODELS)}.")
     given = [flag for flag, on in forbidden.items() if on]
@@ -213,8 +189,7 @@ def _check_model_options(model: str, platform_out: Path | None, forbidden: dict[
 
 def model_method(model: str | None, method: str, payload: bool,
                  platform_out: Path | None) -> str:
-    """The method ``identify`` runs: ``method`` without ``--model``, else the model's
-    estimator (``"physical"``).
+    """The method ``identify`` runs: ``method``, or the ``--model`` estimator.
 
     Raises
     ------
@@ -233,19 +208,8 @@ def model_method(model: str | None, method: str, payload: bool,
 def _check_model_outputs(model: str, platform_out: Path | None,
                         refused: dict[str, bool] | None = None,
                         inputs: Sequence[str | Path] = ()) -> None:
-    """Refuse, before any computation, what ``identify --model`` cannot do
-    (``_check_model_options``) and a ``platform_out`` that would replace an input or a
-    file ``--platform-out`` did not write.
-
-    Parameters
-    ----------
-    model : str
-    platform_out : Path, optional
-    refused : dict of str to bool, optional
-        Options of the command that do not apply, by flag, and whether each was given.
-    inputs : sequence of str or Path
-        Files the command reads, which ``platform_out`` must not be.
-    """
+    """:func:`_check_model_options`, and refuse a ``platform_out`` that would replace an input or a foreign
+    file."""
     _check_model_options(model, platform_out, refused or {})
     if platform_out is not None:
         check_output_file(platform_out, False, inputs, is_result=_is_identified,
@@ -278,23 +242,15 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
                    payload: bool = False, platform_out: Path | None = None) -> IdentifyRun:
     """Identify Mt and Bt from experiment files, as ``stewartid identify`` does.
 
-    The arguments are the command's options (``stewartid identify --help``); ``flags`` maps
-    each estimator flag to the setting it gives. With ``report``, the methods are compared
-    (:func:`~stewartid.comparison.compare_methods`) and the report written
-    (:func:`~stewartid.reports.identification.report.write_report`); with ``model``, the
-    physical model is fitted instead of ``method`` (beside every compared method in a report).
-
-    Returns
-    -------
-    IdentifyRun
-        The result, the report and the reference matrices.
+    The arguments are the command's options; ``flags`` maps each estimator flag to its setting.
+    With ``report`` the methods are compared and the report written; with ``model`` the physical
+    model is fitted instead of ``method``.
 
     Raises
     ------
     StewartidError
-        Bad options or outputs (before any computation), unreadable data, an experiment given
-        twice or a DOF left unexcited, a method that cannot be applied, or an implausible
-        result.
+        Bad options or outputs (before any computation), unreadable data, a repeated experiment,
+        an unexcited DOF, an inapplicable method, or an implausible result.
     """
     delay = parse_delay(delay)
     names = method_names(method)

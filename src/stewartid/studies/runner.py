@@ -1,7 +1,6 @@
-"""Running a study on dask.distributed: resumable, fault tolerant, with a progress bar.
-
-Only the client writes, each task's rows as soon as it finishes, so a lost worker costs one
-task, an interrupted run keeps every finished task, and workers need no shared file system.
+"""Running a study on dask.distributed: resumable, fault tolerant, with a progress bar. Only the
+client writes, each task's rows as it finishes: a lost worker costs one task, an interrupted run
+keeps every finished task, workers need no shared file system.
 """
 
 from __future__ import annotations
@@ -49,7 +48,7 @@ class TaskFailure:
     label : str
         Its parameters and seed.
     message : str
-        The exception, as ``Type: message``.
+        ``Type: message`` of the exception.
     """
 
     task: str
@@ -64,21 +63,17 @@ class StudyRun:
     Attributes
     ----------
     directory : Path
-        The output folder.
     spec : StudySpec
     rows : pandas.DataFrame
-        Every row of the study's tasks found in the folder after the run
-        (:func:`~stewartid.studies.results.read_results`).
-    computed : int
-        Tasks computed and stored by this run.
-    skipped : int
-        Tasks already stored before this run (``resume``).
+        Every row of the study's tasks in the folder after the run.
+    computed, skipped : int
+        Tasks computed by this run; tasks already stored before it (``resume``).
     failures : tuple of TaskFailure
-        Tasks that failed in this run; run again with ``resume`` to retry them.
+        Tasks failed in this run; retried by a run with ``resume``.
     files : list of Path
         Report, figure and table files written.
     runtime_s : float
-        Wall time of the run (s).
+        Wall time (s).
     """
 
     directory: Path
@@ -119,16 +114,14 @@ def _check_folder(spec: StudySpec, directory: Path, resume: bool) -> None:
 
 @contextmanager
 def connect(scheduler: str | None = None, workers: int | None = None) -> Iterator[Any]:
-    """A :class:`distributed.Client` of the cluster at ``scheduler``, or of a new LocalCluster.
+    """A :class:`distributed.Client` of ``scheduler``, or of a new LocalCluster closed on exit.
 
-    The LocalCluster has ``workers`` single-threaded processes (one per core by default) and is
-    closed on exit.
+    The LocalCluster has ``workers`` single-threaded processes (one per core by default).
 
     Raises
     ------
     ConfigError
-        If dask.distributed is not installed (the ``[dask]`` extra), ``workers`` < 1, or the
-        scheduler cannot be reached.
+        dask.distributed missing (the ``[dask]`` extra), ``workers`` < 1, or scheduler unreachable.
     """
     try:
         from distributed import Client, LocalCluster
@@ -198,33 +191,26 @@ def run_study(spec: StudySpec, out: str | Path, *, scheduler: str | None = None,
     out : str or Path
         Output folder (created if missing).
     scheduler : str, optional
-        Address of an existing dask scheduler (``tcp://host:8786``); a LocalCluster otherwise.
+        An existing dask scheduler (``tcp://host:8786``); a LocalCluster otherwise.
     workers : int, optional
-        Worker processes of the LocalCluster; one per core by default.
+        LocalCluster processes; one per core by default.
     resume : bool
-        Continue the study already in ``out``: compute only its missing tasks.
+        Continue the study in ``out``: compute only its missing tasks.
     retries : int
-        Extra attempts of a task that raises (dask ``retries``); a task whose worker dies is
-        rerun by the scheduler regardless (``distributed.scheduler.allowed-failures``).
+        Extra attempts of a task that raises (a dead worker's task is rerun regardless).
     client : distributed.Client, optional
-        Use this client (then ``scheduler`` and ``workers`` are ignored).
+        Use this client (``scheduler`` and ``workers`` ignored).
     progress : bool or callable
-        True: a progress bar on the terminal; a callable: called as
-        ``progress(done, failed, remaining)`` after every task.
+        True: a terminal progress bar; a callable: ``progress(done, failed, remaining)`` per task.
     report : bool
         Write ``report.md``/``report.html`` with figures and tables at the end.
-
-    Returns
-    -------
-    StudyRun
 
     Raises
     ------
     OutputExistsError
-        If ``out`` holds a study and not ``resume``.
+        ``out`` holds a study and not ``resume``.
     ConfigError
-        If ``resume`` meets a study with other fixed settings, dask is unavailable, or
-        another run is writing ``out`` (:func:`~stewartid.studies.lock.study_lock`).
+        ``resume`` meets other fixed settings, dask is unavailable, or another run holds ``out``.
     """
     start = time.perf_counter()
     directory = Path(out)
@@ -288,7 +274,7 @@ def _run_locked(spec: StudySpec, directory: Path, start: float, scheduler: str |
 
 
 def _describe(future: Any) -> str:
-    """``Type: message`` of a future's exception (a cancelled one has none to give)."""
+    """``Type: message`` of a future's exception."""
     if future.status == "cancelled":
         return "CancelledError: the task was cancelled on the cluster"
     error = future.exception()

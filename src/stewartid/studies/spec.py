@@ -1,23 +1,6 @@
-"""The study file: a TOML description of a Monte Carlo study or a parameter sweep.
-
-A study runs the paper's six virtual experiments at every point of a grid of plant and
-excitation parameters, ``seeds`` times with independent sensor noise, and identifies Mt and
-Bt with every listed method. Example::
-
-    [study]
-    platform = "paper"              # or a platform TOML path (relative to the study file)
-    methods = ["wavelet", "fourier", "ls"]
-    duration = 20.0                 # s per experiment
-    seeds = 8                       # noise seeds per grid point
-    [grid]
-    coulomb = [0.0, 5.0, 30.0]      # N m per joint axis
-    noise_scale = [0.0, 1.0, 2.0]   # multiples of the reference sensor noise
-    frequency = [0.5]               # Hz
-
-Every point parameter (:data:`PARAMETERS`) may be fixed in ``[study]`` or swept in
-``[grid]``, not both; those given in neither take their default. Optional ``[settings.NAME]``
-tables pass settings to method ``NAME`` (``[settings.wavelet] friction = "shared"``). Unknown
-keys and tables are errors. The format is documented in ``docs/studies.md``.
+"""The study file: a TOML Monte Carlo study or parameter sweep of the paper's six virtual
+experiments over a grid of plant and excitation parameters, ``seeds`` noise seeds per point,
+every listed method (format: ``docs/studies.md``).
 """
 
 from __future__ import annotations
@@ -78,19 +61,19 @@ class StudySpec:
     Attributes
     ----------
     platform : str
-        ``"paper"`` or the absolute path of the platform TOML file.
+        ``"paper"`` or the platform TOML file's absolute path.
     methods : tuple of str
-        Registered method or preset names, in the file's order.
+        Registered method or preset names, in file order.
     seeds : tuple of int
         Noise seeds run at every grid point.
     fixed : dict
-        ``{parameter: value}`` of the parameters not swept (defaults resolved).
+        ``{parameter: value}`` not swept (defaults resolved).
     grid : dict
-        ``{parameter: tuple of values}`` of the swept parameters, in the file's order.
+        ``{parameter: tuple of values}`` swept, in file order.
     actuator : str or None
-        ``"hydraulic"`` or ``"ideal"`` to override ``[hydraulics] mode``.
+        ``"hydraulic"`` or ``"ideal"``, overriding ``[hydraulics] mode``.
     method_settings : dict
-        ``{method: {setting: value}}`` from the ``[settings.*]`` tables.
+        ``{method: {setting: value}}`` from ``[settings.*]``.
     title : str
     """
 
@@ -105,7 +88,7 @@ class StudySpec:
 
     @property
     def size(self) -> int:
-        """Number of tasks (grid points times seeds); each gives one row per method."""
+        """Number of tasks (grid points × seeds); each gives one row per method."""
         return math.prod(len(values) for values in self.grid.values()) * len(self.seeds)
 
     def load_platform(self) -> Platform:
@@ -121,8 +104,7 @@ class StudySpec:
         return document
 
     def mismatch(self, other: Mapping[str, Any]) -> str | None:
-        """The first setting in which ``other`` (a :meth:`to_dict` document) differs from this
-        study where a resumed run must agree (everything but the grid and the seeds), or None."""
+        """The first setting (not grid, not seeds) where ``other`` (a :meth:`to_dict`) differs, or None."""
         mine = self.to_dict()
         for key in ("platform", "methods", "fixed", "actuator", "method_settings"):
             if mine[key] != other.get(key):
@@ -189,23 +171,13 @@ def _method_settings(table: Mapping[str, Any], methods: tuple[str, ...], where: 
 
 def parse_study(document: Mapping[str, Any], where: str = "study file",
                 base: str | Path = ".") -> StudySpec:
-    """Validate a decoded study file.
-
-    Parameters
-    ----------
-    document : mapping
-        The decoded TOML.
-    where : str
-        Name of the file in error messages.
-    base : str or Path
-        Folder that a relative platform path is relative to.
+    """Validate a decoded study file; ``where`` names it in errors, ``base`` anchors a relative platform.
 
     Raises
     ------
     ConfigError
-        On an unknown table or key, a missing or mistyped value, a value out of range, a
-        parameter both fixed and swept, an unknown method or method setting, or a platform
-        that cannot be loaded.
+        An unknown table or key, a missing, mistyped or out-of-range value, a parameter both fixed
+        and swept, an unknown method or setting, or an unloadable platform.
     """
     unknown = sorted(set(document) - {"study", "grid", "settings"})
     if unknown:
@@ -253,7 +225,7 @@ def load_study(path: str | Path) -> StudySpec:
     Raises
     ------
     ConfigError
-        If the file is missing, is not valid TOML, or fails :func:`parse_study`.
+        Missing file, invalid TOML, or :func:`parse_study` fails.
     """
     path = Path(path)
     if not path.is_file():

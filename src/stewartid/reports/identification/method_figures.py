@@ -1,6 +1,6 @@
-"""The plots of the identification report, each written as PNG and SVG, drawn as
-:mod:`stewartid.reports.drawing` draws; every function returns the written paths. Layouts are
-grids with fixed margins: matplotlib's constrained layout is far slower to draw."""
+"""The identification report's plots, written as PNG and SVG; each returns the written paths.
+Fixed-margin grids: matplotlib's constrained layout is far slower to draw.
+"""
 
 from __future__ import annotations
 
@@ -33,9 +33,7 @@ def _grid(figure, count: int, columns: int = 3, top: float = 0.9, **options):
 
 
 def _log_floor(axis, values: np.ndarray, decades: float | None = 5.0) -> None:
-    """Limit a log axis to ``decades`` decades below its largest value (None: no limit), so
-    that the numerical floor of a noise-free record does not take the panel, and label it with
-    plain numbers (``0.001``), much faster to draw than mathtext powers of ten."""
+    """Limit a log axis to ``decades`` below its maximum (None: no limit), plain tick labels."""
     from matplotlib.ticker import FuncFormatter, NullLocator
 
     top = float(np.nanmax(values)) if np.size(values) else 1.0
@@ -49,17 +47,17 @@ def _log_floor(axis, values: np.ndarray, decades: float | None = 5.0) -> None:
 def plot_spectra(names: Sequence[str], poses: Sequence[np.ndarray], sample_rates: Sequence[float],
                  frequencies_hz: Sequence[float], directory: str | Path,
                  stem: str = "spectrum") -> list[Path]:
-    """Amplitude spectrum of the displacement of every coordinate, one panel per experiment.
+    """Amplitude spectrum of every coordinate's displacement, one panel per experiment.
 
     Parameters
     ----------
     names : sequence of str
     poses : sequence of ndarray, shape (N_k, 6)
-        Measured poses (m, rad).
+        m, rad.
     sample_rates : sequence of float
         Hz.
     frequencies_hz : sequence of float
-        Dominant excitation frequency of each experiment (Hz), marked and used for the range.
+        Dominant excitation frequency of each experiment, marked (Hz).
     """
     figure = new_figure(figsize=(13, 3.3 * int(np.ceil(len(names) / 3)) + 0.6))
     axes = _grid(figure, len(names))
@@ -89,9 +87,7 @@ def plot_spectra(names: Sequence[str], poses: Sequence[np.ndarray], sample_rates
 def plot_intervals(names: Sequence[str], spans: Sequence[tuple[float, float]],
                    intervals: Sequence[np.ndarray], points: Sequence[np.ndarray | None],
                    directory: str | Path, stem: str = "intervals") -> list[Path]:
-    """The constant-direction intervals an identification used, one lane per experiment, and
-    the (a, b) points where the method used them (shift b on the time axis, scale a as the
-    marker's half-width bar).
+    """The constant-direction intervals used, one lane per experiment, with the (a, b) points.
 
     Parameters
     ----------
@@ -101,7 +97,7 @@ def plot_intervals(names: Sequence[str], spans: Sequence[tuple[float, float]],
     intervals : sequence of ndarray, shape (M_k, 2)
         [start, stop] (s).
     points : sequence of ndarray, shape (K_k, 2), or None
-        (a, b) pairs (s, s).
+        (a, b) pairs (s).
     """
     height = 0.55 * len(names) + 1.6
     figure = new_figure(figsize=(11, height))
@@ -128,7 +124,6 @@ def plot_intervals(names: Sequence[str], spans: Sequence[tuple[float, float]],
 
 
 def _significant(nominal: np.ndarray) -> list[tuple[int, int]]:
-    """Entries whose nominal value is not negligible (above 1e-6 of the largest)."""
     scale = np.abs(nominal).max()
     return [(i, j) for i in range(6) for j in range(6)
             if scale > 0 and abs(nominal[i, j]) > 1e-6 * scale]
@@ -138,8 +133,7 @@ def _significant(nominal: np.ndarray) -> list[tuple[int, int]]:
 def plot_matrices(estimates: Mapping[str, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]],
                   colours: Mapping[str, str], M_nominal: np.ndarray, B_nominal: np.ndarray,
                   directory: str | Path, stem: str = "matrices") -> list[Path]:
-    """Identified / nominal for every entry with a non-negligible nominal value, with error
-    bars of two standard errors, per method.
+    """Identified / nominal for every non-negligible nominal entry, ±2 standard errors, per method.
 
     Parameters
     ----------
@@ -172,7 +166,7 @@ def plot_matrices(estimates: Mapping[str, tuple[np.ndarray, np.ndarray, np.ndarr
 
 
 def _concatenated(validation: ValidationResult, values: Sequence[np.ndarray]):
-    """Segments end to end: time axis (s from the first sample) and stacked values."""
+    """Segments end to end: time (s from the first sample) and stacked values."""
     times, offset = [], 0.0
     for segment in validation.segments:
         times.append(segment.t - segment.t[0] + offset)
@@ -183,15 +177,9 @@ def _concatenated(validation: ValidationResult, values: Sequence[np.ndarray]):
 @styled
 def plot_residuals(validation: ValidationResult, frequencies_hz: Sequence[float],
                    directory: str | Path, stem: str = "residuals") -> list[Path]:
-    """Residual of every equation over time (all experiments end to end) and its amplitude
-    spectrum, with the excitation frequencies and their harmonics marked.
+    """Each equation's residual over time (experiments end to end) and its spectrum.
 
-    Parameters
-    ----------
-    validation : ValidationResult
-        Measured and predicted force on the segments (the full fit's, in sample).
-    frequencies_hz : sequence of float
-        Excitation frequency of each experiment (Hz).
+    ``frequencies_hz``: each experiment's excitation frequency, marked with its harmonics.
     """
     residual = [m - p for m, p in zip(validation.measured, validation.predicted, strict=True)]
     t, values = _concatenated(validation, residual)
@@ -227,14 +215,9 @@ def plot_residuals(validation: ValidationResult, frequencies_hz: Sequence[float]
 @styled
 def plot_validation(validations: Mapping[str, ValidationResult], colours: Mapping[str, str],
                     directory: str | Path, stem: str = "validation") -> list[Path]:
-    """Measured versus predicted generalized force on held-out segments: per DOF, every
-    segment of the experiment in which that DOF moves the force most.
+    """Measured vs predicted force on held-out segments, per DOF where it moves the force most.
 
-    Parameters
-    ----------
-    validations : mapping of label to ValidationResult
-        The first one gives the measured force; all share the same segments.
-    colours : mapping of label to colour
+    The first of ``validations`` gives the measured force; all share the segments.
     """
     first = next(iter(validations.values()))
     figure = new_figure(figsize=(13, 9))
@@ -274,11 +257,7 @@ def plot_unexplained(vaf: Mapping[str, np.ndarray], colours: Mapping[str, str],
                      directory: str | Path, stem: str = "methods") -> list[Path]:
     """Held-out unexplained force, 100 − VAF (%), per DOF and method (log scale).
 
-    Parameters
-    ----------
-    vaf : mapping of label to ndarray, shape (6,)
-        Held-out VAF per DOF (%).
-    colours : mapping of label to colour
+    ``vaf``: label -> held-out VAF per DOF, shape (6,) (%).
     """
     figure = new_figure(figsize=(9, 4))
     axis = figure.subplots(gridspec_kw={"left": 0.1, "right": 0.98, "bottom": 0.1,
@@ -309,14 +288,10 @@ def plot_unexplained(vaf: Mapping[str, np.ndarray], colours: Mapping[str, str],
 def plot_friction(levels: Mapping[str, tuple[np.ndarray, np.ndarray]],
                   colours: Mapping[str, str], nominal: float | None, directory: str | Path,
                   stem: str = "friction") -> list[Path]:
-    """Coulomb level per joint type with ±2 standard errors, per method that estimates it.
+    """Coulomb level per joint type, ±2 standard errors, per method that estimates it.
 
-    Parameters
-    ----------
-    levels : mapping of label to (levels, standard errors), each ndarray (3,) (N m)
-    colours : mapping of label to colour
-    nominal : float or None
-        The platform description's Coulomb level (N m per joint axis), drawn as a line.
+    ``levels``: label -> (levels, standard errors), shape (3,) each (N m); ``nominal``: the
+    description's level, drawn as a line.
     """
     figure = new_figure(figsize=(7, 3.6))
     axis = figure.subplots(gridspec_kw={"left": 0.12, "right": 0.98, "bottom": 0.12,
@@ -344,15 +319,10 @@ def _entry_scale(matrix: np.ndarray, entry: tuple[int, int]) -> float:
 @styled
 def plot_workspace(curves: Workspace, directory: str | Path, stem: str = "workspace"
                    ) -> list[Path]:
-    """Mt and Bt across the measured poses: one column per swept coordinate, the diagonal
-    entries and the largest couplings as their change from the identified value at the mean
-    pose (% of the diagonal's scale), a band of ±2 standard errors, the platform description
-    dashed.
+    """Mt and Bt across the measured poses, one column per swept coordinate.
 
-    Parameters
-    ----------
-    curves : Workspace
-        From :func:`~stewartid.comparison.workspace`.
+    Diagonal and largest couplings as % change from the mean-pose value, ±2 standard errors, the
+    description dashed; ``curves`` from :func:`~stewartid.comparison.workspace`.
     """
     figure = new_figure(figsize=(15, 6.5))
     axes = figure.subplots(2, 6, squeeze=False, gridspec_kw={
