@@ -1,11 +1,6 @@
-"""Predicted accuracy of a design: the standard error of every Mt and Bt entry, before any test.
-
-The chosen estimator is fitted once to the design's noise-free data (its deviation from the
-nominal matrices is the noise-free bias) and then to ``seeds`` noisy copies; the spread of those
-estimates is the predicted standard error, the shift of their mean joins the bias. Running
-the estimator itself predicts what it will do, whatever its settings. The noise-free data come
-from the closed-loop plant (``source="plant"``) or from the rigid-body model with perfect
-tracking (``source="model"``: fast, optimistic).
+"""Predicted accuracy of a design before any test: the chosen estimator fitted to the design's
+noise-free data (plant or rigid-body model) and to ``seeds`` noisy copies; their spread is
+the standard error, the mean's shift from nominal the bias.
 """
 
 from __future__ import annotations
@@ -31,13 +26,8 @@ from stewartid.simulation.sensors import SensorNoise, measure_legs, measured_pos
 
 
 def model_datasets(platform: Platform, design: Design) -> list[Dataset]:
-    """Noise-free data of a design from the rigid-body model (commanded motion tracked exactly).
-
-    Returns
-    -------
-    list of Dataset
-        One per record, sampled at ``[sensors] sample_rate``: pose (m, rad), leg lengths (m)
-        and the actuator forces (N) that produce the motion with the platform's friction.
+    """Noise-free data of a design from the rigid-body model with perfect tracking, one per
+    record at ``[sensors] sample_rate``, forces including the platform's friction.
     """
     rate = platform.sensors.sample_rate
     out = []
@@ -52,24 +42,10 @@ def model_datasets(platform: Platform, design: Design) -> list[Dataset]:
 
 def add_noise(platform: Platform, dataset: Dataset, noise: SensorNoise,
               rng: np.random.Generator, inverse_jacobian: np.ndarray | None = None) -> Dataset:
-    """A noisy copy of noise-free data: white noise on lengths and forces, pose to first order.
+    """Noisy copy of noise-free data: white noise on lengths (m) and forces (N), pose to first
+    order (true pose + J_lq^-1 length noise); biases and resolutions not modelled.
 
-    Parameters
-    ----------
-    platform : Platform
-    dataset : Dataset
-        Noise-free data.
-    noise : SensorNoise
-        Standard deviations (m, N); biases and resolutions are not modelled here.
-    rng : numpy.random.Generator
-    inverse_jacobian : ndarray, shape (N, 6, 6), optional
-        J_lq^-1 at the noise-free poses (:func:`inverse_leg_jacobians`), worth keeping when many
-        copies are drawn.
-
-    Returns
-    -------
-    Dataset
-        Pose = true pose + J_lq^-1 (length noise), the first-order forward kinematics.
+    ``inverse_jacobian`` (N, 6, 6) is :func:`inverse_leg_jacobians`, worth keeping over many copies.
     """
     n = len(dataset.t)
     d_lengths = rng.normal(0.0, noise.length_noise, size=(n, 6))
@@ -82,32 +58,30 @@ def add_noise(platform: Platform, dataset: Dataset, noise: SensorNoise,
 
 
 def inverse_leg_jacobians(platform: Platform, poses: list[np.ndarray]) -> list[np.ndarray]:
-    """J_lq^-1 (N, 6, 6) at each array of poses (N, 6) (m and rad per m of leg length)."""
+    """J_lq^-1 (N, 6, 6) at each array of poses (N, 6)."""
     return [np.linalg.inv(leg_jacobian(platform, q)) for q in poses]
 
 
 @dataclasses.dataclass(frozen=True)
 class Prediction:
-    """Predicted accuracy of a design.
+    """Predicted accuracy of a design; matrices in Mt, Bt units.
 
     Attributes
     ----------
     nominal_M, nominal_B : ndarray, shape (6, 6)
-        Nominal Mt, Bt at the neutral pose (kg..., N s/m...).
+        At the neutral pose.
     bias_M, bias_B : ndarray, shape (6, 6)
-        Mean estimate over the seeds minus nominal (same units); without seeds, the expected
-        estimate of the information matrix's fit minus nominal.
+        Mean estimate minus nominal (without seeds, the information fit's expected estimate).
     noise_free_bias_M, noise_free_bias_B : ndarray, shape (6, 6), or None
-        Noise-free estimate minus nominal (same units); None when not fitted.
+        Noise-free estimate minus nominal; None when not fitted.
     std_M, std_B : ndarray, shape (6, 6)
-        Predicted standard errors (same units).
+        Predicted standard errors.
     seeds : int
-        Noise realisations of the Monte Carlo (0: none, the bias is the noise-free one).
+        Monte Carlo realisations (0: none).
     method : str
         Estimator name with its settings.
     monte_carlo_std_M, monte_carlo_std_B : ndarray, shape (6, 6), or None
-        With standard errors from the information matrix: the spread over the ``seeds``
-        realisations of the Monte Carlo check (same units).
+        Monte Carlo spread checking information-matrix standard errors.
     """
 
     nominal_M: np.ndarray
@@ -131,29 +105,27 @@ class Prediction:
 
     @property
     def relative_std(self) -> np.ndarray:
-        """Predicted standard error of the paper's 20 entries, % of nominal; shape (20,)."""
+        """Standard error of the paper's 20 entries, % of nominal, shape (20,)."""
         return self._entries("std")
 
     @property
     def relative_bias(self) -> np.ndarray:
-        """|bias| of the paper's 20 entries, % of nominal; shape (20,)."""
+        """|bias| of the paper's 20 entries, % of nominal, shape (20,)."""
         return self._entries("bias")
 
     @property
     def relative_noise_free_bias(self) -> np.ndarray | None:
-        """|noise-free bias| of the paper's 20 entries, % of nominal; shape (20,); None without a
-        noise-free fit.
-        """
+        """|noise-free bias| of the 20 entries, % of nominal; None without a noise-free fit."""
         return None if self.noise_free_bias_M is None else self._entries("noise_free_bias")
 
     @property
     def relative_monte_carlo_std(self) -> np.ndarray | None:
-        """The Monte Carlo check's spread of the 20 entries, % of nominal; None without."""
+        """Monte Carlo spread of the 20 entries, % of nominal; None without."""
         return None if self.monte_carlo_std_M is None else self._entries("monte_carlo_std")
 
     @property
     def worst_relative_std(self) -> float:
-        """The design criterion: largest relative standard error over the 20 entries (%)."""
+        """Design criterion: largest relative standard error of the 20 entries (%)."""
         return float(self.relative_std.max())
 
     @property
@@ -167,7 +139,7 @@ class Prediction:
                                    std_B=self.std_B / math.sqrt(factor))
 
     def to_dict(self) -> dict:
-        """JSON-ready summary, with the 20 entries by their paper names."""
+        """JSON-ready summary, the 20 entries by their paper names."""
         checked = self.relative_monte_carlo_std
         entries = {entry_label(k): {"std_percent": float(s), "bias_percent": float(b)}
                    for k, s, b in zip(PAPER_ENTRIES, self.relative_std, self.relative_bias,
@@ -197,12 +169,12 @@ def default_estimator(method: str = "wavelet"):
 
 
 def _monte_carlo_estimator(method: str):
-    """:func:`default_estimator` for the Monte Carlo, which reads the estimates only."""
+    """:func:`default_estimator` for the Monte Carlo (reads the estimates only)."""
     return estimates_only(method, **DESIGN_SETTINGS.get(method, {}))
 
 
 def identify_options(method: str = "wavelet") -> list[str]:
-    """The ``stewartid identify`` options that fit :func:`default_estimator`."""
+    """``stewartid identify`` options matching :func:`default_estimator`."""
     options = ["--method", method]
     for name, value in DESIGN_SETTINGS.get(method, {}).items():
         options += [f"--{name}", str(value)]
@@ -219,26 +191,11 @@ SOURCES = ("plant", "model")
 def measured_plant_datasets(platform: Platform, records: list, noise: SensorNoise,
                             generators: list[np.random.Generator],
                             inverse_jacobians: list[np.ndarray] | None = None) -> list[Dataset]:
-    """Measured data of noise-free plant records, the noise drawn as ``simulate`` draws it.
+    """Measured data ``exp1..expN`` of noise-free plant records, noise drawn as ``simulate`` does.
 
-    Parameters
-    ----------
-    platform : Platform
-    records : list of stewartid.simulation.experiments.ExperimentRecord
-        True signals of the played records.
-    noise : SensorNoise
-        Noise, bias and resolution of the lengths (m) and forces (N).
-    generators : list of numpy.random.Generator
-        One per record.
-    inverse_jacobians : list of ndarray, shape (N, 6, 6), optional
-        J_lq^-1 at each record's true poses (:func:`inverse_leg_jacobians`): the pose is then
-        the first Newton step of forward kinematics from the true pose. None: forward
-        kinematics, as ``simulate``.
-
-    Returns
-    -------
-    list of Dataset
-        Named ``exp1..expN``.
+    ``generators`` has one per record. With ``inverse_jacobians`` (:func:`inverse_leg_jacobians`)
+    the pose is one Newton step of forward kinematics from the true pose, else full forward
+    kinematics.
     """
     out = []
     for k, (record, rng) in enumerate(zip(records, generators, strict=True)):
@@ -254,10 +211,7 @@ def measured_plant_datasets(platform: Platform, records: list, noise: SensorNois
 
 
 def plant_records(platform: Platform, design: Design, workers: int | None = None) -> list:
-    """The design played once on the plant without sensor noise: the true signals of every record.
-
-    The records are played over ``workers`` processes (every core by default), each from rest.
-    """
+    """True signals of the design played once on the plant, noise-free, over ``workers`` processes."""
     return run_in_order(_play, design.playable(platform), workers, shared=platform)
 
 
@@ -270,35 +224,29 @@ def predict_accuracy(platform: Platform, design: Design, noise: SensorNoise,
                      source: str = "plant", records: list | None = None,
                      workers: int | None = None,
                      progress: Callable[[int, int], None] | None = None) -> Prediction:
-    """Predicted bias and standard errors of Mt and Bt for a design (module docstring).
+    """Predicted bias and standard errors of Mt and Bt for a design.
 
     Parameters
     ----------
     platform : Platform
-        With the friction the machine is expected to have.
+        With the machine's expected friction.
     design : Design
     noise : SensorNoise
-        Sensor noise standard deviations (m, N).
+        Standard deviations (m, N).
     method : str
-        Registered identification method (:func:`default_estimator`).
+        Registered method (:func:`default_estimator`).
     seeds : int
         Noise realisations, >= 2.
     seed : int
-        Seed of the first realisation; the streams differ from those of ``simulate --seed``.
+        First realisation's seed (streams differ from ``simulate --seed``'s).
     source : {"plant", "model"}
-        Noise-free data from the plant (honest, slower) or from the rigid-body model with
-        perfect tracking (fast, optimistic).
+        Noise-free data from the plant (honest, slower) or the rigid-body model (fast, optimistic).
     records : list of ExperimentRecord, optional
-        The design already played on the plant (:func:`plant_records`), ``source="plant"``.
+        :func:`plant_records`, for ``source="plant"``.
     workers : int, optional
-        Processes the realisations are spread over; None: every available core from
-        :data:`PARALLEL_SEEDS` realisations on, else 1. The result does not depend on it.
+        Processes; None: every core from :data:`PARALLEL_SEEDS` realisations on. Result independent.
     progress : callable, optional
-        Called with (done, total) after each realisation.
-
-    Returns
-    -------
-    Prediction
+        Called with (done, total).
     """
     if source not in SOURCES:
         raise ConfigError(f"source must be one of {', '.join(SOURCES)}; got {source!r}.")
@@ -335,11 +283,8 @@ PARALLEL_SEEDS = 16
 
 @dataclasses.dataclass(frozen=True)
 class NoiseRuns:
-    """The noisy copies of a design's noise-free data and the estimator fitted to each.
-
-    Either ``records`` (true plant signals; the noise drawn as ``simulate`` draws it) or
-    ``datasets`` (noise-free model data; white noise on lengths and forces), with J_lq^-1 at
-    their poses for the first-order forward kinematics.
+    """Noisy copies of a design's noise-free data and the estimator fitted to each: from plant
+    ``records`` (noise as ``simulate``) or model ``datasets`` (white noise), with J_lq^-1 at the poses.
     """
 
     platform: Platform
@@ -372,10 +317,7 @@ class NoiseRuns:
 
     def fit(self, ks: Sequence[int], progress: Callable[[int, int], None] | None = None
             ) -> np.ndarray:
-        """``[M_, B_]`` of the estimator on realisations ``ks``; shape (len(ks), 2, 6, 6).
-
-        ``progress(done, total)`` is called after each.
-        """
+        """``[M_, B_]`` on realisations ``ks``, shape (len(ks), 2, 6, 6); ``progress(done, total)`` each."""
         estimator = _monte_carlo_estimator(self.method)
         out = np.empty((len(ks), 2, 6, 6))
         for i, k in enumerate(ks):
@@ -387,11 +329,7 @@ class NoiseRuns:
 
     def estimates(self, ks: Sequence[int], workers: int | None = None,
                   progress: Callable[[int, int], None] | None = None) -> np.ndarray:
-        """:meth:`fit` over ``workers`` processes, in the order of ``ks``.
-
-        Every core from :data:`PARALLEL_SEEDS` realisations on, else 1; the noise-free data go to
-        each worker once.
-        """
+        """:meth:`fit` over ``workers`` processes, in the order of ``ks``."""
         ks = [int(k) for k in ks]
         if workers is None:
             workers = None if len(ks) >= PARALLEL_SEEDS else 1

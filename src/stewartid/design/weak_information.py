@@ -1,14 +1,6 @@
-"""Predicted standard errors of Method B's Mt and Bt from the information of its weak-form
-equations, without a Monte Carlo.
-
-To first order the generalized least squares of the design's estimator errs by
-dz = N^-1 sum_n D_n^T W_n e_n, N = sum_n D_n^T W_n D_n, so that
-
-    Cov(z) = N^-1 (sum_n D_n^T W_n C_n W_n D_n) N^-1,
-
-with D_n the noise-free design of interval n, W_n its weights and C_n the true covariance of
-its rows' force and pose noise. Everything is computed on the design's noise-free data with
-the noise model known; the Monte Carlo check measures what first order leaves out.
+"""Predicted standard errors of Method B's Mt and Bt from its weak-form equations' information,
+without a Monte Carlo: Cov(z) = N^-1 (sum_n D_n^T W_n C_n W_n D_n) N^-1, N = sum_n D_n^T W_n D_n,
+on the design's noise-free data with the noise model known.
 """
 
 from __future__ import annotations
@@ -61,15 +53,8 @@ from stewartid.simulation.sensors import SensorNoise
 
 
 def known_noise(experiment: Experiment, noise: SensorNoise) -> tuple[np.ndarray, np.ndarray]:
-    """The pose noise and the generalized force's noise per sample of one noise-free experiment,
-    from the sensor noise (white on lengths and forces).
-
-    Returns
-    -------
-    pose : ndarray, shape (6, 6)
-        J_lq^-1 Sigma_l J_lq^-T averaged over the samples (m^2, m rad, rad^2).
-    force : ndarray, shape (6, 6)
-        J_lq^T Sigma_f J_lq + K pose K^T averaged over the samples (N^2, N^2 m, N^2 m^2).
+    """Pose noise J_lq^-1 Sigma_l J_lq^-T and generalized force noise J_lq^T Sigma_f J_lq + K pose K^T
+    per sample, each (6, 6), averaged over one noise-free experiment.
     """
     forces = np.broadcast_to(np.asarray(noise.force_noise, dtype=float), 6) ** 2
     jacobian = experiment.leg_jacobian
@@ -81,16 +66,8 @@ def known_noise(experiment: Experiment, noise: SensorNoise) -> tuple[np.ndarray,
 
 def expected_detection(experiment: Experiment, pose: np.ndarray, force: np.ndarray,
                        settings: dict) -> Detection:
-    """The intervals Method B finds in a noisy copy of a noise-free experiment.
-
-    Parameters
-    ----------
-    experiment : Experiment
-        Noise-free, with its joint-axis Jacobians.
-    pose, force : ndarray, shape (6, 6)
-        :func:`known_noise`.
-    settings : dict
-        The estimator's ``get_params()``.
+    """Intervals Method B finds in a noisy copy of a noise-free experiment (with joint-axis
+    Jacobians); ``pose, force`` from :func:`known_noise`, ``settings`` the estimator's ``get_params()``.
     """
     window, margin = excitation_scales(experiment, settings["differentiation_window"],
                                        settings["margin"], MARGIN_PERIODS)
@@ -109,15 +86,8 @@ def expected_detection(experiment: Experiment, pose: np.ndarray, force: np.ndarr
 
 def expected_equations(platform: Platform, datasets: list[Dataset], noise: SensorNoise,
                        settings: dict) -> tuple[StackedEquations, np.ndarray]:
-    """The weak-form equations of noise-free data, as the estimator forms them from a noisy
-    copy, with the known noise of each experiment.
-
-    Returns
-    -------
-    stacked : StackedEquations
-        Pose noise, force sensitivity and white force variance per interval filled in.
-    force : ndarray, shape (n_experiments, 6, 6)
-        The full covariance of the generalized force's noise per sample of each experiment.
+    """Weak-form equations of noise-free data as the estimator forms them from a noisy copy, with
+    each experiment's known noise; and the force noise covariance per experiment (n, 6, 6).
     """
     equations, poses, forces, sensitivities = [], [], [], []
     for k, dataset in enumerate(datasets):
@@ -137,14 +107,8 @@ def expected_equations(platform: Platform, datasets: list[Dataset], noise: Senso
 
 def expected_scatter(stacked: StackedEquations, designs: list[np.ndarray], theta: np.ndarray,
                      variance: np.ndarray) -> np.ndarray:
-    """tau (6,) the estimator's chi-square match gives on average (N, N m).
-
-    Parameters
-    ----------
-    theta : ndarray, shape (6, 12)
-        Invariant-row estimate on the noise-free data.
-    variance : ndarray, shape (n, 6)
-        Noise variance of every interval's mean row per channel.
+    """tau (6,) the estimator's chi-square match gives on average (N, N m), from ``theta`` (6, 12)
+    and per-interval row noise ``variance`` (n, 6).
     """
     base = stacked.mean_targets - stacked.mean_regressors @ theta.T
     nuisance = np.stack([d[:, -1, N_THETA:] for d in designs], axis=1)       # (n, 6, u)
@@ -162,28 +126,20 @@ def expected_scatter(stacked: StackedEquations, designs: list[np.ndarray], theta
 def information_covariance(stacked: StackedEquations, force: np.ndarray, theta: np.ndarray,
                            model_error: np.ndarray, scatter: np.ndarray
                            ) -> tuple[np.ndarray, np.ndarray]:
-    """The expected estimate and the covariance of every unknown of the joint weak-form fit
-    (module docstring).
+    """Expected estimate z (u,) and covariance (u, u) of every unknown of the joint weak-form fit:
+    [Mt Bt] row-major, then offsets and the Coulomb level.
 
     Parameters
     ----------
     stacked : StackedEquations
     force : ndarray, shape (n_experiments, 6, 6)
-        Generalized force noise per sample of each experiment.
+        Generalized force noise per sample.
     theta : ndarray, shape (6, 12)
-        [Mt Bt] the pose noise's coefficients are taken at.
+        [Mt Bt] for the pose noise's coefficients.
     model_error : ndarray, shape (n, 6)
-        Variance per row the estimator adds for model error.
+        Model-error variance per row.
     scatter : ndarray, shape (6,)
         tau per channel.
-
-    Returns
-    -------
-    z : ndarray, shape (u,)
-        The fit of the noise-free equations with the weights of the noise: the mean of the
-        noisy fits to first order.
-    covariance : ndarray, shape (u, u)
-        [Mt Bt] row-major, then the offsets and the Coulomb level.
     """
     n_experiments = int(stacked.owner.max()) + 1
     designs, targets = channel_systems(stacked, n_experiments, True)
@@ -218,13 +174,8 @@ def information_covariance(stacked: StackedEquations, force: np.ndarray, theta: 
 
 
 def pooled(z: np.ndarray, covariance: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Mt, Bt and their standard errors once every symmetric pair is pooled as the estimator
-    pools it (inverse-variance mean, correlation kept), from [Mt Bt] row-major (the first 72
-    unknowns) and their covariance.
-
-    Returns
-    -------
-    M, B, std_M, std_B : ndarray, shape (6, 6)
+    """M, B, std_M, std_B (6, 6) once symmetric pairs are pooled as the estimator does
+    (inverse-variance mean, correlation kept).
     """
     variance = np.diag(covariance)[:N_THETA].reshape(6, 12)
     values = z[:N_THETA].reshape(6, 12)
@@ -248,24 +199,17 @@ def pooled(z: np.ndarray, covariance: np.ndarray) -> tuple[np.ndarray, ...]:
 
 def information_estimate(platform: Platform, datasets: list[Dataset], noise: SensorNoise,
                          settings: dict) -> tuple[np.ndarray, ...]:
-    """Method B's expected Mt and Bt and their standard errors on noisy copies of noise-free data.
+    """Method B's expected Mt, Bt and standard errors (6, 6 each) on noisy copies of noise-free data.
 
     Parameters
     ----------
     platform : Platform
     datasets : list of Dataset
-        Noise-free data, e.g. the design played on the plant.
+        Noise-free data.
     noise : SensorNoise
-        White noise on lengths (m) and forces (N); biases and resolutions are left out.
+        White noise on lengths (m) and forces (N).
     settings : dict
-        The estimator's ``get_params()`` (``friction`` "shared" or "uniform").
-
-    Returns
-    -------
-    M, B : ndarray, shape (6, 6)
-        The mean estimate to first order (kg, kg m, kg m^2; N s/m, N s, N m s).
-    std_M, std_B : ndarray, shape (6, 6)
-        Standard errors (same units).
+        Estimator's ``get_params()`` (``friction`` "shared" or "uniform").
     """
     stacked, force = expected_equations(platform, datasets, noise, settings)
     designs, _ = channel_systems(stacked, len(datasets), True)
@@ -283,10 +227,7 @@ def information_estimate(platform: Platform, datasets: list[Dataset], noise: Sen
 
 
 def has_information(method: str) -> bool:
-    """Whether the design's estimator for ``method`` has an information-matrix prediction
-    (Method B with its interval constants tied to the friction); the others have the Monte Carlo
-    alone.
-    """
+    """Whether ``method``'s design estimator has an information-matrix prediction (else Monte Carlo only)."""
     return method == "wavelet" and DESIGN_SETTINGS.get(method, {}).get("friction") in (
         "shared", "uniform")
 
@@ -296,37 +237,28 @@ def information_prediction(platform: Platform, design: Design, noise: SensorNois
                            source: str = "plant", records: list | None = None,
                            workers: int | None = None,
                            progress: Callable[[int, int], None] | None = None) -> Prediction:
-    """Predicted bias and standard errors of Mt and Bt for a design, the standard errors from
-    the information matrix (:func:`information_estimate`).
+    """Predicted bias and standard errors of Mt and Bt for a design, standard errors from the
+    information matrix (:func:`information_estimate`).
 
     Parameters
     ----------
     platform : Platform
-        With the friction the machine is expected to have.
+        With the machine's expected friction.
     design : Design
     noise : SensorNoise
-        Sensor noise standard deviations (m, N).
+        Standard deviations (m, N).
     method : str
-        Registered method with :func:`has_information`.
+        A method with :func:`has_information`.
     check_seeds : int
-        0: the bias is the expected estimate's. >= 2: a Monte Carlo of as many realisations
-        (:func:`~stewartid.design.prediction.predict_accuracy`) gives the bias and its spread,
-        kept beside the standard errors as their check.
+        0: bias from the expected estimate; >= 2: a Monte Carlo gives the bias and a spread check.
     seed : int
-        Seed of the Monte Carlo's first realisation.
+        Monte Carlo's first seed.
     source : {"plant", "model"}
-        Noise-free data from the design played on the plant or from the rigid-body model.
     records : list of ExperimentRecord, optional
-        The design already played on the plant, ``source="plant"``.
+        Design already played on the plant.
     workers : int, optional
-        Processes the Monte Carlo is spread over.
     progress : callable, optional
-        Called with (done, total) after each realisation of the Monte Carlo.
-
-    Returns
-    -------
-    Prediction
-        ``seeds`` = ``check_seeds``; ``monte_carlo_std_*`` set when checked.
+        Called with (done, total).
     """
     if not has_information(method):
         raise ConfigError(f"method {method!r} has no information-matrix prediction; use "
@@ -361,10 +293,8 @@ def information_prediction(platform: Platform, design: Design, noise: SensorNois
 
 
 def checked_prediction(prediction: Prediction, monte_carlo: Prediction) -> Prediction:
-    """An information-matrix prediction checked by the Monte Carlo of the same design.
-
-    The standard errors stay the information matrix's, with the Monte Carlo's spread beside them;
-    the bias becomes the Monte Carlo's, which holds what first order leaves out.
+    """Information-matrix prediction with the Monte Carlo's spread beside its standard errors and
+    the Monte Carlo's bias (what first order leaves out).
     """
     return dataclasses.replace(monte_carlo, std_M=prediction.std_M, std_B=prediction.std_B,
                                monte_carlo_std_M=monte_carlo.std_M,

@@ -1,18 +1,6 @@
-"""Weighted least squares of physical parameters, the ones the data cannot tell fixed at known
-values, and the physically consistent parameters nearest to them: the solvers of
-:mod:`stewartid.physical.estimator`.
-
-:func:`nearest_consistent` solves
-
-    minimise (p - p^)^T Sigma^-1 (p - p^)  subject to  J(body) >= 0,  m(body) > 0,  f >= 0,
-
-with J the pseudo-inertia (:func:`~stewartid.model.regressor.pseudo_inertia`), as a small
-semidefinite program in cvxpy (the ``convex`` extra).
-
-References
-----------
-Wensing, P. M., Kim, S., Slotine, J.-J. E. "Linear matrix inequalities for physically
-consistent inertial parameter identification." IEEE RA-L 3(1) (2017).
+"""Solvers of :mod:`stewartid.physical.estimator`: weighted least squares with unidentifiable
+parameters fixed, and the nearest physically consistent parameters (an SDP in cvxpy;
+Wensing, Kim & Slotine, IEEE RA-L 2017).
 """
 
 from __future__ import annotations
@@ -48,15 +36,15 @@ class Solution:
     Attributes
     ----------
     values : ndarray, shape (p,)
-        Every parameter: estimated, or fixed at its nominal value.
+        Estimated, or fixed at nominal.
     covariance : ndarray, shape (p, p)
-        Zero in the rows and columns of the fixed ones.
+        Zero in the fixed ones' rows and columns.
     fixed : dict of str to str
         Fixed parameters and why.
     condition_number : float
-        Of the column-equilibrated, channel-weighted regression of the estimated ones.
+        Of the equilibrated, channel-weighted regression of the estimated ones.
     singular_values : ndarray
-        Its singular values (relative to the largest), every parameter included.
+        Relative to the largest, every parameter included.
     residual_rms : ndarray, shape (6,)
     n_equations : int
     """
@@ -71,12 +59,8 @@ class Solution:
 
 
 def _weighted_fit(gram, cross, weights, free, fixed_values):
-    """Equilibrated weighted least squares from per-channel Gram matrices.
-
-    ``gram`` (6, p, p) and ``cross`` (6, p) = X_c^T y_c; parameters outside ``free`` held at
-    ``fixed_values``. Returns the free estimates, the inverse of their normal matrix (original
-    units), the scaled regression's singular values relative to the largest and its right
-    singular vectors (rows).
+    """Equilibrated weighted LS from per-channel ``gram`` (6, p, p) and ``cross`` (6, p): free
+    estimates, inverse normal matrix, relative singular values and right singular vectors.
     """
     N = np.einsum("c,cpq->pq", weights, gram)
     b = np.einsum("c,cp->p", weights, cross) - N[:, ~free] @ fixed_values[~free]
@@ -101,10 +85,10 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
                      ) -> Solution:
     """Weighted least squares for y = X theta, fixing at ``nominal`` what the data cannot tell.
 
-    Channels are weighted by their residual variance from a first, RMS-weighted pass. A parameter
-    is fixed when the equilibrated regression's condition number exceeds ``max_condition`` (the
-    one weighing most in the weakest direction) or, if positive by nature, when its standard
-    error exceeds ``max_relative_error`` of its size.
+    Channels are weighted by their residual variance from a first RMS-weighted pass. A parameter
+    is fixed when the condition number exceeds ``max_condition`` (the one weighing most in the
+    weakest direction) or, if positive by nature, when its standard error exceeds
+    ``max_relative_error`` of its size.
 
     Parameters
     ----------
@@ -112,26 +96,19 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
     y : ndarray, shape (K, 6)
     names : list of str
     nominal : ndarray, shape (p,)
-        The values a fixed parameter keeps (the platform file's).
+        Values a fixed parameter keeps.
     scales : ndarray, shape (p,), optional
-        The size of each parameter positive by nature, zero for the others.
+        Size of each positive parameter, 0 for the others.
     max_condition, max_relative_error : float
     regressor_noise : ndarray, shape (6, p, p) or (R, 6, p, p), optional
-        Per channel (and per record, R = ``len(segments)``), the expected share of X^T X that
-        noise in the regressor rows adds; subtracted to remove the attenuation bias.
+        Expected noise share of X^T X per channel (and record); subtracted against attenuation bias.
     target_noise : ndarray, shape (6, p) or (R, 6, p), optional
-        The same for X^T y; subtracted.
+        The same for X^T y.
     segments : list of (int, int), optional
-        Per record, its number of rows and the lag (rows) beyond which its noise is
-        uncorrelated. Given, the covariance is :func:`score_covariance`; without, the inverse
-        normal matrix scaled by the residual's variance and autocorrelation time.
+        Per record, rows and correlation lag (rows); given, the covariance is
+        :func:`score_covariance`.
     measured_noise : list of (ndarray, ndarray), optional
-        With ``segments``: per record, a noise of the rows measured apart from the fit, a floor
-        of the standard errors (:func:`score_covariance`).
-
-    Returns
-    -------
-    Solution
+        With ``segments``: per record, a separately measured row noise flooring the standard errors.
     """
     p = X.shape[2]
     scales = np.zeros(p) if scales is None else np.asarray(scales, dtype=float)
@@ -197,8 +174,7 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
 
 @dataclass(frozen=True)
 class Body:
-    """A rigid body of the consistent fit: its ten standard parameters
-    (:data:`~stewartid.model.regressor.BODY_PARAMETERS`) are ``mapping @ p + offset``.
+    """A rigid body of the consistent fit: its ten standard parameters are ``mapping @ p + offset``.
 
     Attributes
     ----------
@@ -206,8 +182,7 @@ class Body:
     mapping : ndarray, shape (10, p)
     offset : ndarray, shape (10,)
     mass_scale : float
-        A mass (kg) of the body's order: its mass is kept above ``STRICT_FRACTION`` of it and
-        its pseudo-inertia scaled by it in the solver.
+        kg; mass kept above ``STRICT_FRACTION`` of it, pseudo-inertia scaled by it.
     """
 
     name: str
@@ -216,25 +191,25 @@ class Body:
     mass_scale: float
 
     def pseudo_inertia(self, p: np.ndarray) -> np.ndarray:
-        """Its pseudo-inertia matrix (4, 4) at the parameters ``p``."""
+        """Pseudo-inertia matrix (4, 4) at ``p``."""
         return pseudo_inertia(self.mapping @ p + self.offset)
 
 
 @dataclass(frozen=True)
 class ConsistentParameters:
-    """The physically consistent parameters nearest an estimate (:func:`nearest_consistent`).
+    """Physically consistent parameters nearest an estimate (:func:`nearest_consistent`).
 
     Attributes
     ----------
     values : ndarray, shape (p,)
     change : ndarray, shape (p,)
-        (consistent - unconstrained) / standard error; 0 for a fixed parameter.
+        (consistent - unconstrained) / standard error; 0 when fixed.
     objective : float
-        (p - p^)^T Sigma^-1 (p - p^) at the solution (squared standard errors).
+        (p - p^)^T Sigma^-1 (p - p^) at the solution.
     min_eigenvalues : dict of str to float
-        Smallest eigenvalue of each body's pseudo-inertia at the solution (kg m^2).
+        Smallest pseudo-inertia eigenvalue per body (kg m^2).
     solver : str
-        The cvxpy solver, or ``"none"`` when the estimate was consistent already.
+        cvxpy solver, or ``"none"`` when already consistent.
     status : str
         ``"optimal"``, ``"optimal_inaccurate"`` or ``"consistent already"``.
     """
@@ -252,35 +227,25 @@ def score_covariance(inverse: np.ndarray, X: np.ndarray, residual: np.ndarray,
                      expected: np.ndarray | None = None,
                      measured_noise: list[tuple[np.ndarray, np.ndarray]] | None = None
                      ) -> np.ndarray:
-    """N^-1 B N^-1, B the long-run covariance of the scores s_k = sum_c w_c X_kc r_kc.
+    """N^-1 B N^-1, B the long-run covariance of the scores s_k = sum_c w_c X_kc r_kc, shape (p, p).
 
-    B is :func:`~stewartid.identification.long_run.score_sandwich` (variances as estimated,
-    correlations made positive semidefinite), each variance raised to that of the scores summed
-    per record where larger (:func:`~stewartid.identification.long_run.record_sandwich`), then to
-    the floor of the measured noise.
+    Each variance of B is raised to the per-record summed scores' where larger
+    (:func:`~stewartid.identification.long_run.record_sandwich`), then to the measured noise floor.
 
     Parameters
     ----------
     inverse : ndarray, shape (p, p)
-        The weighted normal matrix's inverse N^-1.
+        N^-1.
     X : ndarray, shape (K, 6, p)
     residual : ndarray, shape (K, 6)
     weights : ndarray, shape (6,)
-        Channel weights w_c.
     segments : list of (int, int)
-        Rows of each record (summing to K) and its correlation length in rows.
+        Rows of each record and its correlation length in rows.
     expected : ndarray, shape (R, p), optional
-        Each record's expected summed score under noise alone; without, the scores' total
-        shared out by rows. Taken out of the scores: a correction's mean is no fluctuation.
+        Each record's expected summed score under noise alone, taken out of the scores.
     measured_noise : list of (ndarray, ndarray), optional
-        Per record, a noise of the rows measured apart from the fit: its covariance per
-        sample and the filter's autocorrelation at row lags
-        (:func:`~stewartid.identification.long_run.filtered_noise_covariance`); each variance is
-        raised to its share where larger.
-
-    Returns
-    -------
-    ndarray, shape (p, p)
+        Per record, covariance per sample and filter autocorrelation at row lags
+        (:func:`~stewartid.identification.long_run.filtered_noise_covariance`).
     """
     scores = np.einsum("kcp,kc->kp", X, residual * weights, optimize=True)
     rows = np.array([n for n, _ in segments])
@@ -299,31 +264,27 @@ def score_covariance(inverse: np.ndarray, X: np.ndarray, residual: np.ndarray,
 def nearest_consistent(values: np.ndarray, covariance: np.ndarray, bodies: list[Body],
                        nonnegative: np.ndarray, solver: str | None = None
                        ) -> ConsistentParameters:
-    """The consistent parameters nearest ``values`` in the metric of ``covariance``.
+    """Consistent parameters nearest ``values`` in the metric of ``covariance``.
+
+        minimise (p - p^)^T Sigma^-1 (p - p^)  s.t.  J(body) >= 0,  m(body) > 0,  f >= 0
 
     Parameters
     ----------
     values : ndarray, shape (p,)
-        The unconstrained estimate.
     covariance : ndarray, shape (p, p)
-        Its covariance; parameters with zero variance are fixed and stay as they are.
+        Zero-variance parameters stay as they are.
     bodies : list of Body
-        Rigid bodies whose pseudo-inertia must be positive semidefinite and mass positive.
     nonnegative : ndarray of bool, shape (p,)
-        Parameters that cannot be negative (friction coefficients).
+        Friction coefficients.
     solver : str, optional
-        A cvxpy solver; Clarabel when installed, else SCS.
-
-    Returns
-    -------
-    ConsistentParameters
+        cvxpy solver; Clarabel when installed, else SCS.
 
     Raises
     ------
     ConfigError
-        If cvxpy is not installed (the message names the extra).
+        cvxpy not installed.
     IdentificationError
-        If the solver fails or no consistent parameters exist with the fixed ones.
+        Solver fails, or no consistent parameters with the fixed ones.
     """
     require_cvxpy()  # needed whatever the estimate
     values = np.asarray(values, dtype=float)
@@ -358,9 +319,7 @@ def nearest_consistent(values: np.ndarray, covariance: np.ndarray, bodies: list[
 
 
 def _projection(values, std, correlation, solved, bodies, bounded, solver):
-    """The changes z (standard errors) of the parameters ``solved`` minimising z^T C^-1 z under
-    the constraints of :func:`nearest_consistent`, C their ``correlation``; and the solver's status.
-    """
+    """Changes z (standard errors) of ``solved`` minimising z^T C^-1 z under the constraints, and status."""
     cp = require_cvxpy()
     eigenvalues, vectors = np.linalg.eigh(correlation)
     eigenvalues = np.maximum(eigenvalues, eigenvalues[-1] * 1e-15)

@@ -1,9 +1,6 @@
-"""Validation of an identified model on data it was not fitted on.
-
-The model predicts y = J_lq(q)^T f_a - G(q) = Mt q_ddot + Bt q_dot + Fc(q_dot) + c, with c
-taken from each segment's mean. Both sides are filtered with the same zero-phase kernel h
-(:func:`~stewartid.signals.differentiation.kernel_filter`). Scores per DOF, pooled over
-held-out segments: VAF = 100 (1 - sum e^2 / sum y^2) %, NRMSE = rms(e) / (max y - min y).
+"""Validation of an identified model on data it was not fitted on: y = J^T f_a - G(q) against
+Mt q_ddot + Bt q_dot + Fc(q_dot) + c, both filtered with one zero-phase kernel; per DOF
+VAF = 100 (1 - sum e^2 / sum y^2) % and NRMSE = rms(e) / (max y - min y).
 """
 
 from __future__ import annotations
@@ -27,25 +24,22 @@ DEFAULT_FOLDS = 3
 
 @dataclass(frozen=True)
 class Segment:
-    """One held-out piece of one experiment, filtered and ready for prediction.
+    """One held-out piece of one experiment, filtered for prediction.
 
     Attributes
     ----------
     name : str
         ``"exp1[0-4 s]"``.
-    experiment : int
-        Index of the experiment it comes from.
-    fold : int
-        The fold that holds it out.
+    experiment, fold : int
+        Source experiment; fold holding it out.
     t : ndarray, shape (n,)
-        Time (s) of the filtered samples.
+        s.
     force : ndarray, shape (n, 6)
-        Filtered measured generalized force y * h (N, N m).
+        Filtered generalized force y * h (N, N m).
     q_dot, q_ddot : ndarray, shape (n, 6)
-        q * h' (m/s, rad/s) and q * h'' (m/s^2, rad/s^2).
+        q * h' and q * h'' (m/s, rad/s; m/s^2, rad/s^2).
     coulomb : ndarray, shape (n, 3, 6)
-        Filtered generalized Coulomb force per unit level of each joint type (N or N m per
-        N m of level).
+        Filtered generalized Coulomb force per unit level of each joint type.
     """
 
     name: str
@@ -64,13 +58,11 @@ class ValidationResult:
 
     Attributes
     ----------
-    vaf_percent : ndarray, shape (6,)
-        Variance accounted for per DOF (%), 100 for a perfect prediction.
-    nrmse : ndarray, shape (6,)
-        RMS prediction error over the peak-to-peak range of the measured force, per DOF.
+    vaf_percent, nrmse : ndarray, shape (6,)
+        Per DOF.
     folds : int
     measured, predicted : list of ndarray, each (n_k, 6)
-        Centred measured and predicted generalized force of every held-out segment (N, N m).
+        Centred generalized force of every segment (N, N m).
     segments : list of Segment
     """
 
@@ -82,22 +74,22 @@ class ValidationResult:
     segments: list[Segment]
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``validation`` object of ``result.json``: ``vaf_percent``, ``nrmse``, ``folds``."""
+        """``validation`` object of ``result.json``: ``vaf_percent``, ``nrmse``, ``folds``."""
         return {"vaf_percent": self.vaf_percent.tolist(), "nrmse": self.nrmse.tolist(),
                 "folds": int(self.folds)}
 
 
 @dataclass(frozen=True)
 class CrossValidation:
-    """The refits of a k-fold validation and the held-out segments they predict.
+    """Refits of a k-fold validation and the held-out segments they predict.
 
     Attributes
     ----------
     folds : int
     fold_results : list of IdentificationResult
-        The method refitted without fold k, for k = 0 ... folds - 1.
+        The method refitted without fold k.
     segments : list of Segment
-        Every segment of every experiment (each is held out by exactly one fold).
+        Every segment of every experiment.
     """
 
     folds: int
@@ -106,13 +98,8 @@ class CrossValidation:
 
     def scores(self, adjust: Callable[[IdentificationResult], IdentificationResult]
                | None = None) -> ValidationResult:
-        """VAF and NRMSE of the fold models on their held-out segments.
-
-        Parameters
-        ----------
-        adjust : callable, optional
-            Applied to every fold's result before it predicts (e.g. the physically
-            consistent projection), so its effect is validated the same way.
+        """VAF and NRMSE of the fold models on their held-out segments; ``adjust`` (e.g. the
+        physically consistent projection) is applied to every fold's result first.
         """
         results = [r if adjust is None else adjust(r) for r in self.fold_results]
         predicted = [predict(s, results[s.fold]) for s in self.segments]
@@ -120,13 +107,7 @@ class CrossValidation:
 
 
 def coulomb_levels(result: IdentificationResult) -> np.ndarray | None:
-    """Coulomb level per joint type (N m) the method identified, None if it has none.
-
-    Returns
-    -------
-    ndarray, shape (3,), or None
-        In the order of :data:`FRICTION_TYPES`.
-    """
+    """Coulomb level per joint type (N m), shape (3,) in :data:`FRICTION_TYPES` order; None if none."""
     levels = result.diagnostics.get("coulomb")
     if not isinstance(levels, dict) or result.diagnostics.get("friction_model") == "free":
         return None
@@ -135,10 +116,8 @@ def coulomb_levels(result: IdentificationResult) -> np.ndarray | None:
 
 
 def prediction_levels(result: IdentificationResult) -> np.ndarray | None:
-    """Coulomb levels per joint type (N m) a result predicts with.
-
-    Its own (:func:`coulomb_levels`), else those of its companion friction fit
-    (``diagnostics["validation_coulomb"]``, :func:`with_companion_friction`), else None.
+    """Coulomb levels a result predicts with: its own, else its companion fit's
+    (``diagnostics["validation_coulomb"]``), else None.
     """
     levels = coulomb_levels(result)
     if levels is not None:
@@ -155,9 +134,8 @@ def with_companion_friction(result: IdentificationResult, companion: Callable[[]
                             ) -> IdentificationResult:
     """``result`` with the Coulomb levels of a friction-estimating fit of the same data.
 
-    A method that leaves friction free cannot predict it, so its held-out residual would be
-    friction it never claimed to model. The levels go to ``diagnostics["validation_coulomb"]``;
-    Mt and Bt stay the method's own. A result that has levels is returned as it is.
+    A method leaving friction free would otherwise be scored on friction it never modelled. The
+    levels go to ``diagnostics["validation_coulomb"]``; Mt and Bt stay the method's own.
     """
     if companion is None or prediction_levels(result) is not None:
         return result
@@ -172,13 +150,7 @@ def with_companion_friction(result: IdentificationResult, companion: Callable[[]
 
 
 def coulomb_estimate(result: IdentificationResult) -> tuple[np.ndarray, np.ndarray]:
-    """Coulomb level and standard error per joint type (N m), NaN where not estimated.
-
-    Returns
-    -------
-    levels, std_errors : ndarray, shape (3,)
-        In the order of :data:`FRICTION_TYPES`.
-    """
+    """Coulomb levels and standard errors per joint type (N m), shape (3,) each; NaN where not estimated."""
     nan = np.full(len(FRICTION_TYPES), np.nan)
     levels = coulomb_levels(result)
     if levels is None:
@@ -199,18 +171,13 @@ def prepare_segment(dataset: Dataset, platform: Platform, window: float, *, grav
     window : float
         Kernel support (s).
     gravity : bool
-        Subtract the model's G(q), as the identifier did.
+        Subtract G(q).
     experiment, fold : int
-        Labels stored in the segment.
+        Labels.
     coulomb_smoothing : float
-        Rate (rad/s) below which a joint's Coulomb sign is attenuated.
+        Rate (rad/s) below which a Coulomb sign is attenuated.
     remainder : bool
-        Subtract the model's departure from its linearisation
-        (:func:`~stewartid.identification.preparation.model_remainder`).
-
-    Returns
-    -------
-    Segment
+        Subtract :func:`~stewartid.identification.preparation.model_remainder`.
     """
     from stewartid.identification.least_squares import coulomb_regressors
     from stewartid.identification.preparation import prepare
@@ -231,10 +198,7 @@ def prepare_segment(dataset: Dataset, platform: Platform, window: float, *, grav
 
 
 def predict(segment: Segment, result: IdentificationResult) -> np.ndarray:
-    """Generalized force predicted by ``result`` on ``segment``, shape (n, 6) (N, N m), not centred.
-
-    Mt q_ddot + Bt q_dot, plus the Coulomb friction of :func:`prediction_levels` when there is one.
-    """
+    """Generalized force (n, 6) predicted by ``result`` on ``segment`` (N, N m), not centred."""
     out = segment.q_ddot @ np.asarray(result.M).T + segment.q_dot @ np.asarray(result.B).T
     levels = prediction_levels(result)
     if levels is not None:
@@ -244,7 +208,7 @@ def predict(segment: Segment, result: IdentificationResult) -> np.ndarray:
 
 def score(segments: Sequence[Segment], predicted: Sequence[np.ndarray], folds: int
           ) -> ValidationResult:
-    """VAF and NRMSE per DOF of predictions against the segments' measured force (module docstring)."""
+    """VAF and NRMSE per DOF of predictions against the segments' measured force."""
     measured = [s.force - s.force.mean(axis=0) for s in segments]
     centred = [p - p.mean(axis=0) for p in predicted]
     y = np.concatenate(measured)
@@ -271,7 +235,7 @@ def time_piece(dataset: Dataset, start: int, stop: int) -> Dataset:
 
 
 def excitation_window(dataset: Dataset) -> float:
-    """Kernel support (s) for a record: 0.2 periods of its dominant excitation frequency."""
+    """Kernel support (s): 0.2 periods of the record's dominant excitation frequency."""
     from stewartid.signals.differentiation import default_window, estimate_frequency
 
     return default_window(estimate_frequency(dataset.pose, dataset.sample_rate))
@@ -280,10 +244,7 @@ def excitation_window(dataset: Dataset) -> float:
 def held_out_segments(datasets: Sequence[Dataset], platform: Platform,
                       folds: int = DEFAULT_FOLDS, gravity: bool = True,
                       remainder: bool = False) -> list[Segment]:
-    """Every fold segment of every experiment, filtered (:func:`prepare_segment`).
-
-    The same for every method with the same ``gravity`` and ``remainder`` settings.
-    """
+    """Every fold segment of every experiment, filtered (:func:`prepare_segment`)."""
     segments = []
     for e, dataset in enumerate(datasets):
         edges, window = fold_bounds(len(dataset), folds), excitation_window(dataset)
@@ -303,29 +264,23 @@ def cross_validate(create: Callable[[], Any], datasets: Sequence[Dataset], platf
     Parameters
     ----------
     create : callable
-        Returns a new, unfitted identifier (e.g. ``lambda: create_identifier("wavelet")``).
+        Returns a new unfitted identifier.
     datasets : sequence of Dataset
     platform : Platform
     folds : int
         Segments per experiment, >= 2.
     gravity : bool
-        Whether the method subtracts G(q) (its ``gravity`` setting).
+        Whether the method subtracts G(q).
     segments : list of Segment, optional
-        The held-out segments if already prepared (:func:`held_out_segments` with the same
-        ``folds`` and ``gravity``).
+        Already prepared (:func:`held_out_segments`, same ``folds`` and ``gravity``).
     companion : callable, optional
-        Returns a new friction-estimating identifier whose Coulomb levels each fold model
-        predicts with when it has none (:func:`with_companion_friction`).
-
-    Returns
-    -------
-    CrossValidation
+        Returns a friction-estimating identifier lending Coulomb levels
+        (:func:`with_companion_friction`).
 
     Raises
     ------
     DataError
-        If ``folds`` < 2, or a refit fails because the remaining data are too short for the
-        method (the message names the fold and how to fix it).
+        ``folds`` < 2, or a refit fails on too short remaining data.
     """
     if not (isinstance(folds, int | np.integer) and folds >= 2):
         raise DataError(f"validation needs at least 2 folds; got {folds!r}.")
@@ -351,7 +306,7 @@ def cross_validate(create: Callable[[], Any], datasets: Sequence[Dataset], platf
 
 def record_segments(datasets: Sequence[Dataset], platform: Platform, gravity: bool = True,
                     remainder: bool = False) -> list[Segment]:
-    """Validation records, each whole, filtered as held-out segments are (fold 0)."""
+    """Validation records, each whole, filtered as held-out segments (fold 0)."""
     return [prepare_segment(dataset, platform, excitation_window(dataset), gravity=gravity,
                             experiment=k, remainder=remainder)
             for k, dataset in enumerate(datasets)]
@@ -359,25 +314,15 @@ def record_segments(datasets: Sequence[Dataset], platform: Platform, gravity: bo
 
 def validate_on_records(result: IdentificationResult, segments: Sequence[Segment]
                         ) -> ValidationResult:
-    """Scores of a model fitted on all experiments on validation records of another excitation.
-
-    Other motion shows a wrong parameter that a friction term compensated on the fitted one.
-
-    Returns
-    -------
-    ValidationResult
-        With ``folds`` = 0 (no refit).
+    """Scores (``folds`` = 0) of a model fitted on all experiments, on records of another
+    excitation: other motion shows a wrong parameter friction compensated.
     """
     return score(segments, [predict(s, result) for s in segments], folds=0)
 
 
 def validation_entry(held_out: ValidationResult, records: ValidationResult | None = None
                      ) -> dict[str, Any]:
-    """The ``validation`` object of ``result.json``.
-
-    The held-out scores (:meth:`ValidationResult.to_dict`) and, with validation records, their
-    ``"records"``: ``vaf_percent``, ``nrmse`` and ``names``.
-    """
+    """``validation`` object of ``result.json``, with ``"records"`` scores when given."""
     entry = held_out.to_dict()
     if records is not None:
         entry["records"] = {"vaf_percent": records.vaf_percent.tolist(),
@@ -387,11 +332,8 @@ def validation_entry(held_out: ValidationResult, records: ValidationResult | Non
 
 
 def friction_signature(validation: ValidationResult) -> float:
-    """Share of the held-out residual that has the shape of Coulomb joint friction.
-
-    The residuals of the six equations, each scaled by the RMS of its measured force, are
-    least-squares fitted with the three Coulomb regressors (one level per joint type). 0: nothing
-    looks like friction; near 1: the residual is mostly friction the model lacks.
+    """Share of the held-out residual shaped like Coulomb joint friction: 0 none, near 1
+    mostly friction the model lacks (RMS-scaled residuals fitted with the three Coulomb regressors).
     """
     measured = np.concatenate(validation.measured)
     scale = np.sqrt(np.mean(measured ** 2, axis=0))
@@ -410,7 +352,7 @@ def friction_signature(validation: ValidationResult) -> float:
 
 
 def in_sample(segments: Sequence[Segment], result: IdentificationResult) -> ValidationResult:
-    """Scores and residuals of the model fitted on all data, on the same segments."""
+    """Scores of the model fitted on all data, on the same segments."""
     return score(segments, [predict(s, result) for s in segments], folds=1)
 
 

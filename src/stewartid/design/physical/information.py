@@ -1,13 +1,5 @@
-"""Predicted standard errors of the physical model's parameters from the information matrix.
-
-The physical estimator regresses the leg forces on the regressor's columns mapped to them,
-each leg weighted by its noise variance; its covariance is the sandwich
-
-    Cov(theta) = A^-1 B A^-1,   A = sum_k X_k^T W X_k,   B = sum_k X_k^T W S_k W X_k,
-
-summed over the logged samples. The judged parameters (the moving body's or the payload's
-ten) are estimated with the others, and their relative standard errors are taken of sizes
-that turning the frame leaves alone (:func:`parameter_sizes`).
+"""Predicted standard errors of the physical model's parameters for a design, from the
+channel-weighted regression's sandwich covariance (:func:`sandwich_covariance`).
 """
 
 from __future__ import annotations
@@ -49,24 +41,23 @@ class ParameterPrediction:
     Attributes
     ----------
     names : tuple of str
-        Every parameter the estimator fits (nuisance ones included).
+        Every fitted parameter, nuisance ones included.
     nominal : ndarray, shape (p,)
-        Their values in the platform file.
+        Values in the platform file.
     std_errors : ndarray, shape (p,)
-        Predicted standard errors with every parameter estimated (the parameters' units).
+        Standard errors with every parameter estimated.
     expected_std_errors : ndarray, shape (p,)
-        The same once the parameters the estimator would fix are fixed (NaN for those): what a
-        fit will report, and what the design criterion is taken of.
+        Standard errors once the parameters the estimator would fix are fixed (NaN for those).
     fixed : tuple of str
         Those parameters.
     expected_covariance : ndarray, shape (p, p)
-        The covariance ``expected_std_errors`` are of; NaN rows and columns for the fixed.
+        Covariance of ``expected_std_errors``; NaN rows and columns for the fixed.
     sizes : ndarray, shape (p,)
-        What a relative standard error is taken of; 0 for the nuisance parameters.
+        What a relative standard error is taken of; 0 for nuisance parameters.
     payload : bool
         Payload mode.
     accuracy : mapping of str to float
-        Payload mode: what :attr:`criterion` judges against (keys and units of
+        Payload mode: required accuracies (keys and units of
         :data:`~stewartid.design.physical.payload_accuracy.REQUIRED_PAYLOAD_ACCURACY`).
     """
 
@@ -88,7 +79,7 @@ class ParameterPrediction:
 
     @property
     def relative_std(self) -> np.ndarray:
-        """Expected standard error relative to each judged parameter's size (%); NaN for the others."""
+        """Expected standard error over each judged parameter's size (%); NaN for the others."""
         with np.errstate(divide="ignore", invalid="ignore"):
             return np.where(self.judged, 100 * self.expected_std_errors / self.sizes, np.nan)
 
@@ -104,29 +95,22 @@ class ParameterPrediction:
 
     @property
     def payload_std_errors(self) -> dict[str, float] | None:
-        """Payload mode: the payload's quantities' standard errors
-        (:func:`~stewartid.design.physical.payload_accuracy.payload_std_errors`); else None.
-        """
+        """Payload mode: the payload's quantities' standard errors; else None."""
         if not self.payload:
             return None
         return payload_std_errors(self.names, self.nominal, self.expected_covariance)
 
     @property
     def criterion(self) -> float:
-        """What the design is judged by.
-
-        Payload mode: the largest ratio of the payload's quantities' standard errors to their
-        required accuracy (:func:`~stewartid.design.physical.payload_accuracy.payload_criterion`);
-        full mode: the worst relative standard error (%).
+        """What the design is judged by: payload mode, the largest ratio of standard error to
+        required accuracy; else the worst relative standard error (%).
         """
         if self.payload:
             return payload_criterion(self.payload_std_errors, self.accuracy)[0]
         return self.worst_relative_std
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain values (JSON ready): per parameter its nominal value, predicted SE and relative SE
-        (%, None for nuisance parameters).
-        """
+        """Per parameter: nominal value, predicted SE and relative SE (%, None for nuisance); JSON ready."""
         relative = self.relative_std
         out = {"mode": "payload" if self.payload else "full", "criterion": self.criterion,
                 "worst_relative_std_percent": self.worst_relative_std,
@@ -146,12 +130,10 @@ class ParameterPrediction:
 
 
 def parameter_sizes(names: tuple[str, ...], nominal: np.ndarray) -> np.ndarray:
-    """The size each parameter's relative standard error is taken of; 0 for those not judged.
+    """Size each parameter's relative standard error is taken of; 0 for those not judged.
 
-    Judged are the moving body's ten (the payload's in payload mode): the mass against itself,
-    every first moment against the first-moment vector's length (at least a tenth of the mass
-    times the radius of gyration), every inertia entry against the mean of the diagonal. These
-    sizes do not depend on how the frame is turned.
+    Mass against itself, first moments against the first-moment vector's length (at least
+    mass x radius of gyration / 10), inertia entries against the diagonal's mean: frame invariant.
     """
     values = dict(zip((n.removeprefix("payload.") for n in names), nominal, strict=True))
     mass = abs(values.get("m", 0.0))
@@ -173,46 +155,34 @@ def parameter_sizes(names: tuple[str, ...], nominal: np.ndarray) -> np.ndarray:
 
 
 def force_noise_covariance(noise: SensorNoise, rows: int) -> np.ndarray:
-    """S = Sigma_f: the covariance of the leg forces' noise per sample, at every row.
-
-    Returns
-    -------
-    ndarray, shape (rows, 6, 6)
-        N^2.
-    """
+    """Leg force noise covariance S per row, shape (rows, 6, 6), N^2."""
     sigma = np.broadcast_to(np.asarray(noise.force_noise, dtype=float), 6)
     return np.broadcast_to(np.diag(sigma ** 2), (rows, 6, 6))
 
 
 def channel_weights(S: np.ndarray) -> np.ndarray:
-    """W: each leg channel weighted by its mean noise variance over the rows of ``S`` (K, 6, 6),
-    as the estimator weights by its residual's. Shape (6,), 1/N^2.
-    """
+    """Per-leg weights W, shape (6,), 1/N^2: inverse mean noise variance over the rows of ``S``."""
     return 1.0 / np.mean(np.diagonal(S, axis1=1, axis2=2), axis=0)
 
 
 def sandwich_covariance(X: np.ndarray, S: np.ndarray, samples_per_row: float,
                         noise_rows: np.ndarray | None = None,
                         extra: np.ndarray | None = None) -> np.ndarray:
-    """The channel-weighted least-squares covariance A^-1 B A^-1 (module docstring).
+    """Channel-weighted least-squares covariance, shape (p, p).
+
+        Cov = A^-1 B A^-1,   A = sum_k X_k^T W X_k,   B = sum_k X_k^T W S_k W X_k
 
     Parameters
     ----------
     X : ndarray, shape (K, 6, p)
-        Regressor rows.
     S : ndarray, shape (K, 6, 6)
         Noise covariance of each row's channels.
     samples_per_row : float
-        Logged samples each row stands for (sample rate / row rate).
+        Logged samples per row (sample rate / row rate).
     noise_rows : ndarray, shape (K, 6, p), optional
-        The rows B is taken of, when not ``X`` (h * X for kernel-filtered rows).
+        Rows B is taken of when not ``X`` (kernel-filtered rows).
     extra : ndarray, shape (p, p), optional
-        Another noise's share of B, in the same units
-        (:func:`~stewartid.design.pose_noise.pose_noise_scores`).
-
-    Returns
-    -------
-    ndarray, shape (p, p)
+        Another noise's share of B (:func:`~stewartid.design.pose_noise.pose_noise_scores`).
     """
     weights = channel_weights(S)
     Z = weights[None, :, None] * X  # W X
@@ -229,22 +199,18 @@ def sandwich_covariance(X: np.ndarray, S: np.ndarray, samples_per_row: float,
 
 
 def record_rows(design: Design, rate_hz: float = INFORMATION_RATE) -> list[int]:
-    """Rows of each record in :func:`design_rows` at ``rate_hz``: its samples from 0 s to its duration."""
+    """Rows of each record in :func:`design_rows` at ``rate_hz``."""
     return [int(math.floor(r.duration * rate_hz)) + 1 for r in design.records]
 
 
 def record_ends(design: Design, rate_hz: float = INFORMATION_RATE) -> np.ndarray:
-    """Each record's first row in :func:`design_rows` at ``rate_hz`` and, last, the total; shape
-    (records + 1,).
-    """
+    """Each record's first row in :func:`design_rows`, then the total; shape (records + 1,)."""
     return np.cumsum([0, *record_rows(design, rate_hz)])
 
 
 def design_rows(platform: Platform, design: Design, rate_hz: float = INFORMATION_RATE
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The commanded motion of every record at ``rate_hz``, concatenated: q, q_dot, q_ddot, each
-    (K, 6); :func:`record_rows` rows per record.
-    """
+    """Commanded q, q_dot, q_ddot of every record at ``rate_hz``, concatenated, each (K, 6)."""
     parts = [playable.evaluate(np.arange(rows) / rate_hz) for playable, rows
              in zip(design.playable(platform), record_rows(design, rate_hz), strict=True)]
     return tuple(np.concatenate(x) for x in zip(*parts, strict=True))
@@ -252,19 +218,10 @@ def design_rows(platform: Platform, design: Design, rate_hz: float = INFORMATION
 
 def played_states(records: list, design: Design, rate_hz: float
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The true motion of a design's records as the plant played them, at ``rate_hz``.
+    """Motion of a design's records as the plant played them (tracking errors included),
+    q, q_dot, q_ddot, each (K, 6), at ``rate_hz``.
 
-    q, q_dot, q_ddot of shape (K, 6), as :func:`design_rows` gives the commanded motion: the
-    information is in the motion the logs will hold, tracking errors included.
-
-    Parameters
-    ----------
-    records : list of ExperimentRecord
-        The design played on the plant (:func:`~stewartid.design.prediction.plant_records`),
-        one per record of ``design``, from 0 s.
-    design : Design
-    rate_hz : float
-        Hz.
+    ``records`` are :func:`~stewartid.design.prediction.plant_records`, one per record, from 0 s.
     """
     parts = []
     for record, rows in zip(records, record_rows(design, rate_hz), strict=True):
@@ -275,11 +232,7 @@ def played_states(records: list, design: Design, rate_hz: float
 
 
 def record_kernels(design: Design, rate_hz: float, q: np.ndarray) -> list[np.ndarray]:
-    """Each record's taps of the physical estimator's kernel at ``rate_hz``.
-
-    The window is :data:`~stewartid.signals.differentiation.DEFAULT_WINDOW_PERIODS` periods of
-    the record's dominant frequency in ``q`` (K, 6), records one after the other.
-    """
+    """Each record's taps of the physical estimator's kernel at ``rate_hz``."""
     ends = record_ends(design, rate_hz)
     return [kernel_taps(rate_hz, default_window(estimate_frequency(q[a:b], rate_hz)))[0]
             for a, b in zip(ends[:-1], ends[1:], strict=True)]
@@ -288,27 +241,10 @@ def record_kernels(design: Design, rate_hz: float, q: np.ndarray) -> list[np.nda
 def kernel_filtered(design: Design, rate_hz: float, q: np.ndarray, X: np.ndarray,
                     taps: list[np.ndarray] | None = None
                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The pose and the regressor of every record filtered with the physical estimator's kernel,
-    the records' ends dropped, as the estimator's rows are.
+    """Pose ``q`` (K, 6) and regressor ``X`` (K, 6, p) filtered per record with the estimator's
+    kernel, record ends dropped.
 
-    The filtered noise is correlated over the kernel, so B is of h * h * X; this matters for the
-    Coulomb columns, whose reversals the kernel smooths.
-
-    Parameters
-    ----------
-    design : Design
-    rate_hz : float
-        Rate of ``q`` and ``X`` (Hz), records one after the other (:func:`design_rows`).
-    q : ndarray, shape (K, 6)
-    X : ndarray, shape (K, 6, p)
-    taps : list of ndarray, optional
-        Each record's kernel (:func:`record_kernels`), when already computed.
-
-    Returns
-    -------
-    q, X, noise_rows : ndarray
-        Filtered, shapes (K', 6), (K', 6, p) and (K', 6, p); the last filtered twice
-        (``noise_rows`` of :func:`sandwich_covariance`).
+    Returns q, X and ``noise_rows`` = h * h * X (the filtered noise is correlated over the kernel).
     """
     ends = record_ends(design, rate_hz)
     poses, rows, twice = [], [], []
@@ -331,32 +267,24 @@ def predict_parameters(platform: Platform, design: Design, noise: SensorNoise,
     Parameters
     ----------
     platform : Platform
-        The description the design is for (with the expected payload in payload mode).
+        With the expected payload in payload mode.
     design : Design
-        Records of commanded motion.
     noise : SensorNoise
         ``force_noise`` (N); with ``filtered``, ``length_noise`` (m) too.
     payload : bool
-        Payload mode (the payload's ten parameters on the known platform), else every base
-        parameter.
+        Judge the payload's ten parameters on the known platform; else every base parameter.
     rate_hz : float
         Rate the regressor is summed at (Hz).
     max_relative_error : float
-        The estimator's: a parameter positive by nature whose standard error exceeds this
-        fraction of its size is fixed (the worst first, one at a time).
+        The estimator's: a positive parameter whose standard error exceeds this fraction of its
+        size is fixed, worst first.
     states : tuple of ndarray, optional
-        (q, q_dot, q_ddot) at ``rate_hz``: the commanded motion (:func:`design_rows`) or the
-        motion the plant played (:func:`played_states`).
+        (q, q_dot, q_ddot) at ``rate_hz``: :func:`design_rows` or :func:`played_states`.
     rows : ndarray, shape (K, 6, N_STANDARD), optional
-        The standard regressor at ``states``, when already computed.
+        Standard regressor at ``states``, when already computed.
     filtered : bool
-        Filter the regressor with the estimator's kernel (:func:`kernel_filtered`) and add the
-        pose noise's share (:func:`~stewartid.design.pose_noise.pose_noise_scores`). Needs
-        ``rate_hz`` of 100 Hz or more.
-
-    Returns
-    -------
-    ParameterPrediction
+        Filter with the estimator's kernel and add the pose noise's share; needs ``rate_hz``
+        >= 100 Hz.
     """
     names, _, selection, nominal, _ = parameter_model(platform, payload)
     states = design_rows(platform, design, rate_hz) if states is None else states
