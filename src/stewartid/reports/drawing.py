@@ -1,7 +1,6 @@
-"""The figures' common parts: style, saving (PNG and SVG) and the signal figures of an
-experiment that several reports show. Figures are :class:`matplotlib.figure.Figure` objects
-drawn inside ``rc_context(STYLE)``: no pyplot, the caller's settings untouched; matplotlib is
-imported inside the functions so that importing this module is cheap."""
+"""The figures' common parts: style, saving (PNG and SVG), an experiment's signal figures.
+Figures are drawn inside ``rc_context(STYLE)`` without pyplot; matplotlib is imported lazily.
+"""
 
 from __future__ import annotations
 
@@ -31,24 +30,20 @@ class ExperimentTrace:
     Attributes
     ----------
     name : str
-        Experiment name, e.g. ``"exp1"``.
     excited : int
         Index (0-5) of the excited coordinate.
     t : ndarray, shape (N,)
-        Time (s).
-    pose : ndarray, shape (N, 6)
-        Measured pose (m, rad).
+        s.
+    pose, reference : ndarray, shape (N, 6)
+        Measured and commanded pose (m, rad); ``reference`` optional.
     neutral : ndarray, shape (6,)
-        Neutral pose (m, rad); displacements are plotted relative to it.
-    reference : ndarray, shape (N, 6), optional
-        Commanded pose (m, rad).
+        Neutral pose, displacements are plotted from it (m, rad).
     joint_rates : ndarray, shape (N, 36), optional
-        30 rotational joint-axis rates (rad/s) then 6 actuator rates (m/s).
+        30 rotational joint-axis rates (rad/s), then 6 actuator rates (m/s).
     intervals : ndarray, shape (M, 2), optional
         Constant-direction intervals [start, stop] (s).
     forces : dict of ndarray, shape (N, 6)
-        Generalized force components (N, N·m) by name, e.g. ``"inertial"``, ``"viscous"``,
-        ``"coulomb"``, ``"gravity"``, ``"actuators"``.
+        Generalized force components by name (``"inertial"``, ``"gravity"``, ...) (N, N m).
     """
 
     name: str
@@ -84,24 +79,9 @@ def new_figure(**options: Any) -> Any:
 
 def save_figure(figure: Any, directory: str | Path, stem: str, dpi: int = 120,
                 tight: bool = True) -> list[Path]:
-    """Write ``figure`` as ``stem.png`` and ``stem.svg`` in ``directory`` (atomic).
+    """Write ``figure`` as ``stem.png`` and ``stem.svg`` in ``directory`` (atomic); returns both paths.
 
-    Parameters
-    ----------
-    figure : matplotlib.figure.Figure
-    directory : str or Path
-    stem : str
-        File name without suffix.
-    dpi : int
-        Resolution of the PNG (dots per inch).
-    tight : bool
-        Crop to the drawn content; False keeps the fixed margins of a figure laid out with
-        them and saves a layout pass per file.
-
-    Returns
-    -------
-    list of Path
-        The PNG and the SVG file.
+    ``tight`` crops to the drawn content; False keeps a fixed-margin layout and saves a layout pass.
     """
     directory = Path(directory)
     paths = []
@@ -116,8 +96,7 @@ def save_figure(figure: Any, directory: str | Path, stem: str, dpi: int = 120,
 
 
 def thinning_step(t: np.ndarray, max_points: int = 4000) -> slice:
-    """Sample step that keeps at most about ``max_points`` points of a line: enough for the
-    slow motion the figures show, and the SVG files stay small and fast to write."""
+    """Sample step keeping about ``max_points`` points of a line (small, fast SVG files)."""
     return slice(None, None, max(1, int(np.ceil(len(t) / max_points))))
 
 
@@ -132,8 +111,7 @@ def _shade_intervals(axis: Any, intervals: np.ndarray | None, label: bool) -> No
 @styled
 def plot_excitation(traces: Sequence[ExperimentTrace], directory: str | Path,
                     stem: str = "excitation") -> list[Path]:
-    """Commanded and measured motion of the excited coordinate in each experiment, with the
-    tracking error, one panel per experiment; returns the written paths."""
+    """Commanded and measured motion of each experiment's excited coordinate, with tracking error."""
     count = len(traces)
     columns = min(3, count)
     rows = int(np.ceil(count / columns))
@@ -173,13 +151,12 @@ def plot_excitation(traces: Sequence[ExperimentTrace], directory: str | Path,
 @styled
 def plot_joint_rates(trace: ExperimentTrace, directory: str | Path,
                      stem: str = "joint_velocities") -> list[Path]:
-    """Rates of the 30 rotational joint axes and the 6 actuators of one experiment, with the
-    constant-direction intervals shaded; returns the written paths.
+    """Rates of one experiment's 30 rotational joint axes and 6 actuators, intervals shaded.
 
     Raises
     ------
     ValueError
-        If ``trace`` has no joint rates.
+        ``trace`` has no joint rates.
     """
     if trace.joint_rates is None:
         raise ValueError(f"trace {trace.name!r} has no joint rates to plot")

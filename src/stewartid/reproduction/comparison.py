@@ -1,7 +1,5 @@
-"""Identification results of a reproduction, in the form its tables, figures and report use.
-
-Everything the report says is computed from a :class:`ComparisonResults`, so it can be
-rebuilt from ``results.json``.
+"""A reproduction's identification results, as its tables, figures and report use them
+(rebuildable from ``results.json``).
 """
 
 from __future__ import annotations
@@ -26,19 +24,18 @@ from stewartid.reports.methods import paper_letter, report_order
 
 @dataclass(frozen=True)
 class MethodRun:
-    """One identification: a method applied to the experiments at one Coulomb level.
+    """One method applied to the experiments at one Coulomb level.
 
     Attributes
     ----------
     method : str
-        Registered method name (:mod:`stewartid.identification.registry`).
+        Registered method name.
     coulomb : float
-        Coulomb friction of the simulated plant, N·m per joint axis.
+        Coulomb friction of the simulated plant per joint axis (N m).
     result : IdentificationResult
-        What the method found: ``M``, ``B`` (6, 6, paper frame, SI units), their standard
-        errors (NaN where the method gives none), settings and diagnostics.
+        ``M``, ``B`` (paper frame, SI), standard errors (NaN where none), settings, diagnostics.
     seconds : float
-        Wall time of the identification (s).
+        Wall time (s).
     """
 
     method: str
@@ -48,10 +45,8 @@ class MethodRun:
 
     @property
     def diagnostics(self) -> dict[str, Any]:
-        """The run's ``diagnostics`` in ``results.json``, JSON-able.
-
-        Condition number, RMS residual per equation, the method's settings and its own diagnostics
-        (``details``).
+        """JSON-able ``diagnostics`` for ``results.json``: condition number, RMS residual per equation,
+        settings and the method's own (``details``).
         """
         result = self.result
         return {"condition_number": float(result.condition_number),
@@ -60,7 +55,7 @@ class MethodRun:
                 "details": to_jsonable(result.diagnostics)}
 
     def matrix(self, name: str) -> np.ndarray:
-        """The identified ``M`` or ``B`` by name, shape (6, 6)."""
+        """The identified ``M`` or ``B``, shape (6, 6)."""
         return self.result.M if name == "M" else self.result.B
 
     def value(self, key: EntryKey) -> float:
@@ -83,7 +78,7 @@ class ComparisonResults:
     ----------
     runs : tuple of MethodRun
     nominal_M, nominal_B : ndarray, shape (6, 6)
-        Nominal matrices of the simulated plant at the neutral pose.
+        The simulated plant at neutral.
     published : PublishedResults
     settings : dict
         What was run (levels, durations, frequency, seed, ...), JSON-able.
@@ -113,12 +108,12 @@ class ComparisonResults:
         return None
 
     def nominal(self, key: EntryKey) -> float:
-        """Nominal value of one entry (our plant, computed from its description)."""
+        """Nominal value of one entry (computed from our plant's description)."""
         matrix, row, col = key
         return float((self.nominal_M if matrix == "M" else self.nominal_B)[row, col])
 
     def eps(self, run: MethodRun, key: EntryKey) -> float:
-        """ε (%) of one identified entry against our nominal value (NaN at a zero nominal)."""
+        """ε (%) of one identified entry against nominal (NaN at a zero nominal)."""
         return relative_error_percent(run.value(key), self.nominal(key))
 
     def eps_all(self, run: MethodRun, entries: tuple[EntryKey, ...] = PAPER_ENTRIES

@@ -1,12 +1,5 @@
-"""Regenerate the paper's Section 5 comparison: simulate, identify, tabulate, plot, report.
-
-:func:`run_reproduce` writes ``results.json``, ``tables/``, ``figures/``, ``report.md`` and
-``report.html`` into one folder, running simulations and fits in worker processes.
-
-References
-----------
-Zhang, C. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
-Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
+"""Regenerate the paper's Section 5 comparison (Zhang 2020): simulate, identify, tabulate, plot
+and report into one folder, simulations and fits in worker processes.
 """
 
 from __future__ import annotations
@@ -53,17 +46,15 @@ def simulate_one(platform: Platform, experiment: int, frequency_hz: float, durat
                  ) -> tuple[Any, Any, list[float]]:
     """Simulate experiment ``experiment`` (0-5) of the paper's six on ``platform``.
 
-    The noise generator is the one of :func:`~stewartid.simulation.simulate_experiments`, so one
-    task per experiment gives the same data as one call for all six. ``noise_scale`` > 0 measures
-    with that multiple of :func:`~stewartid.simulation.sensors.reference_noise` instead of the
-    platform's ``[sensors]`` errors.
+    Same noise generator as :func:`~stewartid.simulation.simulate_experiments` (one task per
+    experiment gives the same data); ``noise_scale`` > 0 measures with that multiple of
+    :func:`~stewartid.simulation.sensors.reference_noise` instead of the platform's sensors.
 
     Returns
     -------
     dataset : Dataset
-        Measured signals.
     record : ExperimentRecord or None
-        True signals, only when ``keep_record`` (they are large).
+        True signals, only with ``keep_record``.
     tracking_error : list of float
         RMS leg-length tracking error per leg (m).
     """
@@ -109,7 +100,6 @@ class _Silent:
 
 @contextmanager
 def _progress(enabled: bool) -> Iterator[Any]:
-    """A rich progress display of the stages, or a silent stand-in."""
     if not enabled:
         yield _Silent()
         return
@@ -128,7 +118,7 @@ def _progress(enabled: bool) -> Iterator[Any]:
 
 
 def _collect(futures: Sequence[Future], progress: Any, task: Any) -> list[Any]:
-    """Results of ``futures`` in submission order, advancing ``task``; the first failure is raised."""
+    """Results of ``futures`` in submission order, advancing ``task``; raises the first failure."""
     from concurrent.futures import as_completed
 
     for future in as_completed(futures):
@@ -148,21 +138,17 @@ def run_reproduce(out: str | Path = "results/reproduce", quick: bool = False,
     out : str or Path
         Output folder; created if missing, refused if not empty unless ``force``.
     quick : bool
-        Shortened records (for tests and CI).
+        Shortened records (tests, CI).
     jobs : int, optional
         Worker processes; every core by default.
     force : bool
-        Overwrite the results of an earlier run in ``out``.
+        Overwrite an earlier run's results in ``out``.
     seed : int
-        Seed of the simulated sensor noise.
+        Simulated sensor noise seed.
     progress : bool
-        Show a progress bar of the stages on the terminal.
+        Terminal progress bar of the stages.
     settings : ReproduceSettings, optional
-        Full control over what runs (then ``quick``, ``jobs`` and ``seed`` are ignored).
-
-    Returns
-    -------
-    ReproduceOutput
+        Full control (``quick``, ``jobs`` and ``seed`` then ignored).
     """
     from stewartid import __version__
     from stewartid.model.linearization import nominal_matrices

@@ -1,12 +1,5 @@
-"""What a reproduction of the paper's comparison runs: validated settings and the result object.
-
-Every registered method and preset runs at every Coulomb level of the paper (0, 5, 30 N·m)
-on this package's plant simulator.
-
-References
-----------
-Zhang, C. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
-Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
+"""Settings and result object of a reproduction of the paper's comparison (Zhang 2020): every
+registered method and preset at each Coulomb level (0, 5, 30 N m) on the plant simulator.
 """
 
 from __future__ import annotations
@@ -34,10 +27,7 @@ QUICK_DURATION_S = 6.0
 
 
 def default_methods() -> tuple[str, ...]:
-    """Every registered method and preset the comparisons run, in registry order.
-
-    See :attr:`~stewartid.identification.registry.MethodSpec.compared`.
-    """
+    """Every method and preset the comparisons run (``MethodSpec.compared``), in registry order."""
     from stewartid.identification.registry import registered_methods
 
     return tuple(spec.name for spec in registered_methods() if spec.compared)
@@ -54,26 +44,23 @@ class ReproduceSettings:
     Attributes
     ----------
     quick : bool
-        Shortened records (``QUICK_DURATION_S``) for tests and CI.
+        Shortened records (``QUICK_DURATION_S``), for tests and CI.
     duration_s : float
         Record length per experiment (s).
     frequency_hz : float
         Sine excitation frequency (Hz).
     coulomb_levels : tuple of float
-        Coulomb friction per joint axis (N·m), one simulated plant each.
+        Coulomb friction per joint axis, one plant each (N m).
     methods : tuple of str
-        Registered method names (:mod:`stewartid.identification.registry`); every
-        registered method and preset by default.
+        Registered method names; every method and preset by default.
     seed : int
-        Seed of the simulator's noise, the same at every level so that levels differ only by
-        their friction.
+        Simulator noise seed, the same at every level.
     jobs : int
-        Worker processes (1: everything in this process).
+        Worker processes (1: in this process).
     platform : str
         ``"paper"`` or a platform TOML file.
     noise_case : bool
-        Also run every method at the highest level with the reference sensor noise
-        (:mod:`~stewartid.reproduction.noisy`).
+        Also run every method at the highest level with reference sensor noise.
     """
 
     quick: bool = False
@@ -128,7 +115,7 @@ def make_settings(quick: bool = False, jobs: int | None = None, seed: int = 0,
 
 @dataclass(frozen=True)
 class ReproduceOutput:
-    """What :func:`run_reproduce` produced.
+    """What :func:`~stewartid.reproduction.run.run_reproduce` produced.
 
     Attributes
     ----------

@@ -1,39 +1,6 @@
-"""The results of a study: one row per (grid point, seed, method), stored as a partitioned
-Parquet data set.
-
-``DIR/results.parquet/`` holds one atomically written file ``part-<task key>.parquet`` per
-finished task, so a task finishing twice replaces its own rows and a killed run leaves only
-whole files.
-
-Columns
--------
-task : str
-    Task key (:attr:`~stewartid.studies.grid.StudyTask.key`).
-coulomb, viscous, noise_scale, frequency, duration : float
-    The point's parameters (N m, N m s/rad, -, Hz, s).
-seed : int
-    Seed of the sensor noise.
-method : str
-    Registered method name.
-max_error_percent : float
-    Largest relative error ε over the paper's 20 entries (%), NaN if the method failed.
-max_error_entry : str
-    The entry with that error, e.g. ``"Bt(1,1)"``.
-max_error_M_percent, max_error_B_percent : float
-    Largest ε over the paper's 10 entries of Mt, of Bt (%).
-error_Mt(1,1) ... error_Bt(5,1) : float
-    ε of each of the 20 entries (%), in :data:`~stewartid.reference.published.PAPER_ENTRIES`
-    order.
-run_time_s : float
-    Wall time of the identification (s).
-simulation_time_s : float
-    Wall time of the task's simulation, shared by its methods (s).
-task_cpu_time_s : float
-    CPU time of the whole task (s).
-failure : str
-    Why the simulation or the identification failed (a StewartidError), null otherwise.
-worker : str
-    Address of the worker that ran the task, null outside dask.
+"""A study's results: one row per (grid point, seed, method) in ``DIR/results.parquet/``, one
+atomically written ``part-<task key>.parquet`` per finished task (a rerun task replaces its
+rows, a killed run leaves whole files). Columns: ``docs/studies.md``, :func:`columns`.
 """
 
 from __future__ import annotations
@@ -77,18 +44,18 @@ def columns() -> tuple[str, ...]:
 
 
 def part_path(directory: str | Path, task_key: str) -> Path:
-    """The file of task ``task_key`` in the data set of output folder ``directory``."""
+    """The file of task ``task_key`` in output folder ``directory``."""
     return Path(directory) / RESULTS_NAME / f"{_PREFIX}{task_key}{_SUFFIX}"
 
 
 def write_part(directory: str | Path, task_key: str, rows: Sequence[Mapping[str, Any]]
                ) -> Path:
-    """Write the rows of one task as its own Parquet file, atomically; returns the path.
+    """Write one task's rows as its own Parquet file, atomically; returns the path.
 
     Raises
     ------
     ValueError
-        If a row misses a column or belongs to another task (a bug in the caller).
+        A row misses a column or belongs to another task.
     """
 
     schema = _schema()
@@ -104,7 +71,7 @@ def write_part(directory: str | Path, task_key: str, rows: Sequence[Mapping[str,
 
 
 def finished_tasks(directory: str | Path) -> set[str]:
-    """Keys of the tasks whose rows are in the data set of output folder ``directory``."""
+    """Keys of the tasks stored in output folder ``directory``."""
     folder = Path(directory) / RESULTS_NAME
     if not folder.is_dir():
         return set()
@@ -113,19 +80,9 @@ def finished_tasks(directory: str | Path) -> set[str]:
 
 
 def read_results(directory: str | Path, tasks: Iterable[str] | None = None) -> Any:
-    """Every row of the data set of output folder ``directory`` as a pandas DataFrame.
+    """Every row in output folder ``directory`` (only ``tasks`` if given) as a pandas DataFrame.
 
-    Parameters
-    ----------
-    directory : str or Path
-    tasks : iterable of str, optional
-        Keep only these task keys.
-
-    Returns
-    -------
-    pandas.DataFrame
-        The columns of :func:`columns`, one row per (task, method), sorted by the parameters,
-        the seed and the method; empty (with the columns) if no task has finished.
+    Sorted by parameters, seed and method; empty, with the :func:`columns`, before any task ends.
     """
 
     folder = Path(directory) / RESULTS_NAME

@@ -1,6 +1,4 @@
-"""The text of the identification report: data summary, every section of ``report.md``.
-Every statement is computed from the run's numbers, so a sentence changes with the result it
-describes."""
+"""The text of ``report.md``, every statement computed from the run's numbers."""
 
 from __future__ import annotations
 
@@ -29,16 +27,12 @@ _UNRANKED = "Physical model (full model; not ranked)"
 
 
 def data_rows(datasets: Sequence[Dataset], platform: Platform) -> list[dict[str, Any]]:
-    """Summary of each experiment for the data table and the figures.
+    """Per-experiment summary for the data table and figures.
 
-    Returns
-    -------
-    list of dict
-        Per experiment: ``name``, ``samples``, ``duration_s``, ``sample_rate_hz``,
-        ``frequency_hz`` (dominant), ``excited`` (index of the most excited coordinate,
-        rotations weighted by the upper joint radius), ``amplitude`` (its half range, mm or
-        mrad), and the noise estimated from the data: ``pose_noise`` (m, rad) and
-        ``force_noise`` (leg forces, N), shape (6,) each.
+    Keys: ``name``, ``samples``, ``duration_s``, ``sample_rate_hz``, ``frequency_hz`` (dominant),
+    ``excited`` (most excited coordinate, rotations weighted by the upper joint radius),
+    ``amplitude`` (its half range, mm or mrad), ``pose_noise`` (m, rad) and ``force_noise`` (leg
+    forces, N), shape (6,) each, estimated from the data.
     """
     rows = []
     lever = np.array([1.0] * 3 + [platform.geometry.upper_radius] * 3)
@@ -61,18 +55,16 @@ def data_rows(datasets: Sequence[Dataset], platform: Platform) -> list[dict[str,
 
 def used_intervals(runs: Sequence[MethodFit], trusted: str, datasets: Sequence[Dataset]
                    ) -> tuple[str, list[np.ndarray], list[np.ndarray | None]]:
-    """The constant-direction intervals and (a, b) points per experiment, as the diagnostics
-    record them, of the trusted method or else the first that uses them.
+    """The intervals and (a, b) points per experiment, of the trusted method or else the first with them.
 
     Returns
     -------
     display_name : str
-        Of the method they come from ("" if no method uses intervals).
+        The method's ("" if none uses intervals).
     intervals : list of ndarray, shape (M_k, 2)
-        [start, stop] (s); empty if no method uses intervals.
+        [start, stop] (s).
     points : list of ndarray, shape (K_k, 2), or None
-        (a, b) pairs (s, s), None for an experiment without them; empty if no method uses
-        intervals.
+        (a, b) pairs (s); None for an experiment without them.
     """
     def recorded(run: MethodFit) -> list[dict]:
         experiments = [] if run.result is None else run.result.diagnostics.get("experiments")
@@ -147,30 +139,24 @@ def render_report(report: IdentificationReport, datasets: Sequence[Dataset],
     ----------
     report : IdentificationReport
     datasets : sequence of Dataset
-        The experiments fitted.
     platform : Platform
     nominal : (ndarray, ndarray)
-        Reference Mt and Bt, shape (6, 6) each.
+        Reference Mt and Bt, shape (6, 6).
     nominal_source : str
-        Where they come from.
     rows : sequence of dict
         From :func:`data_rows`.
     figures : mapping of str to (str, str)
-        Relative PNG path and caption by figure key.
+        Figure key -> (relative PNG path, caption).
     sources : sequence of str
         The data files.
     folds : int
-        Time segments per experiment of the held-out validation.
+        Held-out time segments per experiment.
     seconds : float
-        Wall time of the comparison and the report (s).
+        Wall time of comparison and report (s).
     records : sequence of str
-        Names of the validation records (``identify --validate``).
+        Validation records (``identify --validate``).
     notes : sequence of str
-        Sentences for the summary (e.g. what a force delay would do to Bt).
-
-    Returns
-    -------
-    str
+        Sentences for the summary.
     """
     from stewartid import __version__
 
