@@ -1,8 +1,4 @@
-"""The estimator base class every identifier derives from (scikit-learn estimator contract).
-
-A subclass's ``__init__`` stores its settings, constrained in ``_parameter_constraints``;
-:meth:`BaseIdentifier.fit` validates them and sets every learned attribute (names ending in ``_``).
-"""
+"""The estimator base class every identifier derives from (scikit-learn estimator contract)."""
 
 from __future__ import annotations
 
@@ -24,18 +20,8 @@ from stewartid.platform import Platform
 class BaseIdentifier:
     """Base class of the identifiers.
 
-    Learned attributes set by :meth:`fit`:
-
-    ``M_``, ``B_`` : ndarray (6, 6)
-        Identified inertial and viscous matrices (paper frame).
-    ``std_errors_`` : dict with ``"M"`` and ``"B"`` : ndarray (6, 6)
-        Standard errors, widened where the log's sampling limits the estimate when
-        ``sampling_check`` is set (:mod:`stewartid.identification.sampling`).
-    ``condition_number_`` : float
-        Condition number of the (equilibrated) regression.
-    ``result_`` : IdentificationResult
-        Everything the fit found, as one object.
-
+    Learned attributes set by :meth:`fit`: ``M_``, ``B_`` (6, 6), ``std_errors_`` (dict ``"M"``, ``"B"``;
+    widened where sampling limits them), ``condition_number_``, ``result_`` (IdentificationResult),
     plus the method-specific ones a subclass's ``_fit`` returns.
     """
 
@@ -84,28 +70,17 @@ class BaseIdentifier:
         raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     def _validate_params(self) -> None:
-        """Check the settings against ``_parameter_constraints``.
-
-        Raises
-        ------
-        ConfigError
-            "The 'name' parameter of Class must be ... Got ... instead."
-        """
+        """Check the settings against ``_parameter_constraints``; raises ConfigError."""
         validate_parameters(self._parameter_constraints, self.get_params(), type(self).__name__)
 
     def fit(self, datasets: Any, platform: Platform | str | Path) -> BaseIdentifier:
-        """Identify Mt and Bt from experiments.
+        """Identify Mt and Bt from experiments; returns self.
 
         Parameters
         ----------
         datasets : Dataset, path, or sequence of them
-            The experiments (several files = several experiments).
+            One per experiment.
         platform : Platform, 'paper' or TOML path
-            The measured hexapod (geometry, leg masses); required.
-
-        Returns
-        -------
-        self
         """
         self._validate_params()
         platform = resolve_platform(platform)
@@ -125,16 +100,13 @@ class BaseIdentifier:
 
     def _fit(self, datasets: list[Dataset], platform: Platform
              ) -> tuple[IdentificationResult, dict[str, Any]]:
-        """The result and the method-specific learned attributes (names ending in ``_``)."""
+        """The result and the method-specific learned attributes."""
         raise NotImplementedError
 
     def _check_sampling(self, datasets: list[Dataset], platform: Platform,
                         result: IdentificationResult, learned: dict[str, Any]
                         ) -> tuple[IdentificationResult, dict[str, Any]]:
-        """``_fit``'s result and learned attributes, standard errors widened where sampling limits them.
-
-        See :func:`~stewartid.identification.sampling.check_sampling`.
-        """
+        """``_fit``'s output, standard errors widened where sampling limits them."""
         return check_sampling(lambda part: self._fit(part, platform)[0], datasets,
                               result), learned
 

@@ -1,19 +1,6 @@
-"""Cramér-Rao bounds on Mt and Bt: the best any unbiased estimator can do with a motion.
-
-For y = Mt q_ddot + Bt q_dot + c + J_lq^T e, with white leg-force noise e (sigma per leg),
-the Fisher information of vec([Mt Bt]) is
-
-    I = sum_t C_t^-1 (x) x_t x_t^T,      C_t = J_lq(q_t)^T diag(sigma^2) J_lq(q_t),
-    x_t = [q_ddot_t, q_dot_t],
-
-with the nuisance constants c profiled out (Schur complement): one per record
-(``friction="known"``) or one per constant-direction interval (``friction="immune"``, the
-Coulomb-invariant case). Pose noise only adds, so these are lower bounds for noisy logs.
-
-References
-----------
-Kay, S. M. "Fundamentals of Statistical Signal Processing: Estimation Theory", ch. 3 and
-the Schur-complement form of the bound with nuisance parameters (Prentice Hall, 1993).
+"""Cramér-Rao bounds on Mt and Bt for white leg-force noise: I = sum_t C_t^-1 (x) x_t x_t^T,
+C_t = J_lq^T diag(sigma^2) J_lq, x_t = [q_ddot, q_dot], constants per record or interval profiled out.
+Kay, "Fundamentals of Statistical Signal Processing: Estimation Theory" (1993), ch. 3.
 """
 
 from __future__ import annotations
@@ -40,12 +27,11 @@ class InformationBound:
     Attributes
     ----------
     covariance : ndarray, shape (72, 72)
-        Of the row-major [Mt Bt] (6, 12): index 12 i + j is Mt(i, j) for j < 6 and
-        Bt(i, j - 6) for j >= 6 (kg, kg m, kg m^2 and N s/m ... squared).
+        Of row-major [Mt Bt] (6, 12): index 12 i + j.
     friction : str
         ``"known"`` or ``"immune"``.
     n_constants : int
-        Nuisance constants per channel (records, or intervals).
+        Nuisance constants per channel.
     """
 
     covariance: np.ndarray
@@ -65,10 +51,7 @@ class InformationBound:
 
 def _profiled_information(q_dot: np.ndarray, q_ddot: np.ndarray, precision: np.ndarray,
                           labels: np.ndarray) -> tuple[np.ndarray, int]:
-    """Fisher information of [Mt Bt] with one free 6-vector constant per label >= 0 profiled out.
-
-    Samples labelled -1 are not used. Returns the (72, 72) information and the number of constants.
-    """
+    """(72, 72) information with one constant per label >= 0 profiled out (-1: unused), and the count."""
     keep = labels >= 0
     x = np.hstack([q_ddot, q_dot])[keep]                                # (n, 12)
     p, lab = precision[keep], labels[keep]
@@ -91,23 +74,16 @@ def information_bound(platform: Platform, motions: Sequence[tuple[np.ndarray, ..
     Parameters
     ----------
     platform : Platform
-        Geometry (for J_lq and the joint-axis rates).
     motions : sequence of (t, q, q_dot, q_ddot)
-        True motion of every record: times (N,) in s, pose, rate and acceleration (N, 6) in
-        m, rad and their derivatives.
+        True motion of every record; (N,) s and (N, 6) m, rad and derivatives.
     force_noise : float or ndarray, shape (6,)
-        Standard deviation of each leg's force sensor (N), > 0.
+        Leg-force noise standard deviation, N.
     friction : {"immune", "known"}
-        Nuisance structure (module docstring).
+        One constant per interval (Coulomb-invariant) or per record.
     margin : float
-        Time cut from both ends of every interval (s), ``friction="immune"``.
+        Cut from both ends of every interval, s.
     ignore_below : float
-        Joints whose rate RMS is below this fraction of the largest of their kind do not
-        split intervals (as in Method B's detection).
-
-    Returns
-    -------
-    InformationBound
+        Joints slower than this fraction of the fastest of their kind do not split intervals.
     """
     if friction not in FRICTION_KNOWLEDGE:
         raise ConfigError(f"friction must be one of {', '.join(FRICTION_KNOWLEDGE)}; "

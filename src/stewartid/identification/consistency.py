@@ -1,20 +1,5 @@
-"""Physical consistency of identified Mt and Bt, and the nearest consistent pair.
-
-Mt must be symmetric positive definite and Bt symmetric positive semidefinite; an
-unconstrained estimate need not be. :func:`project_consistent` solves
-
-    minimise   sum_ij ((M_ij - M^_ij) / s^M_ij)^2 + sum_ij ((B_ij - B^_ij) / s^B_ij)^2
-    subject to M = M^T,  M - delta I positive semidefinite,  B = B^T positive semidefinite,
-
-with M^, B^ the estimate and s its standard errors: the projection in the metric of the
-estimate's own uncertainty, the same for every method. Needs cvxpy
-(``pip install "stewartid[convex]"``).
-
-References
-----------
-Traversaro, S., Brossette, S., Escande, A., Nori, F. "Identification of fully physical
-consistent inertial parameters using optimization on manifolds." IROS 2016, 5446-5451;
-arXiv:1610.08703.
+"""Physical consistency of Mt, Bt and the nearest consistent pair in the estimate's standard errors
+(M symmetric positive definite, B positive semidefinite; needs cvxpy). Traversaro et al., IROS 2016.
 """
 
 from __future__ import annotations
@@ -31,10 +16,7 @@ STRICT_FRACTION = 1e-6
 
 
 def asymmetry(matrix: np.ndarray) -> float:
-    """Relative Frobenius norm of the antisymmetric part, ||(A - A^T) / 2|| / ||A||.
-
-    0 for a symmetric matrix, 1 for an antisymmetric one, NaN for a zero matrix.
-    """
+    """Relative Frobenius norm of the antisymmetric part, ||(A - A^T) / 2|| / ||A|| (NaN for zero A)."""
     matrix = np.asarray(matrix, dtype=float)
     norm = np.linalg.norm(matrix)
     return float(np.linalg.norm(matrix - matrix.T) / 2 / norm) if norm > 0 else float("nan")
@@ -49,28 +31,13 @@ def min_eigenvalue(matrix: np.ndarray) -> float:
 
 
 def consistency_metrics(M: np.ndarray, B: np.ndarray) -> dict[str, float]:
-    """The ``consistency`` object of ``result.json``.
-
-    Parameters
-    ----------
-    M, B : ndarray, shape (6, 6)
-        Inertial (kg, kg m, kg m^2) and viscous (N s/m, N s, N m s) matrices.
-
-    Returns
-    -------
-    dict
-        ``M_min_eigenvalue``, ``B_min_eigenvalue`` (of the symmetric parts) and
-        ``M_asymmetry``, ``B_asymmetry`` (:func:`asymmetry`).
-    """
+    """The ``consistency`` object of ``result.json``: min eigenvalues and asymmetry of M and B."""
     return {"M_min_eigenvalue": min_eigenvalue(M), "B_min_eigenvalue": min_eigenvalue(B),
             "M_asymmetry": asymmetry(M), "B_asymmetry": asymmetry(B)}
 
 
 def is_consistent(M: np.ndarray, B: np.ndarray, tolerance: float = 1e-9) -> bool:
-    """True if M is symmetric positive definite and B symmetric positive semidefinite.
-
-    ``tolerance`` is relative to each matrix's largest entry.
-    """
+    """True if M is symmetric positive definite and B positive semidefinite (tolerance relative)."""
     metrics = consistency_metrics(M, B)
     scale_M, scale_B = np.abs(M).max(), max(np.abs(B).max(), 1e-300)
     return bool(metrics["M_asymmetry"] <= tolerance and metrics["B_asymmetry"] <= tolerance
@@ -86,12 +53,11 @@ class ConsistentEstimate:
     Attributes
     ----------
     M, B : ndarray, shape (6, 6)
-        Symmetric, M positive definite, B positive semidefinite.
     change_M, change_B : ndarray, shape (6, 6)
-        |consistent - unconstrained| in standard errors of the unconstrained estimate.
+        |consistent - unconstrained| in standard errors.
     solver : str
     objective : float
-        The weighted squared distance minimised (sum of squared changes in standard errors).
+        Sum of squared changes in standard errors.
     """
 
     M: np.ndarray
@@ -114,7 +80,7 @@ class ConsistentEstimate:
 
 
 def _weights(std: np.ndarray, estimate: np.ndarray) -> np.ndarray:
-    """1 / standard error; unusable errors (0, NaN) take the median error so no entry is free."""
+    """1 / standard error; unusable errors take the median so no entry is free."""
     std = np.asarray(std, dtype=float)
     usable = np.isfinite(std) & (std > 0)
     scale = float(np.abs(estimate).max()) or 1.0
@@ -128,7 +94,7 @@ def require_cvxpy() -> Any:
     Raises
     ------
     ConfigError
-        If it is not installed; the message names the extra to install.
+        If it is not installed.
     """
     try:
         import cvxpy
@@ -145,24 +111,12 @@ def default_solver() -> str:
 
 
 def solve_convex(problem: Any, solver: str | None, hint: str) -> tuple[str, str]:
-    """Solve a cvxpy problem of a consistent fit; "optimal_inaccurate" counts as solved.
-
-    Parameters
-    ----------
-    problem : cvxpy.Problem
-    solver : str or None
-        :func:`default_solver` when None.
-    hint : str
-        What to check when no solution is found, for the message.
-
-    Returns
-    -------
-    solver, status : str
+    """Solve a consistent-fit cvxpy problem; returns (solver, status), "optimal_inaccurate" counts.
 
     Raises
     ------
     IdentificationError
-        The solver fails or finds no solution.
+        The solver fails or finds no solution (message ends with ``hint``).
     """
     import warnings
 
@@ -183,25 +137,14 @@ def solve_convex(problem: Any, solver: str | None, hint: str) -> tuple[str, str]
 
 def project_consistent(M: np.ndarray, B: np.ndarray, std_M: np.ndarray, std_B: np.ndarray,
                        solver: str | None = None) -> ConsistentEstimate:
-    """The consistent (M, B) nearest to an estimate, in standard errors (module docstring).
+    """The consistent (M, B) nearest to an estimate, weighted by its standard errors.
 
-    Parameters
-    ----------
-    M, B : ndarray, shape (6, 6)
-        Unconstrained estimate.
-    std_M, std_B : ndarray, shape (6, 6)
-        Its standard errors (same units).
-    solver : str, optional
-        A cvxpy solver name; Clarabel when installed, else SCS.
-
-    Returns
-    -------
-    ConsistentEstimate
+    minimise sum ((M - M^) / s_M)^2 + sum ((B - B^) / s_B)^2 s.t. M - delta I, B positive semidefinite.
 
     Raises
     ------
     ConfigError
-        If cvxpy is not installed (the message names the extra to install).
+        If cvxpy is not installed.
     IdentificationError
         If the solver fails.
     """
@@ -230,7 +173,7 @@ def _symmetric(matrix: np.ndarray) -> np.ndarray:
 
 
 def _clip_psd(matrix: np.ndarray, floor: float) -> np.ndarray:
-    """Raise eigenvalues below ``floor`` to it (removes the solver's last tolerance)."""
+    """Raise eigenvalues below ``floor`` to it."""
     values, vectors = np.linalg.eigh(matrix)
     if values[0] >= floor:
         return matrix

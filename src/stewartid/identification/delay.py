@@ -1,15 +1,7 @@
-"""Delay of the force channels relative to the motion, estimated from the logged experiments.
+"""Delay of the force channels relative to the motion, fitted jointly with Mt, Bt in weak form.
 
-A delay tau biases Bt by tau w^2 Mt at one frequency; across two or more frequencies per DOF
-it separates from damping. tau is fitted jointly with Mt, Bt, Coulomb levels and offsets in
-weak form (every signal filtered with one smooth kernel, so no measured signal is
-differentiated), then refitted on the aligned experiments.
-
-References
-----------
-Shinbrot, M. "On the analysis of linear and nonlinear systems." Trans. ASME 79, 547-552
-(1957): the modulating-function (weak-form) method.
-Khalil, W., Dombre, E. Modeling, Identification and Control of Robots, ch. 12 (2002).
+A delay tau biases Bt by tau w^2 Mt at one frequency; two or more per DOF separate it from damping.
+Shinbrot (1957), modulating functions; Khalil and Dombre (2002), ch. 12.
 """
 
 from __future__ import annotations
@@ -49,16 +41,13 @@ class DelayEstimate:
     Attributes
     ----------
     seconds : float
-        Delay (s), positive when the forces are logged after the motion.
-    std_error : float
-        Its standard error (s), for autocorrelated residuals.
-    first_pass : float
-        The estimate of the first pass, before alignment (s).
+        Delay, s; positive when the forces are logged late.
+    std_error, first_pass : float
+        Its standard error and the first-pass estimate before alignment, s.
     lines_hz : tuple of tuple of float
-        The excitation lines found in each DOF's motion (Hz), in the order of
-        :data:`~stewartid.platform.COORDINATES`.
+        Excitation lines per DOF, Hz.
     window_s : float
-        Kernel support of the weak form (s).
+        Kernel support of the weak form, s.
     """
 
     seconds: float
@@ -75,7 +64,7 @@ class DelayEstimate:
                 "lines_hz": {c: list(f) for c, f in zip(COORDINATES, self.lines_hz, strict=True)}}
 
     def describe(self) -> str:
-        """One line for the terminal: the delay in ms with its standard error."""
+        """One terminal line: the delay in ms with its standard error."""
         return (f"force delay {self.seconds * 1e3:.3f} ms (standard error "
                 f"{self.std_error * 1e3:.3f} ms), estimated from "
                 f"{min(len(f) for f in self.lines_hz)} or more lines per DOF")
@@ -83,26 +72,20 @@ class DelayEstimate:
 
 def delay_bias_per_ms(platform: Platform | np.ndarray, frequencies_hz: Sequence[float],
                       stiffness: np.ndarray | None = None) -> np.ndarray:
-    """The bias a delay of 1 ms puts on the Bt diagonal under single sines.
-
-    Delta Bt(i, i) = tau (w_i^2 Mt(i, i) + K(i, i)), with K = d y / d q the geometric and
-    gravity stiffness.
+    """Bias of 1 ms of delay on the Bt diagonal under single sines: tau (w_i^2 Mt(i, i) + K(i, i)).
 
     Parameters
     ----------
     platform : Platform or ndarray, shape (6, 6)
-        The nominal Mt is the platform's at the neutral pose; or an (identified) Mt.
+        Nominal Mt at the neutral pose, or an identified Mt.
     frequencies_hz : sequence of 6 float
-        Each DOF's excitation frequency (Hz).
     stiffness : ndarray, shape (6, 6), optional
-        K at the mean pose and leg forces
-        (:func:`~stewartid.identification.preparation.generalized_force_sensitivity`);
-        without it the inertial term alone.
+        K = dy/dq; without it the inertial term alone.
 
     Returns
     -------
     ndarray, shape (6,)
-        N s/m (translations) and N m s/rad (rotations) per millisecond of delay.
+        N s/m and N m s/rad per ms.
     """
     M = nominal_matrices(platform)[0] if isinstance(platform, Platform) else np.asarray(platform)
     w = 2 * np.pi * np.asarray(frequencies_hz, dtype=float)
@@ -115,20 +98,8 @@ def single_frequency_bias(datasets: Sequence[Dataset], platform: Platform,
                           ) -> dict[str, Any] | None:
     """Where a force delay cannot be told from damping, and what it would do to Bt.
 
-    Parameters
-    ----------
-    datasets : sequence of Dataset
-    platform : Platform
-    lines : tuple of 6 tuples of float, optional
-        The excitation lines per DOF (:func:`~stewartid.datasets.excitation.excitation_lines`)
-        if already found.
-
-    Returns
-    -------
-    dict or None
-        None when every DOF moves at two or more frequencies; else ``{"dofs": [names],
-        "frequencies_hz": [6], "bt_diagonal_per_ms": [6]}`` (:func:`delay_bias_per_ms`;
-        NaN for a DOF that does not move).
+    Returns None when every DOF moves at two or more frequencies, else ``{"dofs", "frequencies_hz",
+    "bt_diagonal_per_ms"}``. ``lines``: the excitation lines per DOF, if already found.
     """
     lines = excitation_lines(datasets) if lines is None else lines
     single = [k for k, f in enumerate(lines) if len(f) < 2]
@@ -147,7 +118,7 @@ def single_frequency_bias(datasets: Sequence[Dataset], platform: Platform,
 
 
 def describe_bias(found: dict[str, Any]) -> str:
-    """The bias of :func:`single_frequency_bias` in words: "Bt(1,1) +123.4, ... per ms"."""
+    """The bias of :func:`single_frequency_bias` in words."""
     return ", ".join(f"Bt({k + 1},{k + 1}) {b:+.4g}"
                      for k, b in enumerate(found["bt_diagonal_per_ms"]) if np.isfinite(b)) \
         + " per ms"
@@ -160,8 +131,7 @@ def check_delay_identifiable(datasets: Sequence[Dataset], platform: Platform
     Raises
     ------
     IdentificationError
-        Naming the DOFs with a single frequency and the bias on the Bt diagonal per
-        millisecond of delay (:func:`single_frequency_bias`).
+        Naming the single-frequency DOFs and the Bt bias per ms.
     """
     lines = excitation_lines(datasets)
     found = single_frequency_bias(datasets, platform, lines)
@@ -178,11 +148,7 @@ def check_delay_identifiable(datasets: Sequence[Dataset], platform: Platform
 
 def _filtered_rows(dataset: Dataset, platform: Platform, window: float
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Weak-form rows of one experiment, all filtered with the kernel.
-
-    Returns q_ddot, q_dot (N', 6), y (N', 6) and the shared regressors (N', 4, 6): the three
-    Coulomb ones and the delay regressor -y_dot.
-    """
+    """Kernel-filtered rows: q_ddot, q_dot, y (N', 6), shared (N', 4, 6) = 3 Coulomb + -y_dot."""
     experiment = prepare_experiment(dataset, platform, gravity=True, joints=True)
     rate = experiment.sample_rate
     # the Coulomb signs need rates at every sample; they only decide signs
@@ -199,25 +165,10 @@ def _filtered_rows(dataset: Dataset, platform: Platform, window: float
 
 def shared_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray,
                          groups: np.ndarray, lags: int) -> tuple[np.ndarray, np.ndarray]:
-    """Shared coefficients c of y(k) = theta phi(k) + sum_s c_s S_s(k), with robust standard errors.
+    """Shared coefficients c of y = theta phi + sum_s c_s S_s, with robust standard errors.
 
-    theta is partialled out (Frisch-Waugh); channels are weighted by their residual variance;
-    the covariance is a sandwich with a Newey-West (Bartlett) long-run covariance of the
-    scores summed over channels, experiments being independent groups.
-
-    Parameters
-    ----------
-    phi : ndarray, shape (K, p)
-    y : ndarray, shape (K, 6)
-    shared : ndarray, shape (K, s, 6)
-    groups : ndarray, shape (K,)
-        Experiment of each row (rows of one experiment consecutive).
-    lags : int
-        Bartlett bandwidth (rows): beyond the residuals' correlation length.
-
-    Returns
-    -------
-    c, std : ndarray, shape (s,)
+    theta partialled out (Frisch-Waugh); channels weighted by residual variance; sandwich covariance
+    with a Newey-West long-run covariance, experiments (``groups``) independent. Returns c, std (s,).
 
     Raises
     ------
@@ -255,22 +206,7 @@ def shared_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray,
 
 def fit_delay(datasets: Sequence[Dataset], platform: Platform, window: float,
               decimate: int = 1) -> tuple[float, float]:
-    """One weak-form least-squares fit of the delay (first order in tau).
-
-    Parameters
-    ----------
-    datasets : sequence of Dataset
-    platform : Platform
-    window : float
-        Kernel support (s).
-    decimate : int
-        Keep every ``decimate``-th filtered row.
-
-    Returns
-    -------
-    delay, std_error : float
-        s.
-    """
+    """One weak-form least-squares fit of the delay (first order in tau); returns delay, std_error in s."""
     n_exp = len(datasets)
     phis, ys, shared, groups = [], [], [], []
     for e, dataset in enumerate(datasets):
@@ -296,24 +232,17 @@ def estimate_delay(datasets: Sequence[Dataset], platform: Platform, window: floa
     Parameters
     ----------
     datasets : sequence of Dataset
-        The experiments, logged with one acquisition chain (one delay for all).
+        Logged with one acquisition chain (one delay for all).
     platform : Platform
-        Description of the measured hexapod.
     window : float, optional
-        Kernel support of the weak form (s); by default :data:`WINDOW_PERIODS` periods of
-        the highest excitation line.
+        Kernel support, s; default :data:`WINDOW_PERIODS` periods of the highest line.
     iterations : int
-        Refits on the experiments aligned by the estimate so far (0 keeps the first pass).
-
-    Returns
-    -------
-    DelayEstimate
+        Refits on the aligned experiments (0 keeps the first pass).
 
     Raises
     ------
     IdentificationError
-        A DOF moved at a single frequency (:func:`check_delay_identifiable`), or the
-        regression is rank deficient.
+        A DOF moved at a single frequency, or the regression is rank deficient.
     ConfigError
         A non-positive window or a negative number of iterations.
     """
@@ -363,38 +292,17 @@ def parse_delay(value: str | float | None) -> str | float | None:
 
 def apply_delay(datasets: Sequence[Dataset], platform: Platform, delay: str | float | None
                 ) -> tuple[list[Dataset], dict[str, Any] | None]:
-    """The experiments with their forces aligned with the motion, before any identifier.
+    """The experiments with their forces aligned with the motion, and the ``"delay"`` result entry.
 
-    Parameters
-    ----------
-    datasets : sequence of Dataset
-    platform : Platform
-    delay : float, 'auto' or None
-        The delay of the force channels relative to the motion (s, positive when the forces
-        are logged late), :data:`AUTO` to estimate it first (:func:`estimate_delay`), or
-        None to use the data as logged.
-
-    Returns
-    -------
-    datasets : list of Dataset
-        Aligned (:func:`~stewartid.datasets.alignment.align_forces`); the input when
-        ``delay`` is None.
-    entry : dict or None
-        The ``"delay"`` entry of ``result.json``: ``seconds``, ``std_error`` (None for a
-        given delay), ``applied``, ``source`` (``"given"`` or ``"estimated"``).
+    ``delay``: seconds (positive when forces are logged late), :data:`AUTO` to estimate it, or None
+    to return the data as logged (entry None).
 
     Raises
     ------
     ConfigError
         A delay that is neither a number nor 'auto', or one longer than the records.
     IdentificationError
-        'auto' on experiments where the delay cannot be estimated
-        (:func:`check_delay_identifiable`).
-
-    Examples
-    --------
-    >>> aligned, entry = apply_delay(datasets, platform, "auto")  # doctest: +SKIP
-    >>> WaveletIdentifier().fit(aligned, platform)  # doctest: +SKIP
+        'auto' where the delay cannot be estimated.
     """
     delay = parse_delay(delay)
     datasets = list(datasets)

@@ -1,17 +1,6 @@
-"""Method A: first-harmonic Fourier identification (Tian et al.), as compared in Zhang (2020).
+"""Method A: first-harmonic Fourier identification over whole periods (Tian et al., in Zhang 2020).
 
-Over whole periods of a sine of angular frequency w the first-harmonic coefficients turn
-y = Mt q_ddot + Bt q_dot + G0 + Fc into y_c = Mt qdd_c + Bt qd_c, y_s = Mt qdd_s + Bt qd_s
-(constants drop out); stacking every period of every experiment gives a least-squares
-problem for the 72 unknowns. Coulomb friction lands in Bt; its third harmonic widens the
-standard errors (:mod:`~stewartid.identification.harmonics`).
-
-References
-----------
-Tian, Y. et al., identification of the dynamic parameters of a Stewart platform from
-single-DOF sine excitation (Method A in the comparison of Zhang 2020).
-Zhang, C. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
-Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
+y_c = Mt qdd_c + Bt qd_c, y_s = Mt qdd_s + Bt qd_s: constants drop out, Coulomb friction lands in Bt.
 """
 
 from __future__ import annotations
@@ -56,22 +45,12 @@ HARMONIC_FRACTION = 0.2
 def check_whole_period(name: str, motion: np.ndarray, sample_rate: float) -> None:
     """Refuse a record shorter than one period of its motion, naming both.
 
-    The period is that of the sine c + a cos(w t) + b sin(w t) fitted to the leg-space motion
-    of the largest excursion, over w from 1/100 of the record's own frequency up to it.
-
-    Parameters
-    ----------
-    name : str
-        Experiment named in the message.
-    motion : ndarray, shape (N, 6)
-        Leg-space motion (m), mean removed.
-    sample_rate : float
-        Hz.
+    The period is that of a sine fitted to the largest leg excursion (``motion`` (N, 6), m, mean removed).
 
     Raises
     ------
     IdentificationError
-        When no leg's motion crosses its mean twice (no whole oscillation).
+        When no leg's motion crosses its mean twice.
     """
     column = motion[:, int(np.argmax(np.ptp(motion, axis=0)))]
     centred = column - column.mean()
@@ -104,25 +83,10 @@ def check_whole_period(name: str, motion: np.ndarray, sample_rate: float) -> Non
 
 def check_single_sine(name: str, pose: np.ndarray, sample_rate: float, platform: Platform,
                       frequencies_hz: Sequence[float], given: bool = False) -> None:
-    """Refuse an experiment whose motion is not one sine at the fitted (or given) frequencies.
+    """Refuse an experiment whose motion is not one sine at the fitted (or ``given``) frequencies.
 
-    Every spectral line of the leg-length motion reaching
-    :data:`~stewartid.datasets.excitation.LINE_FRACTION` of the largest must sit at
-    ``frequencies_hz``, or at a harmonic of them below :data:`HARMONIC_FRACTION`.
-
-    Parameters
-    ----------
-    name : str
-        Experiment named in the message.
-    pose : ndarray, shape (N, 6)
-        m, rad.
-    sample_rate : float
-        Hz.
-    platform : Platform
-    frequencies_hz : sequence of float
-        The frequencies Method A fits (Hz).
-    given : bool
-        They were given by the user (else detected as the dominant sine).
+    Every leg-length line above :data:`~stewartid.datasets.excitation.LINE_FRACTION` of the largest must
+    sit at ``frequencies_hz`` or at a harmonic below :data:`HARMONIC_FRACTION`.
 
     Raises
     ------
@@ -133,7 +97,7 @@ def check_single_sine(name: str, pose: np.ndarray, sample_rate: float, platform:
     tolerance = lines.resolution_hz
 
     def order(f: float) -> int:
-        """1 at a fitted frequency, n >= 2 at its n-th harmonic, 0 elsewhere."""
+        """1 at a fitted frequency, n at its n-th harmonic, 0 elsewhere."""
         if any(abs(f - g) <= tolerance for g in frequencies_hz):
             return 1
         return next((round(f / g) for g in frequencies_hz
@@ -165,41 +129,33 @@ class FourierIdentifier(BaseIdentifier):
     Parameters
     ----------
     frequency_hz : float or sequence of float, optional
-        Excitation frequency (Hz), or several; detected per experiment (the dominant sine)
-        when not given.
+        Hz; the dominant sine of each experiment when not given.
     window : float, optional
-        Savitzky-Golay window (s) for q_dot, q_ddot; 0.2 periods of the highest frequency by
-        default.
+        Savitzky-Golay window, s; default 0.2 periods of the highest frequency.
     order : int
         Savitzky-Golay polynomial order.
     gravity : bool
-        Subtract the model's pose-dependent gravity term G(q).
+        Subtract the model's G(q).
     remainder : bool
-        Subtract the model's departure from its linearisation along the measured motion
-        (:func:`~stewartid.identification.preparation.model_remainder`).
+        Subtract the model's departure from its linearisation along the motion.
     sampling_check : bool
-        Widen the standard errors where the log's sampling limits the estimate
-        (:mod:`~stewartid.identification.sampling`).
+        Widen standard errors where the log's sampling limits them.
     stiffness : bool
-        Identify a stiffness matrix K as well (needs two or more frequencies).
+        Identify a stiffness matrix K too (two or more frequencies).
     symmetric : bool
-        Impose Mt = Mt^T and Bt = Bt^T.
+        Impose Mt = Mt^T, Bt = Bt^T.
     periods_per_segment : int
         Whole periods of the lowest frequency per equation block.
 
     Attributes
     ----------
-    M_, B_ : ndarray, shape (6, 6)
+    M_, B_, stiffness_ : ndarray, shape (6, 6)
+        ``stiffness_`` None unless fitted.
     std_errors_ : dict of ndarray (6, 6)
     condition_number_ : float
-    stiffness_ : ndarray, shape (6, 6) or None
     frequencies_ : list of list of float
-        Frequencies used per experiment (Hz).
+        Hz, per experiment.
     result_ : IdentificationResult
-
-    References
-    ----------
-    Zhang (2020), doi:10.3390/math8020257, Section 4 (Method A).
     """
 
     def __init__(self, frequency_hz: float | Sequence[float] | None = None,

@@ -1,7 +1,5 @@
-"""The shape of Coulomb friction's sign near a reversal, and least squares averaged over it.
-
-Two shapes of slope 1/s at w = 0 bracket what a rig does near a reversal; least squares fits
-both and averages them by their Akaike weights (Burnham and Anderson 2002, ch. 4).
+"""The shape of Coulomb friction's sign near a reversal, and least squares averaged over shapes
+by Akaike weights (Burnham and Anderson 2002, ch. 4).
 """
 
 from __future__ import annotations
@@ -19,22 +17,9 @@ COULOMB_SHAPES = ("algebraic", "erf")
 
 
 def shaped_sign(rates: np.ndarray, smoothing: float, shape: str = "algebraic") -> np.ndarray:
-    """sign(rates), regularised over ``smoothing`` with one of :data:`COULOMB_SHAPES`.
+    """sign(w) regularised over s: ``"algebraic"`` w / sqrt(w^2 + s^2), ``"erf"`` erf(sqrt(pi) w / (2 s)).
 
-    ``"algebraic"`` is w / sqrt(w^2 + s^2); ``"erf"`` is erf(sqrt(pi) w / (2 s)).
-
-    Parameters
-    ----------
-    rates : ndarray, any shape
-        Joint rates w (rad/s).
-    smoothing : float
-        s (rad/s): the slope at w = 0 is 1/s; 0 gives the exact sign.
-    shape : {"algebraic", "erf"}
-
-    Returns
-    -------
-    ndarray, shape of ``rates``
-        In [-1, 1].
+    ``rates`` and ``smoothing`` in rad/s; slope 1/s at 0; s = 0 gives the exact sign.
     """
     if smoothing == 0:
         return np.sign(rates)
@@ -48,16 +33,7 @@ def shaped_sign(rates: np.ndarray, smoothing: float, shape: str = "algebraic") -
 
 
 def akaike_weights(solutions: Sequence[LeastSquaresSolution]) -> np.ndarray:
-    """Akaike weights of least-squares fits of one model's variants on the same rows.
-
-    The log-likelihood of fit k is -1/2 sum_c n_c log(RSS_c), with n_c the first fit's
-    independent rows per channel; the variants have as many unknowns, so the weights are
-    exp(l_k - max l) normalised.
-
-    Returns
-    -------
-    ndarray, shape (len(solutions),)
-    """
+    """Akaike weights of equal-size variants fitted on the same rows: l_k = -1/2 sum_c n_c log(RSS_c)."""
     n = solutions[0].effective_equations
     log_likelihood = np.array([-0.5 * np.sum(n * np.log(np.maximum(s.residual_rms, 1e-300) ** 2))
                                for s in solutions])
@@ -67,11 +43,7 @@ def akaike_weights(solutions: Sequence[LeastSquaresSolution]) -> np.ndarray:
 
 def average_solutions(solutions: Sequence[LeastSquaresSolution], weights: np.ndarray
                       ) -> LeastSquaresSolution:
-    """The weighted mean of fits, with the mixture's variance (Burnham and Anderson 2002, ch. 4).
-
-    Each variance is the weighted mean of the fits' variances plus their squared departures
-    from the mean.
-    """
+    """The weighted mean of fits, with the mixture's variance (within plus between)."""
     w = np.asarray(weights, dtype=float)
 
     def mean_and_std(values, stds):

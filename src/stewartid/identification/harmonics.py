@@ -1,7 +1,5 @@
-"""Harmonic coefficients over whole periods, and the Coulomb bias the force's third harmonic shows.
-
-A Coulomb force switching with a sine's velocity is a square wave: its first harmonic lands
-in Method A's Bt, its third is left unexplained by any linear term.
+"""Harmonic coefficients over whole periods, and the Coulomb bias the force's third harmonic shows
+(a Coulomb square wave's first harmonic lands in Method A's Bt, its third in no linear term).
 """
 
 from __future__ import annotations
@@ -16,22 +14,9 @@ from stewartid.signals.differentiation import savgol_gain
 
 def harmonic_coefficients(x: np.ndarray, t: np.ndarray, frequencies_hz: Sequence[float]
                           ) -> np.ndarray:
-    """In-phase and quadrature coefficients of ``x`` at ``frequencies_hz`` over a segment.
+    """(cos f1, sin f1, cos f2, ...) coefficients (2 F, m) of x(t) = c0 + sum_f [x_c cos + x_s sin].
 
-    Least-squares fit of x(t) = c0 + sum_f [x_c cos(2 pi f t) + x_s sin(2 pi f t)]; over whole
-    periods of one frequency these are the Fourier coefficients.
-
-    Parameters
-    ----------
-    x : ndarray, shape (N, m)
-    t : ndarray, shape (N,)
-        Time (s).
-    frequencies_hz : sequence of float
-
-    Returns
-    -------
-    ndarray, shape (2 * F, m)
-        Rows (cos f1, sin f1, cos f2, sin f2, ...).
+    Least squares on ``x`` (N, m) at times ``t`` (N,), s; over whole periods, the Fourier coefficients.
     """
     columns = [np.ones_like(t)]
     for f in frequencies_hz:
@@ -44,15 +29,8 @@ def harmonic_coefficients(x: np.ndarray, t: np.ndarray, frequencies_hz: Sequence
 
 def motion_gains(frequencies_hz: Sequence[float], sample_rate: float, window: float,
                  order: int) -> np.ndarray:
-    """Savitzky-Golay gain of q_ddot, q_dot and q at each frequency.
-
-    The filter has zero phase, so dividing the harmonic coefficients by it removes its
-    amplitude bias exactly.
-
-    Returns
-    -------
-    ndarray, shape (2 * F, 18)
-        Rows (cos f1, sin f1, ...) as :func:`harmonic_coefficients`; columns q_ddot, q_dot, q.
+    """Savitzky-Golay (zero-phase) gain of q_ddot, q_dot, q per frequency; (2 F, 18), rows as
+    :func:`harmonic_coefficients`.
     """
     gains = np.ones((2 * len(frequencies_hz), 18))
     for k, f in enumerate(frequencies_hz):
@@ -64,24 +42,10 @@ def motion_gains(frequencies_hz: Sequence[float], sample_rate: float, window: fl
 def third_harmonic_blocks(signals: np.ndarray, t: np.ndarray, slices: Sequence[slice],
                           frequency_hz: float, sample_rate: float, window: float, order: int
                           ) -> np.ndarray:
-    """(cos, sin) coefficients at 3 f of the motion and the generalized force, per block.
+    """(cos, sin) coefficients at 3 f per whole-period block; (blocks, 2, 24).
 
-    The motion's coefficients are corrected for the differentiator's gain at 3 f.
-
-    Parameters
-    ----------
-    signals : ndarray, shape (N, 24)
-        q_ddot, q_dot, q - q0 and the generalized force side by side.
-    t : ndarray, shape (N,)
-        Time (s).
-    slices : sequence of slice
-        The whole-period blocks.
-    frequency_hz, sample_rate, window, order
-        The excitation frequency f and the Savitzky-Golay differentiation's settings.
-
-    Returns
-    -------
-    ndarray, shape (blocks, 2, 24)
+    ``signals`` (N, 24): q_ddot, q_dot, q - q0 and the generalized force; the motion's corrected for
+    the differentiator's gain at 3 f.
     """
     gains = np.concatenate([motion_gains([3 * frequency_hz], sample_rate, window, order),
                             np.ones((2, 6))], axis=1)
@@ -96,25 +60,11 @@ SQUARE_WAVE_RATIO = 3.0
 
 def friction_bias_bound(pinv: np.ndarray, rows: Sequence[np.ndarray],
                         third: Sequence[np.ndarray]) -> np.ndarray:
-    """Bias of the first-harmonic estimates that the force's third harmonic implies.
+    """Bias bound (6, p) on the first-harmonic estimates implied by the force's third harmonic.
 
-    A square wave's first harmonic is :data:`SQUARE_WAVE_RATIO` times its third, of unknown
-    phase; it is propagated through the least-squares solution and summed in quadrature over
-    experiments.
-
-    Parameters
-    ----------
-    pinv : ndarray, shape (p, n_equations)
-        Pseudo-inverse of the first-harmonic regressor.
-    rows : sequence of ndarray of int
-        Per experiment, the (cos, sin) equation rows of each of its blocks, shape (blocks, 2).
-    third : sequence of ndarray, shape (6,)
-        Per experiment, the third-harmonic amplitude of each force channel (N, N m).
-
-    Returns
-    -------
-    ndarray, shape (6, p)
-        Bias bound of every parameter of every channel's equation.
+    A square wave's first harmonic is :data:`SQUARE_WAVE_RATIO` times its third, of unknown phase;
+    propagated through ``pinv`` and summed in quadrature over experiments. ``rows``: per experiment,
+    each block's (cos, sin) equation rows; ``third``: per experiment, amplitudes (6,), N, N m.
     """
     bound = np.zeros((len(third[0]) if len(third) else 6, pinv.shape[0]))
     for experiment_rows, amplitude in zip(rows, third, strict=True):
@@ -133,27 +83,9 @@ def third_harmonic(coefficients: Sequence[np.ndarray | None], noise_covariance: 
                    ) -> tuple[list[np.ndarray], float, float]:
     """Third-harmonic amplitude per experiment and force channel that the data show as friction.
 
-    The mean residual coefficients at 3 f are tested as a whole: the sum over experiments of
-    their Mahalanobis norm is chi-squared with 12 degrees of freedom per experiment without
-    friction. Above the point of :data:`THIRD_HARMONIC_LEVEL` every channel keeps its
-    amplitude; below it all are zero.
-
-    Parameters
-    ----------
-    coefficients : sequence of (ndarray, shape (blocks, 2, 6)) or None
-        Per experiment, the (cos, sin) coefficients at 3 f of each channel's residual force,
-        per block (N, N m); None for an experiment of several frequencies (not tested).
-    noise_covariance : ndarray, shape (6, 6)
-        Covariance of one block's harmonic coefficient across the channels.
-
-    Returns
-    -------
-    amplitude : list of ndarray, shape (6,)
-        Per experiment, the third-harmonic amplitude read as friction (N, N m).
-    statistic : float
-        The chi-squared statistic.
-    threshold : float
-        Its point at :data:`THIRD_HARMONIC_LEVEL`.
+    The summed Mahalanobis norm of the residual coefficients at 3 f is chi-squared (12 dof per
+    experiment) without friction; above its :data:`THIRD_HARMONIC_LEVEL` point every amplitude is
+    kept, below all are zero. Returns (amplitudes (6,) per experiment, statistic, threshold).
     """
     precision = np.linalg.pinv(noise_covariance)
     # the channels' noise-free directions: a third harmonic there is shown by any amount
@@ -177,19 +109,7 @@ def third_harmonic(coefficients: Sequence[np.ndarray | None], noise_covariance: 
 
 
 def residual_third_harmonic(blocks: np.ndarray, theta: np.ndarray) -> np.ndarray:
-    """Third-harmonic coefficients of the force that the fitted linear model leaves.
-
-    Parameters
-    ----------
-    blocks : ndarray, shape (blocks, 2, 24)
-        As :func:`third_harmonic_blocks` returns.
-    theta : ndarray, shape (6, p)
-        Fitted parameters: Mt, Bt (and K) side by side, p = 12 or 18.
-
-    Returns
-    -------
-    ndarray, shape (blocks, 2, 6)
-    """
+    """Third-harmonic coefficients (blocks, 2, 6) of the force the fitted ``theta`` (6, p) leaves."""
     return blocks[..., 18:] - blocks[..., :theta.shape[1]] @ theta.T
 
 

@@ -1,18 +1,5 @@
-"""Time-domain least squares with Coulomb friction: the inverse-dynamics model of robotics.
-
-At every sample
-
-    y(t) = Mt q_ddot + Bt q_dot + c_e + sum_types Fc_type S_type(t),
-    S_type(t) = sum_legs sum_{axes of the type} J_j(q)^T sign(J_j(q) q_dot),
-
-with c_e a constant per channel and experiment and one Coulomb level per joint type. By
-default both sides are filtered with one smooth kernel, so no signal is differentiated
-numerically and the equation holds exactly in the filtered signals.
-
-References
-----------
-Khalil, W., Dombre, E. Modeling, Identification and Control of Robots, ch. 12 (2002):
-inverse dynamic identification model with least squares.
+"""Time-domain least squares with Coulomb friction (Khalil and Dombre 2002, ch. 12):
+y = Mt q_ddot + Bt q_dot + c_e + sum_types Fc_type S_type, S_type = sum J_j^T sign(J_j q_dot).
 """
 
 from __future__ import annotations
@@ -52,11 +39,7 @@ from stewartid.signals.differentiation import (
 
 
 def pose_noise_gram(q: np.ndarray, sample_rate: float, window: float) -> np.ndarray:
-    """Covariance (12, 12) of the pose noise one row [q * h'', q * h'] carries.
-
-    The pose's white noise covariance, estimated from the record, times the energy of the
-    kernel's second and first derivative taps (h'' is even and h' odd, so no cross term).
-    """
+    """Covariance (12, 12) of the pose noise a row [q * h'', q * h'] carries."""
     from stewartid.identification.wavelet.noise import white_noise_covariance
 
     smooth = differentiate(q, sample_rate, window)[0]
@@ -70,21 +53,10 @@ def pose_noise_gram(q: np.ndarray, sample_rate: float, window: float) -> np.ndar
 
 def coulomb_regressors(joint_jacobians: np.ndarray, q_dot: np.ndarray, smoothing: float,
                        shape: str = "algebraic") -> np.ndarray:
-    """Generalized Coulomb force per unit level, one per joint type.
+    """Generalized Coulomb force per unit level S_type (N, 3, 6), one per :data:`JOINT_TYPES`.
 
-    Parameters
-    ----------
-    joint_jacobians : ndarray, shape (N, 6, 5, 6)
-    q_dot : ndarray, shape (N, 6)
-    smoothing : float
-        Regularisation rate s (rad/s) of sign(w); 0 for the exact sign.
-    shape : {"algebraic", "erf"}
-        sign(w)'s shape over s (:func:`~stewartid.identification.friction_shape.shaped_sign`).
-
-    Returns
-    -------
-    ndarray, shape (N, 3, 6)
-        S_type(t) for the types of :data:`JOINT_TYPES` (N m per N m of level, or N per N m).
+    ``joint_jacobians`` (N, 6, 5, 6); ``smoothing`` s, rad/s, and ``shape`` as
+    :func:`~stewartid.identification.friction_shape.shaped_sign`.
     """
     rates = np.einsum("nlac,nc->nla", joint_jacobians, q_dot)
     signs = shaped_sign(rates, smoothing, shape)
@@ -95,11 +67,7 @@ def coulomb_regressors(joint_jacobians: np.ndarray, q_dot: np.ndarray, smoothing
 
 
 class _Rows(NamedTuple):
-    """One experiment's rows of the regression.
-
-    Times (s), the kernel's support (s), force, velocity and acceleration (K, 6), per Coulomb
-    shape the regressors (K, 3, 6), and the rows' pose-noise covariance (12, 12) or None.
-    """
+    """One experiment's rows: times, support, force, rates (K, 6), Coulomb regressors, pose-noise Gram."""
 
     t: np.ndarray
     window: float
@@ -123,46 +91,37 @@ class LeastSquaresIdentifier(BaseIdentifier):
     Parameters
     ----------
     window : float, optional
-        Filter window (s); 0.2 periods of each experiment's dominant excitation frequency by
-        default.
+        Filter window, s; default 0.2 periods of each experiment's dominant frequency.
     order : int
         Savitzky-Golay polynomial order.
     gravity : bool
-        Subtract the model's gravity term G(q).
+        Subtract the model's G(q).
     remainder : bool
-        Fit the force less the model's nonlinear remainder
-        (:func:`~stewartid.identification.preparation.model_remainder`).
+        Subtract the model's nonlinear remainder.
     sampling_check : bool
-        Widen the standard errors where the log's sampling limits the estimate
-        (:mod:`~stewartid.identification.sampling`).
+        Widen standard errors where the log's sampling limits them.
     coulomb : bool
         Include the three Coulomb regressors.
     coulomb_smoothing : float
-        Rate (rad/s) below which a joint's Coulomb sign is attenuated.
+        Rate, rad/s, below which a Coulomb sign is attenuated.
     coulomb_shape : {'average', 'algebraic', 'erf'}
-        The sign's shape over ``coulomb_smoothing``
-        (:data:`~stewartid.identification.friction_shape.COULOMB_SHAPES`), or the
-        Akaike-weighted average of fits with each (default).
+        Sign shape, or the Akaike-weighted average of both (default).
     symmetric : bool
-        Impose Mt = Mt^T and Bt = Bt^T.
+        Impose Mt = Mt^T, Bt = Bt^T.
     differentiation : {'kernel', 'savgol'}
-        Filter both sides with a smooth kernel (default) or differentiate with
-        Savitzky-Golay.
+        Filter both sides with a smooth kernel, or differentiate with Savitzky-Golay.
     decimate : int
-        Use every ``decimate``-th sample (the filtered signals are smooth over the window).
+        Use every ``decimate``-th sample.
     noise_correction : bool
-        With ``differentiation="kernel"``: remove the errors-in-variables bias that pose noise
-        puts on Mt and Bt, from the noise covariance estimated in each record.
+        Remove the errors-in-variables bias of pose noise (kernel only).
 
     Attributes
     ----------
     M_, B_ : ndarray, shape (6, 6)
     std_errors_ : dict of ndarray (6, 6)
-    coulomb_ : dict
-        Identified Coulomb level per joint type (N m).
-    coulomb_std_ : dict
+    coulomb_, coulomb_std_ : dict
+        Coulomb level per joint type and its standard error, N m.
     coulomb_shape_weights_ : dict
-        Weight of each Coulomb shape in the fit.
     offsets_ : ndarray, shape (n_experiments, 6)
     condition_number_ : float
     result_ : IdentificationResult
@@ -197,7 +156,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
     }
 
     def _experiment_rows(self, exp: Experiment, shapes: tuple[str, ...]) -> _Rows:
-        """One prepared experiment's rows: force, filtered motion and, per shape, Coulomb regressors."""
+        """One prepared experiment's rows."""
         window = self.window or default_window(estimate_frequency(exp.q, exp.sample_rate))
         if self.differentiation == "savgol":
             _, qd, qdd = differentiate(exp.q, exp.sample_rate, window, self.order)

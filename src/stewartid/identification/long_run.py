@@ -1,6 +1,4 @@
-"""Covariance of an estimate from correlated residuals: sandwiches A^-1 B A^-1 whose B is the
-long-run covariance of the rows' scores or their sum per record, and the more cautious of two.
-"""
+"""Sandwich covariances A^-1 B A^-1 of estimates from correlated residuals."""
 
 from __future__ import annotations
 
@@ -11,20 +9,7 @@ import scipy.ndimage
 
 
 def with_variances(covariance: np.ndarray, variances: np.ndarray) -> np.ndarray:
-    """``covariance`` with its variances replaced by ``variances``, its correlations kept.
-
-    A variance of zero takes its new value with no correlation.
-
-    Parameters
-    ----------
-    covariance : ndarray, shape (n, n)
-    variances : ndarray, shape (n,)
-        Nonnegative.
-
-    Returns
-    -------
-    ndarray, shape (n, n)
-    """
+    """``covariance`` with its variances replaced by ``variances``, correlations kept."""
     own = np.sqrt(np.clip(np.diag(covariance), 0.0, None))
     target = np.sqrt(np.clip(variances, 0.0, None))
     factor = np.where(own > 0, target / np.where(own > 0, own, 1.0), 1.0)
@@ -33,44 +18,17 @@ def with_variances(covariance: np.ndarray, variances: np.ndarray) -> np.ndarray:
 
 
 def with_larger_variances(covariance: np.ndarray, other: np.ndarray) -> np.ndarray:
-    """``covariance`` with each variance raised to ``other``'s where larger, correlations kept.
-
-    Parameters
-    ----------
-    covariance, other : ndarray, shape (n, n)
-
-    Returns
-    -------
-    ndarray, shape (n, n)
-    """
+    """``covariance`` with each variance raised to ``other``'s where larger, correlations kept."""
     return with_variances(covariance, np.maximum(np.diag(covariance), np.diag(other)))
 
 
 def long_run_covariance(scores: np.ndarray, segments: Sequence[tuple[int, int]],
                         stride: int = 1, psd: bool = True) -> np.ndarray:
-    """Covariance of the sum of a series of score vectors, for a sandwich A^-1 B A^-1.
+    """Covariance B (n, n) of the sum of score vectors ``scores`` (K, n), lags within records.
 
-    The scores' autocovariances summed with uniform weights over every lag below each record's
-    correlation length (filtered white noise is correlated over the filter's support only), no
-    lag crossing two records.
-
-    Parameters
-    ----------
-    scores : ndarray, shape (K, n)
-        Per row, the gradient of its weighted squared residual in the unknowns.
-    segments : sequence of (int, int)
-        Rows of each record (summing to K) and its correlation length L (rows): rows L or
-        more apart are uncorrelated.
-    stride : int
-        Take the outer products at every ``stride``-th row only, times ``stride`` (cheaper for
-        slowly varying scores).
-    psd : bool
-        Set the negative eigenvalues to zero (:func:`nearest_psd`); else the symmetrized sum,
-        whose diagonal stays unbiased.
-
-    Returns
-    -------
-    ndarray, shape (n, n)
+    Autocovariances summed uniformly over lags below each record's correlation length; ``segments``:
+    (rows, correlation length) per record; ``stride``: outer products every stride-th row, times stride;
+    ``psd``: clip negative eigenvalues (:func:`nearest_psd`).
     """
     B = np.zeros((scores.shape[1],) * 2)
     start = 0
@@ -90,24 +48,9 @@ def long_run_covariance(scores: np.ndarray, segments: Sequence[tuple[int, int]],
 def filtered_noise_covariance(X: np.ndarray, weights: np.ndarray,
                               segments: Sequence[tuple[int, int]],
                               noises: Sequence[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
-    """B = Cov(sum_k s_k) for scores s_k = sum_c w_c X_kc e_kc whose e is a known filtered noise.
+    """B = Cov(sum_k s_k), s_k = sum_c w_c X_kc e_kc, for a known filtered noise e; (n, n).
 
-    Cov(e_k, e_j) = S rho(|k - j|) over the rows of one record and 0 across records. It
-    estimates nothing from the residual, so it does not scatter between realisations.
-
-    Parameters
-    ----------
-    X : ndarray, shape (K, c, n)
-    weights : ndarray, shape (c,)
-    segments : sequence of (int, int)
-        Rows of each record (summing to K); the second item is not used.
-    noises : sequence of (ndarray, ndarray)
-        Per record, S (c, c) and rho (L,): the filter's autocorrelation at lags of 0, 1, ...
-        rows (rho[0] the filtered noise's variance per unit S).
-
-    Returns
-    -------
-    ndarray, shape (n, n)
+    Cov(e_k, e_j) = S rho(|k - j|) within a record, 0 across; ``noises``: per record (S (c, c), rho (L,)).
     """
     Z = X * weights[None, :, None]
     B = np.zeros((X.shape[2],) * 2)
@@ -124,11 +67,7 @@ def filtered_noise_covariance(X: np.ndarray, weights: np.ndarray,
 
 
 def nearest_psd(matrix: np.ndarray) -> np.ndarray:
-    """A symmetric matrix with its negative eigenvalues set to zero.
-
-    Clipping raises the diagonal of a long-run sum whose value is a small remainder of large
-    autocovariances of either sign.
-    """
+    """A symmetric matrix with its negative eigenvalues set to zero."""
     values, vectors = np.linalg.eigh(matrix)
     return (vectors * np.clip(values, 0.0, None)) @ vectors.T
 
@@ -136,28 +75,10 @@ def nearest_psd(matrix: np.ndarray) -> np.ndarray:
 def score_sandwich(inverse: np.ndarray, scores: np.ndarray,
                    segments: Sequence[tuple[int, int]], basis: np.ndarray | None = None,
                    psd: bool | str = True) -> np.ndarray:
-    """The covariance A^-1 B A^-1 of an estimate, B the :func:`long_run_covariance` of its rows' scores.
+    """A^-1 B A^-1 (m, m), B the :func:`long_run_covariance` of the rows' scores.
 
-    The outer products are taken a sixteenth of the shortest correlation length apart.
-
-    Parameters
-    ----------
-    inverse : ndarray, shape (m, m)
-        A^-1, in the unknowns the estimate is solved for.
-    scores : ndarray, shape (K, n)
-        Per row, the gradient of its weighted squared residual (n = m, or in the unknowns
-        ``basis`` maps from).
-    segments : sequence of (int, int)
-        Rows of each record and its correlation length (rows).
-    basis : ndarray, shape (n, m), optional
-        Maps the solved unknowns to the scores' (B becomes basis^T B basis).
-    psd : bool or "variances"
-        B with its negative eigenvalues set to zero, or not; ``"variances"``: the correlations
-        of the clipped B and the variances of the unclipped one (the clipped where negative).
-
-    Returns
-    -------
-    ndarray, shape (m, m)
+    ``basis`` (n, m) maps solved unknowns to the scores'. ``psd``: clip B, or ``"variances"`` to take
+    the clipped correlations and the unclipped variances.
     """
     stride = max(1, min(length for _, length in segments) // 16)
     raw = long_run_covariance(scores, segments, stride, psd=False)
@@ -177,25 +98,10 @@ def score_sandwich(inverse: np.ndarray, scores: np.ndarray,
 def record_sandwich(inverse: np.ndarray, scores: np.ndarray,
                     segments: Sequence[tuple[int, int]], expected: np.ndarray | None = None
                     ) -> np.ndarray:
-    """The covariance A^-1 B A^-1 with the records as independent clusters.
+    """A^-1 B A^-1 with the records as independent clusters.
 
-    B is the sum over the R records of the outer product of their summed scores (less each
-    record's expected sum), times R / (R - 1). It sees model error correlated with the motion
-    over a whole record, which short-lag autocovariances do not.
-
-    Parameters
-    ----------
-    inverse : ndarray, shape (m, m)
-    scores : ndarray, shape (K, m)
-    segments : sequence of (int, int)
-        Rows of each record (summing to K) and its correlation length (unused here).
-    expected : ndarray, shape (R, m), optional
-        Each record's expected summed score under noise alone (its errors-in-variables
-        correction); by default the total shared out by rows.
-
-    Returns
-    -------
-    ndarray, shape (m, m)
+    B = R / (R - 1) sum_r (summed scores - ``expected``)(...)^T: sees model error correlated with the
+    motion over a whole record.
     """
     rows = np.array([n for n, _ in segments])
     ends = np.cumsum([0, *rows])

@@ -1,10 +1,5 @@
-"""Symmetric pairs: the two estimates of each off-diagonal entry of Mt and Bt.
-
-Mt and Bt are symmetric, but a method that fits every equation separately estimates Mt(i, j)
-and Mt(j, i) from different equations (in the usual protocol, different experiments). Their
-difference tests the standard errors (:func:`symmetric_pair_scores`), calibrates them
-(:func:`pair_calibration`, :func:`calibrate_by_pairs`) and decides which member to report
-(:func:`select_symmetric_pairs`, :func:`combine_pairs`).
+"""Symmetric pairs: the two estimates of each off-diagonal entry of Mt and Bt, from different
+equations; their difference tests and calibrates the standard errors and picks the member to report.
 """
 
 from __future__ import annotations
@@ -15,12 +10,7 @@ import numpy as np
 
 
 def symmetric_pair_scores(matrix: np.ndarray, std: np.ndarray) -> np.ndarray:
-    """|a_ij - a_ji| / sqrt(s_ij^2 + s_ji^2) of every off-diagonal pair (i < j), row-major.
-
-    Returns
-    -------
-    ndarray, shape (n (n - 1) / 2,)
-    """
+    """|a_ij - a_ji| / sqrt(s_ij^2 + s_ji^2) of every off-diagonal pair (i < j), row-major."""
     upper = np.triu_indices(matrix.shape[0], 1)
     spread = np.hypot(std[upper], std.T[upper])
     return np.abs(matrix[upper] - matrix.T[upper]) / np.maximum(spread, 1e-300)
@@ -38,24 +28,9 @@ HALF_NORMAL_MEDIAN = 0.6744897501960817
 def pair_calibration(scores: np.ndarray, clip: bool = False) -> dict[str, Any]:
     """How far the symmetric pairs' scatter exceeds their standard errors.
 
-    The Birge ratio sqrt(mean z^2) of the pair scores z (:func:`symmetric_pair_scores`) is
-    about 1 when the standard errors are honest; the factor for every standard error is that
-    ratio, at least 1. With ``clip`` (a fit immune to the friction law, whose model error shows
-    in a few pairs) the ratio is taken over the pairs within :data:`PAIR_DISAGREEMENT` times
-    it, a fixed point reached from the robust scale up.
-
-    Parameters
-    ----------
-    scores : ndarray
-        Pair scores of one matrix.
-    clip : bool
-        Leave the pairs far beyond the others' ratio out of the factor.
-
-    Returns
-    -------
-    dict
-        ``{"pairs": n, "birge_ratio": r (all pairs), "scale": median |z| / 0.6745,
-        "largest": max z, "outliers": pairs left out of the factor, "factor": max(ratio, 1)}``.
+    The factor is the Birge ratio sqrt(mean z^2), at least 1; with ``clip`` it is taken over the pairs
+    within :data:`PAIR_DISAGREEMENT` times it. Returns ``{"pairs", "birge_ratio", "scale", "largest",
+    "outliers", "factor"}``.
     """
     scores = np.asarray(scores, dtype=float)
     scores = scores[np.isfinite(scores)]
@@ -84,22 +59,8 @@ def calibrate_by_pairs(M: np.ndarray, B: np.ndarray, std_M: np.ndarray,
                        std_B: np.ndarray) -> dict[str, dict[str, Any]]:
     """Calibrate the standard errors of Mt and Bt, in place, by their symmetric pairs.
 
-    Each matrix's errors are multiplied by its pairs' factor (:func:`pair_calibration`); both
-    members of a pair still disagreeing beyond :data:`PAIR_DISAGREEMENT` then get at least half
-    their difference (the data cannot tell which one is biased).
-
-    Parameters
-    ----------
-    M, B : ndarray, shape (6, 6)
-        Unsymmetrized estimates.
-    std_M, std_B : ndarray, shape (6, 6)
-        Their standard errors; modified in place.
-
-    Returns
-    -------
-    dict
-        ``{"M": pair_calibration(...), "B": ...}``, the ``pair_calibration`` entry of a
-        result's diagnostics.
+    Errors times :func:`pair_calibration`'s factor; members still disagreeing beyond
+    :data:`PAIR_DISAGREEMENT` get at least half their difference. Returns ``{"M": ..., "B": ...}``.
     """
     found = {}
     upper = np.triu_indices(M.shape[0], 1)
@@ -117,30 +78,11 @@ def select_symmetric_pairs(matrix: np.ndarray, std: np.ndarray,
                            preferred_rows: tuple[int, ...] = (0, 1, 2),
                            disagreement: float = PAIR_DISAGREEMENT, pool: bool = False
                            ) -> list[dict]:
-    """Copy the better estimate of every off-diagonal pair (or the pooled mean) onto both entries.
+    """Copy the better estimate of every off-diagonal pair (or the pooled mean) onto both entries, in place.
 
-    The member with the smaller standard error is kept. On a disagreement beyond
-    ``disagreement`` the member in ``preferred_rows`` is kept if exactly one is, and the kept
-    error is raised to |difference| / ``disagreement`` so that it covers the disagreement.
-
-    Parameters
-    ----------
-    matrix, std : ndarray, shape (n, n)
-        Estimates and their standard errors; modified in place.
-    preferred_rows : tuple of int
-        0-based rows whose equations are trusted first on a significant disagreement (the
-        translational ones: the rotational equations see idle joints' friction).
-    disagreement : float
-        Threshold of |a - b| / sqrt(s_a^2 + s_b^2).
-    pool : bool
-        Replace two members within ``disagreement`` by their inverse-variance mean, standard
-        error (s_a^-2 + s_b^-2)^(-1/2), recorded as ``"pooled": True``.
-
-    Returns
-    -------
-    list of dict
-        Per pair {"pair": [[i, j], [j, i]], "kept": [i, j], "disagreement": z, "pooled": bool}
-        (1-based; "kept" is the better-determined member when pooled).
+    The smaller standard error wins; beyond ``disagreement`` a member in ``preferred_rows`` (0-based)
+    wins and its error is raised to |difference| / ``disagreement``; ``pool`` averages agreeing members
+    by inverse variance. Returns per pair {"pair", "kept", "disagreement", "pooled"}, 1-based.
     """
     choice = []
     n = matrix.shape[0]
@@ -171,18 +113,8 @@ def combine_pairs(M: np.ndarray, B: np.ndarray, std_M: np.ndarray, std_B: np.nda
                   ) -> tuple[dict, dict]:
     """Method B's symmetric pairs, in place, and their calibration.
 
-    The better-determined member (``pair_selection`` "pooled" or "std_error",
-    :func:`select_symmetric_pairs`; "none" keeps both), then the standard errors multiplied by
-    the pairs' calibration factor (:func:`pair_calibration`, judged on the residual-based
-    errors); or with ``symmetric`` the inverse-variance mean of both.
-
-    Returns
-    -------
-    chosen : dict
-        ``{"M": [...], "B": [...]}`` of :func:`select_symmetric_pairs` (empty for
-        ``symmetric`` or "none").
-    calibration : dict
-        ``{"M": pair_calibration(...), "B": ...}`` (empty for ``symmetric``).
+    Select per ``pair_selection`` ("pooled", "std_error", "none") then calibrate, or with ``symmetric``
+    the inverse-variance mean. Returns (chosen, calibration) dicts keyed "M", "B".
     """
     if symmetric:
         for matrix, std in ((M, std_M), (B, std_B)):

@@ -1,11 +1,5 @@
-"""Data preparation shared by every identifier: each experiment's model terms (Jacobians,
-gravity, the generalized force y = J_lq^T f_a - G(q) and its sensitivity to the pose),
-computed once at every measured pose (Zhang 2020, Eq. 5).
-
-References
-----------
-Zhang, C. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
-Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
+"""Data preparation shared by every identifier: Jacobians, gravity and y = J_lq^T f_a - G(q) at
+every measured pose, computed once (Zhang 2020, Eq. 5).
 """
 
 from __future__ import annotations
@@ -40,26 +34,21 @@ class Experiment:
     ----------
     name : str
     t : ndarray, shape (N,)
-        Time (s), uniform.
+        s, uniform.
     q : ndarray, shape (N, 6)
-        Measured pose (m, rad).
+        m, rad.
     generalized_force : ndarray, shape (N, 6)
-        y = J_lq(q)^T f_a - G(q) (N, N m); without the gravity term when gravity subtraction
-        is off.
+        y = J_lq^T f_a - G(q), N, N m (G omitted when gravity is off).
     leg_jacobian : ndarray, shape (N, 6, 6)
-        J_lq at every measured pose.
     gravity : ndarray, shape (N, 6)
-        G(q) of the platform description (N, N m), whether or not it was subtracted.
+        G(q), N, N m, subtracted or not.
     force_sensitivity : ndarray, shape (6, 6)
-        K = d y / d q at the mean pose and mean leg forces
-        (:func:`generalized_force_sensitivity`).
+        K = dy/dq at the mean pose and forces.
     sample_rate : float
         Hz.
     platform : Platform
-        The description the terms were computed from.
     joint_jacobians : ndarray, shape (N, 6, 5, 6)
-        Joint-axis rate Jacobians (rad/s per unit q_dot), axes lower 1, lower 2, upper 1,
-        upper 2, revolute; computed on first use unless :func:`prepare` was asked for them.
+        Joint-axis rates per unit q_dot; computed on first use.
     """
 
     name: str
@@ -74,7 +63,7 @@ class Experiment:
 
     @cached_property
     def joint_jacobians(self) -> np.ndarray:
-        """Joint-axis rate Jacobians, shape (N, 6, 5, 6); see the class docstring."""
+        """Joint-axis rate Jacobians, shape (N, 6, 5, 6)."""
         return joint_rate_jacobians(self.platform, self.q)
 
     @property
@@ -117,26 +106,9 @@ def resolve_datasets(datasets: Any, platform: Platform) -> list[Dataset]:
 
 def generalized_force_sensitivity(platform: Platform, q: np.ndarray, forces: np.ndarray,
                                   gravity: bool = True, step: float = 1e-6) -> np.ndarray:
-    """K = d(J_lq(q)^T f - G(q)) / dq at the mean pose and mean leg forces.
+    """K = d(J_lq^T f - G(q)) / dq (6, 6) at the mean pose and leg forces, by central differences.
 
-    K maps pose noise into the generalized force, for errors-in-variables corrections.
-
-    Parameters
-    ----------
-    platform : Platform
-    q : ndarray, shape (N, 6)
-        Measured poses (m, rad).
-    forces : ndarray, shape (N, 6)
-        Measured leg forces (N).
-    gravity : bool
-        Whether G(q) is part of the generalized force (as :func:`prepare`'s ``gravity``).
-    step : float
-        Central-difference step (m, rad).
-
-    Returns
-    -------
-    ndarray, shape (6, 6)
-        K[i, j] = d y_i / d q_j (N/m, N/rad, N m/m, N m/rad).
+    Maps pose noise into the generalized force; ``gravity`` as :func:`prepare`'s.
     """
     q0, f0 = q.mean(axis=0), forces.mean(axis=0)
     poses = np.repeat(q0[None], 12, axis=0)
@@ -158,20 +130,12 @@ def prepare_experiment(dataset: Dataset, platform: Platform, gravity: bool = Tru
     ----------
     dataset : Dataset
     platform : Platform
-        Platform description (geometry for J_lq; leg masses for G(q)).
     gravity : bool
-        Subtract the model's pose-dependent gravity term G(q) from J_lq^T f_a (else the
-        legs' gravity stiffness biases Mt).
+        Subtract G(q) (else the legs' gravity stiffness biases Mt).
     joints : bool
-        Compute the joint-axis Jacobians now, in the same pass as J_lq and G(q), rather than
-        on first use.
+        Compute the joint-axis Jacobians now rather than on first use.
     remainder : bool
-        Also subtract the model's departure from its linearisation (:func:`model_remainder`),
-        so that the linear model holds at any amplitude.
-
-    Returns
-    -------
-    Experiment
+        Subtract the model's departure from its linearisation (:func:`model_remainder`).
     """
     G, J, _, joint_jacobians = compute_leg_terms(platform, np.ascontiguousarray(dataset.pose), joints)
     y = np.einsum("nji,nj->ni", J, dataset.forces)
@@ -190,12 +154,9 @@ def prepare_experiment(dataset: Dataset, platform: Platform, gravity: bool = Tru
 
 
 def model_remainder(platform: Platform, q: np.ndarray, sample_rate: float) -> np.ndarray:
-    """The model's departure from its linearisation along a measured motion (N, 6).
+    """The model's departure from its linearisation along a measured motion q (N, 6), (N, 6).
 
-    :func:`~stewartid.model.linearization.linearisation_remainder` at the measured pose q
-    (N, 6) with Savitzky-Golay rates and accelerations (order 5 over a tenth of the dominant
-    period), evaluated every :data:`REMAINDER_STEPS`-th of the window and interpolated by cubic
-    Hermite polynomials (:func:`~stewartid.signals.interpolation.hermite_uniform`).
+    Evaluated every :data:`REMAINDER_STEPS`-th of the Savitzky-Golay window, Hermite-interpolated.
     """
     # the window needs the frequency only roughly: the spectrum's peak without refinement
     window = default_window(estimate_frequency(q, sample_rate, refine=False)) / REMAINDER_FRACTION
@@ -222,19 +183,7 @@ REMAINDER_ORDER, REMAINDER_FRACTION, REMAINDER_STEPS = 5, 2, 8
 
 def prepare(datasets: Sequence[Dataset], platform: Platform, gravity: bool = True,
             joints: bool = False, remainder: bool = False) -> list[Experiment]:
-    """:func:`prepare_experiment` of every data set.
-
-    Parameters
-    ----------
-    datasets : sequence of Dataset
-    platform : Platform
-    gravity, joints, remainder : bool
-        As in :func:`prepare_experiment`.
-
-    Returns
-    -------
-    list of Experiment
-    """
+    """:func:`prepare_experiment` of every data set."""
     return [prepare_experiment(d, platform, gravity, joints, remainder) for d in datasets]
 
 

@@ -1,16 +1,6 @@
 """The one list of identification methods, read by the command line, reproduction and reports.
 
-A method registers itself in its own module with the class decorator :func:`register_method`.
-Discovery imports :data:`BUILTIN_MODULES` in order, then every other module of
-``stewartid.identification`` alphabetically; presets come after every method.
-
-Examples
---------
->>> from stewartid.identification.registry import create_identifier, method_spec
->>> method_spec("ls").display_name
-'Time-domain least squares'
->>> create_identifier("wavelet-paper").variant
-'paper'
+Methods register with :func:`register_method`; discovery imports :data:`BUILTIN_MODULES` first.
 """
 
 from __future__ import annotations
@@ -37,27 +27,23 @@ class MethodSpec:
     Attributes
     ----------
     name : str
-        Name on the command line and in result files, e.g. ``"ls"``.
+        On the command line and in result files, e.g. ``"ls"``.
     display_name : str
-        Label in tables, figures and reports, e.g. ``"Method A (Fourier)"``.
+        In tables, figures and reports.
     letter : str or None
-        The paper's letter for the method (``"A"``, ``"B"``), matching its published columns;
-        None if the paper does not report it.
+        The paper's letter (``"A"``, ``"B"``), if it reports the method.
     reference : str
-        Citation (with DOI where there is one).
     description : str
         One line.
     color : str
-        Matplotlib colour, the same in every figure.
+        Matplotlib colour.
     estimator_class : type
-        The :class:`~stewartid.identification.base.BaseIdentifier` subclass.
     defaults : mapping
-        Settings passed to ``estimator_class`` (a preset's; empty for a method).
+        Settings for ``estimator_class`` (a preset's; empty for a method).
     preset_of : str or None
-        Name of the method this preset configures, None for a method.
+        Method this preset configures.
     compared : bool
-        Run by ``identify --method all`` (and so judged by its verdict) and by the
-        reproduction; False for a method that runs by name only.
+        Run by ``identify --method all`` and the reproduction.
     """
 
     name: str
@@ -78,11 +64,7 @@ class MethodSpec:
 
 @dataclass(frozen=True)
 class Preset:
-    """A named configuration of a method, given to :func:`register_method`.
-
-    The reference is the method's; ``letter`` is the paper's letter if the paper reports
-    exactly this configuration.
-    """
+    """A named configuration of a method, given to :func:`register_method`."""
 
     settings: Mapping[str, Any]
     display_name: str
@@ -118,11 +100,7 @@ def register_method(*, name: str, display_name: str, reference: str, description
                     color: str, letter: str | None = None,
                     presets: Mapping[str, Preset] | None = None,
                     compared: bool = True) -> Callable[[type], type]:
-    """Class decorator registering an estimator class as method ``name`` (and its presets).
-
-    Sets the class's ``method`` attribute (the name stored in its results) to ``name``;
-    ``compared`` as :attr:`MethodSpec.compared`.
-    """
+    """Class decorator registering an estimator class as method ``name`` (and its presets)."""
 
     def decorate(cls: type) -> type:
         cls.method = name
@@ -159,7 +137,7 @@ def _discover() -> None:
 
 
 def registered_methods() -> tuple[MethodSpec, ...]:
-    """Every registered method, built-ins first (wavelet, fourier, ls), then presets."""
+    """Every registered method, built-ins first, then presets."""
     _discover()
     modules = _module_order()
     position = {name: k for k, name in enumerate(_REGISTRY)}
@@ -182,7 +160,7 @@ def method_spec(name: str) -> MethodSpec:
     Raises
     ------
     ConfigError
-        For an unknown name; the message lists the registered ones.
+        For an unknown name.
     """
     _discover()
     try:
@@ -193,12 +171,12 @@ def method_spec(name: str) -> MethodSpec:
 
 
 def create_identifier(name: str, **settings: Any) -> Any:
-    """A new estimator for method or preset ``name``: the preset's settings updated by ``settings``.
+    """A new estimator for method or preset ``name``, the preset's settings updated by ``settings``.
 
     Raises
     ------
     ConfigError
-        For an unknown method or a setting the method does not have.
+        For an unknown method or setting.
     """
     spec = method_spec(name)
     cls = spec.estimator_class
@@ -211,11 +189,7 @@ def create_identifier(name: str, **settings: Any) -> Any:
 
 
 def estimates_only(name: str, **settings: Any) -> Any:
-    """:func:`create_identifier` for a use that never reads the standard errors.
-
-    Turns the sampling check (:mod:`~stewartid.identification.sampling`) off unless
-    ``settings`` ask for it, since it costs extra fits.
-    """
+    """:func:`create_identifier` with the sampling check off unless asked for (it costs extra fits)."""
     if "sampling_check" in method_spec(name).estimator_class.param_names():
         settings = {"sampling_check": False, **settings}
     return create_identifier(name, **settings)

@@ -1,6 +1,5 @@
-"""The result of an identification: matrices, standard errors, settings, diagnostics, its
-JSON file (``result.json``), and the comparison table in the layout of the paper (Zhang 2020,
-Tables 3-6).
+"""The result of an identification, its ``result.json``, and the comparison table in the layout of
+the paper (Zhang 2020, Tables 3-6).
 """
 
 from __future__ import annotations
@@ -28,36 +27,23 @@ class IdentificationResult:
 
     Attributes
     ----------
-    M : ndarray, shape (6, 6)
-        Inertial matrix Mt, paper frame (kg, kg m, kg m^2 blocks).
-    B : ndarray, shape (6, 6)
-        Viscous matrix Bt (N s/m, N s, N m s blocks).
+    M, B : ndarray, shape (6, 6)
+        Mt (kg, kg m, kg m^2) and Bt (N s/m, N s, N m s), paper frame.
     std_errors_M, std_errors_B : ndarray, shape (6, 6)
-        Standard errors of every entry, from the residuals.
     condition_number : float
-        Of the (column-equilibrated) regression solved.
+        Of the column-equilibrated regression.
     residual_rms : ndarray, shape (6,)
-        RMS residual per equation (N, N m, or the units of the transformed equations).
+        Per equation, N, N m (or the transformed equations' units).
     method : str
-        ``"fourier"``, ``"wavelet"``, ``"ls"``.
     settings : dict
-        Every setting of the identifier.
     diagnostics : dict
-        Method-specific: intervals, (a, b) points, frequencies, Coulomb levels, ...
+        Method-specific.
     validation : dict, optional
-        Held-out prediction scores, ``{"vaf_percent": [6], "nrmse": [6], "folds": N}``
-        (:mod:`stewartid.validation.heldout`); None when not validated.
+        Held-out scores ``{"vaf_percent", "nrmse", "folds"}``.
     delay : dict, optional
-        The delay of the force channels relative to the motion the data were aligned by,
-        ``{"seconds", "std_error", "applied", "source": "given" | "estimated", ...}``
-        (:mod:`stewartid.identification.delay`); None when the data were used as logged.
+        The force delay the data were aligned by (:mod:`stewartid.identification.delay`).
     verdict : dict, optional
-        With several methods compared, which to trust and why,
-        ``{"trusted", "ranking", "uncertain_entries", "reasons", ...}``
-        (:meth:`stewartid.verdict.rule.Verdict.to_dict`); None otherwise.
-
-    ``to_dict`` also writes ``consistency``, the symmetry and definiteness of M and B
-    (:func:`~stewartid.identification.consistency.consistency_metrics`).
+        Which method to trust and why, when several were compared.
     """
 
     M: np.ndarray
@@ -74,7 +60,7 @@ class IdentificationResult:
     verdict: dict[str, Any] | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """A JSON-ready dict; non-finite numbers are None (see :mod:`stewartid.files`)."""
+        """A JSON-ready dict (with ``consistency``); non-finite numbers are None."""
         from stewartid.identification.consistency import consistency_metrics
 
         document = {
@@ -124,20 +110,10 @@ class IdentificationResult:
         return cls.from_dict(json.loads(Path(path).read_text()))
 
     def comparison_table(self, M_nominal: np.ndarray, B_nominal: np.ndarray):
-        """Identified versus nominal values, in the layout of the paper's tables.
+        """Identified versus nominal values, one row per paper entry, as a DataFrame.
 
-        Parameters
-        ----------
-        M_nominal, B_nominal : ndarray, shape (6, 6)
-
-        Returns
-        -------
-        pandas.DataFrame
-            One row per entry of :data:`~stewartid.reference.published.PAPER_ENTRIES`,
-            columns ``entry`` ("Mt(1,1)"), ``matrix``, ``i``, ``j`` (1-based, as printed),
-            ``identified``, ``std_error``, ``nominal``, ``error_percent`` (the paper's ε,
-            :func:`~stewartid.reference.published.relative_error_percent`; NaN where the
-            nominal value is zero).
+        Columns ``entry``, ``matrix``, ``i``, ``j`` (1-based), ``identified``, ``std_error``, ``nominal``,
+        ``error_percent`` (the paper's epsilon; NaN where the nominal is zero).
         """
         return comparison_table(self.M, self.B, M_nominal, B_nominal,
                                 self.std_errors_M, self.std_errors_B)
@@ -147,8 +123,7 @@ def comparison_rows(M: np.ndarray, B: np.ndarray, M_nominal: np.ndarray,
                     B_nominal: np.ndarray, std_M: np.ndarray | None = None,
                     std_B: np.ndarray | None = None,
                     entries: Sequence[EntryKey] = PAPER_ENTRIES) -> list[dict[str, Any]]:
-    """The rows of :func:`comparison_table` as dicts, without pandas, for ``entries`` (the
-    paper's 20 by default)."""
+    """The rows of :func:`comparison_table` as dicts, for ``entries`` (the paper's 20 by default)."""
     identified = {"M": np.asarray(M), "B": np.asarray(B)}
     nominal = {"M": np.asarray(M_nominal, dtype=float), "B": np.asarray(B_nominal, dtype=float)}
     std = {"M": std_M if std_M is not None else np.full((6, 6), np.nan),

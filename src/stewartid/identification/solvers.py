@@ -1,10 +1,5 @@
-"""Least-squares solvers shared by the identifiers.
-
-- :func:`solve_least_squares`: weighted (feasible generalized) least squares for
-  y(k) = theta phi(k) + shared terms, with an optional symmetry constraint, rank checks that
-  name the DOF never excited, and standard errors (optionally for autocorrelated residuals);
-- :func:`bias_compensated_least_squares`: the errors-in-variables estimator for regressors
-  measured with noise of known second moments, with cluster-robust standard errors.
+"""Least-squares solvers shared by the identifiers: feasible generalized least squares with rank checks,
+and errors-in-variables least squares with cluster-robust standard errors.
 """
 
 from __future__ import annotations
@@ -25,23 +20,18 @@ class LeastSquaresSolution:
 
     Attributes
     ----------
-    theta : ndarray, shape (6, p)
-        Coefficients: y_i = sum_j theta[i, j] phi_j (+ shared terms); Mt then Bt first when
-        the regressors are ordered [q_ddot, q_dot, ...].
-    theta_std : ndarray, shape (6, p)
-        Standard errors of ``theta``.
-    shared : ndarray, shape (s,)
-        Coefficients of the shared terms (one scalar for all six channels each).
-    shared_std : ndarray, shape (s,)
+    theta, theta_std : ndarray, shape (6, p)
+        y_i = sum_j theta[i, j] phi_j (+ shared terms), and standard errors.
+    shared, shared_std : ndarray, shape (s,)
+        One coefficient per shared term for all channels.
     condition_number : float
-        Of the column-equilibrated, channel-weighted regression matrix (2-norm).
+        Of the column-equilibrated, channel-weighted regression (2-norm).
     residual_rms : ndarray, shape (6,)
-        Per channel (units of y).
+        Units of y.
     n_equations : int
         Rows per channel.
     effective_equations : ndarray, shape (6,)
-        Independent rows per channel: ``n_equations`` over the residual's autocorrelation
-        time; the sample size for comparing fits on the same rows by likelihood.
+        Rows per channel over the residual's autocorrelation time.
     """
 
     theta: np.ndarray
@@ -62,27 +52,12 @@ def _regressor_dof(name: str) -> str | None:
 
 
 def check_rank(normal: np.ndarray, names: Sequence[str], max_condition: float) -> float:
-    """Condition number of the equilibrated regression; raise on rank loss.
-
-    Parameters
-    ----------
-    normal : ndarray, shape (p, p)
-        Normal matrix X^T X (or a weighted one) of the p regressors.
-    names : sequence of str
-        The regressors' names (:func:`regressor_names`), for the error message.
-    max_condition : float
-        Largest acceptable condition number of the column-equilibrated regression.
-
-    Returns
-    -------
-    float
-        The condition number of the equilibrated regression.
+    """Condition number of the equilibrated regression from ``normal`` (p, p); raise on rank loss.
 
     Raises
     ------
     IdentificationError
-        When a regressor is identically zero or the condition number exceeds
-        ``max_condition``; the message names the DOF never excited.
+        A zero regressor or a condition number over ``max_condition``, naming the DOF never excited.
     """
     diag = np.diag(normal).copy()
     scale = np.sqrt(np.abs(diag))
@@ -119,7 +94,7 @@ def _raise_unexcited(regressors: Sequence[str], condition: float | None = None) 
 
 
 def _symmetric_map(p: int, symmetric: bool) -> np.ndarray:
-    """Matrix T with vec(theta) = T z (row-major vec of the (6, p) theta)."""
+    """T with vec(theta) = T z (row-major vec of the (6, p) theta)."""
     if not symmetric:
         return np.eye(6 * p)
     columns = []
@@ -148,45 +123,30 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
                         ) -> LeastSquaresSolution:
     """Least squares for y(k) = theta phi(k) + sum_s c_s S_s(k), with standard errors.
 
-    Every channel of ``y`` shares the rows ``phi``; each shared term S_s is a 6-vector per row
-    with one scalar c_s common to all channels. The solve is weighted by each channel's
-    residual variance from a first, equally weighted pass (feasible generalized least squares),
-    since channels differ in units and noise.
+    Channels share ``phi`` and are weighted by their residual variance from a first pass.
 
     Parameters
     ----------
     phi : ndarray, shape (K, p)
-        Regressor rows; with ``symmetric`` the first 12 columns must be [q_ddot, q_dot]
-        (coefficients Mt, Bt).
+        With ``symmetric``, the first 12 columns are [q_ddot, q_dot].
     y : ndarray, shape (K, 6)
-        Targets (generalized forces or their transforms).
     shared : ndarray, shape (K, s, 6), optional
-        Shared-coefficient terms.
     symmetric : bool
-        Impose Mt = Mt^T and Bt = Bt^T.
+        Impose Mt = Mt^T, Bt = Bt^T.
     regressor_names, shared_names : sequence of str, optional
-        Used in error messages, e.g. ``"q_ddot[rx]"``.
+        For error messages.
     max_condition : float
-        Largest acceptable condition number of the equilibrated regression.
     autocorrelated : bool
-        The residuals are correlated in time (filtered signals): inflate each channel's
-        variance by its integrated autocorrelation time (:func:`integrated_autocorrelation`).
+        Inflate variances by the integrated autocorrelation time.
     regressor_noise : ndarray, shape (p, p), optional
-        Sum over rows of the covariance of the regressors' noise, subtracted from phi^T phi
-        to remove the errors-in-variables attenuation.
+        Summed regressor-noise covariance, subtracted from phi^T phi.
     segments : sequence of (int, int), optional
-        The rows as consecutive records: each one's number of rows and its correlation length
-        (rows). Given, each variance is the larger of the above and the score sandwich
-        (:func:`~stewartid.identification.long_run.score_sandwich`).
-
-    Returns
-    -------
-    LeastSquaresSolution
+        Rows and correlation length per record; variances become at least the score sandwich's.
 
     Raises
     ------
     IdentificationError
-        Too few equations, or rank deficiency (names the DOF that was never excited).
+        Too few equations, or rank deficiency (names the DOF never excited).
     """
     phi, y = np.asarray(phi, dtype=float), np.asarray(y, dtype=float)
     K, p = phi.shape
@@ -270,20 +230,14 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
 
 
 def _row_scores(phi: np.ndarray, S: np.ndarray, weighted: np.ndarray) -> np.ndarray:
-    """Per row, the gradient of its weighted squared residual in the full unknowns, shape (K, 6 p + s).
-
-    ``weighted`` is r / sigma^2, shape (K, 6).
-    """
+    """Per row, the gradient of its weighted squared residual (K, 6 p + s); ``weighted`` = r / sigma^2."""
     K, p = phi.shape
     per_channel = (phi[:, None, :] * weighted[:, :, None]).reshape(K, 6 * p)
     return np.concatenate([per_channel, np.einsum("ksi,ki->ks", S, weighted)], axis=1)
 
 
 def integrated_autocorrelation(x: np.ndarray, max_lag: int | None = None) -> float:
-    """Integrated autocorrelation time tau = 1 + 2 sum_{k>=1} rho_k of a series (samples).
-
-    The sum stops at the first non-positive autocorrelation (initial positive sequence).
-    """
+    """tau = 1 + 2 sum_{k>=1} rho_k (samples), summed up to the first non-positive rho_k."""
     x = np.asarray(x, dtype=float) - np.mean(x)
     n = len(x)
     if n < 4 or not np.any(x):
@@ -315,27 +269,9 @@ def bias_compensated_least_squares(phi: np.ndarray, target: np.ndarray, cluster:
                                    ) -> tuple[np.ndarray, np.ndarray]:
     """Errors-in-variables least squares with cluster-robust standard errors.
 
-        theta_i = (X^T X - sum_k C_k)^-1 (X^T y_i - sum_k D_k[:, i])
-
-    with C_k, D_k the known noise second moments of each row (Stoica and Soderstrom 1982, "Bias
-    correction in least-squares identification"). The covariance is the sandwich over
-    independent clusters (intervals) of the estimating-equation scores.
-
-    Parameters
-    ----------
-    phi : ndarray, shape (K, p)
-    target : ndarray, shape (K, C)
-    cluster : ndarray of int, shape (K,)
-    noise_xx : ndarray, shape (K, p, p)
-        E[e_k e_k^T] of each row's regressor noise (C_k).
-    noise_xy : ndarray, shape (K, p, C)
-        E[e_k e_y,k^T] between regressor and target noise (D_k).
-
-    Returns
-    -------
-    theta : ndarray, shape (C, p)
-    std : ndarray, shape (C, p)
-        Cluster-robust standard errors with the small-sample factor G / (G - 1).
+    theta_i = (X^T X - sum_k C_k)^-1 (X^T y_i - sum_k D_k[:, i]) (Stoica and Soderstrom 1982), with
+    ``noise_xx`` C_k (K, p, p) and ``noise_xy`` D_k (K, p, C); sandwich over ``cluster`` with G / (G - 1).
+    Returns theta, std (C, p).
     """
     K, p = phi.shape
     scale = np.linalg.norm(phi, axis=0)
