@@ -1,8 +1,5 @@
-"""Exception hierarchy.
-
-Every error the package raises on bad input derives from :class:`StewartidError` and from
-the built-in exception a caller would expect, so ``except ValueError`` keeps working.
-Messages say what is wrong, where, what was expected and how to fix it.
+"""Exception hierarchy: each error derives from :class:`StewartidError` and from the built-in
+exception a caller would expect, so ``except ValueError`` keeps working.
 """
 
 from __future__ import annotations
@@ -33,13 +30,11 @@ class OutputExistsError(ConfigError):
 
 
 class DataWarning(UserWarning):
-    """A data set was usable only after a correction (for instance resampling), or looks
-    doubtful against the platform description."""
+    """A data set was usable only after a correction, or looks doubtful against the platform."""
 
 
 class NotFittedError(StewartidError, ValueError, AttributeError):
     """A learned attribute (ending in ``_``) was read before ``fit``.
 
-    Like scikit-learn's ``NotFittedError`` it is both a ValueError and an AttributeError, so
-    ``hasattr(estimator, "M_")`` is False before fitting.
+    Also an AttributeError, so ``hasattr(estimator, "M_")`` is False before fitting.
     """

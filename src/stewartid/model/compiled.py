@@ -1,7 +1,5 @@
-"""The kernels of :mod:`stewartid.model.kernels`, compiled with numba (cached on disk).
-
-Every function of that module is compiled here under the same name; within the compiled
-copies, a kernel's calls to the others go to their compiled copies.
+"""The kernels of :mod:`stewartid.model.kernels` compiled with numba (cached on disk), calling
+each other's compiled copies.
 """
 
 from __future__ import annotations

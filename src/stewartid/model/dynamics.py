@@ -1,19 +1,6 @@
-"""Rigid-body dynamics of the platform with six two-part legs and joint friction.
-
-Equation of motion in the paper's frame and coordinates (z down, q = [x y z rx ry rz]):
-
-    M(q) q_ddot + h(q, q_dot) + G(q) + F(q, q_dot) = J_lq(q)^T f_a
-
-M the mass matrix of the moving body (platform and payload) and the legs, h the
-velocity-product forces, G gravity (along +z), F joint friction (viscous on the four gimbal
-axes, Coulomb on all five rotational axes of each leg), f_a the actuator forces (N, positive
-extends). Newton-Euler per body projected with the velocity Jacobians (Kane's method),
-compiled in :mod:`stewartid.model.compiled`.
-
-A joint's Coulomb torque is regularised as Fc * w / sqrt(w^2 + s^2), w the joint rate,
-s = ``coulomb_smoothing`` (rad/s): sign(w) for |w| >> s, smooth through zero for an ODE
-solver. All functions take q, q_dot, q_ddot of shape (6,) or (N, 6) and return matching
-shapes.
+"""Rigid-body dynamics with six two-part legs and joint friction (Kane's method, z down):
+M(q) q_ddot + h(q, q_dot) + G(q) + F(q, q_dot) = J_lq(q)^T f_a, f_a actuator forces (N,
+positive extends). Functions take q, q_dot, q_ddot of shape (6,) or (N, 6).
 """
 
 from __future__ import annotations
@@ -28,16 +15,13 @@ COULOMB_SMOOTHING = 1e-4
 
 
 class ModelTerms:
-    """Every term of the equation of motion at a batch of samples.
+    """Every term of the equation of motion at a batch of N samples.
 
     Attributes
     ----------
-    mass_matrix : ndarray, shape (N, 6, 6)
-    velocity_product : ndarray, shape (N, 6)
-    gravity : ndarray, shape (N, 6)
-    leg_jacobian : ndarray, shape (N, 6, 6)
+    mass_matrix, leg_jacobian : ndarray, shape (N, 6, 6)
+    velocity_product, gravity, leg_lengths : ndarray, shape (N, 6)
     joint_jacobians : ndarray, shape (N, 6, 5, 6)
-    leg_lengths : ndarray, shape (N, 6)
     """
 
     def __init__(self, platform: Platform, q: np.ndarray, q_dot: np.ndarray | None = None):
@@ -69,20 +53,17 @@ def velocity_product_forces(platform: Platform, q: np.ndarray, q_dot: np.ndarray
 
 
 def gravity_forces(platform: Platform, q: np.ndarray) -> np.ndarray:
-    """Gravity term G(q) of platform and both leg parts (N, N m); shape (6,) or (N, 6).
-
-    G_z is negative: gravity pulls along +z (down) and G sits on the left-hand side.
-    """
+    """Gravity term G(q) of platform and leg parts (N, N m); G_z < 0 as gravity pulls along +z."""
     t = ModelTerms(platform, q)
     return _out(t.gravity, t.single)
 
 
 def friction_forces(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
                     coulomb_smoothing: float = COULOMB_SMOOTHING) -> np.ndarray:
-    """Joint friction F(q, q_dot) mapped to generalized forces (N, N m).
+    """Joint friction F(q, q_dot) as generalized forces (N, N m).
 
-    Viscous ``gimbal_viscous`` on the 4 gimbal axes per leg and Coulomb ``coulomb`` on all 5
-    rotational axes, regularised as described in the module docstring.
+    Viscous on the 4 gimbal axes, Coulomb on all 5 axes of a leg, regularised as
+    Fc w / sqrt(w^2 + s^2), w the joint rate, s = ``coulomb_smoothing`` (rad/s).
     """
     t = ModelTerms(platform, q, q_dot)
     return _out(_joint_friction(platform, t, q_dot, coulomb_smoothing), t.single)
@@ -90,7 +71,6 @@ def friction_forces(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
 
 def _joint_friction(platform: Platform, terms: ModelTerms, q_dot: np.ndarray,
                     coulomb_smoothing: float) -> np.ndarray:
-    """Generalized joint friction (N, 6) at the samples of ``terms``."""
     from stewartid.model import compiled  # numba, started only when a model term is computed
 
     qd2, _ = as_batch(q_dot, "q_dot")
@@ -101,13 +81,7 @@ def _joint_friction(platform: Platform, terms: ModelTerms, q_dot: np.ndarray,
 def inverse_dynamics(platform: Platform, q: np.ndarray, q_dot: np.ndarray, q_ddot: np.ndarray,
                      friction: bool = True,
                      coulomb_smoothing: float = COULOMB_SMOOTHING) -> np.ndarray:
-    """Actuator forces f_a (N) that produce ``q_ddot`` at state (q, q_dot).
-
-    Returns
-    -------
-    ndarray, shape (6,) or (N, 6)
-        Force along each leg, positive extending.
-    """
+    """Actuator forces f_a (N, positive extending), shape (6,) or (N, 6), that produce ``q_ddot``."""
     t = ModelTerms(platform, q, q_dot)
     qdd2, _ = as_batch(q_ddot, "q_ddot")
     rhs = np.einsum("nij,nj->ni", t.mass_matrix, qdd2) + t.velocity_product + t.gravity
@@ -120,12 +94,7 @@ def inverse_dynamics(platform: Platform, q: np.ndarray, q_dot: np.ndarray, q_ddo
 def forward_dynamics(platform: Platform, q: np.ndarray, q_dot: np.ndarray, forces: np.ndarray,
                      friction: bool = True,
                      coulomb_smoothing: float = COULOMB_SMOOTHING) -> np.ndarray:
-    """Accelerations q_ddot (m/s^2, rad/s^2) under actuator forces ``forces`` (N).
-
-    Returns
-    -------
-    ndarray, shape (6,) or (N, 6)
-    """
+    """Accelerations q_ddot (m/s^2, rad/s^2) under actuator forces ``forces`` (N)."""
     t = ModelTerms(platform, q, q_dot)
     f2, _ = as_batch(forces, "forces")
     rhs = np.einsum("nji,nj->ni", t.leg_jacobian, f2) - t.velocity_product - t.gravity
@@ -144,10 +113,7 @@ def kinetic_energy(platform: Platform, q: np.ndarray, q_dot: np.ndarray) -> np.n
 
 
 def potential_energy(platform: Platform, q: np.ndarray) -> np.ndarray:
-    """Gravitational potential energy of platform, payload and leg parts (J), zero at z = 0.
-
-    z points down, so V = -g * sum(m z_com). Shape () or (N,).
-    """
+    """Gravitational potential energy of platform, payload and leg parts (J): V = -g sum(m z_com)."""
     q2, single = as_batch(q)
     legs = inverse_kinematics(platform, q2)
     i, body = platform.inertia, platform.moving_body

@@ -1,11 +1,5 @@
-"""The rotational joints of a leg: their axes, which of them carry viscous friction, and the
-joint types the Coulomb levels are identified per.
-
-Each leg has five rotational joint axes, in the order of the joint-rate Jacobians
-(:func:`stewartid.model.kinematics.joint_rate_jacobians`, shape (..., 6, 5, 6)): two axes of
-the lower gimbal, two of the upper gimbal and the revolute about the leg. The gimbal axes are
-an orthonormal leg frame e1 = unit(z x u) (horizontal), e2 = u x e1; see
-``docs/conventions.md``.
+"""The five rotational joint axes of a leg (two per gimbal, then the revolute), which carry viscous
+friction, and the joint types the Coulomb levels are identified per; see ``docs/conventions.md``.
 """
 
 from __future__ import annotations

@@ -1,25 +1,6 @@
-"""Per-sample kernels of the platform model, in plain Python: the one definition.
-
-:mod:`stewartid.model.compiled` compiles every function here with numba; run as they are,
-they give the same numbers without starting numba. The kernels call each other by their
-global names, which the compiled copies resolve to the compiled kernels. :func:`model_terms`
-evaluates every pose-dependent term at one sample; the per-sample geometry functions are also
-applied to arrays of samples by :mod:`stewartid.model.leg_terms`, so both give the same
-numbers to the last bit. Only what numba compiles belongs here.
-
-Coordinates: q = [x, y, z, rx, ry, rz] (m, rad; R = Rz(rz) Ry(ry) Rx(rx)), q_dot its time
-derivative; the body equations are written in the twist nu = [v, omega] (world frame, at the
-reference point) and mapped to q with nu = T(q) q_dot, T = blockdiag(I, E(q)).
-
-Bodies: the moving body (platform and payload) of mass m, centre of mass c_body and inertia
-I_body about the reference point (platform frame); per leg a lower part turning about the
-lower gimbal point B (centre of mass B + d_l u) and an upper part that also slides with the
-stroke (centre of mass A - d_u u), neither with inertia about the leg's axis.
-
-Joint axes per leg, in the order [lower 1, lower 2, upper 1, upper 2, revolute]: the leg
-frame e1 = unit(z x u), e2 = u x e1, u; gimbal rates are the components on e1, e2 of the
-leg's angular velocity (lower) and of the platform's relative to the leg (upper), the
-revolute rate the relative rate about u.
+"""Per-sample kernels of the platform model in plain Python, the one definition that
+:mod:`stewartid.model.compiled` compiles with numba (only what numba compiles belongs here).
+Twist nu = [v, omega] = T(q) q_dot, T = blockdiag(I, E); see ``docs/conventions.md``.
 """
 
 from __future__ import annotations
@@ -35,25 +16,20 @@ from stewartid.model.joints import N_GIMBAL_AXES, N_JOINTS
 
 
 def rotation_entries(cx, sx, cy, sy, cz, sz):
-    """Entries of R = Rz(rz) Ry(ry) Rx(rx) row by row, (R00, R01, ..., R22), from the cosines
-    and sines of rx, ry, rz."""
+    """Entries of R = Rz Ry Rx row by row, from the cosines and sines of rx, ry, rz."""
     return (cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx,
             sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx,
             -sy, cy * sx, cy * cx)
 
 
 def euler_rate_entries(cy, sy, cz, sz):
-    """Entries (E00, E10, E20, E01, E11) of E with omega_world = E [rx_dot, ry_dot, rz_dot]
-    for R = Rz Ry Rx; the others are E02 = E12 = E21 = 0, E22 = 1."""
+    """Entries (E00, E10, E20, E01, E11) of E, omega = E [rx_dot, ry_dot, rz_dot]; E22 = 1, others 0."""
     return cz * cy, sz * cy, -sy, -sz, cz
 
 
 def leg_vector(R, x, y, z, a0, a1, a2, b0, b1, b2):
-    """One leg at pose position (x, y, z) (m) and rotation entries ``R``, upper joint a
-    (platform frame, from the reference point) and base joint b (fixed frame), all in m.
-
-    Returns (r0, r1, r2, u0, u1, u2, length): r = R a, the unit leg vector u from b to the
-    upper joint, and the leg length (m).
+    """(r0, r1, r2, u0, u1, u2, length) of one leg: r = R a, u the unit vector from base joint b to the
+    upper joint, at position (x, y, z) and rotation entries ``R``; a in the platform frame, all m.
     """
     r0 = R[0] * a0 + R[1] * a1 + R[2] * a2
     r1 = R[3] * a0 + R[4] * a1 + R[5] * a2
@@ -66,8 +42,7 @@ def leg_vector(R, x, y, z, a0, a1, a2, b0, b1, b2):
 
 
 def twist_column(c, r0, r1, r2, zero, one):
-    """Column c of J_A = [I, -[r]x]: the upper joint's velocity per unit of twist component c,
-    with ``zero`` and ``one`` at the structural zeros and ones."""
+    """Column c of J_A = [I, -[r]x], ``zero`` and ``one`` at its structural zeros and ones."""
     if c == 0:
         return one, zero, zero
     if c == 1:
@@ -93,23 +68,18 @@ def leg_angular_rate(u0, u1, u2, b0, b1, b2, length):
 
 
 def centre_of_mass_rates(b, u, rate, length, d_upper, d_lower):
-    """One component of the rates of u, of the lower part's centre of mass (d_lower u) and of
-    the upper part's (joint point - d_upper u), for joint velocity component ``b``, unit leg
-    vector component ``u`` and leg-length rate ``rate``."""
+    """One component of the rates of u and of the lower and upper parts' centres of mass."""
     u_rate = (b - u * rate) / length
     return u_rate, d_lower * u_rate, b - d_upper * u_rate
 
 
 def leg_gravity(g, m_upper, m_lower, lower_z, upper_z):
-    """One leg's share of the gravity force on a twist component, from the vertical rates of
-    its two centres of mass (subtracted from G: z points down)."""
+    """One leg's gravity force on a twist component, from the vertical rates of its centres of mass."""
     return g * (m_lower * lower_z + m_upper * upper_z)
 
 
 def body_gravity(R, g, m, c0, c1, c2):
-    """The moving body's gravity force on the twist components z, rx, ry (the others are
-    zero) for rotation entries ``R``, gravity ``g`` along +z, mass ``m`` and centre of mass
-    (c0, c1, c2) in the platform frame: -m g, and the moment -(R c) x (0, 0, m g)."""
+    """The moving body's gravity force on twist components z, rx, ry: -m g and -(R c) x (0, 0, m g)."""
     w = m * g
     return -w, -w * (R[3] * c0 + R[4] * c1 + R[5] * c2), w * (R[0] * c0 + R[1] * c1 + R[2] * c2)
 
@@ -123,13 +93,10 @@ def leg_frame(u0, u1, u2):
 
 
 def joint_rate_column(c, frame, u0, u1, u2, w0, w1, w2):
-    """Rates of the five joint axes per unit of twist component c, from the leg frame, the
-    unit leg vector and the leg's angular velocity w for that component.
+    """Rates of the five joint axes per unit of twist component c.
 
-    Gimbal rates are the components on e1 and e2 of the leg's angular velocity (lower) and
-    of the platform's relative to the leg (upper); the revolute rate is the relative rate
-    about u. A translation moves the platform's angular velocity by nothing, so its relative
-    rates are the leg's negated.
+    Gimbal rates: components on e1, e2 of the leg's angular velocity (lower) and of the platform's
+    relative to the leg (upper); the revolute rate is the relative rate about u.
     """
     e10, e11, e20, e21, e22 = frame
     lower_1 = e10 * w0 + e11 * w1
@@ -144,8 +111,7 @@ def joint_rate_column(c, frame, u0, u1, u2, w0, w1, w2):
 
 
 def euler_columns(x0, x1, x2, E):
-    """The angular part [x0, x1, x2] of a twist row in Euler-angle rates: [x0, x1, x2] E, with
-    E the entries of :func:`euler_rate_entries`."""
+    """The angular part of a twist row in Euler-angle rates: [x0, x1, x2] E."""
     E00, E10, E20, E01, E11 = E
     return x0 * E00 + x1 * E10 + x2 * E20, x0 * E01 + x1 * E11, x2
 
@@ -172,23 +138,16 @@ def euler_rate_map_derivative_product(ry: float, rz: float, rates: np.ndarray) -
 
 
 def model_terms(params, upper, base, q, qd, M, h, G, J_leg, J_joint, lengths):
-    """Evaluate every model term at one sample, in q coordinates (written into the outputs).
+    """Every model term at one sample, in q coordinates, written into the outputs.
 
-    Scalar loops and a few scratch arrays: the simulator calls it four times per step, where
-    small-matrix BLAS calls and temporaries would dominate the cost.
+    Scalar loops: the simulator calls it four times per step, where small BLAS calls would dominate.
 
     Parameters
     ----------
     params : (N_PARAMETERS,) packed parameters (:mod:`stewartid.model.parameters`).
-    upper : (6, 3) upper joints, platform frame, relative to the reference point (m).
-    base : (6, 3) base joints, fixed frame (m).
-    q, qd : (6,) pose (m, rad) and its rate (m/s, rad/s).
-    M : (6, 6) out, mass matrix.
-    h : (6,) out, velocity-product (Coriolis and centrifugal) forces.
-    G : (6,) out, gravity forces (M qdd + h + G + F = J_leg^T f).
-    J_leg : (6, 6) out, leg-length rates = J_leg qd.
-    J_joint : (6, 5, 6) out, joint axis rates = J_joint[leg] qd.
-    lengths : (6,) out, leg lengths (m).
+    upper, base : (6, 3) upper joints (platform frame, from the reference point), base joints (m).
+    q, qd : (6,) pose (m, rad) and its rate.
+    M, h, G, J_leg, J_joint, lengths : out, (6, 6), (6,), (6,), (6, 6), (6, 5, 6), (6,).
     """
     cx, sx, cy, sy, cz, sz = trigonometry(q)
     R = rotation_entries(cx, sx, cy, sy, cz, sz)
@@ -217,11 +176,10 @@ def model_terms(params, upper, base, q, qd, M, h, G, J_leg, J_joint, lengths):
 
 
 def _body_terms(params, R, omega, Mn, hn, Gn):
-    """The moving body's share (platform and payload), into the twist-coordinate ``Mn``,
-    ``hn``, ``Gn``. With c = R c_body its centre of mass from the reference point and I the
-    inertia about the reference point in the world frame (R I_body R^T), Newton-Euler about
-    the reference point gives M = [[m 1, -m [c]x], [m [c]x, I]],
-    h = [m omega x (omega x c), omega x (I omega)] and G = -[m g e_z, c x m g e_z]."""
+    """The moving body's share into the twist-coordinate ``Mn``, ``hn``, ``Gn`` (Newton-Euler about
+    the reference point, c = R c_body, I = R I_body R^T): M = [[m 1, -m [c]x], [m [c]x, I]],
+    h = [m omega x (omega x c), omega x (I omega)], G = -[m g e_z, c x m g e_z].
+    """
     m = params[layout.MASS]
     ixx, iyy, izz = params[layout.IXX], params[layout.IYY], params[layout.IZZ]
     ixy, ixz, iyz = params[layout.IXY], params[layout.IXZ], params[layout.IYZ]
@@ -259,10 +217,7 @@ def _body_terms(params, R, omega, Mn, hn, Gn):
 
 def _leg_kinematics(params, R, q, qd, omega, a, b, J_leg_row, J_joint_leg, Jcl, Jcu, Jw,
                     acl, acu, wd):
-    """One leg's geometry at one sample: its row of J_leg and joint-rate Jacobian (twist
-    coordinates), the velocity Jacobians of its centres of mass ``Jcl``, ``Jcu`` and of its
-    angular velocity ``Jw`` (3, 6), and their velocity-product accelerations ``acl``, ``acu``,
-    ``wd`` (3,), all written into the arguments; returns the leg length (m)."""
+    """One leg's J_leg row, joint and velocity Jacobians into the arguments; returns its length (m)."""
     d_u, d_l = params[layout.D_UPPER], params[layout.D_LOWER]
     r0, r1, r2, u0, u1, u2, l = leg_vector(R, q[0], q[1], q[2], a[0], a[1], a[2],
                                            b[0], b[1], b[2])
@@ -309,8 +264,7 @@ def _leg_kinematics(params, R, q, qd, omega, a, b, J_leg_row, J_joint_leg, Jcl, 
 
 
 def _add_leg_inertia(params, Jcl, Jcu, Jw, acl, acu, wd, Mn, hn, Gn):
-    """Add one leg's two parts to the twist-coordinate ``Mn``, ``hn``, ``Gn`` (Kane's method:
-    each body's velocity Jacobian transposed times its inertial and gravity forces)."""
+    """Add one leg's two parts to ``Mn``, ``hn``, ``Gn`` (Kane's method)."""
     m_u, m_l = params[layout.M_UPPER], params[layout.M_LOWER]
     I_leg = params[layout.I_UPPER] + params[layout.I_LOWER]
     g = params[layout.GRAVITY]
@@ -329,9 +283,9 @@ def _add_leg_inertia(params, Jcl, Jcu, Jw, acl, acu, wd, Mn, hn, Gn):
 
 
 def _to_pose_coordinates(q, qd, E, Mn, hn, Gn, M, h, G, J_leg, J_joint):
-    """Map the twist equations to q coordinates (into M, h, G, J_leg, J_joint), E the entries
-    of :func:`euler_rate_entries`: nu = T qd, nu_dot = T qdd + [0, Edot rates],
-    T = blockdiag(I, E); M = T^T Mn T, h = T^T (hn + Mn bias), G = T^T Gn, J = J T."""
+    """Twist to q coordinates, T = blockdiag(I, E): M = T^T Mn T, h = T^T (hn + Mn bias), G = T^T Gn,
+    J = J T.
+    """
     bias = euler_rate_map_derivative_product(q[4], q[5], qd[3:])
     for a in range(6):
         hn[a] += Mn[a, 3] * bias[0] + Mn[a, 4] * bias[1] + Mn[a, 5] * bias[2]
@@ -354,9 +308,9 @@ def _to_pose_coordinates(q, qd, E, Mn, hn, Gn, M, h, G, J_leg, J_joint):
 
 
 def joint_friction_torque(rate, gimbal, viscous, coulomb, smoothing):
-    """Friction torque (N m) of one joint axis turning at ``rate`` (rad/s): viscous on a
-    ``gimbal`` axis, Coulomb on every axis, regularised as
-    coulomb * rate / sqrt(rate^2 + smoothing^2)."""
+    """Friction torque (N m) of one axis at ``rate`` (rad/s): viscous if ``gimbal``, Coulomb
+    c r / sqrt(r^2 + s^2).
+    """
     tau = 0.0
     if coulomb > 0.0:
         tau = coulomb * rate / math.sqrt(rate * rate + smoothing * smoothing)
@@ -366,8 +320,7 @@ def joint_friction_torque(rate, gimbal, viscous, coulomb, smoothing):
 
 
 def joint_friction(params, J_joint, qd, smoothing):
-    """Generalized joint friction forces (N, N m) at one sample (:func:`joint_friction_torque`
-    on every axis of every leg)."""
+    """Generalized joint friction forces (N, N m) at one sample."""
     F = np.zeros(6)
     for i in range(6):
         for j in range(N_JOINTS):

@@ -1,11 +1,6 @@
-"""Kinematics of the 6-6 Stewart platform, batched over samples (time on axis 0).
-
-Pose q = [x, y, z, rx, ry, rz] of the reference point in the paper frame (x forward,
-y right, z down; m and rad; R = Rz(rz) Ry(ry) Rx(rx)). Rates q_dot are the time
-derivatives of q (Euler-angle rates, equal to the angular velocity at neutral).
-
-All functions accept a single pose of shape (6,) or a batch of shape (N, 6) and return
-arrays with the same leading shape.
+"""Kinematics of the 6-6 Stewart platform, batched (time on axis 0; a pose (6,) or (N, 6) gives
+results of the same leading shape). Pose q = [x, y, z, rx, ry, rz] of the reference point, paper
+frame (x forward, y right, z down; m, rad), R = Rz(rz) Ry(ry) Rx(rx); q_dot are Euler-angle rates.
 """
 
 from __future__ import annotations
@@ -21,25 +16,12 @@ from stewartid.platform import Platform
 
 
 def as_batch(q: np.ndarray, name: str = "q") -> tuple[np.ndarray, bool]:
-    """A pose-like array (6,) or (N, 6) as a contiguous float batch (N, 6).
-
-    Parameters
-    ----------
-    q : array_like, shape (6,) or (N, 6)
-    name : str
-        Its name in the error message.
-
-    Returns
-    -------
-    batch : ndarray, shape (N, 6)
-        N = 1 for a single row.
-    single : bool
-        Whether ``q`` was a single row (callers return ``result[0]`` then).
+    """A pose-like array (6,) or (N, 6) as a contiguous float batch (N, 6), and whether it was one row.
 
     Raises
     ------
     ValueError
-        If ``q`` has another shape.
+        If ``q`` has another shape; ``name`` names it.
     """
     q = np.asarray(q, dtype=float)
     single = q.ndim == 1
@@ -50,17 +32,7 @@ def as_batch(q: np.ndarray, name: str = "q") -> tuple[np.ndarray, bool]:
 
 
 def rotation_matrix(angles: np.ndarray) -> np.ndarray:
-    """Rotation matrices R = Rz(rz) Ry(ry) Rx(rx).
-
-    Parameters
-    ----------
-    angles : ndarray, shape (3,) or (N, 3)
-        Roll, pitch, yaw (rad).
-
-    Returns
-    -------
-    ndarray, shape (3, 3) or (N, 3, 3)
-    """
+    """Rotation matrices R = Rz(rz) Ry(ry) Rx(rx), (3, 3) or (N, 3, 3), of angles (3,) or (N, 3) (rad)."""
     a = np.asarray(angles, dtype=float)
     entries = rotation_entries(*(f(a[..., k]) for k in range(3) for f in (np.cos, np.sin)))
     return np.stack(entries, -1).reshape(*a.shape[:-1], 3, 3)
@@ -72,11 +44,11 @@ class LegState(NamedTuple):
     Attributes
     ----------
     lengths : ndarray, shape (N, 6)
-        Leg lengths (m), lower gimbal point to upper gimbal point.
+        Lower to upper gimbal point (m).
     directions : ndarray, shape (N, 6, 3)
-        Unit leg vectors, base joint towards platform joint.
+        Unit leg vectors, base towards platform joint.
     upper_joints : ndarray, shape (N, 6, 3)
-        Upper joint positions in the fixed frame (m).
+        Upper joints in the fixed frame (m).
     """
 
     lengths: np.ndarray
@@ -85,19 +57,7 @@ class LegState(NamedTuple):
 
 
 def inverse_kinematics(platform: Platform, q: np.ndarray) -> LegState:
-    """Leg lengths, directions and joint positions for poses ``q``.
-
-    Parameters
-    ----------
-    platform : Platform
-    q : ndarray, shape (6,) or (N, 6)
-        Poses (m, rad).
-
-    Returns
-    -------
-    LegState
-        With a leading sample axis of length N (1 for a single pose).
-    """
+    """Leg lengths, directions and joint positions at poses ``q``, (6,) or (N, 6) (m, rad)."""
     q2, _ = as_batch(q)
     _, _, r, u, lengths = leg_vectors(platform.upper_joints, platform.base_joints, q2)
     upper = np.stack([q2[:, k:k + 1] + r[k] for k in range(3)], -1)
@@ -113,40 +73,18 @@ def leg_lengths(platform: Platform, q: np.ndarray) -> np.ndarray:
 
 def compute_leg_terms(platform: Platform, q: np.ndarray, joints: bool = False,
                       pose_terms: bool = True) -> LegTerms:
-    """G(q), J_lq, leg lengths and joint-rate Jacobians at poses ``q``, without the inertia
-    terms: :func:`stewartid.model.leg_terms.leg_terms` for ``platform``.
+    """G(q), J_lq, leg lengths and (if ``joints``) joint-rate Jacobians at poses ``q`` (N, 6).
 
-    Parameters
-    ----------
-    platform : Platform
-    q : ndarray, shape (N, 6)
-        Poses (m, rad).
-    joints : bool
-        Also compute the joint-rate Jacobians (else ``joint_jacobians`` is empty).
-    pose_terms : bool
-        False: leave ``gravity`` and ``leg_jacobian`` empty.
-
-    Returns
-    -------
-    LegTerms
+    Without the inertia terms; ``pose_terms=False`` leaves ``gravity`` and ``leg_jacobian`` empty.
     """
     return leg_terms(platform.parameters(), platform.upper_joints, platform.base_joints, q,
                      joints, pose_terms)
 
 
 def leg_jacobian(platform: Platform, q: np.ndarray) -> np.ndarray:
-    """Leg Jacobian J_lq: leg-length rates = J_lq q_dot.
+    """Leg Jacobian J_lq, shape (6, 6) or (N, 6, 6): leg-length rates = J_lq q_dot.
 
-    Parameters
-    ----------
-    platform : Platform
-    q : ndarray, shape (6,) or (N, 6)
-
-    Returns
-    -------
-    ndarray, shape (6, 6) or (N, 6, 6)
-        Row k: d l_k / d q (m/m, m/rad). J_lq^T f maps actuator forces (N) to generalized
-        forces (N, N m).
+    J_lq^T f maps actuator forces (N) to generalized forces (N, N m).
     """
     q2, single = as_batch(q)
     J_leg = compute_leg_terms(platform, q2)[1]
@@ -154,16 +92,10 @@ def leg_jacobian(platform: Platform, q: np.ndarray) -> np.ndarray:
 
 
 def joint_rate_jacobians(platform: Platform, q: np.ndarray) -> np.ndarray:
-    """Jacobians of the five rotational joint axes of every leg.
+    """Jacobians of the five rotational joint axes of every leg, shape (6, 5, 6) or (N, 6, 5, 6).
 
-    Joint rates (rad/s) = J[..., leg, axis, :] @ q_dot, axes ordered as
-    :data:`stewartid.model.joints.JOINT_AXES`: two lower gimbal axes, two upper gimbal axes,
-    the revolute about the leg. The gimbal axes are an orthonormal leg frame
-    e1 = unit(z x u) (horizontal), e2 = u x e1; see ``docs/conventions.md``.
-
-    Returns
-    -------
-    ndarray, shape (6, 5, 6) or (N, 6, 5, 6)
+    Joint rates (rad/s) = J[..., leg, axis, :] @ q_dot, axes as
+    :data:`stewartid.model.joints.JOINT_AXES`; gimbal axes e1 = unit(z x u), e2 = u x e1.
     """
     q2, single = as_batch(q)
     J_joint = compute_leg_terms(platform, q2, joints=True, pose_terms=False)[3]
@@ -172,24 +104,14 @@ def joint_rate_jacobians(platform: Platform, q: np.ndarray) -> np.ndarray:
 
 def forward_kinematics(platform: Platform, lengths: np.ndarray, initial: np.ndarray | None = None,
                        tolerance: float = 1e-12, max_iterations: int = 30) -> np.ndarray:
-    """Poses from leg lengths by Newton-Raphson, all samples at once.
+    """Poses (m, rad) from leg lengths (6,) or (N, 6) (m) by Newton-Raphson, all samples at once.
 
     Parameters
     ----------
-    platform : Platform
-    lengths : ndarray, shape (6,) or (N, 6)
-        Measured leg lengths (m), legs numbered as in ``docs/conventions.md``.
     initial : ndarray, shape (6,) or (N, 6), optional
         Starting poses; the neutral pose by default.
     tolerance : float
-        Convergence threshold on the largest leg-length residual (m).
-    max_iterations : int
-        Newton iterations before giving up.
-
-    Returns
-    -------
-    ndarray, shape (6,) or (N, 6)
-        Poses (m, rad).
+        On the largest leg-length residual (m).
 
     Raises
     ------

@@ -1,13 +1,5 @@
-"""Pose-only terms of the platform model, batched over samples in numpy.
-
-Leg lengths, J_lq, G(q) and the joint-axis Jacobians: what command tables, forward kinematics
-and the identifiers need, without the mass matrix and velocity products of
-:func:`stewartid.model.kernels.model_terms`. Numpy, not numba, to spare a process numba's
-start; the terms are the kernels' own per-sample geometry functions applied to arrays, so
-they give the same numbers to the last bit. Where a kernel passes 0.0 and 1.0 for the
-structural zeros and ones of J_A = [I, -[r]x], this module passes :data:`ZERO` and
-:data:`ONE`, which drop out without a whole-array operation. Coordinates and joint axes as
-in :mod:`stewartid.model.kernels`.
+"""Pose-only model terms in numpy (leg lengths, J_lq, G(q), joint-axis Jacobians): the kernels'
+own per-sample geometry applied to arrays, bit for bit, without numba's start-up.
 """
 
 from __future__ import annotations
@@ -61,11 +53,7 @@ BLOCK = 2048
 
 
 class _StructuralZero:
-    """An exact zero in the kernels' arithmetic on arrays: x + ZERO is x, x * ZERO is ZERO.
-
-    IEEE arithmetic gives the same values (up to the sign of a zero) for the kernel's 0.0, so
-    skipping these whole-array operations changes no number.
-    """
+    """An exact zero on arrays (x + ZERO is x, x * ZERO is ZERO), sparing whole-array operations."""
 
     __array_ufunc__ = None  # arrays defer their operators to this class's reflected ones
 
@@ -117,28 +105,18 @@ ONE = _StructuralOne()
 
 def leg_terms(params: np.ndarray, upper: np.ndarray, base: np.ndarray, q: np.ndarray,
               joints: bool = False, pose_terms: bool = True) -> LegTerms:
-    """Leg lengths, J_lq, G(q) and optionally the joint-axis Jacobians at poses ``q``.
+    """Leg lengths, J_lq, G(q) and optionally the joint-axis Jacobians at poses ``q`` (N, 6) (m, rad).
 
     Parameters
     ----------
     params : ndarray, shape (N_PARAMETERS,)
-        Packed mass and friction parameters (``Platform.parameters()``,
-        :mod:`stewartid.model.parameters`).
-    upper : ndarray, shape (6, 3)
-        Upper joints in the platform frame, relative to the reference point (m).
-    base : ndarray, shape (6, 3)
-        Base joints in the fixed frame (m).
-    q : ndarray, shape (N, 6)
-        Poses (m, rad).
+        ``Platform.parameters()``.
+    upper, base : ndarray, shape (6, 3)
+        Upper joints (platform frame, from the reference point) and base joints (fixed frame), m.
     joints : bool
         Also compute the joint-axis Jacobians.
     pose_terms : bool
-        False: the joint-axis Jacobians and lengths only (``gravity`` and ``leg_jacobian``
-        left empty, shape (0, ...)), for the callers that need no more.
-
-    Returns
-    -------
-    LegTerms
+        False leaves ``gravity`` and ``leg_jacobian`` empty, shape (0, ...).
     """
     q = np.asarray(q, dtype=float)
     n = len(q)
@@ -156,23 +134,14 @@ def leg_terms(params: np.ndarray, upper: np.ndarray, base: np.ndarray, q: np.nda
 def leg_vectors(upper: np.ndarray, base: np.ndarray, q: np.ndarray
                 ) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...], list[np.ndarray],
                            list[np.ndarray], np.ndarray]:
-    """Leg vectors at poses ``q`` by :func:`~stewartid.model.kernels.leg_vector`.
-
-    Parameters
-    ----------
-    upper, base : ndarray, shape (6, 3)
-        Upper joints (platform frame, from the reference point) and base joints (m).
-    q : ndarray, shape (N, 6)
-        Poses (m, rad).
+    """Leg vectors at poses ``q`` (N, 6) by :func:`~stewartid.model.kernels.leg_vector`.
 
     Returns
     -------
-    E : tuple of 5 ndarrays, shape (N, 1)
-        Entries of the Euler-rate map (:func:`~stewartid.model.kernels.euler_rate_entries`).
-    R : tuple of 9 ndarrays, shape (N, 1)
-        Entries of the rotation matrix (:func:`~stewartid.model.kernels.rotation_entries`).
+    E, R : tuples of 5 and 9 ndarrays, shape (N, 1)
+        Entries of the Euler-rate map and the rotation matrix.
     r, u : lists of 3 ndarrays, shape (N, 6)
-        Components of R upper_i (m) and of the unit leg vectors, per sample and leg.
+        Components of R upper_i (m) and of the unit leg vectors.
     lengths : ndarray, shape (N, 6)
         Leg lengths (m).
     """
@@ -184,8 +153,7 @@ def leg_vectors(upper: np.ndarray, base: np.ndarray, q: np.ndarray
 
 
 def _leg_terms_block(params, upper, base, q, G, J_leg, lengths, J_joint):
-    """:func:`leg_terms` for one block of samples, into the outputs (G and J_leg, J_joint
-    if not None). Every leg quantity has shape (n, 6): samples by legs."""
+    """:func:`leg_terms` for one block of samples into the outputs; leg quantities are (n, 6)."""
     E, R, (r0, r1, r2), u, length = leg_vectors(upper, base, q)
     lengths[:] = length
     columns = [twist_column(c, r0, r1, r2, ZERO, ONE) for c in range(6)]
@@ -200,9 +168,7 @@ def _leg_terms_block(params, upper, base, q, G, J_leg, lengths, J_joint):
 
 
 def _gravity(params, R, u2, columns, rates, length, E, G):
-    """G (into ``G``, (n, 6)) from the rotation entries R (n,), the vertical component of the
-    unit leg vectors, the columns of J_A, the leg-length rates per column, the leg lengths
-    and the entries of E (n,), summed leg by leg in the kernel's order."""
+    """G into ``G`` (n, 6), summed leg by leg in the kernel's order."""
     m_u, m_l = params[layout.M_UPPER], params[layout.M_LOWER]
     d_u, d_l = params[layout.D_UPPER], params[layout.D_LOWER]
     g = params[layout.GRAVITY]
@@ -218,8 +184,7 @@ def _gravity(params, R, u2, columns, rates, length, E, G):
 
 
 def _joint_jacobians(u, columns, length, E, out):
-    """Joint-axis Jacobians (into ``out``, (n, 6, 5, 6)) from the unit leg vectors ``u``
-    (components (n, 6)), the columns of J_A, the leg lengths (n, 6) and the entries of E."""
+    """Joint-axis Jacobians into ``out`` (n, 6, 5, 6)."""
     frame = leg_frame(*u)
     by_column = [joint_rate_column(c, frame, *u, *leg_angular_rate(*u, *b, length))
                  for c, b in enumerate(columns)]

@@ -1,13 +1,5 @@
-"""Linearisation of the platform dynamics about a pose: the paper's Mt, Bt and the gravity
-stiffness K_G.
-
-About an equilibrium pose q0 with small motion, the equation of motion becomes
-
-    Mt q_ddot + Bt q_dot + G(q0) + K_G (q - q0) + Fc = J_lq^T f_a,
-
-with Mt = M(q0), Bt = c * sum over legs and gimbal axes of J_j^T J_j (the viscous gimbal
-friction), and K_G = dG/dq at q0. These are the "true values calculated with a formula" of
-Zhang (2020), Tables 3-6.
+"""Linearisation about a pose q0 (Zhang 2020, Tables 3-6): Mt q_ddot + Bt q_dot + G(q0) + K_G (q - q0)
++ Fc = J_lq^T f_a, with Mt = M(q0), Bt the viscous gimbal friction, K_G = dG/dq at q0.
 """
 
 from __future__ import annotations
@@ -27,7 +19,6 @@ def viscous_matrix(platform: Platform, q: np.ndarray) -> np.ndarray:
 
 
 def _viscous(platform: Platform, joint_jacobians: np.ndarray) -> np.ndarray:
-    """Bt from joint-axis Jacobians of shape (..., 6, 5, 6); shape (..., 6, 6)."""
     J = joint_jacobians[..., list(GIMBAL_AXES), :]
     return platform.friction.gimbal_viscous * np.einsum("...lai,...laj->...ij", J, J)
 
@@ -45,7 +36,7 @@ def nominal_matrices(platform: Platform, pose: np.ndarray | None = None
     Returns
     -------
     Mt : ndarray, shape (6, 6)
-        kg, kg m, kg m^2 blocks (the mass matrix at ``pose``).
+        The mass matrix at ``pose``: kg, kg m, kg m^2 blocks.
     Bt : ndarray, shape (6, 6)
         N s/m, N s/rad, N m s/rad blocks.
     """
@@ -54,22 +45,7 @@ def nominal_matrices(platform: Platform, pose: np.ndarray | None = None
 
 def nominal_terms(platform: Platform, pose: np.ndarray | None = None
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Mt, Bt and the gravity force G at a pose, from one evaluation of the model.
-
-    Parameters
-    ----------
-    platform : Platform
-    pose : ndarray, shape (6,), optional
-        Absolute pose (m, rad; paper frame, z down); the neutral pose by default.
-
-    Returns
-    -------
-    Mt, Bt : ndarray, shape (6, 6)
-        As :func:`nominal_matrices`.
-    G : ndarray, shape (6,)
-        Gravity generalized force G(q) (N, N m; on the left-hand side of the equation of
-        motion, so G_z < 0 with z down).
-    """
+    """Mt, Bt (as :func:`nominal_matrices`) and G(q) (6,) (N, N m; G_z < 0) at ``pose``, in one evaluation."""
     q0 = platform.neutral_pose if pose is None else np.asarray(pose, dtype=float)
     M, h, G, J_leg, J_joint, lengths = (np.empty(shape) for shape in
                                         ((6, 6), 6, 6, (6, 6), (6, 5, 6), 6))
@@ -81,25 +57,10 @@ def nominal_terms(platform: Platform, pose: np.ndarray | None = None
 
 def linearisation_remainder(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
                             q_ddot: np.ndarray, pose: np.ndarray | None = None) -> np.ndarray:
-    """What the inertial and viscous terms of the model add to their linearisation at ``pose``.
+    """What the inertial and viscous terms add to their linearisation at ``pose``, (N, 6) (N, N m).
 
-    r = [M(q) - Mt] q_ddot + h(q, q_dot) + [Bt(q) - Bt] q_dot, with (Mt, Bt) =
-    :func:`nominal_matrices` at ``pose``, so that the equation of motion less gravity and Coulomb
-    friction is Mt q_ddot + Bt q_dot + r: subtracted from measured forces, it keeps the
-    linearised model exact at any amplitude.
-
-    Parameters
-    ----------
-    platform : Platform
-    q, q_dot, q_ddot : ndarray, shape (N, 6)
-        Absolute pose (m, rad), its rate and acceleration.
-    pose : ndarray, shape (6,), optional
-        Linearisation pose; the neutral pose by default.
-
-    Returns
-    -------
-    ndarray, shape (N, 6)
-        N, N m.
+    r = [M(q) - Mt] q_ddot + h(q, q_dot) + [Bt(q) - Bt] q_dot: subtracted from measured forces, it
+    keeps the linearised model exact at any amplitude.
     """
     Mt, Bt = nominal_matrices(platform, pose)
     terms = ModelTerms(platform, q, q_dot)
@@ -110,13 +71,7 @@ def linearisation_remainder(platform: Platform, q: np.ndarray, q_dot: np.ndarray
 
 def gravity_stiffness(platform: Platform, pose: np.ndarray | None = None,
                       step: float = 1e-6) -> np.ndarray:
-    """Gravity stiffness K_G = dG/dq at ``pose`` by central differences of the exact G(q).
-
-    Returns
-    -------
-    ndarray, shape (6, 6)
-        Column j is dG/dq_j (N/m, N/rad, N m/m, N m/rad).
-    """
+    """Gravity stiffness K_G = dG/dq (6, 6) at ``pose`` by central differences of the exact G(q)."""
     q0 = platform.neutral_pose if pose is None else np.asarray(pose, dtype=float)
     steps = step * np.eye(6)
     G_plus = ModelTerms(platform, q0 + steps).gravity

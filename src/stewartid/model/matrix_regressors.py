@@ -1,6 +1,4 @@
-"""Mt(q) and Bt(q) as linear functions of the standard parameters: the mass matrix and the
-matrix of every term linear in the rates, from the regressor
-(:func:`~stewartid.model.regressor.regressor`) at rest."""
+"""Mt(q) and Bt(q) as linear functions of the standard parameters, from the regressor at rest."""
 
 from __future__ import annotations
 
@@ -19,20 +17,8 @@ from stewartid.platform import Platform
 def inertia_regressor(platform: Platform, pose: np.ndarray | None = None) -> np.ndarray:
     """The mass matrix as a linear function of the parameters: M(q) = A @ pi.
 
-    Column k of M is Y(q, 0, e_k) pi - Y(q, 0, 0) pi: the bodies' columns without gravity at
-    the unit acceleration e_k (the gravity and offset columns do not depend on the
-    acceleration; friction and velocity products vanish at rest).
-
-    Parameters
-    ----------
-    platform : Platform
-    pose : ndarray, shape (6,) or (N, 6), optional
-        Pose(s) (m, rad); the neutral pose by default.
-
-    Returns
-    -------
-    ndarray, shape (6, 6, N_STANDARD) or (N, 6, 6, N_STANDARD)
-        A[i, k] is the row of M[i, k] in the standard parameters.
+    Column k of M is Y(q, 0, e_k) pi - Y(q, 0, 0) pi. ``pose`` (6,) or (N, 6), m, rad (neutral by
+    default); A has shape (6, 6, N_STANDARD) or (N, 6, 6, N_STANDARD).
     """
     q, single = as_batch(platform.neutral_pose if pose is None else pose)
     n = len(q)
@@ -46,20 +32,9 @@ def inertia_regressor(platform: Platform, pose: np.ndarray | None = None) -> np.
 def viscous_regressor(platform: Platform, pose: np.ndarray | None = None) -> np.ndarray:
     """The viscous matrix as a linear function of the parameters: Bt(q) = A @ pi.
 
-    Bt collects every term linear in the rates: the joints' viscous friction per type and
-    the actuators' (the friction columns at the unit rates); the velocity products are
-    quadratic and vanish from the linearisation.
-
-    Parameters
-    ----------
-    platform : Platform
-    pose : ndarray, shape (6,) or (N, 6), optional
-        Pose(s) (m, rad); the neutral pose by default.
-
-    Returns
-    -------
-    ndarray, shape (6, 6, N_STANDARD) or (N, 6, 6, N_STANDARD)
-        Zero outside the columns of :data:`VISCOUS_PARAMETERS`.
+    Every term linear in the rates (joint and actuator viscous friction; velocity products vanish).
+    Shapes as :func:`inertia_regressor`, zero outside
+    :data:`~stewartid.model.regressor.VISCOUS_PARAMETERS`.
     """
     q, single = as_batch(platform.neutral_pose if pose is None else pose)
     n = len(q)

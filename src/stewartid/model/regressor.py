@@ -1,13 +1,6 @@
-"""The regressor of the platform model: the generalized force linear in its physical parameters,
-
-    J_lq(q)^T f_meas = Y(q, q_dot, q_ddot) pi,
-
-with Y of shape (6, P) per sample and pi the standard parameters (:data:`PARAMETERS`): the
-moving body's mass, first moment and inertia; the legs' upper-part mass, first moments and
-transverse inertias about the gimbal points; viscous and Coulomb friction per joint type and
-along the actuators; an offset per force sensor. Some are not separable by any motion;
-:func:`base_parameters` finds the identifiable combinations numerically. Coordinates as in
-:mod:`stewartid.model.kernels`.
+"""The regressor: the generalized force linear in the physical parameters, J_lq(q)^T f_meas =
+Y(q, q_dot, q_ddot) pi, Y (6, P) per sample, pi the standard parameters (:data:`PARAMETERS`);
+:func:`base_parameters` finds their identifiable combinations numerically.
 """
 
 from __future__ import annotations
@@ -59,9 +52,8 @@ def parameter_index(names: tuple[str, ...] | list[str]) -> np.ndarray:
 def standard_parameters(platform: Platform) -> np.ndarray:
     """The standard parameters of a platform description, shape (N_STANDARD,).
 
-    The moving body is :attr:`~stewartid.platform.Platform.moving_body`; the joint friction
-    ``[friction]`` (viscous on the gimbal types only); actuator friction zero; the offsets
-    ``[sensors] force_bias``.
+    Moving body :attr:`~stewartid.platform.Platform.moving_body`, joint friction ``[friction]``
+    (viscous on gimbals only), zero actuator friction, offsets ``[sensors] force_bias``.
     """
     body, i, f = platform.moving_body, platform.inertia, platform.friction
     pi = np.zeros(N_STANDARD)
@@ -84,22 +76,8 @@ def standard_parameters(platform: Platform) -> np.ndarray:
 
 
 def about_centre_of_mass(body: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
-    """A rigid body's mass, centre of mass and inertia about it, from its ten standard
-    parameters (the parallel-axis theorem, I_c = I_o - (h.h 1 - h h^T) / m, h = m c).
-
-    Parameters
-    ----------
-    body : ndarray, shape (10,)
-        In the order of :data:`BODY_PARAMETERS`; a positive mass.
-
-    Returns
-    -------
-    m : float
-        kg.
-    c : ndarray, shape (3,)
-        m.
-    inertia : ndarray, shape (6,)
-        I_xx, I_yy, I_zz, I_xy, I_xz, I_yz about the centre of mass (kg m^2).
+    """Mass (kg), centre of mass (3,) (m) and inertia about it (6,) (I_xx, I_yy, I_zz, I_xy, I_xz, I_yz;
+    kg m^2) of a body's ten standard parameters: I_c = I_o - (h.h 1 - h h^T) / m, h = m c.
     """
     body = np.asarray(body, dtype=float)
     m, h = float(body[0]), body[1:4]
@@ -108,23 +86,10 @@ def about_centre_of_mass(body: np.ndarray) -> tuple[float, np.ndarray, np.ndarra
 
 
 def pseudo_inertia(body: np.ndarray) -> np.ndarray:
-    """The pseudo-inertia matrix of a rigid body from its ten standard parameters.
+    """The pseudo-inertia matrix (..., 4, 4) of bodies' ten standard parameters (..., 10).
 
-    J = [[Sigma, h], [h^T, m]] with Sigma = integral r r^T dm = tr(I) / 2 1 - I the second
-    moment about the reference point, h = m c the first moment and m the mass. The body is
-    physically realisable (a nonnegative mass density exists) exactly when J is positive
-    semidefinite (Wensing, Kim, Slotine, IEEE RA-L 3(1), 2017); J is linear in the parameters.
-
-    Parameters
-    ----------
-    body : ndarray, shape (..., 10)
-        m (kg), m c (kg m), I_xx, I_yy, I_zz, I_xy, I_xz, I_yz about the reference point
-        (kg m^2), in the order of :data:`BODY_PARAMETERS`.
-
-    Returns
-    -------
-    ndarray, shape (..., 4, 4)
-        kg, kg m, kg m^2.
+    J = [[Sigma, h], [h^T, m]], Sigma = tr(I) / 2 1 - I, h = m c; linear in the parameters, and
+    positive semidefinite exactly when the body is physically realisable (Wensing et al., 2017).
     """
     body = np.asarray(body, dtype=float)
     inertia = np.zeros(body.shape[:-1] + (3, 3))
@@ -141,31 +106,21 @@ def regressor(platform: Platform, q: np.ndarray, q_dot: np.ndarray, q_ddot: np.n
               gravity: bool = True, coulomb_smoothing: float = COULOMB_SMOOTHING,
               actuator_smoothing: float = ACTUATOR_SMOOTHING,
               coulomb_rates: np.ndarray | None = None) -> np.ndarray:
-    """Y(q, q_dot, q_ddot): the measured generalized force J_lq^T f_meas = Y pi.
+    """Y(q, q_dot, q_ddot), shape (N, 6, N_STANDARD) or (6, N_STANDARD): J_lq^T f_meas = Y pi.
 
-    Computed by :func:`~stewartid.model.regressor_rows.regressor_columns` (time last, which
-    :func:`regressor_columns` returns as it is).
+    Column k is the generalized force (N, N m) per unit of ``PARAMETERS[k]``; Y depends on the
+    platform's geometry only.
 
     Parameters
     ----------
-    platform : Platform
-        Geometry only (the joints); the regressor does not depend on the masses.
     q, q_dot, q_ddot : ndarray, shape (N, 6) or (6,)
-        Poses (m, rad), their rates and accelerations.
+        m, rad and rates.
     gravity : bool
-        False: leave out gravity (the columns at g = 0).
-    coulomb_smoothing : float
-        Regularisation rate (rad/s) of the joints' Coulomb sign, w / sqrt(w^2 + s^2).
-    actuator_smoothing : float
-        The same for the actuators' (m/s).
+        False leaves gravity out.
+    coulomb_smoothing, actuator_smoothing : float
+        s in the Coulomb sign w / sqrt(w^2 + s^2) of joints (rad/s) and actuators (m/s).
     coulomb_rates : ndarray, shape of q, optional
-        Pose rates the Coulomb signs are taken from, when not ``q_dot`` (the columns at rest
-        with the signs of the motion, for filtering at every sample).
-
-    Returns
-    -------
-    ndarray, shape (N, 6, N_STANDARD) or (6, N_STANDARD)
-        Column k is the generalized force (N, N m) per unit of ``PARAMETERS[k]``.
+        Rates the Coulomb signs are taken from, when not ``q_dot``.
     """
     q2, single = as_batch(q)
     rates = (as_batch(q_dot, "q_dot")[0], as_batch(q_ddot, "q_ddot")[0],
@@ -182,26 +137,10 @@ def regressor_columns(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
                       gravity: bool = True, coulomb_smoothing: float = COULOMB_SMOOTHING,
                       actuator_smoothing: float = ACTUATOR_SMOOTHING, rigid: bool = True,
                       friction: bool = True, out: np.ndarray | None = None) -> np.ndarray:
-    """:func:`regressor` with time last, for many samples: no copy into time-first rows.
+    """:func:`regressor` with time last, shape (6, N_STANDARD, N), for many samples.
 
-    Parameters
-    ----------
-    platform : Platform
-    q, q_dot, q_ddot : ndarray, shape (6, N)
-        Poses (m, rad), their rates and accelerations, time last.
-    coulomb_rates : ndarray, shape (6, N), optional
-        As in :func:`regressor`.
-    gravity : bool
-    coulomb_smoothing, actuator_smoothing : float
-        As in :func:`regressor`.
-    rigid, friction : bool
-        Compute the bodies' columns, the friction and offset columns (each else zero).
-    out : ndarray, shape (6, N_STANDARD, N), optional
-        Written in place and returned (a slice of a larger array: no copy).
-
-    Returns
-    -------
-    ndarray, shape (6, N_STANDARD, N)
+    Inputs (6, N); ``rigid``, ``friction`` compute the bodies', the friction and offset columns
+    (each else zero); ``out`` is written in place and returned.
     """
     return rows.regressor_columns(
         platform.upper_joints, platform.base_joints, np.asarray(q, dtype=float),
@@ -216,15 +155,15 @@ class BaseParameters(NamedTuple):
     Attributes
     ----------
     names : tuple of str
-        Each base parameter is named for the standard parameter whose column it keeps.
+        The standard parameter whose column each keeps.
     columns : ndarray of int, shape (B,)
-        Those columns' indices in :data:`PARAMETERS`: Y_base = Y[..., columns].
+        Y_base = Y[..., columns].
     combination : ndarray, shape (B, N_STANDARD)
-        pi_base = combination @ pi, so that Y pi = Y_base pi_base for every pi.
+        pi_base = combination @ pi, so Y pi = Y_base pi_base.
     combinations : tuple of str
         ``combination`` written out, e.g. ``"m + 6 m_u"``.
     unidentifiable : tuple of str
-        Standard parameters no motion can identify (columns zero on every state).
+        Standard parameters whose columns are zero on every state.
     """
 
     names: tuple[str, ...]
@@ -254,31 +193,14 @@ def base_parameters(platform: Platform, samples: int = 100, seed: int = 0,
                     tolerance: float = 1e-8) -> BaseParameters:
     """The base parameters of the regressor, found numerically.
 
-    The regressor stacked over ``samples`` random states (:func:`random_states`), columns scaled
-    to unit norm, gives its rank by QR with column pivoting; columns are kept in the order of
-    :data:`PARAMETERS` when independent of those kept before, and every other column is written
-    as a combination of the kept.
-
-    Parameters
-    ----------
-    platform : Platform
-        Geometry.
-    samples : int
-        Random states stacked.
-    seed : int
-        Their seed.
-    tolerance : float
-        Relative size (of the largest) below which a diagonal entry of R counts as zero.
-
-    Returns
-    -------
-    BaseParameters
+    The regressor at ``samples`` random states, columns scaled to unit norm, gets its rank by
+    pivoted QR; a column is kept (in :data:`PARAMETERS` order) when independent of those kept
+    before, the others written as combinations. ``tolerance`` is relative to R's largest diagonal.
 
     Raises
     ------
     ArithmeticError
-        If the ordered selection disagrees with the pivoted QR's rank (a tolerance between
-        the scales of independent and dependent columns does not exist for these states).
+        If the ordered selection disagrees with the pivoted QR's rank.
     """
     Y = regressor(platform, *random_states(platform, samples, seed)).reshape(-1, N_STANDARD)
     norms = np.linalg.norm(Y, axis=0)

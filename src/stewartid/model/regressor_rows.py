@@ -1,11 +1,5 @@
-"""The regressor's columns at many samples in numpy, every leg quantity computed once a sample
-(:func:`regressor_columns`, behind :func:`stewartid.model.regressor.regressor`).
-
-Time is last: a body quantity is a row of N samples, a leg quantity an array (6, N), a vector
-a tuple of its three components, so that every operation is on whole contiguous rows. Every
-leg term is the wrench [x, r x x] at the reference point of a vector x at the upper joint,
-summed over the legs, so the joint and actuator Jacobians need not be formed. Coordinates as
-in :mod:`stewartid.model.kernels`.
+"""The regressor's columns in numpy, time last (a leg quantity is (6, N), a vector three
+components), each leg term the wrench [x, r x x] at the reference point of a vector x at the upper joint.
 """
 
 from __future__ import annotations
@@ -22,12 +16,10 @@ INERTIA_ENTRIES = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
 
 
 def _cross(a, b):
-    """a x b of vectors given as three components (arrays, broadcast)."""
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
 def _dot(a, b):
-    """a . b of vectors given as three components."""
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
@@ -37,8 +29,7 @@ def smooth_sign(x: np.ndarray, smoothing: float) -> np.ndarray:
 
 
 class _Geometry:
-    """The pose terms of N samples: the entries of R (9 of (N,), row by row) and of E (5),
-    the vectors r and u (components (6, N)), the leg lengths and their inverses (6, N)."""
+    """The pose terms of N samples: entries of R (9) and E (5), r, u, lengths and inverses (6, N)."""
 
     def __init__(self, upper: np.ndarray, base: np.ndarray, q: np.ndarray):
         cos, sin = np.cos(q[3:]), np.sin(q[3:])
@@ -56,16 +47,14 @@ class _Geometry:
         return (E00 * x[0] + E01 * x[1], E10 * x[0] + E11 * x[1], E20 * x[0] + x[2])
 
     def motion(self, rates: np.ndarray) -> tuple:
-        """The angular velocity, omega x r and the upper joints' velocities v_A of pose rates
-        (6, N)."""
+        """Angular velocity, omega x r and the upper joints' velocities of pose rates (6, N)."""
         omega = self.angular(rates[3:])
         turn = _cross(omega, self.r)
         return omega, turn, tuple(rates[k] + turn[k] for k in range(3))
 
 
 class _Wrenches:
-    """Leg vectors x (components (6, N)) whose wrench summed over the legs, [x, r x x],
-    goes into a column of Y; summed all at once by :meth:`into`."""
+    """Leg vectors x (6, N) whose summed wrench [x, r x x] goes into a column of Y."""
 
     def __init__(self):
         self.columns: list[int] = []
@@ -96,12 +85,11 @@ def _euler_bias(geo: _Geometry, qd: np.ndarray) -> tuple:
 
 
 def _body_columns(geo: _Geometry, omega, alpha, a_g, Y, index, moving) -> None:
-    """The moving body's ten columns (twist coordinates) into ``Y`` (6, P, N).
+    """The moving body's ten columns into ``Y`` (6, P, N).
 
-    The inertia columns in the world frame: R (U alpha_b + w_b x U w_b) = R_a alpha_b[b] +
-    R_b alpha_b[a] + (omega x R_a) w_b[b] + (omega x R_b) w_b[a] for the symmetric unit
-    matrix U of entry (a, b) (its first two terms once for a = b), with R_a the columns of
-    R, alpha_b = R^T alpha and w_b = R^T omega."""
+    Inertia columns in the world frame: R (U alpha_b + w_b x U w_b) for the symmetric unit matrix U of
+    entry (a, b), alpha_b = R^T alpha, w_b = R^T omega.
+    """
     R = np.stack(geo.R).reshape(3, 3, -1)  # R[i, k]: component i of the column k
     first = index["mc_x"]
     Y[:3, index["m"]] = a_g
@@ -118,8 +106,7 @@ def _body_columns(geo: _Geometry, omega, alpha, a_g, Y, index, moving) -> None:
 
 
 def _leg_columns(geo: _Geometry, motion, alpha, a, g, wrenches: _Wrenches, index) -> None:
-    """The legs' inertial and gravity columns (twist coordinates) into ``wrenches``;
-    ``motion`` of :meth:`_Geometry.motion`, None at rest."""
+    """The legs' inertial and gravity columns into ``wrenches``; ``motion`` None at rest."""
     r, u, inverse = geo.r, geo.u, geo.inverse
 
     def project(x):  # (I - u u^T) x / l
@@ -149,8 +136,7 @@ def _leg_columns(geo: _Geometry, motion, alpha, a, g, wrenches: _Wrenches, index
 
 
 def _joint_rates(geo: _Geometry, frame, motion) -> tuple:
-    """The five joint rates of every leg (5 of (6, N)) for ``motion`` of
-    :meth:`_Geometry.motion`."""
+    """The five joint rates of every leg (5 of (6, N))."""
     omega, _, v_A = motion
     e10, e11, e20, e21, e22 = frame
     lower_1 = -(e20 * v_A[0] + e21 * v_A[1] + e22 * v_A[2]) * geo.inverse
@@ -160,9 +146,7 @@ def _joint_rates(geo: _Geometry, frame, motion) -> tuple:
 
 
 def _friction_type_columns(geo: _Geometry, frame, weights, columns, Y, wrenches) -> None:
-    """The joint friction of ``weights`` (5 of (6, N)) into the columns (lower gimbal, upper
-    gimbal, revolute) of ``Y`` (twist coordinates): the pure moments into ``Y``, the
-    wrenches into ``wrenches``."""
+    """Joint friction of ``weights`` (5 of (6, N)) into the per-type columns of ``Y`` and ``wrenches``."""
     e10, e11, e20, e21, e22 = frame
     inverse, (w1, w2, w3, w4, w5) = geo.inverse, weights
     lower, upper, revolute = columns
@@ -178,8 +162,7 @@ def _friction_type_columns(geo: _Geometry, frame, weights, columns, Y, wrenches)
 
 def _friction_columns(geo: _Geometry, motion, sign_motion, smoothing, actuator_smoothing,
                       Y, wrenches, index) -> None:
-    """The joint and actuator friction (the viscous columns when ``motion`` is not None) and
-    the sensor offsets (twist coordinates) into ``Y`` and ``wrenches``."""
+    """Joint and actuator friction and sensor offsets into ``Y`` and ``wrenches``."""
     u, r = geo.u, geo.r
     frame = leg_frame(*u)
     moment_arm = _cross(r, u)  # the offsets' and actuators' moments per unit force
@@ -206,36 +189,26 @@ def regressor_columns(upper: np.ndarray, base: np.ndarray, q: np.ndarray, qd: np
                       sign_rates: np.ndarray | None = None, smoothing: float = 0.0,
                       actuator_smoothing: float = 0.0, rigid: bool = True,
                       friction: bool = True, out: np.ndarray | None = None) -> np.ndarray:
-    """The regressor Y(q, q_dot, q_ddot) of :func:`stewartid.model.regressor.regressor`,
-    time last.
+    """The regressor Y of :func:`stewartid.model.regressor.regressor` time last, (6, len(index), N).
 
     Parameters
     ----------
     upper, base : ndarray, shape (6, 3)
         Upper joints (platform frame, from the reference point) and base joints (m).
     q, qd, qdd : ndarray, shape (6, N)
-        Poses (m, rad), their rates and accelerations, time last.
+        m, rad and rates.
     g : float
         Gravity along +z (m/s^2); 0 leaves it out.
     index : mapping of str to int
-        Column of each standard parameter (:data:`stewartid.model.regressor.PARAMETERS`;
-        the first moments mc_x, mc_y, mc_z and the inertias I_xx ... I_yz in consecutive
-        columns, as there).
+        Column of each standard parameter; first moments and inertias in consecutive columns.
     sign_rates : ndarray, shape (6, N), optional
-        Pose rates the Coulomb signs are taken from; ``qd`` by default.
+        Rates the Coulomb signs are taken from; ``qd`` by default.
     smoothing, actuator_smoothing : float
-        Regularisation rates of the joints' (rad/s) and actuators' (m/s) Coulomb signs.
-    rigid : bool
-        Compute the bodies' columns (else left zero).
-    friction : bool
-        Compute the friction and offset columns (else left zero).
+        Coulomb sign regularisation of joints (rad/s) and actuators (m/s).
+    rigid, friction : bool
+        Compute the bodies', the friction and offset columns (each else zero).
     out : ndarray, shape (6, len(index), N), optional
         Written in place (any strides) and returned.
-
-    Returns
-    -------
-    ndarray, shape (6, len(index), N)
-        Column k of sample n is ``Y[:, k, n]`` (N, N m per unit of the parameter).
     """
     geo = _Geometry(upper, base, q)
     if out is None:

@@ -1,5 +1,3 @@
-"""MuJoCo as an independent engine: the platform as an MJCF model
-(:mod:`~stewartid.mujoco.model`), its state at a pose (:mod:`~stewartid.mujoco.state`) and
-experiments played on it as logs (:mod:`~stewartid.mujoco.closed_loop`). Needs the
-``[mujoco]`` extra.
+"""MuJoCo as an independent engine: the platform as an MJCF model, its state at a pose, and
+experiments played on it as logs. Needs the ``[mujoco]`` extra.
 """

@@ -1,9 +1,5 @@
-"""The platform description: geometry, inertia, friction, actuators, controller, sensors and
-limits of a hexapod, read from TOML into a frozen :class:`Platform`.
-
-- :mod:`~stewartid.platform.description`: :class:`Platform`, :func:`load_platform`;
-- :mod:`~stewartid.platform.sections`: one frozen dataclass per TOML section, each field with
-  its unit, description and constraint (including its physical range).
+"""The platform description: a hexapod's geometry, inertia, friction, actuators, controller,
+sensors and limits, read from TOML into a frozen :class:`~stewartid.platform.Platform`.
 """
 
 from stewartid.platform.description import (

@@ -1,2 +1,1 @@
-"""Reference data: the published results of Zhang (2020) as package data
-(:mod:`~stewartid.reference.published`)."""
+"""Reference data: the published results of Zhang (2020)."""

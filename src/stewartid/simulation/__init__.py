@@ -1,12 +1,6 @@
-"""Plant simulator: hydraulic hexapod under leg-length PID control, sensors, data sets.
-
-The five blocks of the paper's Simulink model (Zhang 2020, Fig. 3): signal generator
-(:mod:`.excitation`), inverse motion and PID (:mod:`.controller`), hydraulic actuators
-(:mod:`.hydraulics`), plant dynamics (:mod:`.plant`, compiled closed loop) and forward
-solution (:mod:`.sensors`). :func:`simulate_experiments` runs the paper's six experiments.
-A real rig's sensor imperfections (channel delays, filtered noise, mains hum, drift:
-:mod:`.imperfections`) are part of :class:`SensorNoise`; :func:`degrade` applies them to any
-data set.
+"""Plant simulator after Zhang (2020), Fig. 3: excitation, leg-length PID, hydraulic actuators,
+compiled plant dynamics and sensors; :func:`~stewartid.simulation.simulate_experiments` runs the
+paper's six experiments.
 """
 
 from stewartid.simulation.excitation import (
