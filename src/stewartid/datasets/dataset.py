@@ -1,14 +1,5 @@
-"""Measured experiments in the interchange format: reading, validation, writing.
-
-One table per experiment (CSV or Parquet) with the columns ``t, x, y, z, rx, ry, rz,
-l1..l6, f1..f6``: time (s), pose of the reference point in the paper frame (m, rad; z down),
-leg lengths (m), actuator forces along the legs (N, positive extends). Either the pose or the
-leg lengths may be missing: kinematics fill them in from the platform description.
-
-Validation happens here, at the boundary, so that identification code can trust its input;
-a jittery or non-uniform time base is made uniform with a :class:`~stewartid.errors.DataWarning`.
-Logs in other layouts or units are read through a :class:`~stewartid.datasets.log_format.LogFormat`
-(``docs/logs.md``).
+"""Measured experiments in the interchange format (``t, x..rz, l1..l6, f1..f6``): reading,
+validation at the boundary, writing.
 """
 
 from __future__ import annotations
@@ -58,21 +49,20 @@ SUFFIXES = {".csv": "csv", ".parquet": "parquet", ".pq": "parquet"}
 
 @dataclass(frozen=True)
 class Dataset:
-    """One experiment: measured pose, leg lengths and actuator forces on a uniform time base.
+    """One experiment on a uniform time base.
 
     Attributes
     ----------
     t : ndarray, shape (N,)
-        Time (s), strictly increasing with a uniform period.
+        s, uniform period.
     pose : ndarray, shape (N, 6)
-        Pose q = [x, y, z, rx, ry, rz] of the reference point, paper frame (m, rad; absolute,
-        z down).
+        [x, y, z, rx, ry, rz] of the reference point, paper frame, absolute, z down (m, rad).
     lengths : ndarray, shape (N, 6)
         Leg lengths (m).
     forces : ndarray, shape (N, 6)
-        Actuator forces along the legs (N, positive extends the leg).
+        Actuator forces along the legs (N, positive extends).
     name : str
-        Label of the experiment (file stem when read from a file).
+        File stem when read from a file.
     """
 
     t: np.ndarray
@@ -95,19 +85,19 @@ class Dataset:
 
     @property
     def sample_rate(self) -> float:
-        """Sample rate (Hz), from the mean period."""
+        """Hz, from the mean period."""
         return float((len(self.t) - 1) / (self.t[-1] - self.t[0]))
 
     @property
     def duration(self) -> float:
-        """Record length t[-1] - t[0] (s)."""
+        """t[-1] - t[0] (s)."""
         return float(self.t[-1] - self.t[0])
 
     def __len__(self) -> int:
         return len(self.t)
 
     def to_frame(self) -> pd.DataFrame:
-        """The experiment as a table with the interchange columns."""
+        """Table with the interchange columns."""
         import pandas as pd  # slow to import: reading and writing data never need it
 
         data = np.column_stack([self.t, self.pose, self.lengths, self.forces])
@@ -128,7 +118,7 @@ def _format_of(path: Path, format: str | None) -> str:
 
 
 def _check_time(t: np.ndarray, where: str) -> bool:
-    """Validate the time column; return True when it is uniform."""
+    """Validate the time column; True when uniform."""
     if len(t) < MIN_SAMPLES:
         raise DataError(f"{where}: only {len(t)} samples; at least {MIN_SAMPLES} are needed "
                         "(record a longer experiment).")
@@ -151,9 +141,9 @@ def _check_time(t: np.ndarray, where: str) -> bool:
 
 
 def _uniform_clock(t: np.ndarray, where: str) -> np.ndarray | None:
-    """The least-squares uniform clock t0 + T i of jittery time stamps, or None when the time
-    base is not a uniform clock with timing noise (a sample off its slot by half a period or
-    more, or a skipped slot)."""
+    """Least-squares uniform clock t0 + T i of jittery time stamps; None when a sample is half a
+    period off its slot or a slot is skipped.
+    """
     index = np.arange(len(t), dtype=float)
     index -= index.mean()
     period = float(index @ (t - t.mean()) / (index @ index))
@@ -183,27 +173,24 @@ def dataset_from_frame(frame: Mapping[str, np.ndarray] | pd.DataFrame,
                        platform: Platform | None = None, name: str = "exp",
                        where: str | None = None,
                        carried: tuple[float, float] = checks.CARRIED_WEIGHT) -> Dataset:
-    """Validate a table in the interchange format and build a :class:`Dataset`.
+    """Validate a table in the interchange format into a :class:`Dataset`.
 
     Parameters
     ----------
     frame : mapping of str to ndarray of shape (N,), or DataFrame
-        Columns (as :func:`~stewartid.datasets.log_format.read_table` gives them) ``t``,
-        ``f1..f6`` and at least one of the groups ``x..rz`` or ``l1..l6``.
-        Unknown extra columns are ignored.
+        ``t``, ``f1..f6`` and ``x..rz`` or ``l1..l6``; extra columns ignored.
     platform : Platform, optional
-        Needed only when the pose or the leg lengths are missing.
+        Needed when pose or lengths are missing.
     name : str
-        Experiment label.
     where : str, optional
-        Source named in error messages (file path); ``name`` by default.
+        Source named in errors; ``name`` by default.
     carried : (float, float)
-        The weight the forces may carry, in multiples of the file's.
+        Allowed weight in multiples of the file's.
 
     Raises
     ------
     DataError
-        Missing columns, non-finite or non-numeric values, non-increasing time, too few samples.
+        Missing columns, non-finite values, non-increasing time, too few samples.
     """
     where = where or name
     present = set(frame.keys())
@@ -280,34 +267,25 @@ def _forward_kinematics_tracked(platform: Platform, lengths: np.ndarray, solve) 
 def read_dataset(path: str | Path, platform: Platform | None = None,
                  format: str | None = None, log_format: LogFormat | None = None,
                  carried: tuple[float, float] = checks.CARRIED_WEIGHT) -> Dataset:
-    """Read and validate one experiment from a CSV or Parquet file.
+    """Read and validate one experiment, named after the file stem.
 
     Parameters
     ----------
     path : str or Path
-        ``.csv`` or ``.parquet`` file in the interchange format, or in the layout and units
-        that ``log_format`` describes. The CSV delimiter (``,`` ``;`` tab) and decimal mark
-        are detected.
+        ``.csv`` or ``.parquet``, interchange format or as ``log_format`` describes.
     platform : Platform, optional
-        Platform description, used when the pose or the leg lengths are missing, and to
-        check the data against it (:mod:`stewartid.datasets.plausibility`).
+        Fills in missing pose or lengths; checks the data
+        (:mod:`stewartid.datasets.plausibility`).
     format : {'csv', 'parquet'}, optional
-        Overrides the file suffix.
+        Overrides the suffix.
     log_format : LogFormat, optional
-        Column mapping with units (:mod:`stewartid.datasets.log_format`).
     carried : (float, float)
-        The weight the forces may carry, in multiples of the file's
-        (:func:`~stewartid.datasets.plausibility.check_static_balance`).
-
-    Returns
-    -------
-    Dataset
-        Named after the file stem.
+        See :func:`~stewartid.datasets.plausibility.check_static_balance`.
 
     Raises
     ------
     DataError
-        The file cannot be parsed or fails validation; the message names file and column.
+        Unparsable or invalid file; the message names file and column.
     """
     path = Path(path)
     kind = _format_of(path, format)
@@ -336,13 +314,8 @@ def read_datasets(paths: str | Path | Sequence[str | Path],
                   platform: Platform | None = None,
                   log_format: LogFormat | None = None,
                   carried: tuple[float, float] = checks.CARRIED_WEIGHT) -> list[Dataset]:
-    """Read several experiments (one file each; a directory means all data files in it),
-    with the ``platform``, ``log_format`` and ``carried`` of :func:`read_dataset`.
-
-    Returns
-    -------
-    list of Dataset
-        In the order given (directory contents sorted by name).
+    """Read several experiments in the given order (directories sorted by name), settings as
+    :func:`read_dataset`.
     """
     if isinstance(paths, str | Path):
         paths = [paths]
@@ -357,22 +330,9 @@ def read_datasets(paths: str | Path | Sequence[str | Path],
 
 
 def write_dataset(dataset: Dataset, path: str | Path, format: str | None = None) -> Path:
-    """Write an experiment in the interchange format, atomically.
+    """Write an experiment in the interchange format atomically; return the path.
 
-    Through :func:`stewartid.files.write_bytes_atomic`, so readers never see a half-written
-    file.
-
-    Parameters
-    ----------
-    dataset : Dataset
-    path : str or Path
-    format : {'csv', 'parquet'}, optional
-        By default from the suffix of ``path``.
-
-    Returns
-    -------
-    Path
-        The written file.
+    ``format`` defaults to the suffix of ``path``.
     """
     path = Path(path)
     kind = _format_of(path, format)

@@ -1,7 +1,5 @@
-"""What the motion of a set of experiments allows an identification to see: which sines a
-record holds (:func:`spectral_lines`) and whether every DOF moves on its own somewhere in the
-set (:func:`excitation_per_dof`, :func:`check_excitation`). Both measure the motion as the
-leg-length change it causes at the neutral pose, dl = J_lq(q0) (q - mean q) (m).
+"""What a set of experiments' motion lets an identification see: a record's sines and whether
+every DOF moves on its own somewhere, measured as leg-length change dl = J_lq(q0) (q - mean q) (m).
 """
 
 from __future__ import annotations
@@ -42,14 +40,12 @@ class SpectralLines:
 
     Attributes
     ----------
-    frequencies_hz : ndarray, shape (L,)
-    amplitudes : ndarray, shape (L,)
-        Relative to the largest line (the first is 1).
+    frequencies_hz, amplitudes : ndarray, shape (L,)
+        Amplitudes relative to the largest (the first is 1).
     resolution_hz : float
-        1 / record length: lines closer than a few of these are one line.
+        1 / record length.
     largest : float
-        Amplitude of the largest line in the Hann-windowed spectrum (units of the motion
-        times the window's gain), to compare lines across records; 0 when empty.
+        Largest line's amplitude in the Hann-windowed spectrum, to compare records; 0 when empty.
     """
 
     frequencies_hz: np.ndarray
@@ -61,65 +57,38 @@ class SpectralLines:
         return len(self.frequencies_hz)
 
     def describe(self) -> str:
-        """The frequencies in ascending order, to the decimal the resolution allows:
-        ``"0.30, 0.70, 1.50 Hz"`` for a 20 s record."""
+        """Frequencies ascending to the resolution's decimal, e.g. ``"0.30, 0.70, 1.50 Hz"``."""
         decimals = max(0, int(np.ceil(-np.log10(self.resolution_hz))))
         return ", ".join(f"{f:.{decimals}f}" for f in np.sort(self.frequencies_hz)) + " Hz"
 
 
 def dof_scales(platform: Platform) -> np.ndarray:
-    """Leg-length change per unit motion of each DOF at the neutral pose.
-
-    Returns
-    -------
-    ndarray, shape (6,)
-        Column norms of J_lq(q0): m/m for x, y, z and m/rad for rx, ry, rz.
-    """
+    """Column norms of J_lq(q0), shape (6,): leg-length change per unit motion (m/m, m/rad)."""
     _, jacobian, _, _ = compute_leg_terms(platform, platform.neutral_pose[None].copy())
     return np.linalg.norm(jacobian[0], axis=0)
 
 
 def leg_space_motion(pose: np.ndarray, platform: Platform) -> np.ndarray:
-    """The motion of the pose as the leg-length change it causes, linearised at neutral.
-
-    Parameters
-    ----------
-    pose : ndarray, shape (N, 6)
-        m, rad.
-    platform : Platform
-
-    Returns
-    -------
-    ndarray, shape (N, 6)
-        J_lq(q0) (q - mean q) (m): a pure sine of the pose stays a pure sine.
-    """
+    """Pose (N, 6), m, rad, as the leg-length change it causes, J_lq(q0) (q - mean q), (N, 6) m."""
     _, jacobian, _, _ = compute_leg_terms(platform, platform.neutral_pose[None].copy())
     return (pose - pose.mean(axis=0)) @ jacobian[0].T
 
 
 def spectral_lines(motion: np.ndarray, sample_rate: float,
                    fraction: float = LINE_FRACTION) -> SpectralLines:
-    """The sines in a multichannel record: peaks of its Hann-windowed amplitude spectrum.
+    """The sines of a multichannel record: peaks of its summed Hann-windowed spectrum.
 
-    The channels' power spectra are summed (so the channels must share a unit), after the
-    mean and a linear drift are removed. A line is a local maximum at least
-    :data:`MIN_LINE_PERIODS` periods long, at least ``fraction`` of the largest line's
-    amplitude, and not a sidelobe of a larger one (:data:`SIDELOBE_BINS`,
-    :data:`SIDELOBE_FRACTION`). Lines closer than about 2 bins merge into one.
+    Mean and linear drift removed; a line lasts at least :data:`MIN_LINE_PERIODS` periods, reaches
+    ``fraction`` of the largest, and is no sidelobe (:data:`SIDELOBE_BINS`, :data:`SIDELOBE_FRACTION`).
 
     Parameters
     ----------
     motion : ndarray, shape (N,) or (N, m)
-        Uniformly sampled channels, time on axis 0.
+        Channels sharing a unit, time on axis 0.
     sample_rate : float
         Hz.
     fraction : float
         Smallest relative amplitude of a line.
-
-    Returns
-    -------
-    SpectralLines
-        Empty when nothing moves.
     """
     x = np.asarray(motion, dtype=float)
     x = x[:, None] if x.ndim == 1 else x
@@ -170,7 +139,7 @@ def spectral_lines(motion: np.ndarray, sample_rate: float,
 
 
 def _regressors(dataset: Dataset, scales: np.ndarray, platform: Platform) -> np.ndarray:
-    """Strided, scaled [q_dot, q_ddot] of one experiment, shape (n, 12) (m/s, m/s^2)."""
+    """Strided, scaled [q_dot, q_ddot] of one experiment, shape (n, 12)."""
     lines = spectral_lines(leg_space_motion(dataset.pose, platform), dataset.sample_rate)
     if not len(lines):
         return np.zeros((0, 12))
@@ -184,23 +153,11 @@ def _regressors(dataset: Dataset, scales: np.ndarray, platform: Platform) -> np.
 
 
 def excitation_per_dof(datasets: Sequence[Dataset], platform: Platform) -> np.ndarray:
-    """How well each DOF is excited on its own over a set of experiments.
+    """How well each DOF is excited on its own, shape (6,) in [0, 1].
 
-    The twelve regressors (Savitzky-Golay velocity and acceleration of each DOF in the
-    leg-length unit of :func:`dof_scales`, stacked over the experiments), each scaled by the
-    largest norm of its kind, are orthogonalised greedily (Gram-Schmidt with column pivoting);
-    a regressor's measure is the norm of the part the ones before it do not explain, and a DOF's
-    the smaller of its two. The standard errors of column k of Mt and Bt scale with its inverse.
-
-    Parameters
-    ----------
-    datasets : sequence of Dataset
-    platform : Platform
-
-    Returns
-    -------
-    ndarray, shape (6,)
-        In [0, 1], order x, y, z, rx, ry, rz.
+    The twelve scaled velocity and acceleration regressors are orthogonalised greedily (pivoted
+    Gram-Schmidt); a DOF's measure is the smaller unexplained norm of its two. Standard errors of
+    column k of Mt and Bt scale with its inverse.
     """
     scales = dof_scales(platform)
     phi = np.concatenate([_regressors(d, scales, platform) for d in datasets])
@@ -225,16 +182,10 @@ def excitation_per_dof(datasets: Sequence[Dataset], platform: Platform) -> np.nd
 def check_excitation(datasets: Sequence[Dataset], platform: Platform) -> None:
     """Refuse a set of experiments that leaves a DOF (nearly) unexcited.
 
-    Parameters
-    ----------
-    datasets : sequence of Dataset
-    platform : Platform
-
     Raises
     ------
     DataError
-        Naming the DOF, its largest motion, the measure of :func:`excitation_per_dof` against
-        :data:`MIN_RELATIVE_EXCITATION`, and the fix.
+        Naming the DOF, its motion, its measure against :data:`MIN_RELATIVE_EXCITATION`, the fix.
     """
     measure = excitation_per_dof(datasets, platform)
     weak = [k for k in range(6) if measure[k] < MIN_RELATIVE_EXCITATION]
@@ -257,9 +208,8 @@ def check_excitation(datasets: Sequence[Dataset], platform: Platform) -> None:
 
 
 def check_experiment_set(datasets: Sequence[Dataset], platform: Platform) -> None:
-    """The checks a set of experiments must pass before any method fits it: no experiment
-    given twice (:func:`~stewartid.datasets.distinct.check_distinct_experiments`) and every
-    DOF excited (:func:`check_excitation`).
+    """Checks before any fit: no experiment twice
+    (:func:`~stewartid.datasets.distinct.check_distinct_experiments`), every DOF excited.
 
     Raises
     ------
@@ -279,22 +229,10 @@ LINE_MERGE_BINS = 3.0
 
 def excitation_lines(datasets: Sequence[Dataset], threshold: float = LINE_THRESHOLD
                      ) -> tuple[tuple[float, ...], ...]:
-    """The distinct excitation frequencies of each DOF over all experiments.
+    """Distinct excitation frequencies (Hz, ascending) of each DOF over all experiments.
 
-    A line counts when its amplitude (in the position spectrum, where white noise stays low) is
-    at least ``threshold`` times the DOF's largest line over the experiments; lines within
-    :data:`LINE_MERGE_BINS` frequency resolutions of each other are one.
-
-    Parameters
-    ----------
-    datasets : sequence of Dataset
-    threshold : float
-        Fraction of the DOF's largest line.
-
-    Returns
-    -------
-    tuple of 6 tuples of float
-        Hz, ascending, per DOF of :data:`~stewartid.platform.COORDINATES`.
+    A line counts when its position-spectrum amplitude is at least ``threshold`` of the DOF's
+    largest; lines within :data:`LINE_MERGE_BINS` resolutions are one.
     """
     found = []
     for dof in range(6):

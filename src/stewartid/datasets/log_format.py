@@ -1,17 +1,5 @@
-"""Controller logs into the interchange format: column mapping with units, delimiter and
-encoding detection, actuator forces from chamber pressures.
-
-A :class:`LogFormat` says which column of a log holds each interchange column (``t``, ``x``
-.. ``rz``, ``l1`` .. ``l6``, ``f1`` .. ``f6``), in which unit, and optionally with a scale
-(``-1`` flips a sign convention) and an offset (added in SI units after the conversion, e.g.
-the leg length at zero stroke). Logs with chamber pressures instead of forces map ``pa1`` ..
-``pa6`` (piston side, extends the leg) and ``pb1`` .. ``pb6`` (rod side); the force is then
-``f = pa * piston_area - pb * annulus_area``. It is read from a TOML file or from an inline
-``KEY=VALUE,...`` string (the CLI's ``--columns``); the format is in ``docs/logs.md``.
-
-Without a log format, CSV files are still read with their delimiter (``,`` ``;`` or tab) and
-decimal mark detected, and in UTF-8 (UTF-16 or UTF-8 with a byte-order mark are recognised);
-another encoding is named in the error with the fix.
+"""Controller logs into the interchange format: column mapping with units (``docs/logs.md``),
+delimiter and encoding detection, actuator forces f = pa * piston_area - pb * annulus_area.
 """
 
 from __future__ import annotations
@@ -68,13 +56,13 @@ class ColumnSource:
     Attributes
     ----------
     name : str
-        Column of the log ("" keeps the interchange name).
+        Log column ("" keeps the interchange name).
     unit : str
-        Unit of the log's column (a key of :data:`UNITS` for its quantity).
+        A key of :data:`UNITS` for its quantity.
     scale : float
-        Multiplier after the unit conversion (-1 flips a sign convention).
+        Multiplier after conversion (-1 flips a sign).
     offset : float
-        Added after conversion and scale, in SI units (s, m, rad, N, Pa).
+        Added after conversion and scale, SI units.
     """
 
     name: str = ""
@@ -90,16 +78,15 @@ class LogFormat:
     Attributes
     ----------
     columns : mapping of str to ColumnSource
-        Interchange column (see :data:`MAPPABLE`) to its source in the log.
+        Interchange column (:data:`MAPPABLE`) to its source.
     delimiter, encoding, decimal : str or None
-        Detected when None (``,`` ``;`` or tab; UTF-8/UTF-16 by byte-order mark; ``.`` or
-        ``,`` from the first data line).
+        Detected when None.
     skip_rows : int
-        Lines before the header line (a logger's preamble).
+        Lines before the header.
     piston_area, annulus_area : float or None
-        Piston-side and rod-side areas of a cylinder (m^2), needed for pressures.
+        m^2, needed for pressures.
     source : str
-        Where the format came from, named in error messages.
+        Named in error messages.
     """
 
     columns: Mapping[str, ColumnSource] = field(default_factory=dict)
@@ -112,25 +99,13 @@ class LogFormat:
     source: str = "--columns"
 
     def to_interchange(self, columns: Columns, where: str) -> Columns:
-        """The log's columns with interchange names, in SI units.
-
-        Parameters
-        ----------
-        columns : dict of str to ndarray, shape (N,) each
-            The log as read (:mod:`stewartid.datasets.columns`).
-        where : str
-            File named in error messages.
-
-        Returns
-        -------
-        dict of str to ndarray
-            Mapped columns converted to SI; unmapped columns unchanged; ``f1..f6`` from
-            the chamber pressures when the log has pressures and no forces.
+        """The log's ``columns`` with interchange names in SI units; unmapped columns unchanged,
+        ``f1..f6`` from pressures when there are no forces.
 
         Raises
         ------
         DataError
-            A mapped column is missing or not numeric, or pressures come without areas.
+            A mapped column missing or not numeric, or pressures without areas.
         """
         out = dict(columns)
         for target, source in self.columns.items():
@@ -159,7 +134,6 @@ class LogFormat:
 
 
 def _missing(value: Any) -> bool:
-    """True for a missing value as read: None or NaN."""
     return value is None or (isinstance(value, float) and math.isnan(value))
 
 
@@ -185,8 +159,9 @@ def _expand(key: str, source: str) -> list[str]:
 
 
 def _column_source(target: str, value: Any, source: str, index: int | None) -> ColumnSource:
-    """One :class:`ColumnSource` from a TOML value: "NAME", "NAME:UNIT", ":UNIT" or a table
-    with name, unit, scale, offset. ``{k}`` in a name is the leg number of ``target``."""
+    """One :class:`ColumnSource` from "NAME", "NAME:UNIT", ":UNIT" or a table; ``{k}`` is the leg
+    number of ``target``.
+    """
     if isinstance(value, str):
         name, unit = value, ""
         head, colon, tail = value.rpartition(":")
@@ -222,13 +197,12 @@ def _column_source(target: str, value: Any, source: str, index: int | None) -> C
 
 
 def log_format_from_mapping(document: Mapping[str, Any], source: str) -> LogFormat:
-    """Build a :class:`LogFormat` from a parsed TOML document with the sections ``[log]``,
-    ``[columns]`` and ``[pressures]`` (all optional).
+    """A :class:`LogFormat` from a parsed TOML document (``[log]``, ``[columns]``, ``[pressures]``).
 
     Raises
     ------
     ConfigError
-        Unknown section or key, unknown unit, or a value of the wrong type.
+        Unknown section, key or unit, or a value of the wrong type.
     """
     sections = {"log": LOG_KEYS, "columns": None, "pressures": AREA_KEYS}
     unknown = sorted(set(document) - set(sections))
@@ -293,19 +267,13 @@ def _checked_settings(settings: dict[str, Any], source: str) -> dict[str, Any]:
 
 
 def load_log_format(spec: str | Path) -> LogFormat:
-    """A :class:`LogFormat` from a TOML file or an inline ``KEY=VALUE,...`` string.
-
-    Parameters
-    ----------
-    spec : str or Path
-        Path of a ``.toml`` file, or entries such as ``"t=Time:ms,l1..l6=Leg{k}:mm,
-        delimiter=;"``: each key is an interchange column (or range) mapped as in the
-        ``[columns]`` section, or a key of ``[log]`` / ``[pressures]``.
+    """A :class:`LogFormat` from a ``.toml`` file or an inline string such as
+    ``"t=Time:ms,l1..l6=Leg{k}:mm,delimiter=;"``.
 
     Raises
     ------
     ConfigError
-        The file is missing, not UTF-8, not valid TOML, or any entry is invalid.
+        File missing, not UTF-8 or not TOML, or an entry invalid.
     """
     text = str(spec)
     if isinstance(spec, Path) or text.lower().endswith(".toml") or Path(text).is_file():
@@ -350,8 +318,7 @@ def decode_text(data: bytes, where: str, encoding: str | None = None) -> str:
 
 
 def detect_delimiter(lines: list[str]) -> str:
-    """The delimiter among ``,`` ``;`` tab that splits the header and the next lines into
-    the same, largest number of fields; ``,`` when none does."""
+    """The delimiter (``,`` ``;`` tab) splitting header and next lines alike into most fields; else ``,``."""
     best, best_count = ",", 0
     for delimiter in DELIMITERS:
         counts = {line.count(delimiter) for line in lines if line.strip()}
@@ -365,24 +332,19 @@ _DECIMAL_COMMA = re.compile(r"^\s*[+-]?\d+,\d+([eE][+-]?\d+)?\s*$")
 
 
 def read_table(path: Path, kind: str, log_format: LogFormat | None = None) -> Columns:
-    """Read a log (CSV or Parquet) and map it to the interchange columns in SI units.
+    """Read a CSV or Parquet log into interchange columns (N,) in SI units.
 
     Parameters
     ----------
     path : Path
     kind : {'csv', 'parquet'}
     log_format : LogFormat, optional
-        Column mapping, units, delimiter, encoding; detection and identity mapping otherwise.
-
-    Returns
-    -------
-    dict of str to ndarray, shape (N,) each
-        The table's columns (:mod:`stewartid.datasets.columns`).
+        Detection and identity mapping otherwise.
 
     Raises
     ------
     DataError
-        The file cannot be decoded or parsed, or the mapping does not fit it.
+        File cannot be decoded or parsed, or the mapping does not fit.
     """
     log_format = log_format or LogFormat()
     where = str(path)
@@ -404,7 +366,6 @@ def read_table(path: Path, kind: str, log_format: LogFormat | None = None) -> Co
 
 
 def _head_lines(text: str, count: int) -> list[str]:
-    """``text.splitlines()[:count]`` without splitting the whole text."""
     size = 4096
     while True:
         lines = text[:size].splitlines()

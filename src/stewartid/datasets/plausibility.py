@@ -1,11 +1,6 @@
-"""Physical consistency of measured data with the platform description.
-
-A log with a wrong unit, frame, leg numbering or platform file is still a table of finite
-numbers, and an identification on it runs to a wrong answer. These checks compare the data
-with what the description implies (leg lengths and pose near neutral, lengths against the
-inverse kinematics of the pose, mean forces against the weight, identified Mt, Bt against the
-nominal ones): a :class:`~stewartid.errors.DataError` naming the likely cause and the fix, or
-a :class:`~stewartid.errors.DataWarning` for a mismatch a user may mean.
+"""Physical consistency of measured data with the platform description: a
+:class:`~stewartid.errors.DataError` naming the likely cause (unit, frame, leg numbering, file)
+and its fix, or a :class:`~stewartid.errors.DataWarning` for a mismatch a user may mean.
 """
 
 from __future__ import annotations
@@ -65,15 +60,7 @@ def _subsample(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
 
 
 def check_leg_lengths(lengths: np.ndarray, platform: Platform, where: str) -> None:
-    """Logged leg lengths must be near the platform's neutral leg length.
-
-    Parameters
-    ----------
-    lengths : ndarray, shape (N, 6)
-        Logged leg lengths (m).
-    platform : Platform
-    where : str
-        File named in the message.
+    """Logged leg lengths (N, 6), m, must be near the neutral leg length; ``where`` names the file.
 
     Raises
     ------
@@ -98,19 +85,12 @@ def check_leg_lengths(lengths: np.ndarray, platform: Platform, where: str) -> No
 
 
 def check_pose(pose: np.ndarray, platform: Platform, where: str) -> None:
-    """A logged pose must be near the neutral pose, in metres and radians, z down.
-
-    Parameters
-    ----------
-    pose : ndarray, shape (N, 6)
-        Logged pose q = [x, y, z, rx, ry, rz] (m, rad; absolute, paper frame).
-    platform : Platform
-    where : str
+    """Logged pose (N, 6), absolute [x, y, z, rx, ry, rz] in m, rad, z down, must be near neutral.
 
     Raises
     ------
     DataError
-        Angles in degrees; positions in mm, relative to neutral or in a z-up frame.
+        Angles in degrees; positions in mm, relative to neutral or z up.
     """
     angles = np.max(np.abs(pose[:, 3:]), axis=0)
     if np.max(angles) > MAX_ANGLE_RAD:
@@ -140,7 +120,7 @@ def check_pose(pose: np.ndarray, platform: Platform, where: str) -> None:
 
 def _ik_misfit(pose: np.ndarray, lengths: np.ndarray, platform: Platform
                ) -> tuple[float, np.ndarray]:
-    """RMS of the varying part of lengths - IK(pose) (m) and its constant part per leg."""
+    """RMS of the varying part of lengths - IK(pose) (m), and its constant part per leg."""
     residual = lengths - leg_lengths(platform, pose)
     constant = residual.mean(axis=0)
     return float(np.sqrt(np.mean((residual - constant) ** 2))), constant
@@ -148,26 +128,17 @@ def _ik_misfit(pose: np.ndarray, lengths: np.ndarray, platform: Platform
 
 def check_inverse_kinematics(pose: np.ndarray, lengths: np.ndarray, platform: Platform,
                              where: str) -> None:
-    """Logged leg lengths must match the inverse kinematics of the logged pose.
-
-    Parameters
-    ----------
-    pose : ndarray, shape (N, 6)
-        Logged pose (m, rad).
-    lengths : ndarray, shape (N, 6)
-        Logged leg lengths (m).
-    platform : Platform
-    where : str
+    """Logged leg lengths (N, 6), m, must match the inverse kinematics of the logged pose (N, 6).
 
     Raises
     ------
     DataError
-        Naming the likely cause (a unit, the frame, the leg numbering, the platform file).
+        Naming the likely cause (unit, frame, leg numbering, platform file).
 
     Warns
     -----
     DataWarning
-        For a constant offset between logged and computed lengths (sensor calibration).
+        Constant offset between logged and computed lengths (sensor calibration).
     """
     pose, lengths = _subsample(pose, lengths)
     excursion = float(np.sqrt(np.mean((lengths - lengths.mean(axis=0)) ** 2)))
@@ -207,7 +178,7 @@ def check_inverse_kinematics(pose: np.ndarray, lengths: np.ndarray, platform: Pl
 
 
 def _leg_order(pose: np.ndarray, lengths: np.ndarray, platform: Platform, fits) -> str | None:
-    """A renumbering of the logged legs that matches the inverse kinematics, as a message."""
+    """A renumbering of the logged legs matching the inverse kinematics, as a message."""
     computed = leg_lengths(platform, pose)
     computed = computed - computed.mean(axis=0)
     logged = lengths - lengths.mean(axis=0)
@@ -226,34 +197,27 @@ def _leg_order(pose: np.ndarray, lengths: np.ndarray, platform: Platform, fits) 
 
 def check_static_balance(pose: np.ndarray, forces: np.ndarray, platform: Platform,
                          where: str, carried: tuple[float, float] = CARRIED_WEIGHT) -> None:
-    """The mean actuator forces must carry the weight the platform description implies.
-
-    Over a record of whole excitation periods the inertial and viscous forces average out,
-    so the mean generalised leg force J_lq(q)^T f balances the gravity term G(q).
+    """Mean actuator forces must carry the weight the description implies: over whole excitation
+    periods the mean J_lq(q)^T f balances G(q).
 
     Parameters
     ----------
-    pose : ndarray, shape (N, 6)
-        Pose (m, rad).
-    forces : ndarray, shape (N, 6)
-        Actuator forces along the legs (N, positive extends).
+    pose, forces : ndarray, shape (N, 6)
+        m, rad; N along the legs, positive extends.
     platform : Platform
     where : str
     carried : (float, float)
-        The weight the forces may carry, in multiples of the file's
-        (:data:`PHYSICAL_CARRIED_WEIGHT` when they identify the payload).
+        Allowed weight in multiples of the file's (:data:`PHYSICAL_CARRIED_WEIGHT` for payload fits).
 
     Raises
     ------
     DataError
-        Forces near zero, in kN, of the opposite sign, a single dead channel, or a weight
-        outside ``carried`` (wrong platform file).
+        Forces near zero, in kN, of opposite sign, a dead channel, or weight outside ``carried``.
 
     Warns
     -----
     DataWarning
-        Unless the range is the physical model's, a weight off by more than
-        :data:`BALANCE_WARNING` (a payload not in the file?).
+        Weight off by more than :data:`BALANCE_WARNING`, unless the range is the physical model's.
     """
     pose, forces = _subsample(pose, forces)
     # the pose-only leg terms that preparation uses too: no mass matrix, no compiled kernel
@@ -292,18 +256,8 @@ def check_static_balance(pose: np.ndarray, forces: np.ndarray, platform: Platfor
 def check_dataset(pose: np.ndarray, lengths: np.ndarray, forces: np.ndarray,
                   platform: Platform, where: str, both_logged: bool,
                   carried: tuple[float, float] = CARRIED_WEIGHT) -> None:
-    """The consistency checks that need pose, lengths and forces together.
-
-    Parameters
-    ----------
-    pose, lengths, forces : ndarray, shape (N, 6)
-        m and rad; m; N.
-    platform : Platform
-    where : str
-    both_logged : bool
-        True when the log held both the pose and the leg lengths (then they must agree).
-    carried : (float, float)
-        As :func:`check_static_balance`.
+    """Consistency checks needing pose (m, rad), lengths (m) and forces (N) together, each (N, 6);
+    lengths must agree with the pose when ``both_logged``; ``carried`` as :func:`check_static_balance`.
     """
     if both_logged:
         check_inverse_kinematics(pose, lengths, platform, where)
@@ -312,29 +266,26 @@ def check_dataset(pose: np.ndarray, lengths: np.ndarray, forces: np.ndarray,
 
 def check_identified(M: np.ndarray, B: np.ndarray, platform: Platform,
                      method: str | None = None, friction_blind: bool = False) -> None:
-    """Identified Mt, Bt against the nominal ones of the platform description.
+    """Identified Mt, Bt against the description's nominal ones.
 
     Parameters
     ----------
     M, B : ndarray, shape (6, 6)
-        Identified inertia (kg, kg m, kg m^2) and viscous (N s/m, N m s/rad) matrices.
     platform : Platform
     method : str, optional
-        Names the method in the messages (several methods are checked for one report).
+        Named in the messages.
     friction_blind : bool
-        The method neither estimates Coulomb friction nor is immune to it (Method A): a Bt
-        above the nominal one is then the friction it takes for damping, and the warning
-        says so instead of pointing at the units.
+        Method takes Coulomb friction for damping (Method A): a high Bt warns so, not of units.
 
     Raises
     ------
     DataError
-        A diagonal entry of Mt beyond :data:`NOMINAL_ERROR_FACTOR` of the nominal one.
+        A diagonal Mt entry beyond :data:`NOMINAL_ERROR_FACTOR` of nominal.
 
     Warns
     -----
     DataWarning
-        A diagonal entry of Mt or Bt beyond :data:`NOMINAL_WARNING_FACTOR`.
+        A diagonal Mt or Bt entry beyond :data:`NOMINAL_WARNING_FACTOR`.
     """
     nominal = dict(zip(("Mt", "Bt"), nominal_matrices(platform), strict=True))
     hint = ("check the units (t s, x..z m, rx..rz rad, f N), the friction model and "

@@ -1,11 +1,6 @@
-"""The physical model: weighted least squares on the base parameters of the regressor, and the
-paper's Mt, Bt at the neutral pose from the identified parameters.
-
-J_lq^T f = Y(q, q_dot, q_ddot) pi is linear in the physical parameters
-(:mod:`stewartid.model.regressor`); both sides are filtered with the kernel h
-(:mod:`~stewartid.physical.regression`). Full mode fits every base parameter; payload mode
-fits the payload on top of the known platform, with friction and sensor offsets as nuisance
-parameters. Parameters the data cannot tell are fixed at the platform file's values.
+"""Physical model: weighted least squares of J_lq^T f = Y(q, q_dot, q_ddot) pi on the regressor's
+base parameters (or a payload on the known platform), both sides kernel-filtered; the paper's
+Mt, Bt at neutral follow from the parameters.
 """
 
 from __future__ import annotations
@@ -59,19 +54,18 @@ POSITIVE_PARAMETERS = ("m", "I_xx", "I_yy", "I_zz", "m_u", "md_u", "md_l", "J_u"
 
 @dataclass(frozen=True)
 class PhysicalResult(IdentificationResult):
-    """An :class:`~stewartid.identification.result.IdentificationResult` of the physical
-    model, whose ``result.json`` adds the parameters.
+    """:class:`~stewartid.identification.result.IdentificationResult` of the physical model.
 
     Attributes
     ----------
     model : str
         ``"physical"``.
     parameters : dict of str to float
-        Identified (or fixed) value of each parameter, by name.
+        Identified or fixed value per parameter.
     parameter_std_errors : dict of str to float
-        Standard errors; NaN (``null`` in JSON) for a parameter fixed at the file's value.
+        NaN (JSON ``null``) when fixed at the file's value.
     base_parameters : dict of str to str
-        The combination of standard parameters each parameter stands for.
+        Standard-parameter combination each stands for.
     """
 
     model: str = "physical"
@@ -80,8 +74,7 @@ class PhysicalResult(IdentificationResult):
     base_parameters: dict[str, str] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
-        """:meth:`IdentificationResult.to_dict` with ``model``, ``parameters``,
-        ``parameter_std_errors`` and ``base_parameters``."""
+        """:meth:`IdentificationResult.to_dict` plus the parameter fields."""
         from stewartid.files import to_jsonable
 
         return {**super().to_dict(), **to_jsonable({
@@ -91,7 +84,7 @@ class PhysicalResult(IdentificationResult):
 
 
 def known_platform(platform: Platform) -> Platform:
-    """The part of a platform description payload mode takes as known: all but its payload."""
+    """What payload mode takes as known: the description without its payload."""
     return platform.replace(payload=None)
 
 
@@ -105,52 +98,44 @@ def known_platform(platform: Platform) -> Platform:
               "ch. 12 (2002); Gautier, M. Numerical calculation of the base inertial "
               "parameters of robots, J. Robotic Systems 8(4) (1991)")
 class PhysicalIdentifier(BaseIdentifier):
-    """The physical parameters of the rigid-body model by weighted least squares, and Mt, Bt
-    at the neutral pose from them.
+    """Physical parameters of the rigid-body model by weighted least squares, and Mt, Bt at
+    neutral from them.
 
     Parameters
     ----------
     payload : bool
-        Identify the payload alone on top of the known platform (the file's description
-        without its ``[payload]``); friction and offsets as nuisance parameters.
+        Identify the payload alone on the known platform; friction and offsets as nuisance.
     window : float, optional
-        Kernel support (s); 0.2 periods of each experiment's dominant frequency by default.
+        Kernel support (s); default 0.2 periods of the dominant frequency.
     order : int
-        Savitzky-Golay order of the rates, accelerations and Coulomb signs.
+        Savitzky-Golay order.
     gravity : bool
-        Model gravity (False only for records without it).
+        Model gravity.
     coulomb_smoothing : float
-        Rate (rad/s) below which a joint's Coulomb sign is attenuated.
+        Rate (rad/s) below which a Coulomb sign is attenuated.
     decimate : int, optional
-        Use every ``decimate``-th filtered row; None: ``ROWS_PER_WINDOW`` rows per kernel window
-        (:func:`~stewartid.physical.regression.row_step`).
+        Row step; None: ``ROWS_PER_WINDOW`` rows per window.
     max_condition : float
-        Largest condition number of the scaled regression before a parameter is fixed.
+        Condition number above which a parameter is fixed.
     max_relative_error : float
-        Largest relative standard error of a positive parameter before it is fixed.
+        Relative standard error above which a positive parameter is fixed.
     consistent : bool
-        Replace the estimate by the physically consistent parameters nearest to it in the
-        metric of its covariance (:func:`~stewartid.physical.parameter_fit.nearest_consistent`);
-        how far each moved, in standard errors, in ``diagnostics["consistent"]``. Needs the
-        ``convex`` extra.
+        Project onto the nearest physically consistent parameters
+        (:func:`~stewartid.physical.parameter_fit.nearest_consistent`; ``convex`` extra).
     noise_correction : bool
-        Remove the bias that pose noise in the regressor's rates and accelerations puts on the
-        estimate (:func:`~stewartid.physical.noise.regressor_noise`).
+        Remove the pose-noise bias (:func:`~stewartid.physical.noise.regressor_noise`).
     sampling_check : bool
-        Refit at a half, a third and a quarter of the log's rate where the residual is not
-        noise, and add each free parameter's change to its variance
-        (:mod:`~stewartid.identification.sampling`).
+        Refit at 1/2, 1/3, 1/4 of the rate and add each parameter's change to its variance.
 
     Attributes
     ----------
     M_, B_ : ndarray, shape (6, 6)
     std_errors_ : dict of ndarray (6, 6)
-    parameters_ : dict of str to float
-    parameter_std_errors_ : dict of str to float
+    parameters_, parameter_std_errors_ : dict of str to float
     covariance_ : ndarray, shape (p, p)
-        Of the parameters in the order of ``parameters_``.
+        In the order of ``parameters_``.
     fixed_ : dict of str to str
-        Parameters fixed at the file's value and why.
+        Fixed parameters and why.
     condition_number_ : float
     result_ : PhysicalResult
     """
@@ -231,9 +216,7 @@ class PhysicalIdentifier(BaseIdentifier):
     def _check_sampling(self, datasets: list[Dataset], platform: Platform,
                         result: IdentificationResult, learned: dict
                         ) -> tuple[IdentificationResult, dict]:
-        """The sampling check on the parameters: each free parameter's largest change over the
-        thinned, unconstrained fits joins its variance.
-        """
+        """Each free parameter's largest change over the thinned fits joins its variance."""
         quick = type(self)(**{**self.get_params(), "consistent": False,
                               "sampling_check": False})
         summary, fits = thinned_fits(lambda part: quick._fit(part, platform)[0], datasets,
@@ -261,10 +244,7 @@ class PhysicalIdentifier(BaseIdentifier):
 
 
 def correlation_segments(data, experiments: list) -> list[tuple[int, int]]:
-    """Per experiment, its filtered rows and the lag (rows) beyond which their noise is uncorrelated.
-
-    The lag is the support of the kernel convolved with the Savitzky-Golay taps.
-    """
+    """Per experiment, filtered rows and the lag (rows) beyond which their noise is uncorrelated."""
     return [(e["samples"], math.ceil((1 + 1 / SAVGOL_FRACTION) * e["window_s"]
                                      * exp.sample_rate / e["row_step"]) + 1)
             for e, exp in zip(data.experiments, experiments, strict=True)]
@@ -272,39 +252,30 @@ def correlation_segments(data, experiments: list) -> list[tuple[int, int]]:
 
 @functools.lru_cache(maxsize=4)
 def _base_parameters(platform: Platform) -> reg.BaseParameters:
-    """:func:`~stewartid.model.regressor.base_parameters`, cached per platform description."""
     return reg.base_parameters(platform)
 
 
 def parameter_model(platform: Platform, payload: bool = False) -> tuple:
-    """The parameters an identification regresses on.
+    """Parameters an identification regresses on.
 
-    Parameters
-    ----------
-    platform : Platform
-        The description the fit starts from (payload mode: without its payload known).
-    payload : bool
-        Payload mode's parameters (the payload's ten and the nuisance ones), else every base
-        parameter.
+    ``platform`` excludes the payload in payload mode; ``payload`` selects the payload's ten and
+    nuisance parameters, else every base parameter.
 
     Returns
     -------
     names : tuple of str
-        The p parameters.
     combinations : dict of str to str
         What each stands for.
     selection : ndarray, shape (p, N_STANDARD)
-        Rows of the identity: the regressor's columns regressed on.
+        Identity rows: the regressor columns used.
     nominal : ndarray, shape (p,)
-        The platform file's values.
     offset : ndarray, shape (N_STANDARD,)
-        Known standard parameters, subtracted from the measured force.
+        Known standard parameters, subtracted from the force.
     """
     return _payload_model(platform) if payload else _full_model(platform)
 
 
 def _full_model(platform: Platform):
-    """The tuple of :func:`parameter_model` for every base parameter."""
     base = _base_parameters(platform)
     pi = reg.standard_parameters(platform)
     return (base.names, dict(zip(base.names, base.combinations, strict=True)),
@@ -313,9 +284,7 @@ def _full_model(platform: Platform):
 
 
 def _payload_model(platform: Platform):
-    """The tuple of :func:`parameter_model` for payload mode; the known platform and legs as the
-    offset.
-    """
+    """Payload mode's :func:`parameter_model`; known platform and legs as the offset."""
     known = reg.standard_parameters(known_platform(platform))
     loaded = reg.standard_parameters(platform)
     body = reg.parameter_index(reg.BODY_PARAMETERS)
@@ -334,9 +303,7 @@ def _payload_model(platform: Platform):
 
 
 def _bodies(platform: Platform, model, payload: bool) -> list[Body]:
-    """The rigid body of the consistent fit: the payload (payload mode) or the moving body, the
-    legs' upper parts held at the file's values.
-    """
+    """Rigid body of the consistent fit (payload or moving body), legs' upper parts at file values."""
     names, _, selection, nominal, _ = model
     body = reg.parameter_index(reg.BODY_PARAMETERS)
     if not np.all(selection[:, body].any(axis=0)):
@@ -354,9 +321,7 @@ def _bodies(platform: Platform, model, payload: bool) -> list[Body]:
 
 def _result(estimator: PhysicalIdentifier, platform: Platform, model, solution: Solution,
             data: Regression, projection: ConsistentParameters | None = None) -> PhysicalResult:
-    """Mt, Bt at neutral with their delta-method standard errors (of the unconstrained
-    estimate), and the parameters (the consistent ones when ``projection`` is given).
-    """
+    """Mt, Bt at neutral with delta-method standard errors, and the (consistent when projected) parameters."""
     names, combinations, selection, _, offset = model
     values = solution.values if projection is None else projection.values
     matrices = [A @ (selection.T @ values + offset)
@@ -394,10 +359,8 @@ def _result(estimator: PhysicalIdentifier, platform: Platform, model, solution: 
 
 def matrix_std_errors(platform: Platform, selection: np.ndarray, covariance: np.ndarray,
                       pose: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Delta-method standard errors, (6, 6) each, of Mt and Bt at ``pose``.
-
-    ``pose`` is absolute (m, rad), neutral by default; ``covariance`` (p, p) is of the parameters
-    that ``selection`` (p, N_STANDARD) places among the standard ones.
+    """Delta-method standard errors (6, 6) of Mt and Bt at absolute ``pose`` (neutral by default),
+    from the parameters' ``covariance`` (p, p) placed by ``selection`` (p, N_STANDARD).
     """
     out = []
     for A in (matrix_regressors.inertia_regressor(platform, pose),
@@ -409,9 +372,8 @@ def matrix_std_errors(platform: Platform, selection: np.ndarray, covariance: np.
 
 
 def payload_section(parameters: dict[str, float]) -> dict[str, Any]:
-    """The ``[payload]`` keys (mass, com, inertia about the centre of mass) of the payload's
-    identified parameters about the reference point; a mass of zero or less puts the centre of mass
-    at the reference point.
+    """``[payload]`` keys (mass, com, inertia about the com) from the payload's identified
+    parameters; mass <= 0 puts the com at the reference point.
     """
     body = np.array([parameters[f"payload.{n}"] for n in reg.BODY_PARAMETERS])
     if not body[0] > 0:
