@@ -1,6 +1,4 @@
-"""Brent's bounded minimisation of a scalar function (:func:`minimize_bounded`), step for step
-as ``scipy.optimize.minimize_scalar(method="bounded")``, without importing scipy.optimize.
-"""
+"""Brent's bounded scalar minimisation, step for step as scipy's ``minimize_scalar(method="bounded")``."""
 
 from __future__ import annotations
 
@@ -10,26 +8,10 @@ from collections.abc import Callable
 
 def minimize_bounded(cost: Callable[[float], float], lower: float, upper: float,
                      tolerance: float, max_evaluations: int = 500) -> float:
-    """Minimiser of a scalar function on [lower, upper] by Brent's bounded method.
+    """Minimiser of ``cost`` on [lower, upper] to absolute ``tolerance`` by Brent's bounded method.
 
-    Golden-section steps safeguarded by parabolic interpolation (Forsythe, Malcolm & Moler,
-    *Computer Methods for Mathematical Computations*, 1977, procedure ``fmin``).
-
-    Parameters
-    ----------
-    cost : callable
-        f(x) -> float.
-    lower, upper : float
-        Bounds, lower <= upper.
-    tolerance : float
-        Absolute tolerance on x.
-    max_evaluations : int
-        Largest number of evaluations of ``cost``.
-
-    Returns
-    -------
-    float
-        The best x found.
+    Golden-section steps safeguarded by parabolic interpolation (Forsythe, Malcolm & Moler 1977,
+    ``fmin``), at most ``max_evaluations`` of ``cost``.
     """
     sqrt_eps = math.sqrt(2.2e-16)
     golden = 0.5 * (3.0 - math.sqrt(5.0))

@@ -1,8 +1,5 @@
-"""Noise-aware differentiation of measured motion, and excitation-frequency estimation.
-
-Velocities and accelerations come from a Savitzky-Golay filter (Savitzky & Golay 1964,
-doi:10.1021/ac60214a047), by default over 0.2 periods of the highest excitation frequency
-(:func:`default_window`).
+"""Noise-aware differentiation of measured motion (Savitzky & Golay 1964; modulating kernels)
+and excitation-frequency estimation.
 """
 
 from __future__ import annotations
@@ -30,7 +27,7 @@ def default_window(frequency_hz: float, periods: float = DEFAULT_WINDOW_PERIODS)
 
 
 def window_samples(window: float, sample_rate: float, order: int = DEFAULT_ORDER) -> int:
-    """Odd number of samples spanning ``window`` seconds, at least order + 2 (or + 3)."""
+    """Odd number of samples spanning ``window`` s, at least order + 2 (or + 3)."""
     n = int(round(window * sample_rate))
     n = max(n, order + 2)
     return n if n % 2 else n + 1
@@ -41,26 +38,20 @@ def differentiate(x: np.ndarray, sample_rate: float, window: float,
                   ) -> tuple[np.ndarray, ...]:
     """Smoothed signal and its first two time derivatives by Savitzky-Golay filtering.
 
-    The first and last half-window come from the end polynomials (``mode="interp"``); they are
-    noisier, so identifiers drop them (:func:`trim`).
+    The first and last half-window come from the end polynomials (noisier; :func:`trim` drops them).
 
     Parameters
     ----------
     x : ndarray, shape (N,) or (N, m)
-        Uniformly sampled signal(s), time on axis 0.
+        Uniformly sampled, time on axis 0.
     sample_rate : float
         Hz.
     window : float
-        Window length (s).
+        s.
     order : int
         Polynomial order (>= 3 for an acceleration).
     derivatives : sequence of int
-        The estimates returned: 0 (smoothed), 1, 2; asking for fewer costs less.
-
-    Returns
-    -------
-    x_smooth, x_dot, x_ddot : ndarray, shape of ``x``
-        Units of x, x/s, x/s^2 (those of ``derivatives``, in its order).
+        Which of 0 (smoothed), 1, 2 to return, in that order (units x, x/s, x/s^2).
 
     Raises
     ------
@@ -97,27 +88,10 @@ def differentiate(x: np.ndarray, sample_rate: float, window: float,
 
 
 def savgol_coefficients(n: int, order: int, deriv: int = 0, delta: float = 1.0) -> np.ndarray:
-    """Convolution taps of the Savitzky-Golay estimate of the ``deriv``-th derivative.
+    """Convolution taps (n,) of the Savitzky-Golay estimate of the ``deriv``-th derivative (1/s^deriv).
 
-    As ``scipy.signal.savgol_coeffs(n, order, deriv, delta, use="conv")``, without importing
-    scipy.signal, and exact to round-off for long windows (the sample offsets are scaled to
-    [-1, 1] first).
-
-    Parameters
-    ----------
-    n : int
-        Window length (samples, odd).
-    order : int
-        Polynomial order (< n).
-    deriv : int
-        Derivative order.
-    delta : float
-        Sample period (s); the taps are in 1/s^deriv.
-
-    Returns
-    -------
-    ndarray, shape (n,)
-        Taps for ``np.convolve`` (``taps[::-1]`` weight the samples from oldest to newest).
+    As ``scipy.signal.savgol_coeffs(n, order, deriv, delta, use="conv")`` without importing
+    scipy.signal, exact for long windows (offsets scaled to [-1, 1]).
     """
     # offsets scaled to [-1, 1]: the raw Vandermonde matrix's condition number is about (n/2)^order
     half = max(n // 2, 1)
@@ -130,8 +104,7 @@ def savgol_coefficients(n: int, order: int, deriv: int = 0, delta: float = 1.0) 
 
 def _end_polynomial(segment: np.ndarray, order: int, deriv: int, delta: float,
                     positions: np.ndarray) -> np.ndarray:
-    """The ``deriv``-th derivative of the polynomial fitted to ``segment`` (n, ...) by least
-    squares, at the sample ``positions`` (k,) of the segment; shape (k, ...)."""
+    """``deriv``-th derivative of the least-squares polynomial of ``segment`` at ``positions``."""
     flat = segment.reshape(len(segment), -1)
     coefficients = np.polyfit(np.arange(len(segment)), flat, order)
     for k in range(deriv):
@@ -142,24 +115,10 @@ def _end_polynomial(segment: np.ndarray, order: int, deriv: int, delta: float,
 
 def convolve_valid(x: np.ndarray, kernels: Sequence[np.ndarray],
                    block_bytes: int = 1 << 26) -> list[np.ndarray]:
-    """Convolve the columns of ``x`` with each kernel along axis 0, "valid" part only.
+    """Convolve ``x`` (N, ...) with each kernel (L,) along axis 0, "valid" part (N - L + 1, ...).
 
-    Overlap-save FFT convolution: one forward transform of ``x`` serves every kernel, and
-    blocks of about ``block_bytes`` bound the scratch memory.
-
-    Parameters
-    ----------
-    x : ndarray, shape (N, ...)
-        Time on axis 0.
-    kernels : sequence of ndarray, each of shape (L,)
-        Same length L <= N.
-    block_bytes : int
-        Approximate size of the blocks of ``x`` transformed at once.
-
-    Returns
-    -------
-    list of ndarray, each of shape (N - L + 1, ...)
-        ``y[j] = sum_k kernel[k] x[j + L - 1 - k]``, as ``np.convolve(..., mode="valid")``.
+    Overlap-save FFT: one transform of ``x`` serves every kernel; blocks of about ``block_bytes``
+    bound the scratch memory. As ``np.convolve(..., mode="valid")``.
     """
     x = np.asarray(x, dtype=float)
     length = len(kernels[0])
@@ -187,10 +146,8 @@ def convolve_valid(x: np.ndarray, kernels: Sequence[np.ndarray],
 
 def savgol_gain(frequency_hz: float, sample_rate: float, window: float,
                 order: int = DEFAULT_ORDER, deriv: int = 0) -> float:
-    """Gain of the Savitzky-Golay estimate of the ``deriv``-th derivative of a sine.
-
-    The filter is symmetric, so for x = sin(w t) the estimate is exactly gain * d^k/dt^k x;
-    dividing harmonic coefficients by it removes the filter's amplitude bias.
+    """Gain of the Savitzky-Golay ``deriv``-th derivative of a sine: the symmetric filter gives exactly
+    gain * d^k/dt^k sin(w t), so dividing harmonic coefficients by it removes its bias.
     """
     n = window_samples(window, sample_rate, order)
     coefficients = savgol_coefficients(n, order, deriv, 1.0 / sample_rate)[::-1]
@@ -206,31 +163,12 @@ KERNEL_EXPONENT = 6
 
 def kernel_filter(x: np.ndarray, sample_rate: float, window: float, derivatives: int = 0,
                   exponent: int = KERNEL_EXPONENT) -> list[np.ndarray]:
-    """Convolve with a smooth compact kernel h and, optionally, its derivatives.
+    """Convolve ``x`` (N, ...) with a smooth compact kernel h and, optionally, its derivatives.
 
-    h(tau) = c (1 - (2 tau / W)^2)^p on |tau| < W/2 (unit integral). h and its first p - 1
-    derivatives vanish at the ends, so d/dt (x * h) = x * h' and d^2/dt^2 (x * h) = x * h''
-    exactly: velocity and acceleration come from the positions without numerical
-    differentiation, and every other term is filtered identically (modulating functions).
-
-    Parameters
-    ----------
-    x : ndarray, shape (N, ...)
-        Uniformly sampled signals, time on axis 0.
-    sample_rate : float
-        Hz.
-    window : float
-        Kernel support W (s).
-    derivatives : {0, 1, 2}
-        Also return x * h' (units x/s) and x * h'' (x/s^2).
-    exponent : int
-        p >= 3.
-
-    Returns
-    -------
-    list of ndarray, each of shape (N - L + 1, ...)
-        [x * h, (x * h'), (x * h'')], aligned with the samples L//2 ... N - 1 - L//2 of x
-        (L = kernel samples, odd).
+    h(tau) = c (1 - (2 tau / W)^2)^p on |tau| < W/2, unit integral: its first p - 1 derivatives vanish
+    at the ends, so d/dt (x * h) = x * h' exactly (modulating functions). ``window`` W in s,
+    ``derivatives`` in {0, 1, 2}, ``exponent`` p >= 3. Returns [x * h, x * h', x * h''] (x, x/s, x/s^2),
+    (N - L + 1, ...), aligned with samples L//2 ... N - 1 - L//2 of x.
     """
     x = np.asarray(x, dtype=float)
     taps = kernel_taps(sample_rate, window, derivatives, exponent)
@@ -256,14 +194,9 @@ def require_window(samples: int, taps: int, window: float) -> None:
 
 def kernel_taps(sample_rate: float, window: float, derivatives: int = 0,
                 exponent: int = KERNEL_EXPONENT) -> list[np.ndarray]:
-    """The discrete taps of :func:`kernel_filter`: h, h' and h'' sampled and scaled so that
-    convolving samples with them gives x * h, x * h' (per s) and x * h'' (per s^2).
+    """Taps (L,), L odd, of :func:`kernel_filter`: h, h' (per s), h'' (per s^2) sampled and scaled.
 
-    Returns
-    -------
-    list of ndarray, each shape (L,)
-        L odd; ``derivatives + 1`` of them. White noise of variance s^2 comes out of the
-        filter with variance s^2 sum(taps^2).
+    White noise of variance s^2 leaves the filter with variance s^2 sum(taps^2).
     """
     n = window_samples(window, sample_rate, 2 * exponent)
     half = (n - 1) / 2 / sample_rate + 0.5 / sample_rate
@@ -285,24 +218,10 @@ def trim(window: float, sample_rate: float, order: int = DEFAULT_ORDER) -> int:
 
 
 def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -> float:
-    """Frequency (Hz) of the dominant sine in ``x``.
+    """Frequency (Hz) of the dominant sine in ``x`` (N,) or (N, m).
 
-    The largest peak of the Hann-windowed, zero-padded spectrum of the channel with the largest
-    relative variation, refined by a least-squares sine fit around it.
-
-    Parameters
-    ----------
-    x : ndarray, shape (N,) or (N, m)
-    sample_rate : float
-        Hz.
-    refine : bool
-        Zero-pad eight-fold and refine by a sine fit; False: the plain spectrum's peak, within
-        half a bin (1 / (2 T) Hz for a record of T s), for settings that need it only roughly.
-
-    Returns
-    -------
-    float
-        Hz.
+    The largest peak of the Hann-windowed, zero-padded spectrum of the most varying channel,
+    refined by a sine fit; ``refine=False``: the plain peak, within half a bin.
 
     Raises
     ------
@@ -332,9 +251,7 @@ def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -
 
 
 def _refine_frequency(x: np.ndarray, sample_rate: float, frequency: float) -> float:
-    """The frequency near ``frequency`` of the sine (with a constant and a trend) that fits
-    ``x`` best by least squares on [sin, cos, 1, t], by projections on an orthonormal basis.
-    """
+    """Frequency near ``frequency`` of the least-squares fit of [sin, cos, 1, t] to ``x``."""
     t = np.arange(len(x)) / sample_rate
     basis = np.empty((4, len(x)))  # orthonormal rows: the constant and trend, then the sine's
     basis[:2] = np.linalg.qr(np.column_stack([np.ones_like(t), t]))[0].T

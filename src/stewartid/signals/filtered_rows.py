@@ -1,5 +1,4 @@
-"""A few rows of the kernel filter of many signals: direct sums where the FFT of every column
-would cost more (:func:`kernel_filter_rows`)."""
+"""A few rows of the kernel filter of many signals, by direct sums where FFTs would cost more."""
 
 from __future__ import annotations
 
@@ -15,28 +14,9 @@ def kernel_filter_rows(x: np.ndarray, sample_rate: float, window: float, step: i
                        exponent: int = KERNEL_EXPONENT, time_last: bool = False) -> np.ndarray:
     """``kernel_filter(x, ...)[0][::step]`` by direct sums, for many columns and few rows.
 
-    Each kept row is the inner product of the kernel's taps with the samples under it, blocks of
-    rows through one banded matrix product: cheaper than an FFT of every column.
-
-    Parameters
-    ----------
-    x : ndarray, shape (N, ...), or (..., N) when ``time_last``
-        Uniformly sampled signals, time on axis 0 (on the last axis when ``time_last``).
-    sample_rate : float
-        Hz.
-    window : float
-        Kernel support W (s).
-    step : int
-        Keep every ``step``-th output row.
-    exponent : int
-        p >= 3.
-    time_last : bool
-        Time on the last axis of ``x`` and of the result (no copy into time-first rows).
-
-    Returns
-    -------
-    ndarray, shape (ceil((N - L + 1) / step), ...), or (..., ceil((N - L + 1) / step))
-        Rows 0, step, 2 step, ... of x * h, aligned with the samples L//2, L//2 + step, ...
+    Blocks of kept rows go through one banded matrix product. ``x`` (N, ...), or (..., N) with time
+    on the last axis of input and result when ``time_last``; ``window`` W in s, ``exponent`` p >= 3.
+    Rows are aligned with samples L//2, L//2 + step, ...
     """
     x = np.asarray(x, dtype=float)
     taps = kernel_taps(sample_rate, window, 0, exponent)[0]

@@ -1,5 +1,4 @@
-"""A uniformly sampled signal between its samples: one cubic spline, exact to its error bound
-up to the ends of the record (channel delays in the simulator, force alignment before a fit)."""
+"""A uniformly sampled signal between its samples: one cubic spline, exact to its bound up to the ends."""
 
 from __future__ import annotations
 
@@ -11,29 +10,10 @@ ONE_SIDED_SLOPE = np.array([-25.0, 48.0, -36.0, 16.0, -3.0]) / 12.0
 
 
 def spline_at(t: np.ndarray, values: np.ndarray, times: np.ndarray) -> np.ndarray:
-    """The sampled signal at ``times``, by a cubic spline through its samples.
+    """The signal ``values`` (N,) or (N, C) sampled at ``t`` (N,), at ``times`` (M,) within the record.
 
-    The end slopes are five-point one-sided differences, which keep the complete spline's error
-    bound (5/384) h^4 max|x''''| up to the ends of the record (Hall & Meyer 1976).
-
-    Parameters
-    ----------
-    t : ndarray, shape (N,)
-        Sample times (s), strictly increasing, uniform over the first and last five.
-    values : ndarray, shape (N,) or (N, C)
-        Sampled signal, any unit.
-    times : ndarray, shape (M,)
-        Where to evaluate (s), within [t[0], t[-1]].
-
-    Returns
-    -------
-    ndarray, shape (M,) or (M, C)
-        Unit of ``values``.
-
-    References
-    ----------
-    C. A. Hall, W. W. Meyer, Optimal error bounds for cubic spline interpolation, J. Approx.
-    Theory 16 (1976) 105-122, doi:10.1016/0021-9045(76)90040-X.
+    A cubic spline whose end slopes are five-point one-sided differences, which keep the error bound
+    (5/384) h^4 max|x''''| up to the ends (Hall & Meyer 1976); ``t`` uniform over the first and last five.
     """
     # scipy.interpolate imported here: the command line needs it only with --delay
     from scipy.interpolate import CubicSpline
@@ -57,23 +37,8 @@ SECOND_SLOPE = np.array([-3.0, -10.0, 18.0, -6.0, 1.0]) / 12.0
 
 
 def hermite_uniform(values: np.ndarray, step: int, n: int) -> np.ndarray:
-    """A signal known every ``step``-th sample, at every sample: piecewise cubic Hermite.
-
-    Knot slopes are five-point differences of the knot values (central inside, one-sided at the
-    ends): a cubic spline's error order without its linear system.
-
-    Parameters
-    ----------
-    values : ndarray, shape (K, C)
-        The signal at samples 0, step, ..., (K - 1) step, K >= 5.
-    step : int
-        Samples between knots.
-    n : int
-        Samples wanted, at most (K - 1) step + 1.
-
-    Returns
-    -------
-    ndarray, shape (n, C)
+    """A signal known at samples 0, step, ..., (K - 1) step (``values`` (K, C), K >= 5) at every one of
+    ``n`` samples, by piecewise cubic Hermite with five-point-difference knot slopes.
     """
     values = np.asarray(values, dtype=float)
     k = len(values)

@@ -1,8 +1,5 @@
-"""The pose rates Coulomb friction's signs are taken from: the shortest Savitzky-Golay window
-the noise allows.
-
-A window rounds off the kink friction puts in the rate at each reversal; noise through a
-short window makes the sign chatter around it.
+"""The pose rates Coulomb friction's signs are taken from: the shortest Savitzky-Golay window the
+noise allows (a window rounds off the reversal's kink; noise makes the sign chatter).
 """
 
 from __future__ import annotations
@@ -23,30 +20,10 @@ SIGN_NOISE = 0.002
 def coulomb_sign_rates(q: np.ndarray, sample_rate: float, window: float,
                        pose_noise: np.ndarray, noise_limit: float = SIGN_NOISE
                        ) -> tuple[np.ndarray, float]:
-    """The pose rates the Coulomb signs are taken from, and their Savitzky-Golay window (s).
+    """The pose rates (N, 6) the Coulomb signs are taken from, and their Savitzky-Golay window (s).
 
-    The shortest of :data:`SIGN_FRACTIONS` whose rate noise (from the pose noise) is within
-    ``noise_limit`` of the rate's RMS; the whole kernel when none is.
-
-    Parameters
-    ----------
-    q : ndarray, shape (N, 6)
-        Measured poses (m, rad).
-    sample_rate : float
-        Hz.
-    window : float
-        The kernel's support (s).
-    pose_noise : ndarray, shape (6, 6)
-        The pose's white-noise covariance per sample
-        (:func:`~stewartid.identification.wavelet.noise.white_noise_covariance`).
-    noise_limit : float
-        Largest rate noise relative to the rate's RMS (:data:`SIGN_NOISE` by default).
-
-    Returns
-    -------
-    rates : ndarray, shape (N, 6)
-    window : float
-        s.
+    The shortest of :data:`SIGN_FRACTIONS` of ``window`` whose rate noise, from the per-sample pose
+    covariance ``pose_noise`` (6, 6), is within ``noise_limit`` of the rate's RMS; else the whole kernel.
     """
     sigma = np.diag(pose_noise)
     # the rates' RMS barely depends on the window: taken once, at an eighth of the kernel

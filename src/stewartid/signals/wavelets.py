@@ -1,18 +1,6 @@
-"""Mother wavelets and the continuous wavelet transform at chosen (scale, shift) points.
-
-W_psi f (a, b) = (1 / a) integral f(t) psi((t - b) / a) dt (Zhang 2020, Section 3), evaluated
-only at the (a, b) points an identification needs, as a sparse matrix of sampled wavelets.
-Each wavelet has analytic integrals and derivatives, so integration by parts moves
-derivatives between signal and wavelet:
-
-    W_psi f'  (a, b) = -(1 / a)   W_psi' f  (a, b)
-    W_psi f'' (a, b) =  (1 / a^2) W_psi'' f (a, b)
-    W_psi F   (a, b) = -a         W_psi1 f  (a, b)        (F' = f, psi1' = psi)
-
-References
-----------
-Zhang, C. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
-Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
+"""Mother wavelets and the continuous wavelet transform W_psi f (a, b) = (1/a) integral f(t)
+psi((t - b)/a) dt at chosen (a, b) points (Zhang 2020); by parts, W_psi f' = -(1/a) W_psi' f,
+W_psi f'' = (1/a^2) W_psi'' f, W_psi F = -a W_psi1 f (F' = f, psi1' = psi).
 """
 
 from __future__ import annotations
@@ -37,8 +25,7 @@ DERIVATIVE_ORDERS = (-2, -1, 0, 1, 2)
 
 @functools.cache
 def _gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss-Legendre nodes and weights on [-1, 1], shape (n,) each; computed once per
-    process (an n x n eigenproblem)."""
+    """Gauss-Legendre nodes and weights on [-1, 1], computed once per process."""
     return np.polynomial.legendre.leggauss(n)
 
 
@@ -48,12 +35,11 @@ class MotherWavelet(ABC):
     Attributes
     ----------
     name : str
-        Short name used in settings and result files.
+        Used in settings and result files.
     half_width : float
-        Effective support is [-half_width, half_width] in units of the scale: the wavelet is
-        zero (compact) or truncated (Gaussian family) beyond it.
+        Support [-half_width, half_width] in scales (truncated beyond it unless compact).
     compact : bool
-        True when the wavelet is exactly zero outside its support.
+        Exactly zero outside its support.
     """
 
     name: str = ""
@@ -61,20 +47,9 @@ class MotherWavelet(ABC):
     compact: bool = True
 
     def __call__(self, x: np.ndarray, derivative: int = 0) -> np.ndarray:
-        """Evaluate psi or one of its integrals/derivatives at ``x`` (dimensionless).
+        """psi^(derivative) at ``x`` = (t - b) / a, zero outside [-half_width, half_width].
 
-        Parameters
-        ----------
-        x : ndarray, any shape
-            (t - b) / a.
-        derivative : int
-            One of :data:`DERIVATIVE_ORDERS`: -2 (second integral), -1 (first integral psi1),
-            0 (psi), 1 (psi'), 2 (psi'').
-
-        Returns
-        -------
-        ndarray, shape of ``x``
-            Zero outside [-half_width, half_width].
+        ``derivative`` in :data:`DERIVATIVE_ORDERS`: -2, -1 (integrals psi2, psi1), 0, 1, 2.
         """
         if derivative not in DERIVATIVE_ORDERS:
             raise ConfigError(
@@ -93,13 +68,7 @@ class MotherWavelet(ABC):
         return {"name": self.name}
 
     def moments(self, derivative: int, degree: int) -> np.ndarray:
-        """Moments m_j = integral psi^(derivative)(x) x^j dx, j = 0..degree, of the ideal
-        (untruncated) wavelet, by Gauss-Legendre quadrature.
-
-        Returns
-        -------
-        ndarray, shape (degree + 1,)
-        """
+        """Moments m_j = integral psi^(derivative)(x) x^j dx, j = 0..degree, of the untruncated wavelet."""
         key = (derivative, degree)
         cache = self.__dict__.setdefault("_moment_cache", {})
         if key not in cache:
@@ -118,14 +87,8 @@ class MotherWavelet(ABC):
 class MexicanHat(MotherWavelet):
     """Mexican hat psi(t) = (1 - t^2) exp(-t^2 / 2), the paper's example wavelet.
 
-    psi1(t) = t exp(-t^2 / 2), psi2(t) = -exp(-t^2 / 2); truncated at +-``truncation`` scales.
-    Unnormalised (psi(0) = 1); PyWavelets' ``'mexh'`` is this function times
-    2 / (sqrt(3) pi^(1/4)).
-
-    Parameters
-    ----------
-    truncation : float
-        Half-width of the effective support, in scales.
+    psi1 = t exp(-t^2 / 2), psi2 = -exp(-t^2 / 2); unnormalised (PyWavelets' ``'mexh'`` times
+    sqrt(3) pi^(1/4) / 2). ``truncation``: half-width of the support, in scales.
     """
 
     name = "mexican_hat"
@@ -158,20 +121,10 @@ class MexicanHat(MotherWavelet):
 
 
 class PolynomialWavelet(MotherWavelet):
-    """Compactly supported wavelet psi = g'' with g(x) = (1 - x^2)^p on [-1, 1].
+    """Compactly supported psi = g'' with g(x) = (1 - x^2)^p on [-1, 1], unit L2 norm.
 
-    The modulating-function (weak-form) wavelet: psi1 = g', psi2 = g, moments of order 0 and 1
-    vanish exactly, and it spans a whole constant-direction interval without truncation error.
-    With ``odd=True`` it is psi = g''' (integrals g'', g'), moments 0 to 2 vanishing; its psi''
-    needs p >= 8 (or the moment correction of :func:`transform_matrix`) to be sampled accurately.
-    Normalised to unit L2 norm on [-1, 1].
-
-    Parameters
-    ----------
-    order : int
-        The exponent p, 5 <= p <= 20.
-    odd : bool
-        The odd companion g''' instead of g''.
+    The modulating-function wavelet: moments 0 and 1 vanish exactly. ``odd=True``: psi = g''',
+    moments 0 to 2 vanishing (its psi'' needs p >= 8 or the moment correction). ``order`` p in [5, 20].
     """
 
     name = "polynomial"
@@ -204,14 +157,8 @@ _WAVELETS = {"mexican_hat": MexicanHat, "polynomial": PolynomialWavelet}
 
 
 def make_wavelet(wavelet: str | MotherWavelet | dict = "polynomial", **options) -> MotherWavelet:
-    """A mother wavelet from its name (``"polynomial"``, ``"mexican_hat"``) or settings dict.
-
-    Parameters
-    ----------
-    wavelet : str or MotherWavelet or dict
-        A name, an instance (returned as is), or the output of ``MotherWavelet.to_dict()``.
-    **options
-        Passed to the wavelet's constructor (``order=``, ``truncation=``).
+    """A mother wavelet from its name (``"polynomial"``, ``"mexican_hat"``), an instance (returned as
+    is) or ``to_dict()`` settings; ``**options`` go to its constructor.
     """
     if isinstance(wavelet, MotherWavelet):
         return wavelet
@@ -226,7 +173,6 @@ def make_wavelet(wavelet: str | MotherWavelet | dict = "polynomial", **options) 
 
 
 def _quadrature_weights(t: np.ndarray) -> np.ndarray:
-    """Trapezoid weights (s) of a strictly increasing time base, shape (N,)."""
     w = np.empty_like(t)
     dt = np.diff(t)
     w[0], w[-1] = dt[0] / 2, dt[-1] / 2
@@ -237,29 +183,12 @@ def _quadrature_weights(t: np.ndarray) -> np.ndarray:
 def transform_matrix(t: np.ndarray, scales: np.ndarray, shifts: np.ndarray,
                      wavelet: MotherWavelet, derivative: int = 0,
                      exact_degree: int | None = None) -> csr_matrix:
-    """Sparse matrix W with (W @ f)[k] = W_psi f (scales[k], shifts[k]) for samples f of t.
+    """Sparse (K, N) matrix W with (W @ f)[k] = W_psi f (scales[k], shifts[k]) for samples f of ``t``.
 
-    Row k holds (1 / a_k) psi^(derivative)((t - b_k) / a_k) times trapezoid weights, on the
-    samples inside the wavelet's support. With ``exact_degree = m`` each row gets the least-norm
-    change that makes it integrate 1, x, ..., x^m exactly (the analytic
-    :meth:`MotherWavelet.moments`), so offsets and trends vanish to rounding whatever the
-    sampling; rows with fewer than m + 2 samples are left as they are.
-
-    Parameters
-    ----------
-    t : ndarray, shape (N,)
-        Strictly increasing sample times (s).
-    scales, shifts : ndarray, shape (K,)
-        Scales a (s, > 0) and shifts b (s).
-    wavelet : MotherWavelet
-    derivative : int
-        Evaluate psi2, psi1, psi, psi' or psi'' (see :data:`DERIVATIVE_ORDERS`).
-    exact_degree : int or None
-        Highest degree of the polynomials integrated exactly; None: plain trapezoid weights.
-
-    Returns
-    -------
-    scipy.sparse.csr_matrix, shape (K, N)
+    Row k is (1 / a_k) psi^(derivative)((t - b_k) / a_k) times trapezoid weights. With
+    ``exact_degree`` m each row gets the least-norm change that integrates 1, ..., x^m exactly
+    (:meth:`MotherWavelet.moments`), so offsets and trends vanish; rows under m + 2 samples stay.
+    Times, scales and shifts in s.
     """
     t = np.asarray(t, dtype=float)
     a = np.atleast_1d(np.asarray(scales, dtype=float))
@@ -289,11 +218,7 @@ def transform_matrix(t: np.ndarray, scales: np.ndarray, shifts: np.ndarray,
 
 def _correct_moments(values: np.ndarray, x: np.ndarray, rows: np.ndarray, counts: np.ndarray,
                      indptr: np.ndarray, target: np.ndarray) -> np.ndarray:
-    """Least-norm change of each row's values so that sum_n v_n x_n^j = target_j.
-
-    With v' = v + V c (V the row's Vandermonde matrix in x), c = (V^T V)^-1 (target - V^T v);
-    all rows at once with segment sums.
-    """
+    """Least-norm change v + V c of each row so that sum_n v_n x_n^j = target_j."""
     m = len(target)
     # x^0 .. x^(2m-2) by repeated products: float powers through pow() are slow
     rows_of_powers = np.empty((2 * m - 1, len(x)))
@@ -320,26 +245,10 @@ def _correct_moments(values: np.ndarray, x: np.ndarray, rows: np.ndarray, counts
 def wavelet_transform(signal: np.ndarray, t: np.ndarray, scales: np.ndarray,
                       shifts: np.ndarray, wavelet: str | MotherWavelet = "mexican_hat",
                       derivative: int = 0, exact_degree: int | None = None) -> np.ndarray:
-    """Continuous wavelet transform of sampled signals at chosen (a, b) points.
+    """Continuous wavelet transform of signals (N,) or (N, C) at points (a_k, b_k): (K,) or (K, C).
 
-    Parameters
-    ----------
-    signal : ndarray, shape (N,) or (N, C)
-        Samples of one or C signals at times ``t`` (any unit u).
-    t : ndarray, shape (N,)
-        Strictly increasing times (s).
-    scales, shifts : ndarray, shape (K,)
-        Scales a (s) and shifts b (s).
-    wavelet : str or MotherWavelet
-    derivative : int
-        Use psi's integral (-1, -2) or derivative (1, 2) instead of psi.
-    exact_degree : int or None
-        Moment correction of the quadrature (see :func:`transform_matrix`).
-
-    Returns
-    -------
-    ndarray, shape (K,) or (K, C)
-        W f (a_k, b_k) in u.
+    ``derivative`` uses psi's integral (-1, -2) or derivative (1, 2); ``exact_degree`` as in
+    :func:`transform_matrix`.
     """
     matrix = transform_matrix(t, scales, shifts, make_wavelet(wavelet), derivative,
                               exact_degree)
