@@ -1,7 +1,6 @@
-"""The ``stewartid`` application: the typer app, its commands (one module per command in
-:mod:`stewartid.cli`) and its error policy: an expected error (bad input, failed numerics, an
-unreadable file, a usage error) is one line ``error: ...`` on stderr and exit code 2; anything
-else is a bug and propagates with its traceback; ``--debug`` shows every traceback."""
+"""The ``stewartid`` typer app and its error policy: an expected error is one line ``error: ...``
+on stderr and exit code 2; anything else is a bug with its traceback (every one with ``--debug``).
+"""
 
 from __future__ import annotations
 
@@ -24,12 +23,10 @@ except ImportError:  # pragma: no cover - older typer on click
 
 
 class OneLineUsageErrors(TyperGroup):
-    """The command group, with usage errors (an unknown option, a value that does not parse)
-    as one line ``error: ...`` and exit code 2 instead of a usage box."""
+    """The command group, usage errors as one line ``error: ...`` and exit code 2, not a usage box."""
 
     def main(self, *args: Any, standalone_mode: bool = True, **kwargs: Any) -> Any:
-        """Run the application; in standalone mode, a usage error is one line on stderr and exit
-        code 2, and the process exits with the command's code."""
+        """Run the application; exit with the command's code (2 after a usage error)."""
         if not standalone_mode:
             return super().main(*args, standalone_mode=False, **kwargs)
         try:
@@ -55,10 +52,7 @@ class OneLineUsageErrors(TyperGroup):
 
 
 class PlainHelpCommand(TyperCommand):
-    """A command whose ``--help`` reads like the ecosystem's (git, pip, click): an argument
-    shows as its metavar (``FILE...``, never ``{files}...`` or ``<list[Path]>``), an option
-    as its flag and metavar (``--out DIR``), a flag alone; the text is reflowed to the
-    terminal, so a line break in the source never breaks a sentence."""
+    """A command whose ``--help`` reads like git's or pip's: ``FILE...``, ``--out DIR``, reflowed text."""
 
     def collect_usage_pieces(self, ctx: Any) -> list[str]:
         """The usage line after the command: the options placeholder, then each argument."""
@@ -69,7 +63,7 @@ class PlainHelpCommand(TyperCommand):
         return pieces
 
     def format_options(self, ctx: Any, formatter: Any) -> None:
-        """Write the "Arguments:" and "Options:" sections, each entry its label and help."""
+        """Write the "Arguments:" and "Options:" sections."""
         arguments = [(_argument_label(parameter, usage=False), parameter.help or "")
                      for parameter in self.get_params(ctx)
                      if parameter.param_type_name == "argument"]
@@ -134,8 +128,8 @@ def _show_warning(message: Warning | str, category: type[Warning], *args: Any,
 
 def clean_errors(command: Callable[..., Any]) -> Callable[..., Any]:
     """Decorator: StewartidError and OSError become one error line and exit code 2 (unless
-    ``--debug``); every other exception propagates. Warnings are one line ``warning: ...``
-    each, without source lines."""
+    ``--debug``); warnings are one line ``warning: ...``.
+    """
 
     @functools.wraps(command)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
@@ -174,12 +168,7 @@ _register()
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Console-script entry point.
-
-    BLAS runs on one thread (worker processes get the same limit): the commands' linear
-    algebra is on small matrices, where extra BLAS threads only synchronise and, on a busy
-    machine, spin.
-    """
+    """Console-script entry point; BLAS on one thread (the commands' matrices are small)."""
     from threadpoolctl import threadpool_limits
 
     with threadpool_limits(limits=1, user_api="blas"):

@@ -186,8 +186,7 @@ def _overridden(description: Platform, coulomb: float | None, viscous: float | N
 def _on_mujoco(description: Platform, coulomb: float | None, viscous: float | None,
                excitation: list[Path] | None, frequency: float, duration: float,
                noise: SensorNoise, seed: int, progress: Any, jobs: int) -> SimulationResult:
-    """``simulate --engine mujoco``: the paper's experiments or the excitation files played on
-    the MuJoCo model (:func:`stewartid.mujoco.experiments.simulate_on_mujoco`)."""
+    """``simulate --engine mujoco``: the experiments or excitation files played on the MuJoCo model."""
     from stewartid.design.export import read_excitation
     from stewartid.simulation import paper_experiments
 
@@ -213,22 +212,16 @@ def _on_mujoco(description: Platform, coulomb: float | None, viscous: float | No
 
 def with_imperfections(noise: SensorNoise, sample_rate: float,
                        given: dict[str, Any]) -> SensorNoise:
-    """``noise`` with the sensor imperfections given on the command line.
+    """``noise`` with the command line's sensor imperfections.
 
-    Parameters
-    ----------
-    noise : SensorNoise
-        The errors of ``[sensors]`` and the noise flags.
-    sample_rate : float
-        Sample rate of the records (Hz): filter and hum frequencies must lie below half of it.
-    given : dict
-        Flag of :data:`IMPERFECTION_FLAGS` -> value, None when not given.
+    ``given``: flag of :data:`IMPERFECTION_FLAGS` -> value (None when not given); filter and hum
+    frequencies must lie below half ``sample_rate`` (Hz).
 
     Raises
     ------
     ConfigError
-        One line naming the flag: a value outside its range, a frequency at or above the
-        Nyquist frequency, a flag that shapes an error nobody switched on.
+        Naming the flag: a value out of range, a frequency at or above Nyquist, or a flag shaping an
+        error not switched on.
     """
     from numbers import Real
 

@@ -1,15 +1,4 @@
-"""Identified matrices for control work: CSV tables and one MATLAB ``.mat`` file.
-
-CSV: one file per matrix, ``<method>_M.csv``, ``<method>_B.csv``, ``<method>_std_errors_M.csv``,
-``<method>_std_errors_B.csv``; a header row and a first column with the coordinate names
-(x, y, z, rx, ry, rz), SI units (Mt: kg, kg m, kg m^2; Bt: N s/m, N s, N m s), full precision.
-
-MAT (``identification.mat``, MATLAB 5 format, :func:`scipy.io.savemat`): one struct per
-method (its name with ``-`` as ``_``) with fields ``M``, ``B``, ``std_errors_M``,
-``std_errors_B`` (6x6), ``vaf_percent`` and ``nrmse`` (1x6, held out), ``coulomb_levels`` and
-``coulomb_std_errors`` (1x3, N m; NaN where the method does not estimate friction),
-plus ``coordinates``, ``friction_types`` and ``trusted`` (the method the report trusts).
-"""
+"""Identified matrices for control work: CSV tables and one MATLAB ``.mat`` file."""
 
 from __future__ import annotations
 
@@ -36,11 +25,9 @@ class ExportedModel:
     name : str
         Registered method name (file prefix).
     result : IdentificationResult
-        With ``validation`` set when it was validated.
-    coulomb : ndarray, shape (3,)
-        Coulomb level per joint type (N m), NaN where not estimated.
-    coulomb_std : ndarray, shape (3,)
-        Their standard errors (N m).
+        With ``validation`` set when validated.
+    coulomb, coulomb_std : ndarray, shape (3,)
+        Coulomb level per joint type and standard error (N m), NaN where not estimated.
     """
 
     name: str
@@ -50,7 +37,7 @@ class ExportedModel:
 
 
 def matrix_csv(matrix: np.ndarray) -> str:
-    """A 6x6 matrix as CSV text with coordinate names on both axes, full precision."""
+    """A 6x6 matrix as CSV, coordinate names on both axes, full precision."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(["", *COORDINATES])
@@ -60,26 +47,20 @@ def matrix_csv(matrix: np.ndarray) -> str:
 
 
 def read_matrix_csv(path: str | Path) -> np.ndarray:
-    """Inverse of :func:`matrix_csv`: the 6x6 matrix of a file written by it."""
+    """Inverse of :func:`matrix_csv`."""
     rows = list(csv.reader(Path(path).read_text().splitlines()))
     return np.array([[float(v) for v in row[1:]] for row in rows[1:]])
 
 
 def write_exports(models: Sequence[ExportedModel], directory: str | Path,
                   trusted: str) -> list[Path]:
-    """Write the CSV files and ``identification.mat`` of every model.
+    """Write every model's CSV files, then ``identification.mat``; returns their paths.
 
-    Parameters
-    ----------
-    models : sequence of ExportedModel
-    directory : str or Path
-    trusted : str
-        Registered name of the trusted method, stored as ``trusted``.
-
-    Returns
-    -------
-    list of Path
-        The CSV files, then the MAT file.
+    CSV: ``<method>_M.csv``, ``_B``, ``_std_errors_M``, ``_std_errors_B``, coordinate names as
+    header and first column, SI units. MAT (MATLAB 5): one struct per method (``-`` as ``_``) with
+    ``M``, ``B``, ``std_errors_M``, ``std_errors_B`` (6x6), held-out ``vaf_percent`` and ``nrmse``
+    (1x6), ``coulomb_levels``, ``coulomb_std_errors`` (1x3, N m, NaN if not estimated); plus
+    ``coordinates``, ``friction_types`` and ``trusted`` (the registered name of the trusted method).
     """
     from scipy.io import savemat
 

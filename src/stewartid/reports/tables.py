@@ -1,5 +1,6 @@
-"""Tables of every report, each built once as a :class:`ResultTable` and written as CSV (full
-precision) and as Markdown (rounded for reading)."""
+"""Every report's tables, built once as a :class:`ResultTable` and written as CSV (full precision)
+and Markdown (rounded).
+"""
 
 from __future__ import annotations
 
@@ -25,11 +26,10 @@ class ResultTable:
     title : str
     columns : tuple of str
     kinds : tuple of str
-        Per column: ``"text"``, ``"value"`` (an identified or nominal value), ``"eps"`` (%)
-        or ``"published"`` (a number reprinted as the paper prints it).
+        Per column: ``"text"``, ``"value"``, ``"eps"`` (%) or ``"published"`` (as the paper prints).
     rows : tuple of tuple
     notes : tuple of str
-        Footnotes printed under the Markdown table.
+        Footnotes under the Markdown table.
     """
 
     name: str
@@ -46,9 +46,9 @@ class ResultTable:
 
 
 def format_cell(value: Cell, kind: str) -> str:
-    """Markdown text of a cell by its column's ``kind``: values to 1 decimal with thousands
-    separators, ε to 2, published numbers as printed; "—" for no value, "n/a" for a
-    non-finite one."""
+    """Markdown text of a cell by ``kind``: values to 1 decimal, ε to 2, published as printed;
+    "—" for none, "n/a" for non-finite.
+    """
     if value is None:
         return "—"
     if isinstance(value, str):
@@ -79,7 +79,7 @@ def to_markdown(table: ResultTable, heading_level: int = 3) -> str:
 
 
 def to_csv(table: ResultTable) -> str:
-    """The table as CSV with full-precision numbers and empty cells for missing values."""
+    """The table as CSV, full precision, empty cells for missing values."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(table.columns)
@@ -90,7 +90,7 @@ def to_csv(table: ResultTable) -> str:
 
 
 def write_tables(tables: Sequence[ResultTable], directory: str | Path) -> list[Path]:
-    """Write each table as ``<name>.md`` and ``<name>.csv`` in ``directory``; return the paths."""
+    """Write each table as ``<name>.md`` and ``<name>.csv``; returns the paths."""
     from stewartid.files import write_text_atomic
 
     directory = Path(directory)

@@ -1,5 +1,5 @@
-"""The figures only a reproduction draws: the force budget and scalogram of the traced
-experiment, and every method's errors beside the paper's. Each returns the written paths.
+"""Figures only a reproduction draws: the traced experiment's force budget and scalogram, and
+every method's errors beside the paper's. Each returns the written paths.
 """
 
 from __future__ import annotations
@@ -32,8 +32,7 @@ FORCE_COMPONENTS = {
 def plot_force_budget(trace: ExperimentTrace, directory: str | Path,
                       channels: Sequence[int] | None = None,
                       stem: str = "force_budget") -> list[Path]:
-    """Generalized force components of one experiment in the excited equation and its most
-    coupled one: inertial, viscous, Coulomb, gravity variation and the actuators' total."""
+    """Inertial, viscous, Coulomb, gravity and actuator force in the excited and most coupled equations."""
     if channels is None:
         coupled = {0: 4, 1: 3, 2: 2, 3: 1, 4: 0, 5: 5}[trace.excited]
         channels = sorted({trace.excited, coupled})
@@ -71,23 +70,20 @@ def plot_scalogram(t: np.ndarray, signal: np.ndarray, points: np.ndarray,
                    directory: str | Path, wavelet: Any = "mexican_hat",
                    signal_label: str = "signal", intervals: np.ndarray | None = None,
                    stem: str = "scalogram", max_rate_hz: float = 100.0) -> list[Path]:
-    """|W_ψ f(a, b)| of one signal over scales and shifts, with the (a, b) points an
-    identification used marked on it.
+    """|W_ψ f(a, b)| of one signal over scales and shifts, the (a, b) points used marked.
 
     Parameters
     ----------
-    t : ndarray, shape (N,)
-        Time (s).
-    signal : ndarray, shape (N,)
-        The transformed signal (any unit u; the colour bar is in u).
+    t, signal : ndarray, shape (N,)
+        Time (s) and the signal (any unit, that of the colour bar).
     points : ndarray, shape (K, 2)
-        (a, b) pairs used (s, s).
+        (a, b) pairs used (s).
     wavelet : str or MotherWavelet
         See :func:`stewartid.signals.wavelets.make_wavelet`.
     intervals : ndarray, shape (M, 2), optional
-        Constant-direction intervals, drawn as bars under the map.
+        Constant-direction intervals, drawn under the map.
     max_rate_hz : float
-        The signal is decimated to at most this rate for the map only.
+        Decimation of the signal for the map only.
     """
     from stewartid.signals.wavelets import make_wavelet, wavelet_transform
 
@@ -135,7 +131,7 @@ def plot_scalogram(t: np.ndarray, signal: np.ndarray, points: np.ndarray,
 
 def _grouped_bars(axis: Any, labels: Sequence[str], series: Sequence[tuple[str, np.ndarray,
                   dict]], log: bool, base: float = 0.0) -> None:
-    """Bars of several series side by side per label, drawn from ``base``."""
+    """Bars of several series side by side per label, from ``base``."""
     width = 0.84 / max(len(series), 1)
     x = np.arange(len(labels))
     for k, (label, values, style) in enumerate(series):
@@ -151,8 +147,7 @@ def _grouped_bars(axis: Any, labels: Sequence[str], series: Sequence[tuple[str, 
 @styled
 def plot_errors(results: ComparisonResults, directory: str | Path,
                 stem: str = "errors") -> list[Path]:
-    """ε (%) per entry, every method against the others and against the paper's published ε,
-    one panel per Coulomb level (log scale)."""
+    """ε (%) per entry, every method and the paper's published ε, one panel per Coulomb level."""
     levels = results.coulomb_levels
     figure = new_figure(figsize=(14, 3.6 * len(levels)), layout="constrained")
     axes = figure.subplots(len(levels), 1, squeeze=False)
@@ -185,8 +180,7 @@ def plot_errors(results: ComparisonResults, directory: str | Path,
 @styled
 def plot_identified_vs_nominal(results: ComparisonResults, coulomb: float,
                                directory: str | Path, stem: str | None = None) -> list[Path]:
-    """Identified value divided by nominal, per entry and method, at one Coulomb level; the
-    nominal values are printed under the entry names (1 = exact)."""
+    """Identified / nominal per entry and method at one Coulomb level (1 = exact), nominals printed."""
     figure = new_figure(figsize=(13, 4.6), layout="constrained")
     axes = figure.subplots(1, 2)
     for axis, matrix in zip(axes, ("M", "B"), strict=True):

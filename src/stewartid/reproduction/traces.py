@@ -1,5 +1,5 @@
-"""The model's force components along a simulated experiment, and the commanded poses, for the
-signal figures of a reproduction.
+"""The model's force components along a simulated experiment, and the commanded poses, for a
+reproduction's signal figures.
 """
 
 from __future__ import annotations
@@ -16,28 +16,23 @@ def experiment_trace(platform: Platform, dataset: Any, excited: int, frequency_h
                      reference: np.ndarray | None = None, record: Any = None):
     """Everything the signal figures need from one simulated experiment.
 
-    The force components are the model's terms along the motion: at the simulator's true pose,
-    velocity and acceleration when ``record`` is given, else at the measured pose differentiated
-    as an identifier would. The actuators' generalized force is always the measured one.
+    Force components are the model's terms at the simulator's true motion when ``record`` is
+    given, else at the measured pose differentiated as an identifier would; the actuators' force
+    is always measured.
 
     Parameters
     ----------
     platform : Platform
         The simulated plant (its Coulomb level sets the Coulomb component).
     dataset : Dataset
-        Measured signals.
     excited : int
         Excited coordinate (0-5).
     frequency_hz : float
-        Excitation frequency (Hz), sets the differentiation window.
+        Excitation frequency, sets the differentiation window (Hz).
     reference : ndarray, shape (N, 6), optional
         Commanded pose (m, rad).
     record : ExperimentRecord, optional
-        True signals of the simulator (``q``, ``q_dot``, ``q_ddot``).
-
-    Returns
-    -------
-    ExperimentTrace
+        The simulator's true ``q``, ``q_dot``, ``q_ddot``.
     """
     from stewartid.identification.wavelet.intervals import (
         constant_direction_intervals,

@@ -1,7 +1,5 @@
-"""Expansion of a study into tasks: one per (grid point, seed).
-
-A task identifies one simulation with every method, so the methods meet the same data. Its
-key hashes the parameters and the seed, so that a resumed run skips finished tasks.
+"""A study expanded into tasks, one per (grid point, seed): the methods meet the same data, and a
+key hashing parameters and seed lets a resumed run skip finished tasks.
 """
 
 from __future__ import annotations
@@ -21,10 +19,9 @@ class StudyTask:
     Attributes
     ----------
     parameters : dict
-        ``{parameter: value}`` for every name of :data:`~stewartid.studies.spec.PARAMETERS`
-        (units there).
+        ``{parameter: value}`` for every :data:`~stewartid.studies.spec.PARAMETERS` name.
     seed : int
-        Seed of the sensor noise.
+        Sensor noise seed.
     """
 
     parameters: dict[str, float]
@@ -32,27 +29,22 @@ class StudyTask:
 
     @property
     def key(self) -> str:
-        """Stable identifier: 16 hex digits of a SHA-1 of the parameters and the seed."""
+        """Stable identifier: 16 hex digits of a SHA-1 of parameters and seed."""
         canonical = json.dumps({**{name: float(self.parameters[name]) for name in PARAMETERS},
                                 "seed": int(self.seed)}, sort_keys=True)
         return hashlib.sha1(canonical.encode("ascii")).hexdigest()[:16]
 
     @property
     def label(self) -> str:
-        """Short human-readable description, e.g. ``"coulomb=5 noise_scale=1 seed=3"``."""
+        """Short description, e.g. ``"coulomb=5 noise_scale=1 seed=3"``."""
         values = " ".join(f"{name}={value:g}" for name, value in self.parameters.items())
         return f"{values} seed={self.seed}"
 
 
 def expand_grid(spec: StudySpec) -> list[StudyTask]:
-    """Every task of ``spec``: the Cartesian product of the grid, times the seeds.
+    """Every task of ``spec`` (``spec.size``, distinct keys): the grid's product times the seeds.
 
-    The seed is the outer loop, so a run stopped half-way has covered the whole grid.
-
-    Returns
-    -------
-    list of StudyTask
-        ``spec.size`` tasks with distinct keys.
+    Seeds are the outer loop, so a run stopped half-way has covered the whole grid.
     """
     names = list(spec.grid)
     tasks = []

@@ -1,5 +1,5 @@
-"""The report of a study: error against each swept parameter, per method, median and spread
-over the seeds, with the table behind every figure and sentences computed from the numbers.
+"""A study's report: error against each swept parameter per method (median and spread over the
+seeds), the table behind every figure, sentences computed from the numbers.
 """
 
 from __future__ import annotations
@@ -43,24 +43,12 @@ def _parameter_text(name: str, value: float) -> str:
 
 
 def sweep_statistics(rows: Any, parameter: str, others: Sequence[str]) -> Any:
-    """Median, quartiles, extremes and count over the seeds of every error metric.
+    """Median, quartiles, extremes and count over the seeds of every error metric (%).
 
-    Parameters
-    ----------
-    rows : pandas.DataFrame
-        Rows of the study (:func:`~stewartid.studies.results.read_results`); failed rows
-        are left out.
-    parameter : str
-        The swept parameter on the horizontal axis.
-    others : sequence of str
-        The other swept parameters (one panel row per combination).
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per (others..., parameter, method); columns ``seeds`` and
-        ``<metric>_<statistic>`` for every metric of :data:`METRICS` and statistic in
-        median, q25, q75, min, max (%).
+    ``rows`` from :func:`~stewartid.studies.results.read_results` (failed rows left out);
+    ``parameter`` on the horizontal axis, one panel row per combination of ``others``. One row per
+    (others..., parameter, method); columns ``seeds`` and ``<metric>_<statistic>`` for each of
+    :data:`METRICS` and median, q25, q75, min, max.
     """
     good = rows[rows["failure"].isna()]
     keys = [*others, parameter, "method"]
@@ -130,7 +118,7 @@ def plot_sweep(statistics: Any, parameter: str, others: Sequence[str],
 
 def sweep_table(statistics: Any, parameter: str, others: Sequence[str],
                 methods: Sequence[str]) -> ResultTable:
-    """The numbers behind :func:`plot_sweep` (median [q25, q75] of Mt, Bt and overall)."""
+    """The numbers behind :func:`plot_sweep`: median [q25, q75] of Mt, Bt and overall."""
     rank = {method: k for k, method in enumerate(methods)}
     ordered = statistics.assign(rank=statistics["method"].map(rank)).sort_values(
         [*others, "rank", parameter], kind="stable")
@@ -165,8 +153,7 @@ def _trend(medians: Sequence[float]) -> str:
 
 def trend_sentences(statistics: Any, parameter: str, others: Sequence[str],
                     methods: Sequence[str]) -> list[str]:
-    """One Markdown sentence per method: the median error at each value of ``parameter``
-    and whether it grows, for every combination of the other swept parameters."""
+    """One Markdown sentence per method: median error at each ``parameter`` value and whether it grows."""
     metric = TREND_METRIC.get(parameter, "max_error_percent")
     label = METRICS[metric][:-4]
     lines = []
@@ -228,22 +215,10 @@ def _failures_table(rows: Any) -> ResultTable | None:
 
 def write_study_report(rows: Any, spec: StudySpec, directory: str | Path,
                        total_tasks: int, failed_tasks: int = 0) -> list[Path]:
-    """Write the figures, tables, ``report.md`` and ``report.html`` of a study.
+    """Write a study's figures (``figures/``), tables (``tables/``), ``report.md`` and ``report.html``.
 
-    Parameters
-    ----------
-    rows : pandas.DataFrame
-        The study's rows (:func:`~stewartid.studies.results.read_results`).
-    spec : StudySpec
-    directory : str or Path
-        Output folder; figures go to ``figures/``, tables to ``tables/``.
-    total_tasks, failed_tasks : int
-        Tasks of the study, and tasks that crashed in the last run.
-
-    Returns
-    -------
-    list of Path
-        Every file written.
+    ``rows`` from :func:`~stewartid.studies.results.read_results`; ``total_tasks`` of the study,
+    ``failed_tasks`` crashed in the last run. Returns every file written.
     """
     directory = Path(directory)
     methods = report_order(spec.methods)

@@ -1,5 +1,5 @@
-"""What one study task computes on a worker: one simulation of the six experiments and its
-identification by every method, as result rows. Picklable and writes nothing.
+"""One study task on a worker: a simulation of the six experiments identified by every method, as
+result rows. Picklable; writes nothing.
 """
 
 from __future__ import annotations
@@ -32,14 +32,9 @@ def _worker_address() -> str | None:
 
 def error_columns(M: np.ndarray, B: np.ndarray, nominal_M: np.ndarray, nominal_B: np.ndarray
                   ) -> dict[str, Any]:
-    """The error columns of a row: ε (%) of the 20 paper entries and their maxima.
+    """A row's error columns: ε (%) of the paper's 20 entries and their maxima.
 
-    Parameters
-    ----------
-    M, B : ndarray, shape (6, 6)
-        Identified Mt (kg, kg·m, kg·m²) and Bt (N·s/m, N·s, N·m·s/rad).
-    nominal_M, nominal_B : ndarray, shape (6, 6)
-        The true matrices, same units.
+    ``M, B`` identified, ``nominal_M, nominal_B`` true, shape (6, 6), SI units.
     """
     matrices = {"M": (M, nominal_M), "B": (B, nominal_B)}
     errors = {key: relative_error_percent(matrices[key[0]][0][key[1], key[2]],
@@ -70,26 +65,24 @@ def run_task(task: StudyTask, platform: Platform, methods: Sequence[str],
              actuator: str | None = None) -> list[dict[str, Any]]:
     """Simulate the six experiments at ``task``'s point and identify them with each method.
 
-    A :class:`~stewartid.errors.StewartidError` of the simulation or of one identification is a
-    result of the study: rows with NaN errors and the message in ``failure``. Any other
-    exception is a bug and propagates.
+    A :class:`~stewartid.errors.StewartidError` is a result (NaN errors, message in ``failure``);
+    any other exception propagates.
 
     Parameters
     ----------
     task : StudyTask
     platform : Platform
-        The study's platform; the task's friction is applied to it.
+        The task's friction is applied to it.
     methods : sequence of str
-        Registered method names.
     method_settings : mapping, optional
-        ``{method: {setting: value}}`` passed to :func:`~stewartid.identification.registry.estimates_only`.
+        ``{method: {setting: value}}``.
     actuator : {"hydraulic", "ideal"}, optional
-        Override ``[hydraulics] mode``.
+        Overrides ``[hydraulics] mode``.
 
     Returns
     -------
     list of dict
-        One row per method, with the columns of :func:`stewartid.studies.results.columns`.
+        One row per method (:func:`stewartid.studies.results.columns`).
     """
     point = task.parameters
     common = {"task": task.key, **point, "seed": int(task.seed), "worker": _worker_address()}

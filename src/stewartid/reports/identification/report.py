@@ -1,7 +1,6 @@
-"""The identification report of a :class:`~stewartid.comparison.Comparison`
-(``stewartid identify --report DIR``): ``report.md`` and a self-contained ``report.html``, the
-figures as PNG and SVG, ``result.json`` (what :attr:`Comparison.result` holds), the physical
-model's ``physical.json`` beside it, and every method's matrices as CSV and MATLAB files."""
+"""The identification report (``stewartid identify --report DIR``): ``report.md``, a self-contained
+``report.html``, figures, ``result.json``, ``physical.json`` and every method's CSV/MATLAB matrices.
+"""
 
 from __future__ import annotations
 
@@ -57,7 +56,7 @@ class IdentificationReport:
 
     @property
     def physical_primary(self) -> bool:
-        """The physical model was asked for by itself: ``result.json`` holds its result."""
+        """The physical model was asked for alone: ``result.json`` holds its result."""
         return self.comparison.physical_primary
 
     @property
@@ -72,7 +71,7 @@ class IdentificationReport:
 
     @property
     def main_result(self) -> IdentificationResult:
-        """What ``result.json`` holds (:attr:`Comparison.result`)."""
+        """What ``result.json`` holds (``Comparison.result``)."""
         return self.comparison.result
 
 
@@ -85,17 +84,12 @@ def write_report(comparison: Comparison, directory: str | Path, *, sources: Sequ
     comparison : Comparison
         From :func:`~stewartid.comparison.compare_methods`.
     directory : str or Path
-        Output folder (created; files in it are replaced). Check it first with
-        :func:`stewartid.files.check_output_folder` when it must not hold results.
+        Output folder (created; its files replaced; see
+        :func:`stewartid.files.check_output_folder`).
     sources : sequence of str
         The data files, listed in the report.
     notes : sequence of str
-        Sentences added to the report's summary.
-
-    Returns
-    -------
-    IdentificationReport
-        The comparison and every file written.
+        Sentences added to the summary.
     """
     started = time.perf_counter()
     directory = Path(directory)
