@@ -1,5 +1,4 @@
-"""Markdown to one self-contained HTML page, the form every report of the package takes beside
-its ``report.md`` (figures inlined, so the page can be moved or mailed alone)."""
+"""Markdown to one self-contained HTML page, figures inlined, every report's form beside ``report.md``."""
 
 from __future__ import annotations
 
@@ -21,21 +20,9 @@ em { color: #555; }
 
 
 def render_html(markdown_text: str, base: str | Path, title: str = "stewartid report") -> str:
-    """A self-contained HTML page from the report's Markdown; PNG figures are inlined as
-    base64 data so the file can be moved or mailed alone.
+    """A self-contained HTML page from a report's Markdown, PNG figures inlined as base64.
 
-    Parameters
-    ----------
-    markdown_text : str
-    base : str or Path
-        Folder the Markdown's relative image paths refer to.
-    title : str
-        The page's ``<title>``.
-
-    Returns
-    -------
-    str
-        The HTML document.
+    ``base``: the folder relative image paths refer to; ``title``: the page's ``<title>``.
     """
     from markdown_it import MarkdownIt
 

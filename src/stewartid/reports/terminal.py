@@ -1,5 +1,4 @@
-"""Readable terminal tables (rich): a 6x6 matrix, a six-vector, and identified versus nominal
-values."""
+"""Terminal tables (rich): a 6x6 matrix, a six-vector, identified versus nominal values."""
 
 from __future__ import annotations
 
@@ -14,8 +13,7 @@ from stewartid.platform import COORDINATES
 
 
 def matrix_table(matrix: np.ndarray, title: str, digits: int = 1) -> Table:
-    """A rich table of a 6x6 matrix with coordinate labels; entries below 1e-9 of the largest
-    are shown as 0 (rounding noise of symmetric terms)."""
+    """A rich table of a 6x6 matrix, coordinate labels; entries below 1e-9 of the largest shown as 0."""
     table = Table(title=title, title_justify="left")
     table.add_column("")
     for name in COORDINATES:
@@ -35,8 +33,7 @@ def print_matrix(matrix: np.ndarray, title: str, digits: int = 1,
 
 def print_vector(vector: np.ndarray, title: str, digits: int = 1,
                  console: Console | None = None) -> None:
-    """Print a vector of the six coordinates as a one-row labelled table; entries below 1e-9
-    of the largest are shown as 0, as in :func:`matrix_table`."""
+    """Print a six-coordinate vector as a one-row table, small entries as 0 (:func:`matrix_table`)."""
     table = Table(title=title, title_justify="left")
     for name in COORDINATES:
         table.add_column(name, justify="right")
@@ -49,12 +46,7 @@ def print_comparison(rows: Iterable[Mapping[str, Any]], title: str,
                      console: Console | None = None) -> None:
     """Print identified versus nominal values of the paper's 20 entries.
 
-    Parameters
-    ----------
-    rows : iterable of mapping
-        As :func:`~stewartid.identification.result.comparison_rows` returns them (the rows
-        of a comparison table: ``table.to_dict("records")``).
-    title : str
+    ``rows`` as :func:`~stewartid.identification.result.comparison_rows` returns them.
     """
     view = Table(title=title, title_justify="left")
     for column, justify in (("entry", "left"), ("identified", "right"), ("± std", "right"),

@@ -1,8 +1,5 @@
-"""The noisy case of a reproduction: every method on the highest Coulomb level with the
-reference sensor noise (:func:`~stewartid.simulation.sensors.reference_noise`).
-
-The paper shows noise-free simulations only; a real log always carries sensor noise. The case
-reports a table, a figure and one summary line.
+"""A reproduction's noisy case: every method at the highest Coulomb level with the reference sensor
+noise (the paper shows noise-free simulations only); a table, a figure and a summary line.
 """
 
 from __future__ import annotations
@@ -33,7 +30,7 @@ def within_three_std(results: ComparisonResults, run: MethodRun) -> int:
 
 
 def noisy_summary(results: ComparisonResults) -> str:
-    """One line: per method the largest ε over the 20 entries and the entries within 3 SE."""
+    """One line: per method, the largest ε over the 20 entries and the entries within 3 SE."""
     level = max(results.coulomb_levels)
     parts = []
     for method in results.methods:
@@ -66,11 +63,7 @@ def noisy_results(runs: Sequence[MethodRun], clean: ComparisonResults) -> Compar
 
 
 def noisy_document(results: ComparisonResults) -> dict:
-    """JSON-ready record of the noisy case (``results.json`` key ``noise_case``).
-
-    The runs as :func:`~stewartid.reproduction.document.run_record` writes them, each with
-    ``within_3_std``.
-    """
+    """JSON-ready noisy case (``results.json`` key ``noise_case``), each run with ``within_3_std``."""
     level = max(results.coulomb_levels)
     runs = [{**run_record(results, run), "within_3_std": within_three_std(results, run)}
             for run in (results.run(m, level) for m in results.methods) if run is not None]

@@ -1,7 +1,4 @@
-"""The report of a reproduction: ``report.md`` and a self-contained ``report.html``.
-
-The summary's sentences are derived from the numbers, never fixed text.
-"""
+"""A reproduction's ``report.md`` and self-contained ``report.html``; the summary derived from the numbers."""
 
 from __future__ import annotations
 
@@ -85,9 +82,7 @@ def wavelet_summary(results: ComparisonResults) -> list[str]:
 
 
 def fourier_summary(results: ComparisonResults) -> list[str]:
-    """Sentences on Method A: its errors by group with and without Coulomb friction, and
-    whether they show the paper's pattern (diagonal Mt accurate, Bt and couplings biased).
-    """
+    """Sentences on Method A: errors by group with and without Coulomb friction, vs the paper's pattern."""
     lines = []
     for level in results.coulomb_levels:
         run = results.run("fourier", level)
@@ -135,7 +130,7 @@ def others_summary(results: ComparisonResults) -> list[str]:
 
 
 def summary_lines(results: ComparisonResults) -> list[str]:
-    """The automatic summary, one Markdown sentence group per bullet."""
+    """The automatic summary, one Markdown bullet each."""
     noisy = results.settings.get("noise_case_summary")
     return (wavelet_summary(results) + fourier_summary(results) + others_summary(results)
             + ([str(noisy)] if noisy else []))
@@ -218,7 +213,7 @@ def render_markdown(results: ComparisonResults, tables: Sequence[ResultTable],
 def write_report(results: ComparisonResults, tables: Sequence[ResultTable],
                  figures: Sequence[FigureEntry], directory: str | Path
                  ) -> tuple[Path, Path]:
-    """Write ``report.md`` and ``report.html`` into ``directory``; return both paths."""
+    """Write ``report.md`` and ``report.html`` into ``directory``; returns both paths."""
     directory = Path(directory)
     text = render_markdown(results, tables, figures)
     markdown_path = write_text_atomic(directory / "report.md", text)

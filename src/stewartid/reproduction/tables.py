@@ -1,7 +1,5 @@
-"""The tables of a reproduction: the paper's Tables 3-6 with ours beside the published values,
-every method per Coulomb level and the largest error per method.
-
-ε is the relative absolute error (%) against the nominal value of the simulated plant.
+"""A reproduction's tables: the paper's Tables 3-6 with ours beside, every method per Coulomb level,
+the largest error per method. ε: relative absolute error (%) against the simulated plant's nominal.
 """
 
 from __future__ import annotations
@@ -17,11 +15,7 @@ def _entry_cells(key: EntryKey) -> list[Cell]:
 
 
 def paper_table(results: ComparisonResults, number: int) -> ResultTable:
-    """The paper's Table ``number`` (3-6) with our identified values and ε beside its own.
-
-    Per paper method: our value and ε, then the paper's; the row ends with our nominal value
-    and the paper's printed one.
-    """
+    """The paper's Table ``number`` (3-6): per method our value and ε, then the paper's; both nominals."""
     published = results.published.table(number)
     letters = paper_methods()
     methods = [name for name, letter in letters.items() if letter in published.methods]
@@ -59,9 +53,7 @@ def paper_table(results: ComparisonResults, number: int) -> ResultTable:
 
 
 def comparison_table(results: ComparisonResults, coulomb: float) -> ResultTable:
-    """Every method at one Coulomb level: identified value and ε per entry, with the paper's
-    values for the methods it reports at that level.
-    """
+    """Every method at one Coulomb level: value and ε per entry, with the paper's where it reports them."""
     columns = ["Parameter", "Unit", "Nominal"]
     kinds = ["text", "text", "value"]
     runs = [r for r in (results.run(m, coulomb) for m in results.methods) if r is not None]
@@ -111,7 +103,7 @@ def summary_table(results: ComparisonResults) -> ResultTable:
 
 
 def build_tables(results: ComparisonResults) -> list[ResultTable]:
-    """All tables of a run: the summary, the paper's Tables 3-6, one comparison per level."""
+    """All tables of a run: summary, the paper's Tables 3-6, one comparison per level."""
     tables = [summary_table(results)]
     tables += [paper_table(results, n) for n in sorted(results.published.tables)]
     tables += [comparison_table(results, level) for level in results.coulomb_levels]

@@ -1,7 +1,5 @@
-"""One study run at a time per output folder: an advisory lock on a file in the folder.
-
-The lock is the operating system's (``fcntl.flock``), held by the open file: a run that is
-killed releases it with its process, and the next run takes it over without a stale-lock check.
+"""One study run at a time per output folder: an ``fcntl.flock`` on a file in it, released when its
+process dies (no stale-lock check).
 """
 
 from __future__ import annotations
@@ -27,17 +25,12 @@ def _holder(path: Path) -> str:
 
 @contextlib.contextmanager
 def study_lock(directory: str | Path) -> Iterator[Path]:
-    """Hold the lock of a study folder (created if missing) while the block runs.
-
-    Yields
-    ------
-    Path
-        The lock file, which holds the running process's id.
+    """Hold a study folder's lock (folder created if missing) while the block runs; yields the lock file.
 
     Raises
     ------
     ConfigError
-        Another live process holds the folder's lock; the message names it.
+        Another live process, named, holds the lock.
     """
     import fcntl
 

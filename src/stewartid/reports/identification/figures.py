@@ -1,6 +1,4 @@
-"""The figures of the identification report in report order: what is drawn, with which data
-and caption (the drawing itself is :mod:`~stewartid.reports.identification.method_figures`
-and :mod:`stewartid.reports.drawing`)."""
+"""The identification report's figures in report order: what is drawn, with which data and caption."""
 
 from __future__ import annotations
 
@@ -22,15 +20,13 @@ from stewartid.signals.differentiation import differentiate
 
 
 class FigureDrawer:
-    """Draws the figures into one folder, in this process (a worker process would pay its
-    own imports and slow the fits beside it), and keeps their captions in report order.
+    """Draws the figures into one folder in this process and keeps their captions in report order.
 
     Attributes
     ----------
     folder : Path
-        Where the figures are written.
     entries : dict of str to (str, str)
-        Relative PNG path and caption by figure key, in report order.
+        Figure key -> (relative PNG path, caption), in report order.
     files : list of Path
         Every file written.
     """
@@ -42,14 +38,14 @@ class FigureDrawer:
 
     def add(self, key: str, caption: str, function: Callable[..., list[Path]],
             *args: Any) -> None:
-        """Draw ``function(*args)`` as ``figures/<key>.png`` and ``.svg`` with ``caption``."""
+        """Draw ``function(*args)`` as ``figures/<key>.png`` and ``.svg``."""
         self.entries[key] = (f"figures/{key}.png", caption)
         self.files += function(*args, directory=self.folder, stem=key)
 
 
 def data_figures(drawer: FigureDrawer, datasets: Sequence[Dataset], platform: Platform,
                  rows: Sequence[dict[str, Any]]) -> None:
-    """The figures of the data alone: excitation and spectrum."""
+    """The data's figures: excitation and spectrum."""
     neutral = np.asarray(platform.neutral_pose, dtype=float)
     traces = [ExperimentTrace(name=d.name, excited=row["excited"], t=d.t, pose=d.pose,
                               neutral=neutral) for d, row in zip(datasets, rows, strict=True)]
@@ -65,8 +61,7 @@ def result_figures(drawer: FigureDrawer, runs: Sequence[MethodFit],
                    datasets: Sequence[Dataset], platform: Platform,
                    nominal: tuple[np.ndarray, np.ndarray], trusted: str,
                    rows: Sequence[dict[str, Any]]) -> None:
-    """The figures of the identification: intervals, matrices, residuals, validation, the
-    comparison of methods and friction."""
+    """The identification's figures: intervals, matrices, residuals, validation, methods, friction."""
     ok = [run for run in runs if run.result is not None]
     best = next(run for run in ok if run.name == trusted)
     frequencies = [row["frequency_hz"] for row in rows]
@@ -118,8 +113,7 @@ def result_figures(drawer: FigureDrawer, runs: Sequence[MethodFit],
 
 
 def physical_figures(drawer: FigureDrawer, section: PhysicalSection | None) -> None:
-    """The physical model's figure: Mt and Bt across the measured poses (none without its
-    section)."""
+    """The physical model's Mt and Bt across the measured poses (none without its section)."""
     if section is None or section.workspace is None:
         return
     drawer.add("workspace", "Mt and Bt of the physical model across the poses the data cover: "

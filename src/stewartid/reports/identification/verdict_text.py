@@ -1,6 +1,5 @@
-"""The identification report's verdict in words: what to know about one method's result
-(:func:`method_lines`), and for several which to trust and what set the others back
-(:func:`verdict_lines`, the :class:`~stewartid.verdict.rule.Verdict` in sentences).
+"""The verdict in words: what to know about one method's result, and among several which to trust
+and what set the others back.
 """
 
 from __future__ import annotations
@@ -29,14 +28,13 @@ CLOSE_VAF, ADEQUATE_VAF = 99.0, 95.0
 
 
 def changed_text(projection: Any) -> str:
-    """The largest change of the consistent fit, in standard errors, for a sentence."""
+    """The consistent fit's largest change, in standard errors, for a sentence."""
     change = projection.max_change
     return "less than 0.001" if change < 1e-3 else f"{change:.3g}"
 
 
 def quality_text(vaf: float) -> str:
-    """How well a model predicts the held-out force, in words, from the VAF (%) of its worst
-    DOF (:data:`CLOSE_VAF`, :data:`ADEQUATE_VAF`)."""
+    """How well a model predicts held-out force, in words, from its worst DOF's VAF (%)."""
     if vaf >= CLOSE_VAF:
         return "predicts the held-out force closely"
     if vaf >= ADEQUATE_VAF:
@@ -82,9 +80,7 @@ def method_lines(run: MethodFit) -> list[str]:
 
 
 def verdict_lines(verdict: Verdict, runs: Sequence[MethodFit]) -> list[str]:
-    """The verdict in plain language, Markdown sentences: for one applicable method what to
-    know about it (:func:`method_lines`), for several which to trust and what set the others
-    back."""
+    """The verdict as Markdown sentences: one method's notes, or which to trust and why not the others."""
     ok = [run for run in runs if run.result is not None]
     if len(ok) == 1:
         return method_lines(ok[0])
@@ -162,8 +158,7 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodFit]) -> list[str]:
 
 
 def consensus_text(verdict: Verdict, best: MethodFit, names: dict[str, str]) -> str:
-    """The verdict's first sentences when it trusts the consensus of a close call
-    (:mod:`stewartid.verdict.close_call`); ``names``: display name by registry name."""
+    """The verdict's first sentences when it trusts a close call's consensus (``names``: display names)."""
     members = verdict.close
     standing = verdict.standings[best.name]
     agreement = best.result.diagnostics.get("consensus", {}).get("agreement", float("nan"))
@@ -188,8 +183,7 @@ def consensus_text(verdict: Verdict, best: MethodFit, names: dict[str, str]) -> 
 
 
 def sampling_lines(runs: Sequence[MethodFit]) -> list[str]:
-    """A sentence naming the methods whose result the log's sampling limits, if any
-    (:mod:`stewartid.identification.sampling`)."""
+    """A sentence naming the methods whose result the log's sampling limits, if any."""
     limited = [(run.display_name, run.result.diagnostics["sampling"]) for run in runs
                if run.result.diagnostics.get("sampling", {}).get("limited")]
     if not limited:
