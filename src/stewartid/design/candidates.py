@@ -1,13 +1,6 @@
-"""Excitation designs: records of one sine along a fixed pose direction, with level schedules.
-
-A designed record moves the platform along direction d of pose space as
-
-    q(t) = q0 + d * a(t) * sin(2 pi f t),
-
-with a(t) a quintic fade-in, holds at each level joined by one-period ramps, and a fade-out.
-Every leg and joint then reverses at the same instants, so the constant-direction intervals
-are the half-periods; two levels give two speeds with one joint-direction pattern, which lets
-Method B with ``friction="shared"`` separate viscous from Coulomb friction.
+"""Excitation designs: records q(t) = q0 + d a(t) sin(2 pi f t) along a fixed pose direction d,
+with level schedules a(t); two levels give Method B's ``friction="shared"`` two speeds with one
+joint-direction pattern, separating viscous from Coulomb friction.
 """
 
 from __future__ import annotations
@@ -32,8 +25,8 @@ def quintic_ramp(s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def fade_envelope(t: np.ndarray, fade: float, duration: float
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Quintic fade-in over ``fade`` s times quintic fade-out ending at ``duration`` s, and its
-    first two time derivatives (1/s, 1/s^2), each of the shape of ``t``.
+    """Quintic fade-in over ``fade`` s times fade-out ending at ``duration`` s, and its first two
+    time derivatives, each shaped like ``t``.
     """
     rise, d_rise, dd_rise = quintic_ramp(t / fade)
     fall, d_fall, dd_fall = quintic_ramp((duration - t) / fade)
@@ -49,15 +42,14 @@ class DesignedRecord:
     Attributes
     ----------
     direction : tuple of 6 float
-        Motion per unit level along x, y, z, rx, ry, rz (m, m, m, rad, rad, rad).
+        Motion per unit level (m, rad).
     frequency_hz : float
-        Hz.
     levels : tuple of float
-        Amplitude levels (-, multiplying ``direction``), held one after the other.
+        Amplitude levels multiplying ``direction``, held in turn.
     hold_periods : int
-        Whole periods held at each level.
+        Whole periods held per level.
     fade_periods : int
-        Periods of the fade-in, of the fade-out and of every ramp between levels.
+        Periods of each fade and ramp between levels.
     name : str
     """
 
@@ -89,26 +81,26 @@ class DesignedRecord:
 
     @property
     def period(self) -> float:
-        """Sine period (s)."""
+        """s."""
         return 1.0 / self.frequency_hz
 
     @property
     def duration(self) -> float:
-        """Record length (s): fade-in, holds and ramps, fade-out."""
+        """Record length (s): fades, holds and ramps."""
         n = len(self.levels)
         return self.period * (n * self.hold_periods + (n + 1) * self.fade_periods)
 
     @property
     def max_frequency(self) -> float:
-        """Highest frequency of the motion (Hz), for the sampling check of the plant."""
+        """Highest frequency of the motion (Hz)."""
         return self.frequency_hz
 
     def scaled(self, factor: float) -> DesignedRecord:
-        """The record with its direction (every amplitude) times ``factor``."""
+        """The record with every amplitude times ``factor``."""
         return dataclasses.replace(self, direction=tuple(factor * v for v in self.direction))
 
     def envelope(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Amplitude envelope a(t) and its first two time derivatives; each shape (N,)."""
+        """Envelope a(t) and its first two time derivatives, each (N,)."""
         t = np.asarray(t, dtype=float)
         a, da, dda = np.zeros_like(t), np.zeros_like(t), np.zeros_like(t)
         fade, hold = self.fade_periods * self.period, self.hold_periods * self.period
@@ -123,7 +115,7 @@ class DesignedRecord:
         return a, da, dda
 
     def evaluate_offsets(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Motion about the base pose: dq, dq_dot, dq_ddot, each shape (N, 6) (m, rad, /s, /s^2)."""
+        """dq, dq_dot, dq_ddot about the base pose, each (N, 6)."""
         t = np.asarray(t, dtype=float)
         a, da, dda = self.envelope(t)
         omega = 2 * math.pi * self.frequency_hz
@@ -134,7 +126,7 @@ class DesignedRecord:
         return tuple(np.outer(x, d) for x in scalar)
 
     def to_dict(self) -> dict:
-        """Plain data (JSON ready); :func:`record_from_dict` reads it back."""
+        """JSON-ready data; :func:`record_from_dict` reads it back."""
         return {**dataclasses.asdict(self), "direction": list(self.direction),
                 "levels": list(self.levels), "duration_s": self.duration}
 
@@ -148,8 +140,8 @@ def record_from_dict(data: dict) -> DesignedRecord:
 
 @dataclasses.dataclass(frozen=True)
 class PlayableRecord:
-    """A designed record about a base pose: what the plant plays (``evaluate``, ``name``,
-    ``max_frequency``, as :class:`~stewartid.simulation.excitation.Excitation`)."""
+    """A designed record about a base pose, played as an
+    :class:`~stewartid.simulation.excitation.Excitation`."""
 
     record: DesignedRecord
     base_pose: tuple[float, ...]
@@ -165,21 +157,19 @@ class PlayableRecord:
         return self.record.max_frequency
 
     def evaluate(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Pose, velocity and acceleration at times ``t`` (s); each shape (N, 6)."""
+        """Pose, velocity and acceleration at ``t`` (s), each (N, 6)."""
         dq, dqd, dqdd = self.record.evaluate_offsets(t)
         return dq + np.asarray(self.base_pose), dqd, dqdd
 
 
 @dataclasses.dataclass(frozen=True)
 class Design:
-    """A set of records to run one after the other (each from rest at the neutral pose).
+    """Records run one after the other, each from rest at neutral.
 
     Attributes
     ----------
     records : tuple of DesignedRecord
-        Or of any record with the same interface (``name``, ``duration``, ``max_frequency``,
-        ``evaluate_offsets``, ``scaled``, ``to_dict``), such as
-        :class:`~stewartid.design.multisine.MultisineRecord`.
+        Or any record with the same interface, e.g. :class:`~stewartid.design.multisine.MultisineRecord`.
     label : str
         Short description for reports.
     """
@@ -198,7 +188,7 @@ class Design:
         return [PlayableRecord(r, base) for r in self.records]
 
     def to_dict(self) -> dict:
-        """Plain data (JSON ready)."""
+        """JSON-ready data."""
         return {"label": self.label, "duration_s": self.duration,
                 "records": [r.to_dict() for r in self.records]}
 
@@ -217,10 +207,7 @@ def unit_direction(dof: int, amplitude: float) -> tuple[float, ...]:
 
 def paper_design(frequency_hz: float = 0.5, duration_s: float = 20.0,
                  amplitudes: Sequence[float] = DEFAULT_AMPLITUDES) -> Design:
-    """The paper's set: six records, record k a single-level sine on DOF k.
-
-    The record length is ``duration_s`` rounded to whole periods, the one-period fades included.
-    """
+    """The paper's set: record k a single-level sine on DOF k, ``duration_s`` rounded to whole periods."""
     periods = max(1, round(duration_s * frequency_hz) - 2)
     return Design(tuple(
         DesignedRecord(unit_direction(k, amplitudes[k]), frequency_hz, (1.0,), periods, 1,
@@ -232,20 +219,17 @@ def scheduled_design(amplitudes: Sequence[float], frequency_hz: float | Sequence
                      durations_s: Sequence[float],
                      levels: Sequence[float] | Sequence[Sequence[float]] = (1.0, 0.5),
                      label: str | None = None) -> Design:
-    """Six single-DOF records with a level schedule, each of (about) its own duration.
+    """Six single-DOF records with level schedules, each about its own duration.
 
     Parameters
     ----------
     amplitudes : sequence of 6 float
-        Largest amplitude per DOF (m, m, m, rad, rad, rad); ``levels`` scale it.
+        Largest amplitude per DOF (m, rad).
     frequency_hz : float or sequence of 6 float
-        Hz, one for every record or one per record (a record's half-periods are its
-        constant-direction intervals).
     durations_s : sequence of 6 float
-        Record lengths (s), rounded down to whole hold periods per level.
+        Rounded down to whole hold periods per level.
     levels : sequence of float, or 6 sequences of float
-        Level schedule relative to the amplitude, largest first (e.g. (1, 0.5)): one for
-        every record, or one per record.
+        Relative levels, largest first, for every record or per record.
     label : str, optional
     """
     schedules = ([tuple(v) for v in levels] if isinstance(levels[0], Sequence)
@@ -269,10 +253,8 @@ def scheduled_design(amplitudes: Sequence[float], frequency_hz: float | Sequence
 
 
 def schedule_label(schedules: Sequence, unit: str = "") -> str:
-    """A short text for one schedule (or value) per record.
-
-    '1/0.5' when all six are equal, else runs of equal ones ('x and y 0.75 Hz, z 0.5 Hz,
-    rotations 0.75 Hz'); ``unit`` follows every value.
+    """Short text for one schedule per record: '1/0.5' when all equal, else runs
+    ('x and y 0.75 Hz, z 0.5 Hz, rotations 0.75 Hz'), ``unit`` after each value.
     """
     tail = f" {unit}" if unit else ""
     names = ["/".join(f"{v:g}" for v in np.atleast_1d(s)) + tail for s in schedules]

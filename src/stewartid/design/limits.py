@@ -1,8 +1,5 @@
-"""Operating limits of a hexapod and how much of them a motion uses.
-
-:func:`resolve_limits` fills the keys a ``[limits]`` section leaves out from the model;
-:func:`limit_use` gives the fraction of every limit used at every sample (1 = the limit), for
-designed trajectories and simulated plants alike.
+"""Operating limits of a hexapod (:func:`resolve_limits`) and the fraction of each a motion
+uses per sample (:func:`limit_use`, 1 = the limit).
 """
 
 from __future__ import annotations
@@ -22,22 +19,20 @@ LIMIT_NAMES = ("stroke", "leg_velocity", "leg_acceleration", "actuator_force", "
 
 @dataclasses.dataclass(frozen=True)
 class OperatingLimits:
-    """All limits with numbers: the ``[limits]`` section with its derived defaults filled in.
+    """The ``[limits]`` section with derived defaults filled in.
 
     Attributes
     ----------
     stroke_min, stroke_max : float
         Leg-length range (m).
-    leg_velocity : float
-        Largest |leg-length rate| (m/s).
-    leg_acceleration : float
-        Largest |leg-length acceleration| (m/s^2).
+    leg_velocity, leg_acceleration : float
+        m/s, m/s^2.
     actuator_force : float
-        Largest |actuator force| (N).
+        N.
     gimbal_angle : float
-        Largest deflection of a leg from its neutral direction at either gimbal (rad).
+        Deflection from the neutral leg direction at either gimbal (rad).
     neutral_length : float
-        Leg length at the neutral pose (m), the reference of the stroke use.
+        Leg length at neutral (m), the stroke use's reference.
     """
 
     stroke_min: float
@@ -49,21 +44,18 @@ class OperatingLimits:
     neutral_length: float
 
     def to_dict(self) -> dict[str, float]:
-        """Plain values (JSON ready)."""
+        """JSON-ready values."""
         return dataclasses.asdict(self)
 
 
 def resolve_limits(platform: Platform) -> OperatingLimits:
-    """The platform's limits, every missing one derived from its other sections.
-
-    The stroke ends from ``[hydraulics] stroke`` centred on the neutral leg length, the leg
-    velocity from the rated valve flow through the piston area, the force from the smaller stall
-    force of the cylinder.
+    """The platform's limits, missing ones from its other sections: stroke centred on the neutral
+    length, velocity from rated flow / piston area, force from the smaller stall force.
 
     Raises
     ------
     ConfigError
-        If the neutral leg length lies outside [stroke_min, stroke_max].
+        Neutral leg length outside [stroke_min, stroke_max].
     """
     given, hydraulics = platform.limits, platform.hydraulics
     neutral = platform.neutral_leg_length
@@ -95,9 +87,8 @@ class LimitUse:
     t : ndarray, shape (N,)
         s.
     use : ndarray, shape (N, 5)
-        Per sample, the largest over the legs of |value| / limit for each of
-        :data:`LIMIT_NAMES` (-); the stroke use is measured from the neutral leg length
-        towards the end the leg moves to.
+        Largest |value| / limit over the legs per :data:`LIMIT_NAMES`; stroke from neutral
+        toward the end the leg moves to.
     """
 
     t: np.ndarray
@@ -105,7 +96,7 @@ class LimitUse:
 
     @property
     def peak(self) -> dict[str, float]:
-        """Largest use of every limit over the motion (-)."""
+        """Largest use of every limit over the motion."""
         return {name: float(self.use[:, k].max()) for k, name in enumerate(LIMIT_NAMES)}
 
     @property
@@ -115,19 +106,8 @@ class LimitUse:
 
 
 def gimbal_angles(platform: Platform, q: np.ndarray) -> np.ndarray:
-    """Deflection of every leg from its neutral direction at both gimbals.
-
-    Parameters
-    ----------
-    platform : Platform
-    q : ndarray, shape (N, 6)
-        Poses (m, rad).
-
-    Returns
-    -------
-    ndarray, shape (N, 6, 2)
-        rad; [..., 0] at the lower gimbal (leg direction in the base frame), [..., 1] at the
-        upper gimbal (leg direction in the platform frame).
+    """Deflection (N, 6, 2), rad, of every leg from neutral at the lower [..., 0] and upper [..., 1]
+    gimbal, at poses ``q`` (N, 6).
     """
     q = np.atleast_2d(np.asarray(q, dtype=float))
     u = inverse_kinematics(platform, q).directions
@@ -139,21 +119,13 @@ def gimbal_angles(platform: Platform, q: np.ndarray) -> np.ndarray:
 
 
 def require_within_limits(platform: Platform, pose: np.ndarray, subject: str) -> None:
-    """Refuse a pose outside the workspace: a leg outside its stroke or a gimbal deflected
-    beyond ``[limits] gimbal_angle``.
-
-    Parameters
-    ----------
-    platform : Platform
-    pose : ndarray, shape (6,)
-        Absolute pose (m, rad), paper frame.
-    subject : str
-        What the pose is, as the message names it (``"--pose"``).
+    """Refuse an absolute ``pose`` (6,) with a leg outside its stroke or a gimbal beyond
+    ``[limits] gimbal_angle``; ``subject`` names it (``"--pose"``).
 
     Raises
     ------
     ConfigError
-        Naming the leg and limit at fault and the neutral pose.
+        Naming the leg, the limit and the neutral pose.
     """
     limits = resolve_limits(platform)
     q = np.asarray(pose, dtype=float).reshape(1, 6)
@@ -185,17 +157,12 @@ def limit_use(platform: Platform, limits: OperatingLimits, t: np.ndarray, q: np.
     platform : Platform
     limits : OperatingLimits
     t : ndarray, shape (N,)
-        s.
     q : ndarray, shape (N, 6)
-        Poses (m, rad).
+        m, rad.
     lengths, length_rates, length_accelerations : ndarray, shape (N, 6)
-        Leg lengths (m), rates (m/s) and accelerations (m/s^2).
+        m, m/s, m/s^2.
     forces : ndarray, shape (N, 6)
-        Actuator forces (N).
-
-    Returns
-    -------
-    LimitUse
+        N.
     """
     stretch = lengths - limits.neutral_length
     stroke = np.where(stretch >= 0, stretch / (limits.stroke_max - limits.neutral_length),
@@ -211,14 +178,7 @@ def limit_use(platform: Platform, limits: OperatingLimits, t: np.ndarray, q: np.
 
 
 def record_limit_use(platform: Platform, record) -> LimitUse:
-    """Limit use of a simulated experiment, from the plant's true states.
-
-    Parameters
-    ----------
-    platform : Platform
-    record : stewartid.simulation.ExperimentRecord
-        True signals; the leg accelerations are central differences of the true leg rates.
-    """
+    """Limit use of a simulated record's true states (leg accelerations by central differences)."""
     accelerations = np.gradient(record.length_rates, record.t, axis=0)
     return limit_use(platform, resolve_limits(platform), record.t, record.q, record.lengths,
                      record.length_rates, accelerations, record.forces)

@@ -1,10 +1,6 @@
-"""Choosing a design: amplitudes at the limits of the plant, a small grid judged at full length.
-
-Each candidate of the grid (:func:`~stewartid.design.candidates.scheduled_design`, one
-frequency per group of :data:`FREQUENCY_GROUPS`) gets the largest amplitudes within
-``max_use`` of every limit, is scaled down where the plant's true states exceed it, and is
-predicted at full length, since the bias does not shrink with time as the standard error
-does. The best by :func:`required_score` is then checked by a Monte Carlo.
+"""Choosing a design: a small grid of schedules, each with the largest amplitudes within ``max_use``
+of every limit, scaled down where the plant exceeds it, predicted at full length (bias does not
+shrink with time); the best by :func:`required_score` is checked by a Monte Carlo.
 """
 
 from __future__ import annotations
@@ -47,7 +43,7 @@ REQUIRED_ACCURACY = {"Mt diagonal": 0.5, "Bt diagonal": 2.0, "couplings": 8.0}
 
 
 def entry_group(key: tuple[str, int, int]) -> str:
-    """Group of a paper entry (matrix, row, column): a key of :data:`REQUIRED_ACCURACY`."""
+    """Group (a key of :data:`REQUIRED_ACCURACY`) of a paper entry (matrix, row, column)."""
     matrix, row, column = key
     if row != column:
         return "couplings"
@@ -55,9 +51,7 @@ def entry_group(key: tuple[str, int, int]) -> str:
 
 
 def commanded_use(platform: Platform, record: DesignedRecord) -> LimitUse:
-    """Limit use of a record played exactly: inverse kinematics for the legs, the rigid-body
-    model with the platform's friction for the forces.
-    """
+    """Limit use of a record played exactly (inverse kinematics, rigid-body forces with friction)."""
     rate = platform.sensors.sample_rate
     t = np.arange(int(record.duration * rate) + 1) / rate
     dq, q_dot, q_ddot = record.evaluate_offsets(t)
@@ -72,11 +66,8 @@ def commanded_use(platform: Platform, record: DesignedRecord) -> LimitUse:
 
 def largest_root(g: Callable[[float], float], low: float, high: float, tolerance: float
                  ) -> float:
-    """The largest x in [low, high] with g(x) <= 0, to within ``tolerance``.
-
-    For g increasing with g(high) > 0; 0 when g(low) > 0 already. Regula falsi with the Illinois
-    modification, each point kept a quarter of ``tolerance`` inside the bracket: a limit's use is
-    nearly linear in the amplitude, so it needs far fewer evaluations than bisection.
+    """Largest x in [low, high] with g(x) <= 0 within ``tolerance``, for increasing g; 0 when
+    g(low) > 0. Illinois regula falsi: limit use is nearly linear in amplitude.
     """
     g_low, g_high = g(low), g(high)
     if g_low > 0:
@@ -100,23 +91,16 @@ def largest_root(g: Callable[[float], float], low: float, high: float, tolerance
 def largest_amplitudes(platform: Platform, frequency_hz: float | Sequence[float],
                        max_use: float = 0.7,
                        cap: float | Sequence[float] = DEFAULT_AMPLITUDE_CAP) -> np.ndarray:
-    """Per DOF, the largest sine amplitude whose commanded motion stays within ``max_use`` of
-    every limit.
+    """Per DOF, the largest sine amplitude (6,), m, rad, within ``max_use`` of every limit.
 
     Parameters
     ----------
     platform : Platform
     frequency_hz : float or sequence of 6 float
-        Hz, for every DOF or per DOF.
     max_use : float
-        Fraction of every limit the motion may use, in (0, 1].
+        In (0, 1].
     cap : float or sequence of 6 float
-        Upper bound, as a multiple of the paper's amplitudes.
-
-    Returns
-    -------
-    ndarray, shape (6,)
-        m, m, m, rad, rad, rad.
+        Upper bound, multiple of the paper's amplitudes.
     """
     if not 0 < max_use <= 1:
         raise ConfigError(f"max_use must be in (0, 1]; got {max_use!r}.")
@@ -144,20 +128,9 @@ def largest_amplitudes(platform: Platform, frequency_hz: float | Sequence[float]
 def within_plant_limits(platform: Platform, design: Design, max_use: float,
                         rounds: int = 4, workers: int | None = None
                         ) -> tuple[Design, list, list[LimitUse]]:
-    """Play a design on the plant and scale down the records whose true states use more than
-    ``max_use`` of a limit, until none does.
-
-    The records are played over ``workers`` processes, every core by default.
-
-    Returns
-    -------
-    design : Design
-        With the offending records scaled by max_use / peak use per round (several rounds,
-        since the force carries the static load).
-    records : list of ExperimentRecord
-        The design's true signals on the plant (no sensor noise).
-    uses : list of LimitUse
-        Limit use of every record from its true states.
+    """Play a design on the plant (``workers`` processes) and scale down, round by round, records
+    whose true states use more than ``max_use`` of a limit; return the design, its noise-free
+    records and their limit uses.
     """
     records = plant_records(platform, design, workers)
     uses = [record_limit_use(platform, r) for r in records]
@@ -183,13 +156,7 @@ def within_plant_limits(platform: Platform, design: Design, max_use: float,
 def within_plant_limits_all(platform: Platform, designs: Sequence[Design], max_use: float,
                             workers: int | None = None
                             ) -> list[tuple[Design, list, tuple[LimitUse, ...]]]:
-    """:func:`within_plant_limits` of several designs, each distinct record played once.
-
-    Returns
-    -------
-    list of (design, records, uses)
-        Per design, as :func:`within_plant_limits`.
-    """
+    """:func:`within_plant_limits` of several designs, each distinct record played once."""
     distinct = list(dict.fromkeys(r for d in designs for r in d.records))
     played, records, uses = within_plant_limits(platform, Design(tuple(distinct)), max_use,
                                                 workers=workers)
@@ -204,8 +171,8 @@ def within_plant_limits_all(platform: Platform, designs: Sequence[Design], max_u
 
 def required_score(prediction: Prediction,
                    required: Mapping[str, float] = REQUIRED_ACCURACY) -> float:
-    """The design criterion: the largest (|bias| + 2 SE) / required accuracy over the 20
-    entries (-); below 1, every entry is expected within its group's accuracy.
+    """Design criterion: max over the 20 entries of (|bias| + 2 SE) / required accuracy; below 1
+    every entry is expected within its group's accuracy.
     """
     need = np.array([required[entry_group(k)] for k in PAPER_ENTRIES])
     return float(np.max((prediction.relative_bias + 2 * prediction.relative_std) / need))
@@ -213,7 +180,7 @@ def required_score(prediction: Prediction,
 
 @dataclasses.dataclass(frozen=True)
 class Candidate:
-    """One evaluated design: its prediction and its limit use on the plant."""
+    """One evaluated design: prediction and limit use on the plant."""
 
     design: Design
     prediction: Prediction
@@ -223,7 +190,7 @@ class Candidate:
 
     @property
     def score(self) -> float:
-        """:func:`required_score` of the prediction (-)."""
+        """:func:`required_score` of the prediction."""
         return required_score(self.prediction, self.required)
 
 
@@ -244,42 +211,37 @@ def optimise_design(platform: Platform, budget_s: float, noise: SensorNoise,
     ----------
     platform : Platform
     budget_s : float
-        Total motion time (s) of the six records (each rounded down to whole periods).
+        Total motion time (s) of the six records.
     noise : SensorNoise
     method : str
-        Identification method the design is for.
+        Method the design is for.
     frequencies : sequence of 3 sequences of float
-        Hz tried for each of :data:`FREQUENCY_GROUPS`.
+        Hz tried per :data:`FREQUENCY_GROUPS` group.
     schedules : sequence
-        Level plans: each one schedule (largest level first) for every record, or six.
+        Level plans: one schedule for every record, or six.
     max_use : float
-        Fraction of every limit the design may use (on the plant's true states with
-        ``source="plant"``, on the commanded motion with ``"model"``).
+        Fraction of every limit used (plant states with ``"plant"``, commanded with ``"model"``).
     cap : float or sequence of 6 float
-        Amplitude cap, multiple of the paper's amplitudes.
+        Amplitude cap, multiple of the paper's.
     screening_seeds : int
-        Noise realisations per candidate of methods without an information-matrix
-        prediction (:func:`~stewartid.design.weak_information.has_information`).
+        Realisations per candidate for methods without
+        :func:`~stewartid.design.weak_information.has_information`.
     seeds : int
-        Noise realisations of the best candidate's Monte Carlo, >= 2.
+        Realisations of the best candidate's Monte Carlo, >= 2.
     source : {"plant", "model"}
-        Noise-free data of the predictions (:func:`~stewartid.design.prediction.predict_accuracy`).
     required : mapping
-        Accuracy (%) required of the groups of :data:`REQUIRED_ACCURACY`.
+        Accuracy (%) per :data:`REQUIRED_ACCURACY` group.
     progress : callable, optional
-        Called with one line of text per step.
+        One line of text per step.
     workers : int, optional
-        Processes the candidates' plays on the plant and the realisations are spread over
-        (:func:`~stewartid.design.prediction.predict_accuracy`).
     realisations : callable, optional
-        Called with (done, total) after each noise realisation of a prediction.
+        Called with (done, total) per realisation.
 
     Returns
     -------
     best : Candidate
-        Predicted and checked with ``seeds`` realisations.
+        Checked with ``seeds`` realisations.
     screened : list of Candidate
-        Every candidate with its screening prediction.
     """
     say = progress or (lambda text: None)
     if not budget_s > 0:

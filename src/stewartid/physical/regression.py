@@ -1,6 +1,4 @@
-"""The physical model's regression: the regressor at every sample and the measured
-generalized force, both filtered with the smooth kernel h and kept at a few rows per kernel
-window (:func:`filtered_regression`)."""
+"""Physical model's regression: regressor and generalized force, kernel-filtered, a few rows per window."""
 
 from __future__ import annotations
 
@@ -26,25 +24,21 @@ from stewartid.signals.sign_rates import coulomb_sign_rates
 
 @dataclass(frozen=True)
 class Regression:
-    """The filtered regression of one set of experiments.
+    """Filtered regression of one set of experiments.
 
     Attributes
     ----------
     Y : ndarray, shape (K, 6, N_STANDARD)
-        Filtered standard regressor rows.
     y : ndarray, shape (K, 6)
-        Filtered measured generalized force J_lq^T f (N, N m).
+        J_lq^T f (N, N m).
     experiments : list of dict
-        Per experiment: name, window (s), rows used.
+        Name, window (s), rows used.
     pose_noise : list of ndarray, each shape (6, 6)
-        Per experiment, the pose's white-noise covariance per sample (m^2, rad^2), estimated
-        against the Savitzky-Golay smoothed pose
-        (:func:`~stewartid.identification.wavelet.noise.white_noise_covariance`).
+        Pose white-noise covariance per sample (m^2, rad^2).
     poses : ndarray, shape (K, 6)
-        The filtered pose at every row (m, rad): where the leg Jacobian of a row is taken.
+        Filtered pose per row (m, rad).
     force_noise : list of ndarray, each shape (6, 6)
-        Per experiment, the leg forces' white-noise covariance per sample (N^2), estimated
-        against their Savitzky-Golay smoothed copy.
+        Leg force white-noise covariance per sample (N^2).
     """
 
     Y: np.ndarray
@@ -55,10 +49,8 @@ class Regression:
     force_noise: list[np.ndarray]
 
     def measured_force_noise(self) -> list[tuple[np.ndarray, np.ndarray]]:
-        """Per experiment, the leg forces' noise as the rows carry it.
-
-        Its covariance per sample and the kernel's autocorrelation at lags of 0, 1, ... rows, for
-        :func:`~stewartid.identification.long_run.filtered_noise_covariance`.
+        """Per experiment, leg force covariance per sample and the kernel's autocorrelation at row lags
+        (:func:`~stewartid.identification.long_run.filtered_noise_covariance`).
         """
         out = []
         for S, e in zip(self.force_noise, self.experiments, strict=True):
@@ -78,7 +70,7 @@ ROWS_PER_WINDOW = 20
 
 
 def row_step(window: float, sample_rate: float) -> int:
-    """Automatic row step: ``ROWS_PER_WINDOW`` rows per kernel window (``window`` s), at least 1."""
+    """Row step giving ``ROWS_PER_WINDOW`` rows per ``window`` (s), at least 1."""
     return max(1, int(window * sample_rate) // ROWS_PER_WINDOW)
 
 
@@ -86,32 +78,24 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
                         window: float | None = None, order: int = SAVGOL_ORDER,
                         decimate: int | None = 1, gravity: bool = True,
                         coulomb_smoothing: float = 1e-4) -> Regression:
-    """The regressor and the generalized force of every experiment, filtered with h.
-
-    The regressor is evaluated at every sample from the pose and its Savitzky-Golay rates and
-    accelerations, then filtered like the force. The equation J_lq^T f = Y pi is linear in pi,
-    so the filtered one holds exactly whatever the motion's amplitude.
+    """Regressor Y and generalized force of every experiment, filtered with h; J_lq^T f = Y pi is
+    linear in pi, so the filtered equation holds exactly.
 
     Parameters
     ----------
     experiments : list of Experiment
-        Prepared without gravity subtraction (``generalized_force`` = J_lq^T f).
+        Prepared without gravity subtraction.
     platform : Platform
     window : float, optional
-        Kernel support (s); 0.2 periods of each experiment's dominant frequency by default.
+        Kernel support (s); default 0.2 periods of the dominant frequency.
     order : int
-        Savitzky-Golay order of the rates, accelerations and Coulomb signs.
+        Savitzky-Golay order.
     decimate : int, optional
-        Keep every ``decimate``-th filtered row; None: the smallest :func:`row_step` of the
-        experiments' windows, the same for all.
+        Row step; None: smallest :func:`row_step` over the experiments.
     gravity : bool
         Include the gravity columns.
     coulomb_smoothing : float
-        Regularisation rate of the Coulomb signs (rad/s).
-
-    Returns
-    -------
-    Regression
+        rad/s.
     """
     Ys, ys, used, pose_noise, poses, force_noise = [], [], [], [], [], []
     windows = [window or default_window(estimate_frequency(exp.q, exp.sample_rate))
@@ -151,19 +135,8 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
 
 
 def leg_force_transforms(platform: Platform, poses: np.ndarray) -> np.ndarray:
-    """J_lq^-T at every row's pose: the map from a row's generalized force to the leg forces.
-
-    In leg forces a filtered row's noise has equal, uncorrelated channels, so weighting each
-    channel by its residual variance is generalized least squares.
-
-    Parameters
-    ----------
-    platform : Platform
-    poses : ndarray, shape (K, 6)
-
-    Returns
-    -------
-    ndarray, shape (K, 6, 6)
+    """J_lq^-T (K, 6, 6) at each row's pose: in leg forces a row's noise has equal uncorrelated
+    channels, so residual-variance weighting is generalized least squares.
     """
     return np.swapaxes(np.linalg.inv(leg_jacobian(platform, poses)), 1, 2)
 

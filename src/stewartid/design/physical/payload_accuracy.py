@@ -1,10 +1,5 @@
-"""What payload mode's design aims at: the payload's mass, centre of mass and inertia about
-it, each within the accuracy it is needed to.
-
-A payload is wanted as ``[payload]`` holds it (:func:`~stewartid.physical.estimator.payload_section`),
-not as the ten parameters about the reference point the estimator fits, and its three
-quantities are needed to different accuracies. Their standard errors follow from the
-parameters' covariance to first order (:func:`payload_jacobian`).
+"""Payload mode's design target: mass, centre of mass and inertia about it as ``[payload]`` holds
+them, each within its required accuracy, standard errors by first order (:func:`payload_jacobian`).
 """
 
 from __future__ import annotations
@@ -28,19 +23,8 @@ ACCURACY_COVERAGE = 0.95
 
 
 def payload_jacobian(parameters: np.ndarray) -> np.ndarray:
-    """Derivative of (mass, centre of mass, inertia about it) by the body parameters.
-
-    Parameters
-    ----------
-    parameters : ndarray, shape (10,)
-        m (kg), first moment h (kg m), inertia about the reference point (kg m^2), in the
-        order of :data:`~stewartid.model.regressor.BODY_PARAMETERS`.
-
-    Returns
-    -------
-    ndarray, shape (10, 10)
-        Rows: m, c_x, c_y, c_z, I_xx, I_yy, I_zz, I_xy, I_xz, I_yz (about the centre of
-        mass); columns: the parameters.
+    """Derivative (10, 10) of (m, c_x, c_y, c_z, I about the com in
+    :data:`~stewartid.model.regressor.BODY_PARAMETERS` order) by the ten body ``parameters``.
     """
     m, h = parameters[0], parameters[1:4]
     J = np.zeros((10, 10))
@@ -60,27 +44,16 @@ def payload_jacobian(parameters: np.ndarray) -> np.ndarray:
 
 def payload_std_errors(names: tuple[str, ...], nominal: np.ndarray, covariance: np.ndarray
                        ) -> dict[str, float]:
-    """Predicted standard errors of the payload's quantities, each in the unit its accuracy is
-    needed in (:data:`REQUIRED_PAYLOAD_ACCURACY`).
+    """Standard errors of the payload's quantities in :data:`REQUIRED_PAYLOAD_ACCURACY` units.
 
-    Parameters
-    ----------
-    names : tuple of str
-        The estimator's parameters in payload mode (``payload.m``, ...).
-    nominal : ndarray, shape (p,)
-        Their values (the payload expected).
-    covariance : ndarray, shape (p, p)
-        Their covariance; a parameter the estimator fixes has NaN rows and columns, and
-        counts as known.
+    ``names``, ``nominal`` (p,) and ``covariance`` (p, p) are the payload-mode parameters'; NaN rows
+    of a fixed parameter count as known.
 
     Returns
     -------
     dict
-        ``mass``: relative to the mass; ``com``: the centre of mass's standard error along its
-        least certain direction (m); ``inertia``: the largest of the six inertia entries about
-        the centre of mass relative to the mean of its diagonal; ``com_distance``: the distance
-        a run's centre of mass error stays within in :data:`ACCURACY_COVERAGE` of runs (m,
-        :func:`distance_quantile`).
+        ``mass`` relative; ``com`` along its least certain direction (m); ``inertia`` largest entry
+        over the diagonal's mean; ``com_distance`` (m, :func:`distance_quantile`).
     """
     index = [names.index(f"payload.{n}") for n in reg.BODY_PARAMETERS]
     values = np.asarray(nominal, dtype=float)[index]
@@ -98,9 +71,7 @@ def payload_std_errors(names: tuple[str, ...], nominal: np.ndarray, covariance: 
 
 def payload_criterion(std_errors: Mapping[str, float],
                       accuracy: Mapping[str, float] | None = None) -> tuple[float, str]:
-    """The largest ratio of a payload quantity's standard error to the accuracy it is needed to,
-    and the quantity (below 1 every one is within its accuracy at one standard error).
-    """
+    """Largest ratio of a payload quantity's standard error to its accuracy, and the quantity."""
     accuracy = REQUIRED_PAYLOAD_ACCURACY if accuracy is None else accuracy
     ratios = {k: std_errors[k] / accuracy[k] for k in REQUIRED_PAYLOAD_ACCURACY}
     worst = max(ratios, key=ratios.__getitem__)
@@ -108,21 +79,8 @@ def payload_criterion(std_errors: Mapping[str, float],
 
 
 def distance_quantile(variances: np.ndarray, coverage: float) -> float:
-    """The distance a Gaussian error with these variances along its principal directions stays
-    within in ``coverage`` of draws, by Satterthwaite's scaled chi-square (matched in mean and
-    variance).
-
-    Parameters
-    ----------
-    variances : ndarray, shape (k,)
-        Variances along the principal directions (m^2), >= 0.
-    coverage : float
-        In (0, 1).
-
-    Returns
-    -------
-    float
-        m; 0 if every variance is 0.
+    """Distance (m) a Gaussian error with principal ``variances`` (k,), m^2, stays within in
+    ``coverage`` of draws, by Satterthwaite's scaled chi-square; 0 when all are 0.
     """
     variances = np.asarray(variances, dtype=float)
     total, squares = variances.sum(), (variances ** 2).sum()
@@ -134,10 +92,8 @@ def distance_quantile(variances: np.ndarray, coverage: float) -> float:
 
 def held_share(std_errors: Mapping[str, float],
                accuracy: Mapping[str, float] | None = None) -> tuple[float, str]:
-    """The largest ratio of a payload quantity's error in :data:`ACCURACY_COVERAGE` of runs to its
-    required accuracy, and the quantity; at most 1, every one is within its accuracy in that
-    share of runs. The mass and inertia errors are one number each; the centre of mass's is a
-    distance in three directions (``com_distance``).
+    """Largest ratio of a payload quantity's error in :data:`ACCURACY_COVERAGE` of runs to its
+    accuracy, and the quantity (the com's as a 3-D distance).
     """
     accuracy = REQUIRED_PAYLOAD_ACCURACY if accuracy is None else accuracy
     z = math.sqrt(special.chdtri(1, 1 - ACCURACY_COVERAGE))
@@ -150,16 +106,14 @@ def held_share(std_errors: Mapping[str, float],
 
 def payload_objective(worst_relative_std: float, std_errors: Mapping[str, float],
                       accuracy: Mapping[str, float] | None = None) -> float:
-    """What payload mode's search minimises: the ten parameters' worst relative standard error,
-    times :func:`held_share` ^10 where that exceeds 1, a constraint the search crosses only for a
-    large gain.
+    """Payload search objective: the worst relative standard error times :func:`held_share` ^10
+    where that exceeds 1.
     """
     return worst_relative_std * max(1.0, held_share(std_errors, accuracy)[0]) ** 10
 
 
 def parse_accuracy(text: str) -> dict[str, float]:
-    """The ``design --accuracy`` value ``MASS,COM,INERTIA`` (%, mm, %) as
-    :data:`REQUIRED_PAYLOAD_ACCURACY` holds it (fractions and metres).
+    """``design --accuracy`` ``MASS,COM,INERTIA`` (%, mm, %) as fractions and metres.
 
     Raises
     ------

@@ -1,12 +1,6 @@
-"""Choosing the physical design: all-DOF multisines at the limits, :func:`design_objective`
-minimised.
-
-The family (:func:`~stewartid.design.multisine.multisine_design`) has eight parameters: six
-DOF log-weights on the paper's amplitudes, the log speed of the frequency pool and the
-second-frequency share. Each candidate is scaled to the limits (:func:`scale_to_limits`) and
-judged by its information-matrix prediction. Random candidates (fixed seed), then
-Nelder-Mead, each within a fixed number of evaluations, so that the design does not depend on
-the machine's speed.
+"""Choosing the physical design: all-DOF multisines scaled to the limits, :func:`design_objective`
+minimised over eight family parameters by seeded random candidates then Nelder-Mead, each
+within a fixed evaluation count so the design does not depend on the machine's speed.
 """
 
 from __future__ import annotations
@@ -61,15 +55,9 @@ PLANT_ROUNDS = 2
 
 def commanded_limit_use(platform: Platform, design: Design, rate_hz: float = INFORMATION_RATE
                         ) -> tuple[LimitUse, tuple[np.ndarray, np.ndarray, np.ndarray]]:
-    """Limit use of a design's commanded motion at ``rate_hz``, the forces those of the rigid-body
-    model (J_lq^-T Y pi), and the states it was taken at.
-
-    Returns
-    -------
-    use : LimitUse
-        Of all records one after the other.
-    states : tuple of ndarray
-        (q, q_dot, q_ddot), each (K, 6), and the standard regressor there (K, 6, N_STANDARD).
+    """Limit use of a design's commanded motion at ``rate_hz`` (records in sequence, rigid-body
+    forces J_lq^-T Y pi), and the states: (q, q_dot, q_ddot) each (K, 6) and the standard
+    regressor (K, 6, N_STANDARD).
     """
     q, q_dot, q_ddot = design_rows(platform, design, rate_hz)
     jacobian = leg_jacobian(platform, q)
@@ -86,9 +74,7 @@ def commanded_limit_use(platform: Platform, design: Design, rate_hz: float = INF
 
 def record_peaks(design: Design, use: LimitUse, rate_hz: float = INFORMATION_RATE
                  ) -> np.ndarray:
-    """Largest use of any limit in each record, from the use of all records one after the other
-    at ``rate_hz`` (:func:`commanded_limit_use`); shape (records,).
-    """
+    """Largest use of any limit per record, shape (records,), from :func:`commanded_limit_use`."""
     edges = record_ends(design, rate_hz)
     return np.array([use.use[a:b].max() for a, b in zip(edges[:-1], edges[1:], strict=True)])
 
@@ -96,18 +82,8 @@ def record_peaks(design: Design, use: LimitUse, rate_hz: float = INFORMATION_RAT
 def scale_to_limits(platform: Platform, design: Design, max_use: float | np.ndarray,
                     rate_hz: float = INFORMATION_RATE, rounds: int = 4
                     ) -> tuple[Design, LimitUse, tuple]:
-    """Scale each record's amplitudes until its commanded motion uses ``max_use`` of its most
-    used limit (within 2 %; one value for all records, or one per record).
-
-    Each record on its own, so that the one reaching a limit first does not hold the others below
-    theirs.
-
-    Returns
-    -------
-    design : Design
-    use : LimitUse
-    states : tuple of ndarray
-        (q, q_dot, q_ddot) of the scaled design at ``rate_hz`` and the standard regressor.
+    """Scale each record's amplitudes, on its own, until its commanded motion uses ``max_use``
+    (scalar or per record, within 2 %) of its most used limit; return design, use and states.
     """
     target = np.broadcast_to(np.asarray(max_use, dtype=float), len(design.records))
     for _ in range(rounds):
@@ -132,7 +108,7 @@ class PhysicalCandidate:
     design : Design
     prediction : ParameterPrediction
     parameters : ndarray, shape (8,)
-        Log-weights of the six DOFs, log speed, second-frequency share.
+        Six DOF log-weights, log speed, second-frequency share.
     commanded_peak : dict of str to float
         Peak use of every limit by the commanded motion.
     """
@@ -144,19 +120,16 @@ class PhysicalCandidate:
 
     @property
     def score(self) -> float:
-        """What the search minimises (:func:`design_objective`)."""
+        """:func:`design_objective` of the prediction."""
         return design_objective(self.prediction)
 
 
 def design_objective(prediction: ParameterPrediction,
                      correction: Mapping[str, float] | None = None) -> float:
-    """What the search minimises.
-
-    Full mode: the criterion (the worst relative standard error). Payload mode: the ten
-    parameters' worst relative standard error with the payload's quantities held within their
-    accuracy (:func:`~stewartid.design.physical.payload_accuracy.payload_objective`).
-    ``correction`` (:func:`~stewartid.design.physical.refine.search_correction`) multiplies the
-    worst relative standard error (``"worst"``) and each payload quantity's.
+    """What the search minimises: the worst relative standard error; in payload mode with the
+    payload's quantities held within their accuracy
+    (:func:`~stewartid.design.physical.payload_accuracy.payload_objective`). ``correction``
+    (:func:`~stewartid.design.physical.refine.search_correction`) multiplies those terms.
     """
     factor = correction or {}
     if not prediction.payload:
@@ -167,7 +140,7 @@ def design_objective(prediction: ParameterPrediction,
 
 
 def criterion_text(prediction: ParameterPrediction) -> str:
-    """The criterion's value, with its unit and what sets it, in words."""
+    """The criterion's value, unit and what sets it, in words."""
     if not prediction.payload:
         return (f"worst relative SE {prediction.worst_relative_std:.3g} % "
                 f"({prediction.worst_parameter})")
@@ -177,26 +150,21 @@ def criterion_text(prediction: ParameterPrediction) -> str:
 
 
 def _bounds(payload: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Lower and upper bounds of the search's eight parameters."""
     speeds = np.log(speed_bounds(payload))
     return (np.array([WEIGHT_BOUNDS[0]] * 6 + [speeds[0], SHARE_BOUNDS[0]]),
             np.array([WEIGHT_BOUNDS[1]] * 6 + [speeds[1], SHARE_BOUNDS[1]]))
 
 
 def speed_bounds(payload: bool) -> tuple[float, float]:
-    """The search's bounds on the frequency pool's speed (:data:`SPEED_BOUNDS`, or
-    :data:`PAYLOAD_SPEED_BOUNDS` in payload mode).
-    """
+    """Bounds on the frequency pool's speed: :data:`SPEED_BOUNDS` or :data:`PAYLOAD_SPEED_BOUNDS`."""
     return PAYLOAD_SPEED_BOUNDS if payload else SPEED_BOUNDS
 
 
 def candidate(platform: Platform, budget_s: float, noise: SensorNoise, payload: bool,
               parameters: np.ndarray, max_use: float, scales: np.ndarray | None = None,
               accuracy: Mapping[str, float] | None = None) -> PhysicalCandidate:
-    """One member of the family at the limits, with its prediction.
-
-    With ``scales`` (:func:`plant_scales`) each record's amplitudes are then multiplied by its
-    own; ``accuracy`` is what payload mode judges against (:func:`judged_against`).
+    """One family member at the limits with its prediction; record amplitudes times ``scales``
+    (:func:`plant_scales`) when given, payload mode judged against ``accuracy``.
     """
     weights, speed, share = parameters[:6], parameters[6], parameters[7]
     amplitudes = np.exp(np.clip(weights, *WEIGHT_BOUNDS)) * np.asarray(DEFAULT_AMPLITUDES)
@@ -218,18 +186,13 @@ def candidate(platform: Platform, budget_s: float, noise: SensorNoise, payload: 
 
 def judged_against(prediction: ParameterPrediction, accuracy: Mapping[str, float] | None
                    ) -> ParameterPrediction:
-    """``prediction`` with payload mode's criterion taken against ``accuracy`` (keys and units of
-    :data:`~stewartid.design.physical.payload_accuracy.REQUIRED_PAYLOAD_ACCURACY`; None: those).
-    """
+    """``prediction`` with payload mode's criterion against ``accuracy`` (None: the required one)."""
     return prediction if accuracy is None else dataclasses.replace(prediction,
                                                                    accuracy=dict(accuracy))
 
 
 def plant_scales(design: Design, played: Design) -> np.ndarray:
-    """Per record, the factor its amplitudes were scaled by to keep the plant's states within the
-    limits (``played`` against ``design``): what the plant's tracking takes from the commanded
-    motion. Shape (records,), at most 1.
-    """
+    """Per record, factor (<= 1) the plant's limits scaled ``played`` from ``design``; shape (records,)."""
     return np.array([np.linalg.norm(b.amplitudes) / np.linalg.norm(a.amplitudes)
                      for a, b in zip(design.records, played.records, strict=True)])
 
@@ -239,17 +202,9 @@ def refine_for_plant(platform: Platform, budget_s: float, noise: SensorNoise, pa
                      evaluations: int = PLANT_EVALUATIONS,
                      accuracy: Mapping[str, float] | None = None,
                      correction: Mapping[str, float] | None = None) -> PhysicalCandidate:
-    """Nelder-Mead again from ``start``, each candidate's record k scaled by the played pick's
-    plant scale of record k (:func:`plant_scales`): the motion judged as the plant will allow it.
-
-    Record k keeps its order of frequencies across candidates, so its scale carries over to the
-    neighbours; ``correction`` (:func:`~stewartid.design.physical.refine.search_correction`)
-    carries the played pick's final prediction over likewise.
-
-    Returns
-    -------
-    PhysicalCandidate
-        The best candidate seen, by :func:`design_objective` with ``correction``.
+    """Nelder-Mead again from ``start``, record k of each candidate scaled by the played pick's
+    plant scale k, so the motion is judged as the plant will allow; best by :func:`design_objective`
+    with ``correction``.
     """
     lower, upper = _bounds(payload)
     seen: list[PhysicalCandidate] = []
@@ -274,7 +229,7 @@ def search_design(platform: Platform, budget_s: float, noise: SensorNoise,
                   local_evaluations: int = LOCAL_EVALUATIONS,
                   progress: Callable[[str], None] | None = None,
                   accuracy: Mapping[str, float] | None = None) -> PhysicalCandidate:
-    """The member of the family with the smallest :func:`design_objective`.
+    """Member of the family with the smallest :func:`design_objective`.
 
     Parameters
     ----------
@@ -283,23 +238,18 @@ def search_design(platform: Platform, budget_s: float, noise: SensorNoise,
         Total motion time (s).
     noise : SensorNoise
     payload : bool
-        Judge the payload's ten parameters (payload mode), else every base parameter but
-        friction and offsets.
+        Judge the payload's ten parameters, else every base parameter but friction and offsets.
     max_use : float
-        Fraction of the most used limit the commanded motion reaches, in (0, 1].
+        Fraction of the most used limit reached, in (0, 1].
     seed : int
-        Of the random candidates and the phases.
+        Random candidates and phases.
     random_candidates, local_evaluations : int
         Evaluations of the random stage and of Nelder-Mead.
     progress : callable, optional
-        Receives a line of text per stage.
+        Receives a line per stage.
     accuracy : mapping, optional
-        Payload mode: the accuracy each payload quantity is needed to (default
+        Payload mode's required accuracies (default
         :data:`~stewartid.design.physical.payload_accuracy.REQUIRED_PAYLOAD_ACCURACY`).
-
-    Returns
-    -------
-    PhysicalCandidate
     """
     if not 0 < max_use <= 1:
         raise ConfigError(f"max_use must be in (0, 1]; got {max_use!r}.")

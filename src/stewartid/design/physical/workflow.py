@@ -50,12 +50,11 @@ class PhysicalDesignOutput:
     ----------
     design : Design
     prediction, baseline : ParameterPrediction
-        Of the design and of the all-DOFs multisine of the same length.
+        The design's and the same-length all-DOF multisine's.
     check : dict
-        The Monte Carlo check of the prediction (:func:`monte_carlo_check`).
+        :func:`monte_carlo_check`.
     commands : dict of str to str
-        ``play``: the ``simulate`` command that plays the records on the plant;
-        ``identify``: the ``identify`` command of their logs.
+        ``play`` (``simulate``) and ``identify`` commands.
     files : list of Path
     """
 
@@ -73,25 +72,22 @@ UNDERPREDICTED = 1.5
 
 
 def physical_identify_command(payload: bool, run: str = "RUN") -> str:
-    """The ``stewartid identify`` command of the physical model (payload mode or full)."""
+    """``stewartid identify`` command of the physical model (payload or full)."""
     return (f"stewartid identify {run} --platform PLATFORM --model physical"
             + (" --payload" if payload else ""))
 
 
 def monte_carlo_check(platform: Platform, records: list, noise: SensorNoise,
                       prediction: ParameterPrediction, seeds: int) -> dict[str, Any]:
-    """Fit the physical model to ``seeds`` noisy copies of the design played on the plant, and
-    compare with the prediction.
-
-    The platform description is the plant's truth, so each fit's errors are known too.
+    """Fit the physical model to ``seeds`` noisy copies of the played design and compare with the
+    prediction (errors known: the description is the plant's truth).
 
     Returns
     -------
     dict
-        ``seeds``, ``ratio_median`` (predicted / reported), ``within_30_percent``,
-        ``max_abs_z``, ``underpredicted`` (the parameters whose reported standard error is
-        over :data:`UNDERPREDICTED` times the prediction), and per parameter ``predicted``,
-        ``reported``, ``errors``.
+        ``seeds``, ``ratio_median`` (predicted / reported), ``within_30_percent``, ``max_abs_z``,
+        ``underpredicted`` (reported over :data:`UNDERPREDICTED` x predicted), and per parameter
+        ``predicted``, ``reported``, ``errors``.
     """
     names = prediction.names
     if seeds == 0:
@@ -145,42 +141,31 @@ def run_physical_design(platform: Platform, budget_s: float, noise: SensorNoise,
     Parameters
     ----------
     platform : Platform
-        With the expected payload in ``[payload]`` (required in payload mode: the
-        payload's relative errors are taken of it).
+        With the expected ``[payload]`` (required in payload mode).
     budget_s : float
         Total motion time (s).
     noise : SensorNoise
-        Sensor noise the prediction assumes (its force noise, N).
     out : str or Path
     payload : bool
-        Design for payload mode (the payload's ten parameters), else for every base
-        parameter (judged on the moving body's ten).
+        Design for the payload's ten parameters, else every base parameter.
     rate_hz : float
         Controller rate of the command files (Hz).
     max_use : float
-        Largest fraction of every limit used, on the plant's simulated states.
+        Largest fraction of every limit, on the plant's states.
     check_seeds : int
-        Noisy copies of the played design the physical model is fitted to, to check the
-        prediction (0: no check).
+        Noisy copies for the Monte Carlo check (0: none).
     force : bool
-        Overwrite an earlier design in ``out``.
+        Overwrite an earlier design.
     progress : callable, optional
     search : dict, optional
-        ``random_candidates`` and ``local_evaluations`` of
-        :func:`~stewartid.design.physical.search.search_design` and ``plant_evaluations``
-        of :func:`played_pick`.
+        ``random_candidates``, ``local_evaluations``, ``plant_evaluations``.
     accuracy : mapping, optional
-        Payload mode: the accuracy each payload quantity is needed to (keys and units of
-        :data:`~stewartid.design.physical.payload_accuracy.REQUIRED_PAYLOAD_ACCURACY`).
-
-    Returns
-    -------
-    PhysicalDesignOutput
+        Payload mode's required accuracies.
 
     Raises
     ------
     ConfigError
-        Payload mode on a platform without ``[payload]``.
+        Payload mode without ``[payload]``.
     """
     out = Path(out)
     if payload and platform.payload is None:
@@ -235,9 +220,7 @@ def render_physical_markdown(design: Design, prediction: ParameterPrediction,
                              peaks: list[dict[str, float]], settings: dict,
                              commands: dict[str, str],
                              commanded: ParameterPrediction | None = None) -> str:
-    """The report text of a physical design (``commanded``: its prediction along the commanded
-    motion, beside the one along the plant's).
-    """
+    """Report text of a physical design (``commanded``: prediction along the commanded motion)."""
     lines = ["# Excitation design for the physical model", "",
              f"{design.label}; {design.duration:.1f} s of motion.", "", "## Settings", ""]
     lines += [f"- {key}: {value}" for key, value in settings.items()]
@@ -284,11 +267,7 @@ def render_physical_markdown(design: Design, prediction: ParameterPrediction,
 
 
 def criterion_summary(prediction: ParameterPrediction, baseline: ParameterPrediction) -> str:
-    """The design's criterion beside the all-DOFs multisine's, in a sentence.
-
-    Payload mode: the payload's quantities against their required accuracy, then the ten
-    parameters' worst relative standard error.
-    """
+    """The design's criterion beside the all-DOF multisine's, in a sentence."""
     worst = (f"worst relative standard error of the "
              f"{'payload' if prediction.payload else 'moving body'}'s ten parameters "
              f"{prediction.worst_relative_std:.3g} % ({prediction.worst_parameter}; the "
