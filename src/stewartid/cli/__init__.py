@@ -1,7 +1,6 @@
-"""Command-line interface: ``stewartid COMMAND ...``. :mod:`~stewartid.cli.application` holds
-the application and its error policy; one module per command (``nominal``, ``simulate``,
-``identify`` with :mod:`~stewartid.cli.identify_run`, ``reproduce``, ``methods``, ``study``,
-``design``)."""
+"""Command-line interface ``stewartid COMMAND``: :mod:`stewartid.cli.application` and one module
+per command.
+"""
 
 from stewartid.cli.application import app, main
 

@@ -1,5 +1,4 @@
-"""``stewartid nominal``: the nominal Mt and Bt of a platform description, at the neutral
-pose or at a pose given with ``--pose`` (then with the gravity force G there)."""
+"""``stewartid nominal``: a platform description's nominal Mt and Bt, at neutral or ``--pose``."""
 
 from __future__ import annotations
 
@@ -19,12 +18,12 @@ POSE_FORM = ("X,Y,Z,RX,RY,RZ: the absolute pose of the reference point in the pa
 
 
 def parse_pose(text: str) -> np.ndarray:
-    """The six numbers of ``--pose`` (m, rad), shape (6,).
+    """The six numbers of ``--pose``, shape (6,) (m, rad).
 
     Raises
     ------
     ConfigError
-        Unless ``text`` is six finite numbers separated by commas.
+        ``text`` is not six finite comma-separated numbers.
     """
     parts = [part.strip() for part in text.split(",")]
     try:

@@ -1,5 +1,4 @@
-"""Method labels of every report: display names, colours, the paper's letters and report order,
-all taken from the registry (:mod:`stewartid.identification.registry`)."""
+"""Method labels of every report from the registry: display names, colours, paper letters, order."""
 
 from __future__ import annotations
 
@@ -13,13 +12,13 @@ def _spec(method: str) -> MethodSpec | None:
 
 
 def method_name(method: str) -> str:
-    """Display name of a method (the registry's; the name itself when not registered)."""
+    """Display name of a method (the name itself when not registered)."""
     spec = _spec(method)
     return method if spec is None else spec.display_name
 
 
 def method_color(method: str) -> str:
-    """Colour of a method in every figure (the registry's; grey when not registered)."""
+    """Colour of a method in every figure (grey when not registered)."""
     spec = _spec(method)
     return "grey" if spec is None else spec.color
 
@@ -37,8 +36,7 @@ def paper_methods() -> dict[str, str]:
 
 
 def report_order(methods: Iterable[str]) -> tuple[str, ...]:
-    """``methods`` in report order: those the paper reports by their letter (A, B), then the
-    others in registry order, then unregistered names alphabetically."""
+    """``methods`` in report order: the paper's by letter, the others by registry, unknown alphabetically."""
     registry = [spec.name for spec in registered_methods()]
 
     def key(method: str) -> tuple[int, str, int, str]:

@@ -1,6 +1,4 @@
-"""``results.json`` of a reproduction: every result of a run as one JSON document, and back
-(:func:`load_results`).
-"""
+"""A reproduction's ``results.json``: every result of a run as one JSON document, and back."""
 
 from __future__ import annotations
 
@@ -29,10 +27,8 @@ LEGACY_METHOD_NAMES = {"least_squares": "ls", "wavelet_paper": "wavelet-paper"}
 
 
 def run_record(results: ComparisonResults, run: MethodRun) -> dict[str, Any]:
-    """One identification of a run as a JSON-ready dict.
-
-    Matrices, standard errors, ε per entry and the largest, the paper's values where published,
-    time and diagnostics.
+    """One identification as a JSON-ready dict: matrices, standard errors, ε per entry and the
+    largest, the paper's values where published, time and diagnostics.
     """
     eps = results.eps_all(run)
     worst = max(eps, key=eps.__getitem__)
@@ -58,7 +54,7 @@ def run_record(results: ComparisonResults, run: MethodRun) -> dict[str, Any]:
 
 def results_document(results: ComparisonResults, runtime_s: float,
                      files: Sequence[str] = ()) -> dict[str, Any]:
-    """Everything of a run as a JSON-ready dict (see the module docstring)."""
+    """Everything of a run as a JSON-ready dict: settings, nominal matrices and every run's record."""
     from stewartid import __version__
 
     runs = [run_record(results, run) for run in results.runs]
@@ -79,7 +75,7 @@ def results_document(results: ComparisonResults, runtime_s: float,
 
 
 def _method_run(item: dict[str, Any]) -> MethodRun:
-    """A :class:`MethodRun` from its :func:`run_record` (the inverse, for what it keeps)."""
+    """A :class:`MethodRun` from its :func:`run_record`, as far as it keeps it."""
     method = LEGACY_METHOD_NAMES.get(item["method"], str(item["method"]))
     diagnostics = dict(item.get("diagnostics", {}))
     result = IdentificationResult.from_dict({

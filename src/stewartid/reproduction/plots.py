@@ -1,4 +1,4 @@
-"""The figures of a reproduction, submitted to the worker pool in report order with their captions."""
+"""A reproduction's figures, drawn on the worker pool in report order with their captions."""
 
 from __future__ import annotations
 
@@ -32,14 +32,13 @@ class FigureQueue:
 
     def submit(self, function: Callable[..., Any], stem: str, caption: str, *args: Any,
                **kwargs: Any) -> None:
-        """Draw ``function(*args, directory=folder, stem=stem, **kwargs)`` on the pool, as
-        ``figures/{stem}.png`` of the report with ``caption``."""
+        """Draw ``function(*args, directory=folder, stem=stem, **kwargs)`` on the pool as ``stem``."""
         future = self.pool.submit(function, *args, directory=self.folder, stem=stem, **kwargs)
         future.add_done_callback(lambda _: self.bar.advance(self.task))
         self.submitted.append((future, FigureEntry(f"figures/{stem}.png", caption)))
 
     def finish(self) -> tuple[list[FigureEntry], list[Path]]:
-        """Wait for every figure; return their report entries in submission order and the files written."""
+        """Wait for every figure; returns their report entries and the files written."""
         files: list[Path] = []
         for future, _ in self.submitted:
             files += future.result()

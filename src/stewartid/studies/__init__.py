@@ -1,7 +1,5 @@
-"""Studies: Monte Carlo runs and parameter sweeps of simulation and identification.
-
-``stewartid study FILE --out DIR`` runs every (grid point, seed) of a study file on
-dask.distributed (the ``[dask]`` extra) and reports the errors of every method.
+"""Studies: Monte Carlo runs and parameter sweeps of simulation and identification on
+dask.distributed (``stewartid study FILE --out DIR``, the ``[dask]`` extra).
 """
 
 from stewartid.studies.grid import StudyTask, expand_grid

@@ -1,5 +1,4 @@
-"""The identification report's sentences about friction: the levels a method estimates, the
-friction treatment Method B kept, and the third harmonic Method A tests."""
+"""The identification report's sentences about friction."""
 
 from __future__ import annotations
 
@@ -15,7 +14,7 @@ from stewartid.validation.heldout import friction_signature
 
 
 def friction_text(run: MethodFit) -> str:
-    """A method's Coulomb levels per joint type with their standard errors, for a sentence."""
+    """A method's Coulomb levels per joint type, ± standard errors, for a sentence."""
     levels, std = run.coulomb
     return ", ".join(f"{name.replace('_', ' ')} {v:.3g} ± {s:.2g} N·m"
                      for name, v, s in zip(FRICTION_TYPES, levels, std, strict=True))
@@ -47,8 +46,7 @@ def friction_law_lines(result: IdentificationResult) -> list[str]:
 
 
 def friction_shape_lines(result: IdentificationResult) -> list[str]:
-    """Least squares: how the data weigh the two shapes of the Coulomb sign near a reversal
-    (:mod:`~stewartid.identification.friction_shape`)."""
+    """Least squares: how the data weigh the two shapes of the Coulomb sign near a reversal."""
     weights = result.diagnostics.get("coulomb_shape_weights") or {}
     if len(weights) < 2:
         return []
@@ -60,8 +58,7 @@ def friction_shape_lines(result: IdentificationResult) -> list[str]:
 
 
 def third_harmonic_lines(result: IdentificationResult) -> list[str]:
-    """Method A: whether the force's third harmonic shows the Coulomb friction its Bt reads as
-    viscous, and what that puts in the standard errors."""
+    """Method A: whether the force's third harmonic shows Coulomb friction read as viscous."""
     bias = result.diagnostics.get("friction_bias") or {}
     if "statistic" not in bias or not np.isfinite(bias["threshold"]):
         return []
@@ -76,8 +73,7 @@ def third_harmonic_lines(result: IdentificationResult) -> list[str]:
 
 
 def friction_section(ok: Sequence[MethodFit], platform: Platform) -> list[str]:
-    """The report's friction section: per method its Coulomb levels, or what its residual
-    shows of the friction it does not estimate."""
+    """The friction section: per method its Coulomb levels, or what its residual shows of friction."""
     lines: list[str] = []
     for run in ok:
         if np.all(np.isfinite(run.coulomb[0])):

@@ -1,5 +1,6 @@
-"""The physical model's section of the identification report: its parameters with the fixed
-ones named, its held-out prediction and Mt, Bt across the poses the data cover."""
+"""The identification report's physical-model section: parameters, held-out prediction, Mt and Bt
+across the measured poses.
+"""
 
 from __future__ import annotations
 
@@ -19,9 +20,9 @@ def _value(value: float) -> str:
 
 
 def parameter_table(result: PhysicalResult) -> str:
-    """The identified parameters as a Markdown table: value, standard error, the combination
-    each stands for, and which are fixed and why (or, for the consistent fit, how far each
-    moved in standard errors)."""
+    """The identified parameters as Markdown: value, standard error, combination, and why fixed (or
+    how far the consistent fit moved each, in standard errors).
+    """
     fixed = result.diagnostics.get("fixed", {})
     moved = (result.diagnostics.get("consistent") or {}).get("change_std_errors", {})
     rows = []
@@ -38,7 +39,7 @@ def parameter_table(result: PhysicalResult) -> str:
 
 def physical_lines(section: PhysicalSection | None,
                    figures: Mapping[str, tuple[str, str]]) -> list[str]:
-    """The report's "Physical model" section (nothing without a section)."""
+    """The report's "Physical model" section (nothing without ``section``)."""
     if section is None:
         return []
     lines = ["## Physical model", ""]
@@ -78,7 +79,6 @@ def physical_lines(section: PhysicalSection | None,
 
 
 def _range_text(curves: Workspace | None) -> str:
-    """The measured range of each coordinate the curves cover."""
     if curves is None:
         return ""
     scale = np.array([1e3] * 3 + [np.degrees(1.0)] * 3)
