@@ -1,15 +1,6 @@
-"""Leg-length servo controller: PID with anti-windup, gravity feed-forward, inner force loop.
-
-Each leg's force demand, clamped to the cylinder's force range, is
-
-    f_d = f_ff + K_p e + K_i z + K_d (l_cmd' - l'),      z' = e  (unless winding up),
-
-with e = l_cmd - l (m) and f_ff = J_lq(q_cmd)^-T G(q_cmd) the optional gravity feed-forward;
-z stops integrating while f_d is saturated and e would push it further. The controller is
-continuous-time, so the closed loop stays an ODE. In ``ideal`` actuator mode the demand is
-the leg force; in ``hydraulic`` mode an inner loop opens the valve by u = k_f (f_d - f),
-saturated to [-1, 1], and :func:`~stewartid.simulation.stability.require_stable` refuses
-gains k_f that make the loop unstable.
+"""Leg-length servo: continuous-time PID f_d = f_ff + K_p e + K_i z + K_d (l_cmd' - l'), z' = e,
+e = l_cmd - l, clamped to the cylinder's range, with gravity feed-forward f_ff = J_lq^-T G(q_cmd)
+and, for hydraulic actuators, an inner force loop u = k_f (f_d - f) in [-1, 1].
 """
 
 from __future__ import annotations
@@ -26,12 +17,8 @@ C_KP, C_KI, C_KD, C_KF, C_FMIN, C_FMAX = range(6)
 
 
 def controller_parameters(platform: Platform) -> np.ndarray:
-    """Pack the ``[controller]`` section and the force limits for the compiled plant.
-
-    Returns
-    -------
-    ndarray, shape (6,)
-        [K_p (N/m), K_i (N/(m s)), K_d (N s/m), k_f (1/N), f_min (N), f_max (N)].
+    """Pack ``[controller]`` and the force limits: [K_p (N/m), K_i (N/(m s)), K_d (N s/m), k_f (1/N),
+    f_min, f_max (N)].
     """
     c = platform.controller
     f_min, f_max = force_limits(platform.hydraulics)
@@ -42,12 +29,7 @@ def controller_parameters(platform: Platform) -> np.ndarray:
 @njit(cache=True)
 def pid_force(cp: np.ndarray, error: float, error_rate: float, integral: float,
               feedforward: float) -> tuple[float, float]:
-    """Force demand (N) and integrator rate (m) of one leg.
-
-    Returns
-    -------
-    (f_d, z_dot) : the clamped demand and the (anti-windup gated) integrator input.
-    """
+    """Clamped force demand (N) and integrator input (m) of one leg; z stops while f_d saturates outward."""
     f = feedforward + cp[C_KP] * error + cp[C_KI] * integral + cp[C_KD] * error_rate
     z_dot = error
     if f > cp[C_FMAX]:
@@ -63,7 +45,7 @@ def pid_force(cp: np.ndarray, error: float, error_rate: float, integral: float,
 
 @njit(cache=True)
 def valve_command(cp: np.ndarray, demand: float, force: float) -> float:
-    """Inner force loop: valve opening (fraction, in [-1, 1]) for a force error (N)."""
+    """Inner force loop: valve opening in [-1, 1] for a force error (N)."""
     u = cp[C_KF] * (demand - force)
     if u > 1.0:
         return 1.0
@@ -73,18 +55,8 @@ def valve_command(cp: np.ndarray, demand: float, force: float) -> float:
 
 
 def command_tables(params, upper, base, q_cmd, qd_cmd, feedforward):
-    """Leg-length commands, their rates and the gravity feed-forward along a trajectory.
-
-    Parameters
-    ----------
-    params, upper, base : packed platform (see :func:`stewartid.model.kernels.model_terms`).
-    q_cmd, qd_cmd : (N, 6) commanded poses (m, rad) and rates.
-    feedforward : bool
-        Compute J_lq^-T G at the commanded pose (zeros otherwise).
-
-    Returns
-    -------
-    lengths, rates, forces : (N, 6) each; m, m/s, N.
+    """Leg-length commands (m), rates (m/s) and, if ``feedforward``, J_lq^-T G (N), each (N, 6), along
+    commanded poses and rates ``q_cmd``, ``qd_cmd`` (N, 6).
     """
     G, J, lengths, _ = leg_terms(params, upper, base, np.ascontiguousarray(q_cmd))
     rates, forces = _rates_and_feedforward(J, G, np.ascontiguousarray(qd_cmd), feedforward)
@@ -93,7 +65,6 @@ def command_tables(params, upper, base, q_cmd, qd_cmd, feedforward):
 
 @njit(cache=True)
 def _rates_and_feedforward(J, G, qd_cmd, feedforward):
-    """Leg-length rates J qd and, when ``feedforward``, forces J^-T G at every sample."""
     n = qd_cmd.shape[0]
     rates = np.empty((n, 6))
     forces = np.zeros((n, 6))
@@ -111,10 +82,7 @@ def _rates_and_feedforward(J, G, qd_cmd, feedforward):
 
 @njit(cache=True)
 def _solve_transposed(J, b, A, x):
-    """Solve J^T x = b (6x6) by Gaussian elimination with partial pivoting, into ``x``.
-
-    A (6, 7) is scratch; a LAPACK call per sample would cost more than the model itself.
-    """
+    """Solve J^T x = b (6x6) by partial pivoting into ``x`` (``A`` (6, 7) scratch; cheaper than LAPACK)."""
     n = 6
     for i in range(n):
         for j in range(n):

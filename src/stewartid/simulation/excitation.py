@@ -1,8 +1,5 @@
-"""Excitation trajectories of the platform pose: sines, multi-sines and a smooth fade-in.
-
-A trajectory is a base pose plus a sum of sines times a fade-in window, so that the plant
-starts at rest; :meth:`Excitation.evaluate` returns q, q_dot and q_ddot analytically. The
-paper's set (Zhang 2020, Section 4) is :func:`paper_experiments`.
+"""Excitation trajectories: base pose + fade-in window x sum of sines, q, q_dot, q_ddot analytic;
+:func:`paper_experiments` is the set of Zhang (2020), Section 4.
 """
 
 from __future__ import annotations
@@ -31,15 +28,12 @@ class Sine:
     Attributes
     ----------
     dof : int
-        Pose coordinate 0..5 (x, y, z, rx, ry, rz).
-    amplitude : float
-        m for x, y, z; rad for rx, ry, rz.
+        0..5 for x, y, z, rx, ry, rz.
+    amplitude, offset : float
+        m or rad; the offset is not faded.
     frequency_hz : float
-        Hz.
     phase : float
         rad.
-    offset : float
-        Constant added to the base pose (m or rad); not faded.
     """
 
     dof: int
@@ -60,11 +54,7 @@ class Sine:
 
 
 def _fade(t: np.ndarray, duration: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Quintic smoothstep window w(t) from 0 to 1 over ``duration``, with w' and w''.
-
-    w, w' and w'' vanish at t = 0, so the faded trajectory starts at rest with zero
-    acceleration (no force step for the plant), and w' = w'' = 0 at the end of the fade.
-    """
+    """Quintic smoothstep w from 0 to 1 over ``duration`` with w', w'': zero at t = 0 (start at rest)."""
     if duration <= 0:
         one = np.ones_like(t)
         return one, np.zeros_like(t), np.zeros_like(t)
@@ -83,13 +73,12 @@ class Excitation:
     Attributes
     ----------
     sines : tuple of Sine
-        Components; several on one DOF make a multi-sine.
+        Several on one DOF make a multi-sine.
     base_pose : tuple of 6 float
-        Pose about which the platform moves (m, rad), usually the neutral pose.
+        m, rad; usually the neutral pose.
     fade_in : float
-        Duration (s) of the quintic fade-in window; 0 for none.
+        Quintic fade-in (s); 0 for none.
     name : str
-        Label of the experiment.
     """
 
     sines: tuple[Sine, ...]
@@ -112,18 +101,7 @@ class Excitation:
         return max((s.frequency_hz for s in self.sines), default=0.0)
 
     def evaluate(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Pose, velocity and acceleration at times ``t``.
-
-        Parameters
-        ----------
-        t : ndarray, shape (N,)
-            Times (s).
-
-        Returns
-        -------
-        q, q_dot, q_ddot : ndarray, shape (N, 6)
-            m, rad; m/s, rad/s; m/s^2, rad/s^2.
-        """
+        """q, q_dot, q_ddot (N, 6) at times ``t`` (s): m, rad and their derivatives."""
         t = np.asarray(t, dtype=float)
         n = t.shape[0]
         q = np.tile(np.asarray(self.base_pose), (n, 1))
@@ -145,23 +123,9 @@ class Excitation:
 def sine_excitation(platform: Platform, dof: int, amplitude: float, frequency_hz: float,
                     phase: float = 0.0, offset: float = 0.0, fade_in: float = DEFAULT_FADE_IN,
                     name: str | None = None) -> Excitation:
-    """A single sine on one DOF about the platform's neutral pose.
+    """A single sine on one DOF (0..5 for x, y, z, rx, ry, rz) about the neutral pose.
 
-    Parameters
-    ----------
-    platform : Platform
-    dof : int
-        0..5 for x, y, z, rx, ry, rz.
-    amplitude : float
-        m or rad.
-    frequency_hz : float
-        Hz.
-    phase, offset : float
-        rad; m or rad.
-    fade_in : float
-        s.
-    name : str, optional
-        Label; ``"<dof name>_sine"`` by default.
+    Amplitude and offset in m or rad, phase in rad, fade-in in s; named ``"<dof name>_sine"`` by default.
     """
     return Excitation((Sine(dof, amplitude, frequency_hz, phase, offset),),
                       tuple(platform.neutral_pose), fade_in,
@@ -177,22 +141,9 @@ def multisine_excitation(platform: Platform, sines: Sequence[Sine],
 def paper_experiments(platform: Platform, frequency_hz: float = 0.5,
                       amplitudes: Sequence[float] = DEFAULT_AMPLITUDES,
                       fade_in: float = DEFAULT_FADE_IN) -> list[Excitation]:
-    """The paper's six experiments: experiment k excites DOF k with a sine (names exp1..exp6).
+    """The paper's six experiments, ``exp1..exp6``: experiment k excites DOF k with a sine from rest.
 
-    Parameters
-    ----------
-    platform : Platform
-    frequency_hz : float
-        Sine frequency (Hz); 0.5 in the paper.
-    amplitudes : sequence of 6 float
-        Per DOF (m, m, m, rad, rad, rad).
-    fade_in : float
-        Fade-in duration (s).
-
-    Returns
-    -------
-    list of Excitation
-        Six trajectories, each starting at rest at the neutral pose.
+    ``amplitudes`` per DOF (m, rad), ``fade_in`` in s.
     """
     amplitudes = tuple(float(a) for a in amplitudes)
     if len(amplitudes) != 6:

@@ -1,9 +1,5 @@
-"""Virtual experiments: run the closed-loop plant along excitations and record data sets.
-
-:func:`simulate_experiment` runs one trajectory; :func:`simulate_experiments` runs the
-paper's six (experiment k excites DOF k) and returns a :class:`SimulationResult` with the
-measured data sets, the true states and a metadata dictionary; :func:`write_experiments`
-writes them as ``exp1.csv ... exp6.csv`` + ``meta.json``.
+"""Virtual experiments: run the closed-loop plant along excitations, record data sets and write
+them as ``exp1.csv ... exp6.csv`` + ``meta.json``.
 """
 
 from __future__ import annotations
@@ -51,13 +47,11 @@ class ExperimentRecord:
     t : ndarray, shape (N,)
         s.
     q, q_dot, q_ddot : ndarray, shape (N, 6)
-        True pose, rate and acceleration (m, rad and their derivatives).
-    lengths, length_rates : ndarray, shape (N, 6)
-        True leg lengths (m) and rates (m/s).
+        m, rad and derivatives.
+    lengths, length_rates, command_lengths : ndarray, shape (N, 6)
+        m, m/s, m.
     forces, demands : ndarray, shape (N, 6)
-        Actual actuator forces and controller force demands (N).
-    command_lengths : ndarray, shape (N, 6)
-        Commanded leg lengths (m).
+        Actual actuator forces and controller demands (N).
     pressures : ndarray, shape (N, 6, 2)
         Chamber pressures p_A, p_B (Pa); constant in ideal actuator mode.
     spools : ndarray, shape (N, 6)
@@ -89,9 +83,9 @@ class SimulationResult:
     Attributes
     ----------
     datasets : list of Dataset
-        Measured data, one per experiment, as they would be written to files.
+        Measured data, one per experiment.
     meta : dict
-        Full configuration, seed, nominal matrices, package version (JSON-ready).
+        Configuration, seed, nominal matrices, package version (JSON-ready).
     states : list of ExperimentRecord
         True signals, one per experiment.
     """
@@ -102,8 +96,7 @@ class SimulationResult:
 
 
 def check_timing(duration_s: float, sample_rate: float, max_frequency: float) -> None:
-    """Raise ConfigError, in one line, on a record length that is not positive or an
-    excitation frequency (Hz) not below the Nyquist limit of ``sample_rate`` (Hz)."""
+    """Raise ConfigError on a non-positive record length or a frequency not below Nyquist."""
     if not (math.isfinite(duration_s) and duration_s > 0):
         raise ConfigError(f"duration must be > 0 s; got {duration_s!r}.")
     nyquist = sample_rate / 2
@@ -121,39 +114,18 @@ def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: 
                         step: float = DEFAULT_STEP,
                         coulomb_smoothing: float = COULOMB_SMOOTHING,
                         ) -> tuple[Dataset, ExperimentRecord]:
-    """Run the closed-loop plant along one excitation.
+    """Run the closed-loop plant along one excitation; returns the measured data set and the true
+    :class:`ExperimentRecord`.
 
-    Parameters
-    ----------
-    platform : Platform
-        Plant description, including ``[hydraulics]``, ``[controller]`` and ``[sensors]``.
-    excitation : Excitation
-        Commanded pose trajectory.
-    duration_s : float
-        Record length (s); samples at ``platform.sensors.sample_rate``.
-    noise : SensorNoise, optional
-        Sensor errors (delays, noise, hum, drift, quantisation:
-        :func:`stewartid.simulation.sensors.measure_legs`); those of ``[sensors]`` by default.
-    rng : numpy.random.Generator, optional
-        Noise source; a fresh ``default_rng(0)`` by default.
-    step : float
-        Largest integration step (s); rounded down to divide the sample period.
-    coulomb_smoothing : float
-        Regularisation rate of the Coulomb friction (rad/s).
-
-    Returns
-    -------
-    dataset : Dataset
-        Measured signals (pose from forward kinematics of the measured lengths).
-    record : ExperimentRecord
-        True signals.
+    ``duration_s`` in s, sampled at ``platform.sensors.sample_rate``; ``noise`` defaults to
+    ``[sensors]``, ``rng`` to ``default_rng(0)``; ``step`` (s) is rounded down to divide the sample
+    period; ``coulomb_smoothing`` in rad/s.
 
     Raises
     ------
     ConfigError
-        On a non-positive duration, an excitation, filter or hum frequency at or above the
-        Nyquist limit, an actuator that cannot hold the platform, or a servo loop that is
-        unstable at the start pose (:func:`stewartid.simulation.stability.require_stable`).
+        On a non-positive duration, a frequency not below Nyquist, an actuator that cannot hold the
+        platform, or a servo loop unstable at the start pose.
     StewartidError
         If a leg leaves its stroke or the integration diverges.
     """
@@ -212,11 +184,8 @@ def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: 
 
 
 def noise_generator(seed: int, experiment: int, count: int = 6) -> np.random.Generator:
-    """Random generator of the sensor noise of experiment ``experiment`` of ``count``.
-
-    The ``experiment``-th child of ``SeedSequence(seed)``: independent streams per experiment,
-    and the same data whether the experiments are simulated together
-    (:func:`simulate_experiments`) or one per worker process.
+    """Generator of experiment ``experiment`` of ``count``: that child of ``SeedSequence(seed)``, the
+    same whether experiments run together or one per worker.
     """
     return np.random.default_rng(np.random.SeedSequence(int(seed)).spawn(count)[experiment])
 
@@ -237,33 +206,27 @@ def simulate_experiments(platform: Platform, coulomb: float | None = None,
     ----------
     platform : Platform
     coulomb, viscous : float, optional
-        Override the platform's Coulomb (N m per joint axis) and gimbal viscous
-        (N m s/rad) friction.
+        Override the Coulomb (N m per joint axis) and gimbal viscous (N m s/rad) friction.
     frequency_hz : float
         Sine frequency (Hz), 0.5 in the paper.
     duration_s : float
         Length of each record (s).
     amplitudes : sequence of 6 float
-        Sine amplitudes per DOF (m, rad).
+        Per DOF (m, rad).
     noise : SensorNoise, optional
-        Sensor errors; the platform's ``[sensors]`` section by default.
+        Sensor errors; ``[sensors]`` by default.
     seed : int
-        Seed of the sensor noise (one independent stream per experiment).
+        Seed of the sensor noise, one stream per experiment.
     actuator : {"hydraulic", "ideal"}, optional
         Override ``[hydraulics] mode``.
     fade_in : float
-        Fade-in duration (s).
+        s.
     step : float
         Largest integration step (s).
     progress : callable, optional
-        Called as ``progress(done, total, name)`` after each experiment.
+        ``progress(done, total, name)`` after each experiment.
     jobs : int
-        Worker processes; the experiments are independent (each has its own noise stream),
-        so the data are the same for any number.
-
-    Returns
-    -------
-    SimulationResult
+        Worker processes; the data are the same for any number.
     """
     updates: dict[str, Any] = {}
     if coulomb is not None:
@@ -317,23 +280,10 @@ def _simulate_run(run: tuple) -> tuple[Dataset, ExperimentRecord]:
 def run_experiments(runs: Sequence[tuple], jobs: int | None = 1,
                     progress: Callable[[int, int, str], Any] | None = None,
                     ) -> list[tuple[Dataset, ExperimentRecord]]:
-    """Simulate ``runs`` in order, on up to ``jobs`` worker processes.
+    """Simulate ``runs`` in order on up to ``jobs`` workers (every core when None); results in order.
 
-    Parameters
-    ----------
-    runs : sequence of tuple
-        ``(platform, excitation, duration_s, noise, seed, k, count, step)``: experiment ``k``
-        of ``count``, with the noise stream :func:`noise_generator` ``(seed, k, count)``.
-    jobs : int, optional
-        Worker processes (:func:`stewartid.parallel.run_in_order`; every core when None);
-        1 runs here.
-    progress : callable, optional
-        ``progress(done, total, name)`` as experiments finish.
-
-    Returns
-    -------
-    list of (Dataset, ExperimentRecord)
-        In the order of ``runs``.
+    Each run is ``(platform, excitation, duration_s, noise, seed, k, count, step)``, its noise stream
+    :func:`noise_generator` ``(seed, k, count)``; ``progress(done, total, name)`` as they finish.
     """
     def finished(done: int, total: int, index: int) -> None:
         progress(done, total, runs[index][1].name)
@@ -353,7 +303,7 @@ def write_experiments(result: SimulationResult, out: str | Path, format: str = "
     Raises
     ------
     OutputExistsError
-        If ``out`` already holds results (``meta.json`` or ``exp*`` files) and not ``force``.
+        If ``out`` already holds results and not ``force``.
     ConfigError
         If ``format`` is unknown.
     """

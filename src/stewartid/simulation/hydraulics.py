@@ -1,23 +1,6 @@
-"""Hydraulic leg actuators: servo-valve, orifice flows, chamber pressures, actuator force.
-
-Per leg (all six alike, parameters from the ``[hydraulics]`` section):
-
-* Servo-valve spool, second order: x_v'' = w_v^2 (u - x_v) - 2 zeta_v w_v x_v', with u the
-  valve command (fraction of full opening, saturated to [-1, 1]).
-* Critically lapped four-edge valve with turbulent orifices:
-  x_v >= 0: Q_A = K x_v phi(p_s - p_A), Q_B = -K x_v phi(p_B - p_r);
-  x_v < 0:  Q_A = K x_v phi(p_A - p_r), Q_B = -K x_v phi(p_s - p_B),
-  K = Q_rated / sqrt(dp_rated / 2), phi(dp) = dp / (dp^2 + p_t^2)^(1/4): sign(dp) sqrt(|dp|)
-  above the transition pressure p_t, laminar below it (differentiable everywhere).
-* Chambers with compressible oil and stroke-dependent volumes, internal leakage C_i:
-  p_A' = beta / V_A (Q_A - A_A x' - C_i (p_A - p_B)),
-  p_B' = beta / V_B (Q_B + A_B x' + C_i (p_A - p_B)),
-  V_A = V_0 + A_A (S/2 + x), V_B = V_0 + A_B (S/2 - x); x = leg length - neutral leg length.
-* Actuator force along the leg (N, positive extends): f = p_A A_A - p_B A_B.
-
-References
-----------
-H. E. Merritt, *Hydraulic Control Systems*, Wiley, 1967 (orifice and chamber equations).
+"""Hydraulic leg actuators (``[hydraulics]``; Merritt 1967): second-order servo-valve spool
+x_v'' = w_v^2 (u - x_v) - 2 zeta_v w_v x_v', u in [-1, 1]; critically lapped turbulent orifices;
+compressible chambers with internal leakage; force f = p_A A_A - p_B A_B.
 """
 
 from __future__ import annotations
@@ -36,18 +19,9 @@ H_GAIN, H_TRANSITION, H_VALVE_OMEGA, H_VALVE_ZETA, H_LEAK = range(8, 13)
 
 
 def hydraulic_parameters(hydraulics: Hydraulics, mid_stroke_length: float) -> np.ndarray:
-    """Pack the ``[hydraulics]`` section for the compiled plant.
-
-    Parameters
-    ----------
-    hydraulics : Hydraulics
-    mid_stroke_length : float
-        Leg length (m) at which the piston is at mid-stroke (the neutral leg length).
-
-    Returns
-    -------
-    ndarray, shape (13,)
-        [A_A, A_B, p_s, p_r, beta, V_0, S, l_mid, K, p_t, w_v, zeta_v, C_i] (SI units).
+    """Pack ``[hydraulics]`` for the compiled plant, ``mid_stroke_length`` the neutral leg length (m):
+    [A_A, A_B, p_s, p_r, beta, V_0, S, l_mid, K, p_t, w_v, zeta_v, C_i] (SI),
+    K = Q_rated / sqrt(dp_rated / 2).
     """
     h = hydraulics
     gain = h.valve_rated_flow / math.sqrt(h.valve_rated_pressure_drop / 2.0)
@@ -66,7 +40,10 @@ def orifice(dp: float, transition: float) -> float:
 
 @njit(cache=True)
 def valve_flows(hp: np.ndarray, xv: float, pA: float, pB: float) -> tuple[float, float]:
-    """Flows into chamber A and chamber B (m^3/s) at spool position ``xv`` (fraction)."""
+    """Flows into chambers A, B (m^3/s) at spool position ``xv`` (fraction), phi = :func:`orifice`:
+    x_v >= 0: Q_A = K x_v phi(p_s - p_A), Q_B = -K x_v phi(p_B - p_r);
+    x_v < 0: Q_A = K x_v phi(p_A - p_r), Q_B = -K x_v phi(p_s - p_B).
+    """
     K = hp[H_GAIN]
     pt = hp[H_TRANSITION]
     if xv >= 0.0:
@@ -80,7 +57,7 @@ def valve_flows(hp: np.ndarray, xv: float, pA: float, pB: float) -> tuple[float,
 
 @njit(cache=True)
 def chamber_volumes(hp: np.ndarray, length: float) -> tuple[float, float]:
-    """Oil volumes (m^3) of chambers A and B at leg length ``length`` (m)."""
+    """Oil volumes (m^3) V_A = V_0 + A_A (S/2 + x), V_B = V_0 + A_B (S/2 - x), x from mid-stroke."""
     x = length - hp[H_MID]
     half = 0.5 * hp[H_STROKE]
     return hp[H_DEAD] + hp[H_AREA_A] * (half + x), hp[H_DEAD] + hp[H_AREA_B] * (half - x)
@@ -89,7 +66,9 @@ def chamber_volumes(hp: np.ndarray, length: float) -> tuple[float, float]:
 @njit(cache=True)
 def pressure_rates(hp: np.ndarray, xv: float, pA: float, pB: float, length: float,
                    length_rate: float) -> tuple[float, float]:
-    """Time derivatives of the chamber pressures (Pa/s)."""
+    """Chamber pressure rates (Pa/s): p_A' = beta / V_A (Q_A - A_A x' - C_i (p_A - p_B)),
+    p_B' = beta / V_B (Q_B + A_B x' + C_i (p_A - p_B)).
+    """
     qa, qb = valve_flows(hp, xv, pA, pB)
     va, vb = chamber_volumes(hp, length)
     leak = hp[H_LEAK] * (pA - pB)
@@ -105,39 +84,17 @@ def actuator_force(hp: np.ndarray, pA: float, pB: float) -> float:
 
 
 def force_limits(hydraulics: Hydraulics) -> tuple[float, float]:
-    """Smallest and largest force (N) the cylinder can exert at standstill.
-
-    Returns
-    -------
-    (f_min, f_max) : tuple of float
-        f_max = p_s A_A - p_r A_B (extending), f_min = p_r A_A - p_s A_B (retracting).
-    """
+    """(f_min, f_max) at standstill (N): p_r A_A - p_s A_B and p_s A_A - p_r A_B."""
     h = hydraulics
     return (h.return_pressure * h.piston_area - h.supply_pressure * h.annulus_area,
             h.supply_pressure * h.piston_area - h.return_pressure * h.annulus_area)
 
 
 def static_state(hp: np.ndarray, force: float, length: float) -> tuple[float, float, float]:
-    """Spool position and chamber pressures that hold ``force`` at rest.
+    """Spool position (fraction) and chamber pressures (Pa) that hold ``force`` (N) at rest.
 
-    At rest the valve only feeds the leakage, and both metering edges see the same pressure
-    drop, so p_A + p_B = p_s + p_r; with p_A A_A - p_B A_B = force the pressures follow in
-    closed form, the spool position from the leakage flow.
-
-    Parameters
-    ----------
-    hp : ndarray, shape (13,)
-        Packed parameters (:func:`hydraulic_parameters`).
-    force : float
-        N, positive extends.
-    length : float
-        Leg length (m); unused (no flow into the chambers at rest), kept for a uniform per-leg
-        signature.
-
-    Returns
-    -------
-    (x_v, p_A, p_B) : tuple of float
-        Fraction of full opening, Pa, Pa.
+    At rest the valve only feeds the leakage and both edges see the same drop, so p_A + p_B = p_s + p_r;
+    ``length`` is unused (uniform per-leg signature).
 
     Raises
     ------
@@ -163,10 +120,8 @@ def static_state(hp: np.ndarray, force: float, length: float) -> tuple[float, fl
 
 def hydraulic_natural_frequency(hydraulics: Hydraulics, effective_mass: float,
                                 piston_position: float = 0.0) -> float:
-    """Hydraulic natural frequency w_h (rad/s) of one leg moving a mass ``effective_mass`` (kg).
-
-    w_h = sqrt(beta (A_A^2 / V_A + A_B^2 / V_B) / m), with chamber volumes at
-    ``piston_position`` (m from mid-stroke).
+    """Natural frequency w_h = sqrt(beta (A_A^2 / V_A + A_B^2 / V_B) / m) (rad/s) of one leg moving
+    ``effective_mass`` (kg), volumes at ``piston_position`` (m from mid-stroke).
     """
     h = hydraulics
     va = h.dead_volume + h.piston_area * (h.stroke / 2 + piston_position)

@@ -1,15 +1,6 @@
-"""The compiled closed loop: rigid-body plant, joint friction, actuators and leg servos.
-
-State vector y (42 values): q (6), q_dot (6), PID integrators z (6, m s), valve spools x_v
-(6, fraction) and their rates (6, 1/s), chamber pressures p_A (6, Pa) and p_B (6, Pa). In
-``ideal`` actuator mode the valve and pressure states are frozen and the leg forces are the
-controller's demands.
-
-Integration: fixed-step RK4 inside one numba loop, the commands tabulated beforehand on the
-half-step grid RK4 samples; the default step lies well inside RK4's stability limit for the
-loop's fastest pole (:func:`stewartid.simulation.stability.closed_loop_poles`). Joint
-friction is regularised (:func:`stewartid.model.kernels.joint_friction_torque`), so a joint
-sticks and slips without event detection.
+"""The compiled closed loop (plant, joint friction, actuators, leg servos), fixed-step RK4 in one numba
+loop. State y (42): q, q_dot, PID integrators (m s), spools, spool rates (1/s), p_A, p_B (Pa),
+six each; ``ideal`` actuators freeze valves and pressures and apply the demands.
 """
 
 from __future__ import annotations
@@ -36,7 +27,7 @@ STATUS_OK, STATUS_STROKE, STATUS_NONFINITE = 0, 1, 2
 
 @njit(cache=True)
 def _solve_spd(M: np.ndarray, b: np.ndarray, L: np.ndarray, out: np.ndarray) -> None:
-    """Solve M x = b for a symmetric positive definite 6x6 M by Cholesky (no allocation)."""
+    """Solve M x = b for a symmetric positive definite 6x6 M by Cholesky, without allocating."""
     n = 6
     for i in range(n):
         for j in range(i + 1):
@@ -61,8 +52,7 @@ def _solve_spd(M: np.ndarray, b: np.ndarray, L: np.ndarray, out: np.ndarray) -> 
 
 @njit(cache=True)
 def _scratch():
-    """Scratch arrays of :func:`rhs` after ``dy``: M, h, G, J, Jj, lengths, rates, force,
-    demand, work, chol, qdd."""
+    """Scratch arrays of :func:`rhs` after ``dy``."""
     return (np.empty((6, 6)), np.empty(6), np.empty(6), np.empty((6, 6)), np.empty((6, 5, 6)),
             np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.zeros((6, 6)),
             np.empty(6))
@@ -71,11 +61,8 @@ def _scratch():
 @njit(cache=True)
 def rhs(y, dy, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, hydraulic,
         smoothing, M, h, G, J, Jj, lengths, rates, force, demand, work, chol, qdd):
-    """Closed-loop state derivative (written into ``dy``) at one instant.
-
-    ``cmd_*`` are the (6,) commanded leg lengths (m), rates (m/s) and feed-forward (N) at
-    this instant; the remaining arrays are scratch outputs: model terms, leg lengths and
-    rates, the actual leg forces ``force`` and the controller's ``demand`` (N).
+    """Closed-loop state derivative into ``dy``, for this instant's commanded leg lengths (m), rates
+    (m/s) and feed-forward (N); the remaining arrays are scratch outputs (model terms, leg forces).
     """
     q = y[S_Q:S_Q + 6]
     qd = y[S_QD:S_QD + 6]
@@ -135,38 +122,12 @@ def rhs(y, dy, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, hyd
 @njit(cache=True)
 def integrate(y0, step, substeps, n_out, cmd_length, cmd_rate, cmd_force, params, upper, base,
               hp, cp, hydraulic, smoothing):
-    """Integrate the closed loop with RK4 and record every ``substeps`` steps.
+    """Integrate the closed loop with RK4 (step h, s) and record every ``substeps`` steps, n_out samples.
 
-    Parameters
-    ----------
-    y0 : (42,) initial state.
-    step : float
-        Integration step h (s).
-    substeps : int
-        Steps per recorded sample (output period = substeps * h).
-    n_out : int
-        Number of recorded samples (the first at t = 0).
-    cmd_length, cmd_rate, cmd_force : (2 * substeps * (n_out - 1) + 1, 6)
-        Commands on the half-step grid t = k h / 2.
-    params, upper, base : packed platform.
-    hp, cp : packed hydraulic and controller parameters.
-    hydraulic : bool
-        Hydraulic actuators (True) or ideal force actuators (False).
-    smoothing : float
-        Coulomb regularisation rate (rad/s).
-
-    Returns
-    -------
-    status : int
-        0 ok, 1 a leg left its stroke, 2 the state became non-finite.
-    where : int
-        Recorded sample at which integration stopped (n_out if it finished), or the leg for
-        status 1 is ``leg`` below.
-    leg : int
-        Leg index for status 1, else -1.
-    states : (n_out, 42) recorded states.
-    qdd, lengths, rates, force, demand : (n_out, 6) recorded accelerations, leg lengths,
-        leg rates, actual leg forces and force demands.
+    Commands (2 substeps (n_out - 1) + 1, 6) are on the half-step grid t = k h / 2; ``hydraulic``
+    False for ideal force actuators; ``smoothing`` in rad/s. Returns (status, where, leg, states
+    (n_out, 42), qdd, lengths, rates, force, demand (n_out, 6)): status 0 ok, 1 leg ``leg`` left its
+    stroke, 2 non-finite state; ``where`` the sample integration stopped at (n_out if finished).
     """
     n = N_STATES
     states = np.zeros((n_out, n))
@@ -231,11 +192,8 @@ def integrate(y0, step, substeps, n_out, cmd_length, cmd_rate, cmd_force, params
 @njit(cache=True)
 def linearize(y0, scales, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp,
               hydraulic, smoothing):
-    """State matrix A = d(dy/dt)/dy (42, 42) of the closed loop at ``y0``, commands frozen.
-
-    Central differences with the per-state step ``scales`` (42,); the right-hand side is
-    smooth (regularised orifices and Coulomb friction), so the truncation error is
-    O(scale^2).
+    """State matrix A = d(dy/dt)/dy (42, 42) at ``y0``, commands frozen, by central differences of
+    steps ``scales`` (42,): O(scale^2) on the smooth right-hand side.
     """
     n = N_STATES
     M, h, G, J, Jj, lengths, rates, force, demand, work, chol, qdd = _scratch()

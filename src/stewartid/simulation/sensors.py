@@ -1,14 +1,6 @@
-"""Sensors: sampling, leg-length and actuator-force measurement errors, forward kinematics.
-
-A measurement is quantise(true(t - delay) + bias + noise + hum + drift): the true signal
-logged ``*_delay`` seconds after the motion, a constant ``*_bias``, Gaussian noise of
-standard deviation ``*_noise`` (white, or low-pass filtered for the forces), a mains hum on
-the forces, a random-walk drift, and rounding to a multiple of ``*_resolution`` (none when
-0); every error is drawn from a seeded generator (:mod:`.imperfections`). The force sensor
-stands for the two pressure transducers of a leg (f = p_A A_A - p_B A_B); its errors are
-given in newtons. The measured pose is the forward kinematics of the measured leg lengths,
-as on a real hexapod without pose sensors. :func:`degrade` applies the same errors to an
-existing data set, simulated or logged.
+"""Sensors: measured = quantise(true(t - delay) + bias + noise + hum + drift) on leg lengths and
+forces (a leg's pressure transducers, in N), seeded; the pose is the forward kinematics of the
+measured lengths, as on a rig without pose sensors.
 """
 
 from __future__ import annotations
@@ -37,7 +29,7 @@ _SENSORS_FIELDS = {f.name: f for f in dataclasses.fields(Sensors)}
 
 
 def _as_in_sensors(name: str) -> Any:
-    """A field declared as the platform's ``[sensors] name`` (unit, description, values), 0."""
+    """A field declared as the platform's ``[sensors] name``, default 0."""
     return dataclasses.field(default=0.0, metadata=_SENSORS_FIELDS[name].metadata)
 
 
@@ -54,36 +46,24 @@ LENGTH_ERRORS = ("length_noise", "length_bias", "length_resolution", "length_del
 class SensorNoise:
     """Measurement errors of the leg-length and force sensors (defaults: ideal sensors).
 
-    Declared with the constraints of :mod:`stewartid.fields` (the first six as the
-    platform's ``[sensors]`` section); every error is drawn from the generator given to
-    :func:`measure_legs`, in the order of the attributes below, so that switching on a hum
-    or a drift leaves the noise of the same seed unchanged.
+    Errors are drawn in the order of the attributes, so switching on a hum or a drift leaves the
+    noise of the same seed unchanged.
 
     Attributes
     ----------
-    length_noise : float or tuple of 6 float
-        Standard deviation of the white leg-length noise (m), one per leg when six.
-    length_bias, length_resolution : float
-        Offset and quantisation step of the leg lengths (m).
-    force_noise : float or tuple of 6 float
-        Standard deviation of the force noise (N), one per leg when six; white, or coloured
-        by ``force_lowpass`` (the standard deviation after filtering).
-    force_bias, force_resolution : float
-        Offset and quantisation step of the forces (N).
+    length_noise, force_noise : float or tuple of 6 float
+        Standard deviation (m, N), per leg when six; the force noise white, or after ``force_lowpass``.
+    length_bias, length_resolution, force_bias, force_resolution : float
+        Offsets and quantisation steps (m, N).
     length_delay, force_delay : float
-        Delay of the channel behind the motion (s): measured(t) = true(t - delay).
+        Channel delay behind the motion (s).
     force_lowpass : float
-        Cut-off (-3 dB) of the Butterworth low-pass filter colouring the force noise (Hz);
-        0: white noise.
+        -3 dB cut-off of the Butterworth filter colouring the force noise (Hz); 0: white.
     force_lowpass_order : int
-        Order of that filter.
-    hum_amplitude : float
-        Amplitude of the mains hum on every force channel (N), a random phase per leg.
-    hum_frequency : float
-        Mains frequency (Hz).
+    hum_amplitude, hum_frequency : float
+        Mains hum on every force channel (N, random phase per leg) and its frequency (Hz).
     length_drift, force_drift : float
-        Standard deviation at the end of the record of a random walk from zero per channel
-        (m, N).
+        Standard deviation at the record's end of a random walk per channel (m, N).
     """
 
     length_noise: float | tuple[float, ...] = _as_in_sensors("length_noise")
@@ -150,7 +130,7 @@ class SensorNoise:
         Raises
         ------
         ConfigError
-            Naming the setting, the Nyquist frequency and the sample rate (Hz).
+            Naming the setting, the Nyquist frequency and the sample rate.
         """
         nyquist = sample_rate / 2
         for name, used in (("force_lowpass", self.force_lowpass > 0),
@@ -176,16 +156,8 @@ def static_leg_force(platform: Platform) -> float:
 
 
 def reference_noise(platform: Platform, scale: float = 1.0) -> SensorNoise:
-    """The platform's ``[sensors]`` errors with the noise set to ``scale`` times the reference.
-
-    The reference is 20 µm on the leg lengths and 0.5 % of the static leg force
-    (:func:`static_leg_force`) on the forces; biases and resolutions stay the platform's.
-
-    Parameters
-    ----------
-    platform : Platform
-    scale : float
-        Multiple of the reference noise (-), >= 0; 0 gives noise-free lengths and forces.
+    """The platform's ``[sensors]`` errors with the noise at ``scale`` (>= 0) times the reference:
+    20 µm on the leg lengths, 0.5 % of the static leg force on the forces.
     """
     if not (np.isfinite(scale) and scale >= 0):
         raise ConfigError(f"noise scale must be a finite number >= 0; got {scale!r}.")
@@ -202,24 +174,11 @@ REFERENCE_CHOICES = ("never", "always", "where_zero")
 
 def sensor_noise(platform: Platform, reference: str = "never", length_noise: float | None = None,
                  force_noise: float | None = None) -> SensorNoise:
-    """The sensor errors of a run: the platform's ``[sensors]``, the reference noise
-    (:func:`reference_noise`) where ``reference`` asks, then the given standard deviations.
+    """A run's sensor errors: the platform's ``[sensors]``, the reference noise where ``reference``
+    asks, then the given standard deviations (m, N); biases and resolutions stay the platform's.
 
-    Parameters
-    ----------
-    platform : Platform
-    reference : {"never", "always", "where_zero"}
-        Take the reference noise standard deviation of a channel never, always
-        (``simulate --noise``), or where ``[sensors]`` declares none (``design``).
-    length_noise : float, optional
-        Leg-length noise standard deviation (m), overriding the above.
-    force_noise : float, optional
-        Force noise standard deviation (N), overriding the above.
-
-    Returns
-    -------
-    SensorNoise
-        Biases and resolutions are always the platform's.
+    ``reference``: "never", "always" (``simulate --noise``) or "where_zero" (channels ``[sensors]``
+    leaves noise-free, ``design``).
 
     Raises
     ------
@@ -250,7 +209,7 @@ def quantise(values: np.ndarray, resolution: float) -> np.ndarray:
 
 def measure(true: np.ndarray, noise: float, bias: float, resolution: float,
             rng: np.random.Generator) -> np.ndarray:
-    """quantise(true + bias + N(0, noise^2)) element-wise; same shape as ``true``."""
+    """quantise(true + bias + N(0, noise^2)) element-wise."""
     out = np.asarray(true, dtype=float) + bias
     if noise > 0:
         out = out + rng.normal(0.0, noise, size=out.shape)
@@ -262,22 +221,13 @@ def measure_legs(lengths: np.ndarray, forces: np.ndarray, noise: SensorNoise,
                  ) -> tuple[np.ndarray, np.ndarray]:
     """Measured leg lengths (m) and forces (N), both (N, 6), from the true ones.
 
-    Parameters
-    ----------
-    lengths, forces : ndarray, shape (N, 6)
-        True leg lengths (m) and actuator forces (N).
-    noise : SensorNoise
-    rng : numpy.random.Generator
-        Draws, in this order and only for the errors that are nonzero: the length noise, the
-        force noise, the hum phases, the length drift, the force drift.
-    t : ndarray, shape (N,), optional
-        Sample times (s), uniform; required for delays, filtered noise and hum.
+    ``rng`` draws, only for nonzero errors: length noise, force noise, hum phases, length drift,
+    force drift. ``t`` (N,) (s, uniform) is needed for delays, filtered noise and hum.
 
     Raises
     ------
     ConfigError
-        If ``t`` is missing where it is required, or a filter or hum frequency is not below
-        the Nyquist frequency.
+        If ``t`` is missing where needed, or a filter or hum frequency is not below Nyquist.
     """
     n = len(lengths)
     rate = None
@@ -312,39 +262,19 @@ def measure_legs(lengths: np.ndarray, forces: np.ndarray, noise: SensorNoise,
 
 def measured_pose(platform: Platform, lengths: np.ndarray,
                   initial: np.ndarray | None = None) -> np.ndarray:
-    """The forward-kinematics block: pose (N, 6) from measured leg lengths (N, 6).
-
-    Newton iterations to a residual of 1e-12 m on the leg lengths, started from ``initial``
-    (N, 6), e.g. the commanded poses that the controller knows, or from the neutral pose.
+    """Pose (N, 6) from measured leg lengths (N, 6) by Newton to 1e-12 m, from ``initial`` (e.g. the
+    commanded poses) or the neutral pose.
     """
     return forward_kinematics(platform, lengths, initial=initial, tolerance=1e-12)
 
 
 def degrade(dataset: Dataset, platform: Platform, noise: SensorNoise,
             rng: np.random.Generator | int | None = None) -> Dataset:
-    """A copy of a data set measured by imperfect sensors: a rig's errors on a clean log.
+    """A copy of a data set (same times and name) measured by the imperfect sensors ``noise``.
 
-    The leg lengths and forces go through the sensor model of the simulator
-    (:func:`measure_legs`: delay, bias, white or filtered noise, hum, drift, quantisation);
-    the pose is then the forward kinematics of the measured lengths, started from the
-    data set's pose (unchanged when the lengths are: no length error in ``noise``).
-
-    Parameters
-    ----------
-    dataset : Dataset
-        A clean log, simulated or a rig's own (then its errors add to those it has). Its
-        first sample is held before it for the delays (the rig at rest before the record).
-    platform : Platform
-        Geometry for the forward kinematics.
-    noise : SensorNoise
-        The errors to apply.
-    rng : numpy.random.Generator or int, optional
-        Generator or seed of the random errors (seed 0 when None).
-
-    Returns
-    -------
-    Dataset
-        Same times and name.
+    Lengths and forces go through :func:`measure_legs` (the first sample held before the record for
+    the delays); the pose is the forward kinematics of the measured lengths. ``rng`` is a generator
+    or seed (0 when None).
 
     Raises
     ------

@@ -1,8 +1,5 @@
-"""Closed-loop equilibrium at rest and the poles of the loop linearised about it.
-
-An unstable servo loop grows into a limit cycle no rigid-body model explains, so every
-experiment is checked before it is integrated (:func:`require_stable`), from the state matrix
-of :func:`stewartid.simulation.plant.linearize` at the equilibrium of :func:`initial_state`.
+"""Closed-loop equilibrium at rest and the poles of the loop linearised about it: an unstable servo
+grows a limit cycle no rigid-body model explains, so every experiment is checked first.
 """
 
 from __future__ import annotations
@@ -23,25 +20,8 @@ GROWTH_TOLERANCE = 1e-3
 
 def initial_state(platform: Platform, q0: np.ndarray, feedforward_force: np.ndarray,
                   hp: np.ndarray, cp: np.ndarray) -> np.ndarray:
-    """Closed-loop equilibrium at rest at pose ``q0``: no start-up transient.
-
-    Leg forces hold the pose against gravity; the valves feed the leakage; the PID integrators
-    hold the force demand that the inner loop needs.
-
-    Parameters
-    ----------
-    platform : Platform
-    q0 : ndarray, shape (6,)
-        Pose (m, rad).
-    feedforward_force : ndarray, shape (6,)
-        Gravity feed-forward of the controller at ``q0`` (N).
-    hp, cp : ndarray
-        Packed hydraulic and controller parameters.
-
-    Returns
-    -------
-    ndarray, shape (42,)
-        State vector (layout in :mod:`stewartid.simulation.plant`).
+    """Closed-loop equilibrium (42,) at rest at pose ``q0``: forces hold the pose, valves feed the
+    leakage, integrators hold the demand; ``feedforward_force`` (6,) in N.
     """
     t = ModelTerms(platform, q0)
     J, G = t.leg_jacobian[0], t.gravity[0]
@@ -64,7 +44,6 @@ def initial_state(platform: Platform, q0: np.ndarray, feedforward_force: np.ndar
 
 
 def _difference_steps(y0: np.ndarray) -> np.ndarray:
-    """Finite-difference step per state: ~1e-7 of each block's natural scale."""
     steps = np.empty(plant.N_STATES)
     steps[plant.S_Q:plant.S_Q + 6] = 1e-7       # m, rad
     steps[plant.S_QD:plant.S_QD + 6] = 1e-7     # m/s, rad/s: below the Coulomb smoothing
@@ -79,33 +58,15 @@ def loop_poles(y0: np.ndarray, cmd_length: np.ndarray, cmd_rate: np.ndarray,
                cmd_force: np.ndarray, params: np.ndarray, upper: np.ndarray,
                base: np.ndarray, hp: np.ndarray, cp: np.ndarray, hydraulic: bool,
                smoothing: float = COULOMB_SMOOTHING) -> np.ndarray:
-    """Eigenvalues (1/s) of the closed loop linearised at state ``y0`` (packed arguments).
-
-    Returns
-    -------
-    ndarray, shape (42,), complex
-        Poles; the frozen valve and pressure states of ideal actuators give exact zeros.
-    """
+    """Eigenvalues (42,) (1/s) of the loop linearised at ``y0``; frozen ideal-actuator states give zeros."""
     A = plant.linearize(y0, _difference_steps(y0), cmd_length, cmd_rate, cmd_force, params,
                         upper, base, hp, cp, hydraulic, float(smoothing))
     return np.linalg.eigvals(A)
 
 
 def closed_loop_poles(platform: Platform, pose: np.ndarray | None = None) -> np.ndarray:
-    """Poles (1/s) of the servo loop linearised at rest at ``pose`` (neutral by default).
-
-    Parameters
-    ----------
-    platform : Platform
-        With its ``[hydraulics]`` (including ``mode``), ``[controller]`` and friction.
-    pose : ndarray, shape (6,), optional
-        m, rad.
-
-    Returns
-    -------
-    ndarray, shape (42,), complex
-        Sorted by decreasing real part. A pole s = sigma + i w has natural frequency |s|,
-        damping ratio -sigma / |s| and oscillates at w / (2 pi) Hz.
+    """Poles (42,) (1/s) of the servo loop linearised at rest at ``pose`` (neutral by default), by
+    decreasing real part; s = sigma + i w has damping -sigma / |s| and oscillates at w / (2 pi) Hz.
     """
     q0 = platform.neutral_pose if pose is None else np.asarray(pose, dtype=float)
     q0 = np.ascontiguousarray(q0, dtype=float).reshape(1, 6)
@@ -128,7 +89,7 @@ def require_stable(poles: np.ndarray, platform: Platform, where: str) -> None:
     Raises
     ------
     ConfigError
-        Naming the unstable mode (frequency, growth rate) and the gains to lower.
+        Naming the unstable mode and the gains to lower.
     """
     worst = poles[np.argmax(poles.real)]
     if worst.real <= GROWTH_TOLERANCE:
