@@ -1,9 +1,6 @@
-"""Time alignment of the force channels with the motion channels.
-
-Forces logged ``delay`` seconds late, f_logged(t) = f(t - delay), are aligned as
-f(t) = f_logged(t + delay), read between the samples by a cubic spline; samples whose
-t + delay falls outside the record are dropped, never extrapolated. The delay is estimated by
-:func:`stewartid.identification.delay.estimate_delay`.
+"""Time alignment of late force channels with the motion: f(t) = f_logged(t + delay) by cubic
+spline, samples beyond the record dropped (delay from
+:func:`stewartid.identification.delay.estimate_delay`).
 """
 
 from __future__ import annotations
@@ -18,28 +15,13 @@ from stewartid.signals.interpolation import spline_at
 
 
 def shift_forces(dataset: Dataset, delay: float) -> Dataset:
-    """The experiment with its forces moved ``delay`` seconds earlier (aligned with the motion).
-
-    Parameters
-    ----------
-    dataset : Dataset
-        Forces logged ``delay`` seconds after the motion they belong to.
-    delay : float
-        Delay of the force channels relative to the motion (s); positive when the forces are
-        late, negative when they are early; zero returns ``dataset`` itself.
-
-    Returns
-    -------
-    Dataset
-        The samples k with t_k + delay inside [t_0, t_end], pose and lengths unchanged there,
-        forces f_logged(t_k + delay) (:func:`~stewartid.signals.interpolation.spline_at`; a delay that
-        is a whole number of sample periods gives the logged samples themselves).
+    """The experiment with its forces moved ``delay`` s earlier (positive: forces late; 0 returns
+    ``dataset``), keeping samples with t_k + delay inside the record.
 
     Raises
     ------
     ConfigError
-        A non-finite delay, or one so long that fewer than
-        :data:`~stewartid.datasets.dataset.MIN_SAMPLES` samples would remain.
+        Non-finite delay, or fewer than :data:`~stewartid.datasets.dataset.MIN_SAMPLES` samples left.
     """
     delay = float(delay)
     if not np.isfinite(delay):
@@ -68,25 +50,14 @@ def shift_forces(dataset: Dataset, delay: float) -> Dataset:
 
 
 def align_forces(datasets: Sequence[Dataset], delay: float) -> list[Dataset]:
-    """:func:`shift_forces` of every experiment (one delay for all: the same acquisition
-    chain).
-
-    Parameters
-    ----------
-    datasets : sequence of Dataset
-    delay : float
-        Delay of the force channels relative to the motion (s), positive when late.
-
-    Returns
-    -------
-    list of Dataset
+    """:func:`shift_forces` of every experiment with one delay (one acquisition chain).
 
     Raises
     ------
     ConfigError
         As :func:`shift_forces`.
     DataError
-        No experiments given.
+        No experiments.
     """
     if not datasets:
         raise DataError("no experiments given to align; pass one or more data sets.")

@@ -1,9 +1,5 @@
-"""``meta.json`` (and ``truth.json``) beside the data files: the platform the data come from
-and the nominal Mt, Bt they should give.
-
-``stewartid simulate`` writes ``meta.json`` with the whole platform description under
-``"platform"`` and the plant's nominal matrices; a hand-written one may name a preset or a
-TOML file instead. A file that cannot be read as JSON is skipped.
+"""``meta.json`` (and ``truth.json``) beside the data: the platform the data come from and the
+nominal Mt, Bt; unreadable JSON is skipped.
 """
 
 from __future__ import annotations
@@ -21,8 +17,7 @@ from stewartid.platform import Platform, load_platform, platform_from_mapping
 
 
 def _documents(files: Sequence[Path], names: Sequence[str]):
-    """(path, JSON document) of every readable file named ``names`` beside ``files``, folder by
-    folder in the order of ``files``."""
+    """(path, document) of every readable ``names`` file beside ``files``, folder by folder."""
     for folder in dict.fromkeys(f.parent for f in files):
         for name in names:
             path = folder / name
@@ -36,21 +31,14 @@ def _documents(files: Sequence[Path], names: Sequence[str]):
 
 
 def platform_from_meta(files: Sequence[Path]) -> tuple[Platform, Path] | None:
-    """The platform description that a ``meta.json`` beside the data names, if any.
+    """The description a ``meta.json`` beside the data names, and that file; None without.
 
-    ``stewartid simulate`` writes the whole description under ``"platform"``; a hand-written
-    ``meta.json`` may name a preset or a TOML file instead (``{"platform": "paper"}`` or
-    ``{"platform": "hexapod.toml"}``, relative to the ``meta.json``).
-
-    Returns
-    -------
-    (Platform, Path) or None
-        The description and the ``meta.json`` that names it.
+    Under ``"platform"``: the whole description, a preset or a TOML path relative to the file.
 
     Raises
     ------
     ConfigError
-        The data folders name different platforms, or a named description is invalid.
+        Folders name different platforms, or a named description is invalid.
     """
     found = []
     for path, document in _documents(files, ("meta.json",)):
@@ -70,17 +58,13 @@ def platform_from_meta(files: Sequence[Path]) -> tuple[Platform, Path] | None:
 
 
 def platform_for_data(files: Sequence[Path], platform: str | Path | None) -> Platform:
-    """The platform description of the data: ``platform`` (``"paper"`` or a TOML file) if
-    given, else the one a ``meta.json`` beside the data names.
-
-    When both are there, ``platform`` decides (a broken ``meta.json`` does not matter then);
-    a ``meta.json`` with another geometry or inertia draws a warning. Friction may differ: it
-    is what the data measure.
+    """The data's platform: ``platform`` (preset or TOML) if given, else the ``meta.json``'s.
+    With both, ``platform`` decides and differing geometry or inertia warns (friction may differ).
 
     Raises
     ------
     ConfigError
-        Neither is there, or (without ``platform``) the ``meta.json`` files are inconsistent.
+        Neither given, or inconsistent ``meta.json`` files.
     """
     try:
         named = platform_from_meta(files)
@@ -105,15 +89,9 @@ def platform_for_data(files: Sequence[Path], platform: str | Path | None) -> Pla
 
 
 def nominal_from_meta(files: Sequence[Path]) -> tuple[np.ndarray, np.ndarray, str] | None:
-    """Nominal (Mt, Bt) from a ``meta.json`` or ``truth.json`` beside the data files.
+    """Nominal (M, B, source file) from a ``meta.json`` or ``truth.json`` beside the data, or None.
 
-    Accepted layouts: ``{"nominal": {"M": ..., "B": ...}}`` or ``{"Mt": ..., "Bt": ...}``.
-
-    Returns
-    -------
-    (M, B, source) or None
-        The matrices, shape (6, 6) each (kg, kg m, kg m^2 and N s/m, N s, N m s blocks), and
-        the file they come from; None when no such file holds them.
+    Layouts: ``{"nominal": {"M": ..., "B": ...}}`` or ``{"Mt": ..., "Bt": ...}``.
     """
     for path, document in _documents(files, ("meta.json", "truth.json")):
         nominal: Any = document.get("nominal", document) if isinstance(document, dict) else {}

@@ -1,9 +1,5 @@
-"""Command files of a design, and playing any excitation file on the plant.
-
-A command file is a CSV table of one record at the controller's rate: ``t`` (s), the pose
-``x, y, z, rx, ry, rz`` (m, rad; absolute, paper frame) and the leg lengths ``l1..l6`` (m).
-:func:`read_excitation` reads such a file, or one with the pose or the lengths alone, into a
-:class:`TabulatedExcitation` the plant plays through a cubic spline.
+"""Command files of a design (CSV at the controller rate: ``t``, absolute pose in m, rad,
+``l1..l6`` in m), and playing any excitation file on the plant.
 """
 
 from __future__ import annotations
@@ -35,13 +31,7 @@ LENGTH_COLUMNS = tuple(f"l{k}" for k in range(1, 7))
 
 def command_table(platform: Platform, design: Design, rate_hz: float
                   ) -> list[tuple[str, np.ndarray]]:
-    """Pose and leg-length commands of every record at ``rate_hz``.
-
-    Returns
-    -------
-    list of (name, table)
-        ``table`` has shape (N, 13): t (s), pose (m, rad), leg lengths (m).
-    """
+    """Per record, (name, table (N, 13)): t (s), pose (m, rad), leg lengths (m) at ``rate_hz``."""
     if not (math.isfinite(rate_hz) and rate_hz > 0):
         raise ConfigError(f"controller rate must be > 0 Hz; got {rate_hz!r}.")
     out = []
@@ -60,12 +50,7 @@ def command_table(platform: Platform, design: Design, rate_hz: float
 
 def write_commands(platform: Platform, design: Design, directory: str | Path,
                    rate_hz: float = 500.0) -> list[Path]:
-    """Write one command file ``<record>.csv`` per record into ``directory``.
-
-    Returns
-    -------
-    list of Path
-    """
+    """Write one command file ``<record>.csv`` per record into ``directory``; return the paths."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     header = ",".join(("t", *COORDINATES, *LENGTH_COLUMNS))
@@ -78,7 +63,7 @@ def write_commands(platform: Platform, design: Design, directory: str | Path,
 
 @dataclasses.dataclass(frozen=True)
 class TabulatedExcitation:
-    """A pose trajectory given by samples, played through a cubic spline.
+    """A sampled pose trajectory played through a cubic spline.
 
     Attributes
     ----------
@@ -88,7 +73,7 @@ class TabulatedExcitation:
         m, rad.
     name : str
     max_frequency : float
-        Dominant frequency of the motion (Hz), for the plant's sampling check.
+        Dominant frequency (Hz), for the plant's sampling check.
     """
 
     t: np.ndarray
@@ -102,22 +87,19 @@ class TabulatedExcitation:
         return float(self.t[-1] - self.t[0])
 
     def evaluate(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Pose, velocity and acceleration at ``t`` (s), each (N, 6); held at the last sample after
-        the end of the table.
-        """
+        """Pose, velocity and acceleration at ``t`` (s), each (N, 6); held after the end."""
         spline = CubicSpline(self.t, self.pose, axis=0, bc_type="clamped")
         inside = np.clip(np.asarray(t, dtype=float), self.t[0], self.t[-1])
         return spline(inside), spline(inside, 1), spline(inside, 2)
 
 
 def read_excitation(path: str | Path, platform: Platform) -> TabulatedExcitation:
-    """Read an excitation file: ``t`` and the pose columns, or ``t`` and ``l1..l6``.
+    """Read an excitation file: ``t`` with the pose columns or ``l1..l6``.
 
     Raises
     ------
     DataError
-        If the file cannot be read, lacks ``t`` or both column groups, has non-finite values,
-        or its time is not strictly increasing.
+        Unreadable, missing columns, non-finite values, or time not strictly increasing.
     """
     path = Path(path)
     if not path.is_file():
@@ -150,24 +132,20 @@ def read_excitation(path: str | Path, platform: Platform) -> TabulatedExcitation
 def simulate_excitations(platform: Platform, excitations: Sequence[Any],
                          noise: SensorNoise | None = None, seed: int = 0,
                          progress: Callable[[int, int, str], Any] | None = None):
-    """Play excitations on the plant, one experiment each, named ``exp1..expN``.
+    """Play excitations on the plant, one experiment each (``exp1..expN``); return a
+    :class:`~stewartid.simulation.SimulationResult`.
 
     Parameters
     ----------
     platform : Platform
     excitations : sequence
-        :class:`TabulatedExcitation` or designed records
-        (:meth:`~stewartid.design.candidates.Design.playable`); each runs for its duration.
+        :class:`TabulatedExcitation` or :meth:`~stewartid.design.candidates.Design.playable` records.
     noise : SensorNoise, optional
-        The platform's ``[sensors]`` errors by default.
+        Default: the platform's ``[sensors]``.
     seed : int
-        Noise seed (one independent stream per experiment, as ``simulate``).
+        One stream per experiment, as ``simulate``.
     progress : callable, optional
         ``progress(done, total, name)``.
-
-    Returns
-    -------
-    stewartid.simulation.SimulationResult
     """
     noise = SensorNoise.from_sensors(platform.sensors) if noise is None else noise
     datasets, records, sources = [], [], []

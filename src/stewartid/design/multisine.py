@@ -1,12 +1,5 @@
-"""Records that move every DOF at once: a few sines per DOF, faded in and out.
-
-DOF d of a :class:`MultisineRecord` moves as
-
-    q_d(t) = q0_d + a(t) * sum_h A[d, h] sin(2 pi F[d, h] t + phi[d, h]),
-
-with a(t) a quintic fade-in and fade-out, so that it starts and ends at rest. The physical
-model's parameters are seen only through motion that spans the workspace; a record has the
-interface of a designed record, so designs hold it and the plant plays it.
+"""Records moving every DOF at once, q_d(t) = q0_d + a(t) sum_h A[d, h] sin(2 pi F[d, h] t + phi[d, h]),
+a(t) a quintic fade: the physical parameters need motion spanning the workspace.
 """
 
 from __future__ import annotations
@@ -40,20 +33,16 @@ def _table(value, name: str) -> tuple[tuple[float, ...], ...]:
 
 @dataclasses.dataclass(frozen=True)
 class MultisineRecord:
-    """Every DOF at once: a sum of sines per DOF under a fade-in and fade-out.
+    """Every DOF at once: sines per DOF under a fade-in and fade-out.
 
     Attributes
     ----------
-    amplitudes : tuple of 6 tuples of H float
-        A[d, h] (m for x, y, z; rad for rx, ry, rz).
-    frequencies_hz : tuple of 6 tuples of H float
-        F[d, h] (Hz), > 0.
-    phases : tuple of 6 tuples of H float
-        phi[d, h] (rad).
+    amplitudes, frequencies_hz, phases : tuple of 6 tuples of H float
+        A (m, rad), F (Hz, > 0), phi (rad).
     duration : float
-        Record length (s), fades included.
+        s, fades included.
     fade : float
-        Fade-in and fade-out (s), each; at most half the duration.
+        Each fade (s), at most half the duration.
     name : str
     """
 
@@ -79,7 +68,7 @@ class MultisineRecord:
 
     @property
     def max_frequency(self) -> float:
-        """Highest frequency (Hz), for the plant's sampling check."""
+        """Highest frequency (Hz)."""
         return float(np.max(self.frequencies_hz))
 
     def scaled(self, factor: float) -> MultisineRecord:
@@ -87,11 +76,11 @@ class MultisineRecord:
         return dataclasses.replace(self, amplitudes=np.asarray(self.amplitudes) * factor)
 
     def envelope(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Fade-in times fade-out and its first two time derivatives, shape (N,) each."""
+        """Fade envelope and its first two time derivatives, each (N,)."""
         return fade_envelope(t, self.fade, self.duration)
 
     def evaluate_offsets(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Motion about the base pose: dq, dq_dot, dq_ddot, each shape (N, 6)."""
+        """dq, dq_dot, dq_ddot about the base pose, each (N, 6)."""
         t = np.asarray(t, dtype=float)
         omega = 2 * math.pi * np.asarray(self.frequencies_hz)  # (6, H)
         amplitude = np.asarray(self.amplitudes)
@@ -104,7 +93,7 @@ class MultisineRecord:
         return a * x, da * x + a * dx, dda * x + 2 * da * dx + a * ddx
 
     def to_dict(self) -> dict:
-        """Plain data (JSON ready)."""
+        """JSON-ready data."""
         return {"kind": "multisine", "name": self.name, "duration_s": self.duration,
                 "fade_s": self.fade,
                 **{key: [list(row) for row in getattr(self, key)]
@@ -124,29 +113,24 @@ def multisine_design(budget_s: float, amplitudes: Sequence[float], speed: float 
                      share: float = 0.0, seed: int = 0, label: str | None = None,
                      record_length: float = RECORD_LENGTH, fade: float = MULTISINE_FADE
                      ) -> Design:
-    """The physical design's family: records of every DOF at once, the frequency pool rotated
-    by record so that every DOF meets every frequency and no two DOFs share one in a record.
+    """Physical design family: all-DOF records, the frequency pool rotated by record so every DOF
+    meets every frequency and no two DOFs share one in a record.
 
     Parameters
     ----------
     budget_s : float
-        Total motion time (s), split by :func:`record_lengths`.
+        Total motion (s), split by :func:`record_lengths`.
     amplitudes : sequence of 6 float
-        Sum of the amplitudes of each DOF (m, m, m, rad, rad, rad).
+        Sum of each DOF's amplitudes (m, rad).
     speed : float
-        The frequency pool is ``speed * REFERENCE_HZ``.
+        Pool = ``speed * REFERENCE_HZ``.
     share : float
-        Fraction of each DOF's amplitude at a second frequency, the pool's entry three places
-        on (0: one sine per DOF).
+        Fraction of amplitude at a second frequency, three pool places on.
     seed : int
-        Seed of the phases (uniform; the design is reproducible).
+        Phases.
     label : str, optional
     record_length, fade : float
-        Longest record, and each record's fade-in and fade-out (s).
-
-    Returns
-    -------
-    Design
+        Longest record and each fade (s).
     """
     if not 0 <= share < 1:
         raise ConfigError(f"share must be in [0, 1); got {share!r}.")
@@ -166,8 +150,8 @@ def multisine_design(budget_s: float, amplitudes: Sequence[float], speed: float 
 
 
 def all_dofs_multisine(budget_s: float, scale: float = 1.0, slower: float = 1.0) -> Design:
-    """The reference design: record k moves DOF d at ``REFERENCE_HZ[(d + k) % 6] / slower``
-    with ``scale`` times the paper's amplitude, phase ``0.5 d + k`` rad.
+    """Reference design: record k moves DOF d at ``REFERENCE_HZ[(d + k) % 6] / slower``, ``scale``
+    times the paper's amplitude, phase ``0.5 d + k`` rad.
     """
     records = []
     for k, length in enumerate(record_lengths(budget_s)):

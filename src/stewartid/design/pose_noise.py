@@ -1,12 +1,6 @@
-"""The pose noise's share of the physical model's predicted parameter covariance.
-
-White pose noise e reaches a row's model force through the differentiated rate and
-acceleration, n_j = D_a(j) (g2 * e)_j + D_v(j) (g1 * e)_j with D_a = M(q) and
-D_v = d(Y theta)/d q_dot. Its share of the scores is sum_i G_i e_i with G = P'' - Q',
-P = U D_a, Q = U D_v and U the kernel-filtered scores' weights; its covariance
-sum_i G_i Sigma_q G_i^T adds to B of the sandwich
-(:func:`~stewartid.design.physical.information.sandwich_covariance`). The Coulomb signs are
-left out.
+"""Pose noise's share of the physical model's predicted covariance: white pose noise reaches the
+scores as sum_i G_i e_i through the differentiated rates, adding sum_i G_i Sigma_q G_i^T to the
+sandwich's B (Coulomb signs left out).
 """
 
 from __future__ import annotations
@@ -26,21 +20,7 @@ RATE_STEP = 1e-3
 
 
 def pose_covariance(noise: SensorNoise, jacobian: np.ndarray) -> np.ndarray:
-    """Sigma_q = J_lq^-1 Sigma_l J_lq^-T: the pose's white noise per sample from the legs'
-    length noise, to first order.
-
-    Parameters
-    ----------
-    noise : SensorNoise
-        ``length_noise`` (m).
-    jacobian : ndarray, shape (K, 6, 6)
-        J_lq at each pose (:func:`~stewartid.model.kinematics.leg_jacobian`).
-
-    Returns
-    -------
-    ndarray, shape (K, 6, 6)
-        m^2, rad^2.
-    """
+    """Sigma_q = J_lq^-1 Sigma_l J_lq^-T (K, 6, 6), m^2, rad^2, from ``length_noise`` and J_lq (K, 6, 6)."""
     sigma = np.broadcast_to(np.asarray(noise.length_noise, dtype=float), 6)
     inverse = np.linalg.inv(jacobian)
     return np.einsum("kij,j,klj->kil", inverse, sigma ** 2, inverse, optimize=True)
@@ -48,14 +28,7 @@ def pose_covariance(noise: SensorNoise, jacobian: np.ndarray) -> np.ndarray:
 
 def rate_sensitivity(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
                      q_ddot: np.ndarray, theta: np.ndarray) -> np.ndarray:
-    """d(Y theta)/d q_dot along a motion: the viscous matrix and the velocity products'
-    derivative (Coulomb signs left out).
-
-    Returns
-    -------
-    ndarray, shape (K, 6, 6)
-        Generalized force per unit rate.
-    """
+    """d(Y theta)/d q_dot (K, 6, 6) along a motion (Coulomb signs left out)."""
     out = matrix_regressors.viscous_regressor(platform, q) @ theta
     step = RATE_STEP * max(float(np.max(np.abs(q_dot))), 1e-12)
     for c in range(6):
@@ -72,34 +45,26 @@ def pose_noise_scores(platform: Platform, noise: SensorNoise, rate_hz: float,
                       states: tuple[np.ndarray, np.ndarray, np.ndarray], ends: np.ndarray,
                       taps: list[np.ndarray], rows: np.ndarray, transforms: np.ndarray,
                       weights: np.ndarray, theta: np.ndarray) -> np.ndarray:
-    """The pose noise's share of the scores' covariance B, in the units of
-    :func:`~stewartid.design.physical.information.sandwich_covariance` (summed over the rows at
-    ``rate_hz``, which stand for every logged sample).
+    """Pose noise's share (p, p) of B, in the units of
+    :func:`~stewartid.design.physical.information.sandwich_covariance`.
 
     Parameters
     ----------
     platform : Platform
     noise : SensorNoise
     rate_hz : float
-        Rate of the states and rows (Hz).
     states : tuple of ndarray, each shape (K, 6)
-        q, q_dot, q_ddot of every record, one after the other.
+        q, q_dot, q_ddot, records in sequence.
     ends : ndarray, shape (R + 1,)
-        Each record's first row in ``states`` and, last, K.
+        Each record's first row, then K.
     taps : list of ndarray
-        Each record's kernel taps at ``rate_hz``.
+        Each record's kernel at ``rate_hz``.
     rows : ndarray, shape (K', 6, p)
-        The filtered rows in leg forces (each record's ``valid`` part, in turn).
+        Filtered rows in leg forces.
     transforms : ndarray, shape (K', 6, 6)
-        J_lq^-T at the filtered rows' poses.
+        J_lq^-T at those rows.
     weights : ndarray, shape (6,)
-        The leg channels' weights.
     theta : ndarray, shape (N_STANDARD,)
-        The standard parameters the forces are of.
-
-    Returns
-    -------
-    ndarray, shape (p, p)
     """
     p = rows.shape[2]
     B = np.zeros((p, p))

@@ -1,12 +1,5 @@
-"""``stewartid design`` end to end: optimise, predict the baseline, export, report.
-
-Output folder layout::
-
-    design.json           the design, its prediction, the baseline's, the limits
-    commands/exp*.csv     pose and leg-length commands at the controller rate
-    validation/validation.csv  a record of every DOF at once, for ``identify --validate``
-    figures/*.png, *.svg  limit use over time, predicted accuracy vs the paper's set
-    report.md, report.html
+"""``stewartid design`` end to end: optimise, predict the baseline, export, report
+(``design.json``, ``commands/``, ``validation/``, ``figures/``, ``report.md``/``.html``).
 """
 
 from __future__ import annotations
@@ -52,7 +45,7 @@ class DesignOutput:
     ----------
     design : Design
     prediction, baseline : Prediction
-        Of the design and of the paper's set of the same total length.
+        The design's and the same-length paper set's.
     files : list of Path
     """
 
@@ -82,36 +75,28 @@ def run_design(platform: Platform, budget_s: float, noise: SensorNoise, out: str
     budget_s : float
         Total motion time (s).
     noise : SensorNoise
-        Sensor noise the prediction assumes.
     out : str or Path
-        Output folder.
     method : str
-        Identification method the design is for.
+        Method the design is for.
     rate_hz : float
         Controller rate of the command files (Hz).
     max_use : float
-        Fraction of every limit the design may use (on the plant's true states).
+        Fraction of every limit used on the plant's states.
     seeds : int, optional
-        Noise realisations of the Monte Carlo of the chosen design: its check beside the
-        information matrix's standard errors (default :data:`CHECK_SEEDS`), or, for a
-        method without one, its prediction and the paper's set's (default 120).
+        Monte Carlo realisations: check of the information matrix (default :data:`CHECK_SEEDS`),
+        or the prediction itself for other methods (default 120).
     source : {"plant", "model"}
-        Noise-free data of the predictions: the design played on the plant, or the
-        rigid-body model with perfect tracking (faster, optimistic).
+        Noise-free data from the plant or the rigid-body model (faster, optimistic).
     quick : bool
-        One candidate and no screening (for tests).
+        One candidate, no screening (tests).
     force : bool
-        Overwrite an earlier design in ``out``.
+        Overwrite an earlier design.
     workers : int, optional
-        Processes the predictions are spread over (default: every available core).
+        Default: every core.
     progress : callable, optional
-        Receives one line of text per step.
+        One line per step.
     realisations : callable, optional
-        Called with (done, total) after each noise realisation of a prediction.
-
-    Returns
-    -------
-    DesignOutput
+        Called with (done, total) per realisation.
     """
     out = Path(out)
     check_output_folder(out, force, is_design_file)

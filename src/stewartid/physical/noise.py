@@ -1,12 +1,5 @@
-"""Errors in variables for the physical model: the share of the normal equations that pose
-noise, carried into the regressor's rates and accelerations, adds.
-
-To first order a filtered row's noise is
-
-    delta Y(t) ~ sum_c A_c(q) (h * g2 * e_c)(t) + sum_c B_c(q) (h * g1 * e_c)(t),
-
-with A = d Y / d q_ddot, B = d Y / d q_dot at rest and g1, g2 the Savitzky-Golay derivative
-taps; its expected outer product is what the least squares subtract to be unbiased.
+"""Errors in variables for the physical model: the share of the normal equations that pose noise,
+through the Savitzky-Golay rates and accelerations, adds (subtracted for an unbiased fit).
 """
 
 from __future__ import annotations
@@ -30,10 +23,8 @@ from stewartid.signals.sign_rates import coulomb_sign_rates
 
 def derivative_noise_gains(sample_rate: float, window: float, savgol_window: float,
                            order: int) -> tuple[float, float]:
-    """Variance of h * g1 * e and h * g2 * e per unit variance of white e.
-
-    The energies of the kernel (support ``window`` s) convolved with the Savitzky-Golay rate and
-    acceleration taps (``savgol_window`` s, ``order``). Units 1/s^2 and 1/s^4.
+    """Variance of h * g1 * e and h * g2 * e per unit white variance (1/s^2, 1/s^4): kernel
+    (``window`` s) convolved with Savitzky-Golay taps (``savgol_window`` s, ``order``).
     """
     h = kernel_taps(sample_rate, window)[0]
     n = window_samples(savgol_window, sample_rate, order)
@@ -42,10 +33,8 @@ def derivative_noise_gains(sample_rate: float, window: float, savgol_window: flo
 
 
 def measured_sign_rates(q: np.ndarray, sample_rate: float, window: float) -> np.ndarray:
-    """Coulomb sign rates, shape (N, 6), of a record whose pose noise is not known yet.
-
-    :func:`~stewartid.signals.sign_rates.coulomb_sign_rates` with the noise estimated against the
-    pose smoothed as the physical model's regressor is (order 5 over an eighth of the kernel).
+    """Coulomb sign rates (N, 6) of a record with unknown pose noise, estimated against the pose
+    smoothed as the regressor is (:func:`~stewartid.signals.sign_rates.coulomb_sign_rates`).
     """
     smooth = differentiate(q, sample_rate, window / 8, 5, (0,))[0]
     return coulomb_sign_rates(q, sample_rate, window, white_noise_covariance(q, smooth))[0]
@@ -56,7 +45,7 @@ JACOBIAN_STRIDE = 5
 
 
 def _factor(covariance: np.ndarray) -> np.ndarray:
-    """L with L L^T = covariance (positive semidefinite; a noise-free record gives ~0)."""
+    """L with L L^T = covariance (positive semidefinite)."""
     values, vectors = np.linalg.eigh(covariance)
     return vectors * np.sqrt(np.clip(values, 0.0, None))
 
@@ -66,34 +55,31 @@ def regressor_noise(experiments: list[Experiment], windows: list[float], row_ste
                     pose_noise: list[np.ndarray],
                     transforms: list[np.ndarray] | None = None, by_experiment: bool = False
                     ) -> np.ndarray:
-    """Per channel, the sum over the kept rows of E[delta Y_i^T delta Y_i].
+    """Per channel, the sum over the kept rows of E[delta Y_i^T delta Y_i],
+
+        delta Y ~ sum_c A_c(q) (h * g2 * e_c) + sum_c B_c(q) (h * g1 * e_c),  A = dY/dq_ddot, B = dY/dq_dot.
 
     Parameters
     ----------
     experiments : list of Experiment
     windows : list of float
-        Each experiment's kernel support (s).
+        Kernel support per experiment (s).
     row_step : int
-        The rows kept (every ``row_step``-th filtered row).
     platform : Platform
     savgol_fraction : float
-        The Savitzky-Golay window is ``window / savgol_fraction``.
+        Savitzky-Golay window = ``window / savgol_fraction``.
     order : int
-        Savitzky-Golay order.
     pose_noise : list of ndarray, each shape (6, 6)
-        Each experiment's pose white-noise covariance per sample
-        (:attr:`~stewartid.physical.regression.Regression.pose_noise`).
+        :attr:`~stewartid.physical.regression.Regression.pose_noise`.
     transforms : list of ndarray, each shape (K_e, 6, 6), optional
-        Per experiment, a map applied to each kept row's channels (the leg forces'
-        :func:`~stewartid.physical.regression.leg_force_transforms`).
+        Map of each kept row's channels
+        (:func:`~stewartid.physical.regression.leg_force_transforms`).
     by_experiment : bool
-        Return each experiment's sum, not their total.
+        Per-experiment sums instead of the total.
 
     Returns
     -------
     ndarray, shape (6, N_STANDARD, N_STANDARD), or (E, 6, N_STANDARD, N_STANDARD)
-        In the standard parameters, by channel (of the generalized force, or of what
-        ``transforms`` maps it to).
     """
     terms = np.zeros((len(experiments), 6, reg.N_STANDARD, reg.N_STANDARD))
     if transforms is None:

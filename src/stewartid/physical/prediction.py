@@ -1,9 +1,5 @@
-"""The identified physical model anywhere: Mt(q), Bt(q) at any pose with delta-method
-standard errors.
-
-With the parameters p selecting standard columns S and the known part o,
-J_lq^T f = Y(q, q_dot, q_ddot) (S^T p + o) and Mt(q) = A(q) (S^T p + o); each entry's standard
-error is sqrt(a^T C a) with a = A(q) S^T its row and C the parameters' covariance.
+"""Identified physical model at any pose: Mt(q) = A(q) (S^T p + o), Bt(q) likewise, each entry's
+standard error sqrt(a^T C a) with a = A(q) S^T its row (delta method).
 """
 
 from __future__ import annotations
@@ -30,12 +26,12 @@ class ParameterMap:
     Attributes
     ----------
     names : tuple of str
-        The result's parameters, in the order of its covariance.
+        In covariance order.
     values : ndarray, shape (p,)
     selection : ndarray, shape (p, N_STANDARD)
-        Rows of the identity: the standard column each parameter multiplies.
+        Identity rows S.
     offset : ndarray, shape (N_STANDARD,)
-        The known standard parameters (zero in full mode).
+        Known standard parameters o (zero in full mode).
     """
 
     names: tuple[str, ...]
@@ -45,18 +41,17 @@ class ParameterMap:
 
     @property
     def standard(self) -> np.ndarray:
-        """S^T p + o, shape (N_STANDARD,): Y times it is the model's generalized force."""
+        """S^T p + o, shape (N_STANDARD,)."""
         return self.selection.T @ self.values + self.offset
 
 
 def parameter_map(platform: Platform, result: PhysicalResult) -> ParameterMap:
-    """The :class:`ParameterMap` of ``result`` on the platform it was fitted with.
+    """:class:`ParameterMap` of ``result`` on the platform it was fitted with.
 
     Raises
     ------
     IdentificationError
-        When the result's parameters are not those of this platform's model (another platform
-        description, or another mode).
+        Parameters not those of this platform's model or mode.
     """
     payload = result.diagnostics.get("mode") == "payload"
     names, _, selection, _, offset = (_payload_model(platform) if payload
@@ -74,10 +69,7 @@ class PoseMatrices:
 
     Attributes
     ----------
-    M, B : ndarray, shape (n, 6, 6)
-        kg, kg m, kg m^2 and N s/m, N s, N m s blocks.
-    std_errors_M, std_errors_B : ndarray, shape (n, 6, 6)
-        Delta-method standard errors (same units).
+    M, B, std_errors_M, std_errors_B : ndarray, shape (n, 6, 6)
     """
 
     M: np.ndarray
@@ -88,24 +80,8 @@ class PoseMatrices:
 
 def matrices_at(platform: Platform, result: PhysicalResult, covariance: np.ndarray,
                 poses: np.ndarray, mapping: ParameterMap | None = None) -> PoseMatrices:
-    """Mt(q) and Bt(q) of ``result`` at ``poses`` with their standard errors.
-
-    Parameters
-    ----------
-    platform : Platform
-        The description the result was fitted with.
-    result : PhysicalResult
-    covariance : ndarray, shape (p, p)
-        Of the result's parameters in their order (``PhysicalIdentifier.covariance_``).
-    poses : ndarray, shape (n, 6)
-        Absolute poses (m, rad).
-    mapping : ParameterMap, optional
-        :func:`parameter_map` of the result, if already at hand (it costs a base-parameter
-        decomposition).
-
-    Returns
-    -------
-    PoseMatrices
+    """Mt(q), Bt(q) of ``result`` at absolute ``poses`` (n, 6) with standard errors, from the
+    parameters' ``covariance`` (p, p); ``mapping`` is :func:`parameter_map` when at hand.
     """
     mapping = mapping or parameter_map(platform, result)
     covariance = np.asarray(covariance, dtype=float)

@@ -1,8 +1,5 @@
-"""Held-out prediction of the physical model by its full nonlinear model, scored as every
-other method's (:mod:`stewartid.validation.heldout`).
-
-The model predicts J_lq^T f = Y(q, q_dot, q_ddot) p at the measured poses, with gravity,
-Coulomb friction and sensor offsets, the regressor filtered as the fit filters it.
+"""Held-out prediction of the physical model by its full nonlinear model (J_lq^T f = Y p with
+gravity, Coulomb friction and offsets), scored as :mod:`stewartid.validation.heldout` does.
 """
 
 from __future__ import annotations
@@ -35,21 +32,10 @@ from stewartid.validation.heldout import (
 def predict_physical(segment: Segment, dataset: Dataset, platform: Platform,
                      result: PhysicalResult, window: float,
                      standard: np.ndarray | None = None) -> np.ndarray:
-    """The physical model's prediction of ``segment.force``, shape (n, 6) (N, N m).
+    """Physical model's prediction (n, 6) of ``segment.force`` (N, N m).
 
-    Parameters
-    ----------
-    segment : Segment
-        The filtered record (:func:`~stewartid.validation.heldout.prepare_segment`).
-    dataset : Dataset
-        The record it was filtered from.
-    platform : Platform
-        The description the result was fitted with.
-    result : PhysicalResult
-    window : float
-        The kernel support (s) the segment was filtered with.
-    standard : ndarray, shape (N_STANDARD,), optional
-        The result's :attr:`~stewartid.physical.prediction.ParameterMap.standard`, if at hand.
+    ``dataset`` is the record filtered with kernel support ``window`` (s); ``standard`` is
+    :attr:`~stewartid.physical.prediction.ParameterMap.standard` when at hand.
     """
     settings = result.settings
     experiments = prepare([dataset], platform, gravity=False)
@@ -68,21 +54,8 @@ def predict_physical(segment: Segment, dataset: Dataset, platform: Platform,
 def cross_validate_physical(create: Callable[[], Any], datasets: Sequence[Dataset],
                             platform: Platform, folds: int = DEFAULT_FOLDS,
                             segments: list[Segment] | None = None) -> ValidationResult:
-    """Held-out scores of the physical model, each time segment predicted by the fit without it.
-
-    Parameters
-    ----------
-    create : callable
-        Returns a new, unfitted :class:`~stewartid.physical.estimator.PhysicalIdentifier`.
-    datasets : sequence of Dataset
-    platform : Platform
-    folds : int
-    segments : list of Segment, optional
-        The held-out segments (:func:`~stewartid.validation.heldout.held_out_segments`).
-
-    Returns
-    -------
-    ValidationResult
+    """Held-out scores of the physical model, each segment predicted by the fit without it;
+    ``create`` returns a new :class:`~stewartid.physical.estimator.PhysicalIdentifier`.
     """
     gravity = bool(create().get_params().get("gravity", True))
     found = cross_validate(create, datasets, platform, folds, gravity, segments)
@@ -101,13 +74,8 @@ def cross_validate_physical(create: Callable[[], Any], datasets: Sequence[Datase
 def validate_physical_on_records(result: PhysicalResult, records: Sequence[Dataset],
                                  segments: Sequence[Segment], platform: Platform
                                  ) -> ValidationResult:
-    """Scores of the physical model fitted on all experiments on validation records
-    (``segments``: :func:`~stewartid.validation.heldout.record_segments` of ``records``).
-
-    Returns
-    -------
-    ValidationResult
-        With ``folds`` = 0 (no refit).
+    """Scores (``folds`` = 0) of the model fitted on all experiments, on validation records'
+    :func:`~stewartid.validation.heldout.record_segments`.
     """
     standard = parameter_map(platform, result).standard
     predicted = [predict_physical(s, record, platform, result, excitation_window(record),

@@ -1,9 +1,5 @@
-"""The physical design's pick against the plant: played, refined where the plant allows less
-of it than its commanded motion at the limits, and predicted along the motion it played.
-
-The plant's servo does not follow the command exactly, so a record may keep only part of its
-amplitudes; :func:`played_pick` keeps the best pick by the worse of its final predictions
-along the plant's motion and along the command.
+"""The physical design's pick played on the plant, refined where the servo allows less than the
+commanded motion, and predicted along what it played.
 """
 
 from __future__ import annotations
@@ -43,15 +39,12 @@ class PlayedPick(NamedTuple):
     pick : PhysicalCandidate
         As the search chose it.
     design : Design
-        As played: records whose plant states used more than ``max_use`` of a limit scaled
-        down.
+        As played, records over ``max_use`` scaled down.
     records : list of ExperimentRecord
-        Its true signals on the plant.
+        True plant signals.
     uses : list of LimitUse
-        Their limit use.
     prediction, commanded : ParameterPrediction
-        Final predictions (filtered, at :data:`FINAL_RATE`) along the plant's motion and
-        along the command.
+        Final predictions (filtered, :data:`FINAL_RATE`) along the plant's motion and the command.
     """
 
     pick: PhysicalCandidate
@@ -67,19 +60,10 @@ def played_pick(platform: Platform, best: PhysicalCandidate, budget_s: float,
                 evaluations: int = PLANT_EVALUATIONS,
                 progress: Callable[[str], None] | None = None,
                 accuracy: Mapping[str, float] | None = None) -> PlayedPick:
-    """The search's pick played on the plant and predicted as the final design is.
-
-    Where the plant allowed less of a record than its commanded motion at the limits
-    (:func:`~stewartid.design.physical.search.plant_scales`), the search is refined against that
-    (:func:`~stewartid.design.physical.search.refine_for_plant`, corrected by
-    :func:`search_correction`) and its pick played too, for up to
-    :data:`~stewartid.design.physical.search.PLANT_ROUNDS` rounds.
-
-    Returns
-    -------
-    PlayedPick
-        Of the picks, the one whose worse prediction has the smallest
-        :func:`~stewartid.design.physical.search.design_objective`.
+    """The search's pick played and predicted as the final design; where the plant allowed less
+    (:func:`~stewartid.design.physical.search.plant_scales`) the search is refined and replayed for
+    up to :data:`~stewartid.design.physical.search.PLANT_ROUNDS` rounds. The pick whose worse
+    prediction has the smallest objective wins.
     """
     if progress:
         progress("playing the design on the plant")
@@ -102,8 +86,7 @@ def played_pick(platform: Platform, best: PhysicalCandidate, budget_s: float,
 
 def _played(platform: Platform, pick: PhysicalCandidate, noise: SensorNoise, payload: bool,
             max_use: float, accuracy: Mapping[str, float] | None) -> PlayedPick:
-    """``pick`` played on the plant within ``max_use``, and its final predictions along the
-    plant's motion and along the command (a machine that tracks it exactly moves less)."""
+    """``pick`` played within ``max_use``, with final predictions along plant motion and command."""
     design, records, uses = within_plant_limits(platform, pick.design, max_use)
     return PlayedPick(pick, design, records, uses, *(judged_against(predict_parameters(
         platform, design, noise, payload, FINAL_RATE, states=states, filtered=True), accuracy)
@@ -112,12 +95,8 @@ def _played(platform: Platform, pick: PhysicalCandidate, noise: SensorNoise, pay
 
 def search_correction(platform: Platform, played: PlayedPick, noise: SensorNoise,
                       payload: bool) -> dict[str, float]:
-    """How much a played pick's final prediction (the worse of plant and command, filtered)
-    exceeds the search's prediction of the same records (commanded, unfiltered).
-
-    Per payload quantity and for the worst relative standard error (``"worst"``): what
-    :func:`~stewartid.design.physical.search.refine_for_plant` multiplies its candidates'
-    predictions by.
+    """Ratio of a played pick's final prediction (worse of plant and command, filtered) to the
+    search's (commanded, unfiltered), per payload quantity and ``"worst"``.
     """
     search = predict_parameters(platform, played.design, noise, payload)
     final = (played.prediction, played.commanded)
