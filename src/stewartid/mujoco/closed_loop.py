@@ -1,9 +1,5 @@
-"""An experiment played on the MuJoCo model: the plant's leg servo on ideal force actuators,
-logged like a rig's record.
-
-The same command as :func:`stewartid.simulation.simulate_experiment`, integrated by an
-independent engine (its own rigid-body algorithms, Cardan axes, friction constraints and
-integrator; no hydraulics), recorded as a :class:`~stewartid.datasets.dataset.Dataset`.
+"""An experiment played on the MuJoCo model (the plant's leg servo on ideal force actuators) and
+logged like a rig's record: an independent engine for the same command.
 """
 
 from __future__ import annotations
@@ -19,62 +15,47 @@ from stewartid.platform import Platform
 
 
 class Commanded(Protocol):
-    """A commanded motion: a :class:`~stewartid.simulation.excitation.Excitation` or a command
-    file's :class:`~stewartid.design.export.TabulatedExcitation`."""
+    """A commanded motion: an excitation or a command file's tabulated excitation."""
 
     name: str
     #: Highest frequency in the motion (Hz): what the log's rate must resolve.
     max_frequency: float
 
     def evaluate(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Pose, rate and acceleration at ``t`` (s), each of shape (N, 6)."""
+        """Pose, rate and acceleration (N, 6) at ``t`` (s)."""
         ...
 
 
 def steps_per_sample(rate: float, step: float) -> int:
-    """MuJoCo steps per logged sample at ``rate`` (Hz): ``step`` (s) rounded down to divide
-    the sample period."""
+    """MuJoCo steps per sample at ``rate`` (Hz), ``step`` (s) rounded down to divide the period."""
     return max(1, int(np.ceil(1.0 / (rate * step) - 1e-9)))
 
 
 def simulate_mujoco(platform: Platform, excitation: Commanded, duration: float, *,
                     step: float = mjcf.DEFAULT_TIMESTEP, integrator: str = "RK4") -> Dataset:
-    """Play ``excitation`` on the MuJoCo model and record it at the sensors' rate.
+    """Play ``excitation`` on the MuJoCo model and record it at the sensors' rate, named as the excitation.
 
-    The legs are ideal force actuators under the PD part of the plant's leg-length servo with
-    its gravity feed-forward (:func:`~stewartid.mujoco.state.add_leg_servo`; the integral term
-    would need an extra state per leg and is left out). Every sample is MuJoCo's exact state:
-    the platform's pose, the slides' leg lengths and the actuator forces; no sensor errors (add
-    them with :func:`stewartid.simulation.degrade`).
-
-    The command is evaluated at every stage of the integrator through MuJoCo's control callback
-    (a command held over each step acts like a damper along the legs). That callback is global
-    to the process: run one simulation per process at a time (worker processes, not threads).
+    Ideal force actuators under the PD part of the plant's servo with gravity feed-forward (no
+    integral term); each sample is MuJoCo's exact state, without sensor errors. The command is
+    evaluated at every integrator stage through MuJoCo's process-global control callback: one
+    simulation per process at a time.
 
     Parameters
     ----------
     platform : Platform
         Mechanism, friction, ``[controller]`` gains and ``[sensors] sample_rate``.
     excitation : Commanded
-        The commanded motion (a sine excitation, or a command file read by
-        :func:`stewartid.design.export.read_excitation`).
     duration : float
         Record length (s).
     step : float
-        MuJoCo's time step (s); rounded down to divide the sample period.
+        MuJoCo's time step (s), rounded down to divide the sample period.
     integrator : {"RK4", "implicitfast", "implicit", "Euler"}
-        MuJoCo integrator; its stages must lie on the half-step table (RK4's do, and the
-        one-stage integrators').
-
-    Returns
-    -------
-    Dataset
-        Samples at t = 0, 1/rate, ... up to ``duration``; named as the excitation.
+        Its stages must lie on the half-step command table.
 
     Raises
     ------
     ImportError
-        If MuJoCo is not installed (``pip install "stewartid[mujoco]"``).
+        If MuJoCo is not installed.
     ValueError
         If ``duration`` or ``step`` is not positive.
     """

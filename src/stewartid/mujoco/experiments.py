@@ -1,9 +1,4 @@
-"""Experiments played on the MuJoCo model with sensor errors (``--engine mujoco`` of the
-``simulate`` command): each played by :func:`~stewartid.mujoco.closed_loop.simulate_mujoco`,
-then measured by the plant's sensor
-model (:func:`~stewartid.simulation.sensors.degrade`, the noise stream of
-:func:`~stewartid.simulation.experiments.noise_generator`).
-"""
+"""Experiments on the MuJoCo model with the plant's sensor errors (``simulate --engine mujoco``)."""
 
 from __future__ import annotations
 
@@ -38,43 +33,35 @@ def simulate_on_mujoco(platform: Platform, excitations: Sequence[Any],
                        progress: Callable[[int, int, str], Any] | None = None,
                        jobs: int = 1, excitation_meta: dict | None = None
                        ) -> SimulationResult:
-    """Play excitations on the MuJoCo model, one experiment each, with sensor errors.
+    """Play excitations on the MuJoCo model, experiment k named ``exp{k+1}``, with sensor errors.
+
+    The result has no true states; ``meta["engine"]`` is ``"mujoco"``.
 
     Parameters
     ----------
     platform : Platform
-        Mechanism, friction, ``[controller]`` gains and ``[sensors]``.
-    excitations : sequence
-        Commanded motions (:class:`~stewartid.mujoco.closed_loop.Commanded`); experiment k
-        is named ``exp{k+1}``.
+    excitations : sequence of Commanded
     durations : sequence of float
-        Record length of each (s).
+        s.
     noise : SensorNoise, optional
-        Sensor errors; the platform's ``[sensors]`` section by default.
+        ``[sensors]`` by default.
     seed : int
-        Seed of the sensor errors (one independent stream per experiment, as our plant's).
+        One independent noise stream per experiment, as the plant's.
     step : float
         MuJoCo's time step (s).
     progress : callable, optional
-        ``progress(done, total, name)`` as experiments finish.
+        ``progress(done, total, name)``.
     jobs : int
-        Worker processes (MuJoCo's control callback is global to a process, so experiments
-        run in separate processes or one after another); the data do not depend on it.
+        Worker processes (the control callback is process-global); the data do not depend on it.
     excitation_meta : dict, optional
-        The ``excitation`` entry of the metadata (default: the experiments' names).
-
-    Returns
-    -------
-    SimulationResult
-        No true states (``states`` empty); ``meta["engine"]`` is ``"mujoco"``.
+        The metadata's ``excitation`` entry; the experiments' names by default.
 
     Raises
     ------
     ImportError
-        If MuJoCo is not installed (``pip install "stewartid[mujoco]"``).
+        If MuJoCo is not installed.
     ConfigError
-        On a record length that is not positive, or an excitation or sensor-filter
-        frequency at or above the Nyquist limit.
+        On a non-positive record length or a frequency not below Nyquist.
     """
     mujoco = require_mujoco()
     noise = SensorNoise.from_sensors(platform.sensors) if noise is None else noise

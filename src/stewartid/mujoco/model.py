@@ -1,48 +1,6 @@
-"""The platform as a MuJoCo model: an independent engine for the same mechanism.
-
-:func:`build_mjcf` writes MJCF for a :class:`~stewartid.platform.Platform`;
-:func:`load_model` compiles it. The helpers move poses, rates and forces between our
-coordinates and MuJoCo's, so the two engines can be compared term by term. MuJoCo is
-imported only when a function needs it: ``pip install "stewartid[mujoco]"``.
-
-Frames
-------
-MuJoCo's world is the paper frame turned half a turn about x (z up)::
-
-    p_mujoco = T p_paper,   T = diag(1, -1, -1)   (a proper rotation, R_x(pi)).
-
-The platform body's world orientation is T R T: pose q = [x, y, z, rx, ry, rz] has position
-T [x, y, z] and roll-pitch-yaw (rx, -ry, -rz); generalized forces and rates transform with
-diag(1, -1, -1, 1, -1, -1).
-
-Mechanism
----------
-Each leg is an open chain from the base, closed on the platform by a weld:
-
-* ``leg<k>_cylinder`` at the base joint B: hinges ``leg<k>_lower1`` (axis e1) then
-  ``leg<k>_lower2`` (axis e2), a Cardan joint; the lower part's mass, centre of mass
-  B + d_l u and transverse inertia.
-* ``leg<k>_rod``: slide ``leg<k>_slide`` along the leg (qpos = l - l_0, l_0 the neutral
-  leg length), driven by the ideal force actuator ``leg<k>`` (``<motor>``, N, positive
-  extends); the upper part's mass, centre of mass A - d_u u and transverse inertia.
-* ``leg<k>_end`` at the upper joint A: hinges ``leg<k>_upper1`` (e1), ``leg<k>_upper2``
-  (e2), then ``leg<k>_revolute`` about the leg; welded to the platform.
-
-The platform is a free body at the reference point; a ``[payload]`` is a body fixed in it.
-The axes are the leg frame of ``docs/conventions.md`` at the neutral pose, every joint's
-zero; away from it the Cardan axes move with their bodies while our model re-evaluates e1,
-e2, so the joint friction (not the masses, gravity or leg Jacobian) differs at the order of
-the gimbal deflection.
-
-Friction: damping ``gimbal_viscous`` on the four gimbal hinges; Coulomb ``coulomb`` as
-``frictionloss`` on all five hinges, a constraint rather than our regularised law. The
-friction rows take the welds' time constant and impedance, since at MuJoCo's default
-softness the hinges of the light end bodies would not pass their full friction.
-
-Masses: MuJoCo requires mass and inertia on every moving body, so each ``end`` body carries
-``END_MASS_FRACTION`` of the platform's mass, taken from the platform body so that the
-platform and the six ends together have the description's mass and inertia. Leg parts get a
-token inertia about the leg axis, where our model has none.
+"""The platform as a MuJoCo model, an independent engine for the same mechanism (``[mujoco]``
+extra). MuJoCo's world is the paper frame turned about x: p_mujoco = T p_paper, T = diag(1, -1, -1),
+so pose q has position T [x, y, z], angles (rx, -ry, -rz); forces and rates take diag(T, T).
 """
 
 from __future__ import annotations
@@ -74,11 +32,6 @@ DEFAULT_TIMESTEP = 5e-4
 def require_mujoco() -> Any:
     """Import MuJoCo, or explain which extra installs it.
 
-    Returns
-    -------
-    module
-        The ``mujoco`` package.
-
     Raises
     ------
     ImportError
@@ -98,14 +51,7 @@ def _unit(v: np.ndarray) -> np.ndarray:
 
 
 def leg_frames(platform: Platform) -> np.ndarray:
-    """Orthonormal leg frames at the neutral pose, paper frame.
-
-    Returns
-    -------
-    ndarray, shape (6, 3, 3)
-        Columns e1 = unit(z x u), e2 = u x e1, u for each leg (u from base to platform
-        joint), as in ``docs/conventions.md``.
-    """
+    """Leg frames (6, 3, 3) at the neutral pose, paper frame: columns e1 = unit(z x u), e2 = u x e1, u."""
     legs = inverse_kinematics(platform, platform.neutral_pose)
     frames = np.empty((6, 3, 3))
     for k, u in enumerate(legs.directions[0]):
@@ -119,18 +65,8 @@ def _vec(v: Any) -> str:
 
 
 def _platform_inertial(platform: Platform) -> tuple[float, np.ndarray, np.ndarray, float, float]:
-    """Mass, centre of mass and full inertia of the platform body once the ends are removed.
-
-    Returns
-    -------
-    mass : float
-        kg.
-    com : ndarray, shape (3,)
-        m, platform body frame (MuJoCo orientation).
-    inertia : ndarray, shape (6,)
-        Ixx, Iyy, Izz, Ixy, Ixz, Iyz about ``com`` (kg m^2), MuJoCo's ``fullinertia``.
-    end_mass, end_inertia : float
-        kg and kg m^2 of each end body.
+    """Mass (kg), centre of mass (3,) (m, body frame), ``fullinertia`` (6,) about it (kg m^2) of the
+    platform body without the ends, and each end body's mass and inertia.
     """
     i = platform.inertia
     end_mass = END_MASS_FRACTION * i.platform_mass
@@ -153,29 +89,26 @@ def build_mjcf(platform: Platform, *, integrator: str = "RK4",
                timestep: float = DEFAULT_TIMESTEP,
                constraint_timeconst: float | None = None, constraint_impedance: float = 0.9999,
                coulomb: bool = True) -> str:
-    """MJCF text of the platform's mechanism (frames and bodies in the module docstring).
+    """MJCF text of the platform's mechanism.
+
+    Each leg is an open chain from the base closed on the platform by a weld: cylinder on the lower
+    Cardan hinges (e1, e2), rod on a slide (qpos = l - l_0) driven by motor ``leg<k>`` (N, extending),
+    end body on the upper hinges and the revolute. The platform is a free body, a payload a body fixed
+    in it; each end takes ``END_MASS_FRACTION`` of the platform's mass. Gimbal damping; Coulomb as
+    ``frictionloss`` on the five hinges (a constraint, as stiff as the welds). The Cardan axes move with
+    their bodies, so joint friction differs from ours at the order of the gimbal deflection.
 
     Parameters
     ----------
-    platform : Platform
-        Geometry, masses and joint friction; ``[hydraulics]`` and ``[controller]`` are not
-        used (the legs have ideal force actuators).
     integrator : {"RK4", "implicitfast", "implicit", "Euler"}
-        MuJoCo integrator.
     timestep : float
-        Integration step (s).
+        s.
     constraint_timeconst : float, optional
-        Time constant of the welds that close the legs on the platform (s); ``2 * timestep``
-        by default, the smallest MuJoCo recommends for stability.
+        Of the welds (s); ``2 * timestep`` by default, MuJoCo's smallest stable.
     constraint_impedance : float
-        Impedance d of the welds, in (0, 1); closer to 1 is stiffer.
+        Of the welds, in (0, 1); closer to 1 is stiffer.
     coulomb : bool
-        Model the Coulomb friction as ``frictionloss`` on the five hinges of each leg.
-
-    Returns
-    -------
-    str
-        MJCF XML.
+        Model Coulomb friction as ``frictionloss``.
     """
     if integrator not in INTEGRATORS:
         raise ValueError(f"integrator must be one of {INTEGRATORS}; got {integrator!r}.")
@@ -201,8 +134,7 @@ def build_mjcf(platform: Platform, *, integrator: str = "RK4",
 
 def _world_lines(platform: Platform, integrator: str, timestep: float, mass: float,
                  com: np.ndarray, full: np.ndarray) -> list[str]:
-    """MJCF from the model's opening tag to the platform body: options, base and platform
-    (``mass``, ``com``, ``full`` from :func:`_platform_inertial`)."""
+    """MJCF from the opening tag to the platform body: options, base and platform."""
     g = platform.geometry
     p0 = T @ platform.neutral_pose[:3]
     return [
@@ -231,9 +163,7 @@ def _world_lines(platform: Platform, integrator: str, timestep: float, mass: flo
 
 
 def _payload_lines(platform: Platform) -> list[str]:
-    """MJCF of the payload: a body fixed in the platform's, with the description's mass,
-    centre of mass (``pos``) and inertia matrix (``fullinertia``) turned into the platform
-    body's MuJoCo frame; none without a payload or for one of zero mass."""
+    """MJCF of the payload, a body fixed in the platform's; none without one or of zero mass."""
     payload = platform.payload
     if payload is None or payload.mass == 0.0:
         return []
@@ -249,8 +179,7 @@ def _payload_lines(platform: Platform) -> list[str]:
 
 def _leg_lines(platform: Platform, k: int, frame: np.ndarray, frictionloss: str,
                end_mass: float, end_inertia: float) -> list[str]:
-    """MJCF of leg ``k``'s chain: cylinder on the lower gimbal, rod on the slide, end body on
-    the upper gimbal and revolute; ``frame`` (3, 3) its leg frame (:func:`leg_frames`)."""
+    """MJCF of leg ``k``'s chain in its leg ``frame`` (3, 3)."""
     i = platform.inertia
     damping = platform.friction.gimbal_viscous
     l0 = platform.neutral_leg_length
@@ -294,8 +223,7 @@ def _leg_lines(platform: Platform, k: int, frame: np.ndarray, frictionloss: str,
 
 
 def _closure_lines(tau: float, impedance: float) -> list[str]:
-    """MJCF of the welds that close each leg on the platform (time constant ``tau`` s,
-    impedance d) and of the leg motors."""
+    """MJCF of the welds (time constant ``tau`` s, impedance d) and of the leg motors."""
     imp = f"{impedance:.17g}"
     lines = ["  <equality>"]
     for k in range(6):
@@ -316,7 +244,7 @@ def load_model(platform: Platform, **options: Any) -> mujoco.MjModel:
     Raises
     ------
     ImportError
-        If MuJoCo is not installed (``pip install "stewartid[mujoco]"``).
+        If MuJoCo is not installed.
     """
     mj = require_mujoco()
     return mj.MjModel.from_xml_string(build_mjcf(platform, **options))

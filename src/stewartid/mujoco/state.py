@@ -1,6 +1,5 @@
-"""State, projection and control helpers for the MuJoCo model of :mod:`stewartid.mujoco.model`:
-setting a closed pose from a platform pose, reading pose and rates back, projecting MuJoCo's
-equations onto the six platform coordinates, and the leg servo.
+"""Poses, rates and forces between our coordinates and the MuJoCo model's: closed poses, MuJoCo's
+equations projected onto the six platform coordinates, and the leg servo.
 """
 
 from __future__ import annotations
@@ -24,11 +23,11 @@ class Indices:
     Attributes
     ----------
     platform_qpos, platform_dof : int
-        First qpos (7 values) and dof (6 values) of the platform's free joint.
+        First qpos (7 values) and dof (6) of the free joint.
     slide_qpos, slide_dof : ndarray, shape (6,)
-        qpos and dof addresses of the six slide joints.
+        Of the six slide joints.
     joint_qpos : ndarray, shape (6, 5)
-        qpos addresses of lower1, lower2, upper1, upper2, revolute per leg.
+        lower1, lower2, upper1, upper2, revolute per leg.
     leg_dofs : ndarray, shape (36,)
         Every dof that is not the platform's.
     """
@@ -64,18 +63,7 @@ def _ry(a: float) -> np.ndarray:
 
 
 def euler_rate_matrix(angles: np.ndarray) -> np.ndarray:
-    """Map from roll-pitch-yaw rates to the body's angular velocity in its own frame.
-
-    Parameters
-    ----------
-    angles : ndarray, shape (3,)
-        rx, ry, rz (rad), R = Rz(rz) Ry(ry) Rx(rx).
-
-    Returns
-    -------
-    ndarray, shape (3, 3)
-        E with omega_body = E @ [rx', ry', rz'] (paper frame).
-    """
+    """E (3, 3) with omega_body = E @ [rx', ry', rz'] (paper frame), R = Rz Ry Rx, angles in rad."""
     rx, ry, rz = (float(a) for a in angles)
     Rz = rotation_matrix(np.array([0.0, 0.0, rz]))
     Rzy = rotation_matrix(np.array([0.0, ry, rz]))
@@ -85,14 +73,8 @@ def euler_rate_matrix(angles: np.ndarray) -> np.ndarray:
 
 
 def platform_velocity_map(angles: np.ndarray) -> np.ndarray:
-    """Map P from our rates q_dot to the free joint's velocity (MuJoCo frames).
-
-    MuJoCo's free joint velocity is [v (world), omega (body frame)]; with our conventions
-    v = T [x', y', z'] and omega = T E(angles) [rx', ry', rz'].
-
-    Returns
-    -------
-    ndarray, shape (6, 6)
+    """P (6, 6) from our rates q_dot to the free joint's velocity [v (world), omega (body)]:
+    v = T [x', y', z'], omega = T E(angles) [rx', ry', rz'].
     """
     P = np.zeros((6, 6))
     P[:3, :3] = T
@@ -101,20 +83,7 @@ def platform_velocity_map(angles: np.ndarray) -> np.ndarray:
 
 
 def joint_positions(platform: Platform, model: mujoco.MjModel, q: np.ndarray) -> np.ndarray:
-    """Full ``qpos`` that places the platform at pose ``q`` with every chain closed exactly.
-
-    Parameters
-    ----------
-    platform : Platform
-        The description the model was built from.
-    model : mujoco.MjModel
-    q : ndarray, shape (6,)
-        Pose (m, rad), paper frame.
-
-    Returns
-    -------
-    ndarray, shape (model.nq,)
-    """
+    """Full ``qpos`` (model.nq,) placing the platform at pose ``q`` (m, rad) with every chain closed."""
     mj = require_mujoco()
     idx = Indices(model)
     q = np.asarray(q, dtype=float)
@@ -145,12 +114,7 @@ def joint_positions(platform: Platform, model: mujoco.MjModel, q: np.ndarray) ->
 
 
 def equality_jacobian(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
-    """Rows of the constraint Jacobian that belong to the welds (after ``mj_forward``).
-
-    Returns
-    -------
-    ndarray, shape (36, model.nv)
-    """
+    """The welds' rows (36, model.nv) of the constraint Jacobian (after ``mj_forward``)."""
     mj = require_mujoco()
     rows = data.efc_type[:data.nefc] == mj.mjtConstraint.mjCNSTR_EQUALITY
     J = np.asarray(data.efc_J[:data.nefc * model.nv]).reshape(data.nefc, model.nv)
@@ -158,15 +122,8 @@ def equality_jacobian(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
 
 
 def closure_map(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
-    """Map S from the platform's free-joint velocity to all joint velocities.
-
-    Velocities that keep the chains closed satisfy J_c,p v_p + J_c,l v_l = 0 (J_c the welds'
-    Jacobian), so v_l = -J_c,l^-1 J_c,p v_p; the welds do no work along S, so S^T projects
-    MuJoCo's joint-space equations onto the platform's six coordinates.
-
-    Returns
-    -------
-    ndarray, shape (model.nv, 6)
+    """S (model.nv, 6) from the free joint's velocity to all joint velocities keeping the chains closed:
+    v_l = -J_c,l^-1 J_c,p v_p; the welds do no work along S, so S^T projects MuJoCo's equations.
     """
     idx = Indices(model)
     J = equality_jacobian(model, data)
@@ -178,10 +135,7 @@ def closure_map(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
 
 def set_state(platform: Platform, model: mujoco.MjModel, data: mujoco.MjData, q: np.ndarray,
               q_dot: np.ndarray | None = None) -> None:
-    """Put the MuJoCo model at pose ``q`` with rates ``q_dot`` (ours, paper frame), closed.
-
-    Runs ``mj_forward`` so every derived quantity of ``data`` is current.
-    """
+    """Put the model at pose ``q`` and rates ``q_dot`` (paper frame), closed, and run ``mj_forward``."""
     mj = require_mujoco()
     data.qpos[:] = joint_positions(platform, model, q)
     data.qvel[:] = 0.0
@@ -194,13 +148,7 @@ def set_state(platform: Platform, model: mujoco.MjModel, data: mujoco.MjData, q:
 
 
 def platform_state(model: mujoco.MjModel, data: mujoco.MjData) -> tuple[np.ndarray, np.ndarray]:
-    """Pose and rates of the platform in our coordinates (paper frame).
-
-    Returns
-    -------
-    q, q_dot : ndarray, shape (6,) each
-        m, rad and their time derivatives.
-    """
+    """Pose and rates (6,) each of the platform in our coordinates (m, rad, paper frame)."""
     mj = require_mujoco()
     idx = Indices(model)
     a, d = idx.platform_qpos, idx.platform_dof
@@ -216,7 +164,7 @@ def platform_state(model: mujoco.MjModel, data: mujoco.MjData) -> tuple[np.ndarr
 
 
 def dense_mass_matrix(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
-    """Joint-space mass matrix of the current state (after ``mj_forward``), shape (nv, nv)."""
+    """Joint-space mass matrix (nv, nv) of the current state (after ``mj_forward``)."""
     mj = require_mujoco()
     M = np.empty((model.nv, model.nv))
     if hasattr(data, "qM"):  # MuJoCo 3.x: mj_fullM(m, dst, qM)
@@ -228,28 +176,11 @@ def dense_mass_matrix(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
 
 def platform_space_terms(platform: Platform, model: mujoco.MjModel, data: mujoco.MjData,
                          q: np.ndarray) -> dict[str, np.ndarray]:
-    """MuJoCo's equation of motion projected on our coordinates, at rest at pose ``q``.
+    """MuJoCo's equation of motion on our coordinates at rest at pose ``q``, by virtual work with V = S P.
 
-    With S the closure map and P the map from our rates to the free joint's velocity,
-    V = S P maps q_dot to every joint rate, and (virtual work) the platform-space terms are
-
-    * mass matrix V^T M V (``mj_fullM``),
-    * gravity V^T qfrc_bias (at rest MuJoCo's bias force is gravity alone),
-    * leg Jacobian: the slide rows of V (a slide's rate is its leg's length rate),
-    * viscous matrix V^T D V, D the joint damping.
-
-    Parameters
-    ----------
-    platform, model, data
-    q : ndarray, shape (6,)
-        Pose (m, rad), paper frame.
-
-    Returns
-    -------
-    dict
-        ``mass_matrix`` (6, 6), ``gravity`` (6,), ``leg_jacobian`` (6, 6), ``viscous``
-        (6, 6) in our units and frame, and ``constraint_violation`` (m, largest weld
-        position error after assembly).
+    Returns ``mass_matrix`` V^T M V, ``gravity`` V^T qfrc_bias (6,), ``leg_jacobian`` (the slide rows
+    of V), ``viscous`` V^T D V (D the joint damping), all (6, 6) unless said, and
+    ``constraint_violation`` (m, largest weld error after assembly).
     """
     mj = require_mujoco()
     set_state(platform, model, data, q)
@@ -268,32 +199,21 @@ def platform_space_terms(platform: Platform, model: mujoco.MjModel, data: mujoco
 
 def static_leg_forces(platform: Platform, model: mujoco.MjModel, data: mujoco.MjData,
                       q: np.ndarray) -> np.ndarray:
-    """Actuator forces (N, positive extending) that hold pose ``q`` at rest, by MuJoCo.
-
-    Solves J_lq^T f = G with both terms from :func:`platform_space_terms`.
-
-    Returns
-    -------
-    ndarray, shape (6,)
-    """
+    """Actuator forces (6,) (N, extending) holding pose ``q`` at rest: J_lq^T f = G by MuJoCo."""
     t = platform_space_terms(platform, model, data, q)
     return np.linalg.solve(t["leg_jacobian"].T, t["gravity"])
 
 
 def leg_lengths(platform: Platform, model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
-    """Leg lengths (m) of the MuJoCo state: neutral length plus slide position; shape (6,)."""
+    """Leg lengths (6,) (m) of the MuJoCo state: neutral length plus slide position."""
     return platform.neutral_leg_length + data.qpos[Indices(model).slide_qpos]
 
 
 # -- the leg servo of the plant, on MuJoCo's actuators ----------------------------------------
 
 def add_leg_servo(platform: Platform, model: mujoco.MjModel) -> None:
-    """Give the six leg motors the PD part of the plant's leg-length servo, in place.
-
-    The terms in l and l' of f = f_ff + K_p (l_cmd - l) + K_d (l_cmd' - l') become the motors'
-    affine bias, evaluated at every integrator stage; the command terms come through ``ctrl``
-    (:func:`servo_controls`). With zero gains the motors are the plain ``<motor>`` of
-    :func:`build_mjcf`.
+    """Give the leg motors, in place, the PD part of the plant's servo f = f_ff + K_p (l_cmd - l) +
+    K_d (l_cmd' - l'): the l, l' terms as the motors' affine bias, the rest through ``ctrl``.
     """
     mj = require_mujoco()
     c = platform.controller
@@ -303,21 +223,8 @@ def add_leg_servo(platform: Platform, model: mujoco.MjModel) -> None:
 
 
 def servo_controls(platform: Platform, q_cmd: np.ndarray, q_dot_cmd: np.ndarray) -> np.ndarray:
-    """``ctrl`` values of :func:`add_leg_servo` along a commanded trajectory.
-
-    ctrl = f_ff + K_p (l_cmd - l_0) + K_d l_cmd', with f_ff the leg forces that hold the
-    commanded pose at rest (the plant's gravity feed-forward, if ``[controller]`` enables it).
-
-    Parameters
-    ----------
-    platform : Platform
-    q_cmd, q_dot_cmd : ndarray, shape (N, 6)
-        Commanded poses (m, rad) and rates.
-
-    Returns
-    -------
-    ndarray, shape (N, 6)
-        N.
+    """``ctrl`` (N, 6) (N) of :func:`add_leg_servo` along commanded poses and rates (N, 6):
+    f_ff + K_p (l_cmd - l_0) + K_d l_cmd', f_ff the forces holding the commanded pose if enabled.
     """
     from stewartid.model.dynamics import inverse_dynamics
     from stewartid.model.kinematics import leg_jacobian, leg_lengths
