@@ -6,15 +6,8 @@ import numpy as np
 
 
 def median(values: np.ndarray) -> float:
-    """``np.median(values)`` over all elements, equal to the last bit.
-
-    Without ``np.median``'s NaN check, whose first call imports numpy.ma (the command line's
-    start-up cost); NaN anywhere gives NaN as there.
-
-    Parameters
-    ----------
-    values : array_like
-        Any shape, at least one element.
+    """``np.median(values)`` over all elements, bit for bit, without its NaN check's numpy.ma import
+    (start-up cost); NaN anywhere gives NaN.
     """
     flat = np.asarray(values, dtype=float).ravel()
     if np.isnan(flat).any():

@@ -1,10 +1,5 @@
-"""The one reader of data files: CSV and Parquet tables into NumPy columns, with pyarrow.
-
-A table is a dict of column name to array: float64 for numeric columns (NaN where missing),
-the values as read otherwise, so that a message can quote a bad value. Pandas is not
-imported to read data (a command line's start-up cost). Column names are cleaned as pandas'
-``read_csv(skipinitialspace=True)`` cleans them: spaces and quotes stripped, an empty name
-read as ``Unnamed: k``, a repeated one as ``name.1``, ``name.2`` ...
+"""The one reader of data files: CSV and Parquet into NumPy columns via pyarrow (no pandas at
+start-up), float64 where numeric, else as read; names cleaned as pandas' ``read_csv`` does.
 """
 
 from __future__ import annotations
@@ -21,24 +16,12 @@ Columns = dict[str, np.ndarray]
 
 def read_csv_columns(text: str, where: str, delimiter: str = ",", decimal: str = ".",
                      skip_rows: int = 0) -> Columns:
-    """The columns of a CSV log.
-
-    Parameters
-    ----------
-    text : str
-        The decoded log: ``skip_rows`` preamble lines, a header line of names, then one line
-        per sample.
-    where : str
-        File named in error messages.
-    delimiter, decimal : str
-        Field separator and decimal mark.
-    skip_rows : int
-        Lines before the header line.
+    """Columns of a decoded CSV log: ``skip_rows`` preamble lines, a header, one line per sample.
 
     Raises
     ------
     DataError
-        The text is not a table (a row with more or fewer fields than the header, say).
+        Not a table (a row with more or fewer fields than the header).
     """
     options = dict(
         read_options=pyarrow.csv.ReadOptions(skip_rows=skip_rows, use_threads=False),
@@ -54,12 +37,12 @@ def read_csv_columns(text: str, where: str, delimiter: str = ",", decimal: str =
 
 
 def read_parquet_columns(path: str, where: str) -> Columns:
-    """The columns of a Parquet file.
+    """Columns of a Parquet file.
 
     Raises
     ------
     DataError
-        The file is not Parquet.
+        Not Parquet.
     """
     from pyarrow import parquet  # here: a command line reading CSV never needs it
 
@@ -83,7 +66,7 @@ def _columns(table: pa.Table) -> Columns:
 
 
 def _values(column: pa.ChunkedArray) -> np.ndarray:
-    """float64 values of a numeric column (NaN where missing), else the values as read."""
+    """float64 of a numeric column (NaN where missing), else the values as read."""
     kind = column.type
     if not (pa.types.is_floating(kind) or pa.types.is_integer(kind)):
         return np.array(column.to_pylist(), dtype=object)
@@ -106,7 +89,7 @@ def _chunk_values(chunk: pa.Array, dtype: np.dtype) -> np.ndarray:
 
 
 def to_numbers(values: np.ndarray) -> np.ndarray:
-    """Values as float64, NaN where one is missing or not a number; shape unchanged."""
+    """Values as float64, NaN where missing or not a number."""
     values = np.asarray(values)
     if values.dtype != object:
         return values.astype(float)
@@ -120,7 +103,7 @@ def to_numbers(values: np.ndarray) -> np.ndarray:
 
 
 def shown_value(values: np.ndarray, row: int) -> object:
-    """The value at ``row`` for a message: as a number when it reads as one."""
+    """Value at ``row`` for a message, as a number when it reads as one."""
     value = values[row]
     try:
         return float(value)

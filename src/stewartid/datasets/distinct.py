@@ -1,7 +1,5 @@
-"""An experiment given twice: the same file under two spellings, or two files with the same
-numbers. Counted twice, an experiment weighs its DOF double and hides the one it displaced,
-which then comes out wrong without any rank warning; both checks run before anything is
-fitted.
+"""An experiment given twice (one file, two spellings, or equal numbers) weighs its DOF double
+and hides the one it displaced; refused before any fit.
 """
 
 from __future__ import annotations
@@ -26,11 +24,7 @@ def _give_once(what: str) -> DataError:
 
 
 def check_distinct_paths(files: Sequence[Path]) -> None:
-    """Refuse a file given twice, however spelled (relative, absolute, through a link).
-
-    Parameters
-    ----------
-    files : sequence of Path
+    """Refuse a file given twice, however spelled (relative, absolute, link).
 
     Raises
     ------
@@ -47,23 +41,13 @@ def check_distinct_paths(files: Sequence[Path]) -> None:
 
 
 def experiment_digest(dataset: Dataset) -> str:
-    """SHA-256 of the pose and forces of an experiment (the numbers every method uses).
-
-    Two files with equal digests hold the same experiment, whatever their time stamps,
-    names or formats.
-    """
+    """SHA-256 of an experiment's pose and forces, whatever its times, name or format."""
     numbers = np.ascontiguousarray(np.concatenate([dataset.pose, dataset.forces], axis=1))
     return hashlib.sha256(numbers.tobytes()).hexdigest()
 
 
 def check_distinct_experiments(datasets: Sequence[Dataset], labels: Sequence[str]) -> None:
-    """Refuse two experiments with identical pose and forces (a file copied or given twice).
-
-    Parameters
-    ----------
-    datasets : sequence of Dataset
-    labels : sequence of str
-        Their names in the message (file paths or experiment names).
+    """Refuse two experiments with identical pose and forces; ``labels`` name them.
 
     Raises
     ------

@@ -1,6 +1,4 @@
-"""The design report: limit use over time, interval lengths, predicted accuracy against the
-paper's set, as Markdown and a self-contained HTML page.
-"""
+"""Design report: limit use, interval lengths, predicted accuracy vs the paper's set (Markdown, HTML)."""
 
 from __future__ import annotations
 
@@ -21,7 +19,7 @@ from stewartid.reports.html import render_html
 
 def plot_limit_use(uses: Sequence[LimitUse], names: Sequence[str], directory: str | Path
                    ) -> list[Path]:
-    """Use of every limit (fraction, 1 = the limit) over time, one panel per record."""
+    """Use of every limit (1 = the limit) over time, one panel per record."""
     import matplotlib
     from matplotlib.figure import Figure
 
@@ -43,7 +41,7 @@ def plot_limit_use(uses: Sequence[LimitUse], names: Sequence[str], directory: st
 
 def plot_accuracy(design: Prediction, baseline: Prediction, directory: str | Path
                   ) -> list[Path]:
-    """Predicted relative standard error of the 20 entries, design beside the paper's set."""
+    """Relative standard error of the 20 entries, design beside the paper's set."""
     import matplotlib
     from matplotlib.figure import Figure
 
@@ -73,21 +71,20 @@ def render_markdown(design: Design, prediction: Prediction, baseline: Prediction
     ----------
     design : Design
     prediction, baseline : Prediction
-        Of the design and of the paper's set at the same budget.
+        The design's and the paper set's at the same budget.
     peaks : sequence of dict
-        Peak use of every limit, per record.
+        Peak use of every limit per record.
     intervals : sequence of float
-        Constant-direction interval length of each record (s): its half period.
+        Half period of each record (s).
     settings : dict
-        Budget, noise, method, grid (shown as given).
+        Budget, noise, method, grid.
     use_source : str
-        What the limit use was measured on.
+        What limit use was measured on.
     method : str
-        Identification method the design is for.
     coulomb : float
-        Coulomb friction the design assumed (N m).
+        Assumed Coulomb friction (N m).
     folder : str
-        Where the design is written (its command files are under ``commands/``).
+        Output folder.
     """
     lines = ["# Excitation design", "", f"{design.label}; {design.duration:.1f} s of motion.",
              "", "## Settings", ""]
@@ -134,8 +131,7 @@ def render_markdown(design: Design, prediction: Prediction, baseline: Prediction
 
 def play_command(design: Design, coulomb: float, folder: str = "DIR", run: str = "RUN"
                  ) -> str:
-    """The ``stewartid simulate`` command that plays the exported records on the plant with
-    the Coulomb friction (N m) the design assumed."""
+    """``stewartid simulate`` command playing the exported records with the assumed Coulomb friction."""
     files = " ".join(f"--excitation {shlex.quote(f'{folder}/commands/{r.name}.csv')}"
                      for r in design.records)
     return (f"stewartid simulate --platform PLATFORM --coulomb {coulomb:g} {files} --noise "
@@ -143,15 +139,13 @@ def play_command(design: Design, coulomb: float, folder: str = "DIR", run: str =
 
 
 def identify_command(method: str, run: str = "RUN") -> str:
-    """The ``stewartid identify`` command of the estimator a design is made for."""
+    """``stewartid identify`` command of the design's estimator."""
     return f"stewartid identify {run} --platform PLATFORM {' '.join(identify_options(method))}"
 
 
 def validation_commands(method: str, coulomb: float, folder: str = "DIR", run: str = "RUN"
                         ) -> list[str]:
-    """The commands that play the design's validation record on the plant and identify with
-    it held out (``identify --validate``).
-    """
+    """Commands playing the validation record and identifying with it held out."""
     record = shlex.quote(f"{folder}/validation/validation.csv")
     return [f"stewartid simulate --platform PLATFORM --coulomb {coulomb:g} --excitation "
             f"{record} --noise --seed 1 --out {run}_validation",
@@ -160,7 +154,7 @@ def validation_commands(method: str, coulomb: float, folder: str = "DIR", run: s
 
 
 def write_design_report(directory: str | Path, markdown_text: str) -> list[Path]:
-    """Write ``report.md`` and the self-contained ``report.html`` into ``directory``."""
+    """Write ``report.md`` and self-contained ``report.html`` into ``directory``."""
     directory = Path(directory)
     return [write_text_atomic(directory / "report.md", markdown_text),
             write_text_atomic(directory / "report.html",

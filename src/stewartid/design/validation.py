@@ -1,8 +1,5 @@
-"""The short validation record a design is checked with: every DOF at once, at frequencies
-of its own, within the platform's limits.
-
-Motion along other directions at other frequencies shows a wrong coupling that a friction term
-compensated on the fitted sines (``stewartid identify --validate``).
+"""Short validation record of a design: every DOF at once at frequencies of its own, within the
+limits, showing a wrong coupling that friction compensated (``identify --validate``).
 """
 
 from __future__ import annotations
@@ -35,15 +32,12 @@ class ValidationRecord:
 
     Attributes
     ----------
-    amplitudes : tuple of 6 float
-        m, m, m, rad, rad, rad.
-    frequencies_hz : tuple of 6 float
-    duration : float
-        s.
-    fade : float
-        s, each end.
+    amplitudes, frequencies_hz : tuple of 6 float
+        m, rad; Hz.
+    duration, fade : float
+        s; fade at each end.
     base_pose : tuple of 6 float
-        m, rad; the platform's neutral pose.
+        Neutral pose (m, rad).
     name : str
     """
 
@@ -60,11 +54,11 @@ class ValidationRecord:
         return max(self.frequencies_hz)
 
     def envelope(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Fade-in times fade-out, and its first two time derivatives, shape (N,) each."""
+        """Fade envelope and its first two time derivatives, each (N,)."""
         return fade_envelope(t, self.fade, self.duration)
 
     def evaluate_offsets(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Motion about the base pose: dq, dq_dot, dq_ddot, each shape (N, 6)."""
+        """dq, dq_dot, dq_ddot about the base pose, each (N, 6)."""
         t = np.asarray(t, dtype=float)
         a, da, dda = self.envelope(t)
         omega = 2 * math.pi * np.asarray(self.frequencies_hz)
@@ -76,18 +70,14 @@ class ValidationRecord:
                 amplitude * (dda * s + 2 * da * omega * c - a * omega ** 2 * s))
 
     def evaluate(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Pose, velocity and acceleration at times ``t`` (s); each shape (N, 6)."""
+        """Pose, velocity and acceleration at ``t`` (s), each (N, 6)."""
         dq, dq_dot, dq_ddot = self.evaluate_offsets(t)
         return dq + np.asarray(self.base_pose), dq_dot, dq_ddot
 
 
 def validation_record(platform: Platform, duration_s: float = VALIDATION_DURATION,
                       max_use: float = VALIDATION_USE) -> ValidationRecord:
-    """The validation record of a platform: the paper's amplitudes scaled until the
-    commanded motion uses ``max_use`` of its most used limit.
-
-    Limit use is nearly linear in the amplitudes, so a few rescalings settle it.
-    """
+    """The paper's amplitudes rescaled until the commanded motion uses ``max_use`` of its top limit."""
     from stewartid.design.optimise import commanded_use
 
     record = ValidationRecord(tuple(DEFAULT_AMPLITUDES), duration=float(duration_s),
@@ -102,13 +92,7 @@ def validation_record(platform: Platform, duration_s: float = VALIDATION_DURATIO
 def write_validation_record(platform: Platform, directory: str | Path,
                             rate_hz: float = 500.0, duration_s: float = VALIDATION_DURATION
                             ) -> Path:
-    """Write ``validation.csv`` into ``directory``: t, the pose x..rz and the leg lengths
-    l1..l6 at ``rate_hz``, as the design's command files.
-
-    Returns
-    -------
-    Path
-    """
+    """Write ``validation.csv`` (t, x..rz, l1..l6 at ``rate_hz``) into ``directory``; return the path."""
     record = validation_record(platform, duration_s)
     t = np.arange(int(math.floor(record.duration * rate_hz + 1e-9)) + 1) / rate_hz
     q, _, _ = record.evaluate(t)

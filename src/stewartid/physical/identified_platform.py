@@ -1,9 +1,5 @@
-"""The platform description of an identified physical model: the TOML every command accepts.
-
-Payload mode writes the identified ``[payload]``. Full mode writes the moving body as the
-file's platform plus a ``[payload]`` of the difference (or a light carrier payload when the
-difference is no payload), the legs from their identified moments (masses kept from the file)
-and the mean of the identified friction levels.
+"""Platform description (TOML) of an identified physical model: payload mode writes ``[payload]``;
+full mode the moving body, legs and mean friction levels.
 """
 
 from __future__ import annotations
@@ -30,8 +26,7 @@ IDENTIFIED_HEADER = "# identified by stewartid identify --model physical from"
 
 
 def _standard_values(platform: Platform, result: PhysicalResult) -> np.ndarray:
-    """The standard parameters of a full-mode result: each base parameter less the
-    combinations it stands for, with the file's values for the parameters folded into it."""
+    """Standard parameters of a full-mode result, folded-in ones at the file's values."""
     base = reg.base_parameters(platform)
     pi = reg.standard_parameters(platform)
     values = pi.copy()
@@ -43,7 +38,7 @@ def _standard_values(platform: Platform, result: PhysicalResult) -> np.ndarray:
 
 
 def _full_platform(platform: Platform, result: PhysicalResult) -> Platform:
-    """The description of a full-mode result (see the module docstring)."""
+    """Description of a full-mode result."""
     pi = _standard_values(platform, result)
     value = dict(zip(reg.PARAMETERS, pi, strict=True))
     own = reg.standard_parameters(known_platform(platform))
@@ -84,11 +79,8 @@ CARRIER_SHARE = 0.01
 
 def _body_updates(platform: Platform, difference: dict[str, float], body: np.ndarray
                   ) -> dict[str, Any]:
-    """The moving body (standard parameters ``body``, (10,)) as platform and payload keys.
-
-    The file's platform plus a ``[payload]`` of the difference; when that is no payload, a
-    platform carrying a light payload (CARRIER_SHARE of its mass and principal inertias) that holds
-    the centre of mass offset and products of inertia.
+    """Moving body ``body`` (10,) as platform and payload keys: the file's platform plus the
+    difference, else a light carrier payload (CARRIER_SHARE) holding com offset and products.
     """
     payload = {f"payload__{k}": v for k, v in payload_section(difference).items()}
     try:
@@ -116,8 +108,7 @@ def identified_platform(platform: Platform, result: PhysicalResult) -> Platform:
     Raises
     ------
     ConfigError
-        When they are no valid description (a negative mass or inertia, an inertia no mass
-        distribution has); the message names the section and key.
+        Not a valid description (negative mass, impossible inertia), naming section and key.
     """
     try:
         if result.diagnostics.get("mode") == "payload":
@@ -132,10 +123,7 @@ def identified_platform(platform: Platform, result: PhysicalResult) -> Platform:
 
 def write_identified(platform: Platform, result: PhysicalResult, platform_out: Path,
                      experiments: int) -> Path:
-    """Write the platform description of ``result`` to ``platform_out``; return the path.
-
-    The file starts with the header that marks it as written by ``identify``.
-    """
+    """Write ``result``'s description, with the ``identify`` header, to ``platform_out``; return it."""
     identified = identified_platform(platform, result)
     return write_text_atomic(platform_out, f"{IDENTIFIED_HEADER} {experiments} experiments\n"
                              + identified.to_toml())
