@@ -1,6 +1,7 @@
-"""Cramér-Rao bounds on Mt and Bt for white leg-force noise: I = sum_t C_t^-1 (x) x_t x_t^T,
-C_t = J_lq^T diag(sigma^2) J_lq, x_t = [q_ddot, q_dot], constants per record or interval profiled out.
-Kay, "Fundamentals of Statistical Signal Processing: Estimation Theory" (1993), ch. 3.
+"""Cramér-Rao bounds on Mt and Bt: the best any unbiased estimator can do with a motion.
+
+I = sum_t C_t^-1 (x) x_t x_t^T, C_t = J_lq^T diag(sigma^2) J_lq, x_t = [q_ddot, q_dot], constants
+per record or interval profiled out (Kay 1993, "Estimation Theory", ch. 3).
 """
 
 from __future__ import annotations

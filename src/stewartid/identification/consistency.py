@@ -1,5 +1,7 @@
-"""Physical consistency of Mt, Bt and the nearest consistent pair in the estimate's standard errors
-(M symmetric positive definite, B positive semidefinite; needs cvxpy). Traversaro et al., IROS 2016.
+"""Physical consistency of identified Mt and Bt, and the nearest consistent pair.
+
+M symmetric positive definite, B positive semidefinite, nearest in the estimate's standard errors
+(needs cvxpy; Traversaro et al., IROS 2016).
 """
 
 from __future__ import annotations

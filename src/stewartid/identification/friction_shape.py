@@ -1,5 +1,6 @@
-"""The shape of Coulomb friction's sign near a reversal, and least squares averaged over shapes
-by Akaike weights (Burnham and Anderson 2002, ch. 4).
+"""The shape of Coulomb friction's sign near a reversal, and least squares averaged over it.
+
+Fits with both shapes are averaged by Akaike weights (Burnham and Anderson 2002, ch. 4).
 """
 
 from __future__ import annotations

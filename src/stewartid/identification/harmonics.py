@@ -1,5 +1,6 @@
-"""Harmonic coefficients over whole periods, and the Coulomb bias the force's third harmonic shows
-(a Coulomb square wave's first harmonic lands in Method A's Bt, its third in no linear term).
+"""Harmonic coefficients over whole periods; the Coulomb bias the force's third harmonic shows.
+
+A Coulomb square wave's first harmonic lands in Method A's Bt, its third in no linear term.
 """
 
 from __future__ import annotations
@@ -29,9 +30,7 @@ def harmonic_coefficients(x: np.ndarray, t: np.ndarray, frequencies_hz: Sequence
 
 def motion_gains(frequencies_hz: Sequence[float], sample_rate: float, window: float,
                  order: int) -> np.ndarray:
-    """Savitzky-Golay (zero-phase) gain of q_ddot, q_dot, q per frequency; (2 F, 18), rows as
-    :func:`harmonic_coefficients`.
-    """
+    """Savitzky-Golay gain (2 F, 18) of q_ddot, q_dot, q, rows as :func:`harmonic_coefficients`."""
     gains = np.ones((2 * len(frequencies_hz), 18))
     for k, f in enumerate(frequencies_hz):
         for d, columns in ((2, slice(0, 6)), (1, slice(6, 12)), (0, slice(12, 18))):

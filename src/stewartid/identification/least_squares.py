@@ -1,5 +1,7 @@
-"""Time-domain least squares with Coulomb friction (Khalil and Dombre 2002, ch. 12):
-y = Mt q_ddot + Bt q_dot + c_e + sum_types Fc_type S_type, S_type = sum J_j^T sign(J_j q_dot).
+"""Time-domain least squares with Coulomb friction: the inverse-dynamics model of robotics.
+
+y = Mt q_ddot + Bt q_dot + c_e + sum_types Fc_type S_type, S_type = sum J_j^T sign(J_j q_dot)
+(Khalil and Dombre 2002, ch. 12).
 """
 
 from __future__ import annotations

@@ -1,5 +1,6 @@
-"""Symmetric pairs: the two estimates of each off-diagonal entry of Mt and Bt, from different
-equations; their difference tests and calibrates the standard errors and picks the member to report.
+"""Symmetric pairs: the two estimates of each off-diagonal entry of Mt and Bt.
+
+They come from different equations: their difference tests and calibrates the standard errors.
 """
 
 from __future__ import annotations

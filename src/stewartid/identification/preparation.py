@@ -1,5 +1,6 @@
-"""Data preparation shared by every identifier: Jacobians, gravity and y = J_lq^T f_a - G(q) at
-every measured pose, computed once (Zhang 2020, Eq. 5).
+"""Data preparation shared by every identifier.
+
+Jacobians, gravity and y = J_lq^T f_a - G(q) at every measured pose, computed once (Zhang 2020, Eq. 5).
 """
 
 from __future__ import annotations

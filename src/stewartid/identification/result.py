@@ -1,5 +1,6 @@
-"""The result of an identification, its ``result.json``, and the comparison table in the layout of
-the paper (Zhang 2020, Tables 3-6).
+"""The result of an identification.
+
+Matrices, standard errors, ``result.json`` and the paper's comparison table (Zhang 2020, Tables 3-6).
 """
 
 from __future__ import annotations

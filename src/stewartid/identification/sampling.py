@@ -1,5 +1,6 @@
-"""Whether a result is limited by its log's sampling rather than its noise: refit at 1/2 (then 1/3,
-1/4) of the rate and add each entry's largest change to its standard error in quadrature.
+"""Whether a result is limited by its log's sampling rather than by its noise.
+
+Refit at 1/2 (then 1/3, 1/4) of the rate; each entry's largest change adds to its standard error.
 """
 
 from __future__ import annotations

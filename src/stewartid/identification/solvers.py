@@ -1,5 +1,6 @@
-"""Least-squares solvers shared by the identifiers: feasible generalized least squares with rank checks,
-and errors-in-variables least squares with cluster-robust standard errors.
+"""Least-squares solvers shared by the identifiers.
+
+Feasible generalized least squares with rank checks; errors-in-variables with cluster-robust errors.
 """
 
 from __future__ import annotations

@@ -1,7 +1,6 @@
 """Constant-direction intervals of one measured experiment: the interval step of Method B.
 
-The smoothed pose rates are mapped to the joint and actuator rates and cut where an active
-joint reverses beyond its noise band (:mod:`.intervals`).
+Smoothed joint rates are cut where an active joint reverses beyond its noise band.
 """
 
 from __future__ import annotations
@@ -27,21 +26,15 @@ class Detection(NamedTuple):
     Attributes
     ----------
     intervals : ndarray, shape (M, 2)
-        Usable [start, stop] (s).
+        Usable [start, stop], s.
     info : dict
-        Counts, lengths, the differentiation window, the pose-noise covariance and the
-        white-noise variance of the generalized force.
-    joint_rates : ndarray, shape (N, 6, 5)
-        Smoothed joint-axis rates (rad/s).
-    rate_noise : ndarray, shape (6, 5)
-        Their noise levels (rad/s).
+        Counts, lengths, window, pose-noise covariance, force white-noise variance.
+    joint_rates, sign_rates : ndarray, shape (N, 6, 5)
+        Smoothed joint-axis rates, and those the Coulomb signs use, rad/s.
+    rate_noise, sign_rate_noise : ndarray, shape (6, 5)
+        Their noise levels, rad/s.
     q_dot, q_ddot : ndarray, shape (N, 6)
         Savitzky-Golay derivatives of the pose.
-    sign_rates : ndarray, shape (N, 6, 5)
-        Joint-axis rates the Coulomb signs are taken from (rad/s), over the shortest window
-        the noise allows (:func:`~stewartid.signals.sign_rates.coulomb_sign_rates`).
-    sign_rate_noise : ndarray, shape (6, 5)
-        Their noise levels (rad/s).
     """
 
     intervals: np.ndarray
@@ -66,10 +59,7 @@ COVERAGE_FRACTION = 0.1
 
 
 def raise_no_interval(infos: Sequence[dict]) -> None:
-    """Raise the error for data without a usable interval, naming the longest found and the need.
-
-    ``infos`` as :func:`detect_intervals` returns them.
-    """
+    """Raise for data without a usable interval, naming the longest found and the need."""
     longest = max(info["longest_interval"] for info in infos)
     needed = min(info["shortest_usable"] for info in infos)
     raise IdentificationError(
@@ -83,14 +73,7 @@ def raise_no_interval(infos: Sequence[dict]) -> None:
 def check_coverage(names: Sequence[str], motion: np.ndarray, counts: Sequence[int]) -> None:
     """Warn for every experiment without a usable interval; raise if they alone moved a DOF.
 
-    Parameters
-    ----------
-    names : sequence of str
-        Experiment names.
-    motion : ndarray, shape (n_experiments, 6)
-        RMS of each pose coordinate about its mean (m, rad).
-    counts : sequence of int
-        Usable intervals per experiment.
+    ``motion`` (n_experiments, 6): RMS of each pose coordinate, m, rad; ``counts``: usable intervals.
     """
     counts = np.asarray(counts)
     for name, count in zip(names, counts, strict=True):
@@ -116,22 +99,7 @@ SINGLE_SINE_SHARE = 0.9
 
 
 def sine_share(lengths: np.ndarray, sample_rate: float) -> float:
-    """Share of the leg-length variance one sine at the dominant frequency explains.
-
-    With an offset and a drift per leg, over the legs that move; leg lengths share one unit.
-
-    Parameters
-    ----------
-    lengths : ndarray, shape (N, 6)
-        Leg lengths (m).
-    sample_rate : float
-        Hz.
-
-    Returns
-    -------
-    float
-        In [0, 1]: near 1 for one sine per experiment (the paper's protocol).
-    """
+    """Share in [0, 1] of the leg-length variance (N, 6) one sine at the dominant frequency explains."""
     frequency = estimate_frequency(lengths, sample_rate)
     t = np.arange(len(lengths)) / sample_rate
     basis = np.column_stack([np.sin(2 * np.pi * frequency * t),
@@ -145,22 +113,10 @@ def sine_share(lengths: np.ndarray, sample_rate: float) -> float:
 
 def excitation_scales(experiment: Experiment, window: float | None, margin: float | None,
                       margin_periods: float) -> tuple[float, float]:
-    """The Savitzky-Golay window and the interval margin of one experiment (s).
+    """The Savitzky-Golay window and the interval margin of one experiment, s.
 
-    Parameters
-    ----------
-    experiment : Experiment
-    window : float or None
-        Savitzky-Golay window (s); None: from the excitation frequency estimated from the
-        pose (:func:`~stewartid.signals.differentiation.default_window`).
-    margin : float or None
-        Time cut from both ends of every interval (s); None: ``margin_periods`` periods of
-        the estimated excitation frequency.
-    margin_periods : float
-
-    Returns
-    -------
-    window, margin : float
+    None for either: from the excitation frequency estimated from the pose (margin ``margin_periods``
+    periods).
     """
     if window is None or margin is None:
         frequency = estimate_frequency(experiment.q, 1.0 / experiment.period)
@@ -177,25 +133,20 @@ def detect_intervals(experiment: Experiment, noise: NoiseModel, *, margin: float
     Parameters
     ----------
     experiment : Experiment
-        Prepared with its joint-axis Jacobians.
+        With its joint-axis Jacobians.
     noise : NoiseModel
-        Its smoothed motion and noise levels (:func:`.noise.estimate_noise`).
     margin : float
-        Time cut from both ends of every interval (s).
+        Cut from both ends of every interval, s.
     hysteresis : float
-        Multiple of each rate's noise level inside which its direction counts as unknown.
+        Noise multiples inside which a direction is unknown.
     ignore_below : float
-        Joints whose rate RMS is below this fraction of the largest of their kind are left out.
+        Joints slower than this fraction of the fastest of their kind are left out.
     min_interval : float or None
-        Shortest usable interval (s); None: half the median interval.
+        Shortest usable interval, s; None: half the median.
     min_support_samples : int
-        Fewest samples the smallest test function's support may cover.
+        Fewest samples the smallest test function may cover.
     smallest : float
-        The smallest support as a fraction of an interval (1 for a whole interval).
-
-    Returns
-    -------
-    Detection
+        Smallest support as a fraction of an interval.
     """
     t, period, rate_noise = experiment.t, experiment.period, noise.rate_noise
     rates = joint_rates(experiment.platform, experiment.q, noise.q_dot,
@@ -226,7 +177,6 @@ def detect_intervals(experiment: Experiment, noise: NoiseModel, *, margin: float
 
 
 def _sign_rates(experiment: Experiment, noise: NoiseModel) -> dict:
-    """``sign_rates`` and ``sign_rate_noise`` of :class:`Detection`."""
     q_dot, window = coulomb_sign_rates(experiment.q, experiment.sample_rate, noise.window,
                                        noise.pose_covariance, SIGN_NOISE_LIMIT)
     jacobians = experiment.joint_jacobians

@@ -1,18 +1,6 @@
-"""Method B: wavelet transform on constant-direction intervals (Zhang 2020).
+"""Method B: wavelet transform on constant-direction intervals (Zhang 2020, doi:10.3390/math8020257).
 
-Inside an interval where no joint reverses, Coulomb friction and what gravity leaves are a
-constant c in Mt q_ddot + Bt q_dot + c = y; a wavelet psi with vanishing moments of order 0
-and 1 removes it:
-
-    [Mt Bt] [W_psi q_ddot ; W_psi q_dot](a, b) = W_psi y (a, b).
-
-By default each interval carries a family of zero-mean test functions (:mod:`.weak_form`)
-solved by generalized least squares (:mod:`.gls`).
-
-References
-----------
-Zhang, C. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
-Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
+A zero-mean psi removes an interval's constant friction: [Mt Bt] [W q_ddot ; W q_dot](a, b) = W y (a, b).
 """
 
 from __future__ import annotations
@@ -81,72 +69,51 @@ class WaveletIdentifier(BaseIdentifier):
     Parameters
     ----------
     wavelet : {"polynomial", "mexican_hat"}
-        Mother wavelet: psi = g'' with g = (1 - x^2)^p on [-1, 1] (compact support), or the
-        paper's Mexican hat truncated at +-``truncation`` scales.
+        psi = g'', g = (1 - x^2)^p on [-1, 1]; or the paper's Mexican hat.
     wavelet_order : int
-        Exponent p of the polynomial wavelet, 5..20.
+        Exponent p, 5..20.
     truncation : float
-        Half-width (scales) at which the Mexican hat is cut.
+        Mexican hat half-width, scales.
     variant : {"position", "paper", "derivative"}
-        How W q_ddot and W q_dot are obtained: "position" moves both derivatives onto the
-        wavelet (W psi'' q / a^2, -W psi' q / a); "paper" uses a Savitzky-Golay q_ddot and
-        W q_dot = -a W_psi1 q_ddot; "derivative" Savitzky-Golay q_ddot and q_dot.
+        "position": both derivatives moved onto the wavelet; "paper": Savitzky-Golay q_ddot and
+        W q_dot = -a W_psi1 q_ddot; "derivative": Savitzky-Golay q_ddot and q_dot.
     test_functions : int or None
-        Number K of orthonormalised zero-mean test functions per interval, 1..12
-        (:mod:`~stewartid.identification.wavelet.weak_form`). None: the wavelet transform at
-        (a, b) points set by ``scale_fractions`` and ``shifts_per_scale``, as in the paper.
-        Needs the polynomial wavelet and the position variant.
+        Orthonormal zero-mean test functions per interval, 1..12 (polynomial, position); None: the
+        paper's (a, b) points.
     friction : {"auto", "free", "shared", "uniform", "coulomb"}
-        With ``test_functions``: "coulomb", windows of :data:`.friction_models.WINDOW_LENGTH`
-        s across joint reversals with each joint type's Coulomb force (:mod:`.windows`);
-        "free", every interval constant free (invariant to any friction law; Coulomb levels
-        kept only where the rows need them, :mod:`.rate_selection`); "shared", an offset per
-        experiment plus the Coulomb level of each joint type; "uniform", one level for every
-        axis. "auto": "coulomb", or on one sine per experiment both it and "free", the data
-        choosing (:mod:`.friction_models`).
+        "coulomb": windows across reversals with per-type Coulomb forces; "free": every interval
+        constant free; "shared": per-experiment offsets and per-type levels; "uniform": one level;
+        "auto": "coulomb", or on one sine per experiment the better of it and "free".
     scale_fractions : tuple of float
-        Wavelet support as fractions of each interval's length, each in (0, 1].
+        Wavelet supports as fractions of the interval, in (0, 1].
     shifts_per_scale : int
-        Shifts per scale and interval.
     margin : float or None
-        Time (s) cut from both ends of every constant-direction interval. None:
-        :data:`MARGIN_PERIODS` periods of the estimated excitation frequency.
+        Cut from both ends of every interval, s; None: :data:`MARGIN_PERIODS` periods.
     ignore_below : float
-        Joints whose rate RMS is below this fraction of the largest of their kind are left
-        out of the interval detection.
+        Joints slower than this fraction of the fastest of their kind are left out.
     min_interval : float or None
-        Shortest usable interval (s); None: half the median interval of each experiment.
+        Shortest usable interval, s; None: half the median.
     min_support_samples : int
-        Fewest samples the smallest wavelet's support may cover.
+        Fewest samples the smallest wavelet may cover.
     differentiation_window : float or None
-        Savitzky-Golay window (s) for the joint rates of the interval detection and, in the
-        ``"paper"`` and ``"derivative"`` variants, for q_dot and q_ddot. None: a fifth of the
-        period of the experiment's dominant frequency.
+        Savitzky-Golay window, s; None: a fifth of the dominant period.
     hysteresis : float
-        A joint's direction counts as known only while its rate exceeds this many times the
-        rate's noise level (:func:`~stewartid.identification.wavelet.noise.joint_rate_noise`).
+        A direction is known only while the rate exceeds this many noise levels.
     odd_companion : bool
-        ``test_functions=None``: also use the polynomial wavelet's odd companion g'''
-        (:class:`~stewartid.signals.wavelets.PolynomialWavelet`; ``wavelet_order`` >= 8).
+        Also use the odd companion g''' (``test_functions=None``, order >= 8).
     noise_correction : bool
-        Position variant: weight by and remove the pose noise's contribution to the normal
-        equations (errors in variables; :mod:`.gls`,
-        :func:`~stewartid.identification.solvers.bias_compensated_least_squares`).
+        Weight by and remove the pose noise's errors-in-variables bias (position variant).
     symmetric : bool
-        Impose Mt = Mt^T and Bt = Bt^T in the solve.
+        Impose Mt = Mt^T, Bt = Bt^T.
     pair_selection : {"pooled", "std_error", "none"}
-        Symmetric pairs (not with ``symmetric``): "pooled" the inverse-variance mean of
-        members within 3 standard errors, else the translational one; "std_error" the
-        better-determined member
-        (:func:`~stewartid.identification.pairs.select_symmetric_pairs`).
+        Symmetric pairs: inverse-variance mean within 3 standard errors, else the translational one;
+        or the better-determined member.
     gravity : bool
-        Subtract the model's pose-dependent gravity G(q) before identification.
+        Subtract the model's G(q).
     remainder : bool
-        Subtract the model's departure from its linearisation along the measured motion
-        (:func:`~stewartid.identification.preparation.model_remainder`).
+        Subtract the model's departure from its linearisation.
     sampling_check : bool
-        Widen the standard errors where the log's sampling limits the estimate
-        (:mod:`~stewartid.identification.sampling`).
+        Widen standard errors where the log's sampling limits them.
 
     Attributes
     ----------
@@ -154,12 +121,7 @@ class WaveletIdentifier(BaseIdentifier):
     std_errors_ : dict of ndarray (6, 6)
     condition_number_ : float
     result_ : IdentificationResult
-        ``diagnostics`` holds, per experiment, the intervals and the (a, b) points used, the
-        joints left out, and which member of each symmetric pair was taken.
-
-    References
-    ----------
-    Zhang (2020), see the module docstring.
+        Diagnostics: intervals, (a, b) points, joints left out, symmetric pairs taken.
     """
 
     def __init__(self, wavelet: str = "polynomial", wavelet_order: int = 6,
@@ -245,12 +207,7 @@ class WaveletIdentifier(BaseIdentifier):
 
     def _fit_weak_form(self, datasets: list[Dataset], platform: Platform,
                        wavelet: MotherWavelet) -> tuple[IdentificationResult, dict]:
-        """The default path: test-function families per interval, one experiment at a time.
-
-        Each experiment's arrays are dropped once its equations are formed, so that long logs fit
-        in memory; with several friction models each is solved and one kept
-        (:mod:`.friction_models`).
-        """
+        """Test-function families per interval, one experiment at a time (long logs fit in memory)."""
         models = friction_models(self.friction, datasets)
         infos, sensitivities, motion = [], [], []
         equations: dict[str, list] = {model: [] for model in models}
@@ -311,10 +268,7 @@ class WaveletIdentifier(BaseIdentifier):
         return result, {"coulomb_": levels, "coulomb_std_": levels_std}
 
     def _point_equations(self, experiment: Experiment, wavelet: MotherWavelet):
-        """Wavelet equations of one prepared experiment at (a, b) points, with their pose-noise covariances.
-
-        Per row E[e_x e_x^T] (12, 12) and E[e_x e_y^T] (12, 6), zero without noise correction.
-        """
+        """Wavelet equations at (a, b) points with per-row pose-noise moments (12, 12), (12, 6)."""
         found = self._noise_and_intervals(experiment, min(self.scale_fractions))
         wavelets = [wavelet]
         if self.odd_companion and isinstance(wavelet, PolynomialWavelet):
@@ -334,10 +288,7 @@ class WaveletIdentifier(BaseIdentifier):
 
     def _combine_pairs(self, M: np.ndarray, B: np.ndarray, std_M: np.ndarray,
                        std_B: np.ndarray, clip: bool = False) -> dict:
-        """Symmetric pairs, in place (:func:`~stewartid.identification.pairs.combine_pairs`).
-
-        ``clip`` for the free interval constants; the calibration is kept for the diagnostics.
-        """
+        """Symmetric pairs, in place; ``clip`` for the free interval constants."""
         chosen, self.pair_calibration_ = combine_pairs(
             M, B, std_M, std_B, bool(self.symmetric), self.pair_selection, clip)
         return chosen

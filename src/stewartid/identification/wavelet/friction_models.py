@@ -1,5 +1,6 @@
-"""Method B's friction treatments (free interval constants, Coulomb law per joint type): the
-equations and solve of each, and the choice between them on one sine per experiment.
+"""Method B's friction treatments (free interval constants, Coulomb law per joint type).
+
+The equations and solve of each, and the choice between them on one sine per experiment.
 """
 
 from __future__ import annotations
@@ -30,11 +31,7 @@ WINDOW_LENGTH = 2.0
 
 
 def friction_models(setting: str, datasets: Sequence[Dataset]) -> tuple[str, ...]:
-    """The friction models to fit for ``setting``.
-
-    For "auto": both "free" and "coulomb" when every experiment is one sine
-    (:func:`.detection.sine_share`), else "coulomb".
-    """
+    """The friction models to fit: "auto" gives "free" and "coulomb" on one sine per experiment."""
     if setting != "auto":
         return (setting,)
     single = all(sine_share(d.lengths, 1.0 / float(d.t[1] - d.t[0])) >= SINGLE_SINE_SHARE
@@ -44,11 +41,7 @@ def friction_models(setting: str, datasets: Sequence[Dataset]) -> tuple[str, ...
 
 def model_equations(model: str, experiment: Experiment, found: Detection, order: int,
                     functions: int, k: int) -> list:
-    """The weak-form equations of experiment ``k`` under friction model ``model``.
-
-    Windows with Coulomb rows for "coulomb" (:func:`.windows.window_equations`), else the
-    constant-direction intervals (:func:`.weak_form.experiment_equations`).
-    """
+    """The weak-form equations of one experiment under friction model ``model`` (windows or intervals)."""
     if model == "coulomb":
         return window_equations(experiment, found, order, functions, k, False, WINDOW_LENGTH)
     return experiment_equations(experiment, found, order, functions, k, model)
@@ -56,10 +49,7 @@ def model_equations(model: str, experiment: Experiment, found: Detection, order:
 
 def solve_model(model: str, equations: list, infos: list[dict], motion: list[np.ndarray],
                 noise: dict) -> tuple[WeakFormSolution, float]:
-    """Solve one friction model's equations over the soft-sign rates; returns the solution and its rate.
-
-    The intervals' coverage of every DOF is checked first.
-    """
+    """Solve one friction model's equations over the soft-sign rates; returns the solution and its rate."""
     if not equations:
         raise_no_interval(infos)
     if model == "coulomb":
@@ -72,17 +62,7 @@ def solve_model(model: str, equations: list, infos: list[dict], motion: list[np.
 def solve_models(models: Sequence[str], equations: Mapping[str, list], infos: list[dict],
                  motion: list[np.ndarray], noise: dict
                  ) -> tuple[dict[str, tuple[WeakFormSolution, float]], dict[str, str]]:
-    """:func:`solve_model` of every friction model; a refused one is left out with its reason.
-
-    Raises the first refusal when every model is refused.
-
-    Returns
-    -------
-    solved : dict
-        Model -> (solution, soft-sign rate).
-    refused : dict
-        Model -> the first line of its refusal.
-    """
+    """:func:`solve_model` of every model: (solved, refused) dicts; raises the first refusal if all fail."""
     solved, refused, first = {}, {}, None
     for model in models:
         try:
@@ -99,23 +79,8 @@ def choose_friction_fit(results: Mapping[str, IdentificationResult],
                         solutions: Mapping[str, WeakFormSolution]) -> tuple[str, dict]:
     """Which fit to keep, and the diagnostics that say why.
 
-    Of "free" and "coulomb", the one whose standard errors predict the smaller worst error
-    (:func:`~stewartid.verdict.accuracy.predicted_worst_error`), unless
-    :func:`friction_law_test` rejects the law.
-
-    Parameters
-    ----------
-    results : mapping
-        Friction model -> its result.
-    solutions : mapping
-        Friction model -> its solve, before the symmetric pairs are combined.
-
-    Returns
-    -------
-    chosen : str
-    diagnostics : dict
-        ``{"friction_candidates": {model: {"predicted_worst_relative_error": e}},
-        "friction_law_test": friction_law_test(...)}``; empty for one fit.
+    Of "free" and "coulomb", the smaller predicted worst error, unless :func:`friction_law_test`
+    rejects the law. ``results`` and ``solutions`` (before pairs are combined) map model names.
     """
     if len(results) == 1:
         return next(iter(results)), {}
@@ -137,23 +102,9 @@ def friction_law_test(free: np.ndarray, free_std: np.ndarray, law: np.ndarray,
                       law_std: np.ndarray) -> dict:
     """Does the fit with a friction law depart from the fit immune to it?
 
-    A Hausman-style specification test on the diagonals of Mt and Bt: each difference is
-    scored in sqrt(s_free^2 + s_law^2) of the residual-based standard errors, and the largest of
-    the 12 scores compared with the two-sided normal point at :data:`FRICTION_LAW_LEVEL`
-    shared over them (Bonferroni).
-
-    Parameters
-    ----------
-    free, law : ndarray, shape (6, 12)
-        [Mt Bt] of the ``friction="free"`` and ``friction="coulomb"`` solves of the same
-        data, before the symmetric pairs are combined.
-    free_std, law_std : ndarray, shape (6, 12)
-        Their residual-based standard errors.
-
-    Returns
-    -------
-    dict
-        ``{"largest_disagreement": z, "entry": "Bt(6,6)", "threshold": t, "rejected": bool}``.
+    Hausman-style test on the diagonals of ``free`` and ``law`` [Mt Bt] (6, 12): the largest of the
+    12 differences in sqrt(s_free^2 + s_law^2) against the Bonferroni point at :data:`FRICTION_LAW_LEVEL`.
+    Returns ``{"largest_disagreement", "entry", "threshold", "rejected"}``.
     """
     from scipy.special import ndtri
 

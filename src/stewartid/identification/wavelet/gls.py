@@ -1,24 +1,7 @@
 """Generalized least squares for the weak-form equations, with pose noise propagated.
 
-The rows of an interval carry white force-side noise (variance s_i per row of channel i)
-and pose noise n (covariance Sigma per sample) entering both regressors and target; channel
-i's rows then have covariance s_i I + Q with
-
-    Q_rs = sum_ab (c_a Sigma c_b) <phi_r^(a), phi_s^(b)>,   c_0 = k_i, c_1 = b_i, c_2 = -m_i.
-
-As in WENDy, each interval's rows are weighted by the inverse of that covariance
-(iteratively, Q depending on the estimate) and the expected noise parts of the weighted
-normal equations are subtracted (errors in variables). Sigma and the white force noise are
-measured from the data (:mod:`~stewartid.identification.wavelet.noise`).
-
-References
-----------
-Bortz, D. M., Messenger, D. A., Dukic, V. "Direct Estimation of Parameters in ODE Models Using
-WENDy: Weak-Form Estimation of Nonlinear Dynamics." Bull. Math. Biol. 85, 110 (2023).
-doi:10.1007/s11538-023-01208-6
-
-Söderström, T. "Errors-in-variables methods in system identification." Automatica 43(6),
-939-958 (2007). doi:10.1016/j.automatica.2006.11.025
+Rows of channel i have covariance s_i I + Q, Q_rs = sum_ab (c_a Sigma c_b) <phi_r^(a), phi_s^(b)>;
+the noise bias is removed (Bortz, Messenger, Dukic, WENDy 2023; Söderström 2007).
 """
 
 from __future__ import annotations
@@ -60,22 +43,20 @@ class WeakFormSolution:
     theta, theta_std : ndarray, shape (6, 12)
         [Mt Bt] and standard errors.
     coulomb, coulomb_std : ndarray, shape (n_types,)
-        Coulomb level per joint type (N m), NaN without shared friction.
+        Per joint type, N m; NaN without shared friction.
     offsets : ndarray, shape (n_experiments, 6)
-        Constant per experiment (N, N m), NaN without shared friction.
+        N, N m; NaN without shared friction.
     noise_std : ndarray, shape (6,)
-        Force-side noise per row and channel, sqrt(s_i) (N s^(1/2), N m s^(1/2)).
+        Force-side noise per row, sqrt(s_i).
     pose_noise_share : ndarray, shape (6,)
-        Share of the invariant rows' residual power that the pose noise explains.
+        Share of the invariant rows' residual power the pose noise explains.
     constant_scatter : ndarray, shape (6,)
-        tau: spread of the interval constants around the friction structure (N, N m).
+        tau, the interval constants' spread around the friction structure, N, N m.
     condition_number : float
-        Of the column-equilibrated invariant regression.
     n_equations : int
         Rows per channel.
     rate_weights : dict of str to float, optional
-        Weight of each soft-sign transition rate (rad/s, as text) the solution averages
-        (:func:`.rate_selection.averaged_over_rates`); None for a single fit.
+        Weight per soft-sign rate averaged over; None for a single fit.
     """
 
     theta: np.ndarray
@@ -93,11 +74,7 @@ class WeakFormSolution:
 
 def _weighted_normal(design: np.ndarray, weights: np.ndarray, target: np.ndarray
                      ) -> tuple[np.ndarray, np.ndarray]:
-    """sum_n D_n^T W_n D_n and sum_n D_n^T W_n t_n.
-
-    For designs (n, R, u), weights (n, R, R) and targets (n, R). A channel's design is zero
-    outside its own unknowns and the shared ones: only the columns used are multiplied.
-    """
+    """sum_n D_n^T W_n D_n and sum_n D_n^T W_n t_n, multiplying only the columns a channel uses."""
     used = np.flatnonzero(np.any(design, axis=(0, 1)))
     sub = design[..., used] if used.size < design.shape[-1] else design
     weighted = (weights @ sub).reshape(-1, sub.shape[-1])               # (n R, k)
@@ -115,10 +92,8 @@ def channel_systems(stacked: StackedEquations, n_experiments: int, shared_fricti
                     variation: bool = False) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """Design (n, R, u) and targets (n, R) of each of the 6 channels over all u unknowns.
 
-    Unknowns: [Mt Bt] row-major, then (shared friction) an offset per experiment and channel,
-    then the Coulomb levels (shared friction, or ``variation``). R = K invariant rows, plus the
-    mean row with shared friction. With ``variation`` the invariant rows carry the Coulomb
-    levels too: the generalized Coulomb force changes with the pose inside an interval.
+    Unknowns: [Mt Bt] row-major, then (shared friction) per-experiment offsets, then Coulomb levels
+    (shared friction or ``variation``, which gives them to the invariant rows too).
     """
     x, y, owner = stacked.regressors, stacked.targets, stacked.owner
     n, k_rows = x.shape[:2]
@@ -146,12 +121,7 @@ def channel_systems(stacked: StackedEquations, n_experiments: int, shared_fricti
 
 def channel_covariance(stacked: StackedEquations, gram: np.ndarray, noise: np.ndarray,
                        i: int, theta_i: np.ndarray, scatter: float | None) -> np.ndarray:
-    """Covariance (n, R, R) of channel i's rows.
-
-    The force-side noise ``noise`` (n,) per row, the pose noise at the estimate theta_i (12,)
-    and, with shared friction (``scatter`` not None), the interval constants' scatter on the
-    mean row.
-    """
+    """Covariance (n, R, R) of channel i's rows: force noise, pose noise at theta_i, constants' scatter."""
     rows = gram.shape[-1]
     v = noise[:, None, None] * np.eye(rows) + pose_covariance(
         gram, stacked.sigma, pose_coefficients(stacked.sensitivity[:, i], theta_i))
@@ -161,11 +131,7 @@ def channel_covariance(stacked: StackedEquations, gram: np.ndarray, noise: np.nd
 
 
 class InvariantFit(NamedTuple):
-    """Result of :func:`fit_invariant_rows`.
-
-    theta (6, 12), the force-side noise variance (n, 6) per interval and channel, and the share
-    of each channel's residual power the pose noise explains (6,).
-    """
+    """theta (6, 12), force-side noise variance (n, 6) and pose-noise share (6,) of the invariant rows."""
 
     theta: np.ndarray
     noise: np.ndarray
@@ -173,11 +139,7 @@ class InvariantFit(NamedTuple):
 
 
 def fit_invariant_rows(stacked: StackedEquations, iterations: int) -> InvariantFit:
-    """Each channel from the invariant rows alone, reweighted ``iterations`` times.
-
-    The row covariance is s_i I + Q, s_i the white force noise plus the chi-square excess of
-    the residuals; this estimate is the one the interval constants' scatter is measured with.
-    """
+    """Each channel from the invariant rows alone, reweighted ``iterations`` times."""
     x, y = stacked.regressors, stacked.targets
     n, k_rows = x.shape[:2]
     sigma, sensitivity, white = stacked.sigma, stacked.sensitivity, stacked.white
@@ -205,11 +167,7 @@ def fit_invariant_rows(stacked: StackedEquations, iterations: int) -> InvariantF
 
 def constant_scatter(stacked: StackedEquations, designs: Sequence[np.ndarray],
                      invariant: InvariantFit) -> np.ndarray:
-    """tau (6,): the scatter of the interval constants around the friction structure (N, N m).
-
-    Measured with the invariant estimate, since a joint fit would bend Bt to hide a structure
-    that does not hold.
-    """
+    """tau (6,), N, N m: the interval constants' scatter around the friction structure (invariant fit)."""
     theta, n = invariant.theta, len(stacked.owner)
     gram = stacked.gram
     variance = np.stack([channel_covariance(stacked, gram, invariant.noise[:, i], i, theta[i],
@@ -237,15 +195,13 @@ class JointFit(NamedTuple):
     Attributes
     ----------
     z : ndarray, shape (u,)
-        All unknowns.
     normal : ndarray, shape (u, u)
-        The compensated normal matrix of the last pass.
+        Compensated normal matrix of the last pass.
     scale : ndarray, shape (u,)
         Its column equilibration.
     weights : list of ndarray, shape (n, R, R)
-        Row weights of each channel in the last pass.
     uncorrected : ndarray of bool, shape (6,)
-        Channels the errors-in-variables correction was left out of in the last pass.
+        Channels left without the errors-in-variables correction.
     """
 
     z: np.ndarray
@@ -258,11 +214,7 @@ class JointFit(NamedTuple):
 def fit_jointly(stacked: StackedEquations, designs: Sequence[np.ndarray],
                 targets: Sequence[np.ndarray], invariant: InvariantFit,
                 scatter: np.ndarray | None, iterations: int) -> JointFit:
-    """All channels at once, rows weighted by the inverse of their covariance, noise bias removed.
-
-    The Coulomb levels are shared by the channels; reweighted ``iterations`` times with shared
-    friction (``scatter`` not None), once without.
-    """
+    """All channels at once, rows weighted by their inverse covariance, noise bias removed."""
     n_unknowns = designs[0].shape[-1]
     rows = designs[0].shape[1]
     gram = stacked.gram[..., :rows, :rows]
@@ -301,11 +253,7 @@ def fit_jointly(stacked: StackedEquations, designs: Sequence[np.ndarray],
 
 def standard_errors(designs: Sequence[np.ndarray], targets: Sequence[np.ndarray],
                     fit: JointFit) -> np.ndarray:
-    """Standard errors (u,) of all unknowns: the larger of the GLS one and a cluster-robust one.
-
-    The sandwich is over intervals, so model errors that show in the spread between intervals
-    are counted.
-    """
+    """Standard errors (u,): the larger of the GLS one and one cluster-robust over intervals."""
     n, n_unknowns = len(designs[0]), len(fit.z)
     scores = np.zeros((n, n_unknowns))
     squares, n_rows = 0.0, 0
@@ -336,46 +284,25 @@ def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
     Parameters
     ----------
     equations : sequence of IntervalEquations
-        All with the same number K of invariant rows.
+        All with the same number of invariant rows.
     n_experiments : int
     shared_friction : bool
-        Use the mean rows with the friction structure of
-        :mod:`~stewartid.identification.wavelet.weak_form`; False: the invariant rows alone
-        (every interval constant free).
+        Use the mean rows with the friction structure; False: every interval constant free.
     iterations : int
         Reweighting passes.
     max_condition : float
-        Rank check of the invariant regression (names the DOF never excited).
     pose_covariance : ndarray, shape (n_experiments, 6, 6), optional
-        White pose-noise covariance per sample of each experiment (m^2, m rad, rad^2);
-        None: noise-free poses.
+        White pose noise per sample; None: noise-free.
     force_sensitivity : ndarray, shape (n_experiments, 6, 6), optional
-        K = d(J^T f - G) / dq of each experiment
-        (:attr:`~stewartid.identification.preparation.Experiment.force_sensitivity`); None: zero.
+        K = dy/dq; None: zero.
     force_variance : ndarray, shape (n_experiments, 6), optional
-        White noise variance per sample of each experiment's generalized force (N^2,
-        N^2 m^2); None: zero (the force noise then comes from the residuals alone).
+        White generalized-force noise per sample; None: from the residuals alone.
     rate_index : int
-        Soft-sign transition rate of the invariant rows' Coulomb regressors (an index into
-        each interval's ``coulomb_rows``).
+        Soft-sign rate of the invariant rows' Coulomb regressors.
     variation : bool
-        Give the invariant rows the Coulomb levels (:func:`channel_systems`); the force-side
-        noise is then re-measured from the joint fit's residuals and the fit repeated.
+        Give the invariant rows the Coulomb levels and refit on re-measured noise.
     shared : dict, optional
-        Cache of the work independent of ``rate_index`` and ``variation`` (rank check,
-        :func:`fit_invariant_rows`), filled by the first call and reused on the same equations.
-
-    Returns
-    -------
-    WeakFormSolution
-        With ``variation`` and every constant free, ``coulomb`` holds the levels the
-        invariant rows see.
-
-    Notes
-    -----
-    The steps: :func:`stack_equations`, :func:`channel_systems`, :func:`fit_invariant_rows`,
-    :func:`constant_scatter` (shared friction), :func:`fit_jointly` and
-    :func:`standard_errors`.
+        Cache of the work independent of ``rate_index`` and ``variation``.
     """
     stacked = stack_equations(equations, pose_covariance, force_sensitivity, force_variance,
                               rate_index)

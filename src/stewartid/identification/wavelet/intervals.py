@@ -1,14 +1,6 @@
 """Constant-direction intervals: time spans in which no joint reverses.
 
-Zhang (2020, Section 3) calls them *constant direction spaces*: inside one each joint's
-Coulomb friction is nearly constant, so a wavelet with vanishing moments of order 0 and 1
-removes it together with gravity. The joints are, per leg, the five rotational axes of
-:data:`stewartid.model.joints.JOINT_AXES` and the actuator.
-
-References
-----------
-Zhang, C. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
-Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
+Inside one each joint's Coulomb friction is nearly constant (Zhang 2020, Section 3).
 """
 
 from __future__ import annotations
@@ -37,27 +29,9 @@ JOINT_RATE_NAMES = tuple(
 def joint_rates(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
                 joint_jacobians: np.ndarray | None = None,
                 leg_jacobian: np.ndarray | None = None) -> np.ndarray:
-    """Rates of the 30 rotational joint axes and the 6 actuators.
+    """Rates (N, 36) of the 30 rotational joint axes (rad/s) and 6 actuators (m/s), :data:`JOINT_RATE_NAMES`.
 
-    Parameters
-    ----------
-    platform : Platform
-    q : ndarray, shape (N, 6)
-        Poses (m, rad).
-    q_dot : ndarray, shape (N, 6)
-        Pose rates (m/s, rad/s).
-    joint_jacobians : ndarray, shape (N, 6, 5, 6), optional
-        Joint-axis Jacobians at ``q`` if already computed (a prepared experiment holds
-        them); None: :func:`stewartid.model.kinematics.joint_rate_jacobians`.
-    leg_jacobian : ndarray, shape (N, 6, 6), optional
-        Leg Jacobians J_lq at ``q`` if already computed; None:
-        :func:`stewartid.model.kinematics.leg_jacobian`.
-
-    Returns
-    -------
-    ndarray, shape (N, 36)
-        Columns as :data:`JOINT_RATE_NAMES`: joint axis rates (rad/s), then actuator
-        (leg-length) rates (m/s).
+    ``q`` and ``q_dot`` (N, 6); Jacobians (N, 6, 5, 6) and (N, 6, 6) are computed unless given.
     """
     q = np.atleast_2d(np.asarray(q, dtype=float))
     q_dot = np.atleast_2d(np.asarray(q_dot, dtype=float))
@@ -74,22 +48,7 @@ def joint_rates(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
 
 
 def active_joints(rates: np.ndarray, ignore_below: float = 0.0) -> np.ndarray:
-    """Mask of the joints whose rate amplitude is not negligible.
-
-    A joint is ignored when its rate RMS is below ``ignore_below`` times the largest RMS among
-    joints of its kind (rotational axes, actuators: the 30 + 6 layout of :func:`joint_rates`
-    when there are 36 columns, else one kind).
-
-    Parameters
-    ----------
-    rates : ndarray, shape (N, J)
-    ignore_below : float
-        Relative threshold in [0, 1); 0 keeps every joint.
-
-    Returns
-    -------
-    ndarray of bool, shape (J,)
-    """
+    """Mask (J,) of joints whose rate RMS reaches ``ignore_below`` times the largest of their kind."""
     if not 0.0 <= ignore_below < 1.0:
         raise ConfigError(
             f"ignore_below must be a fraction in [0, 1); got {ignore_below!r}."
@@ -106,32 +65,22 @@ def active_joints(rates: np.ndarray, ignore_below: float = 0.0) -> np.ndarray:
 def constant_direction_intervals(t: np.ndarray, rates: np.ndarray, margin: float = 0.02,
                                  min_duration: float = 0.0, ignore_below: float = 0.0,
                                  hysteresis: np.ndarray | float = 0.0) -> np.ndarray:
-    """Time intervals in which every (active) joint rate keeps its sign.
+    """Time intervals [start, stop] (M, 2), s, in which every active joint rate keeps its sign.
 
     Parameters
     ----------
     t : ndarray, shape (N,)
-        Strictly increasing sample times (s).
+        s, strictly increasing.
     rates : ndarray, shape (N, J)
-        Joint rates, e.g. from :func:`joint_rates`; any units, only signs matter.
+        Only signs matter.
     margin : float
-        Time (s) cut from both ends of every interval, so that a friction reversal lagging
-        the measured zero crossing stays outside.
+        Cut from both ends of every interval, s (a lagging friction reversal stays outside).
     min_duration : float
-        Intervals shorter than this (s, after the margins) are dropped.
+        Shorter intervals, after the margins, are dropped; s.
     ignore_below : float
-        Leave out joints whose rate RMS is below this fraction of the largest of their kind
-        (see :func:`active_joints`).
+        As :func:`active_joints`.
     hysteresis : float or ndarray, shape (J,)
-        Rate thresholds (units of ``rates``): a joint's direction counts as known only while
-        |rate| exceeds its threshold, so the unknown crossing time stays outside both
-        neighbouring intervals. Joints that never exceed it are left out. 0: plain signs.
-
-    Returns
-    -------
-    ndarray, shape (M, 2)
-        [start, stop] times (s) of the intervals, in time order; the first and last runs of
-        the record are kept.
+        A direction is known only while |rate| exceeds it; joints never above it are left out.
     """
     t = np.asarray(t, dtype=float)
     rates = np.asarray(rates, dtype=float)
@@ -186,15 +135,14 @@ class IntervalCheck(NamedTuple):
     Attributes
     ----------
     ok : bool
-        True when at least ``min_count`` intervals of ``min_duration`` exist.
+        At least ``min_count`` intervals of ``min_duration``.
     count : int
-        Intervals at least ``min_duration`` long.
     longest : float
-        Longest interval (s), 0 if none.
+        s, 0 if none.
     coverage : float
-        Fraction of the record covered by such intervals.
+        Fraction of the record covered.
     message : str
-        What was found and, when not ok, what to change.
+        What was found and what to change.
     """
 
     ok: bool
@@ -207,23 +155,7 @@ class IntervalCheck(NamedTuple):
 def check_intervals(t: np.ndarray, rates: np.ndarray, min_duration: float,
                     min_count: int = 1, margin: float = 0.02,
                     ignore_below: float = 0.0) -> IntervalCheck:
-    """Does a trajectory yield constant-direction intervals long enough for identification?
-
-    Parameters
-    ----------
-    t : ndarray, shape (N,)
-    rates : ndarray, shape (N, J)
-    min_duration : float
-        Shortest usable interval (s), e.g. twice the smallest wavelet scale times its support.
-    min_count : int
-        How many such intervals are required.
-    margin, ignore_below : float
-        As in :func:`constant_direction_intervals`.
-
-    Returns
-    -------
-    IntervalCheck
-    """
+    """Does a trajectory yield constant-direction intervals long enough for identification?"""
     t = np.asarray(t, dtype=float)
     all_intervals = constant_direction_intervals(t, rates, margin, 0.0, ignore_below)
     lengths = all_intervals[:, 1] - all_intervals[:, 0] if len(all_intervals) else np.zeros(0)
@@ -250,22 +182,8 @@ def wavelet_points(intervals: np.ndarray, wavelet: MotherWavelet,
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(a, b) points whose wavelet support lies inside an interval.
 
-    Parameters
-    ----------
-    intervals : ndarray, shape (M, 2)
-        [start, stop] (s).
-    wavelet : MotherWavelet
-    scale_fractions : tuple of float
-        Support length as a fraction of the interval length, each in (0, 1].
-    shifts_per_scale : int
-        Shifts per scale and interval (one if the support fills the interval).
-
-    Returns
-    -------
-    scales, shifts : ndarray, shape (K,)
-        a and b (s).
-    interval_index : ndarray of int, shape (K,)
-        Row of ``intervals`` each point belongs to.
+    ``scale_fractions``: supports as fractions of the interval, in (0, 1]. Returns scales, shifts (K,), s,
+    and the interval index of each.
     """
     scales, shifts, owner = [], [], []
     for m, (start, stop) in enumerate(intervals):

@@ -1,6 +1,4 @@
-"""Measurement noise estimated from the data (pose, forces) and the noise it puts on the joint
-rates: the noise-model step of Method B.
-"""
+"""Measurement noise estimated from the data (pose, forces) and the noise it puts on the joint rates."""
 
 from __future__ import annotations
 
@@ -18,22 +16,9 @@ from stewartid.signals.differentiation import (
 
 
 def white_noise_covariance(q: np.ndarray, smooth: np.ndarray | None = None) -> np.ndarray:
-    """Covariance of white measurement noise on a smooth signal, from second differences.
+    """Covariance Sigma (m, m) per sample of white noise on ``q`` (N, m), from second differences (6 Sigma).
 
-    The second differences of q minus a smoothed copy are the noise's, of covariance 6 Sigma
-    for white noise; noise-free data give a covariance near zero.
-
-    Parameters
-    ----------
-    q : ndarray, shape (N, m)
-        Measured signals, e.g. poses (m, rad) or generalized forces (N, N m).
-    smooth : ndarray, shape (N, m), optional
-        A low-pass smoothed copy of ``q``; None: raw second differences.
-
-    Returns
-    -------
-    ndarray, shape (m, m)
-        Sigma per sample (units of q squared).
+    ``smooth``: a low-pass copy of ``q`` subtracted first.
     """
     r = q if smooth is None else q - smooth
     d2 = r[2:] - 2.0 * r[1:-1] + r[:-2]
@@ -44,27 +29,7 @@ def white_noise_covariance(q: np.ndarray, smooth: np.ndarray | None = None) -> n
 def joint_rate_noise(covariance: np.ndarray, sample_rate: float, window: float,
                      joint_jacobians: np.ndarray, leg_jacobian: np.ndarray,
                      order: int = DEFAULT_ORDER) -> np.ndarray:
-    """Standard deviation of each Savitzky-Golay joint rate caused by pose noise.
-
-    |c| sqrt(diag(J Sigma J^T)), with c the velocity filter's coefficients and J the Jacobians
-    averaged over the record.
-
-    Parameters
-    ----------
-    covariance : ndarray, shape (6, 6)
-        Pose noise per sample (:func:`white_noise_covariance`).
-    sample_rate, window : float
-        Hz and the differentiation window (s).
-    joint_jacobians : ndarray, shape (N, 6, 5, 6)
-    leg_jacobian : ndarray, shape (N, 6, 6)
-    order : int
-        Savitzky-Golay order of the rates.
-
-    Returns
-    -------
-    ndarray, shape (36,)
-        Columns as :data:`~stewartid.identification.wavelet.intervals.JOINT_RATE_NAMES`.
-    """
+    """Standard deviation (36,) of each Savitzky-Golay joint rate from pose noise, |c| sqrt(diag(J S J^T))."""
     n = window_samples(window, sample_rate, order)
     gain = np.linalg.norm(savgol_coefficients(n, order, 1, 1.0 / sample_rate))
     jac = np.concatenate([joint_jacobians.mean(axis=0).reshape(30, 6),
@@ -79,16 +44,14 @@ class NoiseModel(NamedTuple):
     Attributes
     ----------
     window : float
-        Savitzky-Golay window (s).
+        Savitzky-Golay window, s.
     q_dot, q_ddot : ndarray, shape (N, 6)
-        Savitzky-Golay derivatives of the pose (m/s, rad/s; m/s^2, rad/s^2).
     pose_covariance : ndarray, shape (6, 6)
-        White pose noise per sample (m^2, m rad, rad^2), :func:`white_noise_covariance`.
+        White pose noise per sample, m^2, m rad, rad^2.
     force_variance : ndarray, shape (6,)
-        White noise variance per sample of the generalized force (N^2, N^2 m^2).
+        White generalized-force noise per sample, N^2, N^2 m^2.
     rate_noise : ndarray, shape (36,)
-        Standard deviation the pose noise causes on each joint rate (:func:`joint_rate_noise`;
-        columns as :data:`~stewartid.identification.wavelet.intervals.JOINT_RATE_NAMES`).
+        Pose noise on each joint rate.
     """
 
     window: float
@@ -100,20 +63,7 @@ class NoiseModel(NamedTuple):
 
 
 def estimate_noise(experiment: Experiment, window: float) -> NoiseModel:
-    """The noise model of one prepared experiment.
-
-    Parameters
-    ----------
-    experiment : Experiment
-        Prepared with its joint-axis Jacobians
-        (:func:`~stewartid.identification.preparation.prepare_experiment`).
-    window : float
-        Savitzky-Golay window (s).
-
-    Returns
-    -------
-    NoiseModel
-    """
+    """The noise model of one prepared experiment (with its joint-axis Jacobians)."""
     q, rate = experiment.q, 1.0 / experiment.period
     q_smooth, q_dot, q_ddot = differentiate(q, rate, window)
     covariance = white_noise_covariance(q, q_smooth)

@@ -1,6 +1,5 @@
 """Method B's equations at chosen (scale, shift) points: the paper's wavelet transform.
 
-Each (a, b) point inside an interval gives
 [Mt Bt] [W_psi q_ddot ; W_psi q_dot](a, b) = W_psi y (a, b).
 """
 
@@ -23,33 +22,11 @@ EXACT_DEGREE = 5
 def point_equations(experiment: Experiment, found: Detection,
                     wavelets: Sequence[MotherWavelet], scale_fractions: tuple[float, ...],
                     shifts_per_scale: int, variant: str):
-    """Wavelet equations of one experiment.
+    """Wavelet equations of one experiment, every wavelet at every (a, b) point of its intervals.
 
-    Parameters
-    ----------
-    experiment : Experiment
-    found : Detection
-        Its intervals and Savitzky-Golay derivatives.
-    wavelets : sequence of MotherWavelet
-        Every wavelet is applied at every (a, b) point.
-    scale_fractions : tuple of float
-        Scales as fractions of the interval length
-        (:func:`~stewartid.identification.wavelet.intervals.wavelet_points`).
-    shifts_per_scale : int
-    variant : {"position", "paper", "derivative"}
-        How the transformed derivatives are obtained.
-
-    Returns
-    -------
-    regressors : ndarray, shape (K, 12)
-    targets : ndarray, shape (K, 6)
-    owner : ndarray of int, shape (K,)
-        Interval of each row.
-    products : ndarray, shape (K, 3, 3)
-        Inner products of the rows acting on q (acceleration, velocity) and on y: the
-        covariances of transformed white pose noise (zero outside the position variant).
-    info : dict
-        The detection's info with the ``scales`` and ``shifts`` used.
+    Returns regressors (K, 12), targets (K, 6), owner interval (K,), products (K, 3, 3) (the rows'
+    inner products on q and y: transformed white pose noise covariances, position variant only) and
+    the detection's info with the ``scales`` and ``shifts`` used.
     """
     t, q = experiment.t, experiment.q
     intervals, info, q_dot, q_ddot = found.intervals, found.info, found.q_dot, found.q_ddot

@@ -1,5 +1,6 @@
-"""Which Coulomb regressors Method B's rows carry: fits at every candidate soft-sign transition
-rate averaged by how well each explains the rows, and whether the Coulomb levels are kept.
+"""Which Coulomb regressors Method B's rows carry.
+
+Fits over soft-sign transition rates averaged by Akaike weight, and whether the levels are kept.
 """
 
 from __future__ import annotations
@@ -18,29 +19,17 @@ VARIATION_TEST_LEVEL = 0.01
 
 
 def residual_cost(solution: WeakFormSolution) -> float:
-    """Sum over channels of the log force-side noise variance.
-
-    Minus twice the profile log-likelihood of Gaussian rows, per row.
-    """
+    """Sum over channels of the log force-side noise variance (-2 profile log-likelihood per row)."""
     return float(np.sum(np.log(solution.noise_std ** 2)))
 
 
 def averaged_over_rates(solve: Callable[[int], WeakFormSolution], rates: Sequence[float]
                         ) -> tuple[WeakFormSolution, float]:
-    """``solve(index)`` at every transition rate, averaged over the rates with Akaike weights.
+    """``solve(index)`` at every transition rate, averaged with Akaike weights exp(-n (c_k - min c) / 2).
 
-    Each weight is exp(-D_k / 2), normalised, with D_k = n (c_k - min c) (n rows per channel,
-    c = :func:`residual_cost`); the mean is sum_k w_k theta_k with standard error
-    sqrt(sum_k w_k (s_k^2 + (theta_k - mean)^2)) (Burnham and Anderson 2002, sec. 6.3), which
-    carries the uncertainty of the choice of rate.
-
-    Returns
-    -------
-    solution : WeakFormSolution
-        [Mt Bt] and the Coulomb levels averaged, with their standard errors; the rest of the
-        candidate of least residual; ``rate_weights`` each rate's weight.
-    rate : float
-        The transition rate of greatest weight (rad/s).
+    Mean sum_k w_k theta_k, standard error sqrt(sum_k w_k (s_k^2 + (theta_k - mean)^2)) (Burnham and
+    Anderson 2002, sec. 6.3). Returns the averaged solution (rest from the best candidate, with
+    ``rate_weights``) and the rate of greatest weight, rad/s.
     """
     solutions = [solve(index) for index in range(len(rates))]
     costs = np.array([residual_cost(solution) for solution in solutions])
@@ -67,18 +56,10 @@ def averaged_over_rates(solve: Callable[[int], WeakFormSolution], rates: Sequenc
 def solve_weak_form_over_rates(equations: Sequence[IntervalEquations], n_experiments: int,
                                shared_friction: bool = True, **settings
                                ) -> tuple[WeakFormSolution, float | None]:
-    """:func:`solve_weak_form` with the rows' Coulomb regressors, averaged over transition rates.
+    """:func:`~stewartid.identification.wavelet.gls.solve_weak_form` with Coulomb rows averaged over rates.
 
-    With ``shared_friction`` the solution without them. Otherwise the levels are kept only when
-    a likelihood-ratio test at :data:`VARIATION_TEST_LEVEL` says they explain the rows and no
-    level is more than 3 standard errors below zero (which no friction has).
-
-    Returns
-    -------
-    solution : WeakFormSolution
-    rate : float or None
-        The transition rate of greatest weight (rad/s, from
-        :data:`.weak_form.SOFT_SIGN_RATES`); None when the levels were left out.
+    Levels are kept only if a likelihood-ratio test at :data:`VARIATION_TEST_LEVEL` accepts them and
+    none is 3 standard errors below zero. Returns (solution, rate of greatest weight or None).
     """
     if shared_friction:  # the mean rows carry the levels
         return solve_weak_form(equations, n_experiments, True, **settings), None

@@ -1,11 +1,6 @@
-"""Variance components of Method B's weak-form rows: the covariance the pose noise puts into
-them, its bias on the normal equations, and the variance residuals hold beyond the noise
-(matched in weighted chi-square, Paule and Mandel 1982).
+"""Variance components of Method B's weak-form rows.
 
-References
-----------
-Paule, R. C., Mandel, J. "Consensus values and weighting factors." J. Res. Natl. Bur. Stand.
-87(5), 377-385 (1982). doi:10.6028/jres.087.022
+Pose-noise covariance, its bias on the normal equations, the excess residual variance (Paule and Mandel 1982).
 """
 
 from __future__ import annotations
@@ -21,24 +16,10 @@ if TYPE_CHECKING:
 
 def pose_covariance(gram: np.ndarray, sigma: np.ndarray, coefficients: np.ndarray
                     ) -> np.ndarray:
-    """The row covariance the pose noise causes in one channel, per interval.
+    """Row covariance Q (n, R, R) pose noise causes in one channel per interval.
 
-    Q_rs = sum_ab (c_a Sigma c_b) <phi_r^(a), phi_s^(b)>.
-
-    Parameters
-    ----------
-    gram : ndarray, shape (n, 3, 3, R, R)
-        Gram matrices of the test functions and their first and second derivatives.
-    sigma : ndarray, shape (n, 6, 6)
-        Pose noise per sample of each interval's experiment (m^2, m rad, rad^2).
-    coefficients : ndarray, shape (n, 3, 6)
-        c_a, what multiplies <phi^(a), n> in the channel's residual
-        (:func:`pose_coefficients`).
-
-    Returns
-    -------
-    ndarray, shape (n, R, R)
-        Q per interval (units of the targets squared).
+    Q_rs = sum_ab (c_a Sigma c_b) <phi_r^(a), phi_s^(b)>; ``gram`` (n, 3, 3, R, R), ``sigma`` (n, 6, 6),
+    ``coefficients`` c_a (n, 3, 6) from :func:`pose_coefficients`.
     """
     c = np.einsum("naj,njk,nbk->nab", coefficients, sigma, coefficients)
     return np.einsum("nab,nabrs->nrs", c, gram)
@@ -46,23 +27,9 @@ def pose_covariance(gram: np.ndarray, sigma: np.ndarray, coefficients: np.ndarra
 
 def noise_bias(weights: np.ndarray, gram: np.ndarray, sigma: np.ndarray,
                sensitivity: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Expected noise parts of sum X^T W X and sum X^T W y over intervals, for one channel.
+    """Expected noise parts (12, 12), (12,) of sum X^T W X and sum X^T W y over intervals, one channel.
 
-    The regressors' noise is [<phi'', n>, -<phi', n>], the target's <phi, k_i n>.
-
-    Parameters
-    ----------
-    weights : ndarray, shape (n, R, R)
-        Row weights W of every interval.
-    gram : ndarray, shape (n, 3, 3, R, R)
-    sigma : ndarray, shape (n, 6, 6)
-    sensitivity : ndarray, shape (n, 6)
-        k_i of every interval's experiment: row i of dy/dq.
-
-    Returns
-    -------
-    normal : ndarray, shape (12, 12)
-    rhs : ndarray, shape (12,)
+    Regressor noise [<phi'', n>, -<phi', n>], target noise <phi, k_i n>; ``sensitivity`` k_i (n, 6).
     """
     t = np.einsum("nrs,nabrs->nab", weights, gram)                     # sum_rs W_rs G_ab,rs
     mm = np.einsum("n,njk->jk", t[:, 2, 2], sigma)
@@ -76,11 +43,7 @@ def noise_bias(weights: np.ndarray, gram: np.ndarray, sigma: np.ndarray,
 def compensate(normal: np.ndarray, rhs: np.ndarray, weights: np.ndarray, gram: np.ndarray,
                sigma: np.ndarray, sensitivity: np.ndarray
                ) -> tuple[np.ndarray, np.ndarray, bool]:
-    """One channel's normal equations less their expected noise part (:func:`noise_bias`).
-
-    Returns the block, its right-hand side and whether it was corrected; unchanged when the
-    correction would leave it not positive definite.
-    """
+    """Normal equations less :func:`noise_bias` unless that breaks definiteness, and whether corrected."""
     bias, bias_rhs = noise_bias(weights, gram, sigma, sensitivity)
     try:
         np.linalg.cholesky(normal - bias)
@@ -90,21 +53,14 @@ def compensate(normal: np.ndarray, rhs: np.ndarray, weights: np.ndarray, gram: n
 
 
 def pose_coefficients(sensitivity: np.ndarray, theta_i: np.ndarray) -> np.ndarray:
-    """(n, 3, 6) coefficients of :func:`pose_covariance` for channel row theta_i = [m, b] (12,).
-
-    Rows k_i (``sensitivity``, (n, 6)), b and -m.
-    """
+    """(n, 3, 6) coefficients of :func:`pose_covariance` for theta_i = [m, b]: rows k_i, b, -m."""
     n = len(sensitivity)
     return np.stack([sensitivity, np.broadcast_to(theta_i[6:], (n, 6)),
                      np.broadcast_to(-theta_i[:6], (n, 6))], axis=1)
 
 
 def chi2_excess(variances: np.ndarray, squares: np.ndarray, dof: float) -> float:
-    """e >= 0 with sum_k squares_k / (variances_k + e) = dof (Paule-Mandel).
-
-    0 when the left side is already at most dof at e = 0. Both arrays of any one shape,
-    variances >= 0.
-    """
+    """e >= 0 with sum_k squares_k / (variances_k + e) = dof (Paule-Mandel); 0 if already below."""
     lam = np.maximum(variances, 0.0)
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):  # noise-free rows
         if np.sum(np.where(squares > 0, squares / lam, 0.0)) <= dof:
@@ -117,22 +73,14 @@ def chi2_excess(variances: np.ndarray, squares: np.ndarray, dof: float) -> float
 
 
 def excess_variance(covariance: np.ndarray, residual: np.ndarray, dof: int) -> float:
-    """e >= 0 with sum_n r_n^T (V_n + e I)^-1 r_n = dof: the white variance per row beyond V.
-
-    Residuals r (n, R), expected covariance V (n, R, R). Weighted, since V varies by orders of
-    magnitude across the test functions.
-    """
+    """e >= 0 with sum_n r_n^T (V_n + e I)^-1 r_n = dof: the white variance per row beyond V."""
     lam, vectors = np.linalg.eigh(covariance)
     return chi2_excess(lam, np.einsum("nrk,nr->nk", vectors, residual) ** 2, dof)
 
 
 def row_noise(stacked: StackedEquations, designs: Sequence[np.ndarray],
               targets: Sequence[np.ndarray], z: np.ndarray) -> np.ndarray:
-    """Force-side noise variance (n, 6) per interval (or window) and channel.
-
-    The white part measured from the data plus the chi-square excess of the rows' residuals
-    at the unknowns z.
-    """
+    """Force-side noise variance (n, 6) per interval and channel: white part plus chi-square excess."""
     n, k_rows = stacked.regressors.shape[:2]
     gram = stacked.gram[..., :k_rows, :k_rows]
     floor = 1e-24 * np.maximum(np.mean(stacked.targets.reshape(-1, 6) ** 2, axis=0), 1e-300)

@@ -1,25 +1,7 @@
 """Weak-form equations on constant-direction intervals: the default rows of Method B.
 
-A test function phi vanishing with its first derivative at the interval's ends moves both
-derivatives of Mt q_ddot + Bt q_dot + c_m = y onto itself,
-
-    Mt <phi'', q> - Bt <phi', q> + c_m <phi, 1> = <phi, y>,
-
-so no signal is differentiated numerically. Per interval, a family of orthonormal zero-mean
-test functions (Coulomb-invariant rows) and one mean row, which keeps c_m; with shared
-friction c_m = o_e + sum_types F_type W_m,type + delta_m, with delta_m of variance tau^2
-estimated from the data.
-
-References
-----------
-Zhang, C. "A Parameter Identification Method for Stewart Manipulator Based on Wavelet
-Transform." Mathematics 8(2), 257 (2020). doi:10.3390/math8020257
-
-Bortz, D. M., Messenger, D. A., Dukic, V. "Direct Estimation of Parameters in ODE Models Using
-WENDy: Weak-Form Estimation of Nonlinear Dynamics." Bull. Math. Biol. 85, 110 (2023).
-doi:10.1007/s11538-023-01208-6
-
-Shinbrot, M. "On the analysis of linear and nonlinear systems." Trans. ASME 79, 547 (1957).
+Mt <phi'', q> - Bt <phi', q> + c_m <phi, 1> = <phi, y>: no signal is differentiated
+(Zhang 2020; Bortz, Messenger, Dukic, WENDy 2023; Shinbrot 1957).
 """
 
 from __future__ import annotations
@@ -39,11 +21,7 @@ from stewartid.model.joints import JOINT_TYPES
 
 @lru_cache(maxsize=32)
 def _family_coefficients(order: int, size: int) -> tuple[np.ndarray, ...]:
-    """Power-series coefficients (degree + 1, size + 1) of g, g', g'', g''' on [-1, 1].
-
-    Column 0 is the bump (1 - x^2)^order; column k + 1 is (1 - x^2)^order x^k, whose
-    derivative is the k-th zero-mean test function.
-    """
+    """Power-series coefficients (degree + 1, size + 1) of g, g', g'', g''' for (1 - x^2)^order x^k."""
     bump = polynomial.polypow([1.0, 0.0, -1.0], order)
     columns = [bump] + [np.r_[np.zeros(k), bump] for k in range(size)]
     degree = 2 * order + size + 1
@@ -59,31 +37,10 @@ def _family_coefficients(order: int, size: int) -> tuple[np.ndarray, ...]:
 
 def test_family(t: np.ndarray, start: float, stop: float, order: int, size: int, h: float
                 ) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
-    """The test functions of one span, sampled and scaled for quadrature.
+    """The test functions of one span, sampled and scaled by ``h`` for quadrature.
 
-    With x = (t - c) / L on the span of centre c and half-length L, phi_k = d/dt [(1 - x^2)^p
-    x^k], k < ``size``, orthonormalised on the samples; the mean row is the bump (1 - x^2)^p
-    orthogonalised against them.
-
-    Parameters
-    ----------
-    t : ndarray, shape (n,)
-        Sample times inside (start, stop) (s).
-    start, stop : float
-        The span (s).
-    order, size : int
-        As in :func:`interval_equations`.
-    h : float
-        Sample period (s): the quadrature weight.
-
-    Returns
-    -------
-    (phi, phi', phi'') : tuple of ndarray, shape (size, n)
-        The zero-mean family, orthonormal on the samples, and its first two derivatives
-        (times h: rows give <phi, x> as plain dot products).
-    (g, g', g'') : tuple of ndarray, shape (n,)
-        The mean row: the bump orthogonalised against the family, unit norm, and its
-        derivatives.
+    phi_k = d/dt [(1 - x^2)^p x^k], x = (t - c) / L, orthonormalised; the mean row is the bump
+    orthogonalised against them. Returns (phi, phi', phi'') (size, n) and (g, g', g'') (n,).
     """
     half, centre = 0.5 * (stop - start), 0.5 * (start + stop)
     x = (t - centre) / half
@@ -109,27 +66,20 @@ class IntervalEquations:
     Attributes
     ----------
     regressors : ndarray, shape (K, 12)
-        Invariant rows: [<phi_k'', q>, -<phi_k', q>] (units of q_ddot and q_dot times s).
+        Invariant rows [<phi_k'', q>, -<phi_k', q>].
     targets : ndarray, shape (K, 6)
-        <phi_k, y> (N s, N m s).
+        <phi_k, y>, N s, N m s.
     mean_regressors : ndarray, shape (12,)
-        The mean row's [<g'', q>, -<g', q>].
     mean_target : ndarray, shape (6,)
-        <g, y>.
     weight : float
-        <g, 1> (s^(1/2)): the mean row's coefficient of the interval constant.
-    coulomb : ndarray, shape (n_types, 6), or (1, 6) with one level for every axis
-        <g, W_type>: generalized Coulomb force per unit level of each joint type, with the
-        interval's joint directions.
-    coulomb_rows : ndarray, shape (n_rates, K, n_types, 6), or (n_rates, K, 1, 6), or None
-        <phi_k, W_type(t)> at each soft-sign transition rate of :func:`coulomb_patterns`: the
-        Coulomb force's change inside the interval seen by the invariant rows (every constant
-        free only).
+        <g, 1>, s^(1/2).
+    coulomb : ndarray, shape (n_types, 6) or (1, 6)
+        <g, W_type> with the interval's joint directions.
+    coulomb_rows : ndarray, shape (n_rates, K, n_types, 6) or None
+        <phi_k, W_type(t)> per soft-sign rate (free constants only).
     experiment : int
-        Index of the experiment the interval belongs to.
     noise_gram : ndarray, shape (3, 3, K + 1, K + 1)
-        Gram matrices <phi^(a), phi^(b)> (a, b = 0, 1, 2) of the invariant rows then the mean
-        row: what white pose noise puts into the rows.
+        <phi^(a), phi^(b)> of the invariant rows then the mean row.
     """
 
     regressors: np.ndarray
@@ -149,41 +99,31 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
                        rate_noise: np.ndarray, interval: Sequence[float], order: int, size: int,
                        experiment: int = 0, uniform: bool = False,
                        patterns: np.ndarray | None = None) -> IntervalEquations | None:
-    """Weak-form equations of one interval (see the module docstring).
+    """Weak-form equations of one interval; None when it holds fewer than 4 (K + 1) samples.
 
     Parameters
     ----------
     t : ndarray, shape (N,)
-        Uniform sample times (s).
-    q : ndarray, shape (N, 6)
-        Measured pose (m, rad).
-    y : ndarray, shape (N, 6)
-        Generalized force J^T f - G(q) (N, N m).
-    joint_jacobians : ndarray, shape (N, 6, 5, 6), or None
-        Joint-axis rate Jacobians (rad/s per unit q_dot). None: no friction structure
-        (``coulomb`` zero).
+        s, uniform.
+    q, y : ndarray, shape (N, 6)
+        Pose (m, rad) and generalized force (N, N m).
+    joint_jacobians : ndarray, shape (N, 6, 5, 6) or None
+        None: no friction structure.
     joint_rates : ndarray, shape (N, 6, 5)
-        Smoothed joint-axis rates (rad/s); their mean over the interval gives the directions.
+        Smoothed, rad/s; their mean gives the directions.
     rate_noise : ndarray, shape (6, 5)
-        Noise level of those rates (rad/s): a direction weighs |mean| / noise when within it.
+        rad/s; a direction weighs |mean| / noise within it.
     interval : (start, stop)
         s.
     order : int
-        Exponent p of the bump (1 - x^2)^p, >= 3 so that phi and phi' vanish at the ends.
+        p of (1 - x^2)^p, >= 3.
     size : int
-        Number of invariant test functions K.
+        K invariant test functions.
     experiment : int
-        Stored in the result.
     uniform : bool
-        One Coulomb level for every joint axis: ``coulomb`` summed over the joint types.
+        One Coulomb level for every joint axis.
     patterns : ndarray, shape (n_rates, N, n_types, 6), optional
-        :func:`coulomb_patterns` of the experiment at each soft-sign transition rate, for
-        ``coulomb_rows``; None: no ``coulomb_rows``.
-
-    Returns
-    -------
-    IntervalEquations or None
-        None when the interval holds fewer than 4 (K + 1) samples.
+        :func:`coulomb_patterns`, for ``coulomb_rows``.
     """
     start, stop = float(interval[0]), float(interval[1])
     sel = np.flatnonzero((t > start) & (t < stop))
@@ -222,12 +162,10 @@ SOFT_SIGN_RATES = (0.0, 1e-4, 3e-4, 1e-3, 3e-3)
 
 def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: bool,
                      rate: float | Sequence[float] = 0.0) -> np.ndarray:
-    """W_type(t) at every sample: generalized force of a unit Coulomb torque on each axis of a type.
+    """W_type(t) (N, n_types, 6): generalized force of a unit Coulomb torque on each axis of a type.
 
-    Each axis's torque opposes its rate (``found.sign_rates``) as the soft sign
-    w / sqrt(w^2 + sigma^2 + r^2), sigma the rate's noise level and r the friction's transition
-    ``rate`` (rad/s). Shape (N, n_types, 6), or (N, 1, 6) with ``uniform``; a sequence of
-    rates adds a leading axis (n_rates,).
+    Soft sign w / sqrt(w^2 + sigma^2 + r^2) of ``found.sign_rates``, r = ``rate``, rad/s; a sequence of
+    rates adds a leading axis.
     """
     rates, noise = found.sign_rates, found.sign_rate_noise
     out = []
@@ -238,10 +176,7 @@ def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: boo
 
 
 def _by_type(pattern: np.ndarray, uniform: bool) -> np.ndarray:
-    """Generalized Coulomb force per unit level (n, n_types, 6), or (n, 1, 6) with ``uniform``.
-
-    From the per-axis pattern (n, 5, 6).
-    """
+    """Per-axis pattern (n, 5, 6) summed per joint type: (n, n_types, 6), or (n, 1, 6) if ``uniform``."""
     by_type = np.stack([pattern[:, list(axes)].sum(axis=1) for axes in JOINT_TYPES.values()],
                        axis=1)
     return by_type.sum(axis=1, keepdims=True) if uniform else by_type
@@ -250,29 +185,10 @@ def _by_type(pattern: np.ndarray, uniform: bool) -> np.ndarray:
 def experiment_equations(experiment: Experiment, found: Detection, order: int, size: int,
                          index: int, friction: str,
                          rates: Sequence[float] = SOFT_SIGN_RATES) -> list[IntervalEquations]:
-    """The equations step of Method B: the weak-form equations of every usable interval.
+    """The weak-form equations of every usable interval of one experiment.
 
-    Parameters
-    ----------
-    experiment : Experiment
-        Prepared with its joint-axis Jacobians.
-    found : Detection
-        Its intervals and joint rates (:func:`.detection.detect_intervals`).
-    order, size : int
-        As in :func:`interval_equations`.
-    index : int
-        Index of the experiment, stored in every interval's equations.
-    friction : {"free", "shared", "uniform"}
-        "free": no friction structure in the mean rows; "uniform": one Coulomb level for
-        every joint axis.
-    rates : sequence of float
-        Soft-sign transition rates (rad/s) of the invariant rows' Coulomb regressors ("free"
-        only).
-
-    Returns
-    -------
-    list of IntervalEquations
-        One per interval long enough for the test functions.
+    ``friction``: "free" (no structure in the mean rows), "shared" or "uniform" (one level); ``rates``:
+    soft-sign rates, rad/s, of the invariant rows' Coulomb regressors ("free" only).
     """
     jacobians = experiment.joint_jacobians
     uniform, free = friction == "uniform", friction == "free"
@@ -291,27 +207,20 @@ class StackedEquations(NamedTuple):
     Attributes
     ----------
     regressors : ndarray, shape (n, K, 12)
-        Invariant rows [<phi'', q>, -<phi', q>].
     targets : ndarray, shape (n, K, 6)
-        <phi, y>.
     mean_regressors : ndarray, shape (n, 12)
     mean_targets : ndarray, shape (n, 6)
     weights : ndarray, shape (n,)
-        <g, 1> of every mean row (s^(1/2)).
+        <g, 1>, s^(1/2).
     coulomb : ndarray, shape (n, n_types, 6)
-        Generalized Coulomb force per unit level of each joint type.
     coulomb_rows : ndarray, shape (n, K, n_types, 6)
-        Its change inside every interval seen by the invariant rows.
     owner : ndarray of int, shape (n,)
         Experiment of every interval.
     gram : ndarray, shape (n, 3, 3, K + 1, K + 1)
-        Gram matrices of the rows' test functions and their derivatives.
-    sigma : ndarray, shape (n, 6, 6)
-        Pose noise per sample of every interval's experiment (zero when not given).
-    sensitivity : ndarray, shape (n, 6, 6)
-        K = dy/dq of every interval's experiment (zero when not given).
+    sigma, sensitivity : ndarray, shape (n, 6, 6)
+        Pose noise per sample and K = dy/dq (zero when not given).
     white : ndarray, shape (n, 6)
-        White noise variance of the generalized force (zero when not given).
+        Generalized-force white noise variance (zero when not given).
     """
 
     regressors: np.ndarray
@@ -333,22 +242,7 @@ def stack_equations(equations: Sequence[IntervalEquations],
                     force_sensitivity: np.ndarray | None = None,
                     force_variance: np.ndarray | None = None, rate_index: int = 0
                     ) -> StackedEquations:
-    """Every interval's equations as arrays, with its experiment's noise levels.
-
-    Parameters
-    ----------
-    equations : sequence of IntervalEquations
-        n intervals, all with the same number K of invariant rows.
-    pose_covariance, force_sensitivity, force_variance : ndarray, optional
-        Per experiment, as in :func:`~stewartid.identification.wavelet.gls.solve_weak_form`;
-        None: zero.
-    rate_index : int
-        The soft-sign transition rate of ``coulomb_rows`` (an index into each interval's).
-
-    Returns
-    -------
-    StackedEquations
-    """
+    """Every interval's equations as arrays, with its experiment's noise levels (None: zero)."""
     owner = np.array([e.experiment for e in equations])
     return StackedEquations(
         regressors=np.stack([e.regressors for e in equations]),
@@ -368,7 +262,7 @@ def stack_equations(equations: Sequence[IntervalEquations],
 
 def _per_interval(values: np.ndarray | None, owner: np.ndarray, shape: tuple[int, ...]
                   ) -> np.ndarray:
-    """Per-experiment ``values`` (n_experiments, *shape) at every interval (n, *shape); zeros for None."""
+    """Per-experiment ``values`` at every interval; zeros for None."""
     if values is None:
         return np.zeros((len(owner), *shape))
     return np.asarray(values, dtype=float)[owner]

@@ -1,13 +1,6 @@
 """Method B on windows that span joint reversals: the Coulomb structure integrated.
 
-Where constant-direction intervals are too short, every test function's row of a window
-gains the Coulomb regressors <phi, W_type>,
-
-    Mt <phi'', q> - Bt <phi', q> + sum_types F_type <phi, W_type> = <phi, y>,
-
-with W_type = sum_{legs, axes of the type} sign(w_axis) J_axis(q), the sign softened by the
-rate's noise and a transition rate; fits at every rate of :data:`SOFT_SIGN_RATES` are
-averaged (:func:`solve_windows_over_rates`).
+Mt <phi'', q> - Bt <phi', q> + sum_types F_type <phi, W_type> = <phi, y>.
 """
 
 from __future__ import annotations
@@ -39,11 +32,7 @@ from stewartid.identification.wavelet.weak_form import (
 
 
 class WindowEquations(NamedTuple):
-    """Weak-form equations of one window.
-
-    ``rows`` the interval equations (mean row unused); ``coulomb`` (n_rates, K, n_types, 6),
-    <phi_k, W_type> of every row for every transition rate (s^(1/2) per N m of level).
-    """
+    """``rows`` (mean row unused) and ``coulomb`` <phi_k, W_type> (n_rates, K, n_types, 6) of one window."""
 
     rows: IntervalEquations
     coulomb: np.ndarray
@@ -60,28 +49,10 @@ def window_bounds(t: np.ndarray, length: float) -> np.ndarray:
 def window_equations(experiment: Experiment, found: Detection, order: int, size: int,
                      index: int, uniform: bool, length: float,
                      rates: Sequence[float] = SOFT_SIGN_RATES) -> list[WindowEquations]:
-    """The equations of every window of one experiment (module docstring).
+    """The equations of every window of one experiment.
 
-    Parameters
-    ----------
-    experiment : Experiment
-        Prepared with its joint-axis Jacobians.
-    found : Detection
-        Its smoothed joint rates and their noise (:func:`.detection.detect_intervals`).
-    order, size : int
-        Exponent of the bump and number K of zero-mean test functions per window.
-    index : int
-        Index of the experiment.
-    uniform : bool
-        One Coulomb level for every joint axis.
-    length : float
-        Window length (s).
-    rates : sequence of float
-        Transition rates of the soft sign (rad/s), one set of Coulomb regressors each.
-
-    Returns
-    -------
-    list of WindowEquations
+    ``order``, ``size``: bump exponent and K; ``length``: window, s; ``rates``: soft-sign transition
+    rates, rad/s, one set of Coulomb regressors each.
     """
     t, q, y = experiment.t, experiment.q, experiment.generalized_force
     patterns = coulomb_patterns(found, experiment.joint_jacobians, uniform,
@@ -106,7 +77,6 @@ def window_equations(experiment: Experiment, found: Detection, order: int, size:
 
 
 def _designs(regressors: np.ndarray, coulomb: np.ndarray) -> list[np.ndarray]:
-    """Design (n, K, 72 + n_types) of each channel: its [Mt Bt] row, then the levels."""
     n, k_rows = regressors.shape[:2]
     designs = []
     for i in range(6):
@@ -122,17 +92,10 @@ def solve_windows(equations: Sequence[WindowEquations], iterations: int = 3,
                   force_sensitivity: np.ndarray | None = None,
                   force_variance: np.ndarray | None = None, rate_index: int = 0
                   ) -> WeakFormSolution:
-    """[Mt Bt] and the Coulomb levels from window equations by iterated generalized least squares.
+    """[Mt Bt] and Coulomb levels from window equations by iterated generalized least squares.
 
-    The levels are shared by the channels; the force-side noise is re-estimated from the
-    residuals ``iterations`` times and the pose-noise bias removed. Parameters as
-    :func:`~stewartid.identification.wavelet.gls.solve_weak_form`; ``rate_index`` picks the
-    soft sign's transition rate.
-
-    Returns
-    -------
-    WeakFormSolution
-        ``offsets`` NaN (each window's constant is removed), ``constant_scatter`` zero.
+    Parameters as :func:`~stewartid.identification.wavelet.gls.solve_weak_form`. ``offsets`` are NaN
+    and ``constant_scatter`` zero.
     """
     stacked = stack_equations([e.rows for e in equations], pose_covariance, force_sensitivity,
                               force_variance)
@@ -165,10 +128,7 @@ def solve_windows(equations: Sequence[WindowEquations], iterations: int = 3,
 def solve_windows_over_rates(equations: Sequence[WindowEquations],
                              rates: Sequence[float] = SOFT_SIGN_RATES, **settings
                              ) -> tuple[WeakFormSolution, float]:
-    """:func:`solve_windows` averaged over the soft sign's transition rates, and the rate of greatest weight.
-
-    See :func:`.rate_selection.averaged_over_rates`; ``settings`` go to :func:`solve_windows`.
-    """
+    """:func:`solve_windows` averaged over transition rates, and the rate of greatest weight."""
     return averaged_over_rates(
         lambda index: solve_windows(equations, rate_index=index, **settings), rates)
 
