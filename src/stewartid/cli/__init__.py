@@ -1,6 +1,5 @@
 """Command-line interface ``stewartid COMMAND``: :mod:`stewartid.cli.application` and one module
-per command.
-"""
+per command."""
 
 from stewartid.cli.application import app, main
 

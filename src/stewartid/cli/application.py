@@ -1,6 +1,5 @@
 """The ``stewartid`` typer app and its error policy: an expected error is one line ``error: ...``
-on stderr and exit code 2; anything else is a bug with its traceback (every one with ``--debug``).
-"""
+on stderr and exit code 2; anything else is a bug with its traceback (every one with ``--debug``)."""
 
 from __future__ import annotations
 
@@ -128,8 +127,7 @@ def _show_warning(message: Warning | str, category: type[Warning], *args: Any,
 
 def clean_errors(command: Callable[..., Any]) -> Callable[..., Any]:
     """Decorator: StewartidError and OSError become one error line and exit code 2 (unless
-    ``--debug``); warnings are one line ``warning: ...``.
-    """
+    ``--debug``); warnings are one line ``warning: ...``."""
 
     @functools.wraps(command)
     def wrapper(*args: Any, **kwargs: Any) -> Any:

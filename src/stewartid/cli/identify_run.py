@@ -1,6 +1,5 @@
 """``stewartid identify`` behind its flags: experiments read and aligned, the method(s) fitted,
-report and result written; every output and flag combination checked before any computation.
-"""
+report and result written; every output and flag combination checked before any computation."""
 
 from __future__ import annotations
 
@@ -208,8 +207,7 @@ def model_method(model: str | None, method: str, payload: bool,
 def _check_model_outputs(model: str, platform_out: Path | None,
                         refused: dict[str, bool] | None = None,
                         inputs: Sequence[str | Path] = ()) -> None:
-    """:func:`_check_model_options`, and refuse a ``platform_out`` that would replace an input or a foreign
-    file."""
+    """:func:`_check_model_options`; refuse a ``platform_out`` replacing an input or a foreign file."""
     _check_model_options(model, platform_out, refused or {})
     if platform_out is not None:
         check_output_file(platform_out, False, inputs, is_result=_is_identified,

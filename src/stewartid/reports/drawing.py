@@ -1,6 +1,5 @@
 """The figures' common parts: style, saving (PNG and SVG), an experiment's signal figures.
-Figures are drawn inside ``rc_context(STYLE)`` without pyplot; matplotlib is imported lazily.
-"""
+Figures are drawn inside ``rc_context(STYLE)`` without pyplot; matplotlib is imported lazily."""
 
 from __future__ import annotations
 
@@ -81,8 +80,7 @@ def save_figure(figure: Any, directory: str | Path, stem: str, dpi: int = 120,
                 tight: bool = True) -> list[Path]:
     """Write ``figure`` as ``stem.png`` and ``stem.svg`` in ``directory`` (atomic); returns both paths.
 
-    ``tight`` crops to the drawn content; False keeps a fixed-margin layout and saves a layout pass.
-    """
+    ``tight`` crops to the drawn content; False keeps a fixed-margin layout and saves a layout pass."""
     directory = Path(directory)
     paths = []
     # metadata dates off: the same run gives byte-identical SVG files

@@ -60,8 +60,7 @@ def write_exports(models: Sequence[ExportedModel], directory: str | Path,
     header and first column, SI units. MAT (MATLAB 5): one struct per method (``-`` as ``_``) with
     ``M``, ``B``, ``std_errors_M``, ``std_errors_B`` (6x6), held-out ``vaf_percent`` and ``nrmse``
     (1x6), ``coulomb_levels``, ``coulomb_std_errors`` (1x3, N m, NaN if not estimated); plus
-    ``coordinates``, ``friction_types`` and ``trusted`` (the registered name of the trusted method).
-    """
+    ``coordinates``, ``friction_types`` and ``trusted`` (the registered name of the trusted method)."""
     from scipy.io import savemat
 
     directory = Path(directory)

@@ -22,8 +22,7 @@ em { color: #555; }
 def render_html(markdown_text: str, base: str | Path, title: str = "stewartid report") -> str:
     """A self-contained HTML page from a report's Markdown, PNG figures inlined as base64.
 
-    ``base``: the folder relative image paths refer to; ``title``: the page's ``<title>``.
-    """
+    ``base``: the folder relative image paths refer to; ``title``: the page's ``<title>``."""
     from markdown_it import MarkdownIt
 
     base = Path(base)

@@ -1,6 +1,5 @@
 """Every report's tables, built once as a :class:`ResultTable` and written as CSV (full precision)
-and Markdown (rounded).
-"""
+and Markdown (rounded)."""
 
 from __future__ import annotations
 
@@ -47,8 +46,7 @@ class ResultTable:
 
 def format_cell(value: Cell, kind: str) -> str:
     """Markdown text of a cell by ``kind``: values to 1 decimal, ε to 2, published as printed;
-    "—" for none, "n/a" for non-finite.
-    """
+    "—" for none, "n/a" for non-finite."""
     if value is None:
         return "—"
     if isinstance(value, str):

@@ -46,8 +46,7 @@ def print_comparison(rows: Iterable[Mapping[str, Any]], title: str,
                      console: Console | None = None) -> None:
     """Print identified versus nominal values of the paper's 20 entries.
 
-    ``rows`` as :func:`~stewartid.identification.result.comparison_rows` returns them.
-    """
+    ``rows`` as :func:`~stewartid.identification.result.comparison_rows` returns them."""
     view = Table(title=title, title_justify="left")
     for column, justify in (("entry", "left"), ("identified", "right"), ("± std", "right"),
                             ("nominal", "right"), ("ε (%)", "right")):

@@ -1,3 +1,2 @@
 """Reproduction of the paper's Section 5 comparison (``stewartid reproduce``,
-:func:`~stewartid.reproduction.run.run_reproduce`).
-"""
+:func:`~stewartid.reproduction.run.run_reproduce`)."""

@@ -1,6 +1,5 @@
 """A reproduction's identification results, as its tables, figures and report use them
-(rebuildable from ``results.json``).
-"""
+(rebuildable from ``results.json``)."""
 
 from __future__ import annotations
 
@@ -46,8 +45,7 @@ class MethodRun:
     @property
     def diagnostics(self) -> dict[str, Any]:
         """JSON-able ``diagnostics`` for ``results.json``: condition number, RMS residual per equation,
-        settings and the method's own (``details``).
-        """
+        settings and the method's own (``details``)."""
         result = self.result
         return {"condition_number": float(result.condition_number),
                 "residual_rms": np.asarray(result.residual_rms, dtype=float).tolist(),

@@ -28,8 +28,7 @@ LEGACY_METHOD_NAMES = {"least_squares": "ls", "wavelet_paper": "wavelet-paper"}
 
 def run_record(results: ComparisonResults, run: MethodRun) -> dict[str, Any]:
     """One identification as a JSON-ready dict: matrices, standard errors, ε per entry and the
-    largest, the paper's values where published, time and diagnostics.
-    """
+    largest, the paper's values where published, time and diagnostics."""
     eps = results.eps_all(run)
     worst = max(eps, key=eps.__getitem__)
     published = {}

@@ -1,6 +1,5 @@
 """Figures only a reproduction draws: the traced experiment's force budget and scalogram, and
-every method's errors beside the paper's. Each returns the written paths.
-"""
+every method's errors beside the paper's. Each returns the written paths."""
 
 from __future__ import annotations
 
@@ -72,19 +71,9 @@ def plot_scalogram(t: np.ndarray, signal: np.ndarray, points: np.ndarray,
                    stem: str = "scalogram", max_rate_hz: float = 100.0) -> list[Path]:
     """|W_ψ f(a, b)| of one signal over scales and shifts, the (a, b) points used marked.
 
-    Parameters
-    ----------
-    t, signal : ndarray, shape (N,)
-        Time (s) and the signal (any unit, that of the colour bar).
-    points : ndarray, shape (K, 2)
-        (a, b) pairs used (s).
-    wavelet : str or MotherWavelet
-        See :func:`stewartid.signals.wavelets.make_wavelet`.
-    intervals : ndarray, shape (M, 2), optional
-        Constant-direction intervals, drawn under the map.
-    max_rate_hz : float
-        Decimation of the signal for the map only.
-    """
+    ``t``, ``signal``: shape (N,) (s, any unit); ``points``: shape (K, 2) (s); ``wavelet``: see
+    :func:`stewartid.signals.wavelets.make_wavelet`; ``intervals``: shape (M, 2), drawn under the
+    map; ``max_rate_hz``: decimation for the map only."""
     from stewartid.signals.wavelets import make_wavelet, wavelet_transform
 
     t = np.asarray(t, dtype=float)

@@ -1,6 +1,5 @@
 """A reproduction's noisy case: every method at the highest Coulomb level with the reference sensor
-noise (the paper shows noise-free simulations only); a table, a figure and a summary line.
-"""
+noise (the paper shows noise-free simulations only); a table, a figure and a summary line."""
 
 from __future__ import annotations
 

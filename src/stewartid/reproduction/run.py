@@ -1,6 +1,5 @@
 """Regenerate the paper's Section 5 comparison (Zhang 2020): simulate, identify, tabulate, plot
-and report into one folder, simulations and fits in worker processes.
-"""
+and report into one folder, simulations and fits in worker processes."""
 
 from __future__ import annotations
 
@@ -49,15 +48,8 @@ def simulate_one(platform: Platform, experiment: int, frequency_hz: float, durat
     Same noise generator as :func:`~stewartid.simulation.simulate_experiments` (one task per
     experiment gives the same data); ``noise_scale`` > 0 measures with that multiple of
     :func:`~stewartid.simulation.sensors.reference_noise` instead of the platform's sensors.
-
-    Returns
-    -------
-    dataset : Dataset
-    record : ExperimentRecord or None
-        True signals, only with ``keep_record``.
-    tracking_error : list of float
-        RMS leg-length tracking error per leg (m).
-    """
+    Returns the dataset, the true signals (only with ``keep_record``, else None) and the RMS
+    leg-length tracking error per leg (m)."""
     from stewartid.simulation import SensorNoise, paper_experiments, simulate_experiment
     from stewartid.simulation.experiments import noise_generator
     from stewartid.simulation.sensors import reference_noise

@@ -1,6 +1,5 @@
 """Settings and result object of a reproduction of the paper's comparison (Zhang 2020): every
-registered method and preset at each Coulomb level (0, 5, 30 N m) on the plant simulator.
-"""
+registered method and preset at each Coulomb level (0, 5, 30 N m) on the plant simulator."""
 
 from __future__ import annotations
 

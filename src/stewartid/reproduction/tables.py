@@ -1,6 +1,5 @@
 """A reproduction's tables: the paper's Tables 3-6 with ours beside, every method per Coulomb level,
-the largest error per method. ε: relative absolute error (%) against the simulated plant's nominal.
-"""
+the largest error per method. ε: relative absolute error (%) against the simulated plant's nominal."""
 
 from __future__ import annotations
 

@@ -1,6 +1,5 @@
 """The model's force components along a simulated experiment, and the commanded poses, for a
-reproduction's signal figures.
-"""
+reproduction's signal figures."""
 
 from __future__ import annotations
 
@@ -18,22 +17,8 @@ def experiment_trace(platform: Platform, dataset: Any, excited: int, frequency_h
 
     Force components are the model's terms at the simulator's true motion when ``record`` is
     given, else at the measured pose differentiated as an identifier would; the actuators' force
-    is always measured.
-
-    Parameters
-    ----------
-    platform : Platform
-        The simulated plant (its Coulomb level sets the Coulomb component).
-    dataset : Dataset
-    excited : int
-        Excited coordinate (0-5).
-    frequency_hz : float
-        Excitation frequency, sets the differentiation window (Hz).
-    reference : ndarray, shape (N, 6), optional
-        Commanded pose (m, rad).
-    record : ExperimentRecord, optional
-        The simulator's true ``q``, ``q_dot``, ``q_ddot``.
-    """
+    is always measured. ``excited``: coordinate 0-5; ``frequency_hz`` sets the differentiation
+    window; ``reference``: commanded pose, shape (N, 6) (m, rad)."""
     from stewartid.identification.wavelet.intervals import (
         constant_direction_intervals,
         joint_rates,

@@ -1,6 +1,5 @@
 """Studies: Monte Carlo runs and parameter sweeps of simulation and identification on
-dask.distributed (``stewartid study FILE --out DIR``, the ``[dask]`` extra).
-"""
+dask.distributed (``stewartid study FILE --out DIR``, the ``[dask]`` extra)."""
 
 from stewartid.studies.grid import StudyTask, expand_grid
 from stewartid.studies.results import read_results

@@ -1,6 +1,5 @@
 """A study expanded into tasks, one per (grid point, seed): the methods meet the same data, and a
-key hashing parameters and seed lets a resumed run skip finished tasks.
-"""
+key hashing parameters and seed lets a resumed run skip finished tasks."""
 
 from __future__ import annotations
 
@@ -44,8 +43,7 @@ class StudyTask:
 def expand_grid(spec: StudySpec) -> list[StudyTask]:
     """Every task of ``spec`` (``spec.size``, distinct keys): the grid's product times the seeds.
 
-    Seeds are the outer loop, so a run stopped half-way has covered the whole grid.
-    """
+    Seeds are the outer loop, so a run stopped half-way has covered the whole grid."""
     names = list(spec.grid)
     tasks = []
     for seed in spec.seeds:

@@ -1,6 +1,5 @@
 """One study run at a time per output folder: an ``fcntl.flock`` on a file in it, released when its
-process dies (no stale-lock check).
-"""
+process dies (no stale-lock check)."""
 
 from __future__ import annotations
 

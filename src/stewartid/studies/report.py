@@ -1,6 +1,5 @@
 """A study's report: error against each swept parameter per method (median and spread over the
-seeds), the table behind every figure, sentences computed from the numbers.
-"""
+seeds), the table behind every figure, sentences computed from the numbers."""
 
 from __future__ import annotations
 
@@ -48,8 +47,7 @@ def sweep_statistics(rows: Any, parameter: str, others: Sequence[str]) -> Any:
     ``rows`` from :func:`~stewartid.studies.results.read_results` (failed rows left out);
     ``parameter`` on the horizontal axis, one panel row per combination of ``others``. One row per
     (others..., parameter, method); columns ``seeds`` and ``<metric>_<statistic>`` for each of
-    :data:`METRICS` and median, q25, q75, min, max.
-    """
+    :data:`METRICS` and median, q25, q75, min, max."""
     good = rows[rows["failure"].isna()]
     keys = [*others, parameter, "method"]
     groups = good.groupby(keys, sort=True)
@@ -218,8 +216,7 @@ def write_study_report(rows: Any, spec: StudySpec, directory: str | Path,
     """Write a study's figures (``figures/``), tables (``tables/``), ``report.md`` and ``report.html``.
 
     ``rows`` from :func:`~stewartid.studies.results.read_results`; ``total_tasks`` of the study,
-    ``failed_tasks`` crashed in the last run. Returns every file written.
-    """
+    ``failed_tasks`` crashed in the last run. Returns every file written."""
     directory = Path(directory)
     methods = report_order(spec.methods)
     lines = [f"# {spec.title}", "",

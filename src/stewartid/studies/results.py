@@ -1,7 +1,6 @@
 """A study's results: one row per (grid point, seed, method) in ``DIR/results.parquet/``, one
 atomically written ``part-<task key>.parquet`` per finished task (a rerun task replaces its
-rows, a killed run leaves whole files). Columns: ``docs/studies.md``, :func:`columns`.
-"""
+rows, a killed run leaves whole files). Columns: ``docs/studies.md``, :func:`columns`."""
 
 from __future__ import annotations
 
@@ -82,8 +81,7 @@ def finished_tasks(directory: str | Path) -> set[str]:
 def read_results(directory: str | Path, tasks: Iterable[str] | None = None) -> Any:
     """Every row in output folder ``directory`` (only ``tasks`` if given) as a pandas DataFrame.
 
-    Sorted by parameters, seed and method; empty, with the :func:`columns`, before any task ends.
-    """
+    Sorted by parameters, seed and method; empty, with the :func:`columns`, before any task ends."""
 
     folder = Path(directory) / RESULTS_NAME
     paths = sorted(folder.glob(f"{_PREFIX}*{_SUFFIX}")) if folder.is_dir() else []

@@ -1,7 +1,6 @@
 """Running a study on dask.distributed: resumable, fault tolerant, with a progress bar. Only the
 client writes, each task's rows as it finishes: a lost worker costs one task, an interrupted run
-keeps every finished task, workers need no shared file system.
-"""
+keeps every finished task, workers need no shared file system."""
 
 from __future__ import annotations
 
@@ -43,12 +42,8 @@ class TaskFailure:
 
     Attributes
     ----------
-    task : str
-        Task key.
-    label : str
-        Its parameters and seed.
-    message : str
-        ``Type: message`` of the exception.
+    task, label, message : str
+        Task key; its parameters and seed; ``Type: message`` of the exception.
     """
 
     task: str
@@ -283,7 +278,6 @@ def _describe(future: Any) -> str:
 
 @contextmanager
 def _given(client: Any) -> Iterator[Any]:
-    """The caller's client, left open."""
     yield client
 
 

@@ -1,7 +1,6 @@
 """The study file: a TOML Monte Carlo study or parameter sweep of the paper's six virtual
 experiments over a grid of plant and excitation parameters, ``seeds`` noise seeds per point,
-every listed method (format: ``docs/studies.md``).
-"""
+every listed method (format: ``docs/studies.md``)."""
 
 from __future__ import annotations
 

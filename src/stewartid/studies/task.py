@@ -1,6 +1,5 @@
 """One study task on a worker: a simulation of the six experiments identified by every method, as
-result rows. Picklable; writes nothing.
-"""
+result rows. Picklable; writes nothing."""
 
 from __future__ import annotations
 
@@ -34,8 +33,7 @@ def error_columns(M: np.ndarray, B: np.ndarray, nominal_M: np.ndarray, nominal_B
                   ) -> dict[str, Any]:
     """A row's error columns: ε (%) of the paper's 20 entries and their maxima.
 
-    ``M, B`` identified, ``nominal_M, nominal_B`` true, shape (6, 6), SI units.
-    """
+    ``M, B`` identified, ``nominal_M, nominal_B`` true, shape (6, 6), SI units."""
     matrices = {"M": (M, nominal_M), "B": (B, nominal_B)}
     errors = {key: relative_error_percent(matrices[key[0]][0][key[1], key[2]],
                                           matrices[key[0]][1][key[1], key[2]])

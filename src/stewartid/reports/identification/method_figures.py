@@ -1,6 +1,5 @@
 """The identification report's plots, written as PNG and SVG; each returns the written paths.
-Fixed-margin grids: matplotlib's constrained layout is far slower to draw.
-"""
+Fixed-margin grids: matplotlib's constrained layout is far slower to draw."""
 
 from __future__ import annotations
 
@@ -49,16 +48,8 @@ def plot_spectra(names: Sequence[str], poses: Sequence[np.ndarray], sample_rates
                  stem: str = "spectrum") -> list[Path]:
     """Amplitude spectrum of every coordinate's displacement, one panel per experiment.
 
-    Parameters
-    ----------
-    names : sequence of str
-    poses : sequence of ndarray, shape (N_k, 6)
-        m, rad.
-    sample_rates : sequence of float
-        Hz.
-    frequencies_hz : sequence of float
-        Dominant excitation frequency of each experiment, marked (Hz).
-    """
+    ``poses``: shape (N_k, 6) (m, rad); ``sample_rates`` and ``frequencies_hz`` (the dominant
+    excitation, marked) in Hz."""
     figure = new_figure(figsize=(13, 3.3 * int(np.ceil(len(names) / 3)) + 0.6))
     axes = _grid(figure, len(names))
     colours = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b"]
@@ -89,16 +80,8 @@ def plot_intervals(names: Sequence[str], spans: Sequence[tuple[float, float]],
                    directory: str | Path, stem: str = "intervals") -> list[Path]:
     """The constant-direction intervals used, one lane per experiment, with the (a, b) points.
 
-    Parameters
-    ----------
-    names : sequence of str
-    spans : sequence of (float, float)
-        First and last time of each record (s).
-    intervals : sequence of ndarray, shape (M_k, 2)
-        [start, stop] (s).
-    points : sequence of ndarray, shape (K_k, 2), or None
-        (a, b) pairs (s).
-    """
+    ``spans``: (first, last) time of each record; ``intervals``: shape (M_k, 2) [start, stop];
+    ``points``: shape (K_k, 2) (a, b) pairs or None; all in s."""
     height = 0.55 * len(names) + 1.6
     figure = new_figure(figsize=(11, height))
     axis = figure.subplots(gridspec_kw={"left": 0.1, "right": 0.98, "bottom": 0.9 / height,
@@ -135,12 +118,7 @@ def plot_matrices(estimates: Mapping[str, tuple[np.ndarray, np.ndarray, np.ndarr
                   directory: str | Path, stem: str = "matrices") -> list[Path]:
     """Identified / nominal for every non-negligible nominal entry, ±2 standard errors, per method.
 
-    Parameters
-    ----------
-    estimates : mapping of label to (M, B, std_M, std_B), each ndarray (6, 6)
-    colours : mapping of label to colour
-    M_nominal, B_nominal : ndarray, shape (6, 6)
-    """
+    ``estimates``: label -> (M, B, std_M, std_B), each shape (6, 6)."""
     figure = new_figure(figsize=(13, 7.5))
     axes = figure.subplots(2, 1, gridspec_kw={"left": 0.07, "right": 0.98, "bottom": 0.1,
                                               "top": 0.95, "hspace": 0.45})
@@ -179,8 +157,7 @@ def plot_residuals(validation: ValidationResult, frequencies_hz: Sequence[float]
                    directory: str | Path, stem: str = "residuals") -> list[Path]:
     """Each equation's residual over time (experiments end to end) and its spectrum.
 
-    ``frequencies_hz``: each experiment's excitation frequency, marked with its harmonics.
-    """
+    ``frequencies_hz``: each experiment's excitation frequency, marked with its harmonics."""
     residual = [m - p for m, p in zip(validation.measured, validation.predicted, strict=True)]
     t, values = _concatenated(validation, residual)
     figure = new_figure(figsize=(13, 12))
@@ -217,8 +194,7 @@ def plot_validation(validations: Mapping[str, ValidationResult], colours: Mappin
                     directory: str | Path, stem: str = "validation") -> list[Path]:
     """Measured vs predicted force on held-out segments, per DOF where it moves the force most.
 
-    The first of ``validations`` gives the measured force; all share the segments.
-    """
+    The first of ``validations`` gives the measured force; all share the segments."""
     first = next(iter(validations.values()))
     figure = new_figure(figsize=(13, 9))
     axes = _grid(figure, 6, top=0.91)
@@ -257,8 +233,7 @@ def plot_unexplained(vaf: Mapping[str, np.ndarray], colours: Mapping[str, str],
                      directory: str | Path, stem: str = "methods") -> list[Path]:
     """Held-out unexplained force, 100 − VAF (%), per DOF and method (log scale).
 
-    ``vaf``: label -> held-out VAF per DOF, shape (6,) (%).
-    """
+    ``vaf``: label -> held-out VAF per DOF, shape (6,) (%)."""
     figure = new_figure(figsize=(9, 4))
     axis = figure.subplots(gridspec_kw={"left": 0.1, "right": 0.98, "bottom": 0.1,
                                         "top": 0.9})
@@ -291,8 +266,7 @@ def plot_friction(levels: Mapping[str, tuple[np.ndarray, np.ndarray]],
     """Coulomb level per joint type, ±2 standard errors, per method that estimates it.
 
     ``levels``: label -> (levels, standard errors), shape (3,) each (N m); ``nominal``: the
-    description's level, drawn as a line.
-    """
+    description's level, drawn as a line."""
     figure = new_figure(figsize=(7, 3.6))
     axis = figure.subplots(gridspec_kw={"left": 0.12, "right": 0.98, "bottom": 0.12,
                                         "top": 0.9})
@@ -322,8 +296,7 @@ def plot_workspace(curves: Workspace, directory: str | Path, stem: str = "worksp
     """Mt and Bt across the measured poses, one column per swept coordinate.
 
     Diagonal and largest couplings as % change from the mean-pose value, ±2 standard errors, the
-    description dashed; ``curves`` from :func:`~stewartid.comparison.workspace`.
-    """
+    description dashed; ``curves`` from :func:`~stewartid.comparison.workspace`."""
     figure = new_figure(figsize=(15, 6.5))
     axes = figure.subplots(2, 6, squeeze=False, gridspec_kw={
         "left": 0.05, "right": 0.86, "bottom": 0.1, "top": 0.9, "hspace": 0.4,

@@ -1,6 +1,5 @@
 """The identification report's physical-model section: parameters, held-out prediction, Mt and Bt
-across the measured poses.
-"""
+across the measured poses."""
 
 from __future__ import annotations
 
@@ -21,8 +20,7 @@ def _value(value: float) -> str:
 
 def parameter_table(result: PhysicalResult) -> str:
     """The identified parameters as Markdown: value, standard error, combination, and why fixed (or
-    how far the consistent fit moved each, in standard errors).
-    """
+    how far the consistent fit moved each, in standard errors)."""
     fixed = result.diagnostics.get("fixed", {})
     moved = (result.diagnostics.get("consistent") or {}).get("change_std_errors", {})
     rows = []

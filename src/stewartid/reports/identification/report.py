@@ -1,6 +1,5 @@
 """The identification report (``stewartid identify --report DIR``): ``report.md``, a self-contained
-``report.html``, figures, ``result.json``, ``physical.json`` and every method's CSV/MATLAB matrices.
-"""
+``report.html``, figures, ``result.json``, ``physical.json`` and every method's CSV/MATLAB matrices."""
 
 from __future__ import annotations
 

@@ -32,8 +32,7 @@ def data_rows(datasets: Sequence[Dataset], platform: Platform) -> list[dict[str,
     Keys: ``name``, ``samples``, ``duration_s``, ``sample_rate_hz``, ``frequency_hz`` (dominant),
     ``excited`` (most excited coordinate, rotations weighted by the upper joint radius),
     ``amplitude`` (its half range, mm or mrad), ``pose_noise`` (m, rad) and ``force_noise`` (leg
-    forces, N), shape (6,) each, estimated from the data.
-    """
+    forces, N), shape (6,) each, estimated from the data."""
     rows = []
     lever = np.array([1.0] * 3 + [platform.geometry.upper_radius] * 3)
     for d in datasets:
@@ -57,15 +56,8 @@ def used_intervals(runs: Sequence[MethodFit], trusted: str, datasets: Sequence[D
                    ) -> tuple[str, list[np.ndarray], list[np.ndarray | None]]:
     """The intervals and (a, b) points per experiment, of the trusted method or else the first with them.
 
-    Returns
-    -------
-    display_name : str
-        The method's ("" if none uses intervals).
-    intervals : list of ndarray, shape (M_k, 2)
-        [start, stop] (s).
-    points : list of ndarray, shape (K_k, 2), or None
-        (a, b) pairs (s); None for an experiment without them.
-    """
+    Returns the method's display name ("" if none uses intervals), the intervals (shape (M_k, 2),
+    [start, stop], s) and the (a, b) points (shape (K_k, 2), s; None for an experiment without)."""
     def recorded(run: MethodFit) -> list[dict]:
         experiments = [] if run.result is None else run.result.diagnostics.get("experiments")
         experiments = experiments or []
@@ -135,29 +127,10 @@ def render_report(report: IdentificationReport, datasets: Sequence[Dataset],
                   ) -> str:
     """The text of ``report.md``, figures referenced by relative path.
 
-    Parameters
-    ----------
-    report : IdentificationReport
-    datasets : sequence of Dataset
-    platform : Platform
-    nominal : (ndarray, ndarray)
-        Reference Mt and Bt, shape (6, 6).
-    nominal_source : str
-    rows : sequence of dict
-        From :func:`data_rows`.
-    figures : mapping of str to (str, str)
-        Figure key -> (relative PNG path, caption).
-    sources : sequence of str
-        The data files.
-    folds : int
-        Held-out time segments per experiment.
-    seconds : float
-        Wall time of comparison and report (s).
-    records : sequence of str
-        Validation records (``identify --validate``).
-    notes : sequence of str
-        Sentences for the summary.
-    """
+    ``nominal``: reference (Mt, Bt); ``rows``: from :func:`data_rows`; ``figures``: key ->
+    (relative PNG path, caption); ``sources``: data files; ``folds``: held-out segments per
+    experiment; ``seconds``: wall time (s); ``records``: the ``--validate`` records; ``notes``:
+    summary sentences."""
     from stewartid import __version__
 
     best = next(run for run in report.runs if run.name == report.trusted)

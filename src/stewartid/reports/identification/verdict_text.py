@@ -1,6 +1,5 @@
 """The verdict in words: what to know about one method's result, and among several which to trust
-and what set the others back.
-"""
+and what set the others back."""
 
 from __future__ import annotations
 
