@@ -87,7 +87,7 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
 
     Channels are weighted by their residual variance from a first RMS-weighted pass. A parameter
     is fixed when the condition number exceeds ``max_condition`` (the one weighing most in the
-    weakest direction) or, if positive by nature, when its standard error exceeds
+    weakest direction) or, if positive by nature (``scales`` > 0), when its standard error exceeds
     ``max_relative_error`` of its size.
 
     Parameters
@@ -95,20 +95,14 @@ def solve_parameters(X: np.ndarray, y: np.ndarray, names: list[str], nominal: np
     X : ndarray, shape (K, 6, p)
     y : ndarray, shape (K, 6)
     names : list of str
-    nominal : ndarray, shape (p,)
-        Values a fixed parameter keeps.
-    scales : ndarray, shape (p,), optional
-        Size of each positive parameter, 0 for the others.
+    nominal, scales : ndarray, shape (p,)
     max_condition, max_relative_error : float
-    regressor_noise : ndarray, shape (6, p, p) or (R, 6, p, p), optional
-        Expected noise share of X^T X per channel (and record); subtracted against attenuation bias.
-    target_noise : ndarray, shape (6, p) or (R, 6, p), optional
-        The same for X^T y.
+    regressor_noise, target_noise : ndarray, shape ([R,] 6, p, p) and ([R,] 6, p), optional
+        Expected noise shares of X^T X and X^T y per channel (and record), subtracted.
     segments : list of (int, int), optional
-        Per record, rows and correlation lag (rows); given, the covariance is
-        :func:`score_covariance`.
+        Per record, rows and correlation lag; given, the covariance is :func:`score_covariance`.
     measured_noise : list of (ndarray, ndarray), optional
-        With ``segments``: per record, a separately measured row noise flooring the standard errors.
+        With ``segments``: a separately measured row noise flooring the standard errors.
     """
     p = X.shape[2]
     scales = np.zeros(p) if scales is None else np.asarray(scales, dtype=float)
@@ -227,25 +221,14 @@ def score_covariance(inverse: np.ndarray, X: np.ndarray, residual: np.ndarray,
                      expected: np.ndarray | None = None,
                      measured_noise: list[tuple[np.ndarray, np.ndarray]] | None = None
                      ) -> np.ndarray:
-    """N^-1 B N^-1, B the long-run covariance of the scores s_k = sum_c w_c X_kc r_kc, shape (p, p).
+    """N^-1 B N^-1 (p, p), B the long-run covariance of the scores s_k = sum_c w_c X_kc r_kc.
 
     Each variance of B is raised to the per-record summed scores' where larger
     (:func:`~stewartid.identification.long_run.record_sandwich`), then to the measured noise floor.
-
-    Parameters
-    ----------
-    inverse : ndarray, shape (p, p)
-        N^-1.
-    X : ndarray, shape (K, 6, p)
-    residual : ndarray, shape (K, 6)
-    weights : ndarray, shape (6,)
-    segments : list of (int, int)
-        Rows of each record and its correlation length in rows.
-    expected : ndarray, shape (R, p), optional
-        Each record's expected summed score under noise alone, taken out of the scores.
-    measured_noise : list of (ndarray, ndarray), optional
-        Per record, covariance per sample and filter autocorrelation at row lags
-        (:func:`~stewartid.identification.long_run.filtered_noise_covariance`).
+    ``inverse`` is N^-1; ``segments`` give each record's rows and correlation length; ``expected``
+    (R, p) each record's summed score under noise alone, taken out; ``measured_noise`` per record
+    the covariance per sample and filter autocorrelation
+    (:func:`~stewartid.identification.long_run.filtered_noise_covariance`).
     """
     scores = np.einsum("kcp,kc->kp", X, residual * weights, optimize=True)
     rows = np.array([n for n, _ in segments])

@@ -33,11 +33,8 @@ class Segment:
     experiment, fold : int
         Source experiment; fold holding it out.
     t : ndarray, shape (n,)
-        s.
-    force : ndarray, shape (n, 6)
-        Filtered generalized force y * h (N, N m).
-    q_dot, q_ddot : ndarray, shape (n, 6)
-        q * h' and q * h'' (m/s, rad/s; m/s^2, rad/s^2).
+    force, q_dot, q_ddot : ndarray, shape (n, 6)
+        y * h (N, N m), q * h', q * h''.
     coulomb : ndarray, shape (n, 3, 6)
         Filtered generalized Coulomb force per unit level of each joint type.
     """
@@ -162,22 +159,11 @@ def coulomb_estimate(result: IdentificationResult) -> tuple[np.ndarray, np.ndarr
 def prepare_segment(dataset: Dataset, platform: Platform, window: float, *, gravity: bool,
                     experiment: int = 0, fold: int = 0,
                     coulomb_smoothing: float = 1e-4, remainder: bool = False) -> Segment:
-    """Filtered force, motion and Coulomb regressors of one record.
+    """Filtered force, motion and Coulomb regressors of one record, kernel support ``window`` (s).
 
-    Parameters
-    ----------
-    dataset : Dataset
-    platform : Platform
-    window : float
-        Kernel support (s).
-    gravity : bool
-        Subtract G(q).
-    experiment, fold : int
-        Labels.
-    coulomb_smoothing : float
-        Rate (rad/s) below which a Coulomb sign is attenuated.
-    remainder : bool
-        Subtract :func:`~stewartid.identification.preparation.model_remainder`.
+    ``gravity`` subtracts G(q); ``remainder`` subtracts
+    :func:`~stewartid.identification.preparation.model_remainder`; ``experiment``, ``fold`` label
+    the segment; below ``coulomb_smoothing`` (rad/s) a Coulomb sign is attenuated.
     """
     from stewartid.identification.least_squares import coulomb_regressors
     from stewartid.identification.preparation import prepare
@@ -272,10 +258,9 @@ def cross_validate(create: Callable[[], Any], datasets: Sequence[Dataset], platf
     gravity : bool
         Whether the method subtracts G(q).
     segments : list of Segment, optional
-        Already prepared (:func:`held_out_segments`, same ``folds`` and ``gravity``).
+        From :func:`held_out_segments` with the same ``folds`` and ``gravity``.
     companion : callable, optional
-        Returns a friction-estimating identifier lending Coulomb levels
-        (:func:`with_companion_friction`).
+        Friction-estimating identifier lending Coulomb levels (:func:`with_companion_friction`).
 
     Raises
     ------

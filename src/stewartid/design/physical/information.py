@@ -42,23 +42,20 @@ class ParameterPrediction:
     ----------
     names : tuple of str
         Every fitted parameter, nuisance ones included.
-    nominal : ndarray, shape (p,)
-        Values in the platform file.
-    std_errors : ndarray, shape (p,)
-        Standard errors with every parameter estimated.
+    nominal, std_errors : ndarray, shape (p,)
+        File values; standard errors with every parameter estimated.
     expected_std_errors : ndarray, shape (p,)
-        Standard errors once the parameters the estimator would fix are fixed (NaN for those).
+        Once the parameters the estimator would fix are fixed (NaN for those).
     fixed : tuple of str
         Those parameters.
     expected_covariance : ndarray, shape (p, p)
-        Covariance of ``expected_std_errors``; NaN rows and columns for the fixed.
+        NaN rows and columns for the fixed.
     sizes : ndarray, shape (p,)
         What a relative standard error is taken of; 0 for nuisance parameters.
     payload : bool
-        Payload mode.
     accuracy : mapping of str to float
-        Payload mode: required accuracies (keys and units of
-        :data:`~stewartid.design.physical.payload_accuracy.REQUIRED_PAYLOAD_ACCURACY`).
+        Payload mode's required accuracies
+        (:data:`~stewartid.design.physical.payload_accuracy.REQUIRED_PAYLOAD_ACCURACY`).
     """
 
     names: tuple[str, ...]
@@ -168,21 +165,12 @@ def channel_weights(S: np.ndarray) -> np.ndarray:
 def sandwich_covariance(X: np.ndarray, S: np.ndarray, samples_per_row: float,
                         noise_rows: np.ndarray | None = None,
                         extra: np.ndarray | None = None) -> np.ndarray:
-    """Channel-weighted least-squares covariance, shape (p, p).
+    """Channel-weighted least-squares covariance (p, p) of rows ``X`` (K, 6, p) with noise ``S`` (K, 6, 6):
 
         Cov = A^-1 B A^-1,   A = sum_k X_k^T W X_k,   B = sum_k X_k^T W S_k W X_k
 
-    Parameters
-    ----------
-    X : ndarray, shape (K, 6, p)
-    S : ndarray, shape (K, 6, 6)
-        Noise covariance of each row's channels.
-    samples_per_row : float
-        Logged samples per row (sample rate / row rate).
-    noise_rows : ndarray, shape (K, 6, p), optional
-        Rows B is taken of when not ``X`` (kernel-filtered rows).
-    extra : ndarray, shape (p, p), optional
-        Another noise's share of B (:func:`~stewartid.design.pose_noise.pose_noise_scores`).
+    Each row stands for ``samples_per_row`` logged samples; B is taken of ``noise_rows`` when given
+    (kernel-filtered rows), plus ``extra`` (:func:`~stewartid.design.pose_noise.pose_noise_scores`).
     """
     weights = channel_weights(S)
     Z = weights[None, :, None] * X  # W X
