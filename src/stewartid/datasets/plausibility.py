@@ -197,17 +197,9 @@ def _leg_order(pose: np.ndarray, lengths: np.ndarray, platform: Platform, fits) 
 
 def check_static_balance(pose: np.ndarray, forces: np.ndarray, platform: Platform,
                          where: str, carried: tuple[float, float] = CARRIED_WEIGHT) -> None:
-    """Mean actuator forces must carry the weight the description implies: over whole excitation
-    periods the mean J_lq(q)^T f balances G(q).
-
-    Parameters
-    ----------
-    pose, forces : ndarray, shape (N, 6)
-        m, rad; N along the legs, positive extends.
-    platform : Platform
-    where : str
-    carried : (float, float)
-        Allowed weight in multiples of the file's (:data:`PHYSICAL_CARRIED_WEIGHT` for payload fits).
+    """Mean actuator forces (N, 6), N, positive extends, must carry the implied weight: over whole
+    periods the mean J_lq(q)^T f balances G(q); ``carried`` is the allowed range in multiples of
+    the file's weight (:data:`PHYSICAL_CARRIED_WEIGHT` for payload fits).
 
     Raises
     ------
@@ -266,16 +258,8 @@ def check_dataset(pose: np.ndarray, lengths: np.ndarray, forces: np.ndarray,
 
 def check_identified(M: np.ndarray, B: np.ndarray, platform: Platform,
                      method: str | None = None, friction_blind: bool = False) -> None:
-    """Identified Mt, Bt against the description's nominal ones.
-
-    Parameters
-    ----------
-    M, B : ndarray, shape (6, 6)
-    platform : Platform
-    method : str, optional
-        Named in the messages.
-    friction_blind : bool
-        Method takes Coulomb friction for damping (Method A): a high Bt warns so, not of units.
+    """Identified Mt, Bt (6, 6) against the description's nominal ones; ``method`` is named in the
+    messages; ``friction_blind`` (Method A) explains a high Bt as Coulomb friction taken for damping.
 
     Raises
     ------
