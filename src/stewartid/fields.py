@@ -1,11 +1,6 @@
-"""One vocabulary of constraints for every value the package takes from outside.
-
-A constraint is declared once, beside what it constrains, in the manner of scikit-learn's
-``_parameter_constraints``: a platform section's field (:func:`spec`), an identifier's
-hyper-parameter, a study parameter (:class:`FieldSpec`), a command-line flag (:func:`check`).
-A setting is valid if it satisfies one of its constraints (``None`` allows None). Every
-refusal reads *"{subject} must be {expected}. Got {value!r} instead."*; a number outside its
-physical range (wide enough for any hexapod) is refused as a probable unit mistake.
+"""One vocabulary of constraints for every value taken from outside, declared beside what it
+constrains (as scikit-learn's ``_parameter_constraints``); every refusal reads *"{subject} must be
+{expected}. Got {value!r} instead."*, and a number outside its physical range is a probable unit slip.
 """
 
 from __future__ import annotations
@@ -37,14 +32,12 @@ class Interval:
     Parameters
     ----------
     kind : {numbers.Real, numbers.Integral}
-        Real numbers or integers (booleans are neither).
+        Booleans are neither.
     low, high : float or None
-        Bounds; None for no bound.
+        None for no bound.
     closed : {"left", "right", "both", "neither"}
-        Which bounds belong to the interval.
     physical : (float, float), optional
-        Closed range, in the value's SI unit, of the values a real machine can have; a value
-        inside the interval but outside this range is refused as a probable unit mistake.
+        Closed range (SI) a real machine can have; outside it, a probable unit mistake.
     """
 
     kind: type
@@ -98,13 +91,8 @@ class Interval:
 
 @dataclasses.dataclass(frozen=True)
 class ListOf:
-    """A list (tuple, one-dimensional array) of numbers, each in ``item``.
-
-    Parameters
-    ----------
-    item : Interval
-    length : int, optional
-        The required number of elements; any number but zero when None.
+    """A list (tuple, one-dimensional array) of numbers, each in ``item``, of ``length`` elements (any
+    number but zero when None).
     """
 
     item: Interval
@@ -185,35 +173,29 @@ def finite(low: float | None = None, high: float | None = None) -> Interval:
 
 
 def constraint_error(subject: str, expected: str, value: Any) -> ConfigError:
-    """The one refusal of a bad setting, as a ConfigError.
-
-    Its message reads ``"{subject} must be {expected}. Got {value!r} instead."``.
-    """
+    """The one refusal of a bad setting: ``"{subject} must be {expected}. Got {value!r} instead."``."""
     return ConfigError(f"{subject} must be {expected}. Got {value!r} instead.")
 
 
 def check(subject: str, value: Any, constraints: Sequence[Constraint | None], unit: str = "",
           condition: str = "") -> None:
-    """Refuse ``value`` unless it satisfies one of ``constraints`` and its physical range.
+    """Refuse ``value`` unless it satisfies one of ``constraints`` (None allows None) and its physical range.
 
     Parameters
     ----------
     subject : str
-        What the value is, as the message names it: ``"The 'order' parameter of
-        FourierIdentifier"``, ``"[inertia] platform_mass"``, ``"--budget"``.
+        As the message names it: ``"[inertia] platform_mass"``, ``"--budget"``.
     value : object
     constraints : sequence of constraint or None
-        The value is valid if it satisfies one; None allows None.
     unit : str
         SI unit shown after the expected values (``"-"`` or ``""``: none).
     condition : str
-        When the constraints apply, shown after them (``"test_functions is None"``).
+        When the constraints apply (``"test_functions is None"``).
 
     Raises
     ------
     ConfigError
-        In the form "{subject} must be {expected}. Got {value!r} instead.", or, for a number
-        outside its physical range, naming the range and the unit to check.
+        As :func:`constraint_error`, or naming the physical range and the unit to check.
     """
     if value is None and None in constraints:
         return
@@ -259,12 +241,10 @@ class FieldSpec:
     Attributes
     ----------
     unit : str
-        SI unit (``"-"`` for none), shown in messages, tables and documentation.
+        SI unit (``"-"`` for none).
     doc : str
-        One-line description.
     constraint : constraint
-        The values it takes (:class:`Interval`, :class:`ListOf`, :class:`Options`,
-        :class:`InstanceOf`).
+        :class:`Interval`, :class:`ListOf`, :class:`Options` or :class:`InstanceOf`.
     """
 
     unit: str
@@ -272,7 +252,7 @@ class FieldSpec:
     constraint: Constraint
 
     def check(self, subject: str, value: Any) -> Any:
-        """``value`` checked, with integers of a real field as floats and lists as tuples.
+        """``value`` checked and normalised (:meth:`normalise`).
 
         Raises
         ------
@@ -284,8 +264,7 @@ class FieldSpec:
         return value
 
     def normalise(self, value: Any) -> Any:
-        """``value`` in its stored form: numbers of a real field as floats, lists as tuples;
-        a value of another type unchanged (for :meth:`check` to refuse)."""
+        """``value`` as stored: numbers of a real field as floats, lists as tuples; other types unchanged."""
         constraint = self.constraint
         if isinstance(constraint, ListOf) and constraint.has_shape(value):
             return tuple(self._number(v, constraint.item) for v in value)
@@ -300,18 +279,8 @@ def spec(unit: str, doc: str, constraint: Constraint, default: Any = dataclasses
          ) -> Any:
     """Declare a section field (a :class:`FieldSpec` in the field's metadata).
 
-    Parameters
-    ----------
-    unit : str
-        SI unit of the value, shown in error messages and documentation.
-    doc : str
-        One-line description.
-    constraint : constraint
-        Values the field takes, with the physical range of a number
-        (e.g. ``positive(0.01, 50.0)``, ``ListOf(positive(1e-6, 1e9), length=3)``).
-    default : optional
-        Default value; fields without one are required in TOML. A default of None (a value
-        derived from other sections) is not checked.
+    ``constraint`` carries a number's physical range (``positive(0.01, 50.0)``); fields without a
+    ``default`` are required in TOML; a default of None (derived from other sections) is not checked.
     """
     metadata = {"spec": FieldSpec(unit, doc, constraint)}
     if isinstance(default, list | tuple):
@@ -325,11 +294,9 @@ def field_spec(field: dataclasses.Field) -> FieldSpec:
 
 
 class Section:
-    """Base of a frozen section dataclass that checks every field when built.
-
-    A subclass is a ``@dataclasses.dataclass(frozen=True)`` declared with :func:`spec`
-    fields and names its TOML table in ``section``; a subclass with checks across fields
-    calls ``super().__post_init__()`` first.
+    """Base of a frozen section dataclass (declared with :func:`spec` fields, its TOML table in
+    ``section``) that checks every field when built; cross-field checks call
+    ``super().__post_init__()`` first.
     """
 
     #: Name of the TOML table, used in messages (``[geometry] upper_radius ...``).
@@ -345,16 +312,7 @@ class Section:
 
 
 def section_from_mapping(cls: type[T], table: Any, where: str) -> T:
-    """Build the section dataclass ``cls`` from a TOML table.
-
-    Parameters
-    ----------
-    cls : type
-        Frozen :class:`Section` dataclass declared with :func:`spec` fields.
-    table : Mapping
-        The parsed TOML table.
-    where : str
-        Section name used in error messages.
+    """Build the section dataclass ``cls`` from a TOML table; ``where`` names it in messages.
 
     Raises
     ------

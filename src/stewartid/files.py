@@ -1,19 +1,5 @@
-"""Every file the package writes goes through here, and every TOML file it reads.
-
-TOML: :func:`read_toml` is the one reader of platform descriptions, study files and column
-mappings; a file that is not UTF-8 or not TOML is refused in one line naming the file, the
-place and the fix.
-
-Atomic: the bytes go to a temporary file in the target folder which is then renamed over the
-target, so a reader never sees a half-written data set, table, figure, report or JSON file,
-and an interrupted run leaves the previous file intact.
-
-JSON: :func:`to_jsonable` turns arrays, NumPy scalars, tuples and paths into plain JSON
-values. JSON has no non-finite numbers, so NaN and ±infinity are written as ``null``
-(readers turn ``null`` back into NaN: :meth:`IdentificationResult.from_dict
-<stewartid.identification.result.IdentificationResult.from_dict>` and
-:func:`stewartid.reproduction.document.load_results` do). Any other object is a bug and
-raises TypeError.
+"""Every file the package writes (atomically: a temporary file renamed over the target) and every
+TOML file it reads; JSON gets plain values, NaN and ±infinity as ``null``.
 """
 
 from __future__ import annotations
@@ -33,10 +19,7 @@ from stewartid.errors import ConfigError, OutputExistsError
 
 
 def write_bytes_atomic(path: str | Path, data: bytes) -> Path:
-    """Write ``data`` to ``path`` through a temporary file in the same folder and a rename.
-
-    The folder is created if missing; the file gets the usual permissions (umask).
-    """
+    """Write ``data`` to ``path`` through a temporary file in its folder (created if missing) and a rename."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
@@ -60,8 +43,8 @@ def write_text_atomic(path: str | Path, text: str) -> Path:
 
 
 def to_jsonable(value: Any) -> Any:
-    """``value`` as plain JSON values: arrays and tuples become lists, NumPy scalars Python
-    numbers, paths strings, dict keys strings, and NaN or ±infinity ``None`` (``null``).
+    """``value`` as plain JSON: arrays and tuples as lists, NumPy scalars as numbers, paths and keys
+    as strings, NaN or ±infinity as None.
 
     Raises
     ------
@@ -93,16 +76,8 @@ def write_json_atomic(path: str | Path, document: Any) -> Path:
 
 def check_output_folder(directory: str | Path, force: bool,
                         is_result: Callable[[Path], bool] | None = None) -> None:
-    """Refuse to write into a folder that already holds results, unless ``force``.
-
-    Parameters
-    ----------
-    directory : str or Path
-        The output folder (need not exist).
-    force : bool
-        Overwrite: existing files are then replaced one by one, nothing else is deleted.
-    is_result : callable, optional
-        Which files count as results; by default every entry (the folder must be empty).
+    """Refuse to write into a folder that holds results (``is_result``; by default any entry), unless
+    ``force``, which replaces files one by one and deletes nothing.
 
     Raises
     ------
@@ -127,26 +102,14 @@ def check_output_file(path: str | Path, force: bool, inputs: Iterable[str | Path
                       option: str = "--out") -> None:
     """Check, before any computation, that ``path`` can take an output file.
 
-    Parameters
-    ----------
-    path : str or Path
-        The output file (its folder is created when written if missing).
-    force : bool
-        Overwrite an existing file that is not an earlier result. Inputs are never
-        overwritten, whatever ``force``.
-    inputs : iterable of str or Path
-        Files the command reads.
-    is_result : callable, optional
-        Which existing files are earlier results of the same command, overwritten without
-        ``force``; by default none is.
-    option : str
-        Option named in the messages.
+    Earlier results (``is_result``; none by default) are overwritten, other files only with
+    ``force``, ``inputs`` never; ``option`` is named in messages.
 
     Raises
     ------
     OutputExistsError
-        ``path`` is a folder, one of ``inputs``, an existing file that is not an earlier
-        result (without ``force``), or lies under a file or a folder that cannot be written.
+        ``path`` is a folder, an input, an existing non-result file without ``force``, or lies where
+        nothing can be written.
     """
     path = Path(path)
     if path.is_dir():
@@ -167,20 +130,13 @@ def check_output_file(path: str | Path, force: bool, inputs: Iterable[str | Path
 
 
 def read_toml(path: str | Path, what: str) -> dict[str, Any]:
-    """The parsed TOML file ``path``, which must be UTF-8 (a byte-order mark is allowed).
-
-    Parameters
-    ----------
-    path : str or Path
-        An existing file (callers say, in their own words, which file is missing).
-    what : str
-        What the file is, first in the messages: ``"platform file"``, ``"study file"``.
+    """The parsed TOML file ``path`` (UTF-8, a byte-order mark allowed); ``what`` names it in messages.
 
     Raises
     ------
     ConfigError
-        Naming the file and the line of the first byte that is not UTF-8, with the fix; or
-        naming the file, line and column of a TOML syntax error.
+        Naming the file and the line of the first non-UTF-8 byte, with the fix, or the line and
+        column of a TOML syntax error.
     """
     data = Path(path).read_bytes()
     try:

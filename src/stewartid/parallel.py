@@ -1,16 +1,5 @@
-"""The one process-pool policy of the package: how independent tasks run on several cores.
-
-Every parallel stage runs through :func:`process_pool` or :func:`run_in_order`:
-
-- **start method "fork"** where the system has it, "spawn" elsewhere: a forked worker starts
-  with this process's modules and compiled kernels (:data:`WORKERS_INHERIT`);
-- **one BLAS thread per task**: the parallelism is across processes, and a fixed thread
-  count keeps the results bitwise the same for any worker count (:data:`WORKER_THREADS` for
-  workers another library starts);
-- **worker count** ``os.cpu_count()`` by default, at most one per task; one worker runs the
-  tasks in this process, without a pool;
-- **results in task order**, each task carrying its own seed;
-- **progress** as ``progress(done, total, index)`` after each finished task.
+"""The one process-pool policy: "fork" where available, one BLAS thread per task (bitwise results
+for any worker count), every core by default, results in task order, progress per finished task.
 """
 
 from __future__ import annotations
@@ -41,15 +30,14 @@ TaskProgress = Callable[[int, int, int], Any]
 
 
 def worker_count(workers: int | None, tasks: int) -> int:
-    """Worker processes for ``tasks`` tasks: ``workers``, or every core when None; at most
-    one per task and at least one."""
+    """Worker processes for ``tasks`` tasks: ``workers`` or every core, at most one per task, at least one."""
     wanted = (os.cpu_count() or 1) if workers is None else int(workers)
     return max(1, min(wanted, tasks))
 
 
 def limit_worker_threads(initializer: Callable[..., Any] | None = None,
                          *initargs: Any) -> None:
-    """Worker initializer: one BLAS/OpenMP thread in this process, then ``initializer(*initargs)``."""
+    """Worker initializer: one BLAS/OpenMP thread here, then ``initializer(*initargs)``."""
     threadpool_limits(limits=1)
     if initializer is not None:
         initializer(*initargs)
@@ -71,17 +59,8 @@ class InlineExecutor(Executor):
 @contextmanager
 def process_pool(workers: int, initializer: Callable[..., Any] | None = None,
                  initargs: tuple = ()) -> Iterator[Executor]:
-    """An executor of ``workers`` processes with one BLAS thread each, shut down on
-    exit; for ``workers`` <= 1 an :class:`InlineExecutor`, with one BLAS thread here until
-    exit.
-
-    Parameters
-    ----------
-    workers : int
-        Worker processes (:func:`worker_count` chooses a default).
-    initializer : callable, optional
-        Run once in every worker process with ``initargs`` (all picklable), after the thread
-        limit; not run without a pool.
+    """An executor of ``workers`` processes with one BLAS thread each, shut down on exit; for
+    ``workers`` <= 1 an :class:`InlineExecutor`. ``initializer(*initargs)`` runs in each worker.
     """
     if workers <= 1:
         with threadpool_limits(limits=1):
@@ -110,24 +89,8 @@ def run_in_order(function: Callable[..., Any], tasks: Sequence[Any], workers: in
                  progress: TaskProgress | None = None, shared: Any = None) -> list[Any]:
     """``[function(task) for task in tasks]`` on :func:`worker_count` processes, in task order.
 
-    Parameters
-    ----------
-    function : callable
-        A module-level (picklable) function: ``function(task)``, or ``function(shared,
-        task)`` when ``shared`` is given.
-    tasks : sequence
-        Picklable arguments, one per task.
-    workers : int, optional
-        Worker processes; every core by default.
-    progress : callable, optional
-        ``progress(done, total, index)`` as tasks finish.
-    shared : object, optional
-        Large data every task needs: sent once to each worker instead of with every task.
-
-    Returns
-    -------
-    list
-        The results, in the order of ``tasks``; the first failure is raised.
+    ``function`` is module-level, called as ``function(shared, task)`` when ``shared`` (large data sent
+    once per worker) is given; ``progress(done, total, index)`` as tasks finish; the first failure is raised.
     """
     tasks = list(tasks)
     count = worker_count(workers, len(tasks))

@@ -1,13 +1,6 @@
-"""The platform description: geometry, inertia and joint friction of a 6-6 Stewart platform.
-
-A :class:`Platform` is a frozen dataclass built from a TOML file (format in
-``docs/platform-format.md``) or from the shipped ``paper`` preset (Zhang 2020, Tables 1-2).
-It checks itself when built: unknown keys, missing keys, wrong types, negative masses and
-geometries whose legs cannot be built are refused with one message naming the key. An
-optional ``[payload]`` moves with the platform as one body (:attr:`Platform.moving_body`).
-
-Frame (the paper's): x forward, y right, z down; origin at the centre of the base joint
-plane. Leg numbering follows ``docs/conventions.md`` and is part of the data format.
+"""The platform description: a frozen :class:`Platform` from TOML (``docs/platform-format.md``) or the
+``paper`` preset (Zhang 2020, Tables 1-2), refusing bad keys, types and unbuildable geometry when
+built. Paper frame: x forward, y right, z down, origin at the base joint plane's centre.
 """
 
 from __future__ import annotations
@@ -52,16 +45,16 @@ REQUIRED_SECTIONS = ("geometry", "inertia", "friction")
 
 
 class MovingBody(NamedTuple):
-    """The moving body, platform and payload, as one rigid body.
+    """The moving body, platform and payload, as one rigid body (platform frame).
 
     Attributes
     ----------
     mass : float
         kg.
     com : ndarray, shape (3,)
-        Centre of mass (m), platform frame, from the reference point.
+        From the reference point (m).
     inertia : ndarray, shape (3, 3)
-        Inertia matrix about the reference point (kg m^2), platform frame.
+        About the reference point (kg m^2).
     """
 
     mass: float
@@ -76,15 +69,15 @@ class Platform:
     Attributes
     ----------
     geometry, inertia, friction : Geometry, Inertia, Friction
-        The required sections of the TOML description.
+        The required sections.
     hydraulics, controller, sensors : Hydraulics, Controller, Sensors
-        Plant simulator settings; documented defaults when absent from the file.
+        Plant simulator settings; documented defaults when absent.
     limits : Limits
         Operating limits of excitation design; derived defaults when absent.
     payload : Payload or None
-        A rigid payload on the platform; None (the section absent) for none.
+        A rigid payload moving with the platform; None when absent.
     name : str
-        Label used in reports ("paper" for the preset, the file stem otherwise).
+        "paper" for the preset, the file stem otherwise.
     """
 
     geometry: Geometry
@@ -104,13 +97,7 @@ class Platform:
     # -- derived geometry -------------------------------------------------------------------
     @property
     def upper_joints(self) -> np.ndarray:
-        """Upper joint positions in the platform frame, relative to the reference point.
-
-        Returns
-        -------
-        ndarray, shape (6, 3)
-            Row k is leg k+1's upper gimbal point (m), platform body frame (z down).
-        """
+        """Upper gimbal points (6, 3) (m), row k leg k+1, platform frame from the reference point."""
         g = self.geometry
         angles = _upper_angles(g.upper_half_angle)
         return np.column_stack([
@@ -121,13 +108,7 @@ class Platform:
 
     @property
     def base_joints(self) -> np.ndarray:
-        """Lower (base) joint positions in the fixed frame.
-
-        Returns
-        -------
-        ndarray, shape (6, 3)
-            Row k is leg k+1's lower gimbal point (m); z = 0 is the base joint plane.
-        """
+        """Lower gimbal points (6, 3) (m), row k leg k+1, fixed frame; z = 0 is their plane."""
         g = self.geometry
         angles = _lower_angles(g.lower_half_angle)
         return np.column_stack([
@@ -138,7 +119,7 @@ class Platform:
 
     @property
     def neutral_pose(self) -> np.ndarray:
-        """Pose q = [x, y, z, rx, ry, rz] at neutral (m, rad): z = -(neutral_height + reference_height)."""
+        """Neutral pose q (m, rad): z = -(neutral_height + reference_height)."""
         g = self.geometry
         return np.array([0.0, 0.0, -(g.neutral_height + g.reference_height), 0.0, 0.0, 0.0])
 
@@ -150,11 +131,8 @@ class Platform:
 
     @property
     def moving_body(self) -> MovingBody:
-        """Platform and payload as one rigid body: its mass, centre of mass and inertia about
-        the reference point (the platform's own centre of mass), by the parallel-axis theorem.
-
-        Without a payload: the platform alone, its centre of mass at the reference point and
-        its inertia the diagonal of ``platform_inertia``, exactly.
+        """Platform and payload as one rigid body about the reference point (parallel-axis theorem); without
+        a payload exactly the platform, centre of mass at the reference point, inertia diagonal.
         """
         i, p = self.inertia, self.payload
         inertia = np.diag(np.asarray(i.platform_inertia, dtype=float))
@@ -166,13 +144,7 @@ class Platform:
         return MovingBody(mass, p.mass * c / mass, inertia + shifted)
 
     def parameters(self) -> np.ndarray:
-        """Mass and friction parameters packed for the compiled kernels.
-
-        Returns
-        -------
-        ndarray, shape (N_PARAMETERS,)
-            Laid out as :mod:`stewartid.model.parameters` defines.
-        """
+        """Mass and friction parameters (N_PARAMETERS,) as :mod:`stewartid.model.parameters` lays out."""
         i, f, body = self.inertia, self.friction, self.moving_body
         packed = np.empty(layout.N_PARAMETERS)
         packed[layout.MASS] = body.mass
@@ -188,7 +160,7 @@ class Platform:
 
     # -- construction and serialisation -----------------------------------------------------
     def replace(self, **sections_or_values: Any) -> Platform:
-        """Return a copy with whole sections, or single values as ``section__key=value``, replaced.
+        """A copy with whole sections, or single values as ``section__key=value``, replaced.
 
         Examples
         --------
@@ -214,8 +186,7 @@ class Platform:
         return dataclasses.replace(self, **updates)
 
     def to_dict(self) -> dict[str, Any]:
-        """All sections as plain dictionaries (JSON/TOML ready); an absent optional section
-        (no payload) is left out."""
+        """All sections as plain dictionaries (JSON/TOML ready); an absent payload left out."""
         return {name: section_to_mapping(getattr(self, name)) for name in SECTIONS
                 if getattr(self, name) is not None}
 
@@ -271,7 +242,7 @@ def _check_buildable(platform: Platform) -> None:
 
 
 def platform_from_mapping(document: Any, name: str = "platform") -> Platform:
-    """Build a :class:`Platform` from a parsed TOML document (a mapping of sections).
+    """Build a :class:`Platform` from a parsed TOML document.
 
     Raises
     ------
@@ -302,8 +273,7 @@ def load_platform(source: str | Path) -> Platform:
     Parameters
     ----------
     source : str or Path
-        ``"paper"`` for the shipped preset of Zhang (2020), Tables 1-2, or the path of a
-        TOML file.
+        ``"paper"`` for the preset of Zhang (2020), Tables 1-2, or a TOML file's path.
 
     Returns
     -------

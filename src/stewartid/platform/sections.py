@@ -1,9 +1,5 @@
-"""The sections of a platform description: one frozen dataclass per TOML table.
-
-Each field is declared once with its unit, description, constraint and default
-(:func:`stewartid.fields.spec`) and checked when the section is built. The physical ranges
-are wide on purpose: they catch factors of a thousand (millimetres, grams, bar), not unusual
-designs. The format is documented in ``docs/platform-format.md``.
+"""One frozen dataclass per TOML table of a platform description, each field declared with unit,
+description, constraint and default; ranges are wide, to catch unit slips (mm, g, bar).
 """
 
 from __future__ import annotations
@@ -77,10 +73,9 @@ class Inertia(Section):
 
 @dataclasses.dataclass(frozen=True)
 class Payload(Section):
-    """A rigid payload fixed to the platform: it moves with the platform as one body.
+    """A rigid payload fixed to the platform, moving with it as one body; zero mass, no inertia.
 
-    The products of inertia are entries of the inertia matrix (Ixy = -integral of x y dm),
-    in the order of MuJoCo's ``fullinertia``. A payload of zero mass has no inertia either.
+    Products of inertia are the matrix's entries (Ixy = -integral x y dm), MuJoCo's ``fullinertia`` order.
     """
 
     section = "payload"
@@ -100,13 +95,12 @@ class Payload(Section):
 
     @property
     def inertia_matrix(self) -> np.ndarray:
-        """The inertia matrix about the payload's centre of mass (kg m^2), shape (3, 3)."""
+        """Inertia matrix (3, 3) about the payload's centre of mass (kg m^2)."""
         return inertia_matrix(self.inertia)
 
 
 def inertia_matrix(entries: Sequence[float]) -> np.ndarray:
-    """The symmetric 3x3 inertia matrix of [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] (kg m^2), the
-    products being its off-diagonal entries (MuJoCo's ``fullinertia`` order)."""
+    """Symmetric 3x3 matrix of [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] (kg m^2), products as off-diagonal entries."""
     xx, yy, zz, xy, xz, yz = (float(v) for v in entries)
     return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
 
@@ -117,11 +111,8 @@ TRIANGLE_SLACK = 1e-6
 
 
 def check_payload_inertia(mass: float, inertia: np.ndarray) -> None:
-    """Refuse an inertia matrix no mass distribution has.
-
-    A body's inertia about its centre of mass is positive definite and its principal moments
-    satisfy the triangle inequalities (each at most the sum of the other two); a body without
-    mass has no inertia.
+    """Refuse an inertia no mass distribution has: not positive definite about the centre of mass,
+    principal moments breaking the triangle inequalities, or inertia without mass.
 
     Raises
     ------
@@ -162,11 +153,10 @@ class Friction(Section):
 
 @dataclasses.dataclass(frozen=True)
 class Hydraulics(Section):
-    """Hydraulic actuators of the legs: servo-valve, cylinder and oil (same for all six legs).
+    """Hydraulic actuators of the legs (all six alike): servo-valve, cylinder and oil.
 
-    Defaults size a flight-simulator class hexapod of about 14 t: a 21 MPa supply, 100/70 mm
-    cylinders with 1 m stroke (mid-stroke at the neutral pose), 200 L/min servo-valves of 80 Hz
-    bandwidth and an effective bulk modulus of 1.2 GPa.
+    Defaults size a ~14 t flight-simulator hexapod: 21 MPa, 100/70 mm cylinders of 1 m stroke,
+    200 L/min 80 Hz valves, bulk modulus 1.2 GPa.
     """
 
     section = "hydraulics"
@@ -223,10 +213,8 @@ class Hydraulics(Section):
 
 @dataclasses.dataclass(frozen=True)
 class Controller(Section):
-    """Leg-length servo: PID on each leg length giving a force demand, plus an inner force loop.
-
-    The PID output is the force demand of the leg (N): applied exactly in ``ideal`` actuator
-    mode; in ``hydraulic`` mode an inner loop opens the valve in proportion to the force error.
+    """Leg-length servo: PID on each leg length giving a force demand (N), applied exactly by ``ideal``
+    actuators; ``hydraulic`` ones open the valve in proportion to the force error.
     """
 
     section = "controller"
@@ -268,12 +256,10 @@ class Sensors(Section):
 
 @dataclasses.dataclass(frozen=True)
 class Limits(Section):
-    """Operating limits an excitation must respect (``stewartid design`` and its checks).
+    """Operating limits an excitation must respect (``stewartid design``).
 
-    Keys left out are derived from the other sections by
-    :func:`stewartid.design.limits.resolve_limits`: the stroke ends from ``[hydraulics]
-    stroke`` centred on the neutral leg length, the leg velocity from the rated valve flow
-    through the piston area, the force from the smaller of the cylinder's stall forces.
+    Keys left out are derived by :func:`stewartid.design.limits.resolve_limits` from the stroke, the
+    rated valve flow and the cylinder's stall forces.
     """
 
     section = "limits"

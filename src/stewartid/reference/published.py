@@ -1,16 +1,5 @@
-"""The published identification results of Zhang (2020), Tables 3-6, as package data.
-
-The values live in ``stewartid/data/published.json`` (copied from the paper's tables, with
-the sign typos of Table 6 corrected and the printed values kept); this module loads them into
-small frozen objects so that reports can set our results beside the paper's.
-
-Entries are addressed by ``(matrix, row, column)`` with ``matrix`` in ``{"M", "B"}`` and
-0-based indices; :data:`PAPER_ENTRIES` lists the 20 entries the paper reports.
-
-References
-----------
-Zhang, C. A Parameter Identification Method for Stewart Manipulator Based on Wavelet
-Transform. Mathematics 2020, 8(2), 257. doi:10.3390/math8020257
+"""The published results of Zhang (2020), Tables 3-6 (``stewartid/data/published.json``, Table 6's
+sign typos corrected, printed values kept); entries keyed ``(matrix, row, column)``, 0-based.
 """
 
 from __future__ import annotations
@@ -50,7 +39,7 @@ def entry_label(key: EntryKey) -> str:
 
 
 def entry_unit(key: EntryKey) -> str:
-    """SI unit of an entry of Mt or Bt (coupling entries carry kg·m or N·s, as Mt q_ddot)."""
+    """SI unit of an entry of Mt or Bt (couplings carry kg·m or N·s)."""
     matrix, row, col = key
     if row == col:
         return _UNITS[matrix][row]
@@ -59,11 +48,9 @@ def entry_unit(key: EntryKey) -> str:
 
 
 def relative_error_percent(value: ArrayLike, nominal: ArrayLike) -> Any:
-    """ε = |value − nominal| / |nominal| · 100 (%), the paper's relative absolute error.
+    """ε = |value − nominal| / |nominal| · 100 (%), the paper's relative error (the package's one definition).
 
-    The one definition of ε in the package. Element-wise on arrays; a float for scalars.
-    Where the nominal value is zero ε is undefined and NaN is returned (no warning, no
-    exception): the paper tabulates only entries with a non-zero nominal value.
+    Element-wise; NaN, silently, where the nominal is zero.
     """
     value = np.asarray(value, dtype=float)
     nominal = np.asarray(nominal, dtype=float)
@@ -81,13 +68,13 @@ class PublishedEntry:
     key : tuple
         ``(matrix, row, column)``, 0-based.
     value : float
-        Identified value (SI units), with known typos corrected.
+        SI, known typos corrected.
     eps : float
         ε (%) as printed.
     printed : float
-        The value exactly as printed (differs from ``value`` only where corrected).
+        As printed.
     note : str or None
-        Why a value was corrected or does not match its printed ε.
+        Why a value was corrected or does not match its ε.
     """
 
     key: EntryKey
@@ -114,12 +101,11 @@ class PublishedTable:
     Attributes
     ----------
     number : int
-        Table number in the paper (3-6).
+        3-6.
     title : str
     coulomb : float
-        Coulomb friction level of the experiment (N·m per joint axis).
+        Coulomb level of the experiment (N·m per joint axis).
     frequency_hz : float
-        Excitation frequency (Hz).
     results : dict
         ``{method letter: {entry key: PublishedEntry}}``.
     """
@@ -151,7 +137,7 @@ class PublishedResults:
     tables : dict
         ``{table number: PublishedTable}``.
     nominal : dict
-        ``{entry key: nominal value}`` as printed (SI units).
+        ``{entry key: nominal value}`` as printed (SI).
     citation, doi : str
     """
 
@@ -170,7 +156,7 @@ class PublishedResults:
                 f"{sorted(self.tables)}") from None
 
     def entry(self, method: str, coulomb: float, key: EntryKey) -> PublishedEntry | None:
-        """The published entry for paper method ``method`` ("A"/"B") at ``coulomb`` N·m, if any."""
+        """The published entry of method ``method`` ("A"/"B") at ``coulomb`` N·m, if any."""
         for table in self.tables.values():
             if math.isclose(table.coulomb, coulomb) and key in table.results.get(method, {}):
                 return table.results[method][key]
@@ -220,7 +206,7 @@ def _parse_entries(matrix: str, mapping: Any, where: str) -> dict[EntryKey, Publ
 
 def parse_published(document: dict[str, Any], where: str = "published.json"
                     ) -> PublishedResults:
-    """Build :class:`PublishedResults` from the decoded JSON document (see the package file)."""
+    """Build :class:`PublishedResults` from the decoded JSON document."""
     try:
         nominal_doc, tables_doc, source = (document["nominal"], document["tables"],
                                            document["source"])
@@ -255,17 +241,7 @@ def parse_published(document: dict[str, Any], where: str = "published.json"
 
 
 def load_published(path: str | Path | None = None) -> PublishedResults:
-    """Load the paper's published Tables 3-6.
-
-    Parameters
-    ----------
-    path : str or Path, optional
-        A JSON file in the package's format; the package's own copy by default.
-
-    Returns
-    -------
-    PublishedResults
-    """
+    """Load the paper's Tables 3-6 from ``path`` (the package's copy by default)."""
     if path is None:
         text = resources.files("stewartid").joinpath("data/published.json").read_text("utf-8")
         where = "stewartid/data/published.json"
