@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from stewartid.files import to_jsonable, write_json_atomic
+from stewartid.model.joints import FRICTION_TYPES
 from stewartid.reference.published import (
     PAPER_ENTRIES,
     EntryKey,
@@ -59,6 +60,42 @@ class IdentificationResult:
     validation: dict[str, Any] | None = None
     delay: dict[str, Any] | None = None
     verdict: dict[str, Any] | None = None
+
+    @property
+    def friction_model(self) -> str | None:
+        """Method B's interval constants (``"free"``, ``"shared"``, ``"uniform"``,
+        ``"coulomb"``); None for a method without them."""
+        return self.diagnostics.get("friction_model")
+
+    @property
+    def coulomb(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """Coulomb level and standard error per joint type (N m), shape (3,) each in
+        :data:`~stewartid.model.joints.FRICTION_TYPES` order, as the method estimated them
+        (standard errors NaN where not given); None when it estimated none, or left its
+        interval constants free."""
+        levels = self.diagnostics.get("coulomb")
+        if not isinstance(levels, dict) or self.friction_model == "free":
+            return None
+        values = np.array([levels.get(name, np.nan) for name in FRICTION_TYPES], dtype=float)
+        if not np.all(np.isfinite(values)):
+            return None
+        std = self.diagnostics.get("coulomb_std") or {}
+        return values, np.array([std.get(name, np.nan) for name in FRICTION_TYPES], dtype=float)
+
+    @property
+    def validation_coulomb(self) -> np.ndarray | None:
+        """The Coulomb levels per joint type (N m, shape (3,)) a result that estimated none is
+        validated with (a friction-estimating fit of the same data); None without."""
+        found = self.diagnostics.get("validation_coulomb")
+        if not isinstance(found, dict):
+            return None
+        values = np.array([found.get(name, np.nan) for name in FRICTION_TYPES], dtype=float)
+        return values if np.all(np.isfinite(values)) else None
+
+    @property
+    def consensus_members(self) -> tuple[str, ...]:
+        """The methods a consensus result combines (empty for any other result)."""
+        return tuple(self.diagnostics.get("consensus", {}).get("members", ()))
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict (with ``consistency``); non-finite numbers are None."""

@@ -105,25 +105,17 @@ class CrossValidation:
 
 def coulomb_levels(result: IdentificationResult) -> np.ndarray | None:
     """Coulomb level per joint type (N m), shape (3,) in :data:`FRICTION_TYPES` order; None if none."""
-    levels = result.diagnostics.get("coulomb")
-    if not isinstance(levels, dict) or result.diagnostics.get("friction_model") == "free":
-        return None
-    values = np.array([levels.get(name, np.nan) for name in FRICTION_TYPES], dtype=float)
-    return values if np.all(np.isfinite(values)) else None
+    found = result.coulomb
+    return None if found is None else found[0]
 
 
 def prediction_levels(result: IdentificationResult) -> np.ndarray | None:
     """Coulomb levels a result predicts with: its own, else its companion fit's
-    (``diagnostics["validation_coulomb"]``), else None.
+    (:attr:`~stewartid.identification.result.IdentificationResult.validation_coulomb`), else
+    None.
     """
     levels = coulomb_levels(result)
-    if levels is not None:
-        return levels
-    companion = result.diagnostics.get("validation_coulomb")
-    if not isinstance(companion, dict):
-        return None
-    values = np.array([companion.get(name, np.nan) for name in FRICTION_TYPES], dtype=float)
-    return values if np.all(np.isfinite(values)) else None
+    return levels if levels is not None else result.validation_coulomb
 
 
 def with_companion_friction(result: IdentificationResult, companion: Callable[[], Any] | None,
@@ -148,12 +140,11 @@ def with_companion_friction(result: IdentificationResult, companion: Callable[[]
 
 def coulomb_estimate(result: IdentificationResult) -> tuple[np.ndarray, np.ndarray]:
     """Coulomb levels and standard errors per joint type (N m), shape (3,) each; NaN where not estimated."""
-    nan = np.full(len(FRICTION_TYPES), np.nan)
-    levels = coulomb_levels(result)
-    if levels is None:
+    found = result.coulomb
+    if found is None:
+        nan = np.full(len(FRICTION_TYPES), np.nan)
         return nan, nan
-    std = result.diagnostics.get("coulomb_std") or {}
-    return levels, np.array([std.get(k, np.nan) for k in FRICTION_TYPES], dtype=float)
+    return found
 
 
 def prepare_segment(dataset: Dataset, platform: Platform, window: float, *, gravity: bool,

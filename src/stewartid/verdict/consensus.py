@@ -110,7 +110,7 @@ def friction_diagnostics(results: Sequence[IdentificationResult]) -> dict[str, A
     has none), else the levels a member was validated with (``"validation_coulomb"``)."""
     for result in results:
         found = result.diagnostics
-        if isinstance(found.get("coulomb"), dict) and found.get("friction_model") != "free":
+        if isinstance(found.get("coulomb"), dict) and result.friction_model != "free":
             return {key: found[key] for key in ("coulomb", "coulomb_std") if key in found}
     for result in results:
         if isinstance(result.diagnostics.get("validation_coulomb"), dict):

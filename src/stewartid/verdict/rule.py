@@ -107,9 +107,7 @@ def friction_immune(result: IdentificationResult) -> bool:
     per constant-direction interval (``friction_model`` "free") and no Coulomb levels on its
     invariant rows (``soft_sign_rate`` None: on large motions it fits the Coulomb force's
     change inside the intervals, and then rests on that structure)."""
-    diagnostics = result.diagnostics
-    return (diagnostics.get("friction_model") == "free"
-            and diagnostics.get("soft_sign_rate") is None)
+    return result.friction_model == "free" and result.diagnostics.get("soft_sign_rate") is None
 
 
 def models_friction(result: IdentificationResult) -> bool:

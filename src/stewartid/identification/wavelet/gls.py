@@ -74,18 +74,11 @@ class WeakFormSolution:
 
 def _weighted_normal(design: np.ndarray, weights: np.ndarray, target: np.ndarray
                      ) -> tuple[np.ndarray, np.ndarray]:
-    """sum_n D_n^T W_n D_n and sum_n D_n^T W_n t_n, multiplying only the columns a channel uses."""
-    used = np.flatnonzero(np.any(design, axis=(0, 1)))
-    sub = design[..., used] if used.size < design.shape[-1] else design
-    weighted = (weights @ sub).reshape(-1, sub.shape[-1])               # (n R, k)
-    flat = sub.reshape(weighted.shape)
-    if sub is design:
-        return flat.T @ weighted, weighted.T @ target.ravel()
-    normal = np.zeros((design.shape[-1], design.shape[-1]))
-    rhs = np.zeros(design.shape[-1])
-    normal[np.ix_(used, used)] = flat.T @ weighted
-    rhs[used] = weighted.T @ target.ravel()
-    return normal, rhs
+    """sum_n D_n^T W_n D_n and sum_n D_n^T W_n t_n, as two matrix products."""
+    weighted = weights @ design                                         # (n, R, u)
+    flat = design.reshape(-1, design.shape[-1])
+    return (flat.T @ weighted.reshape(flat.shape),
+            weighted.reshape(flat.shape).T @ target.ravel())
 
 
 def channel_systems(stacked: StackedEquations, n_experiments: int, shared_friction: bool,
