@@ -28,7 +28,7 @@ def friction_law_lines(result: IdentificationResult) -> list[str]:
         return []
     predicted = {name: 100 * value["predicted_worst_relative_error"]
                  for name, value in candidates.items()}
-    kept = result.diagnostics.get("friction_model")
+    kept = result.friction_model
     test = (f"its diagonals differ from the free constants' by at most "
             f"{law['largest_disagreement']:.3g} standard errors, at {law['entry']}, against a "
             f"threshold of {law['threshold']:.3g}")

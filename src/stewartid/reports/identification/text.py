@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -15,11 +15,9 @@ from stewartid.platform import COORDINATES, Platform
 from stewartid.reports.identification.friction_text import friction_section
 from stewartid.reports.identification.physical_section import physical_lines
 from stewartid.reports.identification.verdict_text import changed_text, verdict_lines
+from stewartid.reports.identification.written import IdentificationReport
 from stewartid.reports.tables import ResultTable, to_markdown
 from stewartid.signals.differentiation import differentiate, estimate_frequency
-
-if TYPE_CHECKING:
-    from stewartid.reports.identification.report import IdentificationReport
 
 _UNITS = ("mm",) * 3 + ("mrad",) * 3
 #: The physical model's row in the validation tables.
