@@ -120,7 +120,7 @@ def test_section_left_out_when_most_parameters_are_fixed(loaded, monkeypatch):
     """Translation-only records fix the inertias and the revolute friction (8 of 27): with
     the threshold below that share, a report that did not ask for the model gives one line
     saying why instead of the section; ``--model physical`` fits them all the same."""
-    import stewartid.reports.identification.physical_section as section_module
+    import stewartid.comparison._physical as section_module
     from test_physical_model import translation_records
 
     records = translation_records(loaded)
