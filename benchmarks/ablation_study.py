@@ -11,10 +11,8 @@ same runs are judged again with one part of the verdict removed each time:
 - ``no_close_call``: ``VerdictPolicy(close_factor=1.0)`` (no consensus of close methods; a
   close call then needs exactly equal predicted errors);
 - ``no_conditioning``: each method's expected error from its own standard errors alone
-  (``error_posterior`` given no other method and a 1 x 1 identity correlation; the method's
-  own symmetric partner still enters);
-- ``no_fold_correlation``: the methods' errors taken as independent (``fold_correlation``
-  returns the identity);
+  (``error_posterior`` given no other method; the method's own symmetric partner still
+  enters);
 - ``no_misfit_gate``: ``VerdictPolicy(misfit_factor=inf)`` (no method ranked last for a large
   held-out misfit);
 - ``no_pair_pooling``: the consensus without pooling each member's symmetric pairs
@@ -75,7 +73,7 @@ from stewartid.verdict.policy import VerdictPolicy  # noqa: E402
 
 TRUST_FACTOR, TRUST_MARGIN = verdict_study.TRUST_FACTOR, verdict_study.TRUST_MARGIN
 
-VARIANTS = ("default", "no_close_call", "no_conditioning", "no_fold_correlation",
+VARIANTS = ("default", "no_close_call", "no_conditioning",
             "no_misfit_gate", "no_pair_pooling")
 #: Refitted variants: (method, variant name, settings, patched rate choice).
 REFITS = (("wavelet", "wavelet_rate_choice", {}, True),
@@ -88,15 +86,10 @@ REFITS = (("wavelet", "wavelet_rate_choice", {}, True),
 _error_posterior = rule.error_posterior
 
 
-def _own_errors_only(result, others, correlation=None, *args, **kwargs):
+def _own_errors_only(result, others, *args, **kwargs):
     """error_posterior given no other method: the error from the result's own standard
     errors (and its own symmetric partner)."""
-    return _error_posterior(result, [], np.eye(1), *args, **kwargs)
-
-
-def _independent(results, folds, entries=PAPER_ENTRIES):
-    """fold_correlation for independent errors."""
-    return np.eye(len(results))
+    return _error_posterior(result, [], *args, **kwargs)
 
 
 def _not_pooled(value, std_error):
@@ -122,8 +115,6 @@ def variant_setup(name: str) -> tuple[VerdictPolicy | None, list]:
         return VerdictPolicy(misfit_factor=float("inf")), []
     if name == "no_conditioning":
         return None, [mock.patch("stewartid.verdict.rule.error_posterior", _own_errors_only)]
-    if name == "no_fold_correlation":
-        return None, [mock.patch("stewartid.verdict.rule.fold_correlation", _independent)]
     if name == "no_pair_pooling":
         return None, [mock.patch("stewartid.verdict.consensus.pooled_pairs", _not_pooled)]
     return None, []

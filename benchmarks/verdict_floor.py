@@ -11,7 +11,7 @@ For each noisy log, the truth of each of the 16 distinct quantities behind the 2
 every plausible method that is not a misfit estimates it (its two symmetric members pooled by
 inverse variance, :func:`~stewartid.verdict.accuracy.pooled`) with its reported standard
 error, the methods' errors correlated as their fold fits show
-(:func:`~stewartid.verdict.accuracy.fold_correlation`), a flat prior. Truths drawn from
+(:func:`fold_correlation`), a flat prior. Truths drawn from
 it give each method's largest error, so the chance that an answer passes the bar on that log
 can be computed for any answer: the verdict's trusted result (a consensus rebuilt from its
 stored members by this version of the package), each method's, the posterior mean,
@@ -37,7 +37,7 @@ import numpy as np
 
 from stewartid.identification.result import IdentificationResult
 from stewartid.reference.published import PAPER_ENTRIES
-from stewartid.verdict.accuracy import fold_correlation, pooled, symmetric_members
+from stewartid.verdict.accuracy import entry_estimate, pooled, symmetric_members
 from stewartid.verdict.consensus import combine_results
 
 #: The bar of the verdict study: within this factor of the best method's largest error ...
@@ -49,6 +49,59 @@ QUANTITIES = list(dict.fromkeys((m, min(i, j), max(i, j)) for m, i, j in PAPER_E
 #: Which quantity each of the 20 entries is.
 ENTRY_QUANTITY = np.array([QUANTITIES.index((m, min(i, j), max(i, j)))
                            for m, i, j in PAPER_ENTRIES])
+
+
+
+def fold_correlation(results, folds,
+                     entries=PAPER_ENTRIES) -> np.ndarray:
+    """Correlation of several methods' errors on the same data, from their fits of the same
+    folds.
+
+    A fold's estimate departs from the folds' mean by the noise of the data it was given;
+    standardised by the method's standard error, two methods' departures on the same folds
+    correlate as their errors do.
+
+    Parameters
+    ----------
+    results : sequence of IdentificationResult
+        The methods' fits of all the data (their standard errors scale the departures).
+    folds : sequence of (sequence of IdentificationResult or None)
+        Each method's fits of the same folds, in the same order (None: not available).
+    entries : sequence of (str, int, int)
+        The entries compared.
+
+    Returns
+    -------
+    ndarray, shape (n, n)
+        The correlation matrix (positive semidefinite); 0 off the diagonal for a method
+        without two or more folds or whose departures do not vary, and everywhere when the
+        methods' numbers of folds differ (they are then not the same folds).
+    """
+    n = len(results)
+    correlation = np.eye(n)
+    counts = {len(f) for f in folds if f is not None and len(f) >= 2}
+    if len(counts) != 1:
+        return correlation
+    rows, used = [], []
+    for k, (result, fits) in enumerate(zip(results, folds, strict=True)):
+        if fits is None or len(fits) not in counts:
+            continue
+        departures = []
+        for matrix, i, j in entries:
+            values = np.array([entry_estimate(fit, matrix, i, j)[0] for fit in fits])
+            departures.append((values - values.mean()) / entry_estimate(result, matrix, i, j)[1])
+        rows.append(np.concatenate(departures))
+        used.append(k)
+    table = np.array(rows)
+    finite = np.all(np.isfinite(table), axis=0) if rows else np.array([], dtype=bool)
+    if len(used) < 2 or finite.sum() < 3:
+        return correlation
+    with np.errstate(divide="ignore", invalid="ignore"):
+        found = np.corrcoef(table[:, finite])
+    found = np.nan_to_num(found, nan=0.0)
+    np.fill_diagonal(found, 1.0)
+    correlation[np.ix_(used, used)] = found
+    return correlation
 
 
 def stored_result(method: dict) -> IdentificationResult:

@@ -220,10 +220,7 @@ def judge(runs: Sequence[MethodFit], consistent: bool = False,
     """
     runs = list(runs)
     verdict = choose_trusted({run.name: None if run.result is None else
-                              (run.result, run.evidence) for run in runs},
-                             {run.name: None if run.cross_validation is None else
-                              run.cross_validation.fold_results for run in runs},
-                             entries, policy)
+                              (run.result, run.evidence) for run in runs}, entries, policy)
     by_name = {run.name: run for run in runs}
     members = consensus_members(verdict)
     if not members or CONSENSUS in by_name:

@@ -9,7 +9,6 @@ import numpy as np
 
 from stewartid.identification.result import IdentificationResult
 from stewartid.reference.published import PAPER_ENTRIES, EntryKey
-from stewartid.verdict.policy import DEFAULT_POLICY
 
 
 def entry_estimate(result: IdentificationResult, matrix: str, i: int, j: int
@@ -97,131 +96,47 @@ def pooled(estimates: Sequence[tuple[float, float]]) -> tuple[float, float]:
     return variance * float(weights @ np.array([value for value, _ in estimates])), variance
 
 
-def fold_correlation(results: Sequence[IdentificationResult],
-                     folds: Sequence[Sequence[IdentificationResult] | None],
-                     entries: Sequence[EntryKey] = PAPER_ENTRIES) -> np.ndarray:
-    """Correlation of several methods' errors on the same data, from their fits of the same
-    folds.
-
-    A fold's estimate departs from the folds' mean by the noise of the data it was given;
-    standardised by the method's standard error, two methods' departures on the same folds
-    correlate as their errors do.
-
-    Parameters
-    ----------
-    results : sequence of IdentificationResult
-        The methods' fits of all the data (their standard errors scale the departures).
-    folds : sequence of (sequence of IdentificationResult or None)
-        Each method's fits of the same folds, in the same order (None: not available).
-    entries : sequence of (str, int, int)
-        The entries compared.
-
-    Returns
-    -------
-    ndarray, shape (n, n)
-        The correlation matrix (positive semidefinite); 0 off the diagonal for a method
-        without two or more folds or whose departures do not vary, and everywhere when the
-        methods' numbers of folds differ (they are then not the same folds).
-    """
-    n = len(results)
-    correlation = np.eye(n)
-    counts = {len(f) for f in folds if f is not None and len(f) >= 2}
-    if len(counts) != 1:
-        return correlation
-    rows, used = [], []
-    for k, (result, fits) in enumerate(zip(results, folds, strict=True)):
-        if fits is None or len(fits) not in counts:
-            continue
-        departures = []
-        for matrix, i, j in entries:
-            values = np.array([entry_estimate(fit, matrix, i, j)[0] for fit in fits])
-            departures.append((values - values.mean()) / entry_estimate(result, matrix, i, j)[1])
-        rows.append(np.concatenate(departures))
-        used.append(k)
-    table = np.array(rows)
-    finite = np.all(np.isfinite(table), axis=0) if rows else np.array([], dtype=bool)
-    if len(used) < 2 or finite.sum() < 3:
-        return correlation
-    with np.errstate(divide="ignore", invalid="ignore"):
-        found = np.corrcoef(table[:, finite])
-    found = np.nan_to_num(found, nan=0.0)
-    np.fill_diagonal(found, 1.0)
-    correlation[np.ix_(used, used)] = found
-    return correlation
-
-
 def error_posterior(result: IdentificationResult, others: Sequence[IdentificationResult],
-                    correlation: np.ndarray | None = None,
-                    entries: Sequence[EntryKey] = PAPER_ENTRIES,
-                    precision_factor: float = DEFAULT_POLICY.precision_factor
-                    ) -> tuple[np.ndarray, np.ndarray, list[int]]:
+                    entries: Sequence[EntryKey] = PAPER_ENTRIES
+                    ) -> tuple[np.ndarray, np.ndarray]:
     """This result's error on each of ``entries``, given other estimates of the same
     quantities: the Gaussian posterior of its error conditioned on them.
 
     Entry (i, j) is estimated by every other fit (its members (i, j) and (j, i) pooled) and by
-    this result's own partner (j, i) where that differs. With Gaussian, unbiased errors at their
-    standard errors, correlated between methods as ``correlation`` says, the error e given the
-    differences d is Gaussian with mean c' V^-1 d and variance s^2 - c' V^-1 c
-    (c = Cov(e, d), V = Cov(d)).
-
-    Parameters
-    ----------
-    result : IdentificationResult
-    others : sequence of IdentificationResult
-        Other methods' fits of the same data.
-    correlation : ndarray, shape (1 + len(others), 1 + len(others)), optional
-        Correlation of the methods' errors, ``result`` first (:func:`fold_correlation`);
-        independent by default. A result's own partner is taken as independent of all.
-    entries : sequence of (str, int, int)
-        The entries judged.
-    precision_factor : float
-        Other estimates this many times more precise measure the error.
+    this result's own partner (j, i) where that differs. With independent, unbiased Gaussian
+    errors at their standard errors, the error e given the differences d is Gaussian with mean
+    c' V^-1 d and variance s^2 - c' V^-1 c (c = Cov(e, d) = s^2 1, V = Cov(d) =
+    s^2 1 1' + diag(s_p^2)).
 
     Returns
     -------
     mean, std : ndarray, shape (len(entries),)
         The error's posterior mean and standard deviation relative to the estimate
         (fractions); (0, :func:`entry_relative_std`) where nothing else estimates the entry.
-    measured : list of int
-        Indices of the entries the other estimates measure: pooled, their standard error is
-        at most s / ``precision_factor``.
     """
-    links = np.eye(1 + len(others)) if correlation is None else np.asarray(correlation, float)
     std = entry_relative_std(result, entries)
     mean = np.zeros_like(std)
-    measured = []
     for k, (matrix, i, j) in enumerate(entries):
         value, own = entry_estimate(result, matrix, i, j)
         if not (value != 0 and np.isfinite(value) and np.isfinite(own) and own > 0):
             continue
-        # (value, standard error, row of ``links``; -1 for the own partner)
         estimates = []
-        for row, other in enumerate(others, start=1):
+        for other in others:
             found = symmetric_members(other, matrix, i, j)
             if found:
                 centre, variance = pooled(found)
-                estimates.append((centre, np.sqrt(variance), row))
-        estimates += [(v, s, -1) for v, s in symmetric_members(result, matrix, i, j)
+                estimates.append((centre, np.sqrt(variance)))
+        estimates += [(v, s) for v, s in symmetric_members(result, matrix, i, j)
                       if (v, s) != (value, own)]
         if not estimates:
             continue
-        rows = np.array([0] + [row for *_, row in estimates])
-        scale = np.array([own] + [s for _, s, _ in estimates])
-        # the own partner is independent of every method's error
-        linked = np.eye(rows.size)
-        methods = rows >= 0
-        linked[np.ix_(methods, methods)] = links[np.ix_(rows[methods], rows[methods])]
-        cov = linked * np.outer(scale, scale)
-        # d_p = e_0 - e_p: Cov(e_0, d) and Cov(d)
-        with_d = cov[0, 0] - cov[0, 1:]
-        of_d = cov[0, 0] - cov[0, 1:][None, :] - cov[1:, 0][:, None] + cov[1:, 1:]
+        with_d = np.full(len(estimates), own ** 2)
+        of_d = own ** 2 + np.diag(np.array([s for _, s in estimates]) ** 2)
         weights = np.linalg.pinv(of_d, hermitian=True) @ with_d
-        differences = value - np.array([v for v, _, _ in estimates])
+        differences = value - np.array([v for v, _ in estimates])
         mean[k] = float(weights @ differences) / abs(value)
         std[k] = np.sqrt(max(own ** 2 - float(with_d @ weights), 0.0)) / abs(value)
-        if precision_factor ** 2 * pooled([(v, s) for v, s, _ in estimates])[1] <= own ** 2:
-            measured.append(k)
-    return mean, std, measured
+    return mean, std
 
 
 def predicted_worst_error(result: IdentificationResult) -> float:
@@ -231,5 +146,5 @@ def predicted_worst_error(result: IdentificationResult) -> float:
 
 
 __all__ = ["entry_estimate", "entry_relative_std", "error_posterior",
-           "expected_worst_error", "fold_correlation", "pooled", "predicted_worst_error",
+           "expected_worst_error", "pooled", "predicted_worst_error",
            "relative_std", "symmetric_members"]

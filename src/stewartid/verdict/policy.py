@@ -32,9 +32,6 @@ class VerdictPolicy:
         A method leaving more than ``misfit_factor`` times the least held-out unexplained
         force in its worst DOF, and more than ``misfit_floor_percent`` % of it, misses part
         of the physics: it is ranked after the others.
-    precision_factor : float
-        Other methods' pooled estimates of an entry this many times more precise than a
-        method's measure its error there.
     uncertain_relative : float
         An entry of the trusted result with a larger relative standard error is uncertain.
     disagreement : float
@@ -53,7 +50,6 @@ class VerdictPolicy:
     close_factor: float = 1.25
     misfit_factor: float = 4.0
     misfit_floor_percent: float = 1.0
-    precision_factor: float = 5.0
     uncertain_relative: float = 0.10
     disagreement: float = 3.0
     significant: float = 3.0

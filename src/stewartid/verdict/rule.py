@@ -28,7 +28,6 @@ from stewartid.verdict.accuracy import (
     entry_relative_std,
     error_posterior,
     expected_worst_error,
-    fold_correlation,
 )
 from stewartid.verdict.policy import DEFAULT_POLICY, VerdictPolicy, entries_text
 
@@ -47,13 +46,6 @@ def worst_relative_std(result: IdentificationResult,
     values = entry_relative_std(result, entries)
     k = int(np.argmax(values))
     return float(values[k]), entry_label(entries[k])
-
-
-def named_entries(entries: Sequence[str], scored: Sequence[EntryKey] = PAPER_ENTRIES) -> str:
-    """Entry labels for a sentence: listed up to six, counted beyond."""
-    if len(entries) <= 6:
-        return ", ".join(entries)
-    return f"{len(entries)} of {entries_text(scored)}"
 
 
 def uncertain_entries(trusted: IdentificationResult,
@@ -163,12 +155,6 @@ class Standing:
     expected_worst : float
         Its expected largest relative error over the scored entries (a fraction), its
         errors conditioned on the others' (:func:`~stewartid.verdict.accuracy.error_posterior`).
-    measured_entries : tuple of str
-        Entries whose error the other plausible methods' estimates measure (over
-        ``policy.precision_factor`` times more precise).
-    error_correlation : dict of str to float
-        Correlation of its errors with each other applicable method's, from their fits of the
-        same folds (:func:`~stewartid.verdict.accuracy.fold_correlation`; 0 without).
     """
 
     name: str
@@ -185,8 +171,6 @@ class Standing:
     misfit: bool = False
     friction_immune: bool = False
     expected_worst: float = float("nan")
-    measured_entries: tuple[str, ...] = ()
-    error_correlation: dict[str, float] = dataclasses.field(default_factory=dict)
 
     @property
     def unexplained_percent(self) -> float:
@@ -252,15 +236,12 @@ class Verdict:
                 "heldout_worst_vaf_percent": st.worst_vaf_percent,
                 "heldout_worst_dof": st.worst_dof, "plausible": st.compared,
                 "misfit": st.misfit, "models_friction": st.models_friction,
-                "friction_immune": st.friction_immune,
-                "measured_entries": list(st.measured_entries),
-                "error_correlation": dict(st.error_correlation)}
+                "friction_immune": st.friction_immune}
                 for name, st in self.standings.items()},
             "uncertain_detail": self.uncertain}
 
 
 def choose_trusted(assessed: Mapping[str, tuple[IdentificationResult, ValidationResult] | None],
-                   folds: Mapping[str, Sequence[IdentificationResult] | None] | None = None,
                    entries: Sequence[EntryKey] = PAPER_ENTRIES,
                    policy: VerdictPolicy = DEFAULT_POLICY) -> Verdict:
     """Which method to trust on these data (``docs/verdict.md`` states the rule).
@@ -270,9 +251,6 @@ def choose_trusted(assessed: Mapping[str, tuple[IdentificationResult, Validation
     assessed : mapping
         Method name -> (result, its held-out validation), or None for a method that could
         not be applied. At least one must be applicable.
-    folds : mapping, optional
-        Method name -> its fits of the validation's (shared) folds, whence the correlation
-        of the methods' errors (:func:`~stewartid.verdict.accuracy.fold_correlation`).
     entries : sequence of (str, int, int)
         The entries of Mt and Bt the methods are judged on
         (:func:`~stewartid.verdict.policy.scored_entries`).
@@ -294,17 +272,11 @@ def choose_trusted(assessed: Mapping[str, tuple[IdentificationResult, Validation
                                                  policy.misfit_floor_percent))
               for name in ok}
     candidates = [name for name in compared if not misfit[name]] or compared
-    names = list(ok)
-    links = fold_correlation([ok[name][0] for name in names],
-                             [(folds or {}).get(name) for name in names], entries)
-    checked = {}
-    for name, (result, _) in ok.items():
-        rows = [names.index(name)] + [names.index(o) for o in candidates if o != name]
-        checked[name] = error_posterior(result, [ok[o][0] for o in candidates if o != name],
-                                        links[np.ix_(rows, rows)], entries,
-                                        policy.precision_factor)
+    checked = {name: error_posterior(result, [ok[o][0] for o in candidates if o != name],
+                                     entries)
+               for name, (result, _) in ok.items()}
     expected = {name: expected_worst_error(std, mean)
-                for name, (mean, std, _) in checked.items()}
+                for name, (mean, std) in checked.items()}
     # an exact tie goes to the better held-out prediction
     trusted = min(candidates, key=lambda name: (expected[name], unexplained[name]))
     friction_source = next((name for name, (result, _) in ok.items()
@@ -324,10 +296,7 @@ def choose_trusted(assessed: Mapping[str, tuple[IdentificationResult, Validation
             damping_excess=excess, friction_share=friction_signature(validation),
             worst_relative_std=spread[name][0], worst_entry=spread[name][1],
             misfit=misfit[name], friction_immune=friction_immune(result),
-            expected_worst=expected[name],
-            measured_entries=tuple(entry_label(entries[k]) for k in checked[name][2]),
-            error_correlation={other: float(links[names.index(name), k])
-                               for k, other in enumerate(names) if other != name})
+            expected_worst=expected[name])
     others = sorted((name for name in ok if name != trusted),
                     key=lambda name: (name not in compared, misfit[name], expected[name]))
     uncertain = uncertain_entries(ok[trusted][0], {name: ok[name][0] for name in compared
@@ -351,13 +320,6 @@ def _reasons(verdict: Verdict) -> list[str]:
                f"standard error {100 * best.worst_relative_std:.3g} %, {best.worst_entry}), the "
                "least of the plausible methods that predict held-out data; held-out VAF "
                f"{best.worst_vaf_percent:.4g} % in its worst DOF ({best.worst_dof})."]
-    for name, standing in standings.items():
-        if standing.measured_entries:
-            reasons.append(f"{name}: the other methods' estimates, over "
-                           f"{policy.precision_factor:g}x more precise, measure its errors of "
-                           f"{named_entries(standing.measured_entries, verdict.entries)}; "
-                           "there its predicted largest error takes their difference, not its "
-                           "standard errors.")
     if len(close) > 1:
         reasons.append(f"close call: {', '.join(close)} predict largest errors within "
                        f"{policy.close_factor:g}x of each other ("
@@ -395,5 +357,5 @@ def uncertain_sentence(uncertain: Sequence[dict]) -> str:
 
 
 __all__ = ["Standing", "Verdict", "choose_trusted", "finds_friction", "friction_immune",
-           "is_definite", "models_friction", "named_entries", "uncertain_entries",
+           "is_definite", "models_friction", "uncertain_entries",
            "uncertain_sentence", "worst_dof", "worst_relative_std"]

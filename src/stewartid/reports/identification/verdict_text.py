@@ -20,7 +20,7 @@ from stewartid.validation.heldout import friction_signature
 from stewartid.verdict.accuracy import relative_std
 from stewartid.verdict.close_call import CONSENSUS, combined_text
 from stewartid.verdict.policy import entries_text
-from stewartid.verdict.rule import Verdict, named_entries, worst_dof
+from stewartid.verdict.rule import Verdict, worst_dof
 
 #: Held-out VAF (%) in the worst DOF above which a model "predicts closely", "adequately".
 CLOSE_VAF, ADEQUATE_VAF = 99.0, 95.0
@@ -97,16 +97,6 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodFit]) -> list[str]:
              "reveal. On held-out segments it leaves "
              f"{trusted.unexplained_percent:.3g} % of the force unexplained in its worst DOF "
              f"({trusted.worst_dof})."]
-    measured = [f"{run.display_name}, "
-                f"{named_entries(standing.measured_entries, verdict.entries)}"
-                for run in ok if (standing := verdict.standings[run.name]).measured_entries]
-    if measured:
-        lines.append("Where the other methods estimate an entry over "
-                     f"{verdict.policy.precision_factor:g}× "
-                     "more precisely, the difference measures the error there and replaces "
-                     "the standard error in these predictions (elsewhere a disagreement is "
-                     "shared out by the methods' standard errors): "
-                     + "; ".join(measured) + ".")
     if len(verdict.close) > 1 and best.name != CONSENSUS:
         lines.append(f"This is a close call: {' and '.join(names[n] for n in verdict.close)} "
                      "predict largest errors "
