@@ -1,6 +1,8 @@
 """One vocabulary of constraints for every value taken from outside, declared beside what it
-constrains (as scikit-learn's ``_parameter_constraints``); every refusal reads *"{subject} must be
-{expected}. Got {value!r} instead."*, and a number outside its physical range is a probable unit slip.
+constrains (as scikit-learn's ``_parameter_constraints``).
+
+Every refusal reads ``"{subject} must be {expected}. Got {value!r} instead."``, and a number
+outside its physical range is a probable unit slip.
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """Virtual experiments: run the closed-loop plant along excitations, record data sets and write
-them as ``exp1.csv ... exp6.csv`` + ``meta.json``.
+them as ``exp1.csv`` to ``exp6.csv`` with ``meta.json``.
 """
 
 from __future__ import annotations
