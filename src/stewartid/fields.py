@@ -1,8 +1,8 @@
 """One vocabulary of constraints for every value taken from outside, declared beside what it
 constrains (as scikit-learn's ``_parameter_constraints``).
 
-Every refusal reads ``"{subject} must be {expected}. Got {value!r} instead."``, and a number
-outside its physical range is a probable unit slip.
+Every refusal names the subject, what it must be and the value given; a number outside its
+physical range is a probable unit slip.
 """
 
 from __future__ import annotations
@@ -175,7 +175,7 @@ def finite(low: float | None = None, high: float | None = None) -> Interval:
 
 
 def constraint_error(subject: str, expected: str, value: Any) -> ConfigError:
-    """The one refusal of a bad setting: ``"{subject} must be {expected}. Got {value!r} instead."``."""
+    """The one refusal of a bad setting: what must hold of the subject, then the value given."""
     return ConfigError(f"{subject} must be {expected}. Got {value!r} instead.")
 
 
