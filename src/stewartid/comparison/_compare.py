@@ -303,7 +303,7 @@ def _compare(experiments, platform, methods, validate, folds, settings, consiste
     if all(run.result is None for run in runs):
         raise runs[0].exception
     scored = (parse_entries(entries) if entries is not None
-              else scored_entries(*nominal_matrices(platform)))
+              else scored_entries(*nominal_matrices(platform), policy.negligible_coupling))
     runs, verdict = judge(runs, consistent, scored, policy)
     section = None if physical is None else fit_physical(
         datasets, platform, physical, folds, segments, records, record_cache)

@@ -14,10 +14,6 @@ import numpy as np
 from stewartid.errors import ConfigError
 from stewartid.reference.published import PAPER_ENTRIES, EntryKey, entry_label
 
-#: Off-diagonal entries smaller than this share of sqrt(|x_ii x_jj|) in the nominal matrices
-#: are negligible: the verdict does not score them.
-NEGLIGIBLE_COUPLING = 1e-2
-
 
 @dataclass(frozen=True)
 class VerdictPolicy:
@@ -45,6 +41,9 @@ class VerdictPolicy:
     agreement : float
         Members of the consensus agree on an entry within this many standard errors of their
         difference.
+    negligible_coupling : float
+        An off-diagonal entry of the nominal matrices below this share of sqrt(|x_ii x_jj|) is
+        not scored (:func:`scored_entries`).
     """
 
     close_factor: float = 1.25
@@ -55,13 +54,15 @@ class VerdictPolicy:
     significant: float = 3.0
     damping_excess: float = 0.05
     agreement: float = 1.0
+    negligible_coupling: float = 1e-2
 
 
 #: The policy of the package.
 DEFAULT_POLICY = VerdictPolicy()
 
 
-def scored_entries(M: np.ndarray, B: np.ndarray, negligible: float = NEGLIGIBLE_COUPLING
+def scored_entries(M: np.ndarray, B: np.ndarray,
+                   negligible: float = DEFAULT_POLICY.negligible_coupling
                    ) -> tuple[EntryKey, ...]:
     """The entries of Mt and Bt worth judging a method on, from a platform's nominal matrices:
     every diagonal entry and each off-diagonal one above ``negligible`` times the geometric
@@ -115,5 +116,5 @@ def entries_text(entries: Sequence[EntryKey]) -> str:
     return f"the {len(entries)} scored entries"
 
 
-__all__ = ["DEFAULT_POLICY", "NEGLIGIBLE_COUPLING", "VerdictPolicy", "entries_text",
+__all__ = ["DEFAULT_POLICY", "VerdictPolicy", "entries_text",
            "parse_entries", "scored_entries"]
