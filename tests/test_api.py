@@ -7,12 +7,11 @@ import json
 import os
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
+from typer.testing import CliRunner
 
 from stewartid.cli import app
-from typer.testing import CliRunner
 
 SCRIPT = """
 import stewartid as sid

@@ -230,10 +230,13 @@ def test_readme_keeps_the_set_up_commands_and_ci_runs_its_test_command() -> None
     install_and_run = "pip install -e . && stewartid reproduce"
     install_and_test = 'pip install -e ".[test]" && python -m pytest'
     assert install_and_run in readme and install_and_test in readme
-    ci = (ROOT / ".ci" / "run").read_text()
-    assert re.search(r"^" + re.escape(install_and_test.split(" && ")[0]) + r" && .*&& "
-                     + re.escape("python -m pytest") + r"$", ci, re.M), ci
-    assert "python -m sphinx -W -b html docs/" in ci
+    # each step on its own line, in the README's order: under `set -e` a failure inside an
+    # && list would not stop the run
+    steps = [line.strip() for line in (ROOT / ".ci" / "run").read_text().splitlines()]
+    install, test = install_and_test.split(" && ")
+    assert "set -euo pipefail" in steps
+    assert install in steps and test in steps and steps.index(install) < steps.index(test)
+    assert "python -m sphinx -W -b html docs/ \"$out\"" in steps
 
 
 # -- commands: they exist ------------------------------------------------------------------
