@@ -17,7 +17,7 @@ SCRIPT = """
 import stewartid as sid
 platform = sid.load_platform(LOGS + "/platform.toml")
 experiments = sid.read_experiments(LOGS, platform)
-comparison = sid.compare_methods(experiments, platform, methods=("fourier", "ls"))
+comparison = sid.compare_methods(experiments, platform, methods=("fourier", "ls"), folds=2)
 assert comparison.trusted in ("fourier", "ls", "consensus"), comparison.trusted
 assert comparison.M.shape == comparison.B.shape == (6, 6)
 assert set(comparison.std_errors) == {"M", "B"}
@@ -46,12 +46,13 @@ def test_write_report_gives_the_command_lines_report(tmp_path, example_dir, exam
     import stewartid as sid
 
     experiments = sid.read_experiments(example_dir, example_platform)
-    comparison = sid.compare_methods(experiments, example_platform, methods="ls",
+    comparison = sid.compare_methods(experiments, example_platform, methods="ls", folds=2,
                                      nominal_source="ignored")
     written = sid.write_report(comparison, tmp_path / "python")
     assert (tmp_path / "python" / "report.html").is_file() and written.trusted == "ls"
     result = CliRunner().invoke(app, ["identify", "--method", "ls", "--platform",
-                                      str(example_dir / "platform.toml"), "--report",
+                                      str(example_dir / "platform.toml"), "--folds", "2",
+                                      "--report",
                                       str(tmp_path / "cli"), str(example_dir)])
     assert result.exit_code == 0, result.output
     ours = json.loads((tmp_path / "python" / "result.json").read_text())
