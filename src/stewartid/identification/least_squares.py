@@ -26,8 +26,8 @@ from stewartid.identification.preparation import Experiment, prepare
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.solvers import regressor_names, solve_least_squares
+from stewartid.identification.wavelet.noise import measured_sign_rates
 from stewartid.model.joints import JOINT_TYPES
-from stewartid.physical.noise import measured_sign_rates
 from stewartid.platform import Platform
 from stewartid.signals.differentiation import (
     DEFAULT_ORDER,

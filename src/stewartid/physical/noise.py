@@ -7,18 +7,15 @@ from __future__ import annotations
 import numpy as np
 
 from stewartid.identification.preparation import Experiment
-from stewartid.identification.wavelet.noise import white_noise_covariance
 from stewartid.model import matrix_regressors
 from stewartid.model import regressor as reg
 from stewartid.platform import Platform
 from stewartid.signals.differentiation import (
-    differentiate,
     kernel_taps,
     savgol_coefficients,
     window_samples,
 )
 from stewartid.signals.filtered_rows import kernel_filter_rows
-from stewartid.signals.sign_rates import coulomb_sign_rates
 
 
 def derivative_noise_gains(sample_rate: float, window: float, savgol_window: float,
@@ -30,14 +27,6 @@ def derivative_noise_gains(sample_rate: float, window: float, savgol_window: flo
     n = window_samples(savgol_window, sample_rate, order)
     return tuple(float(np.sum(np.convolve(h, savgol_coefficients(n, order, d, 1 / sample_rate))
                               ** 2)) for d in (1, 2))
-
-
-def measured_sign_rates(q: np.ndarray, sample_rate: float, window: float) -> np.ndarray:
-    """Coulomb sign rates (N, 6) of a record with unknown pose noise, estimated against the pose
-    smoothed as the regressor is (:func:`~stewartid.signals.sign_rates.coulomb_sign_rates`).
-    """
-    smooth = differentiate(q, sample_rate, window / 8, 5, (0,))[0]
-    return coulomb_sign_rates(q, sample_rate, window, white_noise_covariance(q, smooth))[0]
 
 
 #: Kept rows per evaluation of the noise's Jacobians in :func:`regressor_noise`.
@@ -108,4 +97,4 @@ def regressor_noise(experiments: list[Experiment], windows: list[float], row_ste
     return terms if by_experiment else terms.sum(axis=0)
 
 
-__all__ = ["JACOBIAN_STRIDE", "derivative_noise_gains", "measured_sign_rates", "regressor_noise"]
+__all__ = ["JACOBIAN_STRIDE", "derivative_noise_gains", "regressor_noise"]

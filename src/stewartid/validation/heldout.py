@@ -158,7 +158,7 @@ def prepare_segment(dataset: Dataset, platform: Platform, window: float, *, grav
     """
     from stewartid.identification.least_squares import coulomb_regressors
     from stewartid.identification.preparation import prepare
-    from stewartid.physical.noise import measured_sign_rates
+    from stewartid.identification.wavelet.noise import measured_sign_rates
     from stewartid.signals.differentiation import kernel_filter
 
     record = prepare([dataset], platform, gravity=gravity, remainder=remainder)[0]

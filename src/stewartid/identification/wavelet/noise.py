@@ -13,6 +13,7 @@ from stewartid.signals.differentiation import (
     savgol_coefficients,
     window_samples,
 )
+from stewartid.signals.sign_rates import coulomb_sign_rates
 
 
 def white_noise_covariance(q: np.ndarray, smooth: np.ndarray | None = None) -> np.ndarray:
@@ -75,4 +76,13 @@ def estimate_noise(experiment: Experiment, window: float) -> NoiseModel:
                       force_variance=force_variance, rate_noise=rate_noise)
 
 
-__all__ = ["NoiseModel", "estimate_noise", "joint_rate_noise", "white_noise_covariance"]
+def measured_sign_rates(q: np.ndarray, sample_rate: float, window: float) -> np.ndarray:
+    """Coulomb sign rates (N, 6) of a record with unknown pose noise, estimated against the pose
+    smoothed as the regressor is (:func:`~stewartid.signals.sign_rates.coulomb_sign_rates`).
+    """
+    smooth = differentiate(q, sample_rate, window / 8, 5, (0,))[0]
+    return coulomb_sign_rates(q, sample_rate, window, white_noise_covariance(q, smooth))[0]
+
+
+__all__ = ["NoiseModel", "estimate_noise", "joint_rate_noise", "measured_sign_rates",
+           "white_noise_covariance"]
