@@ -21,11 +21,11 @@ from stewartid.comparison import (
     method_names,
     plausibility_check,
 )
-from stewartid.datasets.dataset import expand_paths, read_datasets
+from stewartid.datasets import read_experiments
+from stewartid.datasets.dataset import expand_paths
 from stewartid.datasets.excitation import check_experiment_set
 from stewartid.datasets.log_format import load_log_format
 from stewartid.datasets.meta import nominal_from_meta, platform_for_data
-from stewartid.datasets.plausibility import CARRIED_WEIGHT, PHYSICAL_CARRIED_WEIGHT
 from stewartid.errors import ConfigError
 from stewartid.files import check_output_file, check_output_folder
 from stewartid.identification import registry
@@ -268,11 +268,11 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
         raise ConfigError(f"--validate {shared[0]!r} is also an experiment to fit; validation "
                           "records must be motion the fit does not see.")
     log_format = load_log_format(columns) if columns is not None else None
-    carried = CARRIED_WEIGHT if model is None else PHYSICAL_CARRIED_WEIGHT
-    datasets = read_datasets(paths, description, log_format, carried)
+    unknown = model is not None  # the forces' weight is the payload's evidence
+    datasets = read_experiments(paths, description, log_format, payload_unknown=unknown)
     check_experiment_set(datasets, description)
-    records = (read_datasets(records_paths, description, log_format, carried) if records_paths
-               else [])
+    records = (read_experiments(records_paths, description, log_format, payload_unknown=unknown)
+               if records_paths else [])
     meta = nominal_from_meta(paths)
     check = plausibility_check(description)
     if consistent:

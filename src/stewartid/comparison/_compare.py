@@ -23,6 +23,7 @@ from stewartid.errors import ConfigError
 from stewartid.identification import registry
 from stewartid.identification.result import IdentificationResult
 from stewartid.model.linearization import nominal_matrices
+from stewartid.parallel import one_blas_thread
 from stewartid.platform import Platform, load_platform
 from stewartid.validation.heldout import DEFAULT_FOLDS, Segment, ValidationResult
 from stewartid.verdict.policy import (
@@ -207,6 +208,7 @@ def _experiments(experiments: Sequence[Dataset | str | Path], platform: Platform
             for item in experiments]
 
 
+@one_blas_thread()
 def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platform | str | Path,
                     methods: str | Sequence[str] = ALL_METHODS,
                     validate: Sequence[Dataset | str | Path] | None = None,
@@ -270,16 +272,6 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
     StewartidError
         Bad settings, or no method could be applied (the first method's message).
     """
-    from threadpoolctl import threadpool_limits
-
-    # many small products: one BLAS thread is faster, and gives the command line's bits
-    with threadpool_limits(limits=1, user_api="blas"):
-        return _compare(experiments, platform, methods, validate, folds, settings, consistent,
-                        physical, nominal, nominal_source, check, entries, policy, delay)
-
-
-def _compare(experiments, platform, methods, validate, folds, settings, consistent, physical,
-             nominal, nominal_source, check, entries, policy, delay) -> Comparison:
     started = time.perf_counter()
     if not isinstance(platform, Platform):
         platform = load_platform(platform)

@@ -82,13 +82,12 @@ class BaseIdentifier:
             One per experiment.
         platform : Platform, 'paper' or TOML path
         """
-        from threadpoolctl import threadpool_limits
+        from stewartid.parallel import one_blas_thread
 
         self._validate_params()
         platform = resolve_platform(platform)
         data = resolve_datasets(datasets, platform)
-        # many small products: one BLAS thread is faster, and gives the command line's bits
-        with threadpool_limits(limits=1, user_api="blas"):
+        with one_blas_thread():
             result, learned = self._fit(data, platform)
             if getattr(self, "sampling_check", False):
                 result, learned = self._check_sampling(data, platform, result, learned)
