@@ -37,6 +37,7 @@ from stewartid.identification.wavelet.friction_models import (
 from stewartid.identification.wavelet.gls import WeakFormSolution
 from stewartid.identification.wavelet.noise import estimate_noise
 from stewartid.identification.wavelet.point_equations import EXACT_DEGREE, point_equations
+from stewartid.identification.wavelet.weak_form import coulomb_patterns
 from stewartid.model.joints import JOINT_TYPES
 from stewartid.platform import COORDINATES, Platform
 from stewartid.signals.wavelets import MotherWavelet, PolynomialWavelet, make_wavelet
@@ -215,10 +216,12 @@ class WaveletIdentifier(BaseIdentifier):
             experiment = prepare_experiment(dataset, platform, self.gravity, joints=True,
                                             remainder=self.remainder)
             found = self._noise_and_intervals(experiment, 1.0)
+            patterns = (coulomb_patterns(found, experiment.joint_jacobians, False)
+                        if {"free", "coulomb"} & set(models) else None)
             for model in models:
                 equations[model] += model_equations(model, experiment, found,
                                                     int(self.wavelet_order),
-                                                    int(self.test_functions), k)
+                                                    int(self.test_functions), k, patterns)
             infos.append(found.info)
             sensitivities.append(experiment.force_sensitivity)
             motion.append(np.std(experiment.q, axis=0))

@@ -40,11 +40,16 @@ def friction_models(setting: str, datasets: Sequence[Dataset]) -> tuple[str, ...
 
 
 def model_equations(model: str, experiment: Experiment, found: Detection, order: int,
-                    functions: int, k: int) -> list:
-    """The weak-form equations of one experiment under friction model ``model`` (windows or intervals)."""
+                    functions: int, k: int, patterns: np.ndarray | None = None) -> list:
+    """The weak-form equations of one experiment under friction model ``model`` (windows or intervals).
+
+    ``patterns``: :func:`~stewartid.identification.wavelet.weak_form.coulomb_patterns` of the
+    experiment, shared by the models that use them.
+    """
     if model == "coulomb":
-        return window_equations(experiment, found, order, functions, k, False, WINDOW_LENGTH)
-    return experiment_equations(experiment, found, order, functions, k, model)
+        return window_equations(experiment, found, order, functions, k, False, WINDOW_LENGTH,
+                                patterns)
+    return experiment_equations(experiment, found, order, functions, k, model, patterns)
 
 
 def solve_model(model: str, equations: list, infos: list[dict], motion: list[np.ndarray],

@@ -122,12 +122,12 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
     experiment : int
     uniform : bool
         One Coulomb level for every joint axis.
-    patterns : ndarray, shape (n_rates, N, n_types, 6), optional
+    patterns : ndarray, shape (N, n_rates, n_types, 6), optional
         :func:`coulomb_patterns`, for ``coulomb_rows``.
     """
     start, stop = float(interval[0]), float(interval[1])
-    sel = np.flatnonzero((t > start) & (t < stop))
-    if len(sel) < 4 * (size + 1):
+    sel = inside(t, start, stop)
+    if sel.stop - sel.start < 4 * (size + 1):
         return None
     (phi0, phi1, phi2), (bump0, bump1, bump2) = test_family(t[sel], start, stop, order, size,
                                                             float(t[1] - t[0]))
@@ -144,10 +144,8 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
             np.einsum("la,nlac->nac", direction, joint_jacobians[sel]), uniform))
     # the invariant rows see the joints' soft signs at every sample (an idle joint, left out
     # of the detection, may reverse inside the interval) and the pose's change
-    rows = None if patterns is None else np.einsum("kn,rntc->rktc", phi0, patterns[:, sel])
-    family = np.stack([np.vstack([phi0, bump0]), np.vstack([phi1, bump1]),
-                       np.vstack([phi2, bump2])])                            # (3, K + 1, n)
-    gram = np.einsum("arn,bsn->abrs", family, family)
+    rows = None if patterns is None else project_patterns(phi0, patterns[sel])
+    gram = noise_gram((phi0, phi1, phi2), (bump0, bump1, bump2))
     return IntervalEquations(
         regressors=np.hstack([phi2 @ qc, -(phi1 @ qc)]), targets=phi0 @ ys,
         mean_regressors=np.r_[bump2 @ qc, -(bump1 @ qc)], mean_target=bump0 @ ys,
@@ -161,38 +159,64 @@ SOFT_SIGN_RATES = (0.0, 1e-4, 3e-4, 1e-3, 3e-3)
 
 
 def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: bool,
-                     rate: float | Sequence[float] = 0.0) -> np.ndarray:
-    """W_type(t) (N, n_types, 6): generalized force of a unit Coulomb torque on each axis of a type.
+                     rates: Sequence[float] = SOFT_SIGN_RATES) -> np.ndarray:
+    """W_type(t) (N, n_rates, n_types, 6): generalized force of a unit Coulomb torque on each axis of a type.
 
-    Soft sign w / sqrt(w^2 + sigma^2 + r^2) of ``found.sign_rates``, r = ``rate``, rad/s; a sequence of
-    rates adds a leading axis.
+    Soft sign w / sqrt(w^2 + sigma^2 + r^2) of ``found.sign_rates`` at every transition rate r of
+    ``rates``, rad/s. Samples lead, so that an interval's rows are one contiguous slice.
     """
-    rates, noise = found.sign_rates, found.sign_rate_noise
-    out = []
-    for r in np.atleast_1d(np.asarray(rate, dtype=float)):
-        direction = rates / np.sqrt(rates ** 2 + noise ** 2 + r ** 2)          # (N, 6, 5)
-        out.append(_by_type(np.einsum("nla,nlac->nac", direction, joint_jacobians), uniform))
-    return np.stack(out) if np.ndim(rate) else out[0]
+    signs, noise = found.sign_rates, found.sign_rate_noise
+    rates = np.asarray(rates, dtype=float)
+    out = np.empty((len(signs), len(rates), 1 if uniform else len(JOINT_TYPES), 6))
+    for k, r in enumerate(rates):
+        direction = signs / np.sqrt(signs ** 2 + noise ** 2 + r ** 2)          # (N, 6, 5)
+        out[:, k] = _by_type(np.einsum("nla,nlac->nac", direction, joint_jacobians), uniform)
+    return out
 
 
 def _by_type(pattern: np.ndarray, uniform: bool) -> np.ndarray:
     """Per-axis pattern (n, 5, 6) summed per joint type: (n, n_types, 6), or (n, 1, 6) if ``uniform``."""
-    by_type = np.stack([pattern[:, list(axes)].sum(axis=1) for axes in JOINT_TYPES.values()],
-                       axis=1)
+    by_type = np.stack([pattern[:, axes[0]:axes[-1] + 1].sum(axis=1)
+                        for axes in JOINT_TYPES.values()], axis=1)
     return by_type.sum(axis=1, keepdims=True) if uniform else by_type
 
 
+def inside(t: np.ndarray, start: float, stop: float) -> slice:
+    """The samples of ``t`` (uniform, increasing) strictly between ``start`` and ``stop``, as a slice."""
+    return slice(int(np.searchsorted(t, start, side="right")),
+                 int(np.searchsorted(t, stop, side="left")))
+
+
+def project_patterns(phi: np.ndarray, patterns: np.ndarray) -> np.ndarray:
+    """<phi_k, W> (n_rates, K, n_types, 6) of test functions ``phi`` (K, n) and patterns W
+    (n, n_rates, n_types, 6)."""
+    rows = phi @ patterns.reshape(len(patterns), -1)
+    return rows.reshape(len(phi), *patterns.shape[1:]).transpose(1, 0, 2, 3)
+
+
+def noise_gram(phi: Sequence[np.ndarray], bump: Sequence[np.ndarray]) -> np.ndarray:
+    """<phi^(a), phi^(b)> (3, 3, K + 1, K + 1), a, b = 0, 1, 2, of the invariant rows ``phi`` (K, n)
+    then the mean row ``bump`` (n,)."""
+    family = np.concatenate([np.vstack([p, g]) for p, g in zip(phi, bump, strict=True)])
+    rows = len(family) // 3
+    return (family @ family.T).reshape(3, rows, 3, rows).transpose(0, 2, 1, 3)
+
+
 def experiment_equations(experiment: Experiment, found: Detection, order: int, size: int,
-                         index: int, friction: str,
-                         rates: Sequence[float] = SOFT_SIGN_RATES) -> list[IntervalEquations]:
+                         index: int, friction: str, patterns: np.ndarray | None = None
+                         ) -> list[IntervalEquations]:
     """The weak-form equations of every usable interval of one experiment.
 
-    ``friction``: "free" (no structure in the mean rows), "shared" or "uniform" (one level); ``rates``:
-    soft-sign rates, rad/s, of the invariant rows' Coulomb regressors ("free" only).
+    ``friction``: "free" (no structure in the mean rows), "shared" or "uniform" (one level);
+    ``patterns``: :func:`coulomb_patterns` (not uniform) of the invariant rows' Coulomb regressors
+    ("free" only; computed when not given).
     """
     jacobians = experiment.joint_jacobians
     uniform, free = friction == "uniform", friction == "free"
-    patterns = coulomb_patterns(found, jacobians, uniform, tuple(rates)) if free else None
+    if free and patterns is None:
+        patterns = coulomb_patterns(found, jacobians, uniform)
+    elif not free:
+        patterns = None
     equations = (interval_equations(experiment.t, experiment.q, experiment.generalized_force,
                                     None if free else jacobians,
                                     found.joint_rates, found.rate_noise, interval,
@@ -269,4 +293,5 @@ def _per_interval(values: np.ndarray | None, owner: np.ndarray, shape: tuple[int
 
 
 __all__ = ["SOFT_SIGN_RATES", "IntervalEquations", "StackedEquations", "coulomb_patterns",
-           "experiment_equations", "interval_equations", "stack_equations", "test_family"]
+           "experiment_equations", "inside", "interval_equations", "noise_gram",
+           "project_patterns", "stack_equations", "test_family"]

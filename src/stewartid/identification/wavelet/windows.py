@@ -26,6 +26,9 @@ from stewartid.identification.wavelet.weak_form import (
     SOFT_SIGN_RATES,
     IntervalEquations,
     coulomb_patterns,
+    inside,
+    noise_gram,
+    project_patterns,
     stack_equations,
     test_family,
 )
@@ -48,31 +51,29 @@ def window_bounds(t: np.ndarray, length: float) -> np.ndarray:
 
 def window_equations(experiment: Experiment, found: Detection, order: int, size: int,
                      index: int, uniform: bool, length: float,
-                     rates: Sequence[float] = SOFT_SIGN_RATES) -> list[WindowEquations]:
+                     patterns: np.ndarray | None = None) -> list[WindowEquations]:
     """The equations of every window of one experiment.
 
-    ``order``, ``size``: bump exponent and K; ``length``: window, s; ``rates``: soft-sign transition
-    rates, rad/s, one set of Coulomb regressors each.
+    ``order``, ``size``: bump exponent and K; ``length``: window, s; ``patterns``:
+    :func:`coulomb_patterns` of the experiment at every soft-sign rate (computed when not given).
     """
     t, q, y = experiment.t, experiment.q, experiment.generalized_force
-    patterns = coulomb_patterns(found, experiment.joint_jacobians, uniform,
-                                tuple(rates))                              # (R, N, types, 6)
+    if patterns is None:
+        patterns = coulomb_patterns(found, experiment.joint_jacobians, uniform)
     h = float(t[1] - t[0])
     out = []
     for start, stop in window_bounds(t, length):
-        sel = np.flatnonzero((t > start) & (t < stop))
-        if len(sel) < 4 * (size + 1):
+        sel = inside(t, start, stop)
+        if sel.stop - sel.start < 4 * (size + 1):
             continue
         (phi0, phi1, phi2), bump = test_family(t[sel], start, stop, order, size, h)
         qc = q[sel] - q[sel].mean(axis=0)
-        family = np.stack([np.vstack([phi0, bump[0]]), np.vstack([phi1, bump[1]]),
-                           np.vstack([phi2, bump[2]])])
         rows = IntervalEquations(
             regressors=np.hstack([phi2 @ qc, -(phi1 @ qc)]), targets=phi0 @ y[sel],
             mean_regressors=np.zeros(12), mean_target=np.zeros(6), weight=0.0,
             coulomb=np.zeros((patterns.shape[2], 6)), experiment=int(index),
-            noise_gram=np.einsum("arn,bsn->abrs", family, family))
-        out.append(WindowEquations(rows, np.einsum("kn,rntc->rktc", phi0, patterns[:, sel])))
+            noise_gram=noise_gram((phi0, phi1, phi2), bump))
+        out.append(WindowEquations(rows, project_patterns(phi0, patterns[sel])))
     return out
 
 
