@@ -16,6 +16,7 @@ from stewartid.identification.pairs import combine_pairs
 from stewartid.identification.preparation import Experiment, prepare_experiment
 from stewartid.identification.registry import Preset, register_method
 from stewartid.identification.result import IdentificationResult
+from stewartid.identification.sampling import check_sampling
 from stewartid.identification.solvers import (
     bias_compensated_least_squares,
     regressor_names,
@@ -269,6 +270,17 @@ class WaveletIdentifier(BaseIdentifier):
             condition_number=solution.condition_number, residual_rms=solution.noise_std,
             method=self.method, settings=self._settings(), diagnostics=diagnostics)
         return result, {"coulomb_": levels, "coulomb_std_": levels_std}
+
+    def _check_sampling(self, datasets: list[Dataset], platform: Platform,
+                        result: IdentificationResult, learned: dict
+                        ) -> tuple[IdentificationResult, dict]:
+        """The sampling check, its thinned fits under the friction model the full-rate fit chose."""
+        chosen = result.diagnostics.get("friction_model")
+        if self.friction != "auto" or chosen is None:
+            return super()._check_sampling(datasets, platform, result, learned)
+        fixed = type(self)(**{**self.get_params(), "friction": chosen})
+        return check_sampling(lambda part: fixed._fit(part, platform)[0], datasets,
+                              result), learned
 
     def _point_equations(self, experiment: Experiment, wavelet: MotherWavelet):
         """Wavelet equations at (a, b) points with per-row pose-noise moments (12, 12), (12, 6)."""
