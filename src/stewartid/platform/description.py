@@ -138,6 +138,14 @@ class Platform:
                                     - self.base_joints[0]))
 
     @property
+    def hydraulic_legs(self) -> bool:
+        """Whether the simulator drives the legs as valve-controlled cylinders: a hydraulic
+        ``[actuator]`` in ``[hydraulics] mode = "hydraulic"``. Otherwise each leg applies its demanded
+        force exactly, as an electric leg's current loop, far faster than the motion, does.
+        """
+        return self.actuator.kind == "hydraulic" and self.hydraulics.mode == "hydraulic"
+
+    @property
     def moving_body(self) -> MovingBody:
         """Platform and payload as one rigid body about the reference point (parallel-axis theorem); without
         a payload exactly the platform, centre of mass at the reference point, inertia diagonal.
