@@ -392,3 +392,22 @@ def test_mapping_turns_motor_angles_into_leg_lengths(tmp_path, frame, example_pl
         read_dataset(path, platform, log_format=load_log_format("motor1..motor6=Motor{k}:rev"))
     with pytest.raises(ConfigError, match=r"length_at_zero_angle must be a leg length in m"):
         load_log_format("length_at_zero_angle=2000")
+
+
+def test_worked_mapping_of_an_electric_drive_log(tmp_path, frame, example_platform):
+    """docs/logs.md, worked mapping 3: time in ms, motor angles in revolutions, currents in mA."""
+    text = (DOCS / "logs.md").read_text()
+    (block,) = [b for b in text.split("```toml\n") if b.startswith("# controller_electric.toml")]
+    mapping = log_format_from_mapping(tomllib.loads(block.split("```")[0]), "docs")
+    log = pd.DataFrame({"Time": frame["t"] * 1e3})
+    for k in range(1, 7):
+        log[f"Motor{k}"] = (frame[f"l{k}"] - 2.95) / 0.010
+    for k in range(1, 7):
+        log[f"Iq{k}"] = frame[f"f{k}"] / 410.0 * 1e3
+    path = tmp_path / "drive.csv"
+    log.to_csv(path, index=False, float_format="%.17g")
+    read = read_dataset(path, electric(example_platform), log_format=mapping)
+    reference = dataset_from_frame(frame, example_platform)
+    np.testing.assert_allclose(read.lengths, reference.lengths, rtol=0, atol=16 * EPS * 4.0)
+    np.testing.assert_allclose(read.forces, reference.forces, rtol=4 * EPS)
+    np.testing.assert_allclose(read.t, reference.t, rtol=0, atol=4 * EPS * reference.t.max())
