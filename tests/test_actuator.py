@@ -411,3 +411,30 @@ def test_worked_mapping_of_an_electric_drive_log(tmp_path, frame, example_platfo
     np.testing.assert_allclose(read.lengths, reference.lengths, rtol=0, atol=16 * EPS * 4.0)
     np.testing.assert_allclose(read.forces, reference.forces, rtol=4 * EPS)
     np.testing.assert_allclose(read.t, reference.t, rtol=0, atol=4 * EPS * reference.t.max())
+
+
+def test_simulate_refuses_hydraulic_cylinders_for_electric_legs(tmp_path, paper):
+    path = tmp_path / "electric.toml"
+    path.write_text(electric(paper).to_toml())
+    result = CliRunner().invoke(app, ["simulate", "--platform", str(path), "--actuator",
+                                      "hydraulic", "--out", str(tmp_path / "sim")])
+    assert result.exit_code == 2
+    assert "platform 'electric' has electric legs" in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1
+
+
+def test_regressor_takes_the_friction_along_the_legs(paper):
+    """Y pi of the physical model's regressor, whose actuator columns are the friction along the
+    legs, against the model's J_lq^T f (a few hundred eps, as tests/test_physical_model.py); the
+    regressor has no reflected-mass column, so the legs here have none."""
+    from stewartid.model import regressor as reg
+
+    moving = electric(paper, reflected_mass=0.0)
+    q, qd, qdd = reg.random_states(moving, 20, seed=3)
+    J = leg_jacobian(moving, q)
+    expected = np.einsum("nji,nj->ni", J, inverse_dynamics(moving, q, qd, qdd))
+    found = reg.regressor(moving, q, qd, qdd) @ reg.standard_parameters(moving)
+    assert np.abs(found - expected).max() < 1e3 * EPS * np.abs(expected).max()
+    # the legs' friction is seen: without it the two differ
+    bare = reg.regressor(paper, q, qd, qdd) @ reg.standard_parameters(paper)
+    assert np.abs(bare - expected).max() > 1e3 * 1e3 * EPS * np.abs(expected).max()
