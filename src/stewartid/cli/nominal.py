@@ -49,7 +49,8 @@ def nominal(
              "within the stroke and gimbal limits.")] = None,
 ) -> None:
     """Nominal Mt and Bt of the linearised model at the neutral pose (paper frame), or Mt, Bt
-    and the gravity force G at the pose given with --pose."""
+    and the gravity force G at the pose given with --pose; with the reflected masses and the
+    viscous friction along the legs of an [actuator] section."""
     from stewartid.model.linearization import gravity_stiffness, nominal_matrices, nominal_terms
     from stewartid.platform import load_platform
 
@@ -74,8 +75,12 @@ def nominal(
     from stewartid.reports.terminal import print_matrix, print_vector
 
     where = "neutral pose" if q is None else f"pose {','.join(f'{v:g}' for v in q)}"
-    print_matrix(M, f"Mt ({description.name}, {where})")
-    print_matrix(B, f"Bt ({description.name}, {where})")
+    actuator = description.actuator
+    # what [actuator] adds, named in the titles only when it adds something
+    mass = f"; legs +{actuator.reflected_mass:g} kg" if actuator.reflected_mass else ""
+    damping = f"; legs +{actuator.viscous:g} N s/m" if actuator.viscous else ""
+    print_matrix(M, f"Mt ({description.name}, {where}{mass})")
+    print_matrix(B, f"Bt ({description.name}, {where}{damping})")
     if G is not None:
         print_vector(G, f"G ({description.name}, {where}; N, N m)")
     if gravity:

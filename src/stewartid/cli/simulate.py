@@ -129,6 +129,10 @@ def simulate(
     if engine == "mujoco" and actuator == "hydraulic":
         raise ConfigError("--actuator hydraulic: MuJoCo's legs are ideal force actuators; "
                           "leave --actuator out or use --engine ours.")
+    if actuator == "hydraulic" and description.actuator.kind == "electric":
+        raise ConfigError(f"--actuator hydraulic: platform '{description.name}' has electric legs "
+                          '([actuator] kind = "electric"), simulated as force sources; leave '
+                          "--actuator out.")
     # before the simulation, which takes a while; write_experiments checks again
     check_output_folder(out, force, is_experiment_file)
     for flag, value, constraint, unit in (

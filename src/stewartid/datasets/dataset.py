@@ -1,5 +1,5 @@
-"""Measured experiments in the interchange format (``t, x..rz, l1..l6, f1..f6``): reading,
-validation at the boundary, writing.
+"""Measured experiments in the interchange format (``t, x..rz, l1..l6, f1..f6``; the motor currents
+``i1..i6`` in place of ``f1..f6`` for electric legs): reading, validation at the boundary, writing.
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ from stewartid.datasets import plausibility as checks
 from stewartid.datasets.arrays import median
 from stewartid.datasets.columns import shown_value, to_numbers
 from stewartid.datasets.distinct import check_distinct_experiments, check_distinct_paths
-from stewartid.datasets.log_format import LogFormat, read_table
-from stewartid.errors import DataError, DataWarning, KinematicsError
+from stewartid.datasets.log_format import CURRENT_COLUMNS, LogFormat, read_table
+from stewartid.errors import ConfigError, DataError, DataWarning, KinematicsError
 from stewartid.files import write_bytes_atomic
 from stewartid.model.kinematics import forward_kinematics, leg_lengths
 from stewartid.platform import COORDINATES, Platform
@@ -178,9 +178,11 @@ def dataset_from_frame(frame: Mapping[str, np.ndarray] | pd.DataFrame,
     Parameters
     ----------
     frame : mapping of str to ndarray of shape (N,), or DataFrame
-        ``t``, ``f1..f6`` and ``x..rz`` or ``l1..l6``; extra columns ignored.
+        ``t``, ``f1..f6`` (or the motor currents ``i1..i6``, A) and ``x..rz`` or ``l1..l6``;
+        extra columns ignored.
     platform : Platform, optional
-        Needed when pose or lengths are missing.
+        Needed when pose or lengths are missing, and for currents: f = force_constant i with
+        ``[actuator] force_constant`` (N/A).
     name : str
     where : str, optional
         Source named in errors; ``name`` by default.
@@ -191,14 +193,22 @@ def dataset_from_frame(frame: Mapping[str, np.ndarray] | pd.DataFrame,
     ------
     DataError
         Missing columns, non-finite values, non-increasing time, too few samples.
+    ConfigError
+        Currents without a platform whose ``[actuator]`` has a force constant.
     """
     where = where or name
     present = set(frame.keys())
-    missing = [c for c in ("t", *FORCE_COLUMNS) if c not in present]
+    currents = (not all(c in present for c in FORCE_COLUMNS)
+                and all(c in present for c in CURRENT_COLUMNS))
+    force_constant = _force_constant(platform, where) if currents else None
+    force_columns = CURRENT_COLUMNS if currents else FORCE_COLUMNS
+    missing = [c for c in ("t", *force_columns) if c not in present]
     if missing:
-        raise DataError(f"{where}: missing required column(s) {', '.join(missing)}; expected "
-                        f"columns {', '.join(COLUMNS)} (other names or units: --columns, "
-                        "docs/logs.md).")
+        electric = platform is not None and platform.actuator.force_constant is not None
+        alternative = " (or the motor currents i1..i6, A)" if electric else ""
+        raise DataError(f"{where}: missing required column(s) {', '.join(missing)}{alternative}; "
+                        f"expected columns {', '.join(COLUMNS)} (other names or units: "
+                        "--columns, docs/logs.md).")
     has_pose = all(c in present for c in POSE_COLUMNS)
     has_lengths = all(c in present for c in LENGTH_COLUMNS)
     if not (has_pose or has_lengths):
@@ -206,7 +216,7 @@ def dataset_from_frame(frame: Mapping[str, np.ndarray] | pd.DataFrame,
         raise DataError(f"{where}: needs either the pose columns x, y, z, rx, ry, rz or the leg "
                         f"lengths l1..l6; missing {', '.join(lacking)}.")
     wanted = ["t", *(POSE_COLUMNS if has_pose else ()), *(LENGTH_COLUMNS if has_lengths else ()),
-              *FORCE_COLUMNS]
+              *force_columns]
     columns: dict[str, np.ndarray] = {}
     for c in wanted:
         column = np.asarray(frame[c])
@@ -225,7 +235,9 @@ def dataset_from_frame(frame: Mapping[str, np.ndarray] | pd.DataFrame,
             t, columns = _resample(t, columns, where)
         else:
             t = clock
-    forces = np.column_stack([columns[c] for c in FORCE_COLUMNS])
+    forces = np.column_stack([columns[c] for c in force_columns])
+    if force_constant is not None:
+        forces = force_constant * forces
     pose = np.column_stack([columns[c] for c in POSE_COLUMNS]) if has_pose else None
     lengths = np.column_stack([columns[c] for c in LENGTH_COLUMNS]) if has_lengths else None
     if platform is not None:
@@ -247,8 +259,28 @@ def dataset_from_frame(frame: Mapping[str, np.ndarray] | pd.DataFrame,
             lengths = leg_lengths(platform, pose)
     if platform is not None:
         checks.check_dataset(pose, lengths, forces, platform, where,
-                             both_logged=has_pose and has_lengths, carried=carried)
+                             both_logged=has_pose and has_lengths, carried=carried,
+                             currents=currents)
     return Dataset(t=t, pose=pose, lengths=lengths, forces=forces, name=name)
+
+
+def _force_constant(platform: Platform | None, where: str) -> float:
+    """[actuator] force_constant (N/A) that turns a log's currents into forces.
+
+    Raises
+    ------
+    ConfigError
+        No platform, or one without a force constant.
+    """
+    if platform is None:
+        raise ConfigError(f"{where}: the motor currents i1..i6 become leg forces through the "
+                          "force constant of the platform's [actuator]; pass platform=... "
+                          "(CLI: --platform).")
+    if platform.actuator.force_constant is None:
+        raise ConfigError(f"{where}: the log has motor currents i1..i6 but platform "
+                          f"'{platform.name}' has no force constant; add force_constant (N/A, "
+                          'leg force per motor current) and kind = "electric" to its [actuator].')
+    return platform.actuator.force_constant
 
 
 def _forward_kinematics_tracked(platform: Platform, lengths: np.ndarray, solve) -> np.ndarray:
@@ -291,7 +323,8 @@ def read_dataset(path: str | Path, platform: Platform | None = None,
     kind = _format_of(path, format)
     if not path.is_file():
         raise DataError(f"{path}: no such data file.")
-    frame = read_table(path, kind, log_format)
+    lead = platform.actuator.screw_lead if platform is not None else None
+    frame = read_table(path, kind, log_format, lead)
     return dataset_from_frame(frame, platform, name=path.stem, where=str(path),
                               carried=carried)
 

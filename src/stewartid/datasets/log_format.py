@@ -1,5 +1,6 @@
 """Controller logs into the interchange format: column mapping with units (``docs/logs.md``),
-delimiter and encoding detection, actuator forces f = pa * piston_area - pb * annulus_area.
+delimiter and encoding detection, actuator forces f = pa * piston_area - pb * annulus_area, leg
+lengths of electric legs from motor angles, l = length_at_zero_angle + screw_lead angle / (2 pi).
 """
 
 from __future__ import annotations
@@ -25,10 +26,15 @@ from stewartid.platform import COORDINATES
 
 #: Interchange columns a log format may map, in order, with the chamber pressures.
 PRESSURE_COLUMNS = tuple(f"pa{k}" for k in range(1, 7)) + tuple(f"pb{k}" for k in range(1, 7))
+#: Motor currents of electric legs (A): forces through [actuator] force_constant.
+CURRENT_COLUMNS = tuple(f"i{k}" for k in range(1, 7))
+#: Motor angles of electric legs (rad): leg lengths through [actuator] screw_lead.
+MOTOR_ANGLE_COLUMNS = tuple(f"motor{k}" for k in range(1, 7))
 _TIME, _POSITIONS, _ANGLES = ("t",), COORDINATES[:3], COORDINATES[3:]
 _LENGTHS = tuple(f"l{k}" for k in range(1, 7))
 _FORCES = tuple(f"f{k}" for k in range(1, 7))
-MAPPABLE = (*_TIME, *_POSITIONS, *_ANGLES, *_LENGTHS, *_FORCES, *PRESSURE_COLUMNS)
+MAPPABLE = (*_TIME, *_POSITIONS, *_ANGLES, *_LENGTHS, *_FORCES, *PRESSURE_COLUMNS,
+            *CURRENT_COLUMNS, *MOTOR_ANGLE_COLUMNS)
 
 #: Units understood for each quantity, as factors to SI (keys are matched case-insensitively).
 UNITS: dict[str, dict[str, float]] = {
@@ -37,15 +43,22 @@ UNITS: dict[str, dict[str, float]] = {
     "angle": {"rad": 1.0, "mrad": 1e-3, "deg": math.pi / 180.0},
     "force": {"n": 1.0, "kn": 1e3},
     "pressure": {"pa": 1.0, "kpa": 1e3, "mpa": 1e6, "bar": 1e5, "psi": 6894.757293168},
+    "current": {"a": 1.0, "ma": 1e-3},
+    "motor angle": {"rad": 1.0, "deg": math.pi / 180.0, "rev": 2.0 * math.pi},
 }
 _QUANTITY = {**dict.fromkeys(_TIME, "time"), **dict.fromkeys(_POSITIONS + _LENGTHS, "length"),
              **dict.fromkeys(_ANGLES, "angle"), **dict.fromkeys(_FORCES, "force"),
-             **dict.fromkeys(PRESSURE_COLUMNS, "pressure")}
+             **dict.fromkeys(PRESSURE_COLUMNS, "pressure"),
+             **dict.fromkeys(CURRENT_COLUMNS, "current"),
+             **dict.fromkeys(MOTOR_ANGLE_COLUMNS, "motor angle")}
 
 #: Keys of the ``[log]`` section (inline: the same names).
 LOG_KEYS = ("delimiter", "encoding", "decimal", "skip_rows")
 #: Keys of the ``[pressures]`` section (m^2).
 AREA_KEYS = ("piston_area", "annulus_area")
+#: Keys of the ``[motors]`` section: the leg length (m) at which a motor angle reads zero, one
+#: for all legs or six.
+MOTOR_KEYS = ("length_at_zero_angle",)
 DELIMITERS = (",", ";", "\t")
 
 
@@ -85,6 +98,8 @@ class LogFormat:
         Lines before the header.
     piston_area, annulus_area : float or None
         m^2, needed for pressures.
+    length_at_zero_angle : tuple of 6 floats or None
+        Leg lengths (m) at which the motor angles read zero, needed for motor angles.
     source : str
         Named in error messages.
     """
@@ -96,16 +111,28 @@ class LogFormat:
     skip_rows: int = 0
     piston_area: float | None = None
     annulus_area: float | None = None
+    length_at_zero_angle: tuple[float, ...] | None = None
     source: str = "--columns"
 
-    def to_interchange(self, columns: Columns, where: str) -> Columns:
+    def to_interchange(self, columns: Columns, where: str,
+                       screw_lead: float | None = None) -> Columns:
         """The log's ``columns`` with interchange names in SI units; unmapped columns unchanged,
-        ``f1..f6`` from pressures when there are no forces.
+        ``f1..f6`` from pressures when there are no forces, ``l1..l6`` from motor angles when
+        there are no leg lengths.
+
+        Parameters
+        ----------
+        columns : mapping of str to ndarray of shape (N,)
+        where : str
+            Named in messages.
+        screw_lead : float, optional
+            Leg travel per motor revolution (m, ``[actuator] screw_lead``), needed for motor angles.
 
         Raises
         ------
         DataError
-            A mapped column missing or not numeric, or pressures without areas.
+            A mapped column missing or not numeric, pressures without areas, motor angles
+            without a screw lead or a length at zero angle.
         """
         out = dict(columns)
         for target, source in self.columns.items():
@@ -130,6 +157,18 @@ class LogFormat:
             for k in range(1, 7):
                 out[f"f{k}"] = (to_numbers(out[f"pa{k}"]) * self.piston_area
                                 - to_numbers(out[f"pb{k}"]) * self.annulus_area)
+        if not all(c in out for c in _LENGTHS) and all(c in out for c in MOTOR_ANGLE_COLUMNS):
+            if screw_lead is None:
+                raise DataError(f"{where}: leg lengths from motor angles motor1..motor6 need "
+                                "the screw lead; add screw_lead (m per motor revolution) to "
+                                "[actuator] of the platform description (docs/logs.md).")
+            if self.length_at_zero_angle is None:
+                raise DataError(f"{where}: leg lengths from motor angles need "
+                                "length_at_zero_angle (m, the leg length where a motor angle "
+                                f"reads 0) in [motors] of {self.source} (docs/logs.md).")
+            for k, reference in enumerate(self.length_at_zero_angle, start=1):
+                out[f"l{k}"] = (reference + screw_lead / (2.0 * math.pi)
+                                * to_numbers(out[f"motor{k}"]))
         return out
 
 
@@ -197,20 +236,21 @@ def _column_source(target: str, value: Any, source: str, index: int | None) -> C
 
 
 def log_format_from_mapping(document: Mapping[str, Any], source: str) -> LogFormat:
-    """A :class:`LogFormat` from a parsed TOML document (``[log]``, ``[columns]``, ``[pressures]``).
+    """A :class:`LogFormat` from a parsed TOML document (``[log]``, ``[columns]``, ``[pressures]``,
+    ``[motors]``).
 
     Raises
     ------
     ConfigError
         Unknown section, key or unit, or a value of the wrong type.
     """
-    sections = {"log": LOG_KEYS, "columns": None, "pressures": AREA_KEYS}
+    sections = {"log": LOG_KEYS, "columns": None, "pressures": AREA_KEYS, "motors": MOTOR_KEYS}
     unknown = sorted(set(document) - set(sections))
     if unknown:
         raise ConfigError(f"{source}: unknown section [{unknown[0]}]; valid sections are "
-                          "[log], [columns], [pressures].")
+                          "[log], [columns], [pressures], [motors].")
     settings: dict[str, Any] = {}
-    for section, keys in (("log", LOG_KEYS), ("pressures", AREA_KEYS)):
+    for section, keys in (("log", LOG_KEYS), ("pressures", AREA_KEYS), ("motors", MOTOR_KEYS)):
         table = document.get(section, {})
         bad = sorted(set(table) - set(keys))
         if bad:
@@ -263,7 +303,24 @@ def _checked_settings(settings: dict[str, Any], source: str) -> dict[str, Any]:
                 raise ConfigError(f"{source}: {key} must be a cylinder area in m^2 between "
                                   f"1e-6 and 10; got {settings[key]!r} (mm^2 or cm^2?).")
             settings[key] = area
+    if settings.get("length_at_zero_angle") is not None:
+        settings["length_at_zero_angle"] = _lengths_at_zero_angle(
+            settings["length_at_zero_angle"], source)
     return settings
+
+
+def _lengths_at_zero_angle(value: Any, source: str) -> tuple[float, ...]:
+    """Six leg lengths (m) from one number or a list of six, each a leg length of 1 cm to 100 m."""
+    values = value if isinstance(value, list | tuple) else [value] * 6
+    try:
+        lengths = tuple(float(v) for v in values)
+    except (TypeError, ValueError):
+        lengths = ()
+    if len(lengths) != 6 or not all(0.01 <= v <= 100.0 for v in lengths):
+        raise ConfigError(f"{source}: length_at_zero_angle must be a leg length in m (0.01 to "
+                          "100), or a list of six, where each motor angle reads 0; got "
+                          f"{value!r} (mm?).")
+    return lengths
 
 
 def load_log_format(spec: str | Path) -> LogFormat:
@@ -282,13 +339,15 @@ def load_log_format(spec: str | Path) -> LogFormat:
             raise ConfigError(f"column mapping file {text!r} not found; give a TOML file "
                               "(docs/logs.md) or inline entries such as t=Time:ms.")
         return log_format_from_mapping(read_toml(path, "column mapping file"), str(path))
-    document: dict[str, dict[str, Any]] = {"log": {}, "columns": {}, "pressures": {}}
+    document: dict[str, dict[str, Any]] = {"log": {}, "columns": {}, "pressures": {},
+                                           "motors": {}}
     for entry in filter(None, (e.strip() for e in text.split(","))):
         key, equals, value = (part.strip() for part in entry.partition("="))
         if not equals:
             raise ConfigError(f"--columns: entry {entry!r} must read KEY=VALUE, e.g. t=Time:ms "
                               "or l1..l6=:mm.")
-        section = "log" if key in LOG_KEYS else "pressures" if key in AREA_KEYS else "columns"
+        section = ("log" if key in LOG_KEYS else "pressures" if key in AREA_KEYS
+                   else "motors" if key in MOTOR_KEYS else "columns")
         document[section][key] = value
     return log_format_from_mapping(document, "--columns")
 
@@ -331,7 +390,8 @@ def detect_delimiter(lines: list[str]) -> str:
 _DECIMAL_COMMA = re.compile(r"^\s*[+-]?\d+,\d+([eE][+-]?\d+)?\s*$")
 
 
-def read_table(path: Path, kind: str, log_format: LogFormat | None = None) -> Columns:
+def read_table(path: Path, kind: str, log_format: LogFormat | None = None,
+               screw_lead: float | None = None) -> Columns:
     """Read a CSV or Parquet log into interchange columns (N,) in SI units.
 
     Parameters
@@ -340,6 +400,8 @@ def read_table(path: Path, kind: str, log_format: LogFormat | None = None) -> Co
     kind : {'csv', 'parquet'}
     log_format : LogFormat, optional
         Detection and identity mapping otherwise.
+    screw_lead : float, optional
+        m per motor revolution, for motor angles (:meth:`LogFormat.to_interchange`).
 
     Raises
     ------
@@ -349,7 +411,8 @@ def read_table(path: Path, kind: str, log_format: LogFormat | None = None) -> Co
     log_format = log_format or LogFormat()
     where = str(path)
     if kind == "parquet":
-        return log_format.to_interchange(read_parquet_columns(str(path), where), where)
+        return log_format.to_interchange(read_parquet_columns(str(path), where), where,
+                                         screw_lead)
     try:
         text = decode_text(path.read_bytes(), where, log_format.encoding)
     except OSError as exc:
@@ -362,7 +425,7 @@ def read_table(path: Path, kind: str, log_format: LogFormat | None = None) -> Co
         decimal = "," if delimiter != "," and any(
             _DECIMAL_COMMA.match(f) for f in fields) else "."
     columns = read_csv_columns(text, where, delimiter, decimal, log_format.skip_rows)
-    return log_format.to_interchange(columns, where)
+    return log_format.to_interchange(columns, where, screw_lead)
 
 
 def _head_lines(text: str, count: int) -> list[str]:
@@ -376,6 +439,7 @@ def _head_lines(text: str, count: int) -> list[str]:
         size *= 4
 
 
-__all__ = ["MAPPABLE", "PRESSURE_COLUMNS", "UNITS", "ColumnSource", "LogFormat",
+__all__ = ["CURRENT_COLUMNS", "MAPPABLE", "MOTOR_ANGLE_COLUMNS", "MOTOR_KEYS", "PRESSURE_COLUMNS",
+           "UNITS", "ColumnSource", "LogFormat",
            "decode_text", "detect_delimiter", "load_log_format", "log_format_from_mapping",
            "read_table"]

@@ -195,16 +195,31 @@ def _leg_order(pose: np.ndarray, lengths: np.ndarray, platform: Platform, fits) 
             f"--columns {mapping}")
 
 
+#: The static balance's advice for logged forces, and for logged motor currents.
+_FORCE_HINTS = {"columns": "f1..f6", "kilo": "forces in kN? map them with --columns f1..f6=:kN",
+                "unplugged": "force channels unplugged or not logged",
+                "unit": "wrong platform file (--platform) or force unit (N)", "warning": ""}
+_CURRENT_HINTS = {"columns": "i1..i6",
+                  "kilo": "wrong force_constant in [actuator] (N/A) or current unit (A)",
+                  "unplugged": "current channels unplugged or not logged",
+                  "unit": "wrong force_constant in [actuator] or current unit (A)",
+                  "warning": ", or a wrong force_constant in [actuator]"}
+
+
 def check_static_balance(pose: np.ndarray, forces: np.ndarray, platform: Platform,
-                         where: str, carried: tuple[float, float] = CARRIED_WEIGHT) -> None:
+                         where: str, carried: tuple[float, float] = CARRIED_WEIGHT,
+                         currents: bool = False) -> None:
     """Mean actuator forces (N, 6), N, positive extends, must carry the implied weight: over whole
     periods the mean J_lq(q)^T f balances G(q); ``carried`` is the allowed range in multiples of
-    the file's weight (:data:`PHYSICAL_CARRIED_WEIGHT` for payload fits).
+    the file's weight (:data:`PHYSICAL_CARRIED_WEIGHT` for payload fits). ``currents``: the
+    forces are logged motor currents (A) times ``[actuator] force_constant``, and the messages
+    speak of the currents and of the force constant.
 
     Raises
     ------
     DataError
-        Forces near zero, in kN, of opposite sign, a dead channel, or weight outside ``carried``.
+        Forces near zero, in kN (currents in mA), of opposite sign, a dead channel, or weight
+        outside ``carried``.
 
     Warns
     -----
@@ -217,43 +232,54 @@ def check_static_balance(pose: np.ndarray, forces: np.ndarray, platform: Platfor
     generalized = np.einsum("nij,ni->nj", leg_jacobian, forces)
     weight = -float(np.mean(gravity[:, 2]))
     ratio = round(-float(np.mean(generalized[:, 2])) / weight, 6) + 0.0  # no "-0"
-    what = (f"{where}: the forces f1..f6 carry {ratio:.3g} times the weight of platform "
-            f"'{platform.name}' ({weight:.4g} N)")
+    if currents:
+        hints = _CURRENT_HINTS
+        constant = f"force_constant = {platform.actuator.force_constant:g} N/A in [actuator]"
+        what = (f"{where}: the currents i1..i6 carry {ratio:.3g} times the weight of platform "
+                f"'{platform.name}' ({weight:.4g} N) with its {constant}")
+    else:
+        hints = _FORCE_HINTS
+        what = (f"{where}: the forces f1..f6 carry {ratio:.3g} times the weight of platform "
+                f"'{platform.name}' ({weight:.4g} N)")
     if abs(ratio * 1000.0 - 1.0) <= BALANCE_ERROR:
-        raise DataError(f"{what}; forces in kN? map them with --columns f1..f6=:kN.")
+        raise DataError(f"{what}; {hints['kilo']}.")
+    if currents and abs(ratio / 1000.0 - 1.0) <= BALANCE_ERROR:
+        raise DataError(f"{what}; currents in mA? map them with --columns i1..i6=:mA.")
     if abs(ratio) < 0.02:
-        raise DataError(f"{what}; force channels unplugged or not logged?")
+        raise DataError(f"{what}; {hints['unplugged']}?")
     if abs(ratio + 1.0) <= BALANCE_ERROR:
-        raise DataError(f"{what}; positive must extend the leg: map f1..f6 with scale = -1 "
-                        "(docs/logs.md).")
+        raise DataError(f"{what}; positive must extend the leg: map {hints['columns']} with "
+                        "scale = -1 (docs/logs.md).")
     if not carried[0] <= ratio <= carried[1]:
-        raise DataError(f"{what}; wrong platform file (--platform) or force unit (N)?")
+        raise DataError(f"{what}; {hints['unit']}?")
     static = np.linalg.solve(np.transpose(leg_jacobian, (0, 2, 1)), gravity[..., None])[..., 0]
     shares = forces.mean(axis=0) / static.mean(axis=0) / ratio
     leg = int(np.argmax(np.abs(shares - 1.0)))
     if abs(shares[leg] - 1.0) > LEG_BALANCE_ERROR:
-        raise DataError(f"{where}: column f{leg + 1} carries {shares[leg]:.3g} times its static "
-                        "load, the other legs about their share; check that channel "
-                        "(unplugged, unit, sign).")
+        raise DataError(f"{where}: column {hints['columns'][0]}{leg + 1} carries "
+                        f"{shares[leg]:.3g} times its static load, the other legs about their "
+                        "share; check that channel (unplugged, unit, sign).")
     if carried == PHYSICAL_CARRIED_WEIGHT:
         return
     if ratio > 1.0 + BALANCE_WARNING:
         _warn(f"{what}: a payload missing from the platform file? `stewartid identify --model "
               "physical --payload` identifies it (docs/physical-model.md), or add its "
-              "[payload] section.")
+              f"[payload] section{hints['warning']}.")
     elif abs(ratio - 1.0) > BALANCE_WARNING:
-        _warn(f"{what}: a payload missing from the platform file (its [payload] section)?")
+        _warn(f"{what}: a payload missing from the platform file (its [payload] "
+              f"section){hints['warning']}?")
 
 
 def check_dataset(pose: np.ndarray, lengths: np.ndarray, forces: np.ndarray,
                   platform: Platform, where: str, both_logged: bool,
-                  carried: tuple[float, float] = CARRIED_WEIGHT) -> None:
+                  carried: tuple[float, float] = CARRIED_WEIGHT, currents: bool = False) -> None:
     """Consistency checks needing pose (m, rad), lengths (m) and forces (N) together, each (N, 6);
-    lengths must agree with the pose when ``both_logged``; ``carried`` as :func:`check_static_balance`.
+    lengths must agree with the pose when ``both_logged``; ``carried`` and ``currents`` as
+    :func:`check_static_balance`.
     """
     if both_logged:
         check_inverse_kinematics(pose, lengths, platform, where)
-    check_static_balance(pose, forces, platform, where, carried)
+    check_static_balance(pose, forces, platform, where, carried, currents)
 
 
 def check_identified(M: np.ndarray, B: np.ndarray, platform: Platform,

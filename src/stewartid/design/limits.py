@@ -50,26 +50,33 @@ class OperatingLimits:
 
 def resolve_limits(platform: Platform) -> OperatingLimits:
     """The platform's limits, missing ones from its other sections: stroke centred on the neutral
-    length, velocity from rated flow / piston area, force from the smaller stall force.
+    length, velocity from rated flow / piston area, force from the smaller stall force; for an
+    electric ``[actuator]``, velocity screw_speed x screw_lead and force peak_current x
+    force_constant when those are given.
 
     Raises
     ------
     ConfigError
         Neutral leg length outside [stroke_min, stroke_max].
     """
-    given, hydraulics = platform.limits, platform.hydraulics
+    given, hydraulics, actuator = platform.limits, platform.hydraulics, platform.actuator
     neutral = platform.neutral_leg_length
     f_min, f_max = force_limits(hydraulics)
+    velocity = hydraulics.valve_rated_flow / hydraulics.piston_area
+    force = min(abs(f_min), abs(f_max))
+    if actuator.kind == "electric":
+        if actuator.screw_speed is not None:  # [actuator] makes screw_lead given with it
+            velocity = actuator.screw_speed * actuator.screw_lead
+        if actuator.peak_current is not None:
+            force = actuator.peak_current * actuator.force_constant
     limits = OperatingLimits(
         stroke_min=(neutral - hydraulics.stroke / 2 if given.stroke_min is None
                     else given.stroke_min),
         stroke_max=(neutral + hydraulics.stroke / 2 if given.stroke_max is None
                     else given.stroke_max),
-        leg_velocity=(hydraulics.valve_rated_flow / hydraulics.piston_area
-                      if given.leg_velocity is None else given.leg_velocity),
+        leg_velocity=velocity if given.leg_velocity is None else given.leg_velocity,
         leg_acceleration=given.leg_acceleration,
-        actuator_force=(min(abs(f_min), abs(f_max)) if given.actuator_force is None
-                        else given.actuator_force),
+        actuator_force=force if given.actuator_force is None else given.actuator_force,
         gimbal_angle=given.gimbal_angle, neutral_length=neutral)
     if not limits.stroke_min < neutral < limits.stroke_max:
         raise ConfigError(

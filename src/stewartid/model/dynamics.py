@@ -1,6 +1,13 @@
 """Rigid-body dynamics with six two-part legs and joint friction (Kane's method, z down):
 M(q) q_ddot + h(q, q_dot) + G(q) + F(q, q_dot) = J_lq(q)^T f_a, f_a actuator forces (N,
 positive extends). Functions take q, q_dot, q_ddot of shape (6,) or (N, 6).
+
+The ``[actuator]`` section adds, per leg, a reflected mass m_r moving with the leg length (the
+rotor and screw of an electric leg) and friction along the leg. Its inertial force m_r l_ddot,
+with l_ddot = J_lq q_ddot + J_lq_dot q_dot, is in M (J_lq^T m_r J_lq) and in h; its weight is
+carried by the leg's housing, not by the actuator, so G is unchanged. The friction along the legs
+(viscous c l_dot, Coulomb Fc sign(l_dot), regularised as the joints') is in F. f_a is then the
+force the motor exerts (for an electric leg, force constant times current).
 """
 
 from __future__ import annotations
@@ -41,7 +48,9 @@ def _out(x: np.ndarray, single: bool) -> np.ndarray:
 
 
 def mass_matrix(platform: Platform, q: np.ndarray) -> np.ndarray:
-    """Mass matrix M(q), symmetric positive definite; shape (6, 6) or (N, 6, 6)."""
+    """Mass matrix M(q), symmetric positive definite, with the legs' reflected masses; shape (6, 6) or
+    (N, 6, 6).
+    """
     t = ModelTerms(platform, q)
     return _out(t.mass_matrix, t.single)
 
@@ -63,7 +72,9 @@ def friction_forces(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
     """Joint friction F(q, q_dot) as generalized forces (N, N m).
 
     Viscous on the 4 gimbal axes, Coulomb on all 5 axes of a leg, regularised as
-    Fc w / sqrt(w^2 + s^2), w the joint rate, s = ``coulomb_smoothing`` (rad/s).
+    Fc w / sqrt(w^2 + s^2), w the joint rate, s = ``coulomb_smoothing`` (rad/s); with an
+    ``[actuator]`` friction along the legs, J_lq^T (c l_dot + Fc l_dot / sqrt(l_dot^2 + s^2)),
+    s then in m/s.
     """
     t = ModelTerms(platform, q, q_dot)
     return _out(_joint_friction(platform, t, q_dot, coulomb_smoothing), t.single)
@@ -74,8 +85,12 @@ def _joint_friction(platform: Platform, terms: ModelTerms, q_dot: np.ndarray,
     from stewartid.model import compiled  # numba, started only when a model term is computed
 
     qd2, _ = as_batch(q_dot, "q_dot")
-    return compiled.batch_friction(platform.parameters(), terms.joint_jacobians, qd2,
-                                   float(coulomb_smoothing))
+    params = platform.parameters()
+    F = compiled.batch_friction(params, terms.joint_jacobians, qd2, float(coulomb_smoothing))
+    actuator = platform.actuator
+    if actuator.viscous != 0.0 or actuator.coulomb != 0.0:  # none: hydraulic results unchanged
+        F += compiled.batch_leg_friction(params, terms.leg_jacobian, qd2, float(coulomb_smoothing))
+    return F
 
 
 def inverse_dynamics(platform: Platform, q: np.ndarray, q_dot: np.ndarray, q_ddot: np.ndarray,
@@ -105,7 +120,9 @@ def forward_dynamics(platform: Platform, q: np.ndarray, q_dot: np.ndarray, force
 
 
 def kinetic_energy(platform: Platform, q: np.ndarray, q_dot: np.ndarray) -> np.ndarray:
-    """Kinetic energy 1/2 q_dot^T M(q) q_dot (J); shape () or (N,)."""
+    """Kinetic energy 1/2 q_dot^T M(q) q_dot (J), the reflected masses' 1/2 m_r l_dot^2 included;
+    shape () or (N,).
+    """
     t = ModelTerms(platform, q)
     qd2, _ = as_batch(q_dot, "q_dot")
     T = 0.5 * np.einsum("ni,nij,nj->n", qd2, t.mass_matrix, qd2)
@@ -113,7 +130,9 @@ def kinetic_energy(platform: Platform, q: np.ndarray, q_dot: np.ndarray) -> np.n
 
 
 def potential_energy(platform: Platform, q: np.ndarray) -> np.ndarray:
-    """Gravitational potential energy of platform, payload and leg parts (J): V = -g sum(m z_com)."""
+    """Gravitational potential energy of platform, payload and leg parts (J): V = -g sum(m z_com); the
+    reflected masses have none (their weight rests on the leg housings).
+    """
     q2, single = as_batch(q)
     legs = inverse_kinematics(platform, q2)
     i, body = platform.inertia, platform.moving_body

@@ -168,10 +168,13 @@ def model_terms(params, upper, base, q, qd, M, h, G, J_leg, J_joint, lengths):
     acl = np.empty(3)
     acu = np.empty(3)
     wd = np.empty(3)
+    reflected = params[layout.REFLECTED_MASS]
     for i in range(6):
-        lengths[i] = _leg_kinematics(params, R, q, qd, omega, upper[i], base[i], J_leg[i],
-                                     J_joint[i], Jcl, Jcu, Jw, acl, acu, wd)
+        lengths[i], leg_bias = _leg_kinematics(params, R, q, qd, omega, upper[i], base[i],
+                                               J_leg[i], J_joint[i], Jcl, Jcu, Jw, acl, acu, wd)
         _add_leg_inertia(params, Jcl, Jcu, Jw, acl, acu, wd, Mn, hn, Gn)
+        if reflected != 0.0:  # skipped at zero: hydraulic results stay bit for bit
+            _add_reflected_mass(reflected, J_leg[i], leg_bias, Mn, hn)
     _to_pose_coordinates(q, qd, E, Mn, hn, Gn, M, h, G, J_leg, J_joint)
 
 
@@ -217,7 +220,9 @@ def _body_terms(params, R, omega, Mn, hn, Gn):
 
 def _leg_kinematics(params, R, q, qd, omega, a, b, J_leg_row, J_joint_leg, Jcl, Jcu, Jw,
                     acl, acu, wd):
-    """One leg's J_leg row, joint and velocity Jacobians into the arguments; returns its length (m)."""
+    """One leg's J_leg row, joint and velocity Jacobians into the arguments; returns its length (m)
+    and the leg acceleration at zero twist rate, u . (omega x (omega x r)) + l |u_dot|^2 (m/s^2).
+    """
     d_u, d_l = params[layout.D_UPPER], params[layout.D_LOWER]
     r0, r1, r2, u0, u1, u2, l = leg_vector(R, q[0], q[1], q[2], a[0], a[1], a[2],
                                            b[0], b[1], b[2])
@@ -260,7 +265,7 @@ def _leg_kinematics(params, R, q, qd, omega, a, b, J_leg_row, J_joint_leg, Jcl, 
         rows = joint_rate_column(c, frame, u0, u1, u2, w0, w1, w2)
         for j in range(N_JOINTS):
             J_joint_leg[j, c] = rows[j]
-    return l
+    return l, ua + l * uu
 
 
 def _add_leg_inertia(params, Jcl, Jcu, Jw, acl, acu, wd, Mn, hn, Gn):
@@ -280,6 +285,18 @@ def _add_leg_inertia(params, Jcl, Jcu, Jw, acl, acu, wd, Mn, hn, Gn):
             s += m_l * Jcl[k, a] * acl[k] + m_u * Jcu[k, a] * acu[k] + I_leg * Jw[k, a] * wd[k]
         hn[a] += s
         Gn[a] -= leg_gravity(g, m_u, m_l, Jcl[2, a], Jcu[2, a])
+
+
+def _add_reflected_mass(mass, J_leg_row, leg_bias, Mn, hn):
+    """Add one leg's reflected mass m_r (kg), moving with the leg length, to ``Mn`` and ``hn``.
+
+    Its inertial force along the leg is m_r l_ddot, l_ddot = J_leg nu_dot + ``leg_bias``; its
+    weight is carried by the leg's housing, so it adds no gravity term.
+    """
+    for a in range(6):
+        for b in range(6):
+            Mn[a, b] += mass * J_leg_row[a] * J_leg_row[b]
+        hn[a] += mass * J_leg_row[a] * leg_bias
 
 
 def _to_pose_coordinates(q, qd, E, Mn, hn, Gn, M, h, G, J_leg, J_joint):
@@ -330,6 +347,20 @@ def joint_friction(params, J_joint, qd, smoothing):
     return F
 
 
+def leg_friction(params, J_leg, qd, smoothing):
+    """Generalized forces (N, N m) of the friction along the legs at one sample: J_lq^T (c l_dot +
+    Fc l_dot / sqrt(l_dot^2 + s^2)), the joints' law with the leg rate l_dot (m/s), s in m/s.
+    """
+    F = np.zeros(6)
+    viscous, coulomb = params[layout.LEG_VISCOUS], params[layout.LEG_COULOMB]
+    if viscous == 0.0 and coulomb == 0.0:
+        return F
+    for i in range(6):
+        rate = J_leg[i] @ qd
+        F += joint_friction_torque(rate, True, viscous, coulomb, smoothing) * J_leg[i]
+    return F
+
+
 def forward_dynamics_sample(params, upper, base, q, qd, forces, smoothing, friction):
     """qdd at one sample for actuator forces ``forces`` (N); friction on when ``friction``."""
     M = np.empty((6, 6))
@@ -342,6 +373,7 @@ def forward_dynamics_sample(params, upper, base, q, qd, forces, smoothing, frict
     rhs = Jl.T @ forces - h - G
     if friction:
         rhs -= joint_friction(params, Jj, qd, smoothing)
+        rhs -= leg_friction(params, Jl, qd, smoothing)
     return np.linalg.solve(M, rhs)
 
 
@@ -365,4 +397,13 @@ def batch_friction(params, J_joint, qd, smoothing):
     F = np.empty((n, 6))
     for k in range(n):
         F[k] = joint_friction(params, J_joint[k], qd[k], smoothing)
+    return F
+
+
+def batch_leg_friction(params, J_leg, qd, smoothing):
+    """leg_friction over samples."""
+    n = qd.shape[0]
+    F = np.empty((n, 6))
+    for k in range(n):
+        F[k] = leg_friction(params, J_leg[k], qd[k], smoothing)
     return F

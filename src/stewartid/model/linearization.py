@@ -1,5 +1,8 @@
 """Linearisation about a pose q0 (Zhang 2020, Tables 3-6): Mt q_ddot + Bt q_dot + G(q0) + K_G (q - q0)
 + Fc = J_lq^T f_a, with Mt = M(q0), Bt the viscous gimbal friction, K_G = dG/dq at q0.
+
+An ``[actuator]`` adds J_lq^T m_r J_lq to Mt (the reflected masses) and J_lq^T c J_lq to Bt (the
+viscous friction along the legs), J_lq at q0.
 """
 
 from __future__ import annotations
@@ -9,18 +12,27 @@ import numpy as np
 from stewartid.model.dynamics import ModelTerms
 from stewartid.model.joints import GIMBAL_AXES
 from stewartid.model.kernels import model_terms
-from stewartid.model.kinematics import joint_rate_jacobians
+from stewartid.model.kinematics import joint_rate_jacobians, leg_jacobian
 from stewartid.platform import Platform
 
 
 def viscous_matrix(platform: Platform, q: np.ndarray) -> np.ndarray:
-    """Bt(q) = c * sum_{legs, gimbal axes} J_j^T J_j; shape (6, 6) or (N, 6, 6)."""
-    return _viscous(platform, joint_rate_jacobians(platform, q))
+    """Bt(q) = c * sum_{legs, gimbal axes} J_j^T J_j + c_leg J_lq^T J_lq; shape (6, 6) or (N, 6, 6).
+
+    c (N m s/rad) from ``[friction] gimbal_viscous``, c_leg (N s/m) from ``[actuator] viscous``.
+    """
+    J_leg = leg_jacobian(platform, q) if platform.actuator.viscous != 0.0 else None
+    return _viscous(platform, joint_rate_jacobians(platform, q), J_leg)
 
 
-def _viscous(platform: Platform, joint_jacobians: np.ndarray) -> np.ndarray:
+def _viscous(platform: Platform, joint_jacobians: np.ndarray,
+             leg_jacobians: np.ndarray | None = None) -> np.ndarray:
     J = joint_jacobians[..., list(GIMBAL_AXES), :]
-    return platform.friction.gimbal_viscous * np.einsum("...lai,...laj->...ij", J, J)
+    B = platform.friction.gimbal_viscous * np.einsum("...lai,...laj->...ij", J, J)
+    c = platform.actuator.viscous
+    if c != 0.0:  # added only when present: hydraulic results stay bit for bit
+        B = B + c * np.einsum("...li,...lj->...ij", leg_jacobians, leg_jacobians)
+    return B
 
 
 def nominal_matrices(platform: Platform, pose: np.ndarray | None = None
@@ -36,9 +48,9 @@ def nominal_matrices(platform: Platform, pose: np.ndarray | None = None
     Returns
     -------
     Mt : ndarray, shape (6, 6)
-        The mass matrix at ``pose``: kg, kg m, kg m^2 blocks.
+        The mass matrix at ``pose``, the legs' reflected masses included: kg, kg m, kg m^2 blocks.
     Bt : ndarray, shape (6, 6)
-        N s/m, N s/rad, N m s/rad blocks.
+        N s/m, N s/rad, N m s/rad blocks; the gimbals' and the legs' viscous friction.
     """
     return nominal_terms(platform, pose)[:2]
 
@@ -52,7 +64,7 @@ def nominal_terms(platform: Platform, pose: np.ndarray | None = None
     # one pose: the kernel interpreted, which spares the command line numba's start
     model_terms(platform.parameters(), platform.upper_joints, platform.base_joints, q0,
                 np.zeros(6), M, h, G, J_leg, J_joint, lengths)
-    return M, _viscous(platform, J_joint), G
+    return M, _viscous(platform, J_joint, J_leg), G
 
 
 def linearisation_remainder(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
@@ -64,7 +76,7 @@ def linearisation_remainder(platform: Platform, q: np.ndarray, q_dot: np.ndarray
     """
     Mt, Bt = nominal_matrices(platform, pose)
     terms = ModelTerms(platform, q, q_dot)
-    viscous = _viscous(platform, terms.joint_jacobians)
+    viscous = _viscous(platform, terms.joint_jacobians, terms.leg_jacobian)
     return (np.einsum("nij,nj->ni", terms.mass_matrix - Mt, q_ddot) + terms.velocity_product
             + np.einsum("nij,nj->ni", viscous - Bt, q_dot))
 

@@ -53,7 +53,8 @@ def standard_parameters(platform: Platform) -> np.ndarray:
     """The standard parameters of a platform description, shape (N_STANDARD,).
 
     Moving body :attr:`~stewartid.platform.Platform.moving_body`, joint friction ``[friction]``
-    (viscous on gimbals only), zero actuator friction, offsets ``[sensors] force_bias``.
+    (viscous on gimbals only), friction along the legs ``[actuator]`` (zero when absent), offsets
+    ``[sensors] force_bias``. The regressor has no column for ``[actuator] reflected_mass``.
     """
     body, i, f = platform.moving_body, platform.inertia, platform.friction
     pi = np.zeros(N_STANDARD)
@@ -65,7 +66,9 @@ def standard_parameters(platform: Platform) -> np.ndarray:
               "J_u": i.upper_leg_inertia + i.upper_leg_mass * i.upper_leg_com ** 2,
               "J_l": i.lower_leg_inertia + i.lower_leg_mass * i.lower_leg_com ** 2,
               "viscous[lower_gimbal]": f.gimbal_viscous,
-              "viscous[upper_gimbal]": f.gimbal_viscous}
+              "viscous[upper_gimbal]": f.gimbal_viscous,
+              "viscous[actuator]": platform.actuator.viscous,
+              "coulomb[actuator]": platform.actuator.coulomb}
     for t in JOINT_TYPES:
         values[f"coulomb[{t}]"] = f.coulomb
     for name in OFFSET_PARAMETERS:

@@ -95,7 +95,10 @@ def build_mjcf(platform: Platform, *, integrator: str = "RK4",
     Cardan hinges (e1, e2), rod on a slide (qpos = l - l_0) driven by motor ``leg<k>`` (N, extending),
     end body on the upper hinges and the revolute. The platform is a free body, a payload a body fixed
     in it; each end takes ``END_MASS_FRACTION`` of the platform's mass. Gimbal damping; Coulomb as
-    ``frictionloss`` on the five hinges (a constraint, as stiff as the welds). The Cardan axes move with
+    ``frictionloss`` on the five hinges (a constraint, as stiff as the welds). An ``[actuator]``
+    gives each slide its reflected mass as ``armature`` (inertia of the joint's own coordinate,
+    without weight), its viscous friction as ``damping`` and its Coulomb friction as
+    ``frictionloss``. The Cardan axes move with
     their bodies, so joint friction differs from ours at the order of the gimbal deflection.
 
     Parameters
@@ -126,8 +129,9 @@ def build_mjcf(platform: Platform, *, integrator: str = "RK4",
     mass, com, full, end_mass, end_inertia = _platform_inertial(platform)
     lines = _world_lines(platform, integrator, timestep, mass, com, full)
     frames = leg_frames(platform)
+    slide = _slide_attributes(platform, tau, imp, coulomb)
     for k in range(6):
-        lines += _leg_lines(platform, k, frames[k], frictionloss, end_mass, end_inertia)
+        lines += _leg_lines(platform, k, frames[k], frictionloss, end_mass, end_inertia, slide)
     lines += ["  </worldbody>", *_closure_lines(tau, constraint_impedance), "</mujoco>", ""]
     return "\n".join(lines)
 
@@ -177,9 +181,23 @@ def _payload_lines(platform: Platform) -> list[str]:
     ]
 
 
+def _slide_attributes(platform: Platform, tau: float, impedance: str, coulomb: bool) -> str:
+    """MJCF attributes of a slide joint for the ``[actuator]``; none for one adding nothing."""
+    a = platform.actuator
+    attributes = ""
+    if a.reflected_mass > 0.0:
+        attributes += f' armature="{a.reflected_mass:.17g}"'
+    if a.viscous > 0.0:
+        attributes += f' damping="{a.viscous:.17g}"'
+    if coulomb and a.coulomb > 0.0:
+        attributes += (f' frictionloss="{a.coulomb:.17g}" solreffriction="{tau:.17g} 1" '
+                       f'solimpfriction="{impedance} {impedance} 0.001 0.5 2"')
+    return attributes
+
+
 def _leg_lines(platform: Platform, k: int, frame: np.ndarray, frictionloss: str,
-               end_mass: float, end_inertia: float) -> list[str]:
-    """MJCF of leg ``k``'s chain in its leg ``frame`` (3, 3)."""
+               end_mass: float, end_inertia: float, slide: str = "") -> list[str]:
+    """MJCF of leg ``k``'s chain in its leg ``frame`` (3, 3); ``slide`` the slide joint's attributes."""
     i = platform.inertia
     damping = platform.friction.gimbal_viscous
     l0 = platform.neutral_leg_length
@@ -202,7 +220,7 @@ def _leg_lines(platform: Platform, k: int, frame: np.ndarray, frictionloss: str,
         f'      <geom type="capsule" size="0.06" fromto="0 0 0 0 0 {0.55 * l0:.6g}" '
         'rgba="0.6 0.6 0.6 1"/>',
         f'      <body name="leg{n}_rod" pos="0 0 {l0:.17g}">',
-        f'        <joint name="leg{n}_slide" type="slide" axis="0 0 1"/>',
+        f'        <joint name="leg{n}_slide" type="slide" axis="0 0 1"{slide}/>',
         f'        <inertial pos="0 0 {-i.upper_leg_com:.17g}" '
         f'mass="{i.upper_leg_mass:.17g}" diaginertia="{upper_t:.17g} {upper_t:.17g} '
         f'{axial}"/>',

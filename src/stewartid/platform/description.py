@@ -18,6 +18,7 @@ from stewartid.fields import section_from_mapping, section_to_mapping
 from stewartid.files import read_toml
 from stewartid.model import parameters as layout
 from stewartid.platform.sections import (
+    Actuator,
     Controller,
     Friction,
     Geometry,
@@ -38,10 +39,13 @@ COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
 
 #: TOML sections of a platform description, in file order, with their dataclass.
 SECTIONS: dict[str, type] = {cls.section: cls for cls in (Geometry, Inertia, Payload, Friction,
-                                                          Hydraulics, Controller, Sensors, Limits)}
+                                                          Actuator, Hydraulics, Controller,
+                                                          Sensors, Limits)}
 #: Sections that must be present in every file; the others take their documented defaults.
 REQUIRED_SECTIONS = ("geometry", "inertia", "friction")
 # [payload] alone has no defaults: its absence means no payload (Platform.payload None).
+# [actuator] absent is a hydraulic leg with nothing along it, and is written as absent, so that
+# the descriptions (and the data files' meta.json) of hydraulic platforms stay as they were.
 
 
 class MovingBody(NamedTuple):
@@ -70,6 +74,9 @@ class Platform:
     ----------
     geometry, inertia, friction : Geometry, Inertia, Friction
         The required sections.
+    actuator : Actuator
+        Leg actuators: kind, reflected mass and friction along the legs, motor constants;
+        absent, a hydraulic leg adding nothing along the leg.
     hydraulics, controller, sensors : Hydraulics, Controller, Sensors
         Plant simulator settings; documented defaults when absent.
     limits : Limits
@@ -83,6 +90,7 @@ class Platform:
     geometry: Geometry
     inertia: Inertia
     friction: Friction
+    actuator: Actuator = dataclasses.field(default_factory=Actuator)
     hydraulics: Hydraulics = dataclasses.field(default_factory=Hydraulics)
     controller: Controller = dataclasses.field(default_factory=Controller)
     sensors: Sensors = dataclasses.field(default_factory=Sensors)
@@ -130,6 +138,14 @@ class Platform:
                                     - self.base_joints[0]))
 
     @property
+    def hydraulic_legs(self) -> bool:
+        """Whether the simulator drives the legs as valve-controlled cylinders: a hydraulic
+        ``[actuator]`` in ``[hydraulics] mode = "hydraulic"``. Otherwise each leg applies its demanded
+        force exactly, as an electric leg's current loop, far faster than the motion, does.
+        """
+        return self.actuator.kind == "hydraulic" and self.hydraulics.mode == "hydraulic"
+
+    @property
     def moving_body(self) -> MovingBody:
         """Platform and payload as one rigid body about the reference point (parallel-axis theorem); without
         a payload exactly the platform, centre of mass at the reference point, inertia diagonal.
@@ -156,6 +172,9 @@ class Platform:
         packed[layout.I_UPPER], packed[layout.I_LOWER] = i.upper_leg_inertia, i.lower_leg_inertia
         packed[layout.VISCOUS], packed[layout.COULOMB] = f.gimbal_viscous, f.coulomb
         packed[layout.GRAVITY] = GRAVITY
+        a = self.actuator
+        packed[layout.REFLECTED_MASS] = a.reflected_mass
+        packed[layout.LEG_VISCOUS], packed[layout.LEG_COULOMB] = a.viscous, a.coulomb
         return packed
 
     # -- construction and serialisation -----------------------------------------------------
@@ -186,9 +205,12 @@ class Platform:
         return dataclasses.replace(self, **updates)
 
     def to_dict(self) -> dict[str, Any]:
-        """All sections as plain dictionaries (JSON/TOML ready); an absent payload left out."""
+        """All sections as plain dictionaries (JSON/TOML ready); an absent payload and a default
+        [actuator] (hydraulic, nothing along the legs) left out.
+        """
         return {name: section_to_mapping(getattr(self, name)) for name in SECTIONS
-                if getattr(self, name) is not None}
+                if getattr(self, name) is not None
+                and not (name == "actuator" and self.actuator == Actuator())}
 
     def to_toml(self) -> str:
         """The description as TOML text that :func:`load_platform` reads back identically."""

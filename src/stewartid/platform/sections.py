@@ -24,6 +24,10 @@ from stewartid.fields import (
 
 #: Actuator models understood by [hydraulics] mode.
 ACTUATOR_MODES = ("hydraulic", "ideal")
+#: Kinds of leg actuator understood by [actuator] kind.
+ACTUATOR_KINDS = ("hydraulic", "electric")
+#: [actuator] keys that describe a servo motor and its ball screw: electric actuators only.
+ELECTRIC_KEYS = ("force_constant", "screw_lead", "peak_current", "screw_speed")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -152,6 +156,57 @@ class Friction(Section):
 
 
 @dataclasses.dataclass(frozen=True)
+class Actuator(Section):
+    """What each leg's actuator adds along the leg (all six alike): a reflected mass and friction.
+
+    An electric leg is a ball screw driven by a servo motor: its rotor and screw, turning at
+    2 pi / lead rad per metre of stroke, weigh J (2 pi / lead)^2 along the leg, and its force is
+    the motor current times a force constant (no force sensor). The defaults, a hydraulic leg with
+    nothing along it, leave the model of ``[inertia]`` and ``[friction]`` as it is.
+    """
+
+    section = "actuator"
+
+    kind: str = spec("-", "'hydraulic' ([hydraulics] applies) or 'electric' (servo motor and "
+                     "ball screw)", Options(ACTUATOR_KINDS), default="hydraulic")
+    reflected_mass: float = spec("kg", "mass seen along each leg by its rotating parts, "
+                                 "J (2 pi / screw_lead)^2 for a rotor and screw of inertia J",
+                                 nonnegative(0.0, 1e5), default=0.0)
+    viscous: float = spec("N s/m", "viscous friction along each leg (screw, nut, seals)",
+                          nonnegative(0.0, 1e8), default=0.0)
+    coulomb: float = spec("N", "Coulomb friction along each leg", nonnegative(0.0, 1e7),
+                          default=0.0)
+    force_constant: float | None = spec(
+        "N/A", "leg force per motor current, Kt 2 pi eta / screw_lead (electric; required)",
+        positive(1e-3, 1e7), default=None)
+    screw_lead: float | None = spec("m", "leg travel per motor revolution (electric)",
+                                    positive(1e-5, 1.0), default=None)
+    peak_current: float | None = spec("A", "largest motor current (electric; default: no "
+                                      "force limit from the motor)", positive(1e-3, 1e5),
+                                      default=None)
+    screw_speed: float | None = spec("rev/s", "largest motor speed (electric, with "
+                                     "screw_lead; default: no speed limit from the motor)",
+                                     positive(1e-3, 1e4), default=None)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.kind == "electric":
+            if self.force_constant is None:
+                raise ConfigError(
+                    '[actuator] kind = "electric" needs force_constant (N/A, the leg force per '
+                    "motor current, Kt 2 pi eta / screw_lead): the leg forces are computed "
+                    "from the currents; add it.")
+            if self.screw_speed is not None and self.screw_lead is None:
+                raise ConfigError(f"[actuator] screw_speed = {self.screw_speed} rev/s needs "
+                                  "screw_lead (m per revolution) to give a leg speed; add it.")
+            return
+        given = [key for key in ELECTRIC_KEYS if getattr(self, key) is not None]
+        if given:
+            raise ConfigError(f'[actuator] {given[0]} describes an electric actuator but kind '
+                              f'= "{self.kind}"; set kind = "electric" or remove {given[0]}.')
+
+
+@dataclasses.dataclass(frozen=True)
 class Hydraulics(Section):
     """Hydraulic actuators of the legs (all six alike): servo-valve, cylinder and oil.
 
@@ -259,7 +314,8 @@ class Limits(Section):
     """Operating limits an excitation must respect (``stewartid design``).
 
     Keys left out are derived by :func:`stewartid.design.limits.resolve_limits` from the stroke, the
-    rated valve flow and the cylinder's stall forces.
+    rated valve flow and the cylinder's stall forces, or, for an electric ``[actuator]``, from its
+    screw_speed and peak_current when given.
     """
 
     section = "limits"
@@ -268,13 +324,15 @@ class Limits(Section):
                                     "length - stroke / 2)", positive(0.01, 100.0), default=None)
     stroke_max: float | None = spec("m", "longest allowed leg length (default: neutral "
                                     "length + stroke / 2)", positive(0.01, 100.0), default=None)
-    leg_velocity: float | None = spec("m/s", "largest leg-length rate (default: rated valve "
+    leg_velocity: float | None = spec("m/s", "largest leg-length rate (default: screw_speed "
+                                      "screw_lead of an electric [actuator], else rated valve "
                                       "flow / piston area)", positive(1e-4, 100.0),
                                       default=None)
     leg_acceleration: float = spec("m/s^2", "largest leg-length acceleration",
                                    positive(1e-3, 1e4), default=5.0)
-    actuator_force: float | None = spec("N", "largest |actuator force| (default: the smaller "
-                                        "of the extending and retracting stall forces)",
+    actuator_force: float | None = spec("N", "largest |actuator force| (default: peak_current "
+                                        "force_constant of an electric [actuator], else the "
+                                        "smaller of the cylinder's stall forces)",
                                         positive(1.0, 1e9), default=None)
     gimbal_angle: float = spec("rad", "largest deflection of a leg from its neutral "
                                "direction, at either gimbal", positive(1e-3, math.pi / 2),
@@ -288,5 +346,6 @@ class Limits(Section):
                               f"stroke_max = {self.stroke_max} m.")
 
 
-__all__ = ["ACTUATOR_MODES", "TRIANGLE_SLACK", "Controller", "Friction", "Geometry", "Hydraulics",
-           "Inertia", "Limits", "Payload", "Sensors", "check_payload_inertia", "inertia_matrix"]
+__all__ = ["ACTUATOR_KINDS", "ACTUATOR_MODES", "ELECTRIC_KEYS", "TRIANGLE_SLACK", "Actuator",
+           "Controller", "Friction", "Geometry", "Hydraulics", "Inertia", "Limits", "Payload",
+           "Sensors", "check_payload_inertia", "inertia_matrix"]

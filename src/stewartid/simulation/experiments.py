@@ -149,7 +149,7 @@ def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: 
     hp = hydraulic_parameters(platform.hydraulics, platform.neutral_leg_length)
     cp = controller_parameters(platform)
     y0 = initial_state(platform, q_cmd[0], cmd_force[0], hp, cp)
-    hydraulic = platform.hydraulics.mode == "hydraulic"
+    hydraulic = platform.hydraulic_legs
     require_stable(loop_poles(y0, cmd_len[0], cmd_rate[0], cmd_force[0], params, upper, base,
                               hp, cp, hydraulic, float(coulomb_smoothing)),
                    platform, excitation.name)

@@ -113,6 +113,13 @@ def rhs(y, dy, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, hyd
             tau = compiled.joint_friction_torque(w, j < N_GIMBAL_AXES, viscous, coulomb, smoothing)
             for c in range(6):
                 work[c] -= tau * Jj[i, j, c]
+    leg_viscous = params[layout.LEG_VISCOUS]
+    leg_coulomb = params[layout.LEG_COULOMB]
+    if leg_viscous != 0.0 or leg_coulomb != 0.0:  # friction along the legs ([actuator])
+        for i in range(6):
+            f = compiled.joint_friction_torque(rates[i], True, leg_viscous, leg_coulomb, smoothing)
+            for c in range(6):
+                work[c] -= f * J[i, c]
     _solve_spd(M, work, chol, qdd)
     for c in range(6):
         dy[S_Q + c] = qd[c]

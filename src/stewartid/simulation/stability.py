@@ -28,7 +28,7 @@ def initial_state(platform: Platform, q0: np.ndarray, feedforward_force: np.ndar
     f0 = np.linalg.solve(J.T, G)
     y = np.zeros(plant.N_STATES)
     y[plant.S_Q:plant.S_Q + 6] = q0
-    hydraulic = platform.hydraulics.mode == "hydraulic"
+    hydraulic = platform.hydraulic_legs
     demand = f0.copy()
     for i in range(6):
         if hydraulic:
@@ -79,7 +79,7 @@ def closed_loop_poles(platform: Platform, pose: np.ndarray | None = None) -> np.
     cp = controller_parameters(platform)
     y0 = initial_state(platform, q0[0], cmd_force[0], hp, cp)
     poles = loop_poles(y0, cmd_len[0], cmd_rate[0], cmd_force[0], params, upper, base, hp, cp,
-                       platform.hydraulics.mode == "hydraulic")
+                       platform.hydraulic_legs)
     return poles[np.argsort(-poles.real)]
 
 
