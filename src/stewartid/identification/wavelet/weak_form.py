@@ -165,12 +165,17 @@ def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: boo
     Soft sign w / sqrt(w^2 + sigma^2 + r^2) of ``found.sign_rates`` at every transition rate r of
     ``rates``, rad/s. Samples lead, so that an interval's rows are one contiguous slice.
     """
-    signs, noise = found.sign_rates, found.sign_rate_noise
+    from stewartid.identification.wavelet._compiled import soft_sign_patterns
+
+    types = np.zeros(5, dtype=np.int64)
+    if not uniform:
+        for index, axes in enumerate(JOINT_TYPES.values()):
+            types[list(axes)] = index
     rates = np.asarray(rates, dtype=float)
-    out = np.empty((len(signs), len(rates), 1 if uniform else len(JOINT_TYPES), 6))
-    for k, r in enumerate(rates):
-        direction = signs / np.sqrt(signs ** 2 + noise ** 2 + r ** 2)          # (N, 6, 5)
-        out[:, k] = _by_type(np.einsum("nla,nlac->nac", direction, joint_jacobians), uniform)
+    out = np.zeros((len(found.sign_rates), len(rates), 1 if uniform else len(JOINT_TYPES), 6))
+    soft_sign_patterns(np.ascontiguousarray(found.sign_rates),
+                       np.ascontiguousarray(found.sign_rate_noise),
+                       np.ascontiguousarray(joint_jacobians), rates, types, out)
     return out
 
 
