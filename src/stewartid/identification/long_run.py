@@ -5,7 +5,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-import scipy.ndimage
 
 
 def with_variances(covariance: np.ndarray, variances: np.ndarray) -> np.ndarray:
@@ -61,7 +60,9 @@ def filtered_noise_covariance(X: np.ndarray, weights: np.ndarray,
         # sum_j rho(|k - j|) Z_j: one symmetric convolution along the rows, zero outside
         near = rho[:rows]
         taps = np.concatenate([near[:0:-1], near])
-        smeared = scipy.ndimage.convolve1d(part, taps, axis=0, mode="constant")
+        from scipy.ndimage import convolve1d  # slow to import: only these scores need it
+
+        smeared = convolve1d(part, taps, axis=0, mode="constant")
         B += np.einsum("kcp,cd,kdq->pq", part, S, smeared, optimize=True)
     return B
 
