@@ -68,11 +68,18 @@ def coulomb_regressors(joint_jacobians: np.ndarray, q_dot: np.ndarray, smoothing
     return out
 
 
+#: Filtered rows kept per filter window by default (``decimate``): fewer change the estimates by
+#: a fraction of their standard errors (docs/benchmarks.md), more only cost time and memory.
+ROWS_PER_WINDOW = 40
+
+
 class _Rows(NamedTuple):
-    """One experiment's rows: times, support, force, rates (K, 6), Coulomb regressors, pose-noise Gram."""
+    """One experiment's rows: times, support, decimation, force, rates (K, 6), Coulomb regressors,
+    pose-noise Gram."""
 
     t: np.ndarray
     window: float
+    decimate: int
     y: np.ndarray
     q_dot: np.ndarray
     q_ddot: np.ndarray
@@ -112,8 +119,9 @@ class LeastSquaresIdentifier(BaseIdentifier):
         Impose Mt = Mt^T, Bt = Bt^T.
     differentiation : {'kernel', 'savgol'}
         Filter both sides with a smooth kernel, or differentiate with Savitzky-Golay.
-    decimate : int
-        Use every ``decimate``-th sample.
+    decimate : int, optional
+        Keep every ``decimate``-th filtered row; default: :data:`ROWS_PER_WINDOW` rows per filter
+        window (the filtered rows are smooth over the window: more of them add no information).
     noise_correction : bool
         Remove the errors-in-variables bias of pose noise (kernel only).
 
@@ -131,7 +139,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
 
     def __init__(self, window: float | None = None, order: int = DEFAULT_ORDER,
                  gravity: bool = True, coulomb: bool = True, coulomb_smoothing: float = 1e-4,
-                 coulomb_shape: str = "average", symmetric: bool = False, decimate: int = 1,
+                 coulomb_shape: str = "average", symmetric: bool = False, decimate: int | None = None,
                  differentiation: str = "kernel", noise_correction: bool = True,
                  remainder: bool = True, sampling_check: bool = True):
         self.window = window
@@ -152,7 +160,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
         "coulomb_smoothing": [nonnegative()],
         "coulomb_shape": [Options(("average", *COULOMB_SHAPES))],
         "differentiation": [Options(("kernel", "savgol"))],
-        "decimate": [Interval(Integral, 1, None)],
+        "decimate": [Interval(Integral, 1, None), None],
         "noise_correction": [BOOLEAN],
         "sampling_check": [BOOLEAN],
     }
@@ -160,14 +168,15 @@ class LeastSquaresIdentifier(BaseIdentifier):
     def _experiment_rows(self, exp: Experiment, shapes: tuple[str, ...]) -> _Rows:
         """One prepared experiment's rows."""
         window = self.window or default_window(estimate_frequency(exp.q, exp.sample_rate))
+        decimate = self.decimate or max(1, int(window * exp.sample_rate) // ROWS_PER_WINDOW)
         if self.differentiation == "savgol":
             _, qd, qdd = differentiate(exp.q, exp.sample_rate, window, self.order)
             cut = trim(window, exp.sample_rate, self.order)
-            sl = slice(cut, len(exp.t) - cut, self.decimate)
+            sl = slice(cut, len(exp.t) - cut, decimate)
             coulomb = [coulomb_regressors(exp.joint_jacobians[sl], qd[sl], self.coulomb_smoothing,
                                           shape) for shape in shapes]
-            return _Rows(exp.t[sl], window, exp.generalized_force[sl], qd[sl], qdd[sl], coulomb,
-                         None)
+            return _Rows(exp.t[sl], window, decimate, exp.generalized_force[sl], qd[sl],
+                         qdd[sl], coulomb, None)
         # the Coulomb signs need the rates at every sample, from a window the noise allows
         # (the physical model's rule), so that they do not chatter
         qd_sign = measured_sign_rates(exp.q, exp.sample_rate, window)
@@ -178,14 +187,14 @@ class LeastSquaresIdentifier(BaseIdentifier):
         filtered = kernel_filter(signals, exp.sample_rate, window)[0]
         _, qd, qdd = kernel_filter(exp.q, exp.sample_rate, window, derivatives=2)
         cut = (len(exp.t) - len(qd)) // 2
-        sl = slice(cut, len(exp.t) - cut, self.decimate)
-        step = slice(None, None, self.decimate)
+        sl = slice(cut, len(exp.t) - cut, decimate)
+        step = slice(None, None, decimate)
         y = filtered[step, :6]
         coulomb = [filtered[step, 6 + 18 * k:24 + 18 * k].reshape(len(y), -1, 6)
                    for k in range(len(units))]
         noise = (pose_noise_gram(exp.q, exp.sample_rate, window) if self.noise_correction
                  else None)
-        return _Rows(exp.t[sl], window, y, qd[step], qdd[step], coulomb, noise)
+        return _Rows(exp.t[sl], window, decimate, y, qd[step], qdd[step], coulomb, noise)
 
     def _fit(self, datasets: list[Dataset], platform: Platform
              ) -> tuple[IdentificationResult, dict]:
@@ -208,8 +217,9 @@ class LeastSquaresIdentifier(BaseIdentifier):
             if rows.noise is not None:
                 noise.append((k, rows.noise))
             # the filters' support: rows further apart share no noise sample
-            segments.append((k, math.ceil(rows.window * exp.sample_rate / self.decimate) + 1))
-            used.append({"name": exp.name, "window_s": rows.window, "samples": k,
+            segments.append((k, math.ceil(rows.window * exp.sample_rate / rows.decimate) + 1))
+            used.append({"name": exp.name, "window_s": rows.window, "decimate": rows.decimate,
+                         "samples": k,
                          "t_start": float(rows.t[0]), "t_stop": float(rows.t[-1])})
         names = regressor_names("q_ddot", "q_dot") + [f"offset[{x.name}]" for x in experiments]
         regressor_noise = None
@@ -249,4 +259,4 @@ class LeastSquaresIdentifier(BaseIdentifier):
             "coulomb_shape_weights_": shape_weights}
 
 
-__all__ = ["LeastSquaresIdentifier", "coulomb_regressors"]
+__all__ = ["ROWS_PER_WINDOW", "LeastSquaresIdentifier", "coulomb_regressors"]

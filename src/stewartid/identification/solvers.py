@@ -170,10 +170,13 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
     gram = phi.T @ phi                                    # (p, p)
     if regressor_noise is not None:
         gram = gram - np.asarray(regressor_noise, dtype=float)
-    cross = np.einsum("kj,ksi->ijs", phi, S)              # (6, p, s)
-    shared_gram = np.einsum("ksi,kti->ist", S, S)         # (6, s, s)
-    rhs_theta = phi.T @ y                                 # (p, 6)
-    rhs_shared = np.einsum("ksi,ki->is", S, y)            # (6, s)
+    # matrix products over the K rows (BLAS), not einsum loops
+    flat = S.reshape(K, s * 6)
+    cross = (phi.T @ flat).reshape(p, s, 6).transpose(2, 0, 1)             # (6, p, s)
+    products = (flat.T @ flat).reshape(s, 6, s, 6)
+    shared_gram = np.stack([products[:, i, :, i] for i in range(6)])       # (6, s, s)
+    rhs_theta = phi.T @ y                                                  # (p, 6)
+    rhs_shared = np.stack([S[:, :, i].T @ y[:, i] for i in range(6)])      # (6, s)
 
     def assemble(weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         n_full = 6 * p
@@ -204,7 +207,7 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
         full = Tf @ z
         theta = full[:6 * p].reshape(6, p)
         c = full[6 * p:]
-        residual = y - phi @ theta.T - np.einsum("ksi,s->ki", S, c)
+        residual = y - phi @ theta.T - c @ S
         return theta, c, residual, N, Tf, condition, scale
 
     scale_y = np.sqrt(np.mean(y ** 2, axis=0))
@@ -233,8 +236,10 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
 def _row_scores(phi: np.ndarray, S: np.ndarray, weighted: np.ndarray) -> np.ndarray:
     """Per row, the gradient of its weighted squared residual (K, 6 p + s); ``weighted`` = r / sigma^2."""
     K, p = phi.shape
-    per_channel = (phi[:, None, :] * weighted[:, :, None]).reshape(K, 6 * p)
-    return np.concatenate([per_channel, np.einsum("ksi,ki->ks", S, weighted)], axis=1)
+    scores = np.empty((K, 6 * p + S.shape[1]))
+    np.multiply(phi[:, None, :], weighted[:, :, None], out=scores[:, :6 * p].reshape(K, 6, p))
+    np.matmul(S, weighted[:, :, None], out=scores[:, 6 * p:, None])
+    return scores
 
 
 def integrated_autocorrelation(x: np.ndarray, max_lag: int | None = None) -> float:
