@@ -60,12 +60,15 @@ def coulomb_regressors(joint_jacobians: np.ndarray, q_dot: np.ndarray, smoothing
     ``joint_jacobians`` (N, 6, 5, 6); ``smoothing`` s, rad/s, and ``shape`` as
     :func:`~stewartid.identification.friction_shape.shaped_sign`.
     """
-    rates = np.einsum("nlac,nc->nla", joint_jacobians, q_dot)
-    signs = shaped_sign(rates, smoothing, shape)
-    out = np.empty((len(q_dot), len(JOINT_TYPES), 6))
+    from stewartid.model import compiled  # numba, which the model remainder loads anyway
+
+    jacobians = np.ascontiguousarray(joint_jacobians)
+    signs = shaped_sign(compiled.batch_joint_rates(jacobians, np.ascontiguousarray(q_dot)),
+                        smoothing, shape)
+    types = np.zeros(5, dtype=np.int64)
     for k, axes in enumerate(JOINT_TYPES.values()):
-        out[:, k] = np.einsum("nla,nlac->nc", signs[:, :, axes], joint_jacobians[:, :, axes])
-    return out
+        types[list(axes)] = k
+    return compiled.batch_typed_forces(signs, jacobians, types, len(JOINT_TYPES))
 
 
 #: Filtered rows kept per filter window by default (``decimate``): fewer change the estimates by
