@@ -426,7 +426,7 @@ def test_simulate_refuses_hydraulic_cylinders_for_electric_legs(tmp_path, paper)
 def test_regressor_takes_the_friction_along_the_legs(paper):
     """Y pi of the physical model's regressor, whose actuator columns are the friction along the
     legs, against the model's J_lq^T f (a few hundred eps, as tests/test_physical_model.py); the
-    regressor has no reflected-mass column, so the legs here have none."""
+    reflected mass's column is tested in tests/test_electric_identification.py."""
     from stewartid.model import regressor as reg
 
     moving = electric(paper, reflected_mass=0.0)

@@ -1,7 +1,9 @@
 """Time-domain least squares with Coulomb friction: the inverse-dynamics model of robotics.
 
 y = Mt q_ddot + Bt q_dot + c_e + sum_types Fc_type S_type, S_type = sum J_j^T sign(J_j q_dot)
-(Khalil and Dombre 2002, ch. 12).
+(Khalil and Dombre 2002, ch. 12); with friction along the legs (an electric leg's screw and
+nut) one more level Fc_leg S_leg, S_leg = sum_legs J_l^T sign(J_l q_dot), J_l a row of J_lq.
+The viscous friction along the legs, J_lq^T c J_lq q_dot, is part of Bt.
 """
 
 from __future__ import annotations
@@ -76,6 +78,25 @@ def coulomb_regressors(joint_jacobians: np.ndarray, q_dot: np.ndarray, smoothing
 ROWS_PER_WINDOW = 40
 
 
+def leg_coulomb_regressor(leg_jacobian: np.ndarray, q_dot: np.ndarray, smoothing: float,
+                          shape: str = "algebraic") -> np.ndarray:
+    """Generalized force per newton of Coulomb friction along every leg, S_leg (N, 1, 6).
+
+    S_leg = sum_legs J_l^T sign(J_l q_dot), J_l (N, 6, 6) the rows of the leg Jacobian
+    ``leg_jacobian``; ``smoothing`` s in m/s of leg rate, ``shape`` as
+    :func:`~stewartid.identification.friction_shape.shaped_sign`.
+    """
+    rates = np.einsum("nlc,nc->nl", leg_jacobian, q_dot)
+    return np.einsum("nl,nlc->nc", shaped_sign(rates, smoothing, shape), leg_jacobian)[:, None]
+
+
+def uses_leg_coulomb(setting: bool | None, platform: Platform) -> bool:
+    """Whether to fit the Coulomb friction along the legs: ``setting``, or when None, for an
+    electric ``[actuator]`` (a ball screw's friction is of the order of its inertial force;
+    a hydraulic cylinder's seals are in its measured pressures' force)."""
+    return platform.actuator.kind == "electric" if setting is None else bool(setting)
+
+
 class _Rows(NamedTuple):
     """One experiment's rows: times, support, decimation, force, rates (K, 6), Coulomb regressors,
     pose-noise Gram."""
@@ -114,8 +135,11 @@ class LeastSquaresIdentifier(BaseIdentifier):
         Widen standard errors where the log's sampling limits them.
     coulomb : bool
         Include the three Coulomb regressors.
+    leg_coulomb : bool, optional
+        With ``coulomb``, also the Coulomb friction along the legs (one level for the six
+        identical legs, N); default: when ``[actuator] kind`` is electric.
     coulomb_smoothing : float
-        Rate, rad/s, below which a Coulomb sign is attenuated.
+        Rate below which a Coulomb sign is attenuated: rad/s of a joint, m/s of a leg.
     coulomb_shape : {'average', 'algebraic', 'erf'}
         Sign shape, or the Akaike-weighted average of both (default).
     symmetric : bool
@@ -134,6 +158,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
     std_errors_ : dict of ndarray (6, 6)
     coulomb_, coulomb_std_ : dict
         Coulomb level per joint type and its standard error, N m.
+    leg_coulomb_, leg_coulomb_std_ : float
+        Coulomb friction along each leg and its standard error, N; NaN when not fitted.
     coulomb_shape_weights_ : dict
     offsets_ : ndarray, shape (n_experiments, 6)
     condition_number_ : float
@@ -141,8 +167,10 @@ class LeastSquaresIdentifier(BaseIdentifier):
     """
 
     def __init__(self, window: float | None = None, order: int = DEFAULT_ORDER,
-                 gravity: bool = True, coulomb: bool = True, coulomb_smoothing: float = 1e-4,
-                 coulomb_shape: str = "average", symmetric: bool = False, decimate: int | None = None,
+                 gravity: bool = True, coulomb: bool = True, leg_coulomb: bool | None = None,
+                 coulomb_smoothing: float = 1e-4,
+                 coulomb_shape: str = "average", symmetric: bool = False,
+                 decimate: int | None = None,
                  differentiation: str = "kernel", noise_correction: bool = True,
                  remainder: bool = True, sampling_check: bool = True):
         self.window = window
@@ -150,6 +178,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
         self.gravity = gravity
         self.remainder = remainder
         self.coulomb = coulomb
+        self.leg_coulomb = leg_coulomb
         self.coulomb_smoothing = coulomb_smoothing
         self.coulomb_shape = coulomb_shape
         self.symmetric = symmetric
@@ -160,6 +189,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
 
     _parameter_constraints = {
         **DIFFERENTIATION_CONSTRAINTS,
+        "leg_coulomb": [BOOLEAN, None],
         "coulomb_smoothing": [nonnegative()],
         "coulomb_shape": [Options(("average", *COULOMB_SHAPES))],
         "differentiation": [Options(("kernel", "savgol"))],
@@ -168,23 +198,31 @@ class LeastSquaresIdentifier(BaseIdentifier):
         "sampling_check": [BOOLEAN],
     }
 
-    def _experiment_rows(self, exp: Experiment, shapes: tuple[str, ...]) -> _Rows:
-        """One prepared experiment's rows."""
+    def _coulomb_units(self, exp: Experiment, rows: slice, q_dot: np.ndarray, shape: str,
+                       legs: bool) -> np.ndarray:
+        """Coulomb regressors (K, 3 or 4, 6) of ``rows`` of an experiment, signs of ``q_dot``."""
+        units = coulomb_regressors(exp.joint_jacobians[rows], q_dot, self.coulomb_smoothing,
+                                   shape)
+        if not legs:
+            return units
+        return np.concatenate([units, leg_coulomb_regressor(
+            exp.leg_jacobian[rows], q_dot, self.coulomb_smoothing, shape)], axis=1)
+
+    def _experiment_rows(self, exp: Experiment, shapes: tuple[str, ...], legs: bool) -> _Rows:
+        """One prepared experiment's rows; ``legs`` adds the legs' Coulomb regressor."""
         window = self.window or default_window(estimate_frequency(exp.q, exp.sample_rate))
         decimate = self.decimate or max(1, int(window * exp.sample_rate) // ROWS_PER_WINDOW)
         if self.differentiation == "savgol":
             _, qd, qdd = differentiate(exp.q, exp.sample_rate, window, self.order)
             cut = trim(window, exp.sample_rate, self.order)
             sl = slice(cut, len(exp.t) - cut, decimate)
-            coulomb = [coulomb_regressors(exp.joint_jacobians[sl], qd[sl], self.coulomb_smoothing,
-                                          shape) for shape in shapes]
+            coulomb = [self._coulomb_units(exp, sl, qd[sl], shape, legs) for shape in shapes]
             return _Rows(exp.t[sl], window, decimate, exp.generalized_force[sl], qd[sl],
                          qdd[sl], coulomb, None)
         # the Coulomb signs need the rates at every sample, from a window the noise allows
         # (the physical model's rule), so that they do not chatter
         qd_sign = measured_sign_rates(exp.q, exp.sample_rate, window)
-        units = [coulomb_regressors(exp.joint_jacobians, qd_sign, self.coulomb_smoothing, shape)
-                 for shape in shapes]
+        units = [self._coulomb_units(exp, slice(None), qd_sign, shape, legs) for shape in shapes]
         signals = np.concatenate(
             [exp.generalized_force] + [u.reshape(len(u), -1) for u in units], axis=1)
         filtered = kernel_filter(signals, exp.sample_rate, window)[0]
@@ -193,7 +231,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
         sl = slice(cut, len(exp.t) - cut, decimate)
         step = slice(None, None, decimate)
         y = filtered[step, :6]
-        coulomb = [filtered[step, 6 + 18 * k:24 + 18 * k].reshape(len(y), -1, 6)
+        width = 6 * (len(JOINT_TYPES) + legs)
+        coulomb = [filtered[step, 6 + width * k:6 + width * (k + 1)].reshape(len(y), -1, 6)
                    for k in range(len(units))]
         noise = (pose_noise_gram(exp.q, exp.sample_rate, window) if self.noise_correction
                  else None)
@@ -206,10 +245,11 @@ class LeastSquaresIdentifier(BaseIdentifier):
         n_exp = len(experiments)
         shapes = (() if not self.coulomb else COULOMB_SHAPES if self.coulomb_shape == "average"
                   else (self.coulomb_shape,))
+        legs = bool(shapes) and uses_leg_coulomb(self.leg_coulomb, platform)
         shared: list[list[np.ndarray]] = [[] for _ in shapes]
         phis, ys, used, noise, segments = [], [], [], [], []
         for e, exp in enumerate(experiments):
-            rows = self._experiment_rows(exp, shapes)
+            rows = self._experiment_rows(exp, shapes, legs)
             k = len(rows.y)
             offsets = np.zeros((k, n_exp))
             offsets[:, e] = 1.0
@@ -234,7 +274,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
         solutions = [solve_least_squares(
             phi, y, None if per_shape is None else np.concatenate(per_shape),
             symmetric=self.symmetric, regressor_names=names,
-            shared_names=[f"coulomb[{t}]" for t in JOINT_TYPES] if shapes else None,
+            shared_names=([f"coulomb[{t}]" for t in JOINT_TYPES] + ["coulomb[actuator]"] * legs
+                          if shapes else None),
             autocorrelated=True, regressor_noise=regressor_noise, segments=segments)
             for per_shape in (shared or [None])]
         weights = akaike_weights(solutions)
@@ -249,8 +290,12 @@ class LeastSquaresIdentifier(BaseIdentifier):
         offsets = theta[:, 12:].T.copy()
         levels = dict(zip(JOINT_TYPES, solution.shared.tolist(), strict=False))
         levels_std = dict(zip(JOINT_TYPES, solution.shared_std.tolist(), strict=False))
+        # N along a leg, kept apart from the joints' N m levels
+        leg_level, leg_std = ((float(solution.shared[-1]), float(solution.shared_std[-1]))
+                              if legs else (math.nan, math.nan))
         diagnostics = {"experiments": used, "offsets": offsets,
                        "coulomb": levels, "coulomb_std": levels_std,
+                       "leg_coulomb": leg_level, "leg_coulomb_std": leg_std,
                        "coulomb_shape_weights": shape_weights,
                        "n_equations": int(solution.n_equations),
                        "pair_calibration": calibration}
@@ -259,7 +304,9 @@ class LeastSquaresIdentifier(BaseIdentifier):
             condition_number=solution.condition_number, residual_rms=solution.residual_rms,
             method=self.method, settings=self.get_params(), diagnostics=diagnostics), {
             "offsets_": offsets, "coulomb_": levels, "coulomb_std_": levels_std,
+            "leg_coulomb_": leg_level, "leg_coulomb_std_": leg_std,
             "coulomb_shape_weights_": shape_weights}
 
 
-__all__ = ["ROWS_PER_WINDOW", "LeastSquaresIdentifier", "coulomb_regressors"]
+__all__ = ["ROWS_PER_WINDOW", "LeastSquaresIdentifier", "coulomb_regressors",
+           "leg_coulomb_regressor", "uses_leg_coulomb"]

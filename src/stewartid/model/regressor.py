@@ -27,12 +27,16 @@ FRICTION_PARAMETERS = (tuple(f"viscous[{t}]" for t in JOINT_TYPES)
                        + tuple(f"coulomb[{t}]" for t in JOINT_TYPES))
 #: Friction along the actuators: viscous (N s/m) and Coulomb (N).
 ACTUATOR_PARAMETERS = ("viscous[actuator]", "coulomb[actuator]")
+#: Mass seen along each leg by an electric actuator's rotor and screw (kg): its column is
+#: computed for an electric ``[actuator]`` (or one with a reflected mass) only, zero otherwise,
+#: so that a hydraulic platform's base parameters are those without it.
+REFLECTED_PARAMETERS = ("reflected_mass",)
 #: Force-sensor offsets per leg (N).
 OFFSET_PARAMETERS = tuple(f"offset[leg{i}]" for i in range(1, 7))
 #: Every standard parameter, in the order of the regressor's columns (and of the preference
 #: for keeping a column in :func:`base_parameters`).
-PARAMETERS = (BODY_PARAMETERS + FRICTION_PARAMETERS + ACTUATOR_PARAMETERS + OFFSET_PARAMETERS
-              + LEG_PARAMETERS)
+PARAMETERS = (BODY_PARAMETERS + FRICTION_PARAMETERS + ACTUATOR_PARAMETERS + REFLECTED_PARAMETERS
+              + OFFSET_PARAMETERS + LEG_PARAMETERS)
 #: Number of standard parameters.
 N_STANDARD = len(PARAMETERS)
 #: Columns linear in the joint or actuator rates: what Bt is made of.
@@ -53,8 +57,8 @@ def standard_parameters(platform: Platform) -> np.ndarray:
     """The standard parameters of a platform description, shape (N_STANDARD,).
 
     Moving body :attr:`~stewartid.platform.Platform.moving_body`, joint friction ``[friction]``
-    (viscous on gimbals only), friction along the legs ``[actuator]`` (zero when absent), offsets
-    ``[sensors] force_bias``. The regressor has no column for ``[actuator] reflected_mass``.
+    (viscous on gimbals only), reflected mass and friction along the legs ``[actuator]`` (zero
+    when absent), offsets ``[sensors] force_bias``.
     """
     body, i, f = platform.moving_body, platform.inertia, platform.friction
     pi = np.zeros(N_STANDARD)
@@ -67,6 +71,7 @@ def standard_parameters(platform: Platform) -> np.ndarray:
               "J_l": i.lower_leg_inertia + i.lower_leg_mass * i.lower_leg_com ** 2,
               "viscous[lower_gimbal]": f.gimbal_viscous,
               "viscous[upper_gimbal]": f.gimbal_viscous,
+              "reflected_mass": platform.actuator.reflected_mass,
               "viscous[actuator]": platform.actuator.viscous,
               "coulomb[actuator]": platform.actuator.coulomb}
     for t in JOINT_TYPES:
@@ -76,6 +81,12 @@ def standard_parameters(platform: Platform) -> np.ndarray:
     for name, value in values.items():
         pi[_INDEX[name]] = value
     return pi
+
+
+def models_reflected_mass(platform: Platform) -> bool:
+    """Whether the regressor has a reflected-mass column for ``platform``: an electric
+    ``[actuator]``, or any with a reflected mass."""
+    return platform.actuator.kind == "electric" or platform.actuator.reflected_mass > 0
 
 
 def about_centre_of_mass(body: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
@@ -112,7 +123,8 @@ def regressor(platform: Platform, q: np.ndarray, q_dot: np.ndarray, q_ddot: np.n
     """Y(q, q_dot, q_ddot), shape (N, 6, N_STANDARD) or (6, N_STANDARD): J_lq^T f_meas = Y pi.
 
     Column k is the generalized force (N, N m) per unit of ``PARAMETERS[k]``; Y depends on the
-    platform's geometry only.
+    platform's geometry only, and on its actuator's kind for the reflected mass's column
+    (:func:`models_reflected_mass`; zero otherwise).
 
     Parameters
     ----------
@@ -149,7 +161,7 @@ def regressor_columns(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
         platform.upper_joints, platform.base_joints, np.asarray(q, dtype=float),
         np.asarray(q_dot, dtype=float), np.asarray(q_ddot, dtype=float),
         GRAVITY if gravity else 0.0, _INDEX, coulomb_rates, coulomb_smoothing,
-        actuator_smoothing, rigid, friction, out)
+        actuator_smoothing, rigid, friction, out, models_reflected_mass(platform))
 
 
 class BaseParameters(NamedTuple):
@@ -247,7 +259,8 @@ def combination_text(row: np.ndarray) -> str:
 
 __all__ = ["ACTUATOR_PARAMETERS", "ACTUATOR_SMOOTHING", "BODY_PARAMETERS", "BaseParameters",
            "FRICTION_PARAMETERS", "INERTIA_ENTRIES", "LEG_PARAMETERS", "N_STANDARD",
-           "OFFSET_PARAMETERS", "PARAMETERS", "SAMPLE_ACCELERATIONS", "SAMPLE_RATES", "SAMPLE_SPAN",
+           "OFFSET_PARAMETERS", "PARAMETERS", "REFLECTED_PARAMETERS", "SAMPLE_ACCELERATIONS",
+           "SAMPLE_RATES", "SAMPLE_SPAN",
            "VISCOUS_PARAMETERS", "about_centre_of_mass", "base_parameters", "combination_text",
-           "parameter_index", "pseudo_inertia", "random_states",
+           "models_reflected_mass", "parameter_index", "pseudo_inertia", "random_states",
            "regressor", "regressor_columns", "standard_parameters"]

@@ -105,8 +105,13 @@ def _body_columns(geo: _Geometry, omega, alpha, a_g, Y, index, moving) -> None:
     Y[3:, index["I_xx"]:index["I_xx"] + 6] = moment
 
 
-def _leg_columns(geo: _Geometry, motion, alpha, a, g, wrenches: _Wrenches, index) -> None:
-    """The legs' inertial and gravity columns into ``wrenches``; ``motion`` None at rest."""
+def _leg_columns(geo: _Geometry, motion, alpha, a, g, wrenches: _Wrenches, index,
+                 reflected: bool = False) -> None:
+    """The legs' inertial and gravity columns into ``wrenches``; ``motion`` None at rest.
+
+    ``reflected`` adds the column of a reflected mass moving with the leg length, l_ddot u (no
+    weight: the leg's housing carries it).
+    """
     r, u, inverse = geo.r, geo.u, geo.inverse
 
     def project(x):  # (I - u u^T) x / l
@@ -133,6 +138,9 @@ def _leg_columns(geo: _Geometry, motion, alpha, a, g, wrenches: _Wrenches, index
     wrenches.add(index["md_u"], tuple(-(x + y) for x, y in zip(u_ddot, project(a_g),
                                                                 strict=True)))
     wrenches.add(index["J_u"], project(u_ddot))
+    if reflected:
+        length_acceleration = radial + speed  # u . a_A + l |u_dot|^2
+        wrenches.add(index["reflected_mass"], tuple(length_acceleration * x for x in u))
 
 
 def _joint_rates(geo: _Geometry, frame, motion) -> tuple:
@@ -188,7 +196,8 @@ def regressor_columns(upper: np.ndarray, base: np.ndarray, q: np.ndarray, qd: np
                       qdd: np.ndarray, g: float, index: Mapping[str, int],
                       sign_rates: np.ndarray | None = None, smoothing: float = 0.0,
                       actuator_smoothing: float = 0.0, rigid: bool = True,
-                      friction: bool = True, out: np.ndarray | None = None) -> np.ndarray:
+                      friction: bool = True, out: np.ndarray | None = None,
+                      reflected: bool = False) -> np.ndarray:
     """The regressor Y of :func:`stewartid.model.regressor.regressor` time last, (6, len(index), N).
 
     Parameters
@@ -209,6 +218,8 @@ def regressor_columns(upper: np.ndarray, base: np.ndarray, q: np.ndarray, qd: np
         Compute the bodies', the friction and offset columns (each else zero).
     out : ndarray, shape (6, len(index), N), optional
         Written in place (any strides) and returned.
+    reflected : bool
+        Compute the reflected mass's column (else zero).
     """
     geo = _Geometry(upper, base, q)
     if out is None:
@@ -225,7 +236,7 @@ def regressor_columns(upper: np.ndarray, base: np.ndarray, q: np.ndarray, qd: np
             alpha = tuple(x + y for x, y in zip(alpha, _euler_bias(geo, qd), strict=True))
         a_g = (qdd[0], qdd[1], qdd[2] - g)
         _body_columns(geo, motion and motion[0], alpha, a_g, Y, index, moving)
-        _leg_columns(geo, motion, alpha, qdd[:3], g, wrenches, index)
+        _leg_columns(geo, motion, alpha, qdd[:3], g, wrenches, index, reflected)
     if friction:
         signs = motion if sign_rates is None else geo.motion(sign_rates)
         _friction_columns(geo, motion, signs or geo.motion(qd), smoothing, actuator_smoothing,

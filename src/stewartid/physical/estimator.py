@@ -44,12 +44,16 @@ from stewartid.platform import Platform
 
 #: Names of the payload's parameters in payload mode (the moving body's columns).
 PAYLOAD_PARAMETERS = tuple(f"payload.{name}" for name in reg.BODY_PARAMETERS)
-#: The nuisance parameters of payload mode.
+#: The nuisance parameters of payload mode; an electric leg's reflected mass
+#: (:data:`~stewartid.model.regressor.REFLECTED_PARAMETERS`) joins them.
 NUISANCE_PARAMETERS = (reg.FRICTION_PARAMETERS + reg.ACTUATOR_PARAMETERS
                        + reg.OFFSET_PARAMETERS)
 #: Standard parameters positive by nature, whose standard error is judged against their size.
 POSITIVE_PARAMETERS = ("m", "I_xx", "I_yy", "I_zz", "m_u", "md_u", "md_l", "J_u", "J_l",
-                       "viscous[lower_gimbal]", "viscous[upper_gimbal]")
+                       "viscous[lower_gimbal]", "viscous[upper_gimbal]", "reflected_mass")
+#: Parameters that cannot be negative: friction coefficients and the reflected mass.
+NONNEGATIVE_PARAMETERS = (reg.FRICTION_PARAMETERS + reg.ACTUATOR_PARAMETERS
+                          + reg.REFLECTED_PARAMETERS)
 
 
 @dataclass(frozen=True)
@@ -204,7 +208,7 @@ class PhysicalIdentifier(BaseIdentifier):
                                     data.measured_force_noise())
         projection = None
         if self.consistent:
-            nonnegative = np.isin(names, reg.FRICTION_PARAMETERS + reg.ACTUATOR_PARAMETERS)
+            nonnegative = np.isin(names, NONNEGATIVE_PARAMETERS)
             projection = nearest_consistent(solution.values, solution.covariance,
                                             _bodies(platform, model, self.payload), nonnegative)
         result = _result(self, platform, model, solution, data, projection)
@@ -288,17 +292,19 @@ def _payload_model(platform: Platform):
     known = reg.standard_parameters(known_platform(platform))
     loaded = reg.standard_parameters(platform)
     body = reg.parameter_index(reg.BODY_PARAMETERS)
-    nuisance = reg.parameter_index(NUISANCE_PARAMETERS)
+    nuisances = NUISANCE_PARAMETERS + (reg.REFLECTED_PARAMETERS
+                                       if reg.models_reflected_mass(platform) else ())
+    nuisance = reg.parameter_index(nuisances)
     columns = np.concatenate([body, nuisance])
     selection = np.eye(reg.N_STANDARD)[columns]
     offset = known.copy()
     offset[columns] = 0.0
     offset[body] = known[body]  # the platform's own body is known
     nominal = np.concatenate([loaded[body] - known[body], known[nuisance]])
-    names = PAYLOAD_PARAMETERS + NUISANCE_PARAMETERS
+    names = PAYLOAD_PARAMETERS + nuisances
     what = {name: f"{standard} of the moving body minus the platform file's own"
             for name, standard in zip(PAYLOAD_PARAMETERS, reg.BODY_PARAMETERS, strict=True)}
-    return (names, {**what, **{name: name for name in NUISANCE_PARAMETERS}}, selection,
+    return (names, {**what, **{name: name for name in nuisances}}, selection,
             nominal, offset)
 
 
@@ -382,6 +388,7 @@ def payload_section(parameters: dict[str, float]) -> dict[str, Any]:
     return {"mass": m, "com": c.tolist(), "inertia": inertia.tolist()}
 
 
-__all__ = ["NUISANCE_PARAMETERS", "PAYLOAD_PARAMETERS", "POSITIVE_PARAMETERS",
+__all__ = ["NONNEGATIVE_PARAMETERS", "NUISANCE_PARAMETERS", "PAYLOAD_PARAMETERS",
+           "POSITIVE_PARAMETERS",
            "PhysicalIdentifier", "PhysicalResult", "correlation_segments", "known_platform",
            "matrix_std_errors", "parameter_model", "payload_section"]

@@ -1,5 +1,6 @@
 """Platform description (TOML) of an identified physical model: payload mode writes ``[payload]``;
-full mode the moving body, legs and mean friction levels.
+full mode the moving body, legs and mean friction levels; both write an electric leg's reflected
+mass and friction along the legs in ``[actuator]``.
 """
 
 from __future__ import annotations
@@ -37,6 +38,19 @@ def _standard_values(platform: Platform, result: PhysicalResult) -> np.ndarray:
     return values
 
 
+def actuator_updates(platform: Platform, parameters: dict[str, float]) -> dict[str, float]:
+    """``[actuator]`` keys of identified ``parameters``: reflected mass (kg), viscous (N s/m) and
+    Coulomb (N) friction along the legs, for an electric actuator (a hydraulic leg's are left
+    as the file has them); those not identified are left out.
+    """
+    if platform.actuator.kind != "electric":
+        return {}
+    keys = {"reflected_mass": "reflected_mass", "viscous[actuator]": "viscous",
+            "coulomb[actuator]": "coulomb"}
+    return {f"actuator__{key}": float(parameters[name]) for name, key in keys.items()
+            if name in parameters}
+
+
 def _full_platform(platform: Platform, result: PhysicalResult) -> Platform:
     """Description of a full-mode result."""
     pi = _standard_values(platform, result)
@@ -61,6 +75,7 @@ def _full_platform(platform: Platform, result: PhysicalResult) -> Platform:
     updates["friction__gimbal_viscous"] = float(np.mean(gimbals))
     updates["friction__coulomb"] = float(np.mean(
         [value[f"coulomb[{t}]"] for t in reg.JOINT_TYPES]))
+    updates.update(actuator_updates(platform, value))
     base = platform.replace(payload=None)
     try:
         return base.replace(**updates, **legs)
@@ -114,7 +129,8 @@ def identified_platform(platform: Platform, result: PhysicalResult) -> Platform:
         if result.diagnostics.get("mode") == "payload":
             section = result.diagnostics["payload"]
             return platform.replace(payload=None).replace(
-                **{f"payload__{key}": value for key, value in section.items()})
+                **{f"payload__{key}": value for key, value in section.items()},
+                **actuator_updates(platform, result.parameters))
         return _full_platform(platform, result)
     except ConfigError as exc:
         raise ConfigError(f"the identified parameters are no valid platform description: "
@@ -129,4 +145,4 @@ def write_identified(platform: Platform, result: PhysicalResult, platform_out: P
                              + identified.to_toml())
 
 
-__all__ = ["IDENTIFIED_HEADER", "identified_platform", "write_identified"]
+__all__ = ["IDENTIFIED_HEADER", "actuator_updates", "identified_platform", "write_identified"]

@@ -9,7 +9,7 @@ import numpy as np
 
 from stewartid.comparison import PhysicalSection, Workspace
 from stewartid.physical.estimator import PhysicalResult
-from stewartid.platform import COORDINATES
+from stewartid.platform import COORDINATES, Platform
 from stewartid.reports.tables import ResultTable, to_markdown
 from stewartid.verdict.rule import worst_dof
 
@@ -35,9 +35,41 @@ def parameter_table(result: PhysicalResult) -> str:
         ("text", "value", "value", "text", "text"), tuple(rows)), heading_level=4)
 
 
+def actuator_lines(result: PhysicalResult, platform: Platform | None) -> list[str]:
+    """The physical section's part on electric legs: reflected mass and friction along the legs,
+    and the force constant every identified mass scales with (nothing for hydraulic legs)."""
+    if platform is None or platform.actuator.kind != "electric":
+        return []
+    values, errors = result.parameters, result.parameter_std_errors
+    file = platform.actuator
+
+    def quantity(name: str, unit: str, given: float) -> str:
+        if name not in values:
+            return f"not identified (file: {given:.6g} {unit})"
+        note = " (fixed at the file's value)" if name in result.diagnostics.get("fixed", {}) \
+            else f" ± {_value(errors[name])} {unit}"
+        return f"{_value(values[name])} {unit}{note} (file: {given:.6g} {unit})"
+
+    return [
+        "### Electric actuators", "",
+        "Along each leg (the six alike): reflected mass of rotor and screw "
+        + quantity("reflected_mass", "kg", file.reflected_mass) + "; viscous friction "
+        + quantity("viscous[actuator]", "N·s/m", file.viscous) + "; Coulomb friction "
+        + quantity("coulomb[actuator]", "N", file.coulomb) + ".", "",
+        f"The leg forces are the motor currents times the force constant, {file.force_constant:.6g}"
+        " N/A in the platform file: every identified mass, first moment, inertia and friction "
+        "level scales with it, so an error of x % in the force constant is an error of x % in "
+        "all of them (Mt and Bt too). A known test mass calibrates it: fix the weighed mass to "
+        "the platform, record, identify with `--model physical --payload` on the platform file "
+        "without it, and pass the result and the mass to "
+        "`stewartid.physical.calibration.corrected_force_constant` (docs/physical-model.md).", ""]
+
+
 def physical_lines(section: PhysicalSection | None,
-                   figures: Mapping[str, tuple[str, str]]) -> list[str]:
-    """The report's "Physical model" section (nothing without ``section``)."""
+                   figures: Mapping[str, tuple[str, str]],
+                   platform: Platform | None = None) -> list[str]:
+    """The report's "Physical model" section (nothing without ``section``); ``platform`` the
+    description the fit used, for its actuators."""
     if section is None:
         return []
     lines = ["## Physical model", ""]
@@ -73,7 +105,8 @@ def physical_lines(section: PhysicalSection | None,
     if "workspace" in figures:
         path, caption = figures["workspace"]
         lines += [f"![{caption}]({path})", "", f"*{caption}* ([SVG]({path[:-4]}.svg))", ""]
-    return lines + [_range_text(section.workspace), "", parameter_table(result)]
+    return (lines + [_range_text(section.workspace), ""] + actuator_lines(result, platform)
+            + [parameter_table(result)])
 
 
 def _range_text(curves: Workspace | None) -> str:
@@ -86,4 +119,4 @@ def _range_text(curves: Workspace | None) -> str:
     return f"Measured range (absolute pose): {spans}."
 
 
-__all__ = ["parameter_table", "physical_lines"]
+__all__ = ["actuator_lines", "parameter_table", "physical_lines"]

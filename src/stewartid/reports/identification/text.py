@@ -177,7 +177,8 @@ def render_report(report: IdentificationReport, datasets: Sequence[Dataset],
               + _records_section(report, records))
     lines += _consistency_section(ok)
     lines += ["## Friction", ""] + friction_section(ok, platform)
-    lines += [""] + _figure(figures, "friction") + physical_lines(report.physical, figures)
+    lines += [""] + _figure(figures, "friction") + physical_lines(report.physical, figures,
+                                                                    platform)
     if several:
         lines += ["## Methods compared", "", *verdict, ""]
         lines += _figure(figures, "methods")
