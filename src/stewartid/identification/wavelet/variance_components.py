@@ -21,8 +21,9 @@ def pose_covariance(gram: np.ndarray, sigma: np.ndarray, coefficients: np.ndarra
     Q_rs = sum_ab (c_a Sigma c_b) <phi_r^(a), phi_s^(b)>; ``gram`` (n, 3, 3, R, R), ``sigma`` (n, 6, 6),
     ``coefficients`` c_a (n, 3, 6) from :func:`pose_coefficients`.
     """
-    c = np.einsum("naj,njk,nbk->nab", coefficients, sigma, coefficients)
-    return np.einsum("nab,nabrs->nrs", c, gram)
+    n, rows = gram.shape[0], gram.shape[-1]
+    c = coefficients @ sigma @ coefficients.transpose(0, 2, 1)                 # (n, 3, 3)
+    return (c.reshape(n, 1, 9) @ gram.reshape(n, 9, rows * rows)).reshape(n, rows, rows)
 
 
 def noise_bias(weights: np.ndarray, gram: np.ndarray, sigma: np.ndarray,
@@ -31,7 +32,9 @@ def noise_bias(weights: np.ndarray, gram: np.ndarray, sigma: np.ndarray,
 
     Regressor noise [<phi'', n>, -<phi', n>], target noise <phi, k_i n>; ``sensitivity`` k_i (n, 6).
     """
-    t = np.einsum("nrs,nabrs->nab", weights, gram)                     # sum_rs W_rs G_ab,rs
+    n, rows = gram.shape[0], gram.shape[-1]
+    t = (gram.reshape(n, 9, rows * rows) @ weights.reshape(n, rows * rows, 1)
+         ).reshape(n, 3, 3)                                             # sum_rs W_rs G_ab,rs
     mm = np.einsum("n,njk->jk", t[:, 2, 2], sigma)
     mb = -np.einsum("n,njk->jk", t[:, 2, 1], sigma)
     bb = np.einsum("n,njk->jk", t[:, 1, 1], sigma)
