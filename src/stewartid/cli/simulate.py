@@ -82,7 +82,7 @@ def simulate(
         "--force-noise", metavar="NEWTONS", help="Force sensor noise, standard deviation (N); default: "
         "[sensors] force_noise.")] = None,
     actuator: Annotated[str | None, typer.Option(
-        "--actuator", metavar="hydraulic|electric|ideal",
+        "--actuator", metavar="KIND",
         help="The legs' own model, 'hydraulic' (valves and cylinders) or 'electric' (servo "
         "motors with current loops, logging currents i1..i6), which must be the platform's "
         "[actuator] kind; or 'ideal' (the demanded forces applied exactly). Default: the "
