@@ -219,9 +219,10 @@ def test_forward_dynamics_inverts_inverse_dynamics_with_the_actuator(paper, rng)
     np.testing.assert_allclose(back, qdd, rtol=0, atol=1e-10 * np.abs(qdd).max())
 
 
-def test_the_simulator_moves_electric_legs_as_force_sources_with_the_model(paper):
+def test_the_simulator_moves_electric_legs_with_the_model(paper):
     """The plant's recorded accelerations are the model's forward dynamics under its recorded leg
-    forces: reflected masses and leg friction are in the simulator too."""
+    forces (force_constant times the motor currents): reflected masses and leg friction are in the
+    simulator too."""
     from stewartid.simulation import Sine, multisine_excitation, simulate_experiment
 
     moving = electric(paper).replace(sensors__sample_rate=500.0)

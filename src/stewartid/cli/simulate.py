@@ -73,7 +73,8 @@ def simulate(
     noise_on: Annotated[bool, typer.Option(
         "--noise", help="Switch on the reference sensor noise: 20 um on the leg lengths and "
         "0.5 % of the static leg force on the forces (--length-noise/--force-noise override "
-        "either).")] = False,
+        "either); for electric legs 0.5 % of each motor current's RMS over the record, and "
+        "no length noise beyond the encoders' counts.")] = False,
     length_noise: Annotated[float | None, typer.Option(
         "--length-noise", metavar="METRES", help="Leg-length sensor noise, standard deviation (m); default: "
         "[sensors] length_noise.")] = None,
@@ -81,8 +82,11 @@ def simulate(
         "--force-noise", metavar="NEWTONS", help="Force sensor noise, standard deviation (N); default: "
         "[sensors] force_noise.")] = None,
     actuator: Annotated[str | None, typer.Option(
-        "--actuator", metavar="hydraulic|ideal",
-        help="'hydraulic' or 'ideal'; default: [hydraulics] mode.")] = None,
+        "--actuator", metavar="KIND",
+        help="The legs' own model, 'hydraulic' (valves and cylinders) or 'electric' (servo "
+        "motors with current loops, logging currents i1..i6), which must be the platform's "
+        "[actuator] kind; or 'ideal' (the demanded forces applied exactly). Default: the "
+        "platform's kind, or 'ideal' when [hydraulics] mode = \"ideal\".")] = None,
     seed: Annotated[int, typer.Option("--seed", metavar="N", help="Seed of the sensor noise.")] = 0,
     format: Annotated[str, typer.Option("--format", metavar="csv|parquet",
                                         help="'csv' or 'parquet'.")] = "csv",
@@ -93,10 +97,14 @@ def simulate(
         "with t and the pose x..rz (m, rad) or t and l1..l6 (m), e.g. a command file of "
         "`stewartid design`; repeat for more experiments (exp1, exp2, ...).")] = None,
     engine: Annotated[str, typer.Option(
-        "--engine", metavar="ours|mujoco", help="'ours' (the hydraulic plant) or 'mujoco' (the "
+        "--engine", metavar="ours|mujoco", help="'ours' (the plant) or 'mujoco' (the "
         "same platform in MuJoCo, an independent engine: ideal leg actuators under the "
-        "servo's PD law, MuJoCo's friction constraints; needs the [mujoco] extra). The sensor "
-        "errors are the same on both.")] = "ours",
+        "servo's PD law, or electric legs' motors under its PID law, MuJoCo's friction "
+        "constraints; needs the [mujoco] extra). The sensor errors are the same on "
+        "both.")] = "ours",
+    sample_rate: Annotated[float | None, typer.Option(
+        "--sample-rate", metavar="HZ", help="Sample rate of the logs (Hz); default: [sensors] "
+        "sample_rate.")] = None,
     jobs: Annotated[int | None, typer.Option(
         "--jobs", metavar="N", help="Worker processes for the paper's experiments (default: every core); "
         "the data do not depend on it.")] = None,
@@ -113,26 +121,34 @@ def simulate(
     length_resolution: Annotated[float | None,
                                  imperfection_option("--length-resolution")] = None,
 ) -> None:
-    """Simulate the six experiments (experiment k excites DOF k) on the hydraulic plant, or
-    with ``--engine mujoco`` on MuJoCo's model of the platform."""
+    """Simulate the six experiments (experiment k excites DOF k) on the plant (hydraulic or
+    electric legs), or with ``--engine mujoco`` on MuJoCo's model of the platform."""
     # imported when this command runs: every command's module is imported at start-up
     from rich.progress import Progress
 
     from stewartid.fields import Options, check, nonnegative, positive
     from stewartid.simulation import simulate_experiments, write_experiments
     from stewartid.simulation.experiments import is_experiment_file
-    from stewartid.simulation.sensors import sensor_noise
+    from stewartid.simulation.sensors import REFERENCE_CURRENT_NOISE, sensor_noise
 
     description = load_platform(platform)
     check("--format", format, [Options(("csv", "parquet"))])
     check("--engine", engine, [Options(("ours", "mujoco"))])
+    if actuator is not None:
+        check("--actuator", actuator, [Options(("hydraulic", "electric", "ideal"))])
     if engine == "mujoco" and actuator == "hydraulic":
         raise ConfigError("--actuator hydraulic: MuJoCo's legs are ideal force actuators; "
                           "leave --actuator out or use --engine ours.")
-    if actuator == "hydraulic" and description.actuator.kind == "electric":
-        raise ConfigError(f"--actuator hydraulic: platform '{description.name}' has electric legs "
-                          '([actuator] kind = "electric"), simulated as force sources; leave '
-                          "--actuator out.")
+    if actuator is not None and actuator not in ("ideal", description.actuator.kind):
+        fix = ("leave --actuator out" if description.actuator.kind == "electric" else
+               'give the platform an [actuator] with kind = "electric" and its motor constants')
+        raise ConfigError(f"--actuator {actuator}: platform '{description.name}' has "
+                          f"{description.actuator.kind} legs ([actuator] kind = "
+                          f'"{description.actuator.kind}"); {fix}, or use --actuator ideal.')
+    if sample_rate is not None:
+        check("--sample-rate", sample_rate, [positive()], "Hz")
+        description = description.replace(sensors__sample_rate=sample_rate)
+    electric = _overridden(description, None, None, actuator).electric_legs
     # before the simulation, which takes a while; write_experiments checks again
     check_output_folder(out, force, is_experiment_file)
     for flag, value, constraint, unit in (
@@ -143,8 +159,11 @@ def simulate(
             ("--duration", duration, positive(), "s")):
         if value is not None:  # an optional flag not given
             check(flag, value, [constraint], unit)
+    # an encoder has no white noise: for electric legs --noise is the current sensing's
+    reference = "always" if noise_on and not electric else "never"
+    current_noise = REFERENCE_CURRENT_NOISE if noise_on and electric else 0.0
     noise = with_imperfections(
-        sensor_noise(description, "always" if noise_on else "never", length_noise, force_noise),
+        sensor_noise(description, reference, length_noise, force_noise),
         description.sensors.sample_rate,
         {"--force-delay": force_delay, "--length-delay": length_delay,
          "--force-lowpass": force_lowpass, "--force-lowpass-order": force_lowpass_order,
@@ -160,36 +179,44 @@ def simulate(
         workers = (os.cpu_count() or 1) if jobs is None else jobs
         if engine == "mujoco":
             result = _on_mujoco(description, coulomb, viscous, excitation, frequency, duration,
-                                noise, seed, progress, workers)
+                                noise, seed, progress, workers, actuator, current_noise)
         elif excitation:
             from stewartid.design.export import read_excitation, simulate_excitations  # as above
 
             description = _overridden(description, coulomb, viscous, actuator)
             result = simulate_excitations(
                 description, [read_excitation(path, description) for path in excitation],
-                noise, seed, progress)
+                noise, seed, progress, current_noise)
         else:
             result = simulate_experiments(description, coulomb=coulomb, viscous=viscous,
                                           frequency_hz=frequency, duration_s=duration,
                                           noise=noise, seed=seed, actuator=actuator,
-                                          progress=progress, jobs=workers)
+                                          progress=progress, jobs=workers,
+                                          current_noise=current_noise)
     paths = write_experiments(result, out, format=format, force=force)
-    engine_note = " (MuJoCo: ideal leg actuators, no hydraulics)" if engine == "mujoco" else ""
+    engine_note = ""
+    if engine == "mujoco":
+        engine_note = (" (MuJoCo: electric legs)" if electric
+                       else " (MuJoCo: ideal leg actuators, no hydraulics)")
+    if electric:
+        engine_note += ", currents i1..i6 (A) in place of forces"
     typer.echo(f"wrote {len(paths) - 1} experiments and meta.json to {out}{engine_note}")
 
 
 def _overridden(description: Platform, coulomb: float | None, viscous: float | None,
                 actuator: str | None) -> Platform:
     """The platform with the friction and actuator flags given on the command line."""
+    mode = None if actuator is None else ("ideal" if actuator == "ideal" else "hydraulic")
     overrides = {key: value for key, value in (
         ("friction__coulomb", coulomb), ("friction__gimbal_viscous", viscous),
-        ("hydraulics__mode", actuator)) if value is not None}
+        ("hydraulics__mode", mode)) if value is not None}
     return description.replace(**overrides) if overrides else description
 
 
 def _on_mujoco(description: Platform, coulomb: float | None, viscous: float | None,
                excitation: list[Path] | None, frequency: float, duration: float,
-               noise: SensorNoise, seed: int, progress: Any, jobs: int) -> SimulationResult:
+               noise: SensorNoise, seed: int, progress: Any, jobs: int,
+               actuator: str | None = None, current_noise: float = 0.0) -> SimulationResult:
     """``simulate --engine mujoco``: the experiments or excitation files played on the MuJoCo model."""
     from stewartid.design.export import read_excitation
     from stewartid.simulation import paper_experiments
@@ -201,7 +228,7 @@ def _on_mujoco(description: Platform, coulomb: float | None, viscous: float | No
         require_mujoco()
     except ImportError as exc:
         raise ConfigError(f"--engine mujoco: {exc}.") from None
-    description = _overridden(description, coulomb, viscous, None)
+    description = _overridden(description, coulomb, viscous, actuator)
     if excitation:
         played = [read_excitation(path, description) for path in excitation]
         durations = [e.duration for e in played]
@@ -211,7 +238,7 @@ def _on_mujoco(description: Platform, coulomb: float | None, viscous: float | No
         durations = [duration] * len(played)
         meta = {"frequency_hz": frequency, "duration_s": duration}
     return simulate_on_mujoco(description, played, durations, noise, seed, progress=progress,
-                              jobs=jobs, excitation_meta=meta)
+                              jobs=jobs, excitation_meta=meta, current_noise=current_noise)
 
 
 def with_imperfections(noise: SensorNoise, sample_rate: float,

@@ -362,15 +362,20 @@ def read_datasets(paths: str | Path | Sequence[str | Path],
     return datasets
 
 
-def write_dataset(dataset: Dataset, path: str | Path, format: str | None = None) -> Path:
+def write_dataset(dataset: Dataset, path: str | Path, format: str | None = None,
+                  force_constant: float | None = None) -> Path:
     """Write an experiment in the interchange format atomically; return the path.
 
-    ``format`` defaults to the suffix of ``path``.
+    ``format`` defaults to the suffix of ``path``. With ``force_constant`` (N/A, electric legs) the
+    forces are written as the motor currents ``i1..i6`` = f / force_constant (A), which reading with
+    the platform's ``[actuator] force_constant`` turns back into the forces to 2 eps.
     """
     path = Path(path)
     kind = _format_of(path, format)
-    data = np.column_stack([dataset.t, dataset.pose, dataset.lengths, dataset.forces]).T
-    table = pa.table(dict(zip(COLUMNS, data, strict=True)))
+    forces = dataset.forces if force_constant is None else dataset.forces / force_constant
+    columns = COLUMNS if force_constant is None else (*COLUMNS[:13], *CURRENT_COLUMNS)
+    data = np.column_stack([dataset.t, dataset.pose, dataset.lengths, forces]).T
+    table = pa.table(dict(zip(columns, data, strict=True)))
     buffer = pa.BufferOutputStream()
     if kind == "csv":
         # Arrow writes the shortest decimal that reads back to the same double: a bit-exact round trip

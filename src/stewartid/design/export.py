@@ -23,7 +23,13 @@ from stewartid.model.kinematics import forward_kinematics, inverse_kinematics
 from stewartid.model.linearization import nominal_matrices
 from stewartid.platform import COORDINATES, Platform
 from stewartid.signals.differentiation import estimate_frequency
-from stewartid.simulation.experiments import SimulationResult, noise_generator, simulate_experiment
+from stewartid.simulation.experiments import (
+    SimulationResult,
+    electric_meta,
+    logged_force_constant,
+    noise_generator,
+    simulate_experiment,
+)
 from stewartid.simulation.sensors import SensorNoise
 
 LENGTH_COLUMNS = tuple(f"l{k}" for k in range(1, 7))
@@ -131,7 +137,8 @@ def read_excitation(path: str | Path, platform: Platform) -> TabulatedExcitation
 
 def simulate_excitations(platform: Platform, excitations: Sequence[Any],
                          noise: SensorNoise | None = None, seed: int = 0,
-                         progress: Callable[[int, int, str], Any] | None = None):
+                         progress: Callable[[int, int, str], Any] | None = None,
+                         current_noise: float = 0.0):
     """Play excitations on the plant, one experiment each (``exp1..expN``); return a
     :class:`~stewartid.simulation.SimulationResult`.
 
@@ -146,6 +153,8 @@ def simulate_excitations(platform: Platform, excitations: Sequence[Any],
         One stream per experiment, as ``simulate``.
     progress : callable, optional
         ``progress(done, total, name)``.
+    current_noise : float
+        Electric legs: noise of each motor current as a fraction of its RMS, as ``simulate``.
     """
     noise = SensorNoise.from_sensors(platform.sensors) if noise is None else noise
     datasets, records, sources = [], [], []
@@ -153,7 +162,8 @@ def simulate_excitations(platform: Platform, excitations: Sequence[Any],
         duration = (excitation.duration if hasattr(excitation, "duration")
                     else excitation.record.duration)
         dataset, record = simulate_experiment(platform, excitation, duration, noise,
-                                              noise_generator(seed, k, len(excitations)))
+                                              noise_generator(seed, k, len(excitations)),
+                                              current_noise=current_noise)
         datasets.append(dataclasses.replace(dataset, name=f"exp{k + 1}"))
         records.append(record)
         sources.append(excitation.name)
@@ -164,5 +174,6 @@ def simulate_excitations(platform: Platform, excitations: Sequence[Any],
             "excitation": {"sources": sources}, "noise": dataclasses.asdict(noise),
             "seed": int(seed),
             "tracking_error_rms": [r.tracking_error().tolist() for r in records],
-            "nominal": {"M": M.tolist(), "B": B.tolist()}, "version": stewartid.__version__}
-    return SimulationResult(datasets, meta, records)
+            "nominal": {"M": M.tolist(), "B": B.tolist()}, "version": stewartid.__version__,
+            **electric_meta(platform, current_noise)}
+    return SimulationResult(datasets, meta, records, logged_force_constant(platform))

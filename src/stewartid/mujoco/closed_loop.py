@@ -9,6 +9,7 @@ from typing import Protocol
 import numpy as np
 
 from stewartid.datasets.dataset import Dataset
+from stewartid.model.dynamics import ModelTerms
 from stewartid.mujoco import model as mjcf
 from stewartid.mujoco import state as mujoco_state
 from stewartid.platform import Platform
@@ -36,7 +37,8 @@ def simulate_mujoco(platform: Platform, excitation: Commanded, duration: float, 
     """Play ``excitation`` on the MuJoCo model and record it at the sensors' rate, named as the excitation.
 
     Ideal force actuators under the PD part of the plant's servo with gravity feed-forward (no
-    integral term); each sample is MuJoCo's exact state, without sensor errors. The command is
+    integral term); electric legs (``platform.electric_legs``) as the plant drives them, see
+    :func:`_simulate_electric`. Each sample is MuJoCo's exact state, without sensor errors. The command is
     evaluated at every integrator stage through MuJoCo's process-global control callback: one
     simulation per process at a time.
 
@@ -64,6 +66,8 @@ def simulate_mujoco(platform: Platform, excitation: Commanded, duration: float, 
         raise ValueError(f"duration must be > 0 s; got {duration!r}.")
     if not (np.isfinite(step) and step > 0):
         raise ValueError(f"step must be > 0 s; got {step!r}.")
+    if platform.electric_legs:
+        return _simulate_electric(platform, excitation, duration, step, integrator)
     rate = platform.sensors.sample_rate
     per_sample = steps_per_sample(rate, step)
     step = 1.0 / (rate * per_sample)
@@ -92,6 +96,75 @@ def simulate_mujoco(platform: Platform, excitation: Commanded, duration: float, 
             pose[i] = mujoco_state.platform_state(model, data)[0]
             lengths[i] = mujoco_state.leg_lengths(platform, model, data)
             forces[i] = data.actuator_force
+    finally:
+        mj.set_mjcb_control(previous)
+    return Dataset(np.arange(n_samples) / rate, pose, lengths, forces, name=excitation.name)
+
+
+def _simulate_electric(platform: Platform, excitation: Commanded, duration: float, step: float,
+                       integrator: str) -> Dataset:
+    """:func:`simulate_mujoco` for electric legs: the plant's whole servo on MuJoCo's motors.
+
+    Every integrator stage, the control callback evaluates the plant's PID law (gravity
+    feed-forward, integral term, clamp to +-peak_current with the same anti-windup) on MuJoCo's
+    slide positions and rates, and commands the current; MuJoCo integrates the current loops and
+    the integral terms as actuator states (:func:`~stewartid.mujoco.model.build_mjcf`). The
+    step is no longer than the plant's for the current loop. The data set's forces are
+    force_constant times MuJoCo's currents.
+    """
+    from stewartid.simulation.controller import command_tables, controller_parameters
+    from stewartid.simulation.electric import largest_step
+
+    mj = mjcf.require_mujoco()
+    rate = platform.sensors.sample_rate
+    per_sample = steps_per_sample(rate, min(step, largest_step(platform.actuator)))
+    step = 1.0 / (rate * per_sample)
+    n_samples = int(np.floor(duration * rate + 1e-9)) + 1
+    model = mjcf.load_model(platform, integrator=integrator, timestep=step)
+    data = mj.MjData(model)
+    half = step / 2
+    q_cmd, qd_cmd, _ = excitation.evaluate(np.arange(2 * (n_samples - 1) * per_sample + 3) * half)
+    params = platform.parameters()
+    cmd_len, cmd_rate, cmd_force = command_tables(
+        params, np.ascontiguousarray(platform.upper_joints),
+        np.ascontiguousarray(platform.base_joints), q_cmd, qd_cmd,
+        bool(platform.controller.gravity_feedforward))
+    c = platform.controller
+    cp = controller_parameters(platform)
+    f_min, f_max = cp[4], cp[5]
+    kt = platform.actuator.force_constant
+    slides = mujoco_state.Indices(model)
+    l0 = platform.neutral_leg_length
+
+    def control(_model: object, state: object) -> None:
+        k = int(round(state.time / half))
+        error = cmd_len[k] - (l0 + state.qpos[slides.slide_qpos])
+        rate_error = cmd_rate[k] - state.qvel[slides.slide_dof]
+        demand = (cmd_force[k] + c.proportional_gain * error + c.integral_gain * state.act[6:]
+                  + c.derivative_gain * rate_error)
+        # the plant's anti-windup: the integral stops while the demand saturates outward
+        high, low = demand > f_max, demand < f_min
+        state.ctrl[6:] = np.where((high & (error > 0)) | (low & (error < 0)), 0.0, error)
+        state.ctrl[:6] = np.clip(demand, f_min, f_max) / kt
+
+    mujoco_state.set_state(platform, model, data, q_cmd[0], qd_cmd[0])
+    start = ModelTerms(platform, q_cmd[0])
+    held = np.linalg.solve(start.leg_jacobian[0].T, start.gravity[0])
+    data.act[:6] = held / kt
+    data.act[6:] = (held - cmd_force[0]) / c.integral_gain if c.integral_gain > 0 else 0.0
+    pose = np.empty((n_samples, 6))
+    lengths = np.empty((n_samples, 6))
+    forces = np.empty((n_samples, 6))
+    previous = mj.get_mjcb_control()
+    mj.set_mjcb_control(control)
+    try:
+        for i in range(n_samples):
+            for _ in range(per_sample if i else 0):
+                mj.mj_step(model, data)
+            mj.mj_forward(model, data)
+            pose[i] = mujoco_state.platform_state(model, data)[0]
+            lengths[i] = mujoco_state.leg_lengths(platform, model, data)
+            forces[i] = kt * data.act[:6]
     finally:
         mj.set_mjcb_control(previous)
     return Dataset(np.arange(n_samples) / rate, pose, lengths, forces, name=excitation.name)

@@ -98,7 +98,8 @@ def build_mjcf(platform: Platform, *, integrator: str = "RK4",
     ``frictionloss`` on the five hinges (a constraint, as stiff as the welds). An ``[actuator]``
     gives each slide its reflected mass as ``armature`` (inertia of the joint's own coordinate,
     without weight), its viscous friction as ``damping`` and its Coulomb friction as
-    ``frictionloss``. The Cardan axes move with
+    ``frictionloss``; electric legs (``platform.electric_legs``) get motors with a current loop
+    (:func:`_electric_lines`). The Cardan axes move with
     their bodies, so joint friction differs from ours at the order of the gimbal deflection.
 
     Parameters
@@ -132,7 +133,8 @@ def build_mjcf(platform: Platform, *, integrator: str = "RK4",
     slide = _slide_attributes(platform, tau, imp, coulomb)
     for k in range(6):
         lines += _leg_lines(platform, k, frames[k], frictionloss, end_mass, end_inertia, slide)
-    lines += ["  </worldbody>", *_closure_lines(tau, constraint_impedance), "</mujoco>", ""]
+    lines += ["  </worldbody>", *_closure_lines(tau, constraint_impedance, platform), "</mujoco>",
+              ""]
     return "\n".join(lines)
 
 
@@ -240,8 +242,9 @@ def _leg_lines(platform: Platform, k: int, frame: np.ndarray, frictionloss: str,
     ]
 
 
-def _closure_lines(tau: float, impedance: float) -> list[str]:
-    """MJCF of the welds (time constant ``tau`` s, impedance d) and of the leg motors."""
+def _closure_lines(tau: float, impedance: float, platform: Platform | None = None) -> list[str]:
+    """MJCF of the welds (time constant ``tau`` s, impedance d) and of the leg motors: force
+    actuators, or for electric legs (``platform.electric_legs``) :func:`_electric_lines`."""
     imp = f"{impedance:.17g}"
     lines = ["  <equality>"]
     for k in range(6):
@@ -250,9 +253,29 @@ def _closure_lines(tau: float, impedance: float) -> list[str]:
         lines.append(f'    <weld name="leg{k + 1}" body1="platform" body2="leg{k + 1}_end" '
                      f'anchor="0 0 0" solref="{tau:.17g} 1" solimp="{imp} {imp} 0.001 0.5 2"/>')
     lines += ["  </equality>", "  <actuator>"]
-    for k in range(6):
-        lines.append(f'    <motor name="leg{k + 1}" joint="leg{k + 1}_slide" gear="1"/>')
+    if platform is not None and platform.electric_legs:
+        lines += _electric_lines(platform)
+    else:
+        for k in range(6):
+            lines.append(f'    <motor name="leg{k + 1}" joint="leg{k + 1}_slide" gear="1"/>')
     lines.append("  </actuator>")
+    return lines
+
+
+def _electric_lines(platform: Platform) -> list[str]:
+    """MJCF of electric leg motors: actuator ``leg<k>`` takes the current command (A) through the
+    current loop, a first-order filter of time constant 1 / (2 pi current_bandwidth) whose state is
+    the current, and pushes force_constant times it along the slide; ``leg<k>_integral``, of no
+    force, integrates its control: the state of the servo's integral term (m s).
+    """
+    from stewartid.simulation.electric import current_bandwidth
+
+    a = platform.actuator
+    tau = 1.0 / (2.0 * math.pi * current_bandwidth(a))
+    lines = [f'    <general name="leg{k + 1}" joint="leg{k + 1}_slide" dyntype="filter" '
+             f'dynprm="{tau:.17g}" gainprm="{a.force_constant:.17g}"/>' for k in range(6)]
+    lines += [f'    <general name="leg{k + 1}_integral" joint="leg{k + 1}_slide" '
+              'dyntype="integrator" gainprm="0"/>' for k in range(6)]
     return lines
 
 

@@ -140,10 +140,17 @@ class Platform:
     @property
     def hydraulic_legs(self) -> bool:
         """Whether the simulator drives the legs as valve-controlled cylinders: a hydraulic
-        ``[actuator]`` in ``[hydraulics] mode = "hydraulic"``. Otherwise each leg applies its demanded
-        force exactly, as an electric leg's current loop, far faster than the motion, does.
+        ``[actuator]`` in ``[hydraulics] mode = "hydraulic"``. Otherwise each leg is a servo motor
+        (:attr:`electric_legs`) or, in mode "ideal", applies its demanded force exactly.
         """
         return self.actuator.kind == "hydraulic" and self.hydraulics.mode == "hydraulic"
+
+    @property
+    def electric_legs(self) -> bool:
+        """Whether the simulator drives the legs as servo motors on ball screws, each with its
+        current loop: an electric ``[actuator]`` unless ``[hydraulics] mode = "ideal"``.
+        """
+        return self.actuator.kind == "electric" and self.hydraulics.mode == "hydraulic"
 
     @property
     def moving_body(self) -> MovingBody:

@@ -27,7 +27,12 @@ ACTUATOR_MODES = ("hydraulic", "ideal")
 #: Kinds of leg actuator understood by [actuator] kind.
 ACTUATOR_KINDS = ("hydraulic", "electric")
 #: [actuator] keys that describe a servo motor and its ball screw: electric actuators only.
-ELECTRIC_KEYS = ("force_constant", "screw_lead", "peak_current", "screw_speed")
+ELECTRIC_KEYS = ("force_constant", "screw_lead", "peak_current", "screw_speed",
+                 "current_bandwidth", "encoder_resolution")
+#: Current-loop bandwidth (Hz) of an electric [actuator] that gives none.
+DEFAULT_CURRENT_BANDWIDTH = 1000.0
+#: Leg travel per encoder count (m) of an electric [actuator] that gives none.
+DEFAULT_ENCODER_RESOLUTION = 1e-6
 
 
 @dataclasses.dataclass(frozen=True)
@@ -161,7 +166,9 @@ class Actuator(Section):
 
     An electric leg is a ball screw driven by a servo motor: its rotor and screw, turning at
     2 pi / lead rad per metre of stroke, weigh J (2 pi / lead)^2 along the leg, and its force is
-    the motor current times a force constant (no force sensor). The defaults, a hydraulic leg with
+    the motor current times a force constant (no force sensor). The simulator gives each motor a
+    first-order current loop of ``current_bandwidth`` limited to ``peak_current``, and an encoder
+    of ``encoder_resolution`` that measures the leg length. The defaults, a hydraulic leg with
     nothing along it, leave the model of ``[inertia]`` and ``[friction]`` as it is.
     """
 
@@ -187,6 +194,12 @@ class Actuator(Section):
     screw_speed: float | None = spec("rev/s", "largest motor speed (electric, with "
                                      "screw_lead; default: no speed limit from the motor)",
                                      positive(1e-3, 1e4), default=None)
+    current_bandwidth: float | None = spec(
+        "Hz", "-3 dB bandwidth of each motor's current loop (electric; default 1000 Hz)",
+        positive(1.0, 1e5), default=None)
+    encoder_resolution: float | None = spec(
+        "m", "leg travel per count of each motor's encoder, screw_lead / counts per revolution "
+        "(electric; default 1e-6 m; 0: an ideal encoder)", nonnegative(0.0, 1e-2), default=None)
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -216,8 +229,9 @@ class Hydraulics(Section):
 
     section = "hydraulics"
 
-    mode: str = spec("-", "'hydraulic' (valve, cylinder, oil) or 'ideal' (the demanded force "
-                     "is applied exactly)", Options(ACTUATOR_MODES), default="hydraulic")
+    mode: str = spec("-", "'hydraulic' (valve, cylinder, oil; electric legs: their motors) or "
+                     "'ideal' (the demanded force is applied exactly)", Options(ACTUATOR_MODES),
+                     default="hydraulic")
     supply_pressure: float = spec("Pa", "supply pressure p_s", positive(1e5, 1e8), default=21.0e6)
     return_pressure: float = spec("Pa", "return (tank) pressure p_r", nonnegative(0.0, 1e7), default=0.5e6)
     bore_diameter: float = spec("m", "cylinder bore (piston side area A_A = pi D^2 / 4)",
@@ -346,6 +360,7 @@ class Limits(Section):
                               f"stroke_max = {self.stroke_max} m.")
 
 
-__all__ = ["ACTUATOR_KINDS", "ACTUATOR_MODES", "ELECTRIC_KEYS", "TRIANGLE_SLACK", "Actuator",
+__all__ = ["ACTUATOR_KINDS", "ACTUATOR_MODES", "DEFAULT_CURRENT_BANDWIDTH",
+           "DEFAULT_ENCODER_RESOLUTION", "ELECTRIC_KEYS", "TRIANGLE_SLACK", "Actuator",
            "Controller", "Friction", "Geometry", "Hydraulics", "Inertia", "Limits", "Payload",
            "Sensors", "check_payload_inertia", "inertia_matrix"]

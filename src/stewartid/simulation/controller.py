@@ -1,6 +1,7 @@
 """Leg-length servo: continuous-time PID f_d = f_ff + K_p e + K_i z + K_d (l_cmd' - l'), z' = e,
-e = l_cmd - l, clamped to the cylinder's range, with gravity feed-forward f_ff = J_lq^-T G(q_cmd)
-and, for hydraulic actuators, an inner force loop u = k_f (f_d - f) in [-1, 1].
+e = l_cmd - l, clamped to the cylinder's range (electric legs: the motor's peak current), with
+gravity feed-forward f_ff = J_lq^-T G(q_cmd); for hydraulic actuators an inner force loop
+u = k_f (f_d - f) in [-1, 1], for electric ones the current command f_d / force_constant.
 """
 
 from __future__ import annotations
@@ -10,6 +11,7 @@ from numba import njit
 
 from stewartid.model.leg_terms import leg_terms
 from stewartid.platform import Platform
+from stewartid.simulation.electric import force_limits as electric_force_limits
 from stewartid.simulation.hydraulics import force_limits
 
 # indices into the packed controller parameter vector
@@ -18,10 +20,14 @@ C_KP, C_KI, C_KD, C_KF, C_FMIN, C_FMAX = range(6)
 
 def controller_parameters(platform: Platform) -> np.ndarray:
     """Pack ``[controller]`` and the force limits: [K_p (N/m), K_i (N/(m s)), K_d (N s/m), k_f (1/N),
-    f_min, f_max (N)].
+    f_min, f_max (N)]; the limits are the cylinders' stall forces, or for electric legs the motors'
+    peak current times the force constant.
     """
     c = platform.controller
-    f_min, f_max = force_limits(platform.hydraulics)
+    if platform.actuator.kind == "electric":
+        f_min, f_max = electric_force_limits(platform.actuator)
+    else:
+        f_min, f_max = force_limits(platform.hydraulics)
     return np.array([c.proportional_gain, c.integral_gain, c.derivative_gain,
                      c.force_loop_gain, f_min, f_max])
 

@@ -20,8 +20,15 @@ from stewartid.model.dynamics import COULOMB_SMOOTHING
 from stewartid.model.linearization import gravity_stiffness, nominal_matrices
 from stewartid.parallel import WORKERS_INHERIT, run_in_order, worker_count
 from stewartid.platform import Platform
+from stewartid.platform.sections import ACTUATOR_KINDS
 from stewartid.simulation import plant
 from stewartid.simulation.controller import command_tables, controller_parameters
+from stewartid.simulation.electric import (
+    current_bandwidth,
+    electric_parameters,
+    encoder_resolution,
+    largest_step,
+)
 from stewartid.simulation.excitation import (
     DEFAULT_AMPLITUDES,
     DEFAULT_FADE_IN,
@@ -30,8 +37,13 @@ from stewartid.simulation.excitation import (
     paper_experiments,
 )
 from stewartid.simulation.hydraulics import hydraulic_parameters
-from stewartid.simulation.sensors import SensorNoise, measure_legs, measured_pose
-from stewartid.simulation.stability import initial_state, loop_poles, require_stable
+from stewartid.simulation.sensors import (
+    SensorNoise,
+    measure_electric_legs,
+    measure_legs,
+    measured_pose,
+)
+from stewartid.simulation.stability import initial_state, leg_drive, loop_poles, require_stable
 
 #: Default integration step (s).
 DEFAULT_STEP = 5e-4
@@ -56,6 +68,8 @@ class ExperimentRecord:
         Chamber pressures p_A, p_B (Pa); constant in ideal actuator mode.
     spools : ndarray, shape (N, 6)
         Valve spool positions (fraction of full opening).
+    currents : ndarray, shape (N, 6), or None
+        Motor currents (A) of electric legs (``forces`` = force_constant currents); None otherwise.
     """
 
     name: str
@@ -70,6 +84,7 @@ class ExperimentRecord:
     command_lengths: np.ndarray
     pressures: np.ndarray
     spools: np.ndarray
+    currents: np.ndarray | None = None
 
     def tracking_error(self) -> np.ndarray:
         """RMS of the leg-length tracking error per leg (m), shape (6,)."""
@@ -88,11 +103,15 @@ class SimulationResult:
         Configuration, seed, nominal matrices, package version (JSON-ready).
     states : list of ExperimentRecord
         True signals, one per experiment.
+    force_constant : float, optional
+        N/A; when given (electric legs), :func:`write_experiments` logs the motor currents
+        ``i1..i6`` = forces / force_constant (A) in place of ``f1..f6``.
     """
 
     datasets: list[Dataset]
     meta: dict
     states: list[ExperimentRecord]
+    force_constant: float | None = None
 
 
 def check_timing(duration_s: float, sample_rate: float, max_frequency: float) -> None:
@@ -108,18 +127,32 @@ def check_timing(duration_s: float, sample_rate: float, max_frequency: float) ->
         )
 
 
+def integration_substeps(platform: Platform, step: float) -> int:
+    """RK4 steps per sample: the sample period over ``step`` (s) rounded up, the step no longer than
+    the current loop of electric legs resolves (:func:`~stewartid.simulation.electric.largest_step`).
+    """
+    if platform.electric_legs:
+        step = min(step, largest_step(platform.actuator))
+    fs = platform.sensors.sample_rate
+    return max(1, math.ceil(1.0 / (fs * step) - 1e-9))
+
+
 def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: float,
                         noise: SensorNoise | None = None,
                         rng: np.random.Generator | None = None,
                         step: float = DEFAULT_STEP,
                         coulomb_smoothing: float = COULOMB_SMOOTHING,
+                        current_noise: float = 0.0,
                         ) -> tuple[Dataset, ExperimentRecord]:
     """Run the closed-loop plant along one excitation; returns the measured data set and the true
     :class:`ExperimentRecord`.
 
     ``duration_s`` in s, sampled at ``platform.sensors.sample_rate``; ``noise`` defaults to
     ``[sensors]``, ``rng`` to ``default_rng(0)``; ``step`` (s) is rounded down to divide the sample
-    period; ``coulomb_smoothing`` in rad/s.
+    period (and, for electric legs, to resolve their current loop); ``coulomb_smoothing`` in rad/s.
+    Electric legs (:attr:`~stewartid.platform.Platform.electric_legs`) log their encoders' lengths
+    and the force equivalent of their currents, with ``current_noise`` (-) times each channel's
+    RMS as further noise (see :func:`~stewartid.simulation.sensors.measure_electric_legs`).
 
     Raises
     ------
@@ -127,17 +160,21 @@ def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: 
         On a non-positive duration, a frequency not below Nyquist, an actuator that cannot hold the
         platform, or a servo loop unstable at the start pose.
     StewartidError
-        If a leg leaves its stroke or the integration diverges.
+        If a leg leaves its stroke, an electric leg exceeds its screw speed, or the integration
+        diverges.
     """
     fs = platform.sensors.sample_rate
     check_timing(duration_s, fs, excitation.max_frequency)
     if not (step > 0 and math.isfinite(step)):
         raise ConfigError(f"integration step must be > 0 s; got {step!r}.")
+    if not (math.isfinite(current_noise) and current_noise >= 0):
+        raise ConfigError(f"current_noise must be a fraction >= 0 of each current's RMS; got "
+                          f"{current_noise!r}.")
     noise = SensorNoise.from_sensors(platform.sensors) if noise is None else noise
     rng = np.random.default_rng(0) if rng is None else rng
     noise.check_sampling(fs)
     n_out = int(math.floor(duration_s * fs + 1e-9)) + 1
-    substeps = max(1, math.ceil(1.0 / (fs * step) - 1e-9))
+    substeps = integration_substeps(platform, step)
     h = 1.0 / (fs * substeps)
     t_half = np.arange(2 * substeps * (n_out - 1) + 1) * (h / 2)
     q_cmd, qd_cmd, _ = excitation.evaluate(t_half)
@@ -148,14 +185,15 @@ def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: 
         params, upper, base, q_cmd, qd_cmd, bool(platform.controller.gravity_feedforward))
     hp = hydraulic_parameters(platform.hydraulics, platform.neutral_leg_length)
     cp = controller_parameters(platform)
+    ep = electric_parameters(platform.actuator)
     y0 = initial_state(platform, q_cmd[0], cmd_force[0], hp, cp)
-    hydraulic = platform.hydraulic_legs
+    drive = leg_drive(platform)
     require_stable(loop_poles(y0, cmd_len[0], cmd_rate[0], cmd_force[0], params, upper, base,
-                              hp, cp, hydraulic, float(coulomb_smoothing)),
+                              hp, cp, drive, float(coulomb_smoothing), ep),
                    platform, excitation.name)
     status, where, leg, states, qdd, lengths, rates, forces, demands = plant.integrate(
         y0, h, substeps, n_out, cmd_len, cmd_rate, cmd_force, params, upper, base, hp, cp,
-        hydraulic, float(coulomb_smoothing))
+        ep, drive, float(coulomb_smoothing))
     if status == plant.STATUS_STROKE:
         raise StewartidError(
             f"{excitation.name}: leg {leg + 1} left its {platform.hydraulics.stroke} m stroke "
@@ -165,6 +203,9 @@ def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: 
         raise StewartidError(
             f"{excitation.name}: the closed loop diverged at t = {where / fs:.3f} s; lower "
             "the integration step or the controller gains.")
+    electric = drive == plant.DRIVE_ELECTRIC
+    if electric:
+        _require_screw_speed(platform, rates, excitation.name)
     t = np.arange(n_out) / fs
     record = ExperimentRecord(
         name=excitation.name, t=t, q=states[:, plant.S_Q:plant.S_Q + 6],
@@ -173,14 +214,34 @@ def simulate_experiment(platform: Platform, excitation: Excitation, duration_s: 
         command_lengths=cmd_len[::2 * substeps],
         pressures=np.stack([states[:, plant.S_PA:plant.S_PA + 6],
                             states[:, plant.S_PB:plant.S_PB + 6]], axis=-1),
-        spools=states[:, plant.S_XV:plant.S_XV + 6])
-    measured_lengths, measured_forces = measure_legs(lengths, forces, noise, rng, t)
+        spools=states[:, plant.S_XV:plant.S_XV + 6],
+        currents=states[:, plant.S_I:plant.S_I + 6] if electric else None)
+    if electric:
+        measured_lengths, measured_forces = measure_electric_legs(
+            lengths, forces, noise, rng, t, encoder_resolution(platform.actuator), current_noise)
+    else:
+        measured_lengths, measured_forces = measure_legs(lengths, forces, noise, rng, t)
     # Newton started at the true pose: the same solution as from the commanded one, in fewer
     # iterations
     pose = measured_pose(platform, measured_lengths, record.q)
     dataset = Dataset(t=t, pose=pose, lengths=measured_lengths, forces=measured_forces,
                       name=excitation.name)
     return dataset, record
+
+
+def _require_screw_speed(platform: Platform, rates: np.ndarray, where: str) -> None:
+    """Raise if a leg moved faster than its motor's screw_speed allows (when given)."""
+    a = platform.actuator
+    if a.screw_speed is None or a.screw_lead is None:
+        return
+    limit = a.screw_speed * a.screw_lead
+    fastest = np.abs(rates).max(axis=0)
+    if fastest.max() > limit:
+        leg = int(np.argmax(fastest))
+        raise StewartidError(
+            f"{where}: leg {leg + 1} moved at {fastest[leg]:.4g} m/s, faster than its motor "
+            f"allows ([actuator] screw_speed x screw_lead = {limit:.4g} m/s); lower the "
+            "excitation amplitude or frequency.")
 
 
 def noise_generator(seed: int, experiment: int, count: int = 6) -> np.random.Generator:
@@ -198,7 +259,7 @@ def simulate_experiments(platform: Platform, coulomb: float | None = None,
                          actuator: str | None = None, fade_in: float = DEFAULT_FADE_IN,
                          step: float = DEFAULT_STEP,
                          progress: Callable[[int, int, str], Any] | None = None,
-                         jobs: int = 1,
+                         jobs: int = 1, current_noise: float = 0.0,
                          ) -> SimulationResult:
     """The paper's six virtual experiments (experiment k excites DOF k with a sine).
 
@@ -217,8 +278,10 @@ def simulate_experiments(platform: Platform, coulomb: float | None = None,
         Sensor errors; ``[sensors]`` by default.
     seed : int
         Seed of the sensor noise, one stream per experiment.
-    actuator : {"hydraulic", "ideal"}, optional
-        Override ``[hydraulics] mode``.
+    actuator : {"hydraulic", "electric", "ideal"}, optional
+        "ideal" applies the demanded forces exactly; "hydraulic" or "electric", the platform's own
+        ``[actuator]`` kind, drives the legs by their valves or motors. Default: the kind, or
+        "ideal" when ``[hydraulics] mode = "ideal"``.
     fade_in : float
         s.
     step : float
@@ -227,6 +290,15 @@ def simulate_experiments(platform: Platform, coulomb: float | None = None,
         ``progress(done, total, name)`` after each experiment.
     jobs : int
         Worker processes; the data are the same for any number.
+    current_noise : float
+        Electric legs: noise of each motor current as a fraction of its RMS over the record
+        (0.005 for ``simulate --noise``).
+
+    Raises
+    ------
+    ConfigError
+        On an actuator other than the platform's kind or "ideal", and as
+        :func:`simulate_experiment`.
     """
     updates: dict[str, Any] = {}
     if coulomb is not None:
@@ -234,7 +306,7 @@ def simulate_experiments(platform: Platform, coulomb: float | None = None,
     if viscous is not None:
         updates["friction__gimbal_viscous"] = float(viscous)
     if actuator is not None:
-        updates["hydraulics__mode"] = actuator
+        updates["hydraulics__mode"] = actuator_mode(platform, actuator)
     if updates:
         platform = platform.replace(**updates)
     noise = SensorNoise.from_sensors(platform.sensors) if noise is None else noise
@@ -245,8 +317,8 @@ def simulate_experiments(platform: Platform, coulomb: float | None = None,
     if isinstance(jobs, bool) or not isinstance(jobs, int | np.integer) or jobs < 1:
         raise ConfigError(f"jobs must be a positive integer (worker processes); got {jobs!r}.")
     excitations = paper_experiments(platform, frequency_hz, amplitudes, fade_in)
-    runs = [(platform, excitation, duration_s, noise, seed, k, len(excitations), step)
-            for k, excitation in enumerate(excitations)]
+    runs = [(platform, excitation, duration_s, noise, seed, k, len(excitations), step,
+             current_noise) for k, excitation in enumerate(excitations)]
     datasets, records = zip(*run_experiments(runs, jobs, progress), strict=True)
     datasets, records = list(datasets), list(records)
     M, B = nominal_matrices(platform)
@@ -258,9 +330,9 @@ def simulate_experiments(platform: Platform, coulomb: float | None = None,
             "amplitudes": list(map(float, amplitudes)), "fade_in": fade_in,
             "experiments": [excitation_to_dict(e) for e in excitations],
         },
-        "integration": {"method": "RK4", "step": 1.0 / (platform.sensors.sample_rate * max(
-            1, math.ceil(1.0 / (platform.sensors.sample_rate * step) - 1e-9))),
-            "coulomb_smoothing": COULOMB_SMOOTHING},
+        "integration": {"method": "RK4", "step": 1.0 / (platform.sensors.sample_rate
+                                                         * integration_substeps(platform, step)),
+                        "coulomb_smoothing": COULOMB_SMOOTHING},
         "noise": dataclasses.asdict(noise),
         "seed": int(seed),
         "tracking_error_rms": [r.tracking_error().tolist() for r in records],
@@ -268,13 +340,57 @@ def simulate_experiments(platform: Platform, coulomb: float | None = None,
         "K_G": gravity_stiffness(platform).tolist(),
         "version": stewartid.__version__,
     }
-    return SimulationResult(datasets, meta, records)
+    meta.update(electric_meta(platform, current_noise))
+    return SimulationResult(datasets, meta, records, logged_force_constant(platform))
+
+
+def actuator_mode(platform: Platform, actuator: str) -> str:
+    """``[hydraulics] mode`` for the legs ``actuator`` ("hydraulic", "electric" or "ideal").
+
+    Raises
+    ------
+    ConfigError
+        If ``actuator`` is neither "ideal" nor the platform's ``[actuator] kind``.
+    """
+    kind = platform.actuator.kind
+    if actuator == "ideal":
+        return "ideal"
+    if actuator in ACTUATOR_KINDS and actuator != kind:
+        fix = ('give the platform an [actuator] with kind = "electric" and its motor constants'
+               if actuator == "electric" else "leave the actuator out")
+        raise ConfigError(f"actuator {actuator!r}: platform '{platform.name}' has {kind} legs "
+                          f"([actuator] kind = \"{kind}\"); {fix}, or use 'ideal'.")
+    if actuator != kind:
+        raise ConfigError(f"actuator must be one of 'hydraulic', 'electric', 'ideal'; got "
+                          f"{actuator!r}.")
+    return "hydraulic"
+
+
+def logged_force_constant(platform: Platform) -> float | None:
+    """N/A by which logs of the platform's legs give currents instead of forces; None unless electric."""
+    return platform.actuator.force_constant if platform.electric_legs else None
+
+
+def electric_meta(platform: Platform, current_noise: float) -> dict:
+    """The ``electric`` entry of a simulation's metadata (motor model and sensors); empty for
+    other legs, whose metadata stay as they were.
+    """
+    if not platform.electric_legs:
+        return {}
+    a = platform.actuator
+    return {"electric": {
+        "current_loop": "first order, i' = 2 pi f_c (i_cmd - i), i_cmd within +-peak_current",
+        "current_bandwidth_hz": current_bandwidth(a), "peak_current": a.peak_current,
+        "force_constant": a.force_constant, "encoder_resolution": encoder_resolution(a),
+        "current_noise_fraction_of_rms": float(current_noise),
+        "logged": "i1..i6 (A) = f / force_constant"}}
 
 
 def _simulate_run(run: tuple) -> tuple[Dataset, ExperimentRecord]:
-    platform, excitation, duration_s, noise, seed, k, count, step = run
+    platform, excitation, duration_s, noise, seed, k, count, step, current_noise = run
     return simulate_experiment(platform, excitation, duration_s, noise,
-                               noise_generator(seed, k, count), step)
+                               noise_generator(seed, k, count), step,
+                               current_noise=current_noise)
 
 
 def run_experiments(runs: Sequence[tuple], jobs: int | None = 1,
@@ -282,8 +398,9 @@ def run_experiments(runs: Sequence[tuple], jobs: int | None = 1,
                     ) -> list[tuple[Dataset, ExperimentRecord]]:
     """Simulate ``runs`` in order on up to ``jobs`` workers (every core when None); results in order.
 
-    Each run is ``(platform, excitation, duration_s, noise, seed, k, count, step)``, its noise stream
-    :func:`noise_generator` ``(seed, k, count)``; ``progress(done, total, name)`` as they finish.
+    Each run is ``(platform, excitation, duration_s, noise, seed, k, count, step, current_noise)``,
+    its noise stream :func:`noise_generator` ``(seed, k, count)``; ``progress(done, total, name)``
+    as they finish.
     """
     def finished(done: int, total: int, index: int) -> None:
         progress(done, total, runs[index][1].name)
@@ -298,7 +415,8 @@ def run_experiments(runs: Sequence[tuple], jobs: int | None = 1,
 
 def write_experiments(result: SimulationResult, out: str | Path, format: str = "csv",
                       force: bool = False) -> list[Path]:
-    """Write ``exp1..expN.<format>`` and ``meta.json`` into the folder ``out``.
+    """Write ``exp1..expN.<format>`` and ``meta.json`` into the folder ``out``; the motor currents
+    ``i1..i6`` in place of ``f1..f6`` when ``result.force_constant`` is set.
 
     Raises
     ------
@@ -312,7 +430,8 @@ def write_experiments(result: SimulationResult, out: str | Path, format: str = "
     out = Path(out)
     check_output_folder(out, force, is_experiment_file)
     out.mkdir(parents=True, exist_ok=True)
-    paths = [write_dataset(d, out / f"{d.name}.{format}", format=format)
+    paths = [write_dataset(d, out / f"{d.name}.{format}", format=format,
+                           force_constant=result.force_constant)
              for d in result.datasets]
     return [*paths, write_json_atomic(out / "meta.json", result.meta)]
 

@@ -1,6 +1,8 @@
 """The compiled closed loop (plant, joint friction, actuators, leg servos), fixed-step RK4 in one numba
-loop. State y (42): q, q_dot, PID integrators (m s), spools, spool rates (1/s), p_A, p_B (Pa),
-six each; ``ideal`` actuators freeze valves and pressures and apply the demands.
+loop. State y (48): q, q_dot, PID integrators (m s), spools, spool rates (1/s), p_A, p_B (Pa),
+motor currents (A), six each. The leg ``drive`` chooses the states that move: hydraulic legs
+freeze the currents, electric legs the valves and pressures, ideal actuators all three and apply
+the demands.
 """
 
 from __future__ import annotations
@@ -14,11 +16,17 @@ from stewartid.model import compiled
 from stewartid.model import parameters as layout
 from stewartid.model.joints import N_GIMBAL_AXES, N_JOINTS
 from stewartid.simulation.controller import pid_force, valve_command
+from stewartid.simulation.electric import E_FORCE_CONSTANT, current_rate
 from stewartid.simulation.hydraulics import H_MID, H_STROKE, actuator_force, pressure_rates
 
 # state layout
-S_Q, S_QD, S_Z, S_XV, S_VV, S_PA, S_PB = 0, 6, 12, 18, 24, 30, 36
-N_STATES = 42
+S_Q, S_QD, S_Z, S_XV, S_VV, S_PA, S_PB, S_I = 0, 6, 12, 18, 24, 30, 36, 42
+N_STATES = 48
+#: States of hydraulic and ideal legs (the currents, last, stay zero).
+N_HYDRAULIC_STATES = 42
+#: The leg drives of :func:`rhs`: demanded force applied exactly, valve-controlled cylinder,
+#: servo motor with its current loop.
+DRIVE_IDEAL, DRIVE_HYDRAULIC, DRIVE_ELECTRIC = 0, 1, 2
 H_VALVE_OMEGA, H_VALVE_ZETA = 10, 11
 
 #: Status codes returned by :func:`integrate`.
@@ -59,10 +67,11 @@ def _scratch():
 
 
 @njit(cache=True)
-def rhs(y, dy, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, hydraulic,
+def rhs(y, dy, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, ep, drive,
         smoothing, M, h, G, J, Jj, lengths, rates, force, demand, work, chol, qdd):
     """Closed-loop state derivative into ``dy``, for this instant's commanded leg lengths (m), rates
-    (m/s) and feed-forward (N); the remaining arrays are scratch outputs (model terms, leg forces).
+    (m/s) and feed-forward (N), legs driven by ``drive`` (``DRIVE_*``); the remaining arrays are
+    scratch outputs (model terms, leg forces).
     """
     q = y[S_Q:S_Q + 6]
     qd = y[S_QD:S_QD + 6]
@@ -77,7 +86,8 @@ def rhs(y, dy, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, hyd
                                y[S_Z + i], cmd_force[i])
         demand[i] = f_d
         dy[S_Z + i] = z_dot
-        if hydraulic:
+        dy[S_I + i] = 0.0
+        if drive == DRIVE_HYDRAULIC:
             xv = y[S_XV + i]
             vv = y[S_VV + i]
             pa = y[S_PA + i]
@@ -91,6 +101,14 @@ def rhs(y, dy, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, hyd
             dy[S_PA + i] = dpa
             dy[S_PB + i] = dpb
             force[i] = f
+        elif drive == DRIVE_ELECTRIC:
+            dy[S_XV + i] = 0.0
+            dy[S_VV + i] = 0.0
+            dy[S_PA + i] = 0.0
+            dy[S_PB + i] = 0.0
+            current = y[S_I + i]
+            dy[S_I + i] = current_rate(ep, f_d, current)
+            force[i] = ep[E_FORCE_CONSTANT] * current
         else:
             dy[S_XV + i] = 0.0
             dy[S_VV + i] = 0.0
@@ -128,12 +146,12 @@ def rhs(y, dy, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, hyd
 
 @njit(cache=True)
 def integrate(y0, step, substeps, n_out, cmd_length, cmd_rate, cmd_force, params, upper, base,
-              hp, cp, hydraulic, smoothing):
+              hp, cp, ep, drive, smoothing):
     """Integrate the closed loop with RK4 (step h, s) and record every ``substeps`` steps, n_out samples.
 
-    Commands (2 substeps (n_out - 1) + 1, 6) are on the half-step grid t = k h / 2; ``hydraulic``
-    False for ideal force actuators; ``smoothing`` in rad/s. Returns (status, where, leg, states
-    (n_out, 42), qdd, lengths, rates, force, demand (n_out, 6)): status 0 ok, 1 leg ``leg`` left its
+    Commands (2 substeps (n_out - 1) + 1, 6) are on the half-step grid t = k h / 2; ``drive`` one of
+    ``DRIVE_*``; ``smoothing`` in rad/s. Returns (status, where, leg, states
+    (n_out, 48), qdd, lengths, rates, force, demand (n_out, 6)): status 0 ok, 1 leg ``leg`` left its
     stroke, 2 non-finite state; ``where`` the sample integration stopped at (n_out if finished).
     """
     n = N_STATES
@@ -155,7 +173,7 @@ def integrate(y0, step, substeps, n_out, cmd_length, cmd_rate, cmd_force, params
     for s in range(total + 1):
         g = 2 * s
         rhs(y, k1, cmd_length[g], cmd_rate[g], cmd_force[g], params, upper, base, hp, cp,
-            hydraulic, smoothing, M, h, G, J, Jj, lengths, rates, force, demand, work, chol,
+            ep, drive, smoothing, M, h, G, J, Jj, lengths, rates, force, demand, work, chol,
             qdd)
         if s % substeps == 0:
             r = s // substeps
@@ -179,17 +197,17 @@ def integrate(y0, step, substeps, n_out, cmd_length, cmd_rate, cmd_force, params
         for c in range(n):
             yt[c] = y[c] + 0.5 * step * k1[c]
         rhs(yt, k2, cmd_length[g + 1], cmd_rate[g + 1], cmd_force[g + 1], params, upper, base,
-            hp, cp, hydraulic, smoothing, M, h, G, J, Jj, lengths, rates, force, demand, work,
+            hp, cp, ep, drive, smoothing, M, h, G, J, Jj, lengths, rates, force, demand, work,
             chol, qdd)
         for c in range(n):
             yt[c] = y[c] + 0.5 * step * k2[c]
         rhs(yt, k3, cmd_length[g + 1], cmd_rate[g + 1], cmd_force[g + 1], params, upper, base,
-            hp, cp, hydraulic, smoothing, M, h, G, J, Jj, lengths, rates, force, demand, work,
+            hp, cp, ep, drive, smoothing, M, h, G, J, Jj, lengths, rates, force, demand, work,
             chol, qdd)
         for c in range(n):
             yt[c] = y[c] + step * k3[c]
         rhs(yt, k4, cmd_length[g + 2], cmd_rate[g + 2], cmd_force[g + 2], params, upper, base,
-            hp, cp, hydraulic, smoothing, M, h, G, J, Jj, lengths, rates, force, demand, work,
+            hp, cp, ep, drive, smoothing, M, h, G, J, Jj, lengths, rates, force, demand, work,
             chol, qdd)
         for c in range(n):
             y[c] += step / 6.0 * (k1[c] + 2.0 * k2[c] + 2.0 * k3[c] + k4[c])
@@ -197,10 +215,10 @@ def integrate(y0, step, substeps, n_out, cmd_length, cmd_rate, cmd_force, params
 
 
 @njit(cache=True)
-def linearize(y0, scales, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp,
-              hydraulic, smoothing):
-    """State matrix A = d(dy/dt)/dy (42, 42) at ``y0``, commands frozen, by central differences of
-    steps ``scales`` (42,): O(scale^2) on the smooth right-hand side.
+def linearize(y0, scales, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, ep,
+              drive, smoothing):
+    """State matrix A = d(dy/dt)/dy (48, 48) at ``y0``, commands frozen, by central differences of
+    steps ``scales`` (48,): O(scale^2) on the smooth right-hand side.
     """
     n = N_STATES
     M, h, G, J, Jj, lengths, rates, force, demand, work, chol, qdd = _scratch()
@@ -211,10 +229,10 @@ def linearize(y0, scales, cmd_length, cmd_rate, cmd_force, params, upper, base, 
     for j in range(n):
         e = scales[j]
         y[j] = y0[j] + e
-        rhs(y, plus, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, hydraulic,
+        rhs(y, plus, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, ep, drive,
             smoothing, M, h, G, J, Jj, lengths, rates, force, demand, work, chol, qdd)
         y[j] = y0[j] - e
-        rhs(y, minus, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, hydraulic,
+        rhs(y, minus, cmd_length, cmd_rate, cmd_force, params, upper, base, hp, cp, ep, drive,
             smoothing, M, h, G, J, Jj, lengths, rates, force, demand, work, chol, qdd)
         y[j] = y0[j]
         for i in range(n):

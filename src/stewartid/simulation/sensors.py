@@ -18,6 +18,7 @@ from stewartid.model.dynamics import inverse_dynamics
 from stewartid.model.kinematics import forward_kinematics
 from stewartid.platform import Platform
 from stewartid.platform.sections import Sensors
+from stewartid.simulation.electric import encoder_lengths
 from stewartid.simulation.imperfections import (
     delay_signal,
     lowpass_noise,
@@ -167,6 +168,11 @@ def reference_noise(platform: Platform, scale: float = 1.0) -> SensorNoise:
         force_noise=scale * REFERENCE_FORCE_NOISE * static_leg_force(platform))
 
 
+#: The reference noise of an electric leg's current sensing (``simulate --noise``): standard
+#: deviation as a fraction of each channel's RMS over the record (-).
+REFERENCE_CURRENT_NOISE = 0.005
+
+
 #: When :func:`sensor_noise` takes the reference noise of a channel instead of ``[sensors]``:
 #: never, always, or only where ``[sensors]`` declares no noise.
 REFERENCE_CHOICES = ("never", "always", "where_zero")
@@ -258,6 +264,24 @@ def measure_legs(lengths: np.ndarray, forces: np.ndarray, noise: SensorNoise,
         measured_forces = measured_forces + random_walk(n, noise.force_drift, rng)
     return (quantise(measured_lengths, noise.length_resolution),
             quantise(measured_forces, noise.force_resolution))
+
+
+def measure_electric_legs(lengths: np.ndarray, forces: np.ndarray, noise: SensorNoise,
+                          rng: np.random.Generator, t: np.ndarray | None = None,
+                          encoder_resolution: float = 0.0, current_noise: float = 0.0,
+                          ) -> tuple[np.ndarray, np.ndarray]:
+    """Measured leg lengths (m) and force equivalents force_constant i (N) of electric legs, (N, 6)
+    each, from the true ones.
+
+    The encoders give whole counts of ``encoder_resolution`` (m of leg travel); the current sensing
+    adds noise of ``current_noise`` times each channel's RMS over the record, in quadrature with
+    ``noise.force_noise``; then every error of ``noise`` applies as in :func:`measure_legs`.
+    """
+    if current_noise > 0:
+        rms = np.sqrt(np.mean(np.asarray(forces, dtype=float) ** 2, axis=0))
+        combined = np.hypot(np.broadcast_to(noise.force_noise, (6,)), current_noise * rms)
+        noise = dataclasses.replace(noise, force_noise=tuple(float(v) for v in combined))
+    return measure_legs(encoder_lengths(lengths, encoder_resolution), forces, noise, rng, t)
 
 
 def measured_pose(platform: Platform, lengths: np.ndarray,
