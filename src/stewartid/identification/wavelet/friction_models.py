@@ -5,6 +5,7 @@ The equations and solve of each, and the choice between them on one sine per exp
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -94,6 +95,20 @@ def choose_friction_fit(results: Mapping[str, IdentificationResult],
         for model, value in predicted.items()}, "friction_law_test": law}
 
 
+def law_floor(law: IdentificationResult, free: IdentificationResult) -> IdentificationResult:
+    """The Coulomb-law fit with every standard error at least its entry's difference from the
+    fit with free interval constants, which no friction law biases.
+
+    Under pose noise the soft-sign Coulomb regressors of slowly reversing joints are errors in
+    variables: the law fit's couplings can be biased by several of its standard errors while
+    the free fit stays unbiased. Their difference bounds that bias (and holds the free fit's
+    noise, so it is a floor, not an addition). Both (6, 6) results after their pairs combine.
+    """
+    return dataclasses.replace(
+        law, std_errors_M=np.maximum(law.std_errors_M, np.abs(law.M - free.M)),
+        std_errors_B=np.maximum(law.std_errors_B, np.abs(law.B - free.B)))
+
+
 #: Family-wise level of :func:`friction_law_test` over the 12 diagonal entries of Mt and Bt.
 FRICTION_LAW_LEVEL = 0.01
 
@@ -124,4 +139,4 @@ def friction_law_test(free: np.ndarray, free_std: np.ndarray, law: np.ndarray,
 
 
 __all__ = ["FRICTION_LAW_LEVEL", "WINDOW_LENGTH", "choose_friction_fit", "friction_law_test",
-           "friction_models", "model_equations", "solve_model", "solve_models"]
+           "friction_models", "law_floor", "model_equations", "solve_model", "solve_models"]
