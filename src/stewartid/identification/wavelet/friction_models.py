@@ -96,17 +96,23 @@ def choose_friction_fit(results: Mapping[str, IdentificationResult],
 
 
 def law_floor(law: IdentificationResult, free: IdentificationResult) -> IdentificationResult:
-    """The Coulomb-law fit with every standard error at least its entry's difference from the
-    fit with free interval constants, which no friction law biases.
+    """The Coulomb-law fit, its standard errors widened by its bias as the fit with free
+    interval constants (which no friction law biases) measures it.
 
     Under pose noise the soft-sign Coulomb regressors of slowly reversing joints are errors in
     variables: the law fit's couplings can be biased by several of its standard errors while
-    the free fit stays unbiased. Their difference bounds that bias (and holds the free fit's
-    noise, so it is a floor, not an addition). Both (6, 6) results after their pairs combine.
+    the free fit stays unbiased. With the law fit the efficient one, their difference d has
+    variance s_free^2 - s_law^2 without bias (Hausman 1978), so b^2 = max(d^2 - s_free^2 +
+    s_law^2, 0) estimates the squared bias and the error becomes sqrt(s_law^2 + b^2). Both
+    (6, 6) results after their pairs combine.
     """
+    def widened(value, std, other, other_std):
+        bias = np.maximum((value - other) ** 2 - np.abs(other_std ** 2 - std ** 2), 0.0)
+        return np.sqrt(std ** 2 + bias)
+
     return dataclasses.replace(
-        law, std_errors_M=np.maximum(law.std_errors_M, np.abs(law.M - free.M)),
-        std_errors_B=np.maximum(law.std_errors_B, np.abs(law.B - free.B)))
+        law, std_errors_M=widened(law.M, law.std_errors_M, free.M, free.std_errors_M),
+        std_errors_B=widened(law.B, law.std_errors_B, free.B, free.std_errors_B))
 
 
 #: Family-wise level of :func:`friction_law_test` over the 12 diagonal entries of Mt and Bt.
