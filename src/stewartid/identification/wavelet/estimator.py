@@ -32,6 +32,7 @@ from stewartid.identification.wavelet.detection import (
 from stewartid.identification.wavelet.friction_models import (
     choose_friction_fit,
     friction_models,
+    law_floor,
     model_equations,
     solve_models,
 )
@@ -237,6 +238,8 @@ class WaveletIdentifier(BaseIdentifier):
         fits = {model: self._weak_form_result(solution, infos, len(equations[model]), wavelet,
                                               model, rate, legs and model in ("free", "coulomb"))
                 for model, (solution, rate) in solved.items()}
+        if "free" in fits and "coulomb" in fits:  # the law's bias, before the choice
+            fits["coulomb"] = (law_floor(fits["coulomb"][0], fits["free"][0]), fits["coulomb"][1])
         chosen, why = choose_friction_fit({model: fit[0] for model, fit in fits.items()},
                                           {model: solution for model, (solution, _) in
                                            solved.items()})
