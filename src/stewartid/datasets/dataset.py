@@ -4,11 +4,12 @@
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Hashable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pyarrow as pa
@@ -63,6 +64,11 @@ class Dataset:
         Actuator forces along the legs (N, positive extends).
     name : str
         File stem when read from a file.
+
+    Notes
+    -----
+    The arrays are read-only views: what is derived from a record (:meth:`derived`) is computed
+    once, so the data must not change after the record is built.
     """
 
     t: np.ndarray
@@ -70,6 +76,8 @@ class Dataset:
     lengths: np.ndarray
     forces: np.ndarray
     name: str = "exp"
+    _derived: dict = dataclasses.field(default_factory=dict, init=False, repr=False,
+                                       compare=False)
 
     def __post_init__(self) -> None:
         n = np.shape(self.t)[0] if np.ndim(self.t) == 1 else -1
@@ -80,8 +88,15 @@ class Dataset:
             if value.shape != (n, 6):
                 raise DataError(f"{self.name}: {field} must have shape ({n}, 6) to match t; "
                                 f"got {value.shape}.")
-            object.__setattr__(self, field, value)
-        object.__setattr__(self, "t", np.asarray(self.t, dtype=float))
+            object.__setattr__(self, field, _read_only(value))
+        object.__setattr__(self, "t", _read_only(np.asarray(self.t, dtype=float)))
+
+    def derived(self, key: Hashable, compute: Callable[[Dataset], Any]) -> Any:
+        """``compute(self)``, computed once per ``key`` for this record (leg terms, frequencies,
+        thinned copies: what every method derives from the same record)."""
+        if key not in self._derived:
+            self._derived[key] = compute(self)
+        return self._derived[key]
 
     @property
     def sample_rate(self) -> float:
@@ -102,6 +117,13 @@ class Dataset:
 
         data = np.column_stack([self.t, self.pose, self.lengths, self.forces])
         return pd.DataFrame(data, columns=list(COLUMNS))
+
+
+def _read_only(array: np.ndarray) -> np.ndarray:
+    """A read-only view of ``array`` (the caller's array stays writable)."""
+    view = array.view()
+    view.flags.writeable = False
+    return view
 
 
 def _format_of(path: Path, format: str | None) -> str:

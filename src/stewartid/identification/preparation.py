@@ -5,6 +5,7 @@ Jacobians, gravity and y = J_lq^T f_a - G(q) at every measured pose, computed on
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -125,7 +126,10 @@ def generalized_force_sensitivity(platform: Platform, q: np.ndarray, forces: np.
 
 def prepare_experiment(dataset: Dataset, platform: Platform, gravity: bool = True,
                        joints: bool = False, remainder: bool = False) -> Experiment:
-    """Every model term of one experiment, each computed once, at every measured pose.
+    """Every model term of one experiment, each computed once per record, at every measured pose.
+
+    The terms are kept with the record (:meth:`~stewartid.datasets.dataset.Dataset.derived`), so
+    that every method fitted to it shares them; the joint-axis Jacobians, the largest, are not.
 
     Parameters
     ----------
@@ -138,20 +142,27 @@ def prepare_experiment(dataset: Dataset, platform: Platform, gravity: bool = Tru
     remainder : bool
         Subtract the model's departure from its linearisation (:func:`model_remainder`).
     """
-    G, J, _, joint_jacobians = compute_leg_terms(platform, np.ascontiguousarray(dataset.pose), joints)
+    shared = dataset.derived(("prepared", platform, gravity, remainder),
+                             lambda record: _prepared(record, platform, gravity, remainder))
+    experiment = dataclasses.replace(shared)   # its own slot for the joint-axis Jacobians
+    if joints:
+        experiment.__dict__["joint_jacobians"] = joint_rate_jacobians(platform, dataset.pose)
+    return experiment
+
+
+def _prepared(dataset: Dataset, platform: Platform, gravity: bool, remainder: bool
+              ) -> Experiment:
+    G, J, _, _ = compute_leg_terms(platform, np.ascontiguousarray(dataset.pose))
     y = np.einsum("nji,nj->ni", J, dataset.forces)
     if gravity:
         y = y - G
     if remainder:
         y = y - model_remainder(platform, dataset.pose, dataset.sample_rate)
-    experiment = Experiment(
+    return Experiment(
         name=dataset.name, t=dataset.t, q=dataset.pose, generalized_force=y, leg_jacobian=J,
         gravity=G, force_sensitivity=generalized_force_sensitivity(
             platform, dataset.pose, dataset.forces, gravity),
         sample_rate=dataset.sample_rate, platform=platform)
-    if joints:  # the cached property's slot, as its first use would fill it
-        experiment.__dict__["joint_jacobians"] = joint_jacobians
-    return experiment
 
 
 def model_remainder(platform: Platform, q: np.ndarray, sample_rate: float) -> np.ndarray:

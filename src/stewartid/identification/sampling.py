@@ -30,10 +30,12 @@ SHIFT_LIMIT = 10.0
 
 
 def thinned(dataset: Dataset, factor: int) -> Dataset:
-    """Every ``factor``-th sample of an experiment, from the first (same name, rate / factor)."""
+    """Every ``factor``-th sample of an experiment, from the first (same name, rate / factor);
+    one copy per record, which every method's check shares."""
     rows = slice(0, None, factor)
-    return Dataset(dataset.t[rows], dataset.pose[rows], dataset.lengths[rows],
-                   dataset.forces[rows], dataset.name)
+    return dataset.derived(("thinned", factor), lambda record: Dataset(
+        record.t[rows], record.pose[rows], record.lengths[rows], record.forces[rows],
+        record.name))
 
 
 def _diagonals(result: IdentificationResult) -> tuple[np.ndarray, np.ndarray]:

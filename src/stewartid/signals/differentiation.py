@@ -5,6 +5,7 @@ and excitation-frequency estimation.
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Sequence
 
 import numpy as np
@@ -221,13 +222,31 @@ def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -
     """Frequency (Hz) of the dominant sine in ``x`` (N,) or (N, m).
 
     The largest peak of the Hann-windowed, zero-padded spectrum of the most varying channel,
-    refined by a sine fit; ``refine=False``: the plain peak, within half a bin.
+    refined by a sine fit; ``refine=False``: the plain peak, within half a bin. Computed once for
+    a read-only array (a record's columns): every method asks for it.
 
     Raises
     ------
     DataError
         When no channel moves.
     """
+    if isinstance(x, np.ndarray) and not x.flags.writeable:
+        key = (id(x), float(sample_rate), bool(refine))
+        known = _FREQUENCIES.get(key)
+        if known is None or known[0]() is not x:
+            value = _estimate_frequency(x, sample_rate, refine)
+            _FREQUENCIES[key] = (weakref.ref(x, lambda _, key=key: _FREQUENCIES.pop(key, None)),
+                                 value)
+            return value
+        return known[1]
+    return _estimate_frequency(x, sample_rate, refine)
+
+
+#: Frequencies of read-only arrays, by identity, while the array lives.
+_FREQUENCIES: dict[tuple[int, float, bool], tuple[weakref.ref, float]] = {}
+
+
+def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool) -> float:
     x = np.asarray(x, dtype=float)
     x = x[:, None] if x.ndim == 1 else x
     centered = x - x.mean(axis=0)

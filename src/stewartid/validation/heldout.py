@@ -204,11 +204,15 @@ def fold_bounds(n: int, folds: int) -> np.ndarray:
 
 
 def time_piece(dataset: Dataset, start: int, stop: int) -> Dataset:
-    """Samples ``start:stop`` of a record, named after their time span."""
-    t = dataset.t[start:stop]
-    return Dataset(t=t, pose=dataset.pose[start:stop], lengths=dataset.lengths[start:stop],
-                   forces=dataset.forces[start:stop],
-                   name=f"{dataset.name}[{t[0]:.4g}-{t[-1]:.4g} s]")
+    """Samples ``start:stop`` of a record, named after their time span; one copy per record and
+    span, which every method's folds share."""
+    def piece(record: Dataset) -> Dataset:
+        t = record.t[start:stop]
+        return Dataset(t=t, pose=record.pose[start:stop], lengths=record.lengths[start:stop],
+                       forces=record.forces[start:stop],
+                       name=f"{record.name}[{t[0]:.4g}-{t[-1]:.4g} s]")
+
+    return dataset.derived(("piece", int(start), int(stop)), piece)
 
 
 def excitation_window(dataset: Dataset) -> float:

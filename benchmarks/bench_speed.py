@@ -1,0 +1,137 @@
+"""Speed and memory of the identification path beside an earlier source tree, in one run.
+
+Each command runs in a fresh process, the two trees interleaved (A B A B ...), and its wall
+time, CPU time and peak resident memory are read from the process itself (``os.wait4``).
+Then each tree fits the methods in one process after a warm-up (the library's cost without
+start-up), best of ``--repeats``.
+
+The logs: the paper platform's six experiments of 20 s at 1 kHz with the reference sensor
+noise and 30 N m of Coulomb friction (Parquet), simulated once by this tree, and the same at
+2 kHz.
+
+Usage::
+
+    git worktree add /tmp/before <commit>
+    python benchmarks/bench_speed.py --before /tmp/before/src [--repeats 5] [--reproduce]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+#: A CLI call of a source tree: its own ``main`` on the module path.
+RUN = "import sys; sys.path.insert(0, sys.argv.pop(1)); from stewartid.cli import main; main()"
+#: In-process fits after a warm-up: best CPU time of ``repeats`` fits of each method.
+FIT = """
+import sys, time, warnings
+sys.path.insert(0, sys.argv[1])
+warnings.simplefilter("ignore")
+from pathlib import Path
+from stewartid.platform import load_platform
+from stewartid.identification.registry import create_identifier
+try:
+    from stewartid.datasets import read_datasets
+except ImportError:  # an older layout
+    from stewartid.dataset import read_datasets
+platform = load_platform("paper")
+data = read_datasets(sorted(str(p) for p in Path(sys.argv[2]).glob("exp*.parquet")), platform)
+for name in sys.argv[4].split(","):
+    create_identifier(name).fit(data, platform)
+    best = min(_timed(lambda: create_identifier(name).fit(data, platform))
+               for _ in range(int(sys.argv[3])))
+    print(name, best)
+"""
+TIMER = """
+def _timed(call):
+    start = time.process_time()
+    call()
+    return time.process_time() - start
+"""
+
+
+def measured(command: list[str], env: dict[str, str]) -> tuple[float, float, float]:
+    """Wall s, CPU s and peak resident MiB of one process; NaN wall if it failed (exit 2: the
+    method refused the log)."""
+    start = time.perf_counter()
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                               env=env)
+    _, status, usage = os.wait4(process.pid, 0)
+    wall = time.perf_counter() - start
+    wall = wall if status == 0 else float("nan")
+    return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024
+
+
+def simulate(folder: Path, rate: float) -> None:
+    """The benchmark's log at ``rate`` Hz, by this tree."""
+    from stewartid.platform import load_platform
+    from stewartid.simulation.experiments import simulate_experiments, write_experiments
+    from stewartid.simulation.sensors import reference_noise
+
+    platform = load_platform("paper").replace(sensors__sample_rate=rate)
+    result = simulate_experiments(platform, coulomb=30.0, duration_s=20.0, seed=1,
+                                  noise=reference_noise(platform), jobs=os.cpu_count() or 1)
+    write_experiments(result, folder, format="parquet")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--before", required=True, help="src folder of the earlier tree")
+    parser.add_argument("--after", default=str(Path(__file__).resolve().parents[1] / "src"))
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--reproduce", action="store_true", help="also time reproduce")
+    args = parser.parse_args()
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
+    trees = {"before": args.before, "after": args.after}
+    print(f"{os.cpu_count()} cores; load average before: {os.getloadavg()[0]:.2f}")
+    with tempfile.TemporaryDirectory() as scratch:
+        scratch = Path(scratch)
+        logs = {"1 kHz": scratch / "log1k", "2 kHz": scratch / "log2k"}
+        simulate(logs["1 kHz"], 1000.0)
+        simulate(logs["2 kHz"], 2000.0)
+        commands = {
+            "identify --method wavelet": ["identify", str(logs["1 kHz"]), "--method", "wavelet"],
+            "identify --method wavelet (2 kHz)": ["identify", str(logs["2 kHz"]), "--method",
+                                                  "wavelet"],
+            "identify --method all --report": ["identify", str(logs["1 kHz"]), "--method",
+                                               "all", "--report", str(scratch / "report")],
+        }
+        if args.reproduce:
+            commands["reproduce"] = ["reproduce", "--out", str(scratch / "reproduce"),
+                                     "--force"]
+        rows = []
+        for label, arguments in commands.items():
+            runs: dict[str, list[tuple[float, float, float]]] = {tree: [] for tree in trees}
+            for _ in range(args.repeats if label != "reproduce" else 1):
+                for tree, src in trees.items():
+                    for folder in ("report", "reproduce"):
+                        subprocess.run(["rm", "-rf", str(scratch / folder)], check=True)
+                    runs[tree].append(measured([sys.executable, "-c", RUN, src, *arguments], env))
+            for tree in trees:
+                wall, cpu, memory = (statistics.median(x) for x in zip(*runs[tree], strict=True))
+                rows.append((label, tree, wall, cpu, memory))
+        fits = {}
+        for tree, src in trees.items():
+            output = subprocess.run(
+                [sys.executable, "-c", TIMER + FIT, src, str(logs["1 kHz"]), str(args.repeats),
+                 "wavelet,ls,fourier"], capture_output=True, text=True, env=env, check=True)
+            fits[tree] = dict(line.split() for line in output.stdout.splitlines())
+    width = max(len(r[0]) for r in rows)
+    print(f"{'command':{width}s} {'tree':>6s} {'wall s':>7s} {'CPU s':>7s} {'peak MiB':>9s}")
+    for label, tree, wall, cpu, memory in rows:
+        shown = "failed" if wall != wall else f"{wall:7.2f}"
+        print(f"{label:{width}s} {tree:>6s} {shown:>7s} {cpu:7.2f} {memory:9.0f}")
+    print("in-process fit, best CPU s: " + "; ".join(
+        f"{name}: {float(fits['before'][name]):.2f} -> {float(fits['after'][name]):.2f}"
+        for name in fits["after"]))
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
+
+
+if __name__ == "__main__":
+    main()
