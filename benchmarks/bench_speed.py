@@ -41,17 +41,18 @@ try:
 except ImportError:  # an older layout
     from stewartid.dataset import read_datasets
 platform = load_platform("paper")
-data = read_datasets(sorted(str(p) for p in Path(sys.argv[2]).glob("exp*.parquet")), platform)
+files = sorted(str(p) for p in Path(sys.argv[2]).glob("exp*.parquet"))
 for name in sys.argv[4].split(","):
-    create_identifier(name).fit(data, platform)
-    best = min(_timed(lambda: create_identifier(name).fit(data, platform))
-               for _ in range(int(sys.argv[3])))
+    create_identifier(name).fit(read_datasets(files, platform), platform)
+    # a fresh read for every fit: nothing derived from an earlier fit's records is reused
+    best = min(_timed(lambda data: create_identifier(name).fit(data, platform),
+                      read_datasets(files, platform)) for _ in range(int(sys.argv[3])))
     print(name, best)
 """
 TIMER = """
-def _timed(call):
+def _timed(call, data):
     start = time.process_time()
-    call()
+    call(data)
     return time.process_time() - start
 """
 
@@ -68,16 +69,23 @@ def measured(command: list[str], env: dict[str, str]) -> tuple[float, float, flo
     return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024
 
 
-def simulate(folder: Path, rate: float) -> None:
-    """The benchmark's log at ``rate`` Hz, by this tree."""
-    from stewartid.platform import load_platform
-    from stewartid.simulation.experiments import simulate_experiments, write_experiments
-    from stewartid.simulation.sensors import reference_noise
+SIMULATE = """
+import os, sys
+from stewartid.platform import load_platform
+from stewartid.simulation.experiments import simulate_experiments, write_experiments
+from stewartid.simulation.sensors import reference_noise
 
-    platform = load_platform("paper").replace(sensors__sample_rate=rate)
-    result = simulate_experiments(platform, coulomb=30.0, duration_s=20.0, seed=1,
-                                  noise=reference_noise(platform), jobs=os.cpu_count() or 1)
-    write_experiments(result, folder, format="parquet")
+platform = load_platform("paper").replace(sensors__sample_rate=float(sys.argv[2]))
+result = simulate_experiments(platform, coulomb=30.0, duration_s=20.0, seed=1,
+                              noise=reference_noise(platform), jobs=os.cpu_count() or 1)
+write_experiments(result, sys.argv[1], format="parquet")
+"""
+
+
+def simulate(folder: Path, rate: float) -> None:
+    """The benchmark's log at ``rate`` Hz, by this tree, in a process of its own: a child's peak
+    memory starts from its parent's, which must stay small."""
+    subprocess.run([sys.executable, "-c", SIMULATE, str(folder), str(rate)], check=True)
 
 
 def main() -> None:

@@ -17,8 +17,8 @@ its members' fits (:func:`stewartid.verdict.consensus.combine_results`, as its e
 Usage::
 
     python benchmarks/coverage_study.py [--platform paper|FILE] [--engine ours|mujoco]
-        [--kinds paper,tenx,three,alldof] [--seeds 4] [--methods wavelet,fourier,ls,consensus]
-        --clean DIR [--out FILE.jsonl]
+        [--kinds paper,tenx,three,alldof] [--seeds 4] [--first-seed 0] [--duration 20]
+        [--methods wavelet,fourier,ls,consensus] --clean DIR [--out FILE.jsonl]
     python benchmarks/coverage_study.py --summary FILE.jsonl...
 """
 
@@ -91,7 +91,8 @@ def run(platform_name: str, engine: str, kinds, seeds, methods, clean_dir: Path,
     M, B = nominal_matrices(platform)
     tag = "paper" if platform_name == "paper" else Path(platform_name).stem
     for kind in kinds:
-        folder = clean_dir / f"{engine}_{tag}_{kind}_c{platform.friction.coulomb:g}"
+        suffix = "" if noise_study.KIND_DURATION == 20.0 else f"_d{noise_study.KIND_DURATION:g}"
+        folder = clean_dir / f"{engine}_{tag}_{kind}_c{platform.friction.coulomb:g}{suffix}"
         clean = noise_study.kind_logs(kind, platform, folder, engine)
         for seed in [None, *seeds]:
             data = clean if seed is None else [
@@ -144,6 +145,9 @@ def main() -> None:
     parser.add_argument("--engine", default="ours", choices=("ours", "mujoco"))
     parser.add_argument("--kinds", default=",".join(noise_study.KINDS))
     parser.add_argument("--seeds", type=int, default=4)
+    parser.add_argument("--first-seed", type=int, default=0)
+    parser.add_argument("--duration", type=float, default=noise_study.KIND_DURATION,
+                        help="record length of each experiment (s; shorter for MuJoCo)")
     parser.add_argument("--methods", default=",".join(METHODS),
                         help="comma-separated registered methods (consensus: of wavelet, ls)")
     parser.add_argument("--clean", type=Path, default=Path("noise_study_logs"),
@@ -153,8 +157,10 @@ def main() -> None:
     parser.add_argument("--summary", type=Path, nargs="*",
                         help="only print the table of these result files")
     args = parser.parse_args()
+    noise_study.KIND_DURATION = args.duration
     if args.summary is None:
-        run(args.platform, args.engine, args.kinds.split(","), tuple(range(args.seeds)),
+        seeds = tuple(range(args.first_seed, args.first_seed + args.seeds))
+        run(args.platform, args.engine, args.kinds.split(","), seeds,
             args.methods.split(","), args.clean, args.out)
     files = args.summary or [args.out]
     rows = [json.loads(line) for path in files for line in path.read_text().splitlines()]
