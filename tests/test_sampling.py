@@ -12,7 +12,12 @@ from linear_model_data import make_experiment, random_matrices
 from stewartid.datasets.dataset import Dataset
 from stewartid.identification.registry import registered_methods
 from stewartid.identification.result import IdentificationResult
-from stewartid.identification.sampling import RATIO_LIMIT, check_sampling, thinned
+from stewartid.identification.sampling import (
+    RATIO_LIMIT,
+    SAMPLES_PER_PERIOD,
+    check_sampling,
+    thinned,
+)
 
 
 def _log(rate: float = 1000.0, seconds: float = 2.0) -> list[Dataset]:
@@ -70,6 +75,20 @@ def test_a_sampling_limited_result_gets_errors_that_cover_its_error():
     assert result.M[0, 0] == before.M[0, 0]
 
 
+def test_the_fastest_excitation_sets_the_margin():
+    """Two sines on the legs, 0.7 and 2.5 Hz, 1 % of the variance at 2.5 Hz, at 500 Hz: 99.9 %
+    of the variance lies below 2.5 Hz within a bin (0.1 Hz), so 200 samples per period."""
+    from stewartid.identification.sampling import fastest_frequency, samples_per_period
+
+    t = np.arange(5000) / 500.0
+    legs = 1.0 + np.outer(0.01 * np.sin(2 * np.pi * 0.7 * t) + 0.001 * np.sin(2 * np.pi * 2.5 * t),
+                          np.ones(6))
+    record = Dataset(t=t, pose=np.zeros((len(t), 6)), lengths=legs, forces=np.zeros((len(t), 6)))
+    assert fastest_frequency(record) == pytest.approx(2.5, abs=0.1)
+    assert samples_per_period([record]) == pytest.approx(200.0, rel=0.05)
+    assert samples_per_period(_log()) == 0.0   # no motion: nothing to tell by, the refit runs
+
+
 def test_a_thinned_log_too_short_is_not_checked():
     fit, data = _fake_fit(bias=50.0, noise_std=0.0), _log(rate=100.0, seconds=1.0)
     result = check_sampling(fit, data, fit(data))
@@ -105,9 +124,9 @@ def test_standard_errors_are_calibrated_on_a_noise_free_log(spec, noise_free, pa
 
 
 def test_the_physical_model_widens_its_parameters_on_a_noise_free_plant_log():
-    """Our plant's noise-free log (the paper's sines, 8 s, Coulomb 30 N m): the residual-based
-    errors put 15 % of Mt, Bt beyond 3 SE (6.5 SE); the parameters' changes over the thinned
-    fits join their variances and Mt, Bt follow."""
+    """Our plant's noise-free log (the paper's sines, 8 s, Coulomb 30 N m, 1 kHz): the
+    residual-based errors put 15 % of Mt, Bt beyond 3 SE (6.5 SE). A thousand samples per
+    period of the fastest excitation leave no refit to do: the model floor covers the error."""
     from stewartid.model.linearization import nominal_matrices
     from stewartid.physical.estimator import PhysicalIdentifier
     from stewartid.platform import load_platform
@@ -117,7 +136,8 @@ def test_the_physical_model_widens_its_parameters_on_a_noise_free_plant_log():
     data = simulate_experiments(platform, coulomb=30.0, duration_s=8.0).datasets
     M, B = nominal_matrices(platform)
     estimator = PhysicalIdentifier().fit(data, platform)
-    assert estimator.result_.diagnostics["sampling"]["limited"]
+    sampling = estimator.result_.diagnostics["sampling"]
+    assert not sampling["limited"] and sampling["samples_per_period"] >= SAMPLES_PER_PERIOD
     ratios = np.concatenate([
         (np.abs(estimate - truth) / np.maximum(estimator.std_errors_[matrix],
                                                1e-9 * np.abs(truth).max())).ravel()

@@ -29,6 +29,37 @@ RATIO_LIMIT = 2.5
 SHIFT_LIMIT = 10.0
 
 
+#: Samples per period of the fastest excitation from which the refits are skipped: with the
+#: model floor (:func:`~stewartid.identification.result.with_model_floor`) they change no
+#: coverage there (docs/benchmarks.md, "Sampling check").
+SAMPLES_PER_PERIOD = 400
+
+#: Share of the pose's variance below the fastest excitation frequency (:func:`fastest_frequency`).
+VARIANCE_SHARE = 0.999
+
+
+def fastest_frequency(dataset: Dataset) -> float:
+    """Frequency (Hz) below which :data:`VARIANCE_SHARE` of the legs' length variance lies (all six
+    together: one unit, and the sensor noise's share is negligible); once per record."""
+    def compute(record: Dataset) -> float:
+        centered = record.lengths - record.lengths.mean(axis=0)
+        power = np.sum(np.abs(np.fft.rfft(centered, axis=0)) ** 2, axis=1)
+        power[0] = 0.0
+        if not power.sum() > 0:
+            return 0.0
+        share = np.cumsum(power) / power.sum()
+        return float(np.argmax(share >= VARIANCE_SHARE) * record.sample_rate / len(record))
+
+    return dataset.derived(("fastest frequency",), compute)
+
+
+def samples_per_period(datasets: Sequence[Dataset]) -> float:
+    """The fewest samples per period of the fastest excitation (:func:`fastest_frequency`) of the
+    experiments; 0 when a record does not move (nothing to tell by)."""
+    return min(d.sample_rate / f if (f := fastest_frequency(d)) > 0 else 0.0
+               for d in datasets)
+
+
 def thinned(dataset: Dataset, factor: int) -> Dataset:
     """Every ``factor``-th sample of an experiment, from the first (same name, rate / factor);
     one copy per record, which every method's check shares."""
@@ -70,7 +101,16 @@ def _fit_quietly(fit: Callable[[list[Dataset]], IdentificationResult],
 def thinned_fits(fit: Callable[[list[Dataset]], IdentificationResult],
                  datasets: Sequence[Dataset], result: IdentificationResult
                  ) -> tuple[dict[str, Any], list[IdentificationResult]]:
-    """The sampling summary of :func:`check_sampling` and the thinned fits that succeeded when limited."""
+    """The sampling summary of :func:`check_sampling` and the thinned fits that succeeded when limited.
+
+    No refit where every experiment has :data:`SAMPLES_PER_PERIOD` samples per period of its fastest
+    excitation.
+    """
+    margin = samples_per_period(datasets)
+    if margin >= SAMPLES_PER_PERIOD:
+        return {"limited": False, "samples_per_period": margin,
+                "reason": f"{margin:.0f} samples per period of the fastest excitation: no refit "
+                          f"below {SAMPLES_PER_PERIOD}"}, []
     half = _fit_quietly(fit, datasets, FACTORS[0])
     if isinstance(half, str):
         return {"limited": False, "reason": half}, []
@@ -93,7 +133,8 @@ def check_sampling(fit: Callable[[list[Dataset]], IdentificationResult],
 
     ``fit`` fits a list of experiments with the method's settings. Adds ``diagnostics["sampling"]``:
     ``std_ratio``, ``shift``, ``limited`` (above :data:`RATIO_LIMIT` or :data:`SHIFT_LIMIT`), ``factors``,
-    ``spread_M``/``spread_B`` when limited, or ``reason``.
+    ``spread_M``/``spread_B`` when limited, or ``reason`` (and ``samples_per_period`` where the
+    rate leaves a wide margin).
     """
     summary, fits = thinned_fits(fit, datasets, result)
     if fits:
@@ -106,5 +147,5 @@ def check_sampling(fit: Callable[[list[Dataset]], IdentificationResult],
     return dataclasses.replace(result, diagnostics={**result.diagnostics, "sampling": summary})
 
 
-__all__ = ["FACTORS", "RATIO_LIMIT", "SHIFT_LIMIT", "check_sampling", "thinned",
-           "thinned_fits"]
+__all__ = ["FACTORS", "RATIO_LIMIT", "SAMPLES_PER_PERIOD", "SHIFT_LIMIT", "VARIANCE_SHARE",
+           "check_sampling", "fastest_frequency", "samples_per_period", "thinned", "thinned_fits"]
