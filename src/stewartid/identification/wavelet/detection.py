@@ -188,7 +188,10 @@ def _sign_rates(experiment: Experiment, noise: NoiseModel) -> dict:
     jacobians = experiment.joint_jacobians
     level = joint_rate_noise(noise.pose_covariance, experiment.sample_rate, window, jacobians,
                              experiment.leg_jacobian, SIGN_ORDER)
-    return {"sign_rates": np.einsum("nlac,nc->nla", jacobians, q_dot),
+    from stewartid.model import compiled  # numba, which the model remainder loads anyway
+
+    return {"sign_rates": compiled.batch_joint_rates(np.ascontiguousarray(jacobians),
+                                                     np.ascontiguousarray(q_dot)),
             "sign_rate_noise": np.maximum(level[:30].reshape(6, 5), 1e-12),
             "leg_sign_rates": (experiment.leg_jacobian @ q_dot[:, :, None])[:, :, 0],
             "leg_sign_rate_noise": np.maximum(level[30:], 1e-12)}

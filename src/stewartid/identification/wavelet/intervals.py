@@ -42,7 +42,10 @@ def joint_rates(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
         joint_jacobians = joint_rate_jacobians(platform, q)
     if leg_jacobian is None:
         leg_jacobian = leg_jacobian_at(platform, q)
-    axes = np.einsum("nlaj,nj->nla", joint_jacobians, q_dot).reshape(len(q), 30)
+    from stewartid.model import compiled  # numba, which the model remainder loads anyway
+
+    axes = compiled.batch_joint_rates(np.ascontiguousarray(joint_jacobians),
+                                      np.ascontiguousarray(q_dot)).reshape(len(q), 30)
     legs = np.einsum("nlj,nj->nl", leg_jacobian, q_dot)
     return np.concatenate([axes, legs], axis=1)
 
