@@ -64,6 +64,7 @@ def gls_spread(platform, data, labels, sigma, seeds=400):
     return np.std(z[:, :, :12], axis=0, ddof=1)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("friction", ["known", "immune"])
 def test_bound_is_the_spread_of_the_efficient_estimator(paper, friction):
     """For the linear model with white leg-force noise, generalized least squares is

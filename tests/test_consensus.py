@@ -124,6 +124,7 @@ def test_a_close_call_trusts_the_consensus_and_says_why():
     assert consensus_members(clear) == ()
 
 
+@pytest.mark.slow
 def test_the_report_builds_and_trusts_the_consensus_of_a_close_call(tmp_path, paper):
     """A noisy 4 s log with 30 N m of Coulomb friction where Method B and least squares
     predict largest errors within 1.25x of each other."""

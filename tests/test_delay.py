@@ -116,6 +116,7 @@ def test_noisy_estimate_is_within_its_standard_errors(paper):
     assert estimate.std_error < 1e-4
 
 
+@pytest.mark.slow
 def test_single_sine_is_refused_with_the_bias_a_delay_puts_on_bt(paper):
     single = ((1.0, 0.5, 0.0),)
     with pytest.raises(IdentificationError, match="one frequency only") as refused:
@@ -147,6 +148,7 @@ def late_files(tmp_path_factory, paper):
             for d in experiments(paper, delay=1e-3)]
 
 
+@pytest.mark.slow
 def test_identify_applies_a_given_delay(tmp_path, late_files):
     out = tmp_path / "result.json"
     result = CliRunner().invoke(app, ["identify", "--method", "ls", "--platform", "paper",
@@ -159,6 +161,7 @@ def test_identify_applies_a_given_delay(tmp_path, late_files):
                                  "source": "given"}
 
 
+@pytest.mark.slow
 def test_identify_estimates_the_delay(tmp_path, late_files):
     out = tmp_path / "result.json"
     result = CliRunner().invoke(app, ["identify", "--method", "ls", "--platform", "paper",
@@ -171,6 +174,7 @@ def test_identify_estimates_the_delay(tmp_path, late_files):
     assert delay["seconds"] == pytest.approx(1e-3, abs=1e-6)
 
 
+@pytest.mark.slow
 def test_identify_estimates_and_applies_the_delay_by_default(tmp_path, late_files):
     """Without the flag, a delay the motion identifies and noise cannot explain is removed."""
     out = tmp_path / "result.json"
@@ -183,6 +187,7 @@ def test_identify_estimates_and_applies_the_delay_by_default(tmp_path, late_file
     assert "forces aligned" in result.output
 
 
+@pytest.mark.slow
 def test_identify_with_a_zero_delay_uses_the_forces_as_logged(tmp_path, late_files):
     out = tmp_path / "result.json"
     result = CliRunner().invoke(app, ["identify", "--method", "ls", "--platform", "paper",
@@ -201,6 +206,7 @@ def test_identify_refuses_a_bad_delay(tmp_path, late_files, value, message):
     assert message in result.output
 
 
+@pytest.mark.slow
 def test_identify_on_single_sines_notes_the_bias_a_delay_would_put_on_bt(tmp_path, paper):
     """Without --delay on single-frequency data: one note naming the bias per millisecond,
     the bias measured by fitting the same motion with the forces 1 ms late; result.json

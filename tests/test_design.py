@@ -217,6 +217,7 @@ def test_design_cli_refuses_bad_budget(tmp_path):
         assert result.exit_code == 2 and message in result.output
 
 
+@pytest.mark.slow
 def test_predicted_errors_scale_with_the_noise(paper):
     design = scheduled_design((0.05, 0.05, 0.05, 0.02, 0.02, 0.03), 1.0, [5.0] * 6)
     noise = SensorNoise(length_noise=20e-6, force_noise=150.0)
@@ -234,6 +235,7 @@ def test_predicted_errors_scale_with_the_noise(paper):
     assert one.scaled(4.0).worst_relative_std == pytest.approx(one.worst_relative_std / 2)
 
 
+@pytest.mark.slow
 def test_plant_prediction_draws_the_noise_as_simulate_does(paper):
     design = scheduled_design((0.05, 0.05, 0.05, 0.02, 0.02, 0.03), 1.0, [4.0] * 6, (1.0,))
     noise = SensorNoise(length_noise=20e-6, force_noise=150.0)
@@ -261,6 +263,7 @@ def test_designed_records_on_the_plant_stay_within_limits(paper):
         assert record_limit_use(paper, record).exceeded == []
 
 
+@pytest.mark.slow
 def test_first_order_pose_and_workers_leave_the_prediction_unchanged(paper):
     """The realisations' pose (first Newton step of forward kinematics from the true pose) is
     the converged forward kinematics of the measured lengths to 1e-8 m, and spreading the
@@ -316,6 +319,7 @@ def test_design_cli_names_the_commands_that_play_and_identify_it(tmp_path):
     assert "largest error" in run(commands["command"])
 
 
+@pytest.mark.slow
 def test_information_matrix_prediction_against_a_monte_carlo(paper):
     """The standard errors of Method B (one Coulomb level) from the information matrix of its
     weak-form equations against the spread of 24 noisy fits of a short two-level design

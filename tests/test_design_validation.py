@@ -44,6 +44,7 @@ def test_velocity_and_acceleration_are_the_derivatives_of_the_pose(short):
     assert np.all(ends == 0.0)
 
 
+@pytest.mark.slow
 def test_the_file_plays_on_the_plant_within_the_limits_with_every_dof_at_its_frequency(
         paper, tmp_path):
     path = write_validation_record(paper, tmp_path, rate_hz=500.0, duration_s=12.0)

@@ -147,6 +147,7 @@ def _noisy(clean: list) -> list:
             for _ in range(6)]
 
 
+@pytest.mark.slow
 def test_standard_errors_are_calibrated_on_a_small_noisy_case(spec, noisy_truth, paper):
     """Against the generating model: most of the 72 entries x 6 realisations within 3
     reported standard errors, and the errors not so pessimistic that the check is vacuous.

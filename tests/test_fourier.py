@@ -244,6 +244,7 @@ def test_example_c10_method_a(example_dir, example_platform, example_truth):
     assert est.B_[0, 0] > 1.2 * example_truth["Bt"][0, 0]
 
 
+@pytest.mark.slow
 def test_noise_alone_adds_no_friction_allowance_and_friction_in_noise_is_caught(paper, truth):
     """Force noise has a third harmonic of its own: below the 1 % significance point it is not
     read as friction (the error bars stay the noise's), while a square wave whose third

@@ -89,6 +89,7 @@ def _bt_diagonal_errors(estimator, B):
     return np.abs(np.diag(estimator.B_) - np.diag(B)) / np.diag(B)
 
 
+@pytest.mark.slow
 def test_our_plant_shows_its_algebraic_sign(paper):
     # the plant's joint friction is the algebraic sign over 1e-4 rad/s
     platform = paper.replace(friction__coulomb=30.0)
@@ -99,6 +100,7 @@ def test_our_plant_shows_its_algebraic_sign(paper):
     assert np.max(_bt_diagonal_errors(est, B)) < 1e-4
 
 
+@pytest.mark.slow
 def test_mujoco_constraint_friction_shows_the_erf_sign(paper):
     pytest.importorskip("mujoco")
     from stewartid.mujoco.closed_loop import simulate_mujoco

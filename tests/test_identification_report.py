@@ -119,6 +119,7 @@ def independent_validation(paper, data, folds=3, window=0.2):
     return vaf, nrmse
 
 
+@pytest.mark.slow
 def test_validation_numbers_match_an_independent_computation(linear_report, linear_data,
                                                              paper):
     report, folder = linear_report
@@ -132,6 +133,7 @@ def test_validation_numbers_match_an_independent_computation(linear_report, line
     assert np.asarray(document["validation"]["nrmse"]) == pytest.approx(nrmse, rel=0.01)
 
 
+@pytest.mark.slow
 def test_validation_of_the_exact_model_is_perfect(linear_report, linear_data):
     # VAF of the true matrices on the same segments: what the disturbance alone leaves
     report, _ = linear_report
@@ -147,6 +149,7 @@ def test_validation_of_the_exact_model_is_perfect(linear_report, linear_data):
     assert run.validation.vaf_percent == pytest.approx(best.vaf_percent, abs=0.2)
 
 
+@pytest.mark.slow
 def test_result_json_has_the_validation_and_consistency_contracts(linear_report):
     _, folder = linear_report
     document = json.loads((folder / "result.json").read_text())
@@ -160,6 +163,7 @@ def test_result_json_has_the_validation_and_consistency_contracts(linear_report)
         np.linalg.eigvalsh((M + M.T) / 2).min())
 
 
+@pytest.mark.slow
 def test_report_html_resolves_every_image_and_link(linear_report):
     _, folder = linear_report
     page = (folder / "report.html").read_text()
@@ -178,6 +182,7 @@ def test_report_html_resolves_every_image_and_link(linear_report):
         assert section in (folder / "report.md").read_text()
 
 
+@pytest.mark.slow
 def test_exports_hold_the_result(linear_report):
     report, folder = linear_report
     result = report.result
@@ -246,6 +251,7 @@ def files(tmp_path_factory, linear_data):
     return [write_dataset(d, folder / f"{d.name}.csv") for d in data]
 
 
+@pytest.mark.slow
 def test_cli_report_and_its_errors(tmp_path, files):
     out = tmp_path / "report"
     runner = CliRunner()
@@ -340,6 +346,7 @@ def _validation_record(paper, M, B, name):
                            sample_rate=SAMPLE_RATE, extra=extra, name=name)
 
 
+@pytest.mark.slow
 def test_validation_records_see_a_wrong_parameter(tmp_path, linear_data, paper):
     """A record of the fitted model's own dynamics is predicted to round-off of the filters;
     one whose Mt(1,5) coupling differs by 30 % of the diagonal scale is not: records of another

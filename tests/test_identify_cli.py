@@ -104,6 +104,7 @@ def test_debug_shows_the_traceback_of_expected_errors(files):
     assert "unknown method 'magic'" in str(result.exception)
 
 
+@pytest.mark.slow
 def test_friction_option_reaches_method_b(tmp_path, example_dir, example_truth):
     """``--friction uniform`` (what ``stewartid design`` predicts for) ties the interval
     constants to one Coulomb level: on the independent example it is the simulator's 10 N m."""

@@ -196,6 +196,7 @@ def test_columns_option_maps_a_log(tmp_path, folder):
 
 # -- jittery time stamps ----------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_jittery_time_stamps_cost_below_0p2_percent(example_dir, example_platform,
                                                     example_truth):
     """+-0.3 ms of timing noise on the example's 1 kHz clock, identified by the default

@@ -75,6 +75,7 @@ def test_remainder_is_second_order_in_the_amplitude(paper):
         assert ratio == pytest.approx(4.0, rel=0.02)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["wavelet", "ls"])
 def test_linearisation_identified_at_ten_times_the_amplitude(paper, method):
     """Noise-free records of the model (no Coulomb friction) at ten times the paper's
@@ -89,6 +90,7 @@ def test_linearisation_identified_at_ten_times_the_amplitude(paper, method):
     assert largest_error(averaged, platform) > 0.3
 
 
+@pytest.mark.slow
 def test_free_constants_keep_the_coulomb_force_inside_the_intervals(paper):
     """Ten times the paper's amplitudes with the platform's Coulomb friction on every joint
     axis (30 N m): the idle revolute joints reverse inside the constant-direction intervals

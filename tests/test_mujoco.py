@@ -181,6 +181,7 @@ def _closed_loop(platform, step=5e-4, duration=2.0):
     return record.q, theirs.pose, excitation.evaluate(record.t)[0]
 
 
+@pytest.mark.slow
 def test_closed_loop_without_friction_agrees_to_integration_error(paper):
     """No joint friction: the two engines differ only by O(h^2) effects of MuJoCo's side.
 
@@ -196,6 +197,7 @@ def test_closed_loop_without_friction_agrees_to_integration_error(paper):
     assert err[:, 3:].max() < 5e-7
 
 
+@pytest.mark.slow
 def test_closed_loop_with_gimbal_friction_agrees_to_axis_convention(paper):
     """Paper's viscous gimbal friction: the axis convention shows, at first order.
 
@@ -211,6 +213,7 @@ def test_closed_loop_with_gimbal_friction_agrees_to_axis_convention(paper):
     assert err[:, 3:].max() < 1e-5
 
 
+@pytest.mark.slow
 def test_closed_loop_with_coulomb_friction_agrees_to_the_friction_laws(paper):
     """Coulomb friction alone (30 N m on every hinge): MuJoCo's stiff friction rows beside
     our regularised law.
@@ -256,6 +259,7 @@ def _command_file(path, platform, amplitude=0.03, duration=0.5):
     return path
 
 
+@pytest.mark.slow
 def test_simulate_plays_command_files_on_mujoco_from_the_command_line(paper, tmp_path):
     """``simulate --engine mujoco``: the command file is played (the heave follows it to the
     servo's tracking error: 0.2 mm on 30 mm, measured) and the sensor errors are applied

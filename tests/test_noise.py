@@ -85,6 +85,7 @@ def test_wavelet_noise_free_within_one_percent_and_short_margin_less_noise_sensi
     assert largest["wavelet_free"] < largest["wavelet_m01"], largest
 
 
+@pytest.mark.slow
 def test_method_b_under_reference_noise_is_accurate_and_calibrated():
     """Default Method B on the independent example with the reference sensor noise (20 um on
     the leg lengths, pose by forward kinematics, 0.5 % force noise): the inertia diagonal

@@ -65,6 +65,7 @@ def test_multisine_record_derivatives_match_finite_differences():
     assert all(np.allclose(x, 0.0, atol=1e-15) for x in at_ends)
 
 
+@pytest.mark.slow
 def test_information_matrix_predicts_the_estimators_spread(loaded):
     """Rigid-body data of a short record (the commanded motion, the model's forces), white
     force noise only; the spread of the payload fit over seeds against the prediction."""
@@ -140,6 +141,7 @@ def test_payload_quantities_and_their_derivative(loaded):
     assert np.allclose(J, numeric, rtol=1e-6, atol=1e-8 * np.abs(numeric).max())
 
 
+@pytest.mark.slow
 def test_final_prediction_counts_the_pose_noise(loaded):
     """Rigid-body data of a record at twice the reference frequencies and half its amplitude,
     the leg lengths with the reference white noise (the pose from them by the first Newton
@@ -224,6 +226,7 @@ def test_refinement_against_the_plant_scales_each_record_by_its_own(loaded):
                                      0.7).score
 
 
+@pytest.mark.slow
 def test_payload_design_aims_at_the_accuracy_asked_for(loaded):
     """The same search asked for a centre of mass ten times tighter than the inertia, then
     the other way round: each pick's predicted standard error of what was asked more
@@ -241,6 +244,7 @@ def test_payload_design_aims_at_the_accuracy_asked_for(loaded):
     assert picks["inertia"]["inertia"] < picks["com"]["inertia"]
 
 
+@pytest.mark.slow
 def test_payload_design_sharpens_the_ten_within_the_accuracy_margin(loaded, monkeypatch):
     """The search holds the payload's quantities within the margin of their accuracy and
     sharpens the ten parameters there: against a search of the same candidates judged on
@@ -322,6 +326,7 @@ def test_parameter_sizes_are_those_of_the_vector_and_the_tensor():
     assert np.allclose(parameter_sizes(names, nominal)[1:4], 0.1 * 10 * np.sqrt(0.45))
 
 
+@pytest.mark.slow
 def test_physical_design_writes_commands_prediction_and_check(loaded, tmp_path):
     needed = {"mass": 0.003, "com": 0.001, "inertia": 0.02}
     out = run_physical_design(loaded, 16.0, SensorNoise(force_noise=170.0), tmp_path / "d",

@@ -257,6 +257,7 @@ def test_full_mode_recovers_the_moving_body_mass(loaded, records):
     assert np.all(np.abs(M - fitted.M_) <= fitted.std_errors_["M"] + 1e-9 * np.abs(M).max())
 
 
+@pytest.mark.slow
 def test_another_engines_log_identifies_the_payload(loaded):
     """Two 3 s records of the MuJoCo model (its own rigid-body algorithms, Cardan chains and
     friction constraints, ideal actuators; every DOF at three times the paper's amplitude),
@@ -368,6 +369,7 @@ def test_unexcited_parameters_are_fixed_and_named(loaded):
 
 # -- the command line ------------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_cli_contract(loaded, records, tmp_path):
     """result.json keeps today's keys and adds the model's; --platform-out loads and gives
     the identified Mt within its standard errors."""

@@ -56,6 +56,7 @@ def data(loaded, tmp_path_factory):
     return folder, records, [str(f) for f in files], str(validation)
 
 
+@pytest.mark.slow
 def test_model_physical_report(data, tmp_path):
     """The report of the compared methods with the physical section; result.json is the
     physical model's with the verdict; the validation tables carry its unranked rows."""
@@ -87,6 +88,7 @@ def test_model_physical_report(data, tmp_path):
     assert all((report / "figures" / f"workspace.{kind}").is_file() for kind in ("png", "svg"))
 
 
+@pytest.mark.slow
 def test_band_holds_the_true_mass_matrix(loaded, data):
     """The section a plain ``--method all`` report adds (the model not required): ±2 standard
     errors of Mt(q) across the measured poses hold the compiled model's mass matrix at most
@@ -116,6 +118,7 @@ def test_band_holds_the_true_mass_matrix(loaded, data):
                   < 1e-2 * np.abs(diagonal))
 
 
+@pytest.mark.slow
 def test_section_left_out_when_most_parameters_are_fixed(loaded, monkeypatch):
     """Translation-only records fix the inertias and the revolute friction (8 of 27): with
     the threshold below that share, a report that did not ask for the model gives one line

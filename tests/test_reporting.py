@@ -155,6 +155,7 @@ def _trace() -> ExperimentTrace:
                            forces)
 
 
+@pytest.mark.slow
 def test_signal_figures_are_written(tmp_path):
     trace = _trace()
     for paths in (plot_joint_rates(trace, tmp_path), plot_force_budget(trace, tmp_path)):
@@ -168,6 +169,7 @@ def test_signal_figures_are_written(tmp_path):
         plot_joint_rates(bare, tmp_path)
 
 
+@pytest.mark.slow
 def test_error_figure_has_units_and_legends(tmp_path, results):
     png, svg = plot_errors(results, tmp_path)
     text = svg.read_text()

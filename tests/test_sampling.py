@@ -107,6 +107,7 @@ def noise_free(paper):
     return [make_experiment(paper, M, B, k, frequency_hz=1.0, periods=8) for k in range(6)], M, B
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("spec", COMPARED, ids=[spec.name for spec in COMPARED])
 def test_standard_errors_are_calibrated_on_a_noise_free_log(spec, noise_free, paper):
     """Without noise the estimate's error is what the differentiation at 200 Hz and the
@@ -123,6 +124,7 @@ def test_standard_errors_are_calibrated_on_a_noise_free_log(spec, noise_free, pa
         f"{spec.name}: {np.mean(ratios <= 3.0):.0%} within 3 SE, largest {ratios.max():.3g}")
 
 
+@pytest.mark.slow
 def test_the_physical_model_widens_its_parameters_on_a_noise_free_plant_log():
     """Our plant's noise-free log (the paper's sines, 8 s, Coulomb 30 N m, 1 kHz): the
     residual-based errors put 15 % of Mt, Bt beyond 3 SE (6.5 SE). A thousand samples per
@@ -150,6 +152,7 @@ def test_the_physical_model_widens_its_parameters_on_a_noise_free_plant_log():
                                rtol=1e-12)
 
 
+@pytest.mark.slow
 def test_the_report_says_which_results_the_sampling_limits(tmp_path, noise_free, paper):
     from stewartid import compare_methods, write_report
 

@@ -110,6 +110,7 @@ def test_parts_are_whole_files_one_per_task(tmp_path):
         write_part(tmp_path, "dddd", [{"task": "dddd"}])
 
 
+@pytest.mark.slow
 def test_report_states_the_trends_in_the_numbers(tmp_path):
     from stewartid.studies.report import write_study_report
 
@@ -203,6 +204,7 @@ def _present_once(rows, spec) -> bool:
             and not rows.duplicated(["task", "method"]).any())
 
 
+@pytest.mark.slow
 def test_a_worker_killed_mid_run_loses_and_duplicates_nothing(cluster, tmp_path):
     client, _ = cluster
     spec = parse_study(tiny())
@@ -231,6 +233,7 @@ def test_a_worker_killed_mid_run_loses_and_duplicates_nothing(cluster, tmp_path)
     assert (rows["task_cpu_time_s"] > 0).all() and rows["worker"].str.startswith("tcp://").all()
 
 
+@pytest.mark.slow
 def test_an_interrupted_run_resumes_without_recomputing(cluster, tmp_path):
     client, _ = cluster
     spec = parse_study(tiny())

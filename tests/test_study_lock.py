@@ -27,6 +27,7 @@ def _holding(folder: Path) -> subprocess.Popen:
     return process
 
 
+@pytest.mark.slow
 def test_a_second_run_is_refused_naming_the_holder(tmp_path):
     holder = _holding(tmp_path)
     try:
@@ -37,6 +38,7 @@ def test_a_second_run_is_refused_naming_the_holder(tmp_path):
         holder.wait()
 
 
+@pytest.mark.slow
 def test_the_lock_of_a_killed_run_is_taken_over(tmp_path):
     holder = _holding(tmp_path)
     os.kill(holder.pid, signal.SIGKILL)
@@ -48,6 +50,7 @@ def test_the_lock_of_a_killed_run_is_taken_over(tmp_path):
         pass
 
 
+@pytest.mark.slow
 def test_the_command_refuses_a_locked_folder_in_one_line(tmp_path):
     spec = tmp_path / "study.toml"
     spec.write_text('[study]\nseeds = 1\nduration = 2.0\nmethods = ["ls"]\n')

@@ -91,6 +91,7 @@ def test_wavelet_points_lie_inside_their_intervals(paper, linear_truth, linear_d
         assert any(lo - 1e-9 <= b - a and b + a <= hi + 1e-9 for lo, hi in first["intervals"])
 
 
+@pytest.mark.slow
 def test_shared_friction_recovers_the_coulomb_levels(example_dir, example_truth):
     """Clean independent data: the interval constants hold the gimbals' Coulomb level
     (truth.json: 10 N m on every rotational axis). All six experiments: with the first three
@@ -187,15 +188,24 @@ def test_bad_settings_are_refused(paper, linear_data):
         WaveletIdentifier(wavelet="mexican_hat").fit(linear_data, paper)
 
 
-def test_pose_noise_attenuation_is_compensated(paper):
+@pytest.fixture(scope="module")
+def clean_sines(paper):
+    """Noise-free 1 Hz sines of the linear model with the nominal matrices and 300 N of square
+    wave, 6 s at 1 kHz: the clean records the pose- and force-noise tests add their noise to."""
+    M, B = nominal_matrices(paper)
+    return linear_model_datasets(paper, M, B, np.zeros(6), np.full(6, 300.0), frequency=1.0,
+                                 duration=6.0, period=1e-3)
+
+
+@pytest.mark.slow
+def test_pose_noise_attenuation_is_compensated(paper, clean_sines):
     """Errors in variables: white pose noise in the weak form's regressors attenuates Mt by
     its share of their power. Data from the linear model itself (truth exact), 20 um / 10 urad
     of pose noise, six seeds: without the correction the Mt diagonal is biased low (measured
     -0.4 % on average); with it the mean error over the diagonal and the seeds is within a
     quarter of that."""
-    M, B = nominal_matrices(paper)
-    clean = linear_model_datasets(paper, M, B, np.zeros(6), np.full(6, 300.0), frequency=1.0,
-                                  duration=6.0, period=1e-3)
+    M, _ = nominal_matrices(paper)
+    clean = clean_sines
     level = 2e-5 * np.r_[1, 1, 1, 0.5, 0.5, 0.5]
     errors = {True: [], False: []}
     for seed in range(6):
@@ -233,7 +243,8 @@ def test_an_experiment_without_intervals_is_never_silent():
         check_coverage([f"exp{k + 1}" for k in range(6)], motion, [5, 0, 5, 5, 5, 5])
 
 
-def test_standard_errors_follow_the_spread_with_pose_and_force_noise(paper):
+@pytest.mark.slow
+def test_standard_errors_follow_the_spread_with_pose_and_force_noise(paper, clean_sines):
     """Both noises at once, as on a real log (20 um / 10 urad of pose noise, 150 N of white
     noise per leg force), on the linear model itself: the reported standard errors of the Mt
     and Bt diagonals stay within a factor of 2.5 of the spread of the estimates over eight
@@ -242,9 +253,7 @@ def test_standard_errors_follow_the_spread_with_pose_and_force_noise(paper):
     the power on the narrow test functions) made those moments negative on most channels:
     the widest functions were weighted as if noise-free, and on the designed excitation of
     ``stewartid design`` the standard errors came out up to 40 times the spread."""
-    M, B = nominal_matrices(paper)
-    clean = linear_model_datasets(paper, M, B, np.zeros(6), np.full(6, 300.0), frequency=1.0,
-                                  duration=6.0, period=1e-3)
+    clean = clean_sines
     level = 2e-5 * np.r_[1, 1, 1, 0.5, 0.5, 0.5]
     estimates, errors = [], []
     for seed in range(8):
@@ -263,15 +272,14 @@ def test_standard_errors_follow_the_spread_with_pose_and_force_noise(paper):
     assert np.max(np.max(errors, axis=0) / np.min(errors, axis=0)) < 2.2
 
 
-def test_pose_noise_beyond_the_correction_is_not_silent(paper):
+@pytest.mark.slow
+def test_pose_noise_beyond_the_correction_is_not_silent(paper, clean_sines):
     """With 0.2 mm of pose noise on 10 mm motions the compensated normal matrix is no longer
     positive definite, the attenuation stays (Mt diagonal measured 85-99 % low) and the fit
     says so."""
     from stewartid.errors import DataWarning
 
-    M, B = nominal_matrices(paper)
-    clean = linear_model_datasets(paper, M, B, np.zeros(6), np.full(6, 300.0), frequency=1.0,
-                                  duration=6.0, period=1e-3)
+    clean = clean_sines
     level = 2e-4 * np.r_[1, 1, 1, 0.5, 0.5, 0.5]
     rng = np.random.default_rng(0)
     noisy = [Dataset(t=d.t, pose=d.pose + level * rng.standard_normal(d.pose.shape),
@@ -323,6 +331,7 @@ def coulomb_structured_datasets(platform, M, B, levels, kind, duration=6.0, peri
     return out
 
 
+@pytest.mark.slow
 def test_coulomb_windows_find_the_transition_rate_of_a_regularised_friction(paper,
                                                                            linear_truth):
     """A friction regularised over 1e-3 rad/s (ten times the plant's) is not a sign: joints
@@ -338,6 +347,7 @@ def test_coulomb_windows_find_the_transition_rate_of_a_regularised_friction(pape
     np.testing.assert_allclose(est.B_, B, rtol=0, atol=4e-3 * np.abs(B).max())
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["multisine", "alldof"])
 def test_default_identifies_multisine_and_all_dof_records(paper, linear_truth, kind):
     """Joints reverse every few tens of milliseconds: the default ('auto') takes the windows
@@ -365,6 +375,7 @@ def _force_noise(data, level, seed):
             for d in data]
 
 
+@pytest.mark.slow
 def test_auto_keeps_the_coulomb_law_on_sines_where_it_holds(paper):
     """One 0.5 Hz sine per experiment, joint Coulomb friction of the law's structure, 50 N
     of force noise: both treatments are fitted; the law passes its test (the diagonals of
@@ -393,6 +404,7 @@ def test_auto_keeps_the_coulomb_law_on_sines_where_it_holds(paper):
         assert np.all(np.abs(np.diag(matrix) - np.diag(truth)) < 4 * np.diag(std))
 
 
+@pytest.mark.slow
 def test_auto_rejects_a_friction_law_the_data_contradict(paper, linear_truth):
     """One sine per experiment with a Coulomb force per DOF in the platform's coordinates
     (not the joints' law): the law's fit reads it as damping, its diagonals leave the free
