@@ -254,12 +254,10 @@ def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool) -> floa
     if not np.any(spread > 0):
         raise DataError("the motion is constant; no excitation frequency can be found.")
     n = len(x)
-    from scipy.fft import next_fast_len, rfft
-
-    nfft = next_fast_len(8 * n if refine else n, real=True)
+    nfft = 1 << int(np.ceil(np.log2(8 * n if refine else n)))
     # each channel's transform on contiguous samples (time last): faster, the same numbers
     windowed = np.ascontiguousarray((centered * np.hanning(n)[:, None]).T)
-    relative = np.abs(rfft(windowed, nfft, axis=1)[:, 1:])
+    relative = np.abs(np.fft.rfft(windowed, nfft, axis=1)[:, 1:])
     # compare channels by spectral peak relative to the channel's own scale: units differ
     relative /= np.where(spread > 0, spread, np.inf)[:, None]
     # the largest, the lowest frequency and then the first channel of equal ones
