@@ -66,11 +66,16 @@ class ResidualDelay:
         as :func:`~stewartid.identification.delay.estimate_delay` requires). Where it does
         not, a fit absorbs any delay into Bt and its residuals show none: the numbers say
         nothing about the delay.
+    frequencies_hz : tuple of float
+        Per DOF, the frequency at which a delay reads as damping in a fit of these segments,
+        sqrt(sum q_ddot^2 / sum q_dot^2) / 2 pi: a fit absorbs a delay tau as
+        tau (2 pi f)^2 Mt(i, i) on Bt(i, i).
     """
 
     seconds: float
     std_error: float
     identifiable: bool
+    frequencies_hz: tuple[float, ...] = ()
 
     def significant(self, sigmas: float, floor_s: float) -> bool:
         """Identifiable, more than ``sigmas`` standard errors and ``floor_s`` seconds from 0."""
@@ -237,8 +242,8 @@ def residual_delay(segments: Sequence[Segment], predicted: Sequence[np.ndarray],
 
     A force logged tau late leaves r = y - y_pred ~ -tau y_pred' (first order). A fit on
     such data absorbs part of it into Mt and Bt, so r is first cleared, channel by channel,
-    of what any other Mt, Bt, Coulomb levels and offsets would explain (the regressors
-    q_ddot, q_dot, the Coulomb terms, one constant per segment); tau is the shared
+    of what any other Mt, Bt (one pair per fold), Coulomb levels and offsets would explain
+    (the regressors q_ddot, q_dot, the Coulomb terms, one constant per segment); tau is the shared
     coefficient of -y_pred' in what is left. Channels are weighted by their residual variance;
     the standard error is a sandwich with a Newey-West long-run covariance over two kernel
     supports, segments independent
@@ -265,22 +270,32 @@ def residual_delay(segments: Sequence[Segment], predicted: Sequence[np.ndarray],
     window = min(windows) if windows else 20.0 / rate
     # as the delay estimator: 20 rows per kernel support carry what the filter leaves
     step = max(1, int(window * rate / 20))
+    folds = sorted({s.fold for s in segments})
     phis, ys, shared, groups = [], [], [], []
     for k, (segment, p) in enumerate(zip(segments, predicted, strict=True)):
         slope = np.gradient(p, segment.t, axis=0)
+        # each fold's own Mt, Bt: their fold-to-fold scatter is no delay
+        motion = np.zeros((len(p), len(folds), 12))
+        motion[:, folds.index(segment.fold)] = np.concatenate([segment.q_ddot, segment.q_dot],
+                                                              axis=1)
         offsets = np.zeros((len(p), len(segments)))
         offsets[:, k] = 1.0
-        phis.append(np.concatenate([segment.q_ddot, segment.q_dot, offsets], axis=1)[::step])
+        phis.append(np.concatenate([motion.reshape(len(p), -1), offsets], axis=1)[::step])
         ys.append((segment.force - p)[::step])
         shared.append(np.concatenate([segment.coulomb, -slope[:, None, :]], axis=1)[::step])
         groups.append(np.full(len(ys[-1]), k))
     lags = int(np.ceil(2 * window * rate / step))
+    # the least-squares projection of q_dddot on q_dot, per DOF: sum q_ddot^2 / sum q_dot^2
+    power = [sum(float(np.sum(getattr(s, name)[:, k] ** 2)) for s in segments)
+             for name in ("q_ddot", "q_dot") for k in range(6)]
+    frequencies = tuple(float(np.sqrt(power[k] / power[6 + k]) / (2 * np.pi))
+                        if power[6 + k] > 0 else float("nan") for k in range(6))
     try:
         c, std = shared_least_squares(np.concatenate(phis), np.concatenate(ys),
                                       np.concatenate(shared), np.concatenate(groups), lags)
     except (StewartidError, np.linalg.LinAlgError):
-        return ResidualDelay(float("nan"), float("nan"), bool(identifiable))
-    return ResidualDelay(float(c[-1]), float(std[-1]), bool(identifiable))
+        return ResidualDelay(float("nan"), float("nan"), bool(identifiable), frequencies)
+    return ResidualDelay(float(c[-1]), float(std[-1]), bool(identifiable), frequencies)
 
 
 def score(segments: Sequence[Segment], predicted: Sequence[np.ndarray], folds: int,

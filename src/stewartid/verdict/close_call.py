@@ -105,7 +105,8 @@ def trust_consensus(verdict: Verdict, result: IdentificationResult,
               "the members' errors as fully correlated, and predict a largest error of "
               f"{100 * standings[CONSENSUS].expected_worst:.3g} %; held-out VAF {vaf:.4g} % in "
               f"its worst DOF ({dof}).")
-    uncertain = uncertain_entries(result, compared, entries, verdict.policy)
+    uncertain = uncertain_entries(result, compared, entries, verdict.policy,
+                                  verdict.residual_delay)
     reasons = [reason, *(r for r in verdict.reasons if not r.startswith("uncertain entries:"))]
     if uncertain:
         reasons.append(uncertain_sentence(uncertain))
