@@ -239,7 +239,7 @@ def judge(runs: Sequence[MethodFit], consistent: bool = False,
     compared = {name: by_name[name].result for name, standing in verdict.standings.items()
                 if standing.compared}
     return [*runs, consensus], trust_consensus(verdict, consensus.result, consensus.evidence,
-                                               compared)
+                                               compared, consensus.validation.residual_delay)
 
 
 __all__ = ["consensus_run", "consistent_result", "judge", "run_method", "same_segments"]
