@@ -153,7 +153,8 @@ def test_validation_of_the_exact_model_is_perfect(linear_report, linear_data):
 def test_result_json_has_the_validation_and_consistency_contracts(linear_report):
     _, folder = linear_report
     document = json.loads((folder / "result.json").read_text())
-    assert set(document["validation"]) == {"vaf_percent", "nrmse", "folds"}
+    assert set(document["validation"]) == {"vaf_percent", "nrmse", "folds", "residual_delay"}
+    assert set(document["validation"]["residual_delay"]) == {"ms", "std_ms", "identifiable"}
     assert len(document["validation"]["vaf_percent"]) == 6
     assert len(document["validation"]["nrmse"]) == 6
     assert set(document["consistency"]) == {"M_min_eigenvalue", "B_min_eigenvalue",

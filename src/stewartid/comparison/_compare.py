@@ -21,11 +21,12 @@ from stewartid.datasets.dataset import Dataset
 from stewartid.datasets.plausibility import check_identified
 from stewartid.errors import ConfigError
 from stewartid.identification import registry
+from stewartid.identification.delay import delay_identifiable
 from stewartid.identification.result import IdentificationResult
 from stewartid.model.linearization import nominal_matrices
 from stewartid.parallel import one_blas_thread
 from stewartid.platform import Platform, load_platform
-from stewartid.validation.heldout import DEFAULT_FOLDS, Segment, ValidationResult
+from stewartid.validation.heldout import DEFAULT_FOLDS, ResidualDelay, Segment, ValidationResult
 from stewartid.verdict.policy import (
     DEFAULT_POLICY,
     VerdictPolicy,
@@ -152,6 +153,14 @@ class Comparison:
     def validation(self) -> dict[str, ValidationResult]:
         """Held-out validation (or the validation records' prediction) by method name."""
         return {run.name: run.evidence for run in self.runs if run.evidence is not None}
+
+    @property
+    def residual_delays(self) -> dict[str, ResidualDelay]:
+        """Force delay left in each method's held-out residuals, by method name
+        (:func:`~stewartid.validation.heldout.residual_delay`; ``result.json``:
+        ``validation["residual_delay"]``)."""
+        return {run.name: run.validation.residual_delay for run in self.runs
+                if run.validation is not None and run.validation.residual_delay is not None}
 
     @property
     def trusted_result(self) -> IdentificationResult:
@@ -290,8 +299,11 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
     checker = plausibility_check(platform) if check is True else (check or None)
     segments: dict[tuple[bool, bool], list[Segment]] = {}
     record_cache: dict[tuple[bool, bool], list[Segment]] = {}
+    # where one frequency moves a DOF, a fit absorbs a delay into Bt and leaves none to see
+    identifiable = alignment.sensitivity is None and delay_identifiable(datasets)
     runs = [run_method(name, settings or {}, datasets, platform, folds, consistent, segments,
-                       checker, records, record_cache) for name in dict.fromkeys(names)]
+                       checker, records, record_cache, identifiable)
+            for name in dict.fromkeys(names)]
     if all(run.result is None for run in runs):
         raise runs[0].exception
     scored = (parse_entries(entries) if entries is not None

@@ -64,8 +64,8 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
                segments: dict[tuple[bool, bool], list[Segment]],
                check: Callable[[IdentificationResult], None] | None = None,
                records: Sequence[Dataset] = (),
-               record_cache: dict[tuple[bool, bool], list[Segment]] | None = None
-               ) -> MethodFit:
+               record_cache: dict[tuple[bool, bool], list[Segment]] | None = None,
+               delay_identifiable: bool | None = None) -> MethodFit:
     """Fit, validate and check one method of the comparison.
 
     Parameters
@@ -87,6 +87,10 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
         full fit.
     record_cache : dict, optional
         Their filtered segments by (``gravity``, ``remainder``) setting, filled on first use.
+    delay_identifiable : bool, optional
+        Whether the experiments tell a force delay from damping; when given, the held-out
+        validation measures the delay left in the residuals
+        (:func:`~stewartid.validation.heldout.residual_delay`).
 
     Returns
     -------
@@ -113,7 +117,8 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
             def companion():
                 return registry.estimates_only(name, **{**own, "friction": "uniform"})
         folds_fit = cross_validate(lambda: registry.estimates_only(name, **own), datasets,
-                                   platform, folds, terms[0], segments[terms], companion)
+                                   platform, folds, terms[0], segments[terms], companion,
+                                   delay_identifiable)
     except StewartidError as exc:
         return MethodFit(name, spec.display_name, spec.color, error=str(exc),
                             exception=exc, seconds=time.perf_counter() - start)
@@ -176,7 +181,7 @@ def consensus_run(members: Sequence[MethodFit], consistent: bool,
                                     agreement)
     fitted = CrossValidation(folds[0].folds, [
         combine_results([f.fold_results[k] for f in folds], names, agreement)
-        for k in range(folds[0].folds)], folds[0].segments)
+        for k in range(folds[0].folds)], folds[0].segments, folds[0].delay_identifiable)
     validation = fitted.scores()
     result, projection, before = unconstrained, None, None
     if consistent:
@@ -220,7 +225,9 @@ def judge(runs: Sequence[MethodFit], consistent: bool = False,
     """
     runs = list(runs)
     verdict = choose_trusted({run.name: None if run.result is None else
-                              (run.result, run.evidence) for run in runs}, entries, policy)
+                              (run.result, run.evidence) for run in runs}, entries, policy,
+                             {run.name: run.validation.residual_delay for run in runs
+                              if run.validation is not None})
     by_name = {run.name: run for run in runs}
     members = consensus_members(verdict)
     if not members or CONSENSUS in by_name:
@@ -232,7 +239,7 @@ def judge(runs: Sequence[MethodFit], consistent: bool = False,
     compared = {name: by_name[name].result for name, standing in verdict.standings.items()
                 if standing.compared}
     return [*runs, consensus], trust_consensus(verdict, consensus.result, consensus.evidence,
-                                               compared)
+                                               compared, consensus.validation.residual_delay)
 
 
 __all__ = ["consensus_run", "consistent_result", "judge", "run_method", "same_segments"]

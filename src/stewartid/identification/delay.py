@@ -93,6 +93,18 @@ def delay_bias_per_ms(platform: Platform | np.ndarray, frequencies_hz: Sequence[
     return 1e-3 * (w ** 2 * np.diag(M) + np.diag(K))
 
 
+def single_frequency_dofs(lines: Sequence[Sequence[float]]) -> list[int]:
+    """The DOFs (0-5) whose excitation lines are fewer than two: where a force delay and
+    damping cannot be told apart."""
+    return [k for k, f in enumerate(lines) if len(f) < 2]
+
+
+def delay_identifiable(datasets: Sequence[Dataset]) -> bool:
+    """Whether the experiments tell a force delay from damping: two or more excitation lines
+    in every DOF (what :func:`estimate_delay` requires)."""
+    return not single_frequency_dofs(excitation_lines(datasets))
+
+
 def single_frequency_bias(datasets: Sequence[Dataset], platform: Platform,
                           lines: tuple[tuple[float, ...], ...] | None = None
                           ) -> dict[str, Any] | None:
@@ -102,7 +114,7 @@ def single_frequency_bias(datasets: Sequence[Dataset], platform: Platform,
     "bt_diagonal_per_ms"}``. ``lines``: the excitation lines per DOF, if already found.
     """
     lines = excitation_lines(datasets) if lines is None else lines
-    single = [k for k, f in enumerate(lines) if len(f) < 2]
+    single = single_frequency_dofs(lines)
     if not single:
         return None
     frequencies = []
@@ -316,5 +328,5 @@ def apply_delay(datasets: Sequence[Dataset], platform: Platform, delay: str | fl
 
 
 __all__ = ["AUTO", "DelayEstimate", "apply_delay", "check_delay_identifiable", "delay_bias_per_ms",
-           "describe_bias", "single_frequency_bias",
+           "delay_identifiable", "describe_bias", "single_frequency_bias", "single_frequency_dofs",
            "estimate_delay", "fit_delay", "parse_delay", "shared_least_squares"]

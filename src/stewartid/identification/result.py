@@ -42,7 +42,8 @@ class IdentificationResult:
     diagnostics : dict
         Method-specific.
     validation : dict, optional
-        Held-out scores ``{"vaf_percent", "nrmse", "folds"}``.
+        Held-out scores ``{"vaf_percent", "nrmse", "folds"}``, and ``"residual_delay"``
+        (``{"ms", "std_ms", "identifiable"}``) where measured.
     delay : dict, optional
         The force delay the data were aligned by (:mod:`stewartid.identification.delay`).
     verdict : dict, optional

@@ -37,6 +37,8 @@ class Segment:
         y * h (N, N m), q * h', q * h''.
     coulomb : ndarray, shape (n, 3, 6)
         Filtered generalized Coulomb force per unit level of each joint type.
+    window : float
+        Support of the filter kernel h, s (NaN when not known).
     """
 
     name: str
@@ -47,6 +49,47 @@ class Segment:
     q_dot: np.ndarray
     q_ddot: np.ndarray
     coulomb: np.ndarray
+    window: float = float("nan")
+
+
+@dataclass(frozen=True)
+class ResidualDelay:
+    """Delay of the measured force behind a model's prediction, left in its held-out residuals.
+
+    Attributes
+    ----------
+    seconds, std_error : float
+        The delay (positive: the measured force lags the prediction) and its standard error,
+        s; NaN when the regression is singular.
+    identifiable : bool
+        Whether the motion tells a delay from damping (two or more frequencies in every DOF,
+        as :func:`~stewartid.identification.delay.estimate_delay` requires). Where it does
+        not, a fit absorbs any delay into Bt and its residuals show none: the numbers say
+        nothing about the delay.
+    frequencies_hz : tuple of float
+        Per DOF, the frequency at which a delay reads as damping in a fit of these segments,
+        sqrt(sum q_ddot^2 / sum q_dot^2) / 2 pi: a fit absorbs a delay tau as
+        tau (2 pi f)^2 Mt(i, i) on Bt(i, i).
+    """
+
+    seconds: float
+    std_error: float
+    identifiable: bool
+    frequencies_hz: tuple[float, ...] = ()
+
+    def significant(self, sigmas: float, floor_s: float) -> bool:
+        """Identifiable, more than ``sigmas`` standard errors and ``floor_s`` seconds from 0."""
+        return bool(self.identifiable and np.isfinite(self.seconds)
+                    and abs(self.seconds) > max(sigmas * self.std_error, floor_s))
+
+    def to_dict(self) -> dict[str, Any]:
+        """``validation["residual_delay"]`` of ``result.json``: ``ms``, ``std_ms``
+        (None when not computed), ``identifiable``."""
+        def ms(value: float) -> float | None:
+            return float(value * 1e3) if np.isfinite(value) else None
+
+        return {"ms": ms(self.seconds), "std_ms": ms(self.std_error),
+                "identifiable": bool(self.identifiable)}
 
 
 @dataclass(frozen=True)
@@ -69,11 +112,16 @@ class ValidationResult:
     measured: list[np.ndarray]
     predicted: list[np.ndarray]
     segments: list[Segment]
+    residual_delay: ResidualDelay | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """``validation`` object of ``result.json``: ``vaf_percent``, ``nrmse``, ``folds``."""
-        return {"vaf_percent": self.vaf_percent.tolist(), "nrmse": self.nrmse.tolist(),
-                "folds": int(self.folds)}
+        """``validation`` object of ``result.json``: ``vaf_percent``, ``nrmse``, ``folds``, and
+        ``residual_delay`` (:meth:`ResidualDelay.to_dict`) where measured."""
+        entry = {"vaf_percent": self.vaf_percent.tolist(), "nrmse": self.nrmse.tolist(),
+                 "folds": int(self.folds)}
+        if self.residual_delay is not None:
+            entry["residual_delay"] = self.residual_delay.to_dict()
+        return entry
 
 
 @dataclass(frozen=True)
@@ -87,11 +135,15 @@ class CrossValidation:
         The method refitted without fold k.
     segments : list of Segment
         Every segment of every experiment.
+    delay_identifiable : bool or None
+        Whether the experiments tell a force delay from damping; None: the scores measure no
+        :class:`ResidualDelay`.
     """
 
     folds: int
     fold_results: list[IdentificationResult]
     segments: list[Segment]
+    delay_identifiable: bool | None = None
 
     def scores(self, adjust: Callable[[IdentificationResult], IdentificationResult]
                | None = None) -> ValidationResult:
@@ -100,7 +152,7 @@ class CrossValidation:
         """
         results = [r if adjust is None else adjust(r) for r in self.fold_results]
         predicted = [predict(s, results[s.fold]) for s in self.segments]
-        return score(self.segments, predicted, self.folds)
+        return score(self.segments, predicted, self.folds, self.delay_identifiable)
 
 
 def coulomb_levels(result: IdentificationResult) -> np.ndarray | None:
@@ -171,7 +223,8 @@ def prepare_segment(dataset: Dataset, platform: Platform, window: float, *, grav
     cut = (len(record.t) - len(q_dot)) // 2
     return Segment(name=dataset.name, experiment=experiment, fold=fold,
                    t=record.t[cut:cut + len(q_dot)], force=filtered[:, :6], q_dot=q_dot,
-                   q_ddot=q_ddot, coulomb=filtered[:, 6:].reshape(len(q_dot), 3, 6))
+                   q_ddot=q_ddot, coulomb=filtered[:, 6:].reshape(len(q_dot), 3, 6),
+                   window=float(window))
 
 
 def predict(segment: Segment, result: IdentificationResult) -> np.ndarray:
@@ -183,9 +236,72 @@ def predict(segment: Segment, result: IdentificationResult) -> np.ndarray:
     return out
 
 
-def score(segments: Sequence[Segment], predicted: Sequence[np.ndarray], folds: int
-          ) -> ValidationResult:
-    """VAF and NRMSE per DOF of predictions against the segments' measured force."""
+def residual_delay(segments: Sequence[Segment], predicted: Sequence[np.ndarray],
+                   identifiable: bool) -> ResidualDelay:
+    """The delay of the measured force behind the prediction, from the held-out residuals.
+
+    A force logged tau late leaves r = y - y_pred ~ -tau y_pred' (first order). A fit on
+    such data absorbs part of it into Mt and Bt, so r is first cleared, channel by channel,
+    of what any other Mt, Bt (one pair per fold), Coulomb levels and offsets would explain
+    (the regressors q_ddot, q_dot, the Coulomb terms, one constant per segment); tau is the shared
+    coefficient of -y_pred' in what is left. Channels are weighted by their residual variance;
+    the standard error is a sandwich with a Newey-West long-run covariance over two kernel
+    supports, segments independent
+    (:func:`~stewartid.identification.delay.shared_least_squares`).
+
+    Parameters
+    ----------
+    segments : sequence of Segment
+    predicted : sequence of ndarray, each (n_k, 6)
+        Prediction on each segment (N, N m).
+    identifiable : bool
+        Whether the motion tells a delay from damping; recorded with the estimate.
+
+    Returns
+    -------
+    ResidualDelay
+        NaN where the delay term is not independent of the model's regressors (one frequency
+        per DOF).
+    """
+    from stewartid.identification.delay import shared_least_squares
+
+    windows = [s.window for s in segments if np.isfinite(s.window)]
+    rate = min(1.0 / float(np.median(np.diff(s.t))) for s in segments)
+    window = min(windows) if windows else 20.0 / rate
+    # as the delay estimator: 20 rows per kernel support carry what the filter leaves
+    step = max(1, int(window * rate / 20))
+    folds = sorted({s.fold for s in segments})
+    phis, ys, shared, groups = [], [], [], []
+    for k, (segment, p) in enumerate(zip(segments, predicted, strict=True)):
+        slope = np.gradient(p, segment.t, axis=0)
+        # each fold's own Mt, Bt: their fold-to-fold scatter is no delay
+        motion = np.zeros((len(p), len(folds), 12))
+        motion[:, folds.index(segment.fold)] = np.concatenate([segment.q_ddot, segment.q_dot],
+                                                              axis=1)
+        offsets = np.zeros((len(p), len(segments)))
+        offsets[:, k] = 1.0
+        phis.append(np.concatenate([motion.reshape(len(p), -1), offsets], axis=1)[::step])
+        ys.append((segment.force - p)[::step])
+        shared.append(np.concatenate([segment.coulomb, -slope[:, None, :]], axis=1)[::step])
+        groups.append(np.full(len(ys[-1]), k))
+    lags = int(np.ceil(2 * window * rate / step))
+    # the least-squares projection of q_dddot on q_dot, per DOF: sum q_ddot^2 / sum q_dot^2
+    power = [sum(float(np.sum(getattr(s, name)[:, k] ** 2)) for s in segments)
+             for name in ("q_ddot", "q_dot") for k in range(6)]
+    frequencies = tuple(float(np.sqrt(power[k] / power[6 + k]) / (2 * np.pi))
+                        if power[6 + k] > 0 else float("nan") for k in range(6))
+    try:
+        c, std = shared_least_squares(np.concatenate(phis), np.concatenate(ys),
+                                      np.concatenate(shared), np.concatenate(groups), lags)
+    except (StewartidError, np.linalg.LinAlgError):
+        return ResidualDelay(float("nan"), float("nan"), bool(identifiable), frequencies)
+    return ResidualDelay(float(c[-1]), float(std[-1]), bool(identifiable), frequencies)
+
+
+def score(segments: Sequence[Segment], predicted: Sequence[np.ndarray], folds: int,
+          delay_identifiable: bool | None = None) -> ValidationResult:
+    """VAF and NRMSE per DOF of predictions against the segments' measured force; with
+    ``delay_identifiable`` set, the :func:`residual_delay` too."""
     measured = [s.force - s.force.mean(axis=0) for s in segments]
     centred = [p - p.mean(axis=0) for p in predicted]
     y = np.concatenate(measured)
@@ -194,8 +310,10 @@ def score(segments: Sequence[Segment], predicted: Sequence[np.ndarray], folds: i
     vaf = 100.0 * (1.0 - np.sum(error ** 2, axis=0) / np.where(energy > 0, energy, np.nan))
     spread = y.max(axis=0) - y.min(axis=0)
     nrmse = np.sqrt(np.mean(error ** 2, axis=0)) / np.where(spread > 0, spread, np.nan)
+    delay = (None if delay_identifiable is None
+             else residual_delay(segments, predicted, delay_identifiable))
     return ValidationResult(vaf_percent=vaf, nrmse=nrmse, folds=int(folds), measured=measured,
-                            predicted=centred, segments=list(segments))
+                            predicted=centred, segments=list(segments), residual_delay=delay)
 
 
 def fold_bounds(n: int, folds: int) -> np.ndarray:
@@ -239,7 +357,8 @@ def held_out_segments(datasets: Sequence[Dataset], platform: Platform,
 def cross_validate(create: Callable[[], Any], datasets: Sequence[Dataset], platform: Platform,
                    folds: int = DEFAULT_FOLDS, gravity: bool = True,
                    segments: list[Segment] | None = None,
-                   companion: Callable[[], Any] | None = None) -> CrossValidation:
+                   companion: Callable[[], Any] | None = None,
+                   delay_identifiable: bool | None = None) -> CrossValidation:
     """Refit a method without each time segment and prepare the held-out segments.
 
     Parameters
@@ -256,6 +375,9 @@ def cross_validate(create: Callable[[], Any], datasets: Sequence[Dataset], platf
         From :func:`held_out_segments` with the same ``folds`` and ``gravity``.
     companion : callable, optional
         Friction-estimating identifier lending Coulomb levels (:func:`with_companion_friction`).
+    delay_identifiable : bool, optional
+        Whether the experiments tell a force delay from damping; when given, the scores
+        measure the :func:`residual_delay`.
 
     Raises
     ------
@@ -281,7 +403,8 @@ def cross_validate(create: Callable[[], Any], datasets: Sequence[Dataset], platf
                             "experiments or use fewer folds.") from exc
     if segments is None:
         segments = held_out_segments(datasets, platform, folds, gravity)
-    return CrossValidation(folds=int(folds), fold_results=fold_results, segments=segments)
+    return CrossValidation(folds=int(folds), fold_results=fold_results, segments=segments,
+                           delay_identifiable=delay_identifiable)
 
 
 def record_segments(datasets: Sequence[Dataset], platform: Platform, gravity: bool = True,
@@ -336,8 +459,8 @@ def in_sample(segments: Sequence[Segment], result: IdentificationResult) -> Vali
     return score(segments, [predict(s, result) for s in segments], folds=1)
 
 
-__all__ = ["DEFAULT_FOLDS", "CrossValidation", "Segment", "ValidationResult",
+__all__ = ["DEFAULT_FOLDS", "CrossValidation", "ResidualDelay", "Segment", "ValidationResult",
            "coulomb_estimate", "coulomb_levels", "cross_validate", "excitation_window", "fold_bounds",
            "friction_signature", "held_out_segments", "in_sample", "predict", "prediction_levels",
-           "prepare_segment", "record_segments", "score", "validate_on_records",
+           "prepare_segment", "record_segments", "residual_delay", "score", "validate_on_records",
            "validation_entry", "with_companion_friction"]

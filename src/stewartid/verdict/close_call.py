@@ -14,7 +14,7 @@ import numpy as np
 
 from stewartid.identification.result import IdentificationResult
 from stewartid.reference.published import PAPER_ENTRIES, EntryKey
-from stewartid.validation.heldout import ValidationResult, friction_signature
+from stewartid.validation.heldout import ResidualDelay, ValidationResult, friction_signature
 from stewartid.verdict.accuracy import entry_relative_std, expected_worst_error
 from stewartid.verdict.policy import entries_text
 from stewartid.verdict.rule import (
@@ -61,7 +61,8 @@ def combined_text(result: IdentificationResult, reference: str,
 
 def trust_consensus(verdict: Verdict, result: IdentificationResult,
                     validation: ValidationResult,
-                    compared: dict[str, IdentificationResult]) -> Verdict:
+                    compared: dict[str, IdentificationResult],
+                    residual_delay: ResidualDelay | None = None) -> Verdict:
     """``verdict`` with the consensus of its close call trusted and ranked first.
 
     Parameters
@@ -75,6 +76,8 @@ def trust_consensus(verdict: Verdict, result: IdentificationResult,
     compared : dict of str to IdentificationResult
         The plausible methods' results, by name: the entries the consensus is unsure of are
         those its relative error leaves uncertain or one of them contradicts.
+    residual_delay : ResidualDelay, optional
+        The force delay left in its held-out residuals.
 
     Returns
     -------
@@ -92,7 +95,8 @@ def trust_consensus(verdict: Verdict, result: IdentificationResult,
         compared=True, models_friction=models_friction(result), friction_effect=None,
         damping_excess=float("nan"), friction_share=friction_signature(validation),
         worst_relative_std=worst, worst_entry=entry,
-        expected_worst=expected_worst_error(entry_relative_std(result, entries)))}
+        expected_worst=expected_worst_error(entry_relative_std(result, entries)),
+        residual_delay=residual_delay)}
     standings.update({name: dataclasses.replace(
         standing, unexplained_ratio=standing.unexplained_percent / unexplained)
         for name, standing in verdict.standings.items()})
@@ -105,7 +109,8 @@ def trust_consensus(verdict: Verdict, result: IdentificationResult,
               "the members' errors as fully correlated, and predict a largest error of "
               f"{100 * standings[CONSENSUS].expected_worst:.3g} %; held-out VAF {vaf:.4g} % in "
               f"its worst DOF ({dof}).")
-    uncertain = uncertain_entries(result, compared, entries, verdict.policy)
+    uncertain = uncertain_entries(result, compared, entries, verdict.policy,
+                                  verdict.residual_delay)
     reasons = [reason, *(r for r in verdict.reasons if not r.startswith("uncertain entries:"))]
     if uncertain:
         reasons.append(uncertain_sentence(uncertain))

@@ -19,6 +19,7 @@ from stewartid.identification.result import IdentificationResult
 from stewartid.platform import COORDINATES
 from stewartid.reference.published import PAPER_ENTRIES, EntryKey, entry_label
 from stewartid.validation.heldout import (
+    ResidualDelay,
     ValidationResult,
     coulomb_estimate,
     friction_signature,
@@ -48,10 +49,21 @@ def worst_relative_std(result: IdentificationResult,
     return float(values[k]), entry_label(entries[k])
 
 
+def delay_bias(result: IdentificationResult, delay: ResidualDelay) -> np.ndarray:
+    """What a force delay left in the data puts on the Bt diagonal of ``result``, shape (6,)
+    (N s/m, N m s/rad): |tau| (2 pi f_i)^2 Mt(i, i) at the frequencies the fit reads it at
+    (:attr:`~stewartid.validation.heldout.ResidualDelay.frequencies_hz`; the gravity
+    stiffness's share, 3 % on the paper's Bt(4,4) at 0.5 Hz, left out). NaN where not known."""
+    frequencies = np.full(6, np.nan)
+    frequencies[:len(delay.frequencies_hz)] = delay.frequencies_hz
+    return abs(delay.seconds) * (2 * np.pi * frequencies) ** 2 * np.abs(np.diag(result.M))
+
+
 def uncertain_entries(trusted: IdentificationResult,
                       others: Mapping[str, IdentificationResult],
                       entries: Sequence[EntryKey] = PAPER_ENTRIES,
-                      policy: VerdictPolicy = DEFAULT_POLICY) -> list[dict]:
+                      policy: VerdictPolicy = DEFAULT_POLICY,
+                      delay: ResidualDelay | None = None) -> list[dict]:
     """The scored entries the trusted result is unsure of, and why.
 
     Parameters
@@ -62,14 +74,20 @@ def uncertain_entries(trusted: IdentificationResult,
     entries : sequence of (str, int, int)
         The scored entries.
     policy : VerdictPolicy
+    delay : ResidualDelay, optional
+        A force delay found in the held-out residuals: the Bt diagonal entries it biases by
+        more than their standard error (:func:`delay_bias`) are uncertain too.
 
     Returns
     -------
     list of dict
         ``{"entry": "Bt(5,1)", "relative_std": r, "disagrees_with": [names]}`` for every
         entry whose relative standard error exceeds ``policy.uncertain_relative`` or whose
-        estimate another method contradicts beyond ``policy.disagreement`` combined errors.
+        estimate another method contradicts beyond ``policy.disagreement`` combined errors;
+        ``"delay_bias"`` where the delay biases it: the first-order bias |tau| (2 pi f)^2
+        Mt(i, i) over the entry's value.
     """
+    bias = None if delay is None else delay_bias(trusted, delay)
     found = []
     for matrix, i, j in entries:
         value, std = entry_estimate(trusted, matrix, i, j)
@@ -79,9 +97,15 @@ def uncertain_entries(trusted: IdentificationResult,
             v, s = entry_estimate(other, matrix, i, j)
             if abs(v - value) > policy.disagreement * np.hypot(s, std):
                 against.append(name)
-        if relative > policy.uncertain_relative or against:
-            found.append({"entry": entry_label((matrix, i, j)),
-                          "relative_std": float(relative), "disagrees_with": against})
+        # a bias not known (no motion in that DOF) counts: the delay is there
+        biased = (bias is not None and matrix == "B" and i == j
+                  and not bias[i] <= std)
+        if relative > policy.uncertain_relative or against or biased:
+            item = {"entry": entry_label((matrix, i, j)),
+                    "relative_std": float(relative), "disagrees_with": against}
+            if biased:
+                item["delay_bias"] = float(bias[i] / abs(value)) if value != 0 else np.inf
+            found.append(item)
     return found
 
 
@@ -155,6 +179,8 @@ class Standing:
     expected_worst : float
         Its expected largest relative error over the scored entries (a fraction), its
         errors conditioned on the others' (:func:`~stewartid.verdict.accuracy.error_posterior`).
+    residual_delay : ResidualDelay or None
+        The force delay left in its held-out residuals, where measured.
     """
 
     name: str
@@ -171,6 +197,7 @@ class Standing:
     misfit: bool = False
     friction_immune: bool = False
     expected_worst: float = float("nan")
+    residual_delay: ResidualDelay | None = None
 
     @property
     def unexplained_percent(self) -> float:
@@ -207,6 +234,10 @@ class Verdict:
         The entries the methods were judged on.
     policy : VerdictPolicy
         The thresholds the verdict was reached with.
+    residual_delay : ResidualDelay or None
+        A force delay the trusted method's held-out residuals show beyond
+        ``policy.significant`` standard errors and ``policy.delay_floor_s``: the fits absorbed
+        it, and their standard errors do not cover the bias.
     """
 
     trusted: str
@@ -219,11 +250,13 @@ class Verdict:
     close: tuple[str, ...] = ()
     entries: tuple[EntryKey, ...] = PAPER_ENTRIES
     policy: VerdictPolicy = DEFAULT_POLICY
+    residual_delay: ResidualDelay | None = None
 
     def to_dict(self) -> dict:
         """The ``verdict`` object of ``result.json``: ``trusted``, ``ranking`` (registry
         names), ``uncertain_entries`` (entry labels), ``reasons``, ``close`` (the close call,
-        :attr:`close`), and the evidence per method under ``evidence``."""
+        :attr:`close`), the evidence per method under ``evidence`` (with its
+        ``residual_delay`` where measured) and ``residual_delay``, the delay found or None."""
         return {
             "trusted": self.trusted, "ranking": list(self.ranking),
             "uncertain_entries": [u["entry"] for u in self.uncertain],
@@ -236,14 +269,20 @@ class Verdict:
                 "heldout_worst_vaf_percent": st.worst_vaf_percent,
                 "heldout_worst_dof": st.worst_dof, "plausible": st.compared,
                 "misfit": st.misfit, "models_friction": st.models_friction,
-                "friction_immune": st.friction_immune}
+                "friction_immune": st.friction_immune,
+                **({} if st.residual_delay is None
+                   else {"residual_delay": st.residual_delay.to_dict()})}
                 for name, st in self.standings.items()},
-            "uncertain_detail": self.uncertain}
+            "uncertain_detail": self.uncertain,
+            "residual_delay": (None if self.residual_delay is None
+                               else self.residual_delay.to_dict())}
 
 
 def choose_trusted(assessed: Mapping[str, tuple[IdentificationResult, ValidationResult] | None],
                    entries: Sequence[EntryKey] = PAPER_ENTRIES,
-                   policy: VerdictPolicy = DEFAULT_POLICY) -> Verdict:
+                   policy: VerdictPolicy = DEFAULT_POLICY,
+                   residual_delays: Mapping[str, ResidualDelay | None] | None = None
+                   ) -> Verdict:
     """Which method to trust on these data (``docs/verdict.md`` states the rule).
 
     Parameters
@@ -256,12 +295,17 @@ def choose_trusted(assessed: Mapping[str, tuple[IdentificationResult, Validation
         (:func:`~stewartid.verdict.policy.scored_entries`).
     policy : VerdictPolicy
         The thresholds.
+    residual_delays : mapping, optional
+        Method name -> force delay left in its held-out residuals
+        (:func:`~stewartid.validation.heldout.residual_delay`); the trusted method's, when
+        significant, is a reason and makes the Bt diagonal entries it biases uncertain.
 
     Returns
     -------
     Verdict
     """
     entries = tuple(entries)
+    residual_delays = dict(residual_delays or {})
     ok = {name: pair for name, pair in assessed.items() if pair is not None}
     worst = {name: worst_dof(validation) for name, (_, validation) in ok.items()}
     unexplained = {name: 100.0 - vaf for name, (vaf, _) in worst.items()}
@@ -296,16 +340,21 @@ def choose_trusted(assessed: Mapping[str, tuple[IdentificationResult, Validation
             damping_excess=excess, friction_share=friction_signature(validation),
             worst_relative_std=spread[name][0], worst_entry=spread[name][1],
             misfit=misfit[name], friction_immune=friction_immune(result),
-            expected_worst=expected[name])
+            expected_worst=expected[name], residual_delay=residual_delays.get(name))
     others = sorted((name for name in ok if name != trusted),
                     key=lambda name: (name not in compared, misfit[name], expected[name]))
+    # a delay in the data is in every method's residuals: it sets no method back, but the
+    # bias it puts on Bt is in none of their standard errors
+    delay = residual_delays.get(trusted)
+    if delay is not None and not delay.significant(policy.significant, policy.delay_floor_s):
+        delay = None
     uncertain = uncertain_entries(ok[trusted][0], {name: ok[name][0] for name in compared
-                                                   if name != trusted}, entries, policy)
+                                                   if name != trusted}, entries, policy, delay)
     not_applicable = tuple(name for name, pair in assessed.items() if pair is None)
     close = (trusted, *(name for name in others if name in candidates
                         and expected[name] <= policy.close_factor * expected[trusted]))
     verdict = Verdict(trusted, (trusted, *others), standings, friction_source, not_applicable,
-                      uncertain, [], close, entries, policy)
+                      uncertain, [], close, entries, policy, delay)
     return dataclasses.replace(verdict, reasons=_reasons(verdict))
 
 
@@ -320,6 +369,8 @@ def _reasons(verdict: Verdict) -> list[str]:
                f"standard error {100 * best.worst_relative_std:.3g} %, {best.worst_entry}), the "
                "least of the plausible methods that predict held-out data; held-out VAF "
                f"{best.worst_vaf_percent:.4g} % in its worst DOF ({best.worst_dof})."]
+    if verdict.residual_delay is not None:
+        reasons.append(delay_reason(verdict.residual_delay, standings))
     if len(close) > 1:
         reasons.append(f"close call: {', '.join(close)} predict largest errors within "
                        f"{policy.close_factor:g}x of each other ("
@@ -347,15 +398,36 @@ def _reasons(verdict: Verdict) -> list[str]:
     return reasons
 
 
+def delay_reason(delay: ResidualDelay, standings: Mapping[str, Standing]) -> str:
+    """The reason naming a force delay left in the held-out residuals, and the fix."""
+    others = ", ".join(f"{name} {1e3 * st.residual_delay.seconds:.3g}"
+                       for name, st in standings.items()
+                       if st.residual_delay is not None and st.residual_delay is not delay
+                       and np.isfinite(st.residual_delay.seconds))
+    return (f"force delay left in the held-out residuals: the measured forces lag the "
+            f"prediction by {1e3 * delay.seconds:.3g} ms (standard error "
+            f"{1e3 * delay.std_error:.2g} ms" + (f"; ms by method: {others}" if others else "")
+            + "); every fit absorbed it into Mt and Bt, beyond their standard errors: align "
+            "the forces with --delay auto, or a known --delay SECONDS.")
+
+
+def uncertain_reason(item: dict) -> str:
+    """Why an uncertain entry (:func:`uncertain_entries`) is uncertain, for a parenthesis."""
+    if item["disagrees_with"]:
+        return f"disagrees with {', '.join(item['disagrees_with'])}"
+    if "delay_bias" in item:
+        # the first-order figure understates what the fits' weighting of the lines makes
+        # of it (docs/verdict.md): the entry is named, not the figure
+        return "biased by the force delay"
+    return f"{100 * item['relative_std']:.3g} % standard error"
+
+
 def uncertain_sentence(uncertain: Sequence[dict]) -> str:
     """The reason naming the uncertain entries (:func:`uncertain_entries`) and why."""
     return "uncertain entries: " + ", ".join(
-        u["entry"] + (f" (disagrees with {', '.join(u['disagrees_with'])})"
-                      if u["disagrees_with"] else
-                      f" ({100 * u['relative_std']:.3g} % standard error)")
-        for u in uncertain) + "."
+        f"{u['entry']} ({uncertain_reason(u)})" for u in uncertain) + "."
 
 
-__all__ = ["Standing", "Verdict", "choose_trusted", "finds_friction", "friction_immune",
-           "is_definite", "models_friction", "uncertain_entries",
-           "uncertain_sentence", "worst_dof", "worst_relative_std"]
+__all__ = ["Standing", "Verdict", "choose_trusted", "delay_bias", "delay_reason",
+           "finds_friction", "friction_immune", "is_definite", "models_friction",
+           "uncertain_entries", "uncertain_reason", "uncertain_sentence", "worst_dof", "worst_relative_std"]

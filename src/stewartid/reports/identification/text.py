@@ -216,7 +216,24 @@ def _validation_section(report: IdentificationReport, folds: int) -> list[str]:
         to_markdown(ResultTable("vaf", "Held-out VAF per DOF (%)", ("method", *COORDINATES),
                                 kinds, tuple(vaf_rows))),
         to_markdown(ResultTable("nrmse", "Held-out NRMSE per DOF", ("method", *COORDINATES),
-                                kinds, tuple(nrmse_rows)))]
+                                kinds, tuple(nrmse_rows)))] + _residual_delay_lines(report)
+
+
+def _residual_delay_lines(report: IdentificationReport) -> list[str]:
+    """The force delay left in each method's held-out residuals, or why it cannot be seen."""
+    found = [(run.display_name, run.validation.residual_delay) for run in report.runs
+             if run.validation is not None and run.validation.residual_delay is not None]
+    if not found:
+        return []
+    if not all(delay.identifiable for _, delay in found):
+        return ["", "A force delay left in the data is not identifiable in the held-out "
+                "residuals: a DOF moved at one frequency only, where a fit absorbs the delay "
+                "into Bt and predicts the delayed force as well as the true one.", ""]
+    values = ", ".join(f"{name} {1e3 * d.seconds:.3g} ± {1e3 * d.std_error:.2g}"
+                       for name, d in found if np.isfinite(d.seconds))
+    return ["", "Force delay left in the held-out residuals (ms ± standard error; positive: "
+            "the measured force lags the prediction), once any other Mt, Bt per fold, Coulomb "
+            f"levels and offsets have explained what they can: {values}.", ""]
 
 
 def _records_section(report: IdentificationReport, records: Sequence[str]) -> list[str]:

@@ -16,11 +16,11 @@ from stewartid.reports.identification.friction_text import (
     friction_text,
     third_harmonic_lines,
 )
-from stewartid.validation.heldout import friction_signature
+from stewartid.validation.heldout import ResidualDelay, friction_signature
 from stewartid.verdict.accuracy import relative_std
 from stewartid.verdict.close_call import CONSENSUS, combined_text
 from stewartid.verdict.policy import entries_text
-from stewartid.verdict.rule import Verdict, worst_dof
+from stewartid.verdict.rule import Verdict, uncertain_reason, worst_dof
 
 #: Held-out VAF (%) in the worst DOF above which a model "predicts closely", "adequately".
 CLOSE_VAF, ADEQUATE_VAF = 99.0, 95.0
@@ -42,8 +42,18 @@ def quality_text(vaf: float) -> str:
             "(see the residual spectrum and the friction section)")
 
 
-def method_lines(run: MethodFit) -> list[str]:
-    """What to know about one method's result, one Markdown sentence group each."""
+def delay_text(delay: ResidualDelay) -> str:
+    """A Markdown sentence on a force delay left in the held-out residuals, and the fix."""
+    return (f"**The forces lag the motion by {1e3 * delay.seconds:.3g} ms** (standard error "
+            f"{1e3 * delay.std_error:.2g} ms) in the held-out residuals: a delay the fit did "
+            "not remove, absorbed into Mt and Bt (mostly the Bt diagonal, by about "
+            "τ (2πf)² Mt(i,i)) beyond their standard errors. Align the forces: "
+            "`--delay auto`, or a known `--delay SECONDS`.")
+
+
+def method_lines(run: MethodFit, delay: ResidualDelay | None = None) -> list[str]:
+    """What to know about one method's result, one Markdown sentence group each; ``delay``: a
+    force delay found in its held-out residuals (:attr:`Verdict.residual_delay`)."""
     result = run.result
     vaf, dof = worst_dof(run.validation)
     lines = [f"**{run.display_name}** {quality_text(vaf)}: VAF ≥ {vaf:.2f} % in every DOF "
@@ -64,6 +74,8 @@ def method_lines(run: MethodFit) -> list[str]:
                      f"{changed_text(run.projection)} standard errors; held-out VAF in the worst DOF "
                      f"{np.min(run.validation_unconstrained.vaf_percent):.3f} % → "
                      f"{np.min(run.validation.vaf_percent):.3f} %.")
+    if delay is not None:
+        lines.append(delay_text(delay))
     lines.append(f"Median relative standard error of the diagonal entries: "
                  f"{100 * relative_std(result):.2g} %.")
     lines += sampling_lines([run])
@@ -82,7 +94,7 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodFit]) -> list[str]:
     """The verdict as Markdown sentences: one method's notes, or which to trust and why not the others."""
     ok = [run for run in runs if run.result is not None]
     if len(ok) == 1:
-        return method_lines(ok[0])
+        return method_lines(ok[0], verdict.residual_delay)
     best = next(run for run in ok if run.name == verdict.trusted)
     trusted = verdict.standings[best.name]
     names = {run.name: run.display_name for run in ok}
@@ -105,11 +117,12 @@ def verdict_lines(verdict: Verdict, runs: Sequence[MethodFit]) -> list[str]:
                      "decides which is the more accurate (on logs with a known truth the one "
                      "predicting less was the more accurate in six or seven of ten such "
                      "cases). Where their entries differ, both are in the tables below.")
+    if verdict.residual_delay is not None:
+        lines.append(delay_text(verdict.residual_delay))
     if verdict.uncertain:
         lines.append("Entries to treat with care: " + ", ".join(
             u["entry"] + (f" (other methods disagree: {', '.join(u['disagrees_with'])})"
-                          if u["disagrees_with"] else
-                          f" ({100 * u['relative_std']:.3g} % standard error)")
+                          if u["disagrees_with"] else f" ({uncertain_reason(u)})")
             for u in verdict.uncertain) + ".")
     lines += sampling_lines(ok)
     if verdict.friction_source is not None:
@@ -184,6 +197,7 @@ def sampling_lines(runs: Sequence[MethodFit]) -> list[str]:
         "the rate: a bound of what the sampling does, not an estimate of the noise."]
 
 
-__all__ = ["ADEQUATE_VAF", "CLOSE_VAF", "changed_text", "consensus_text", "method_lines",
+__all__ = ["ADEQUATE_VAF", "CLOSE_VAF", "changed_text", "consensus_text", "delay_text",
+           "method_lines",
            "quality_text",
            "sampling_lines", "verdict_lines"]
