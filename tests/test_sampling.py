@@ -141,5 +141,8 @@ def test_the_report_says_which_results_the_sampling_limits(tmp_path, noise_free,
     line = next(line for line in text.splitlines() if "Limited by the log's sampling" in line)
     # least squares' residual is round-off there (flagged), Method A's errors do not scale
     assert "Time-domain least squares" in line and "Method A" not in line
-    document = json.loads((tmp_path / "result.json").read_text())
-    assert document["diagnostics"]["sampling"]["factors"]
+    # both methods are exact here to the model's approximation floor: a close call, either or
+    # their consensus trusted (result.json); least squares' own result has the sampling summary
+    assert json.loads((tmp_path / "result.json").read_text())["method"] in ("fourier", "ls", "consensus")
+    run = next(run for run in comparison.runs if run.name == "ls")
+    assert run.result.diagnostics["sampling"]["factors"]

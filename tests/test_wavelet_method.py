@@ -369,10 +369,10 @@ def test_auto_keeps_the_coulomb_law_on_sines_where_it_holds(paper):
     """One 0.5 Hz sine per experiment, joint Coulomb friction of the law's structure, 50 N
     of force noise: both treatments are fitted; the law passes its test (the diagonals of
     the two fits agree within their errors), and its rows, which keep the part of the motion
-    that the free constants give away, make the Bt diagonal's errors smaller: at least 1.3
-    times, twice in the median (measured 1.42-3.52; 1.7-3.6 before the law's fits were
-    averaged over the soft-sign rates, whose spread the standard errors now carry), the
-    estimates within 4 of them."""
+    that the free constants give away, make the Bt diagonal's errors smaller: at least 1.2
+    times, twice in the median (measured 1.24-3.52; 1.42-3.52 before the law's errors carried
+    its bias as the free fit measures it, which Bt(6,6) shows here; 1.7-3.6 before the law's
+    fits were averaged over the soft-sign rates), the estimates within 4 of them."""
     M, B = nominal_matrices(paper)
     levels = (30.0, 20.0, 40.0)
     data = _force_noise(coulomb_structured_datasets(paper, M, B, levels, "sine", duration=12.0,
@@ -385,7 +385,7 @@ def test_auto_keeps_the_coulomb_law_on_sines_where_it_holds(paper):
     law = diagnostics["friction_law_test"]
     assert not law["rejected"] and law["largest_disagreement"] < law["threshold"]
     gain = np.diag(free.std_errors_["B"]) / np.diag(auto.std_errors_["B"])
-    assert gain.min() > 1.3 and np.median(gain) > 2.0, np.round(gain, 2)
+    assert gain.min() > 1.2 and np.median(gain) > 2.0, np.round(gain, 2)
     from stewartid.reports.identification.friction_text import friction_law_lines
     assert "kept the law, which passes its test" in friction_law_lines(auto.result_)[0]
     for matrix, truth in ((auto.M_, M), (auto.B_, B)):

@@ -12,7 +12,7 @@ from stewartid.datasets.dataset import Dataset
 from stewartid.errors import ConfigError, NotFittedError
 from stewartid.fields import Constraint, Interval, positive, validate_parameters
 from stewartid.identification.preparation import resolve_datasets, resolve_platform
-from stewartid.identification.result import IdentificationResult
+from stewartid.identification.result import IdentificationResult, with_model_floor
 from stewartid.identification.sampling import check_sampling
 from stewartid.platform import Platform
 
@@ -21,8 +21,9 @@ class BaseIdentifier:
     """Base class of the identifiers.
 
     Learned attributes set by :meth:`fit`: ``M_``, ``B_`` (6, 6), ``std_errors_`` (dict ``"M"``, ``"B"``;
-    widened where sampling limits them), ``condition_number_``, ``result_`` (IdentificationResult),
-    plus the method-specific ones a subclass's ``_fit`` returns.
+    widened where sampling limits them, at least the model's approximation floor of
+    :func:`~stewartid.identification.result.with_model_floor`), ``condition_number_``,
+    ``result_`` (IdentificationResult), plus the method-specific ones a subclass's ``_fit`` returns.
     """
 
     #: Registry name of the method, stored in the result (set by ``register_method``).
@@ -91,6 +92,7 @@ class BaseIdentifier:
             result, learned = self._fit(data, platform)
             if getattr(self, "sampling_check", False):
                 result, learned = self._check_sampling(data, platform, result, learned)
+            result = with_model_floor(result)
         attributes = {"result_": result, "M_": result.M, "B_": result.B,
                       "std_errors_": {"M": result.std_errors_M, "B": result.std_errors_B},
                       "condition_number_": result.condition_number, **learned}

@@ -5,6 +5,7 @@ Matrices, standard errors, ``result.json`` and the paper's comparison table (Zha
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -188,10 +189,33 @@ def comparison_table(M: np.ndarray, B: np.ndarray, M_nominal: np.ndarray,
     return pd.DataFrame(comparison_rows(M, B, M_nominal, B_nominal, std_M, std_B))
 
 
+#: The linearised model's own approximation error (the remainder's derivatives and
+#: interpolation, interval detection) as a share of sqrt(|A_ii A_jj|): the largest error of
+#: any method on noise-free logs, measured by ``benchmarks/coverage_study.py``, is below it.
+MODEL_FLOOR = 1e-3
+
+
+def with_model_floor(result: IdentificationResult) -> IdentificationResult:
+    """The result with every standard error at least :data:`MODEL_FLOOR` sqrt(|A_ii A_jj|).
+
+    On noise-free or long logs the noise-based errors shrink towards zero while the model's
+    approximation error does not; the floor keeps entry (i, j) of Mt and Bt covered, in the
+    units of its own row and column (the diagonals set the scale of the couplings).
+    """
+    def floored(matrix: np.ndarray, std: np.ndarray) -> np.ndarray:
+        diagonal = np.abs(np.diag(matrix))
+        floor = MODEL_FLOOR * np.sqrt(np.outer(diagonal, diagonal))
+        return np.where(np.isfinite(floor), np.fmax(std, floor), std)
+
+    return dataclasses.replace(result, std_errors_M=floored(result.M, result.std_errors_M),
+                               std_errors_B=floored(result.B, result.std_errors_B))
+
+
 def max_error_percent(M: np.ndarray, B: np.ndarray, M_nominal: np.ndarray,
                       B_nominal: np.ndarray) -> float:
     """Largest epsilon (%) over the 20 entries of the paper's tables."""
     return float(comparison_table(M, B, M_nominal, B_nominal)["error_percent"].max())
 
 
-__all__ = ["IdentificationResult", "comparison_rows", "comparison_table", "max_error_percent"]
+__all__ = ["MODEL_FLOOR", "IdentificationResult", "comparison_rows", "comparison_table",
+           "max_error_percent", "with_model_floor"]

@@ -35,6 +35,10 @@ class Detection(NamedTuple):
         Their noise levels, rad/s.
     q_dot, q_ddot : ndarray, shape (N, 6)
         Savitzky-Golay derivatives of the pose.
+    leg_sign_rates : ndarray, shape (N, 6)
+        The leg-length rates the Coulomb signs along the legs use, m/s.
+    leg_sign_rate_noise : ndarray, shape (6,)
+        Their noise levels, m/s.
     """
 
     intervals: np.ndarray
@@ -45,6 +49,8 @@ class Detection(NamedTuple):
     q_ddot: np.ndarray
     sign_rates: np.ndarray
     sign_rate_noise: np.ndarray
+    leg_sign_rates: np.ndarray
+    leg_sign_rate_noise: np.ndarray
 
 
 #: Largest noise of the Coulomb signs' rates relative to their RMS
@@ -181,9 +187,11 @@ def _sign_rates(experiment: Experiment, noise: NoiseModel) -> dict:
                                        noise.pose_covariance, SIGN_NOISE_LIMIT)
     jacobians = experiment.joint_jacobians
     level = joint_rate_noise(noise.pose_covariance, experiment.sample_rate, window, jacobians,
-                             experiment.leg_jacobian, SIGN_ORDER)[:30].reshape(6, 5)
+                             experiment.leg_jacobian, SIGN_ORDER)
     return {"sign_rates": np.einsum("nlac,nc->nla", jacobians, q_dot),
-            "sign_rate_noise": np.maximum(level, 1e-12)}
+            "sign_rate_noise": np.maximum(level[:30].reshape(6, 5), 1e-12),
+            "leg_sign_rates": (experiment.leg_jacobian @ q_dot[:, :, None])[:, :, 0],
+            "leg_sign_rate_noise": np.maximum(level[30:], 1e-12)}
 
 
 __all__ = ["SINGLE_SINE_SHARE", "Detection", "check_coverage", "detect_intervals",

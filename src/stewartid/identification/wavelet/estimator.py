@@ -32,6 +32,7 @@ from stewartid.identification.wavelet.detection import (
 from stewartid.identification.wavelet.friction_models import (
     choose_friction_fit,
     friction_models,
+    law_floor,
     model_equations,
     solve_models,
 )
@@ -211,13 +212,16 @@ class WaveletIdentifier(BaseIdentifier):
                        wavelet: MotherWavelet) -> tuple[IdentificationResult, dict]:
         """Test-function families per interval, one experiment at a time (long logs fit in memory)."""
         models = friction_models(self.friction, datasets)
+        # a ball screw's Coulomb friction along each leg: one more level, in N
+        legs = platform.actuator.kind == "electric"
         infos, sensitivities, motion = [], [], []
         equations: dict[str, list] = {model: [] for model in models}
         for k, dataset in enumerate(datasets):
             experiment = prepare_experiment(dataset, platform, self.gravity, joints=True,
                                             remainder=self.remainder)
             found = self._noise_and_intervals(experiment, 1.0)
-            patterns = (coulomb_patterns(found, experiment.joint_jacobians, False)
+            patterns = (coulomb_patterns(found, experiment.joint_jacobians, False,
+                                         leg_jacobian=experiment.leg_jacobian if legs else None)
                         if {"free", "coulomb"} & set(models) else None)
             for model in models:
                 equations[model] += model_equations(model, experiment, found,
@@ -232,8 +236,10 @@ class WaveletIdentifier(BaseIdentifier):
                   "force_sensitivity": sensitivities} if self.noise_correction else {})
         solved, refused = solve_models(models, equations, infos, motion, noise)
         fits = {model: self._weak_form_result(solution, infos, len(equations[model]), wavelet,
-                                              model, rate)
+                                              model, rate, legs and model in ("free", "coulomb"))
                 for model, (solution, rate) in solved.items()}
+        if "free" in fits and "coulomb" in fits:  # the law's bias, before the choice
+            fits["coulomb"] = (law_floor(fits["coulomb"][0], fits["free"][0]), fits["coulomb"][1])
         chosen, why = choose_friction_fit({model: fit[0] for model, fit in fits.items()},
                                           {model: solution for model, (solution, _) in
                                            solved.items()})
@@ -244,13 +250,18 @@ class WaveletIdentifier(BaseIdentifier):
 
     def _weak_form_result(self, solution: WeakFormSolution, infos: list[dict],
                           n_intervals: int, wavelet: MotherWavelet, friction: str,
-                          rate: float) -> tuple[IdentificationResult, dict]:
-        """The result and the learned Coulomb levels of :meth:`_fit_weak_form`."""
+                          rate: float, legs: bool = False) -> tuple[IdentificationResult, dict]:
+        """The result and the learned Coulomb levels of :meth:`_fit_weak_form`; ``legs``: the last
+        level is the legs' (N)."""
         M, B = solution.theta[:, :6].copy(), solution.theta[:, 6:12].copy()
         std_M, std_B = solution.theta_std[:, :6].copy(), solution.theta_std[:, 6:12].copy()
         chosen = self._combine_pairs(M, B, std_M, std_B, clip=friction == "free")
+        joint_levels = (solution.coulomb[:-1], solution.coulomb_std[:-1]) if legs else (
+            solution.coulomb, solution.coulomb_std)
         levels, levels_std = (dict(zip(JOINT_TYPES, np.resize(v, 3).tolist(), strict=True))
-                              for v in (solution.coulomb, solution.coulomb_std))  # uniform: 1
+                              for v in joint_levels)  # uniform: 1
+        leg_levels = ({"leg_coulomb": float(solution.coulomb[-1]),
+                       "leg_coulomb_std": float(solution.coulomb_std[-1])} if legs else {})
         diagnostics = {
             "position_noise_std": [np.sqrt(np.diag(i["noise_covariance"])).tolist()
                                    for i in infos],
@@ -261,7 +272,7 @@ class WaveletIdentifier(BaseIdentifier):
             "pair_choice": chosen, "pair_calibration": self.pair_calibration_,
             "coordinates": list(COORDINATES), "friction_model": friction,
             "soft_sign_rate": rate, "soft_sign_weights": solution.rate_weights,
-            "coulomb": levels, "coulomb_std": levels_std,
+            "coulomb": levels, "coulomb_std": levels_std, **leg_levels,
             "offsets": solution.offsets, "noise_std": solution.noise_std,
             "constant_scatter": solution.constant_scatter,
             "pose_noise_share": solution.pose_noise_share}

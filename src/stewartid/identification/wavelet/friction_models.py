@@ -5,6 +5,7 @@ The equations and solve of each, and the choice between them on one sine per exp
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -99,6 +100,26 @@ def choose_friction_fit(results: Mapping[str, IdentificationResult],
         for model, value in predicted.items()}, "friction_law_test": law}
 
 
+def law_floor(law: IdentificationResult, free: IdentificationResult) -> IdentificationResult:
+    """The Coulomb-law fit, its standard errors widened by its bias as the fit with free
+    interval constants (which no friction law biases) measures it.
+
+    Under pose noise the soft-sign Coulomb regressors of slowly reversing joints are errors in
+    variables: the law fit's couplings can be biased by several of its standard errors while
+    the free fit stays unbiased. With the law fit the efficient one, their difference d has
+    variance s_free^2 - s_law^2 without bias (Hausman 1978), so b^2 = max(d^2 - s_free^2 +
+    s_law^2, 0) estimates the squared bias and the error becomes sqrt(s_law^2 + b^2). Both
+    (6, 6) results after their pairs combine.
+    """
+    def widened(value, std, other, other_std):
+        bias = np.maximum((value - other) ** 2 - np.abs(other_std ** 2 - std ** 2), 0.0)
+        return np.sqrt(std ** 2 + bias)
+
+    return dataclasses.replace(
+        law, std_errors_M=widened(law.M, law.std_errors_M, free.M, free.std_errors_M),
+        std_errors_B=widened(law.B, law.std_errors_B, free.B, free.std_errors_B))
+
+
 #: Family-wise level of :func:`friction_law_test` over the 12 diagonal entries of Mt and Bt.
 FRICTION_LAW_LEVEL = 0.01
 
@@ -129,4 +150,4 @@ def friction_law_test(free: np.ndarray, free_std: np.ndarray, law: np.ndarray,
 
 
 __all__ = ["FRICTION_LAW_LEVEL", "WINDOW_LENGTH", "choose_friction_fit", "friction_law_test",
-           "friction_models", "model_equations", "solve_model", "solve_models"]
+           "friction_models", "law_floor", "model_equations", "solve_model", "solve_models"]

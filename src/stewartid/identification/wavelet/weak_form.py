@@ -136,7 +136,7 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
     ys = y[sel]
     mean_rate = joint_rates[sel].mean(axis=0)
     direction = mean_rate / np.sqrt(mean_rate ** 2 + rate_noise ** 2)
-    n_types = 1 if uniform else len(JOINT_TYPES)
+    n_types = (1 if uniform else len(JOINT_TYPES)) if patterns is None else patterns.shape[2]
     if joint_jacobians is None:
         coulomb = np.zeros((n_types, 6))
     else:
@@ -159,11 +159,14 @@ SOFT_SIGN_RATES = (0.0, 1e-4, 3e-4, 1e-3, 3e-3)
 
 
 def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: bool,
-                     rates: Sequence[float] = SOFT_SIGN_RATES) -> np.ndarray:
+                     rates: Sequence[float] = SOFT_SIGN_RATES,
+                     leg_jacobian: np.ndarray | None = None) -> np.ndarray:
     """W_type(t) (N, n_rates, n_types, 6): generalized force of a unit Coulomb torque on each axis of a type.
 
     Soft sign w / sqrt(w^2 + sigma^2 + r^2) of ``found.sign_rates`` at every transition rate r of
-    ``rates``, rad/s. Samples lead, so that an interval's rows are one contiguous slice.
+    ``rates``, rad/s. Samples lead, so that an interval's rows are one contiguous slice. With
+    ``leg_jacobian`` J_lq (N, 6, 6), a last type: a unit force along every leg (a ball screw's
+    friction), J_lq^T soft-sign(l_dot) with the same r in m/s.
     """
     from stewartid.identification.wavelet._compiled import soft_sign_patterns
 
@@ -172,10 +175,18 @@ def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: boo
         for index, axes in enumerate(JOINT_TYPES.values()):
             types[list(axes)] = index
     rates = np.asarray(rates, dtype=float)
-    out = np.zeros((len(found.sign_rates), len(rates), 1 if uniform else len(JOINT_TYPES), 6))
+    n_joint_types = 1 if uniform else len(JOINT_TYPES)
+    out = np.zeros((len(found.sign_rates), len(rates), n_joint_types + (leg_jacobian is not None),
+                    6))
+    joints = out[:, :, :n_joint_types] if leg_jacobian is not None else out
     soft_sign_patterns(np.ascontiguousarray(found.sign_rates),
                        np.ascontiguousarray(found.sign_rate_noise),
-                       np.ascontiguousarray(joint_jacobians), rates, types, out)
+                       np.ascontiguousarray(joint_jacobians), rates, types, joints)
+    if leg_jacobian is not None:
+        legs, noise = found.leg_sign_rates, found.leg_sign_rate_noise
+        for k, r in enumerate(rates):
+            direction = legs / np.sqrt(legs ** 2 + noise ** 2 + r ** 2)              # (N, 6)
+            out[:, k, -1] = (direction[:, None, :] @ leg_jacobian)[:, 0]
     return out
 
 
