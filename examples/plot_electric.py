@@ -25,9 +25,9 @@ print(f"force constant {motor.force_constant:g} N/A, reflected mass {motor.refle
       f"screw friction {motor.viscous:g} N s/m and {motor.coulomb:g} N per leg")
 
 # %%
-# Six experiments of 3 s each (a 1 s fade-in, then four periods), every current with 0.5 % of
+# Six experiments of 2.5 s each (a 0.5 s fade-in, then four periods), every current with 0.5 % of
 # its RMS as noise. The records keep the true motor currents beside the logged forces.
-run = sid.simulate_experiments(platform, frequency_hz=2.0, duration_s=3.0, fade_in=1.0,
+run = sid.simulate_experiments(platform, frequency_hz=2.0, duration_s=2.5, fade_in=0.5,
                                noise=sid.SensorNoise(), current_noise=0.005, seed=0)
 heave = run.states[2]
 print(f"heave: largest current {np.abs(heave.currents).max():.2f} A of {motor.peak_current:g} A, "
@@ -50,7 +50,7 @@ print(f"legs' Coulomb friction (least squares): {fitted.leg_coulomb_:.1f} N "
 for name, true in (("reflected_mass", motor.reflected_mass), ("viscous[actuator]", motor.viscous),
                    ("coulomb[actuator]", motor.coulomb)):
     value, error = physical.parameters_[name], physical.parameter_std_errors_[name]
-    print(f"physical model: {name} = {value:.1f} +- {error:.1f} (true {true:g})")
+    print(f"physical model: {name} = {value:.2f} +- {error:.2f} (true {true:g})")
 
 # %%
 # Where a leg's current goes during the heave experiment: leg 1's force (current times force
