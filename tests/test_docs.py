@@ -91,6 +91,9 @@ SCALED = {
     "getting-started.md": [("duration_s=6.0", "duration_s=2.0")],
     # the paper's six 20 s sines and the physical model on them: 8 s records
     "physical-model.md": [("--coulomb 30 --noise", "--coulomb 30 --noise --duration 8")],
+    # the electric platform's six 20 s sines at 2 kHz, identified by every method: 6 s records
+    "electric.md": [("--noise --seed 0 --out electric_run",
+                     "--noise --seed 0 --duration 6 --out electric_run")],
 }
 
 #: A stand-in for dask-jobqueue (a batch system is not at hand): its cluster is a local one.

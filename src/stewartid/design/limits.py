@@ -5,16 +5,24 @@ uses per sample (:func:`limit_use`, 1 = the limit).
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 
 import numpy as np
 
 from stewartid.errors import ConfigError
+from stewartid.model.dynamics import inverse_dynamics
 from stewartid.model.kinematics import inverse_kinematics, rotation_matrix
 from stewartid.platform import Platform
 from stewartid.simulation.hydraulics import force_limits
 
 #: The limits, in the order of the columns of :attr:`LimitUse.use`.
 LIMIT_NAMES = ("stroke", "leg_velocity", "leg_acceleration", "actuator_force", "gimbal_angle")
+#: Force use reported where an electric motor's current is at peak_current (saturated): the
+#: motion asked for more than the limit, by an amount the clamped current no longer shows.
+SATURATED_USE = 1.01
+#: Relative distance to peak_current within which a current counts as saturated: the current
+#: loop reaches its clamped command to 1e-6 within 2.2 time constants.
+SATURATION_TOLERANCE = 1e-6
 
 
 @dataclasses.dataclass(frozen=True)
@@ -184,8 +192,58 @@ def limit_use(platform: Platform, limits: OperatingLimits, t: np.ndarray, q: np.
     return LimitUse(t=np.asarray(t, dtype=float), use=use)
 
 
+def rest_use(platform: Platform) -> dict[str, float]:
+    """Use of every limit at rest at the neutral pose: the static leg forces' share of
+    ``actuator_force``, zero for the others.
+    """
+    q = platform.neutral_pose.reshape(1, 6)
+    zeros = np.zeros((1, 6))
+    lengths = inverse_kinematics(platform, q).lengths
+    return limit_use(platform, resolve_limits(platform), np.zeros(1), q, lengths, zeros, zeros,
+                     inverse_dynamics(platform, q, zeros, zeros)).peak
+
+
+def amplitude_scale(peak: Mapping[str, float], rest: Mapping[str, float], target: float
+                    ) -> float:
+    """Factor on a record's amplitudes that brings its most used limit to ``target``.
+
+    Each limit's use is taken as affine in the amplitude, from its use at rest (:func:`rest_use`)
+    to its ``peak``: the static leg forces do not scale with the motion, and on a light electric
+    platform they are most of the force, so a proportional scale would leave the force use above
+    the target after any number of rounds.
+
+    Raises
+    ------
+    ConfigError
+        When the platform at rest already uses ``target`` or more of a limit.
+    """
+    scales = []
+    for name in LIMIT_NAMES:
+        if peak[name] <= rest[name]:
+            continue
+        if rest[name] >= target:
+            raise ConfigError(
+                f"the platform at rest already uses {rest[name]:.0%} of its {name} limit, not "
+                f"below the {target:.0%} a design may use; raise --max-use or check [limits] "
+                "(or [actuator] peak_current).")
+        scales.append((target - rest[name]) / (peak[name] - rest[name]))
+    return min(scales, default=1.0)
+
+
 def record_limit_use(platform: Platform, record) -> LimitUse:
-    """Limit use of a simulated record's true states (leg accelerations by central differences)."""
+    """Limit use of a simulated record's true states (leg accelerations by central differences).
+
+    An electric leg's servo demand and current loop are held within peak_current, so a saturated
+    motor's force reads the limit exactly while the motion asks for more: where a current sits at
+    peak_current its force use is :data:`SATURATED_USE`, beyond 1, so that
+    :attr:`LimitUse.exceeded` names it and a design is scaled down from it.
+    """
     accelerations = np.gradient(record.length_rates, record.t, axis=0)
-    return limit_use(platform, resolve_limits(platform), record.t, record.q, record.lengths,
-                     record.length_rates, accelerations, record.forces)
+    limits = resolve_limits(platform)
+    use = limit_use(platform, limits, record.t, record.q, record.lengths, record.length_rates,
+                    accelerations, record.forces)
+    peak = platform.actuator.peak_current
+    if getattr(record, "currents", None) is not None and peak is not None:
+        saturated = np.any(np.abs(record.currents) >= (1.0 - SATURATION_TOLERANCE) * peak, axis=1)
+        use.use[saturated, LIMIT_NAMES.index("actuator_force")] = SATURATED_USE
+    return use

@@ -12,7 +12,14 @@ from collections.abc import Callable, Mapping, Sequence
 import numpy as np
 
 from stewartid.design.candidates import Design, DesignedRecord, scheduled_design, unit_direction
-from stewartid.design.limits import LimitUse, limit_use, record_limit_use, resolve_limits
+from stewartid.design.limits import (
+    LimitUse,
+    amplitude_scale,
+    limit_use,
+    record_limit_use,
+    resolve_limits,
+    rest_use,
+)
 from stewartid.design.prediction import Prediction, plant_records, predict_accuracy
 from stewartid.design.weak_information import (
     checked_prediction,
@@ -134,6 +141,7 @@ def within_plant_limits(platform: Platform, design: Design, max_use: float,
     """
     records = plant_records(platform, design, workers)
     uses = [record_limit_use(platform, r) for r in records]
+    rest = rest_use(platform)
     for _ in range(rounds):
         peaks = [max(u.peak.values()) for u in uses]
         over = [k for k, p in enumerate(peaks) if p > max_use + 1e-3]
@@ -141,8 +149,7 @@ def within_plant_limits(platform: Platform, design: Design, max_use: float,
             return design, records, uses
         changed = list(design.records)
         for k in over:
-            scale = 0.995 * max_use / peaks[k]
-            changed[k] = changed[k].scaled(scale)
+            changed[k] = changed[k].scaled(amplitude_scale(uses[k].peak, rest, 0.995 * max_use))
         design = dataclasses.replace(design, records=tuple(changed))
         again = plant_records(platform, Design(tuple(changed[k] for k in over)), workers)
         for k, record in zip(over, again, strict=True):

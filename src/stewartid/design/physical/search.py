@@ -13,7 +13,14 @@ import numpy as np
 import scipy.optimize
 
 from stewartid.design.candidates import Design
-from stewartid.design.limits import LimitUse, limit_use, resolve_limits
+from stewartid.design.limits import (
+    LIMIT_NAMES,
+    LimitUse,
+    amplitude_scale,
+    limit_use,
+    resolve_limits,
+    rest_use,
+)
 from stewartid.design.multisine import MULTISINE_FADE, RECORD_LENGTH, multisine_design
 from stewartid.design.physical.information import (
     INFORMATION_RATE,
@@ -86,14 +93,18 @@ def scale_to_limits(platform: Platform, design: Design, max_use: float | np.ndar
     (scalar or per record, within 2 %) of its most used limit; return design, use and states.
     """
     target = np.broadcast_to(np.asarray(max_use, dtype=float), len(design.records))
+    rest = rest_use(platform)
+    edges = record_ends(design, rate_hz)
     for _ in range(rounds):
         use, states = commanded_limit_use(platform, design, rate_hz)
         peaks = record_peaks(design, use, rate_hz)
         if np.all(np.abs(peaks - target) <= 0.02 * target):
             break
+        limits = [dict(zip(LIMIT_NAMES, use.use[a:b].max(axis=0), strict=True))
+                  for a, b in zip(edges[:-1], edges[1:], strict=True)]
         design = dataclasses.replace(design, records=tuple(
-            r.scaled(aim / peak) for r, peak, aim in zip(design.records, peaks, target,
-                                                         strict=True)))
+            r.scaled(amplitude_scale(peak, rest, aim))
+            for r, peak, aim in zip(design.records, limits, target, strict=True)))
     else:
         use, states = commanded_limit_use(platform, design, rate_hz)
     return design, use, states
