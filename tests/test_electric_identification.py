@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from stewartid.datasets.dataset import Dataset
-from stewartid.errors import ConfigError
+from stewartid.errors import ConfigError, IdentificationError
 from stewartid.identification.least_squares import LeastSquaresIdentifier
 from stewartid.model import regressor as reg
 from stewartid.model.dynamics import inverse_dynamics
@@ -183,3 +183,17 @@ def test_report_part_on_the_actuators(electric, paper, records):
     assert "reflected mass" in text and "(file: 30 kg)" in text
     assert "250 N/A" in text and "corrected_force_constant" in text
     assert actuator_lines(result, paper) == []
+
+
+def test_an_electric_drives_log_is_taken_as_logged(electric, records):
+    """A drive samples currents and encoders in one cycle: the default estimates no delay (the
+    screw's friction would bias it), and says so; --delay auto still estimates one."""
+    from stewartid.comparison import align_experiments
+
+    default = align_experiments(records, electric)
+    assert default.entry["source"] == "not estimated" and not default.entry["applied"]
+    assert "electric drive" in default.entry["reason"]
+    assert default.experiments == records
+    # asked, it is estimated: here refused, as on any log with one frequency per DOF
+    with pytest.raises(IdentificationError, match="one frequency only"):
+        align_experiments(records, electric, "auto")

@@ -16,7 +16,11 @@ from stewartid.datasets.alignment import align_forces
 from stewartid.datasets.dataset import Dataset
 from stewartid.datasets.excitation import excitation_lines
 from stewartid.errors import ConfigError, IdentificationError
-from stewartid.identification.least_squares import coulomb_regressors
+from stewartid.identification.least_squares import (
+    coulomb_regressors,
+    leg_coulomb_regressor,
+    uses_leg_coulomb,
+)
 from stewartid.identification.preparation import generalized_force_sensitivity, prepare_experiment
 from stewartid.model.linearization import nominal_matrices
 from stewartid.platform import COORDINATES, Platform
@@ -160,12 +164,16 @@ def check_delay_identifiable(datasets: Sequence[Dataset], platform: Platform
 
 def _filtered_rows(dataset: Dataset, platform: Platform, window: float
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Kernel-filtered rows: q_ddot, q_dot, y (N', 6), shared (N', 4, 6) = 3 Coulomb + -y_dot."""
+    """Kernel-filtered rows: q_ddot, q_dot, y (N', 6), shared (N', s + 1, 6) = the Coulomb terms
+    (3 joint types, and the legs' for an electric actuator) and -y_dot."""
     experiment = prepare_experiment(dataset, platform, gravity=True, joints=True)
     rate = experiment.sample_rate
     # the Coulomb signs need rates at every sample; they only decide signs
     _, q_dot_sign, _ = differentiate(experiment.q, rate, window / 4, DEFAULT_ORDER)
     coulomb = coulomb_regressors(experiment.joint_jacobians, q_dot_sign, COULOMB_SMOOTHING)
+    if uses_leg_coulomb(None, platform):  # a ball screw's friction would pass for a delay
+        coulomb = np.concatenate([coulomb, leg_coulomb_regressor(
+            experiment.leg_jacobian, q_dot_sign, COULOMB_SMOOTHING)], axis=1)
     y = experiment.generalized_force
     filtered = kernel_filter(np.concatenate([y, coulomb.reshape(len(y), -1)], axis=1), rate,
                              window, derivatives=1)
