@@ -75,15 +75,15 @@ def test_method_a_refuses_several_sines_per_experiment(paper):
         FourierIdentifier().fit(data, paper)
 
 
-def test_method_b_refuses_a_record_shorter_than_a_period(paper):
-    """Half a period of a 1 Hz sine: the dominant frequency found is below one period per record,
-    and the differentiation window it would set is longer than the record."""
+def test_method_b_refuses_a_record_shorter_than_its_window(paper):
+    """A tenth of a period of a 1 Hz sine: the frequency found sets a differentiation window
+    longer than the record."""
     from stewartid.identification.wavelet import WaveletIdentifier
 
     M, B = TRUTH
-    data = [make_experiment(paper, M, B, k, periods=0.5) for k in range(6)]
-    with pytest.raises(IdentificationError, match=r"^exp1: the record lasts 0.495 s, less than "
-                       r"one period of its motion .*record a longer experiment"):
+    data = [make_experiment(paper, M, B, k, periods=0.1) for k in range(6)]
+    with pytest.raises(IdentificationError, match=r"^exp1: the record lasts 0.095 s, shorter "
+                       r"than the differentiation window .*record a longer experiment"):
         WaveletIdentifier().fit(data, paper)
 
 

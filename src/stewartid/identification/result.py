@@ -208,8 +208,20 @@ def with_model_floor(result: IdentificationResult) -> IdentificationResult:
         floor = MODEL_FLOOR * np.sqrt(np.outer(diagonal, diagonal))
         return np.where(np.isfinite(floor), np.fmax(std, floor), std)
 
+    # the floor is an error every method shares: combining methods weighs their own errors
+    own = result.diagnostics.get("own_std_errors",
+                                 {"M": result.std_errors_M, "B": result.std_errors_B})
     return dataclasses.replace(result, std_errors_M=floored(result.M, result.std_errors_M),
-                               std_errors_B=floored(result.B, result.std_errors_B))
+                               std_errors_B=floored(result.B, result.std_errors_B),
+                               diagnostics={**result.diagnostics, "own_std_errors": own})
+
+
+def own_std_errors(result: IdentificationResult) -> tuple[np.ndarray, np.ndarray]:
+    """Standard errors (M, B) of Mt and Bt without the model floor (:func:`with_model_floor`)."""
+    own = result.diagnostics.get("own_std_errors")
+    if own is None:
+        return result.std_errors_M, result.std_errors_B
+    return np.asarray(own["M"], dtype=float), np.asarray(own["B"], dtype=float)
 
 
 def max_error_percent(M: np.ndarray, B: np.ndarray, M_nominal: np.ndarray,
@@ -219,4 +231,4 @@ def max_error_percent(M: np.ndarray, B: np.ndarray, M_nominal: np.ndarray,
 
 
 __all__ = ["MODEL_FLOOR", "IdentificationResult", "comparison_rows", "comparison_table",
-           "max_error_percent", "with_model_floor"]
+           "max_error_percent", "own_std_errors", "with_model_floor"]

@@ -19,7 +19,11 @@ from stewartid.errors import ConfigError
 from stewartid.fields import BOOLEAN, InstanceOf, positive
 from stewartid.identification.base import BaseIdentifier
 from stewartid.identification.registry import create_identifier, method_spec, register_method
-from stewartid.identification.result import IdentificationResult
+from stewartid.identification.result import (
+    IdentificationResult,
+    own_std_errors,
+    with_model_floor,
+)
 from stewartid.platform import Platform
 from stewartid.verdict.policy import DEFAULT_POLICY
 
@@ -142,19 +146,23 @@ def combine_results(results: Sequence[IdentificationResult], names: Sequence[str
     """
     if len(results) != len(names) or not results:
         raise ConfigError("a consensus needs one name per member result, and a member.")
+    # each member's own errors: the model floor, shared by all, is the consensus's again
+    own = [own_std_errors(r) for r in results]
     M, std_M, used_M = combine_estimates(
-        *np.stack([pooled_pairs(r.M, r.std_errors_M) for r in results], axis=1), agreement)
+        *np.stack([pooled_pairs(r.M, s[0]) for r, s in zip(results, own, strict=True)],
+                  axis=1), agreement)
     B, std_B, used_B = combine_estimates(
-        *np.stack([pooled_pairs(r.B, r.std_errors_B) for r in results], axis=1), agreement)
+        *np.stack([pooled_pairs(r.B, s[1]) for r, s in zip(results, own, strict=True)],
+                  axis=1), agreement)
     diagnostics = {"consensus": {"members": list(names), "agreement": float(agreement),
                                  "used_M": used_M, "used_B": used_B},
                    **friction_diagnostics(results)}
-    return IdentificationResult(
+    return with_model_floor(IdentificationResult(
         M=M, B=B, std_errors_M=std_M, std_errors_B=std_B,
         condition_number=float(max(r.condition_number for r in results)),
         residual_rms=np.asarray(results[0].residual_rms, dtype=float), method="consensus",
         settings={"members": list(names), "agreement": float(agreement)},
-        diagnostics=diagnostics)
+        diagnostics=diagnostics))
 
 
 @register_method(

@@ -127,10 +127,11 @@ def excitation_scales(experiment: Experiment, window: float | None, margin: floa
     if window is None or margin is None:
         frequency = estimate_frequency(experiment.q, 1.0 / experiment.period)
         duration = float(experiment.t[-1] - experiment.t[0])
-        if frequency * duration < 1.0:
+        if window is None and default_window(frequency) > duration:
             raise IdentificationError(
-                f"{experiment.name}: the record lasts {duration:.3g} s, less than one period of "
-                f"its motion ({frequency:.3g} Hz found): record a longer experiment, or give "
+                f"{experiment.name}: the record lasts {duration:.3g} s, shorter than the "
+                f"differentiation window ({default_window(frequency):.3g} s) its motion's "
+                f"frequency ({frequency:.3g} Hz found) sets: record a longer experiment, or give "
                 "differentiation_window and margin (s).")
         window = default_window(frequency) if window is None else window
         margin = margin_periods / frequency if margin is None else margin
