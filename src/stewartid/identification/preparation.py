@@ -142,17 +142,25 @@ def prepare_experiment(dataset: Dataset, platform: Platform, gravity: bool = Tru
     remainder : bool
         Subtract the model's departure from its linearisation (:func:`model_remainder`).
     """
+    fresh: dict[str, np.ndarray] = {}   # the joint-axis Jacobians of a first preparation
     shared = dataset.derived(("prepared", platform, gravity, remainder),
-                             lambda record: _prepared(record, platform, gravity, remainder))
+                             lambda record: _prepared(record, platform, gravity, remainder,
+                                                      joints, fresh))
     experiment = dataclasses.replace(shared)   # its own slot for the joint-axis Jacobians
     if joints:
-        experiment.__dict__["joint_jacobians"] = joint_rate_jacobians(platform, dataset.pose)
+        experiment.__dict__["joint_jacobians"] = fresh.get("joint_jacobians")
+        if experiment.__dict__["joint_jacobians"] is None:
+            experiment.__dict__["joint_jacobians"] = joint_rate_jacobians(platform, dataset.pose)
     return experiment
 
 
-def _prepared(dataset: Dataset, platform: Platform, gravity: bool, remainder: bool
-              ) -> Experiment:
-    G, J, _, _ = compute_leg_terms(platform, np.ascontiguousarray(dataset.pose))
+def _prepared(dataset: Dataset, platform: Platform, gravity: bool, remainder: bool,
+              joints: bool, fresh: dict[str, np.ndarray]) -> Experiment:
+    """The shared terms; with ``joints``, the joint-axis Jacobians of the same pass into ``fresh``."""
+    G, J, _, joint_jacobians = compute_leg_terms(platform, np.ascontiguousarray(dataset.pose),
+                                                 joints)
+    if joints:
+        fresh["joint_jacobians"] = joint_jacobians
     y = np.einsum("nji,nj->ni", J, dataset.forces)
     if gravity:
         y = y - G
