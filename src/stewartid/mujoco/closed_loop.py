@@ -4,6 +4,7 @@ logged like a rig's record: an independent engine for the same command.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Protocol
 
 import numpy as np
@@ -83,22 +84,8 @@ def simulate_mujoco(platform: Platform, excitation: Commanded, duration: float, 
         state.ctrl[:] = table[int(round(state.time / half))]
 
     mujoco_state.set_state(platform, model, data, q_cmd[0], qd_cmd[0])
-    pose = np.empty((n_samples, 6))
-    lengths = np.empty((n_samples, 6))
-    forces = np.empty((n_samples, 6))
-    previous = mj.get_mjcb_control()
-    mj.set_mjcb_control(control)
-    try:
-        for i in range(n_samples):
-            for _ in range(per_sample if i else 0):
-                mj.mj_step(model, data)
-            mj.mj_forward(model, data)  # the forces at the sample's own command
-            pose[i] = mujoco_state.platform_state(model, data)[0]
-            lengths[i] = mujoco_state.leg_lengths(platform, model, data)
-            forces[i] = data.actuator_force
-    finally:
-        mj.set_mjcb_control(previous)
-    return Dataset(np.arange(n_samples) / rate, pose, lengths, forces, name=excitation.name)
+    return _record(platform, model, data, control, lambda state: state.actuator_force,
+                   n_samples, per_sample, excitation.name)
 
 
 def _simulate_electric(platform: Platform, excitation: Commanded, duration: float, step: float,
@@ -152,6 +139,17 @@ def _simulate_electric(platform: Platform, excitation: Commanded, duration: floa
     held = np.linalg.solve(start.leg_jacobian[0].T, start.gravity[0])
     data.act[:6] = held / kt
     data.act[6:] = (held - cmd_force[0]) / c.integral_gain if c.integral_gain > 0 else 0.0
+    return _record(platform, model, data, control, lambda state: kt * state.act[:6],
+                   n_samples, per_sample, excitation.name)
+
+
+def _record(platform: Platform, model: object, data: object,
+            control: Callable[[object, object], None], force: Callable[[object], np.ndarray],
+            n_samples: int, per_sample: int, name: str) -> Dataset:
+    """``n_samples`` samples of MuJoCo's exact state, ``per_sample`` steps apart, under the
+    process-global control callback ``control`` (restored after); ``force(data)``: the leg
+    forces (6,) at a sample, N."""
+    mj = mjcf.require_mujoco()
     pose = np.empty((n_samples, 6))
     lengths = np.empty((n_samples, 6))
     forces = np.empty((n_samples, 6))
@@ -161,10 +159,11 @@ def _simulate_electric(platform: Platform, excitation: Commanded, duration: floa
         for i in range(n_samples):
             for _ in range(per_sample if i else 0):
                 mj.mj_step(model, data)
-            mj.mj_forward(model, data)
+            mj.mj_forward(model, data)  # the forces at the sample's own command
             pose[i] = mujoco_state.platform_state(model, data)[0]
             lengths[i] = mujoco_state.leg_lengths(platform, model, data)
-            forces[i] = kt * data.act[:6]
+            forces[i] = force(data)
     finally:
         mj.set_mjcb_control(previous)
-    return Dataset(np.arange(n_samples) / rate, pose, lengths, forces, name=excitation.name)
+    rate = platform.sensors.sample_rate
+    return Dataset(np.arange(n_samples) / rate, pose, lengths, forces, name=name)
