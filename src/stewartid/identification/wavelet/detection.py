@@ -104,9 +104,9 @@ def check_coverage(names: Sequence[str], motion: np.ndarray, counts: Sequence[in
 SINGLE_SINE_SHARE = 0.9
 
 
-def sine_share(lengths: np.ndarray, sample_rate: float) -> float:
-    """Share in [0, 1] of the leg-length variance (N, 6) one sine at the dominant frequency explains."""
-    frequency = estimate_frequency(lengths, sample_rate)
+def sine_share(lengths: np.ndarray, sample_rate: float, frequency: float) -> float:
+    """Share in [0, 1] of the leg-length variance (N, 6) one sine at ``frequency`` (Hz, the
+    motion's dominant one) explains."""
     t = np.arange(len(lengths)) / sample_rate
     basis = np.column_stack([np.sin(2 * np.pi * frequency * t),
                              np.cos(2 * np.pi * frequency * t), np.ones_like(t), t - t.mean()])
@@ -125,7 +125,7 @@ def excitation_scales(experiment: Experiment, window: float | None, margin: floa
     periods).
     """
     if window is None or margin is None:
-        frequency = estimate_frequency(experiment.q, 1.0 / experiment.period)
+        frequency = estimate_frequency(experiment.q, experiment.sample_rate)
         duration = float(experiment.t[-1] - experiment.t[0])
         if window is None and default_window(frequency) > duration:
             raise IdentificationError(

@@ -25,6 +25,7 @@ from stewartid.identification.wavelet.gls import WeakFormSolution
 from stewartid.identification.wavelet.rate_selection import solve_weak_form_over_rates
 from stewartid.identification.wavelet.weak_form import experiment_equations
 from stewartid.identification.wavelet.windows import solve_windows_over_rates, window_equations
+from stewartid.signals.differentiation import estimate_frequency
 from stewartid.verdict.accuracy import predicted_worst_error
 
 #: Window length (s) of ``friction="coulomb"``.
@@ -35,7 +36,9 @@ def friction_models(setting: str, datasets: Sequence[Dataset]) -> tuple[str, ...
     """The friction models to fit: "auto" gives "free" and "coulomb" on one sine per experiment."""
     if setting != "auto":
         return (setting,)
-    single = all(sine_share(d.lengths, 1.0 / float(d.t[1] - d.t[0])) >= SINGLE_SINE_SHARE
+    # the pose's dominant frequency: every method asks for it (computed once per record)
+    single = all(sine_share(d.lengths, 1.0 / float(d.t[1] - d.t[0]),
+                            estimate_frequency(d.pose, d.sample_rate)) >= SINGLE_SINE_SHARE
                  for d in datasets)
     return ("free", "coulomb") if single else ("coulomb",)
 
