@@ -64,15 +64,25 @@ def pose_coefficients(sensitivity: np.ndarray, theta_i: np.ndarray) -> np.ndarra
 
 def chi2_excess(variances: np.ndarray, squares: np.ndarray, dof: float) -> float:
     """e >= 0 with sum_k squares_k / (variances_k + e) = dof (Paule-Mandel); 0 if already below."""
-    lam = np.maximum(variances, 0.0)
-    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):  # noise-free rows
-        if np.sum(np.where(squares > 0, squares / lam, 0.0)) <= dof:
-            return 0.0
-    low, high = 0.0, float(np.sum(squares)) / max(dof, 1)   # chi2(high) <= dof
-    for _ in range(60):  # bisection on the monotone chi2(e), to 1e-18 of the bracket
-        mid = 0.5 * (low + high)
-        low, high = (mid, high) if np.sum(squares / (lam + mid)) > dof else (low, mid)
-    return high
+    lam = np.maximum(variances, 0.0).ravel()
+    s = np.asarray(squares, dtype=float).ravel()
+    keep = s > 0
+    lam, s = lam[keep], s[keep]
+    zero = lam == 0   # noise-free rows: chi2 is infinite at e = 0
+    if not np.any(zero) and np.sum(s / lam) <= dof:
+        return 0.0
+    # Newton on h(e) = 1/chi2(e) - 1/dof, concave and increasing (1/chi2 is a parallel sum of
+    # affine functions of e): from the left the iterates rise monotonically to the root, in a
+    # few steps since h is nearly affine. At e = 0 with zero variances, h and h' are limits.
+    e = float(np.sum(s[zero])) / dof if np.any(zero) else 0.0
+    for _ in range(100):
+        u = s / (lam + e)
+        chi2 = float(np.sum(u))
+        step = (1.0 / dof - 1.0 / chi2) * chi2 ** 2 / float(np.sum(u / (lam + e)))
+        if not step > 4 * np.finfo(float).eps * e:
+            break
+        e += step
+    return e
 
 
 def excess_variance(covariance: np.ndarray, residual: np.ndarray, dof: int) -> float:
