@@ -33,6 +33,21 @@ def test_interval_constant_scatter_is_estimated_in_weighted_chi_square():
     assert chi2_excess(v, 0.01 * r ** 2, n) == 0.0
 
 
+@pytest.mark.parametrize("zeros", [0.0, 0.3, 1.0])
+def test_chi2_excess_solves_its_equation(zeros):
+    """The excess e solves sum s_k / (v_k + e) = dof to round-off, with noise-free rows (v_k = 0,
+    where chi2 is infinite at e = 0) among the rows or all of them, over variance scales from
+    1e-12 to 1e6."""
+    rng = np.random.default_rng(3)
+    for scale in 10.0 ** np.arange(-12, 7, 3):
+        v = scale * rng.exponential(size=400) * (rng.random(400) >= zeros)
+        s = (v + 0.7 * scale) * rng.chisquare(1, size=400)
+        dof = 396
+        e = chi2_excess(v, s, dof)
+        assert e > 0
+        assert np.sum(s / (v + e)) == pytest.approx(dof, rel=1e-12)
+
+
 def _candidate_fits(y, u, shapes):
     """Least squares of y on [u, shape] for each candidate shape, as weak-form solutions: the
     coefficient of u as theta, the shape's as the Coulomb level, one channel."""
