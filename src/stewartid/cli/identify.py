@@ -70,7 +70,7 @@ def identify(
         help="Delay of the force channels behind the motion, in seconds (0.002 for 2 ms; "
              "negative when the forces lead; 0: as logged): every method works on the forces "
              "aligned by it. By default it is estimated where the motion tells it from damping "
-             "(two or more frequencies per DOF) and applied when beyond two standard errors "
+             "(two or more frequencies per DOF) and applied when beyond three standard errors "
              "of zero; 'auto' estimates and applies it, and refuses one-frequency motion "
              "(docs/logs.md).")] = None,
     validate: Annotated[list[Path] | None, typer.Option(

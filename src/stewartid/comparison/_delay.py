@@ -18,8 +18,10 @@ from stewartid.identification.delay import (
 )
 from stewartid.platform import Platform
 
-#: By default an estimated delay is applied when it is this many standard errors from zero.
-DELAY_SIGNIFICANCE = 2.0
+#: By default an estimated delay is applied when it is this many standard errors from zero (the
+#: residual-delay test of the held-out validation uses the same): model error leans the
+#: estimate by about one standard error on some platforms' logs without a delay.
+DELAY_SIGNIFICANCE = 3.0
 
 
 @dataclass(frozen=True)
