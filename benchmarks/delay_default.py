@@ -8,18 +8,22 @@ as ``identify --method all --report`` does: the estimated delay, whether it was 
 trusted method and its errors against the nominal matrices (largest Mt-diagonal error, largest
 error over the paper's 20 entries, entries within 3 reported SE), the best method's largest
 error and the trusted one's ratio to it, and Method B's and least squares' errors.
+``--out FILE`` appends one JSON line per log in the row format of ``verdict_study.py --out``
+(every method's fit, the verdict, the truth; read by ``verdict_floor.py``), with the log's
+``kind``, ``late`` (s) and ``delay`` entry.
 
 Usage::
 
     python benchmarks/delay_default.py [--platform paper|FILE] [--engine ours|mujoco]
         [--kinds three,alldof] [--seeds 4] [--first-seed 0] [--late 0.002] [--duration 20]
-        [--clean DIR]
+        [--clean DIR] [--out FILE]
 """
 
 from __future__ import annotations
 
 import argparse
 import dataclasses
+import json
 import sys
 from pathlib import Path
 
@@ -27,6 +31,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import noise_study  # noqa: E402  (a sibling script)
+import verdict_study  # noqa: E402  (a sibling script)
 
 import stewartid as sid  # noqa: E402
 from stewartid.comparison import compare_methods  # noqa: E402
@@ -68,6 +73,8 @@ def main() -> None:
                         help="record length of each experiment (s)")
     parser.add_argument("--clean", type=Path, default=Path("results/delay_default"),
                         help="folder of the clean logs (simulated there when missing)")
+    parser.add_argument("--out", type=Path, default=None,
+                        help="append one JSON line per log here (verdict_study.py's rows)")
     options = parser.parse_args()
     noise_study.KIND_DURATION = options.duration
     platform = study_platform(options.platform)
@@ -99,6 +106,13 @@ def main() -> None:
                       f"| {entry.get('applied', False)} | {trusted} | {cell(scores[trusted])} | "
                       f"{best:.1f} | {scores[trusted][1] / best:.2f} | "
                       f"{cell(scores.get('wavelet'))} | {cell(scores.get('ls'))} |", flush=True)
+                if options.out is not None:
+                    row = verdict_study.log_row(
+                        f"{tag} {options.engine} {kind} late {late * 1e3:g} ms", seed,
+                        comparison.runs, comparison.verdict, M, B)
+                    row.update(kind=kind, late=late, delay=comparison.delay)
+                    with options.out.open("a") as handle:
+                        handle.write(json.dumps(row, default=float) + "\n")
 
 
 if __name__ == "__main__":

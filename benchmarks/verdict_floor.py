@@ -22,9 +22,17 @@ with the posterior known: a bound for rules that see the data, not an estimator 
 The sum of a rule's chances over the logs is its expected count of passes; their product the
 chance that it passes every log.
 
+The standard errors are the methods' as reported, with the model floor
+(:func:`~stewartid.identification.result.with_model_floor`); ``--own`` takes them without it
+where the file stores them (``own_std_M``, ``own_std_B``, as ``verdict_study.py`` and
+``delay_default.py`` write them): the floor bounds the linearised model's error rather than
+drawing a Gaussian one, and where it sets an entry's standard error (Mt's diagonal and
+couplings on long logs) the posterior is wider there than the errors.
+
 Usage::
 
     python benchmarks/verdict_floor.py FILE.jsonl [FILE.jsonl ...] [--draws 4000] [--seed 0]
+        [--own]
 """
 
 from __future__ import annotations
@@ -104,13 +112,23 @@ def fold_correlation(results, folds,
     return correlation
 
 
-def stored_result(method: dict) -> IdentificationResult:
-    """A method's stored fit (or, without standard errors, one of its fold fits) as a result."""
+def stored_result(method: dict, own: bool = False) -> IdentificationResult:
+    """A method's stored fit (or, without standard errors, one of its fold fits) as a result,
+    with its standard errors without the model floor in ``diagnostics["own_std_errors"]``
+    where the row holds them (``own_std_M``, ``own_std_B``), so that a consensus rebuilt from
+    it weighs its members as the verdict did; ``own``: those as its standard errors."""
     M, B = (np.asarray(method[key], dtype=float) for key in ("M", "B"))
     std_M, std_B = ((np.asarray(method[key], dtype=float) if key in method else np.ones((6, 6)))
                     for key in ("std_M", "std_B"))
+    diagnostics = {}
+    if "own_std_M" in method and "own_std_B" in method:
+        diagnostics["own_std_errors"] = {key: np.asarray(method[f"own_std_{key}"], dtype=float)
+                                         for key in ("M", "B")}
+        if own:
+            std_M, std_B = diagnostics["own_std_errors"]["M"], diagnostics["own_std_errors"]["B"]
     return IdentificationResult(M=M, B=B, std_errors_M=std_M, std_errors_B=std_B,
-                                condition_number=1.0, residual_rms=np.ones(6), method="stored")
+                                condition_number=1.0, residual_rms=np.ones(6), method="stored",
+                                diagnostics=diagnostics)
 
 
 def entries(result: IdentificationResult) -> np.ndarray:
@@ -138,14 +156,15 @@ def realised_pass(row: dict, answers: dict[str, np.ndarray]) -> bool:
     return worst[row["trusted"]] <= TRUST_FACTOR * min(worst.values()) + TRUST_MARGIN
 
 
-def truth_posterior(row: dict) -> tuple[np.ndarray, np.ndarray]:
+def truth_posterior(row: dict, own: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Posterior mean and SD of each quantity (shape (16,) each), from the plausible methods
-    that are not misfits (all fitted methods when none is)."""
+    that are not misfits (all fitted methods when none is); ``own``: their standard errors
+    without the model floor where the row holds them."""
     fitted = [n for n, m in row["methods"].items() if "M" in m and n != "consensus"]
     evidence = row["verdict"]["evidence"]
     plausible = [n for n in fitted if evidence[n]["plausible"]] or fitted
     names = [n for n in plausible if not evidence[n]["misfit"]] or plausible
-    results = [stored_result(row["methods"][n]) for n in names]
+    results = [stored_result(row["methods"][n], own) for n in names]
     folds = [[stored_result({"M": a, "B": b}) for a, b in
               zip(row["methods"][n]["folds_M"], row["methods"][n]["folds_B"], strict=True)]
              or None for n in names]
@@ -168,10 +187,12 @@ def largest_errors(answers: np.ndarray, truths: np.ndarray) -> np.ndarray:
     return 100 * np.max(np.abs(answers[..., None, :] - truth) / np.abs(truth), axis=-1)
 
 
-def log_floor(row: dict, draws: int, rng: np.random.Generator) -> dict[str, float]:
+def log_floor(row: dict, draws: int, rng: np.random.Generator, own: bool = False
+              ) -> dict[str, float]:
     """Chance of passing the bar on one log: the trusted result's, each method's, the
-    posterior mean's and the best found answer's (key ``"best"``)."""
-    mean, sd = truth_posterior(row)
+    posterior mean's and the best found answer's (key ``"best"``); ``own`` as
+    :func:`truth_posterior`."""
+    mean, sd = truth_posterior(row, own)
     truths = mean + sd * rng.standard_normal((draws, len(QUANTITIES)))
     answers = answers_of(row)
     bar = TRUST_FACTOR * np.min(largest_errors(np.stack(list(answers.values())), truths),
@@ -201,6 +222,9 @@ def main() -> None:
     parser.add_argument("files", type=Path, nargs="+", help="verdict_study.py --out files")
     parser.add_argument("--draws", type=int, default=4000)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--own", action="store_true",
+                        help="the posterior from the methods' standard errors without the model "
+                             "floor (files that store them: own_std_M, own_std_B)")
     args = parser.parse_args()
     rng = np.random.default_rng(args.seed)
     print("| log set | noisy logs | trusted within 1.5x (observed) | expected: trusted | "
@@ -211,7 +235,7 @@ def main() -> None:
     for path in args.files:
         rows = [json.loads(t) for t in path.read_text().splitlines() if t.strip()]
         rows = [r for r in rows if r["seed"] is not None]
-        found = [log_floor(r, args.draws, rng) for r in rows]
+        found = [log_floor(r, args.draws, rng, args.own) for r in rows]
         observed = sum(realised_pass(r, answers_of(r)) for r in rows)
         columns = {k: np.array([f[k] for f in found]) for k in ("trusted", "posterior mean",
                                                                  "best")}

@@ -45,6 +45,7 @@ import noise_study  # noqa: E402  (a sibling script)
 
 from stewartid.comparison import judge, run_method  # noqa: E402
 from stewartid.identification import registry  # noqa: E402
+from stewartid.identification.result import own_std_errors  # noqa: E402
 from stewartid.model.linearization import nominal_matrices  # noqa: E402
 from stewartid.platform import load_platform  # noqa: E402
 from stewartid.reference.published import PAPER_ENTRIES, relative_error_percent  # noqa: E402
@@ -93,6 +94,15 @@ def evaluate(label, platform, data, M, B, seed) -> dict:
     segments = {}  # prepared once, shared by the methods as in the report
     runs, verdict = judge([run_method(name, {}, data, platform, 3, False, segments)
                            for name in names])
+    return log_row(label, seed, runs, verdict, M, B)
+
+
+def log_row(label, seed, runs, verdict, M, B) -> dict:
+    """The stored row of one log: every run's fit (its Mt, Bt, standard errors, fold fits and
+    errors over the paper's 20 entries against the truth ``M``, ``B``), the verdict, and
+    whether the trusted result is within the bar of the best. ``runs`` and ``verdict`` as
+    :func:`stewartid.comparison.judge` returns them (or a
+    :class:`~stewartid.comparison.Comparison`'s ``runs`` and ``verdict``)."""
     row = {"log": label, "seed": seed, "trusted": verdict.trusted,
            "truth": {"M": np.asarray(M).tolist(), "B": np.asarray(B).tolist()},
            "verdict": verdict.to_dict(), "methods": {}}
@@ -116,6 +126,9 @@ def evaluate(label, platform, data, M, B, seed) -> dict:
             # the whole matrices, so that a rule can be replayed on the stored rows
             "M": run.result.M.tolist(), "B": run.result.B.tolist(),
             "std_M": run.result.std_errors_M.tolist(), "std_B": run.result.std_errors_B.tolist(),
+            # without the model floor: what a consensus weighs its members by
+            "own_std_M": own_std_errors(run.result)[0].tolist(),
+            "own_std_B": own_std_errors(run.result)[1].tolist(),
             "folds_M": [] if run.cross_validation is None else
             [fit.M.tolist() for fit in run.cross_validation.fold_results],
             "folds_B": [] if run.cross_validation is None else
