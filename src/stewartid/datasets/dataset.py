@@ -98,6 +98,25 @@ class Dataset:
             self._derived[key] = compute(self)
         return self._derived[key]
 
+    def part(self, rows: slice, name: str | None = None) -> Dataset:
+        """The samples ``rows`` of this record as a new record (views of its arrays), which
+        takes what :meth:`pointwise` derives from this one's; named ``name`` (default: its own)."""
+        record = Dataset(t=self.t[rows], pose=self.pose[rows], lengths=self.lengths[rows],
+                         forces=self.forces[rows], name=self.name if name is None else name)
+        record._derived[_SOURCE] = (self, rows)
+        return record
+
+    def pointwise(self, key: Hashable, compute: Callable[[Dataset], tuple[np.ndarray, ...]]
+                  ) -> tuple[np.ndarray, ...]:
+        """:meth:`derived` for arrays computed sample by sample along their first axis (terms of
+        the pose): a :meth:`part` of a record takes the rows of the record's, C-contiguous."""
+        source = self._derived.get(_SOURCE)
+        if source is None:
+            return self.derived(key, compute)
+        record, rows = source
+        return self.derived(key, lambda _: tuple(
+            np.ascontiguousarray(array[rows]) for array in record.pointwise(key, compute)))
+
     @property
     def sample_rate(self) -> float:
         """Hz, from the mean period."""
@@ -117,6 +136,10 @@ class Dataset:
 
         data = np.column_stack([self.t, self.pose, self.lengths, self.forces])
         return pd.DataFrame(data, columns=list(COLUMNS))
+
+
+#: Key of :attr:`Dataset._derived` holding the record and rows a :meth:`Dataset.part` came from.
+_SOURCE = ("part of",)
 
 
 def _read_only(array: np.ndarray) -> np.ndarray:

@@ -326,9 +326,7 @@ def time_piece(dataset: Dataset, start: int, stop: int) -> Dataset:
     span, which every method's folds share."""
     def piece(record: Dataset) -> Dataset:
         t = record.t[start:stop]
-        return Dataset(t=t, pose=record.pose[start:stop], lengths=record.lengths[start:stop],
-                       forces=record.forces[start:stop],
-                       name=f"{record.name}[{t[0]:.4g}-{t[-1]:.4g} s]")
+        return record.part(slice(start, stop), f"{record.name}[{t[0]:.4g}-{t[-1]:.4g} s]")
 
     return dataset.derived(("piece", int(start), int(stop)), piece)
 
