@@ -8,6 +8,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -50,6 +51,14 @@ class Segment:
     q_ddot: np.ndarray
     coulomb: np.ndarray
     window: float = float("nan")
+
+    @cached_property
+    def centred_force(self) -> np.ndarray:
+        """``force`` less its mean, (n, 6), read-only: what every model's prediction is scored
+        against, one array for all of them."""
+        centred = self.force - self.force.mean(axis=0)
+        centred.flags.writeable = False
+        return centred
 
 
 @dataclass(frozen=True)
@@ -302,7 +311,7 @@ def score(segments: Sequence[Segment], predicted: Sequence[np.ndarray], folds: i
           delay_identifiable: bool | None = None) -> ValidationResult:
     """VAF and NRMSE per DOF of predictions against the segments' measured force; with
     ``delay_identifiable`` set, the :func:`residual_delay` too."""
-    measured = [s.force - s.force.mean(axis=0) for s in segments]
+    measured = [s.centred_force for s in segments]
     centred = [p - p.mean(axis=0) for p in predicted]
     y = np.concatenate(measured)
     error = y - np.concatenate(centred)
