@@ -215,25 +215,38 @@ def prepare_segment(dataset: Dataset, platform: Platform, window: float, *, grav
 
     ``gravity`` subtracts G(q); ``remainder`` subtracts
     :func:`~stewartid.identification.preparation.model_remainder`; ``experiment``, ``fold`` label
-    the segment; below ``coulomb_smoothing`` (rad/s) a Coulomb sign is attenuated.
+    the segment; below ``coulomb_smoothing`` (rad/s) a Coulomb sign is attenuated. The motion
+    and the Coulomb regressors, which the force's settings leave alone, are computed once per
+    record and window (:meth:`~stewartid.datasets.dataset.Dataset.derived`).
     """
-    from stewartid.identification.least_squares import coulomb_regressors
     from stewartid.identification.preparation import prepare
-    from stewartid.identification.wavelet.noise import measured_sign_rates
     from stewartid.signals.differentiation import kernel_filter
 
     record = prepare([dataset], platform, gravity=gravity, remainder=remainder)[0]
+    t, q_dot, q_ddot, coulomb = dataset.derived(
+        ("segment motion", platform, float(window), float(coulomb_smoothing)),
+        lambda _: _segment_motion(record, window, coulomb_smoothing))
+    force = kernel_filter(record.generalized_force, record.sample_rate, window)[0]
+    return Segment(name=dataset.name, experiment=experiment, fold=fold, t=t, force=force,
+                   q_dot=q_dot, q_ddot=q_ddot, coulomb=coulomb, window=float(window))
+
+
+def _segment_motion(record: Any, window: float, coulomb_smoothing: float
+                    ) -> tuple[np.ndarray, ...]:
+    """``t``, ``q_dot``, ``q_ddot`` and ``coulomb`` of :func:`prepare_segment` for a prepared
+    experiment ``record``."""
+    from stewartid.identification.least_squares import coulomb_regressors
+    from stewartid.identification.wavelet.noise import measured_sign_rates
+    from stewartid.signals.differentiation import kernel_filter
+
     # the signs need rates at every sample, from the window the noise allows
     q_dot_sign = measured_sign_rates(record.q, record.sample_rate, window)
     unit = coulomb_regressors(record.joint_jacobians, q_dot_sign, coulomb_smoothing)
-    signals = np.concatenate([record.generalized_force, unit.reshape(len(unit), -1)], axis=1)
-    filtered = kernel_filter(signals, record.sample_rate, window)[0]
+    filtered = kernel_filter(unit.reshape(len(unit), -1), record.sample_rate, window)[0]
     _, q_dot, q_ddot = kernel_filter(record.q, record.sample_rate, window, derivatives=2)
     cut = (len(record.t) - len(q_dot)) // 2
-    return Segment(name=dataset.name, experiment=experiment, fold=fold,
-                   t=record.t[cut:cut + len(q_dot)], force=filtered[:, :6], q_dot=q_dot,
-                   q_ddot=q_ddot, coulomb=filtered[:, 6:].reshape(len(q_dot), 3, 6),
-                   window=float(window))
+    return (record.t[cut:cut + len(q_dot)], q_dot, q_ddot,
+            filtered.reshape(len(q_dot), 3, 6))
 
 
 def predict(segment: Segment, result: IdentificationResult) -> np.ndarray:
