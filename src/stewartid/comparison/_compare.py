@@ -315,6 +315,8 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
         runs = [dataclasses.replace(run, result=dataclasses.replace(
             run.result, verdict=verdict.to_dict())) if run.name == verdict.trusted else run
             for run in runs]
+    for record in datasets:  # the fits' terms and time pieces: nothing reads them after the fits
+        record.clear_derived()
     comparison = Comparison(
         tuple(runs), verdict, platform, tuple(datasets), tuple(records), folds, nominal[0],
         nominal[1], nominal_source or "", section, physical is not None and physical.required,

@@ -164,7 +164,9 @@ def fit_physical(datasets: Sequence[Dataset], platform: Platform, request: Physi
         terms = (gravity, False)  # the full model predicts the nonlinear terms itself
         if terms not in segments:
             segments[terms] = held_out_segments(datasets, platform, folds, *terms)
-        validation = cross_validate_physical(lambda: PhysicalIdentifier(**options), datasets,
+        # the fold fits predict: their standard errors (the sampling check's refits) are never read
+        quick = {**options, "sampling_check": False}
+        validation = cross_validate_physical(lambda: PhysicalIdentifier(**quick), datasets,
                                              platform, folds, segments[terms])
         external = None
         if records:

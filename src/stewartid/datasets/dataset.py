@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
+import weakref
 from collections.abc import Callable, Hashable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -91,12 +92,44 @@ class Dataset:
             object.__setattr__(self, field, _read_only(value))
         object.__setattr__(self, "t", _read_only(np.asarray(self.t, dtype=float)))
 
+    def __reduce__(self) -> tuple:
+        # a copy sent to another process starts without what was derived here
+        return (Dataset, (self.t, self.pose, self.lengths, self.forces, self.name))
+
     def derived(self, key: Hashable, compute: Callable[[Dataset], Any]) -> Any:
         """``compute(self)``, computed once per ``key`` for this record (leg terms, frequencies,
         thinned copies: what every method derives from the same record)."""
         if key not in self._derived:
             self._derived[key] = compute(self)
         return self._derived[key]
+
+    def part(self, rows: slice, name: str | None = None) -> Dataset:
+        """The samples ``rows`` of this record as a new record (views of its arrays), which
+        takes what :meth:`pointwise` derives from this one's; named ``name`` (default: its own)."""
+        record = Dataset(t=self.t[rows], pose=self.pose[rows], lengths=self.lengths[rows],
+                         forces=self.forces[rows], name=self.name if name is None else name)
+        record._derived[_SOURCE] = (weakref.ref(self), rows)
+        return record
+
+    def clear_derived(self) -> None:
+        """Drop what was derived from this record (:meth:`derived`), and the memory it holds;
+        it is computed again when asked."""
+        source = self._derived.get(_SOURCE)
+        self._derived.clear()
+        if source is not None:
+            self._derived[_SOURCE] = source
+
+    def pointwise(self, key: Hashable, compute: Callable[[Dataset], tuple[np.ndarray, ...]]
+                  ) -> tuple[np.ndarray, ...]:
+        """:meth:`derived` for arrays computed sample by sample along their first axis (terms of
+        the pose): a :meth:`part` of a record takes the rows of the record's, C-contiguous."""
+        source = self._derived.get(_SOURCE)
+        record = None if source is None else source[0]()
+        if record is None:
+            return self.derived(key, compute)
+        rows = source[1]
+        return self.derived(key, lambda _: tuple(
+            np.ascontiguousarray(array[rows]) for array in record.pointwise(key, compute)))
 
     @property
     def sample_rate(self) -> float:
@@ -117,6 +150,10 @@ class Dataset:
 
         data = np.column_stack([self.t, self.pose, self.lengths, self.forces])
         return pd.DataFrame(data, columns=list(COLUMNS))
+
+
+#: Key of :attr:`Dataset._derived` holding the record and rows a :meth:`Dataset.part` came from.
+_SOURCE = ("part of",)
 
 
 def _read_only(array: np.ndarray) -> np.ndarray:

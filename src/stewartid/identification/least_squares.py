@@ -24,7 +24,7 @@ from stewartid.identification.friction_shape import (
     shaped_sign,
 )
 from stewartid.identification.pairs import calibrate_by_pairs
-from stewartid.identification.preparation import Experiment, prepare
+from stewartid.identification.preparation import Experiment, prepare_experiment
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.solvers import regressor_names, solve_least_squares
@@ -240,15 +240,16 @@ class LeastSquaresIdentifier(BaseIdentifier):
 
     def _fit(self, datasets: list[Dataset], platform: Platform
              ) -> tuple[IdentificationResult, dict]:
-        experiments = prepare(datasets, platform, gravity=self.gravity, joints=self.coulomb,
-                              remainder=self.remainder)
-        n_exp = len(experiments)
+        n_exp = len(datasets)
         shapes = (() if not self.coulomb else COULOMB_SHAPES if self.coulomb_shape == "average"
                   else (self.coulomb_shape,))
         legs = bool(shapes) and uses_leg_coulomb(self.leg_coulomb, platform)
         shared: list[list[np.ndarray]] = [[] for _ in shapes]
         phis, ys, used, noise, segments = [], [], [], [], []
-        for e, exp in enumerate(experiments):
+        for e, dataset in enumerate(datasets):
+            # one experiment at a time: its joint-axis Jacobians go when its rows are built
+            exp = prepare_experiment(dataset, platform, gravity=self.gravity,
+                                     joints=self.coulomb, remainder=self.remainder)
             rows = self._experiment_rows(exp, shapes, legs)
             k = len(rows.y)
             offsets = np.zeros((k, n_exp))
@@ -264,7 +265,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
             used.append({"name": exp.name, "window_s": rows.window, "decimate": rows.decimate,
                          "samples": k,
                          "t_start": float(rows.t[0]), "t_stop": float(rows.t[-1])})
-        names = regressor_names("q_ddot", "q_dot") + [f"offset[{x.name}]" for x in experiments]
+            del exp
+        names = regressor_names("q_ddot", "q_dot") + [f"offset[{x['name']}]" for x in used]
         regressor_noise = None
         if noise:
             regressor_noise = np.zeros((12 + n_exp, 12 + n_exp))

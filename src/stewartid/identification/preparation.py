@@ -130,6 +130,8 @@ def prepare_experiment(dataset: Dataset, platform: Platform, gravity: bool = Tru
 
     The terms are kept with the record (:meth:`~stewartid.datasets.dataset.Dataset.derived`), so
     that every method fitted to it shares them; the joint-axis Jacobians, the largest, are not.
+    G(q) and J_lq, which every setting shares, are the rows of its record's for a part of one
+    (:meth:`~stewartid.datasets.dataset.Dataset.pointwise`).
 
     Parameters
     ----------
@@ -142,7 +144,7 @@ def prepare_experiment(dataset: Dataset, platform: Platform, gravity: bool = Tru
     remainder : bool
         Subtract the model's departure from its linearisation (:func:`model_remainder`).
     """
-    fresh: dict[str, np.ndarray] = {}   # the joint-axis Jacobians of a first preparation
+    fresh: dict[str, np.ndarray] = {}   # the joint-axis Jacobians of a first leg-terms pass
     shared = dataset.derived(("prepared", platform, gravity, remainder),
                              lambda record: _prepared(record, platform, gravity, remainder,
                                                       joints, fresh))
@@ -154,13 +156,25 @@ def prepare_experiment(dataset: Dataset, platform: Platform, gravity: bool = Tru
     return experiment
 
 
+def _pose_terms(dataset: Dataset, platform: Platform, joints: bool,
+                fresh: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """G(q) (N, 6) and J_lq (N, 6, 6) of a record; with ``joints``, the joint-axis Jacobians of
+    the same pass into ``fresh`` when the pass is made."""
+    def compute(record: Dataset) -> tuple[np.ndarray, np.ndarray]:
+        G, J, _, joint_jacobians = compute_leg_terms(platform, np.ascontiguousarray(record.pose),
+                                                     joints and record is dataset)
+        if joints and record is dataset:
+            fresh["joint_jacobians"] = joint_jacobians
+        return G, J
+
+    return dataset.pointwise(("pose terms", platform), compute)
+
+
 def _prepared(dataset: Dataset, platform: Platform, gravity: bool, remainder: bool,
               joints: bool, fresh: dict[str, np.ndarray]) -> Experiment:
-    """The shared terms; with ``joints``, the joint-axis Jacobians of the same pass into ``fresh``."""
-    G, J, _, joint_jacobians = compute_leg_terms(platform, np.ascontiguousarray(dataset.pose),
-                                                 joints)
-    if joints:
-        fresh["joint_jacobians"] = joint_jacobians
+    """The terms of one setting; with ``joints``, the joint-axis Jacobians into ``fresh`` when
+    computed in the same pass as G and J."""
+    G, J = _pose_terms(dataset, platform, joints, fresh)
     y = np.einsum("nji,nj->ni", J, dataset.forces)
     if gravity:
         y = y - G

@@ -63,10 +63,8 @@ def samples_per_period(datasets: Sequence[Dataset]) -> float:
 def thinned(dataset: Dataset, factor: int) -> Dataset:
     """Every ``factor``-th sample of an experiment, from the first (same name, rate / factor);
     one copy per record, which every method's check shares."""
-    rows = slice(0, None, factor)
-    return dataset.derived(("thinned", factor), lambda record: Dataset(
-        record.t[rows], record.pose[rows], record.lengths[rows], record.forces[rows],
-        record.name))
+    return dataset.derived(("thinned", factor),
+                           lambda record: record.part(slice(0, None, factor)))
 
 
 def _diagonals(result: IdentificationResult) -> tuple[np.ndarray, np.ndarray]:

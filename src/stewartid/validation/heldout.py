@@ -8,6 +8,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -50,6 +51,14 @@ class Segment:
     q_ddot: np.ndarray
     coulomb: np.ndarray
     window: float = float("nan")
+
+    @cached_property
+    def centred_force(self) -> np.ndarray:
+        """``force`` less its mean, (n, 6), read-only: what every model's prediction is scored
+        against, one array for all of them."""
+        centred = self.force - self.force.mean(axis=0)
+        centred.flags.writeable = False
+        return centred
 
 
 @dataclass(frozen=True)
@@ -206,25 +215,38 @@ def prepare_segment(dataset: Dataset, platform: Platform, window: float, *, grav
 
     ``gravity`` subtracts G(q); ``remainder`` subtracts
     :func:`~stewartid.identification.preparation.model_remainder`; ``experiment``, ``fold`` label
-    the segment; below ``coulomb_smoothing`` (rad/s) a Coulomb sign is attenuated.
+    the segment; below ``coulomb_smoothing`` (rad/s) a Coulomb sign is attenuated. The motion
+    and the Coulomb regressors, which the force's settings leave alone, are computed once per
+    record and window (:meth:`~stewartid.datasets.dataset.Dataset.derived`).
     """
-    from stewartid.identification.least_squares import coulomb_regressors
     from stewartid.identification.preparation import prepare
-    from stewartid.identification.wavelet.noise import measured_sign_rates
     from stewartid.signals.differentiation import kernel_filter
 
     record = prepare([dataset], platform, gravity=gravity, remainder=remainder)[0]
+    t, q_dot, q_ddot, coulomb = dataset.derived(
+        ("segment motion", platform, float(window), float(coulomb_smoothing)),
+        lambda _: _segment_motion(record, window, coulomb_smoothing))
+    force = kernel_filter(record.generalized_force, record.sample_rate, window)[0]
+    return Segment(name=dataset.name, experiment=experiment, fold=fold, t=t, force=force,
+                   q_dot=q_dot, q_ddot=q_ddot, coulomb=coulomb, window=float(window))
+
+
+def _segment_motion(record: Any, window: float, coulomb_smoothing: float
+                    ) -> tuple[np.ndarray, ...]:
+    """``t``, ``q_dot``, ``q_ddot`` and ``coulomb`` of :func:`prepare_segment` for a prepared
+    experiment ``record``."""
+    from stewartid.identification.least_squares import coulomb_regressors
+    from stewartid.identification.wavelet.noise import measured_sign_rates
+    from stewartid.signals.differentiation import kernel_filter
+
     # the signs need rates at every sample, from the window the noise allows
     q_dot_sign = measured_sign_rates(record.q, record.sample_rate, window)
     unit = coulomb_regressors(record.joint_jacobians, q_dot_sign, coulomb_smoothing)
-    signals = np.concatenate([record.generalized_force, unit.reshape(len(unit), -1)], axis=1)
-    filtered = kernel_filter(signals, record.sample_rate, window)[0]
+    filtered = kernel_filter(unit.reshape(len(unit), -1), record.sample_rate, window)[0]
     _, q_dot, q_ddot = kernel_filter(record.q, record.sample_rate, window, derivatives=2)
     cut = (len(record.t) - len(q_dot)) // 2
-    return Segment(name=dataset.name, experiment=experiment, fold=fold,
-                   t=record.t[cut:cut + len(q_dot)], force=filtered[:, :6], q_dot=q_dot,
-                   q_ddot=q_ddot, coulomb=filtered[:, 6:].reshape(len(q_dot), 3, 6),
-                   window=float(window))
+    return (record.t[cut:cut + len(q_dot)], q_dot, q_ddot,
+            filtered.reshape(len(q_dot), 3, 6))
 
 
 def predict(segment: Segment, result: IdentificationResult) -> np.ndarray:
@@ -302,7 +324,7 @@ def score(segments: Sequence[Segment], predicted: Sequence[np.ndarray], folds: i
           delay_identifiable: bool | None = None) -> ValidationResult:
     """VAF and NRMSE per DOF of predictions against the segments' measured force; with
     ``delay_identifiable`` set, the :func:`residual_delay` too."""
-    measured = [s.force - s.force.mean(axis=0) for s in segments]
+    measured = [s.centred_force for s in segments]
     centred = [p - p.mean(axis=0) for p in predicted]
     y = np.concatenate(measured)
     error = y - np.concatenate(centred)
@@ -326,9 +348,7 @@ def time_piece(dataset: Dataset, start: int, stop: int) -> Dataset:
     span, which every method's folds share."""
     def piece(record: Dataset) -> Dataset:
         t = record.t[start:stop]
-        return Dataset(t=t, pose=record.pose[start:stop], lengths=record.lengths[start:stop],
-                       forces=record.forces[start:stop],
-                       name=f"{record.name}[{t[0]:.4g}-{t[-1]:.4g} s]")
+        return record.part(slice(start, stop), f"{record.name}[{t[0]:.4g}-{t[-1]:.4g} s]")
 
     return dataset.derived(("piece", int(start), int(stop)), piece)
 

@@ -57,6 +57,20 @@ def data_figures(drawer: FigureDrawer, datasets: Sequence[Dataset], platform: Pl
                [d.sample_rate for d in datasets], [row["frequency_hz"] for row in rows])
 
 
+def _joint_rate_trace(dataset: Dataset, platform: Platform, row: dict[str, Any],
+                      intervals: np.ndarray | None) -> ExperimentTrace:
+    """The joint rates of one experiment, ready to plot; its joint-axis Jacobians, shape
+    (N, 6, 5, 6), are not kept."""
+    first = prepare([dataset], platform)[0]
+    _, q_dot, _ = differentiate(first.q, first.sample_rate, 0.2 / row["frequency_hz"])
+    return ExperimentTrace(
+        name=dataset.name, excited=row["excited"], t=first.t, pose=first.q,
+        neutral=np.asarray(platform.neutral_pose, dtype=float),
+        joint_rates=joint_rates(platform, first.q, q_dot, first.joint_jacobians,
+                                first.leg_jacobian),
+        intervals=intervals)
+
+
 def result_figures(drawer: FigureDrawer, runs: Sequence[MethodFit],
                    datasets: Sequence[Dataset], platform: Platform,
                    nominal: tuple[np.ndarray, np.ndarray], trusted: str,
@@ -66,14 +80,8 @@ def result_figures(drawer: FigureDrawer, runs: Sequence[MethodFit],
     best = next(run for run in ok if run.name == trusted)
     frequencies = [row["frequency_hz"] for row in rows]
     owner, intervals, points = used_intervals(runs, trusted, datasets)
-    first = prepare([datasets[0]], platform)[0]
-    _, q_dot, _ = differentiate(first.q, first.sample_rate, 0.2 / frequencies[0])
-    trace = ExperimentTrace(
-        name=datasets[0].name, excited=rows[0]["excited"], t=first.t, pose=first.q,
-        neutral=np.asarray(platform.neutral_pose, dtype=float),
-        joint_rates=joint_rates(platform, first.q, q_dot, first.joint_jacobians,
-                                first.leg_jacobian),
-        intervals=intervals[0] if intervals else None)
+    trace = _joint_rate_trace(datasets[0], platform, rows[0],
+                              intervals[0] if intervals else None)
     drawer.add("joint_rates", f"Joint rates of {datasets[0].name}; shaded: the "
                f"constant-direction intervals {owner} used." if intervals else
                f"Joint rates of {datasets[0].name} (no method here uses constant-direction "
