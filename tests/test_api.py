@@ -60,3 +60,31 @@ def test_write_report_gives_the_command_lines_report(tmp_path, example_dir, exam
     assert ours == theirs
     assert sorted(p.name for p in (tmp_path / "python").glob("*.csv")) == sorted(
         p.name for p in (tmp_path / "cli").glob("*.csv"))
+
+
+@pytest.mark.slow
+def test_methods_fitted_side_by_side_give_the_same_comparison(example_dir, example_platform):
+    """Worker processes (fork) fit the methods as one process does, to the bit; the runs share
+    one copy of the held-out segments, as in one process."""
+    import numpy as np
+
+    import stewartid as sid
+
+    experiments = sid.read_experiments(example_dir, example_platform)
+    alone, side = (sid.compare_methods(experiments, example_platform, methods=("fourier", "ls"),
+                                       folds=2, jobs=jobs) for jobs in (1, 2))
+    assert alone.verdict.to_dict() == side.verdict.to_dict()
+    for a, b in zip(alone.runs, side.runs, strict=True):
+        for name in ("M", "B", "std_errors_M", "std_errors_B"):
+            assert np.array_equal(getattr(a.result, name), getattr(b.result, name)), name
+        assert np.array_equal(a.validation.vaf_percent, b.validation.vaf_percent)
+    fitted = [run for run in side.runs if run.validation is not None]
+    assert all(run.validation.segments is fitted[0].validation.segments for run in fitted)
+
+
+def test_a_worker_count_below_one_is_one_line(example_dir):
+    result = CliRunner().invoke(app, ["identify", "--method", "all", "--jobs", "0", "--report",
+                                      "unused", str(example_dir)])
+    assert result.exit_code == 2
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and "--jobs" in lines[0], result.output

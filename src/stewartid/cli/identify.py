@@ -62,6 +62,9 @@ def identify(
                              "the physically consistent parameters (pseudo-inertia positive "
                              "semidefinite, friction nonnegative). Needs the 'convex' "
                              "extra.")] = False,
+    jobs: Annotated[int | None, typer.Option(
+        "--jobs", metavar="N", help="--report: worker processes fitting the methods side by "
+        "side (default: every core); the results do not depend on it.")] = None,
     folds: Annotated[int | None, typer.Option(
         "--folds", metavar="N", help="--report: time segments per experiment for the validation "
                         "(default 3).")] = None,
@@ -108,7 +111,7 @@ def identify(
     found = identify_files(files, method, platform, flags=flags, columns=columns, out=out,
                            force=force, report=report, consistent=consistent, folds=folds,
                            delay=delay, validate=validate or (), model=model,
-                           payload=payload, platform_out=platform_out)
+                           payload=payload, platform_out=platform_out, jobs=jobs)
     if found.delay is not None:
         entry = found.delay
         if entry["source"] == "given":

@@ -16,6 +16,7 @@ from stewartid.comparison import (
     ALL_METHODS,
     PhysicalRequest,
     align_experiments,
+    check_jobs,
     compare_methods,
     consistent_result,
     method_names,
@@ -237,10 +238,12 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
                    report: Path | None = None, consistent: bool = False,
                    folds: int | None = None, delay: str | float | None = None,
                    validate: Sequence[str | Path] = (), model: str | None = None,
-                   payload: bool = False, platform_out: Path | None = None) -> IdentifyRun:
+                   payload: bool = False, platform_out: Path | None = None,
+                   jobs: int | None = None) -> IdentifyRun:
     """Identify Mt and Bt from experiment files, as ``stewartid identify`` does.
 
-    The arguments are the command's options; ``flags`` maps each estimator flag to its setting.
+    The arguments are the command's options; ``flags`` maps each estimator flag to its setting;
+    ``jobs``: worker processes of the comparison (None: every core).
     With ``report`` the methods are compared and the report written; with ``model`` the physical
     model is fitted instead of ``method``.
 
@@ -251,6 +254,7 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
         an unexcited DOF, an inapplicable method, or an implausible result.
     """
     delay = parse_delay(delay)
+    check_jobs(jobs)
     names = method_names(method)
     settings = settings_for(names, method, flags or {})
     paths = expand_paths(files)
@@ -287,7 +291,7 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
             consistent=consistent and model is None,
             physical=_physical_request(model, method, payload, consistent, settings),
             nominal=None if meta is None else meta[:2],
-            nominal_source=None if meta is None else meta[2], delay=delay)
+            nominal_source=None if meta is None else meta[2], delay=delay, jobs=jobs)
         check(comparison.result)
         written = write_report(comparison, report, sources=[str(p) for p in paths])
         result, delay_entry = comparison.result, comparison.delay

@@ -5,6 +5,7 @@
 from stewartid.comparison._compare import (
     ALL_METHODS,
     Comparison,
+    check_jobs,
     compare_methods,
     method_names,
     plausibility_check,
@@ -31,7 +32,7 @@ from stewartid.comparison._runs import (
 )
 
 __all__ = ["ALL_METHODS", "DELAY_SIGNIFICANCE", "Alignment", "Comparison", "MethodFit", "PhysicalRequest",
-           "PhysicalSection", "Workspace", "align_experiments", "compare_methods",
+           "PhysicalSection", "Workspace", "align_experiments", "check_jobs", "compare_methods",
            "consensus_run", "consistent_result", "delay_note", "fit_physical", "judge",
            "largest_couplings", "method_names", "plausibility_check", "run_method",
            "same_segments", "workspace"]

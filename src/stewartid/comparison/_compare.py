@@ -15,7 +15,7 @@ import numpy as np
 from stewartid.comparison._delay import align_experiments, delay_note
 from stewartid.comparison._physical import PhysicalRequest, fit_physical
 from stewartid.comparison._records import MethodFit, PhysicalSection
-from stewartid.comparison._runs import judge, run_method
+from stewartid.comparison._runs import judge, run_method, same_segments
 from stewartid.datasets.alignment import align_forces
 from stewartid.datasets.dataset import Dataset
 from stewartid.datasets.plausibility import check_identified
@@ -24,7 +24,7 @@ from stewartid.identification import registry
 from stewartid.identification.delay import delay_identifiable
 from stewartid.identification.result import IdentificationResult
 from stewartid.model.linearization import nominal_matrices
-from stewartid.parallel import one_blas_thread
+from stewartid.parallel import one_blas_thread, run_in_order, worker_count
 from stewartid.platform import Platform, load_platform
 from stewartid.validation.heldout import DEFAULT_FOLDS, ResidualDelay, Segment, ValidationResult
 from stewartid.verdict.policy import (
@@ -218,6 +218,75 @@ def _experiments(experiments: Sequence[Dataset | str | Path], platform: Platform
 
 
 @one_blas_thread()
+def check_jobs(jobs: int | None) -> None:
+    """Refuse a worker count that is not a whole number of at least 1 (None: every core)."""
+    if jobs is not None and not (isinstance(jobs, int | np.integer) and jobs >= 1):
+        raise ConfigError(f"jobs (--jobs) must be a whole number of worker processes, 1 or "
+                          f"more; got {jobs!r}.")
+
+
+#: The physical model's task among the methods' in :func:`compare_methods`.
+PHYSICAL_TASK = "physical model"
+
+
+@dataclass
+class _Work:
+    """What every task of :func:`compare_methods` shares; the held-out segments are prepared once
+    per worker process and shared by its tasks."""
+
+    settings: dict[str, Any]
+    datasets: list[Dataset]
+    platform: Platform
+    folds: int
+    consistent: bool
+    check: Callable[[IdentificationResult], None] | None
+    records: list[Dataset]
+    delay_identifiable: bool
+    physical: PhysicalRequest | None
+    segments: dict[tuple[bool, bool], list[Segment]] = dataclasses.field(default_factory=dict)
+    record_cache: dict[tuple[bool, bool], list[Segment]] = dataclasses.field(
+        default_factory=dict)
+
+
+def _run_task(work: _Work, task: str) -> MethodFit | PhysicalSection:
+    """One method fitted and validated, or the physical model (:data:`PHYSICAL_TASK`)."""
+    if task == PHYSICAL_TASK:
+        return fit_physical(work.datasets, work.platform, work.physical, work.folds,
+                            work.segments, work.records, work.record_cache)
+    return run_method(task, work.settings, work.datasets, work.platform, work.folds,
+                      work.consistent, work.segments, work.check, work.records,
+                      work.record_cache, work.delay_identifiable)
+
+
+def _one_copy_of_segments(done: dict[str, Any]) -> dict[str, Any]:
+    """Fits made in worker processes each bring back their own copy of the held-out segments;
+    the first copy of equal ones serves them all again, as in one process."""
+    known: list[list[Segment]] = []
+
+    def canonical(segments: list[Segment]) -> list[Segment]:
+        same = next((k for k in known if same_segments(k, segments)), None)
+        if same is None:
+            known.append(segments)
+        return segments if same is None else same
+
+    def scores(found: Any) -> Any:
+        if found is None:
+            return None
+        segments = canonical(found.segments)
+        if segments is found.segments:
+            return found
+        if isinstance(found, ValidationResult):
+            return dataclasses.replace(found, segments=segments,
+                                       measured=[s.centred_force for s in segments])
+        return dataclasses.replace(found, segments=segments)
+
+    fields = ("validation", "validation_unconstrained", "in_sample", "records",
+              "cross_validation")
+    return {task: dataclasses.replace(item, **{name: scores(getattr(item, name))
+                                               for name in fields if hasattr(item, name)})
+            for task, item in done.items()}
+
+
 def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platform | str | Path,
                     methods: str | Sequence[str] = ALL_METHODS,
                     validate: Sequence[Dataset | str | Path] | None = None,
@@ -228,7 +297,7 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
                     check: bool | Callable[[IdentificationResult], None] = True,
                     entries: Sequence[str] | None = None,
                     policy: VerdictPolicy = DEFAULT_POLICY,
-                    delay: str | float | None = None) -> Comparison:
+                    delay: str | float | None = None, jobs: int = 1) -> Comparison:
     """Fit every method to the same experiments, validate each on held-out time segments and
     say which to trust; writes no file.
 
@@ -271,6 +340,9 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
         The force channels' delay behind the motion (s; 0: as logged); by default estimated
         where the motion tells it from damping and applied when beyond noise
         (:func:`~stewartid.comparison.align_experiments`).
+    jobs : int
+        Worker processes fitting and validating the methods (and the physical model) side by
+        side; None: every core. The results do not depend on it.
 
     Returns
     -------
@@ -282,6 +354,7 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
         Bad settings, or no method could be applied (the first method's message).
     """
     started = time.perf_counter()
+    check_jobs(jobs)
     if not isinstance(platform, Platform):
         platform = load_platform(platform)
     if not (isinstance(folds, int | np.integer) and folds >= 2):
@@ -297,20 +370,23 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
         nominal_source = nominal_source or (f"platform description '{platform.name}' at the "
                                             "neutral pose")
     checker = plausibility_check(platform) if check is True else (check or None)
-    segments: dict[tuple[bool, bool], list[Segment]] = {}
-    record_cache: dict[tuple[bool, bool], list[Segment]] = {}
     # where one frequency moves a DOF, a fit absorbs a delay into Bt and leaves none to see
     identifiable = alignment.sensitivity is None and delay_identifiable(datasets)
-    runs = [run_method(name, settings or {}, datasets, platform, folds, consistent, segments,
-                       checker, records, record_cache, identifiable)
-            for name in dict.fromkeys(names)]
+    work = _Work(dict(settings or {}), datasets, platform, folds, consistent, checker,
+                 records, identifiable, physical)
+    names = tuple(dict.fromkeys(names))
+    # the physical model first: beside Method B it is the longest task
+    tasks = ([PHYSICAL_TASK] if physical is not None else []) + list(names)
+    done = dict(zip(tasks, run_in_order(_run_task, tasks, jobs, shared=work), strict=True))
+    if worker_count(jobs, len(tasks)) > 1:
+        done = _one_copy_of_segments(done)
+    runs = [done[name] for name in names]
     if all(run.result is None for run in runs):
         raise runs[0].exception
     scored = (parse_entries(entries) if entries is not None
               else scored_entries(*nominal_matrices(platform), policy.negligible_coupling))
     runs, verdict = judge(runs, consistent, scored, policy)
-    section = None if physical is None else fit_physical(
-        datasets, platform, physical, folds, segments, records, record_cache)
+    section = done.get(PHYSICAL_TASK)
     if len(runs) > 1:
         runs = [dataclasses.replace(run, result=dataclasses.replace(
             run.result, verdict=verdict.to_dict())) if run.name == verdict.trusted else run
