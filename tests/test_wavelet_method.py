@@ -442,3 +442,17 @@ def test_friction_law_test_scores_the_diagonals_against_the_normal_point():
     found = friction_law_test(free, std, law, std)
     assert found["rejected"] and found["entry"] == "Mt(3,3)"
     assert not friction_law_test(free, np.full((6, 12), np.nan), law, std)["rejected"]
+
+
+@pytest.mark.slow
+def test_experiments_prepared_side_by_side_give_the_same_fit(example_dir, example_platform):
+    """Worker processes preparing the experiments' equations (jobs=2) give the one-process fit
+    to the bit, and the settings recorded do not name the worker count."""
+    from stewartid.datasets import read_experiments
+
+    experiments = read_experiments(example_dir, example_platform)
+    alone, side = (WaveletIdentifier(jobs=jobs).fit(experiments, example_platform).result_
+                   for jobs in (1, 2))
+    for name in ("M", "B", "std_errors_M", "std_errors_B"):
+        assert np.array_equal(getattr(alone, name), getattr(side, name)), name
+    assert alone.settings == side.settings and "jobs" not in side.settings

@@ -63,8 +63,9 @@ def identify(
                              "semidefinite, friction nonnegative). Needs the 'convex' "
                              "extra.")] = False,
     jobs: Annotated[int | None, typer.Option(
-        "--jobs", metavar="N", help="--report: worker processes fitting the methods side by "
-        "side (default: every core); the results do not depend on it.")] = None,
+        "--jobs", metavar="N", help="Worker processes: the methods fitted side by side with "
+        "--report, the experiments prepared side by side by Method B (default: every core); "
+        "the results do not depend on it.")] = None,
     folds: Annotated[int | None, typer.Option(
         "--folds", metavar="N", help="--report: time segments per experiment for the validation "
                         "(default 3).")] = None,

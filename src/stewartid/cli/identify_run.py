@@ -243,7 +243,8 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     """Identify Mt and Bt from experiment files, as ``stewartid identify`` does.
 
     The arguments are the command's options; ``flags`` maps each estimator flag to its setting;
-    ``jobs``: worker processes of the comparison (None: every core).
+    ``jobs``: worker processes of the comparison or of a method that takes them (None: every
+    core).
     With ``report`` the methods are compared and the report written; with ``model`` the physical
     model is fitted instead of ``method``.
 
@@ -299,6 +300,8 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     else:
         alignment = align_experiments(datasets, description, delay)
         delay_entry, sensitivity = alignment.entry, alignment.sensitivity
+        if model is None and "jobs" in registry.method_spec(method).estimator_class.param_names():
+            settings = {**settings, "jobs": jobs}
         result = _fit_alone(alignment.experiments, description, method, settings, consistent,
                             model, payload)
         check(result)

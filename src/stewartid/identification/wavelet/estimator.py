@@ -41,6 +41,7 @@ from stewartid.identification.wavelet.noise import estimate_noise
 from stewartid.identification.wavelet.point_equations import EXACT_DEGREE, point_equations
 from stewartid.identification.wavelet.weak_form import coulomb_patterns
 from stewartid.model.joints import JOINT_TYPES
+from stewartid.parallel import run_in_order, worker_count
 from stewartid.platform import COORDINATES, Platform
 from stewartid.signals.wavelets import MotherWavelet, PolynomialWavelet, make_wavelet
 
@@ -117,6 +118,9 @@ class WaveletIdentifier(BaseIdentifier):
         Subtract the model's departure from its linearisation.
     sampling_check : bool
         Widen standard errors where the log's sampling limits them.
+    jobs : int or None
+        Worker processes preparing the experiments' equations side by side (None: every core);
+        the results do not depend on it.
 
     Attributes
     ----------
@@ -137,7 +141,7 @@ class WaveletIdentifier(BaseIdentifier):
                  odd_companion: bool = False, noise_correction: bool = True,
                  symmetric: bool = False,
                  pair_selection: str = "pooled", gravity: bool = True, remainder: bool = True,
-                 sampling_check: bool = True):
+                 sampling_check: bool = True, jobs: int | None = 1):
         self.wavelet = wavelet
         self.wavelet_order = wavelet_order
         self.truncation = truncation
@@ -159,6 +163,7 @@ class WaveletIdentifier(BaseIdentifier):
         self.gravity = gravity
         self.remainder = remainder
         self.sampling_check = sampling_check
+        self.jobs = jobs
 
     # ------------------------------------------------------------------ settings
     _parameter_constraints = {
@@ -176,6 +181,7 @@ class WaveletIdentifier(BaseIdentifier):
         "friction": [Options(FRICTION_MODELS)],
         "sampling_check": [BOOLEAN],
         "pair_selection": [Options(PAIR_SELECTIONS)],
+        "jobs": [Interval(Integral, 1, None), None],
     }
 
     def _validate_params(self) -> None:
@@ -214,23 +220,15 @@ class WaveletIdentifier(BaseIdentifier):
         models = friction_models(self.friction, datasets)
         # a ball screw's Coulomb friction along each leg: one more level, in N
         legs = platform.actuator.kind == "electric"
-        infos, sensitivities, motion = [], [], []
         equations: dict[str, list] = {model: [] for model in models}
-        for k, dataset in enumerate(datasets):
-            experiment = prepare_experiment(dataset, platform, self.gravity, joints=True,
-                                            remainder=self.remainder)
-            found = self._noise_and_intervals(experiment, 1.0)
-            patterns = (coulomb_patterns(found, experiment.joint_jacobians, False,
-                                         leg_jacobian=experiment.leg_jacobian if legs else None)
-                        if {"free", "coulomb"} & set(models) else None)
+        if worker_count(self.jobs, len(datasets)) > 1:
+            _load_kernels(platform)
+        parts = run_in_order(_experiment_equations, range(len(datasets)), self.jobs,
+                             shared=(self, datasets, platform, models, legs))
+        for part in parts:
             for model in models:
-                equations[model] += model_equations(model, experiment, found,
-                                                    int(self.wavelet_order),
-                                                    int(self.test_functions), k, patterns)
-            infos.append(found.info)
-            sensitivities.append(experiment.force_sensitivity)
-            motion.append(np.std(experiment.q, axis=0))
-            del experiment, found
+                equations[model] += part[0][model]
+        infos, sensitivities, motion = ([part[k] for part in parts] for k in (1, 2, 3))
         noise = ({"pose_covariance": [i["noise_covariance"] for i in infos],
                   "force_variance": [i["force_noise_variance"] for i in infos],
                   "force_sensitivity": sensitivities} if self.noise_correction else {})
@@ -320,7 +318,9 @@ class WaveletIdentifier(BaseIdentifier):
         return chosen
 
     def _settings(self) -> dict:
-        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.get_params().items()}
+        # the worker count changes no result
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.get_params().items()
+                if k != "jobs"}
 
     def _fit(self, datasets: list[Dataset], platform: Platform
              ) -> tuple[IdentificationResult, dict]:
@@ -378,6 +378,39 @@ class WaveletIdentifier(BaseIdentifier):
             residual_rms=np.sqrt(np.mean(residual ** 2, axis=0)), method=self.method,
             settings=self._settings(),
             diagnostics=diagnostics), {}
+
+
+def _load_kernels(platform: Platform) -> None:
+    """Load the compiled kernels the experiments' equations use, once, before the worker
+    processes start: they inherit them instead of each loading its own."""
+    from stewartid.identification.wavelet._compiled import soft_sign_patterns
+    from stewartid.model import compiled
+    from stewartid.model.dynamics import ModelTerms
+
+    pose = platform.neutral_pose[None]
+    ModelTerms(platform, pose, np.zeros_like(pose))
+    compiled.batch_joint_rates(np.zeros((1, 6, 5, 6)), np.zeros((1, 6)))
+    soft_sign_patterns(np.zeros((1, 6, 5)), np.ones((6, 5)), np.zeros((1, 6, 5, 6)), np.zeros(1),
+                       np.zeros(5, dtype=np.int64), np.zeros((1, 1, 3, 6)))
+
+
+def _experiment_equations(work: tuple, k: int) -> tuple[dict[str, list], dict, np.ndarray,
+                                                        np.ndarray]:
+    """Experiment ``k``'s weak-form equations under each friction model, its detection info,
+    force sensitivity (6, 6) and pose spread (6,): one task of
+    :meth:`WaveletIdentifier._fit_weak_form` (``work``: the estimator, the data sets, the platform,
+    the friction models and whether the legs carry a Coulomb level)."""
+    estimator, datasets, platform, models, legs = work
+    experiment = prepare_experiment(datasets[k], platform, estimator.gravity, joints=True,
+                                    remainder=estimator.remainder)
+    found = estimator._noise_and_intervals(experiment, 1.0)
+    patterns = (coulomb_patterns(found, experiment.joint_jacobians, False,
+                                 leg_jacobian=experiment.leg_jacobian if legs else None)
+                if {"free", "coulomb"} & set(models) else None)
+    equations = {model: model_equations(model, experiment, found, int(estimator.wavelet_order),
+                                        int(estimator.test_functions), k, patterns)
+                 for model in models}
+    return equations, found.info, experiment.force_sensitivity, np.std(experiment.q, axis=0)
 
 
 __all__ = ["EXACT_DEGREE", "FRICTION_MODELS", "MARGIN_PERIODS", "PAIR_SELECTIONS", "VARIANTS",
