@@ -63,9 +63,11 @@ def test_write_report_gives_the_command_lines_report(tmp_path, example_dir, exam
 
 
 @pytest.mark.slow
-def test_methods_fitted_side_by_side_give_the_same_comparison(example_dir, example_platform):
+def test_methods_fitted_side_by_side_give_the_same_comparison(tmp_path, example_dir,
+                                                               example_platform):
     """Worker processes (fork) fit the methods as one process does, to the bit; the runs share
-    one copy of the held-out segments, as in one process."""
+    one copy of the held-out segments, as in one process; figures drawn side by side are the
+    same files."""
     import numpy as np
 
     import stewartid as sid
@@ -80,6 +82,12 @@ def test_methods_fitted_side_by_side_give_the_same_comparison(example_dir, examp
         assert np.array_equal(a.validation.vaf_percent, b.validation.vaf_percent)
     fitted = [run for run in side.runs if run.validation is not None]
     assert all(run.validation.segments is fitted[0].validation.segments for run in fitted)
+    sid.write_report(alone, tmp_path / "one", jobs=1)
+    sid.write_report(side, tmp_path / "two", jobs=2)
+    pictures = sorted(p.name for p in (tmp_path / "one" / "figures").glob("*.png"))
+    assert pictures == sorted(p.name for p in (tmp_path / "two" / "figures").glob("*.png"))
+    assert all((tmp_path / "one" / "figures" / name).read_bytes()
+               == (tmp_path / "two" / "figures" / name).read_bytes() for name in pictures)
 
 
 def test_a_worker_count_below_one_is_one_line(example_dir):

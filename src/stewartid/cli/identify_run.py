@@ -294,7 +294,7 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
             nominal=None if meta is None else meta[:2],
             nominal_source=None if meta is None else meta[2], delay=delay, jobs=jobs)
         check(comparison.result)
-        written = write_report(comparison, report, sources=[str(p) for p in paths])
+        written = write_report(comparison, report, sources=[str(p) for p in paths], jobs=jobs)
         result, delay_entry = comparison.result, comparison.delay
         sensitivity = comparison.delay_sensitivity
     else:

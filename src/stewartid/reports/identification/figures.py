@@ -12,6 +12,7 @@ from stewartid.comparison import MethodFit, PhysicalSection
 from stewartid.datasets.dataset import Dataset
 from stewartid.identification.preparation import prepare
 from stewartid.identification.wavelet.intervals import joint_rates
+from stewartid.parallel import run_in_order
 from stewartid.platform import Platform
 from stewartid.reports.drawing import ExperimentTrace, plot_excitation, plot_joint_rates
 from stewartid.reports.identification import method_figures as plots
@@ -20,7 +21,7 @@ from stewartid.signals.differentiation import differentiate
 
 
 class FigureDrawer:
-    """Draws the figures into one folder in this process and keeps their captions in report order.
+    """Collects the figures of one folder in report order, then draws them (:meth:`draw`).
 
     Attributes
     ----------
@@ -35,12 +36,29 @@ class FigureDrawer:
         self.folder = folder
         self.entries: dict[str, tuple[str, str]] = {}
         self.files: list[Path] = []
+        self._pending: list[tuple[str, Callable[..., list[Path]], tuple]] = []
 
     def add(self, key: str, caption: str, function: Callable[..., list[Path]],
             *args: Any) -> None:
-        """Draw ``function(*args)`` as ``figures/<key>.png`` and ``.svg``."""
+        """Have ``function(*args)`` drawn as ``figures/<key>.png`` and ``.svg``."""
         self.entries[key] = (f"figures/{key}.png", caption)
-        self.files += function(*args, directory=self.folder, stem=key)
+        self._pending.append((key, function, args))
+
+    def draw(self, jobs: int | None = 1) -> list[Path]:
+        """Draw every figure added, in ``jobs`` worker processes (None: every core); returns
+        the files written."""
+        pending, self._pending = self._pending, []
+        for written in run_in_order(_draw, range(len(pending)), jobs,
+                                    shared=(self.folder, pending)):
+            self.files += written
+        return self.files
+
+
+def _draw(work: tuple[Path, list], k: int) -> list[Path]:
+    """Figure ``k`` of a :class:`FigureDrawer`'s pending list, drawn into its folder."""
+    folder, pending = work
+    key, function, args = pending[k]
+    return function(*args, directory=folder, stem=key)
 
 
 def data_figures(drawer: FigureDrawer, datasets: Sequence[Dataset], platform: Platform,

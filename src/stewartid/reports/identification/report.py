@@ -22,7 +22,7 @@ from stewartid.reports.identification.written import IdentificationReport
 
 
 def write_report(comparison: Comparison, directory: str | Path, *, sources: Sequence[str] = (),
-                 notes: Sequence[str] = ()) -> IdentificationReport:
+                 notes: Sequence[str] = (), jobs: int | None = 1) -> IdentificationReport:
     """Write the identification report of ``comparison`` into ``directory``.
 
     Parameters
@@ -36,6 +36,8 @@ def write_report(comparison: Comparison, directory: str | Path, *, sources: Sequ
         The data files, listed in the report.
     notes : sequence of str
         Sentences added to the summary.
+    jobs : int or None
+        Worker processes drawing the figures (None: every core); the files do not depend on it.
     """
     started = time.perf_counter()
     directory = Path(directory)
@@ -47,6 +49,7 @@ def write_report(comparison: Comparison, directory: str | Path, *, sources: Sequ
     result_figures(drawer, comparison.runs, datasets, platform, nominal, comparison.trusted,
                    rows)
     physical_figures(drawer, comparison.physical)
+    drawer.draw(jobs)
     models = [ExportedModel(run.name, run.result, *run.coulomb) for run in comparison.runs
               if run.result is not None]
     files = drawer.files + write_exports(models, directory, comparison.trusted)
