@@ -24,12 +24,13 @@ from stewartid.identification.friction_shape import (
     shaped_sign,
 )
 from stewartid.identification.pairs import calibrate_by_pairs
-from stewartid.identification.preparation import Experiment, prepare_experiment
+from stewartid.identification.preparation import Experiment, load_kernels, prepare_experiment
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.solvers import regressor_names, solve_least_squares
 from stewartid.identification.wavelet.noise import measured_sign_rates
 from stewartid.model.joints import JOINT_TYPES
+from stewartid.parallel import run_in_order, worker_count
 from stewartid.platform import Platform
 from stewartid.signals.differentiation import (
     DEFAULT_ORDER,
@@ -151,6 +152,9 @@ class LeastSquaresIdentifier(BaseIdentifier):
         window (the filtered rows are smooth over the window: more of them add no information).
     noise_correction : bool
         Remove the errors-in-variables bias of pose noise (kernel only).
+    jobs : int or None
+        Worker processes building the experiments' rows side by side (None: every core); the
+        results do not depend on it.
 
     Attributes
     ----------
@@ -172,7 +176,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
                  coulomb_shape: str = "average", symmetric: bool = False,
                  decimate: int | None = None,
                  differentiation: str = "kernel", noise_correction: bool = True,
-                 remainder: bool = True, sampling_check: bool = True):
+                 remainder: bool = True, sampling_check: bool = True, jobs: int | None = 1):
         self.window = window
         self.order = order
         self.gravity = gravity
@@ -186,6 +190,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
         self.differentiation = differentiation
         self.noise_correction = noise_correction
         self.sampling_check = sampling_check
+        self.jobs = jobs
 
     _parameter_constraints = {
         **DIFFERENTIATION_CONSTRAINTS,
@@ -196,6 +201,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
         "decimate": [Interval(Integral, 1, None), None],
         "noise_correction": [BOOLEAN],
         "sampling_check": [BOOLEAN],
+        "jobs": [Interval(Integral, 1, None), None],
     }
 
     def _coulomb_units(self, exp: Experiment, rows: slice, q_dot: np.ndarray, shape: str,
@@ -246,11 +252,11 @@ class LeastSquaresIdentifier(BaseIdentifier):
         legs = bool(shapes) and uses_leg_coulomb(self.leg_coulomb, platform)
         shared: list[list[np.ndarray]] = [[] for _ in shapes]
         phis, ys, used, noise, segments = [], [], [], [], []
-        for e, dataset in enumerate(datasets):
-            # one experiment at a time: its joint-axis Jacobians go when its rows are built
-            exp = prepare_experiment(dataset, platform, gravity=self.gravity,
-                                     joints=self.coulomb, remainder=self.remainder)
-            rows = self._experiment_rows(exp, shapes, legs)
+        if worker_count(self.jobs, n_exp) > 1:
+            load_kernels(platform)
+        built = run_in_order(_experiment_rows, range(n_exp), self.jobs,
+                             shared=(self, datasets, platform, shapes, legs))
+        for e, (rows, name, rate) in enumerate(built):
             k = len(rows.y)
             offsets = np.zeros((k, n_exp))
             offsets[:, e] = 1.0
@@ -261,11 +267,10 @@ class LeastSquaresIdentifier(BaseIdentifier):
             if rows.noise is not None:
                 noise.append((k, rows.noise))
             # the filters' support: rows further apart share no noise sample
-            segments.append((k, math.ceil(rows.window * exp.sample_rate / rows.decimate) + 1))
-            used.append({"name": exp.name, "window_s": rows.window, "decimate": rows.decimate,
+            segments.append((k, math.ceil(rows.window * rate / rows.decimate) + 1))
+            used.append({"name": name, "window_s": rows.window, "decimate": rows.decimate,
                          "samples": k,
                          "t_start": float(rows.t[0]), "t_stop": float(rows.t[-1])})
-            del exp
         names = regressor_names("q_ddot", "q_dot") + [f"offset[{x['name']}]" for x in used]
         regressor_noise = None
         if noise:
@@ -304,10 +309,22 @@ class LeastSquaresIdentifier(BaseIdentifier):
         return IdentificationResult(
             M=theta[:, :6], B=theta[:, 6:12], std_errors_M=std[:, :6], std_errors_B=std[:, 6:12],
             condition_number=solution.condition_number, residual_rms=solution.residual_rms,
-            method=self.method, settings=self.get_params(), diagnostics=diagnostics), {
+            method=self.method, settings={k: v for k, v in self.get_params().items() if k != "jobs"},
+            diagnostics=diagnostics), {
             "offsets_": offsets, "coulomb_": levels, "coulomb_std_": levels_std,
             "leg_coulomb_": leg_level, "leg_coulomb_std_": leg_std,
             "coulomb_shape_weights_": shape_weights}
+
+
+def _experiment_rows(work: tuple, e: int) -> tuple[_Rows, str, float]:
+    """Experiment ``e``'s rows, name and sample rate (Hz): one task of
+    :meth:`LeastSquaresIdentifier._fit` (``work``: the estimator, the data sets, the platform,
+    the Coulomb sign shapes and whether the legs carry a Coulomb level). Its joint-axis
+    Jacobians go when its rows are built."""
+    estimator, datasets, platform, shapes, legs = work
+    exp = prepare_experiment(datasets[e], platform, gravity=estimator.gravity,
+                             joints=estimator.coulomb, remainder=estimator.remainder)
+    return estimator._experiment_rows(exp, shapes, legs), exp.name, exp.sample_rate
 
 
 __all__ = ["ROWS_PER_WINDOW", "LeastSquaresIdentifier", "coulomb_regressors",

@@ -13,7 +13,7 @@ from stewartid.datasets.dataset import Dataset
 from stewartid.fields import BOOLEAN, Interval, ListOf, Options, nonnegative, positive, validate_parameters
 from stewartid.identification.base import BaseIdentifier
 from stewartid.identification.pairs import combine_pairs
-from stewartid.identification.preparation import Experiment, prepare_experiment
+from stewartid.identification.preparation import Experiment, load_kernels, prepare_experiment
 from stewartid.identification.registry import Preset, register_method
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.sampling import check_sampling
@@ -222,7 +222,7 @@ class WaveletIdentifier(BaseIdentifier):
         legs = platform.actuator.kind == "electric"
         equations: dict[str, list] = {model: [] for model in models}
         if worker_count(self.jobs, len(datasets)) > 1:
-            _load_kernels(platform)
+            load_kernels(platform)
         parts = run_in_order(_experiment_equations, range(len(datasets)), self.jobs,
                              shared=(self, datasets, platform, models, legs))
         for part in parts:
@@ -378,20 +378,6 @@ class WaveletIdentifier(BaseIdentifier):
             residual_rms=np.sqrt(np.mean(residual ** 2, axis=0)), method=self.method,
             settings=self._settings(),
             diagnostics=diagnostics), {}
-
-
-def _load_kernels(platform: Platform) -> None:
-    """Load the compiled kernels the experiments' equations use, once, before the worker
-    processes start: they inherit them instead of each loading its own."""
-    from stewartid.identification.wavelet._compiled import soft_sign_patterns
-    from stewartid.model import compiled
-    from stewartid.model.dynamics import ModelTerms
-
-    pose = platform.neutral_pose[None]
-    ModelTerms(platform, pose, np.zeros_like(pose))
-    compiled.batch_joint_rates(np.zeros((1, 6, 5, 6)), np.zeros((1, 6)))
-    soft_sign_patterns(np.zeros((1, 6, 5)), np.ones((6, 5)), np.zeros((1, 6, 5, 6)), np.zeros(1),
-                       np.zeros(5, dtype=np.int64), np.zeros((1, 1, 3, 6)))
 
 
 def _experiment_equations(work: tuple, k: int) -> tuple[dict[str, list], dict, np.ndarray,
