@@ -1,9 +1,12 @@
 """Speed and memory of the identification path beside an earlier source tree, in one run.
 
 Each command runs in a fresh process, the two trees interleaved (A B A B ...), and its wall
-time, CPU time and peak resident memory are read from the process itself (``os.wait4``).
+time, CPU time (with its worker processes) and peak resident memory of its largest process are
+read from the process itself (``os.wait4``), the peak memory of the whole process tree sampled
+as PSS (pages shared by forked workers counted once).
 Then each tree fits the methods in one process after a warm-up (the library's cost without
-start-up), best of ``--repeats``.
+start-up), best CPU time of ``--repeats``, and, where a method takes worker processes
+(``jobs``), its best wall time on every core.
 
 The logs: the paper platform's six experiments of 20 s at 1 kHz with the reference sensor
 noise and 30 N m of Coulomb friction (Parquet), simulated once by this tree, and the same at
@@ -23,6 +26,7 @@ import statistics
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -47,26 +51,66 @@ for name in sys.argv[4].split(","):
     # a fresh read for every fit: nothing derived from an earlier fit's records is reused
     best = min(_timed(lambda data: create_identifier(name).fit(data, platform),
                       read_datasets(files, platform)) for _ in range(int(sys.argv[3])))
-    print(name, best)
+    # a tree whose method takes worker processes: its wall time on every core too
+    wall = float("nan")
+    if "jobs" in create_identifier(name).get_params():
+        wall = min(_walled(lambda data: create_identifier(name, jobs=None).fit(data, platform),
+                           read_datasets(files, platform)) for _ in range(int(sys.argv[3])))
+    print(name, best, wall)
 """
 TIMER = """
 def _timed(call, data):
     start = time.process_time()
     call(data)
     return time.process_time() - start
+
+def _walled(call, data):
+    start = time.perf_counter()
+    call(data)
+    return time.perf_counter() - start
 """
 
 
-def measured(command: list[str], env: dict[str, str]) -> tuple[float, float, float]:
-    """Wall s, CPU s and peak resident MiB of one process; NaN wall if it failed (exit 2: the
+def tree_pss(root: int) -> float:
+    """Proportional set size (MiB) of a process and its descendants (Linux ``/proc``): pages
+    shared between them, as a forked worker's, counted once."""
+    total, stack = 0, [root]
+    while stack:
+        pid = stack.pop()
+        try:
+            rollup = Path(f"/proc/{pid}/smaps_rollup").read_text().splitlines()
+            for children in Path(f"/proc/{pid}/task").glob("*/children"):
+                stack += [int(child) for child in children.read_text().split()]
+        except OSError:
+            continue
+        total += next((int(line.split()[1]) for line in rollup if line.startswith("Pss:")), 0)
+    return total / 1024
+
+
+def measured(command: list[str], env: dict[str, str]) -> tuple[float, float, float, float]:
+    """Wall s, CPU s (with its worker processes), peak resident MiB of its largest process and
+    peak PSS MiB of its process tree (sampled every 0.1 s); NaN wall if it failed (exit 2: the
     method refused the log)."""
     start = time.perf_counter()
     process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                env=env)
+    peak = [0.0]
+    running = threading.Event()
+    running.set()
+
+    def sample() -> None:
+        while running.is_set():
+            peak[0] = max(peak[0], tree_pss(process.pid))
+            time.sleep(0.1)
+
+    sampler = threading.Thread(target=sample, daemon=True)
+    sampler.start()
     _, status, usage = os.wait4(process.pid, 0)
+    running.clear()
+    sampler.join()
     wall = time.perf_counter() - start
     wall = wall if status == 0 else float("nan")
-    return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024
+    return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024, peak[0]
 
 
 SIMULATE = """
@@ -122,22 +166,28 @@ def main() -> None:
                         subprocess.run(["rm", "-rf", str(scratch / folder)], check=True)
                     runs[tree].append(measured([sys.executable, "-c", RUN, src, *arguments], env))
             for tree in trees:
-                wall, cpu, memory = (statistics.median(x) for x in zip(*runs[tree], strict=True))
-                rows.append((label, tree, wall, cpu, memory))
+                wall, cpu, memory, pss = (statistics.median(x)
+                                          for x in zip(*runs[tree], strict=True))
+                rows.append((label, tree, wall, cpu, memory, pss))
         fits = {}
         for tree, src in trees.items():
             output = subprocess.run(
                 [sys.executable, "-c", TIMER + FIT, src, str(logs["1 kHz"]), str(args.repeats),
                  "wavelet,ls,fourier"], capture_output=True, text=True, env=env, check=True)
-            fits[tree] = dict(line.split() for line in output.stdout.splitlines())
+            fits[tree] = {line.split()[0]: line.split()[1:] for line in output.stdout.splitlines()}
     width = max(len(r[0]) for r in rows)
-    print(f"{'command':{width}s} {'tree':>6s} {'wall s':>7s} {'CPU s':>7s} {'peak MiB':>9s}")
-    for label, tree, wall, cpu, memory in rows:
+    print(f"{'command':{width}s} {'tree':>6s} {'wall s':>7s} {'CPU s':>7s} {'peak MiB':>9s} "
+          f"{'tree PSS':>9s}")
+    for label, tree, wall, cpu, memory, pss in rows:
         shown = "failed" if wall != wall else f"{wall:7.2f}"
-        print(f"{label:{width}s} {tree:>6s} {shown:>7s} {cpu:7.2f} {memory:9.0f}")
-    print("in-process fit, best CPU s: " + "; ".join(
-        f"{name}: {float(fits['before'][name]):.2f} -> {float(fits['after'][name]):.2f}"
+        print(f"{label:{width}s} {tree:>6s} {shown:>7s} {cpu:7.2f} {memory:9.0f} {pss:9.0f}")
+    print("in-process fit, best CPU s (one process): " + "; ".join(
+        f"{name}: {float(fits['before'][name][0]):.2f} -> {float(fits['after'][name][0]):.2f}"
         for name in fits["after"]))
+    print("in-process fit, best wall s on every core (jobs=None), where the tree has it: "
+          + "; ".join(f"{name}: {float(fits[tree][name][1]):.2f} ({tree})"
+                      for name in fits["after"] for tree in trees
+                      if fits[tree][name][1] != "nan"))
     print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 
