@@ -216,9 +216,8 @@ REMAINDER_ORDER, REMAINDER_FRACTION, REMAINDER_STEPS = 5, 2, 8
 
 
 def load_kernels(platform: Platform) -> None:
-    """Load the compiled kernels the identifiers' preparation uses, once, before worker
+    """Load the compiled model kernels the identifiers' preparation uses, once, before worker
     processes start: they inherit them instead of each loading its own."""
-    from stewartid.identification.wavelet._compiled import soft_sign_patterns
     from stewartid.model import compiled
     from stewartid.model.dynamics import ModelTerms
 
@@ -227,8 +226,6 @@ def load_kernels(platform: Platform) -> None:
     compiled.batch_joint_rates(np.zeros((1, 6, 5, 6)), np.zeros((1, 6)))
     compiled.batch_typed_forces(np.zeros((1, 6, 5)), np.zeros((1, 6, 5, 6)),
                                 np.zeros(5, dtype=np.int64), 3)
-    soft_sign_patterns(np.zeros((1, 6, 5)), np.ones((6, 5)), np.zeros((1, 6, 5, 6)), np.zeros(1),
-                       np.zeros(5, dtype=np.int64), np.zeros((1, 1, 3, 6)))
 
 
 def prepare(datasets: Sequence[Dataset], platform: Platform, gravity: bool = True,

@@ -222,7 +222,7 @@ class WaveletIdentifier(BaseIdentifier):
         legs = platform.actuator.kind == "electric"
         equations: dict[str, list] = {model: [] for model in models}
         if worker_count(self.jobs, len(datasets)) > 1:
-            load_kernels(platform)
+            _load_kernels(platform)
         parts = run_in_order(_experiment_equations, range(len(datasets)), self.jobs,
                              shared=(self, datasets, platform, models, legs))
         for part in parts:
@@ -378,6 +378,15 @@ class WaveletIdentifier(BaseIdentifier):
             residual_rms=np.sqrt(np.mean(residual ** 2, axis=0)), method=self.method,
             settings=self._settings(),
             diagnostics=diagnostics), {}
+
+
+def _load_kernels(platform: Platform) -> None:
+    """:func:`~stewartid.identification.preparation.load_kernels` and Method B's own."""
+    from stewartid.identification.wavelet._compiled import soft_sign_patterns
+
+    load_kernels(platform)
+    soft_sign_patterns(np.zeros((1, 6, 5)), np.ones((6, 5)), np.zeros((1, 6, 5, 6)), np.zeros(1),
+                       np.zeros(5, dtype=np.int64), np.zeros((1, 1, 3, 6)))
 
 
 def _experiment_equations(work: tuple, k: int) -> tuple[dict[str, list], dict, np.ndarray,
