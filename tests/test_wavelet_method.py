@@ -456,3 +456,18 @@ def test_experiments_prepared_side_by_side_give_the_same_fit(example_dir, exampl
     for name in ("M", "B", "std_errors_M", "std_errors_B"):
         assert np.array_equal(getattr(alone, name), getattr(side, name)), name
     assert alone.settings == side.settings and "jobs" not in side.settings
+
+
+def test_a_faded_in_sine_is_one_sine():
+    """A 1 Hz sine faded in over 2 s of a 5 s record is one sine (the paper's protocol); two
+    lines of like amplitude are not."""
+    from stewartid.identification.wavelet.detection import SINGLE_SINE_SHARE, sine_share
+
+    rate = 1000.0
+    t = np.arange(0.0, 5.0, 1 / rate)
+    fade = np.clip(t / 2.0, 0.0, 1.0) ** 2 * (3 - 2 * np.clip(t / 2.0, 0.0, 1.0))
+    gains = np.linspace(0.5, 1.5, 6)
+    faded = 0.8 + 0.01 * fade[:, None] * np.sin(2 * np.pi * t)[:, None] * gains
+    assert sine_share(faded, rate, 1.0) >= SINGLE_SINE_SHARE
+    two = faded + 0.01 * np.sin(2 * np.pi * 1.7 * t)[:, None] * gains[::-1]
+    assert sine_share(two, rate, 1.0) < SINGLE_SINE_SHARE
