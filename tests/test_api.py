@@ -96,3 +96,15 @@ def test_a_worker_count_below_one_is_one_line(example_dir):
     assert result.exit_code == 2
     lines = result.output.strip().splitlines()
     assert len(lines) == 1 and "--jobs" in lines[0], result.output
+
+
+def test_workers_that_would_start_afresh_are_not_started(monkeypatch):
+    """Worker processes pay only when they start with this process's data and kernels (fork);
+    where they would start afresh (spawn) a fit runs in one process."""
+    from stewartid import parallel
+
+    monkeypatch.setattr(parallel, "WORKERS_INHERIT", True)
+    assert parallel.inheriting_workers(None, 6) == min(6, os.cpu_count() or 1)
+    assert parallel.inheriting_workers(2, 6) == 2
+    monkeypatch.setattr(parallel, "WORKERS_INHERIT", False)
+    assert parallel.inheriting_workers(None, 6) == 1 and parallel.inheriting_workers(4, 6) == 1

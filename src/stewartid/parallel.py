@@ -35,6 +35,13 @@ def worker_count(workers: int | None, tasks: int) -> int:
     return max(1, min(wanted, tasks))
 
 
+def inheriting_workers(workers: int | None, tasks: int) -> int:
+    """:func:`worker_count` where workers start with this process's modules, data and compiled
+    kernels ("fork"); else 1: a started ("spawn") worker would import, load and receive
+    everything again, which costs more than the tasks that share a fit."""
+    return worker_count(workers, tasks) if WORKERS_INHERIT else 1
+
+
 def limit_worker_threads(initializer: Callable[..., Any] | None = None,
                          *initargs: Any) -> None:
     """Worker initializer: one BLAS/OpenMP thread here, then ``initializer(*initargs)``."""
@@ -126,5 +133,5 @@ def run_in_order(function: Callable[..., Any], tasks: Sequence[Any], workers: in
 
 
 __all__ = ["START_METHOD", "WORKERS_INHERIT", "WORKER_THREADS", "InlineExecutor", "TaskProgress",
-           "limit_worker_threads", "one_blas_thread", "process_pool", "run_in_order",
+           "inheriting_workers", "limit_worker_threads", "one_blas_thread", "process_pool", "run_in_order",
            "worker_count"]

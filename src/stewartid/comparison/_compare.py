@@ -24,7 +24,7 @@ from stewartid.identification import registry
 from stewartid.identification.delay import delay_identifiable
 from stewartid.identification.result import IdentificationResult
 from stewartid.model.linearization import nominal_matrices
-from stewartid.parallel import one_blas_thread, run_in_order, worker_count
+from stewartid.parallel import inheriting_workers, one_blas_thread, run_in_order
 from stewartid.platform import Platform, load_platform
 from stewartid.validation.heldout import DEFAULT_FOLDS, ResidualDelay, Segment, ValidationResult
 from stewartid.verdict.policy import (
@@ -297,7 +297,7 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
                     check: bool | Callable[[IdentificationResult], None] = True,
                     entries: Sequence[str] | None = None,
                     policy: VerdictPolicy = DEFAULT_POLICY,
-                    delay: str | float | None = None, jobs: int = 1) -> Comparison:
+                    delay: str | float | None = None, jobs: int | None = 1) -> Comparison:
     """Fit every method to the same experiments, validate each on held-out time segments and
     say which to trust; writes no file.
 
@@ -340,9 +340,10 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
         The force channels' delay behind the motion (s; 0: as logged); by default estimated
         where the motion tells it from damping and applied when beyond noise
         (:func:`~stewartid.comparison.align_experiments`).
-    jobs : int
+    jobs : int or None
         Worker processes fitting and validating the methods (and the physical model) side by
-        side; None: every core. The results do not depend on it.
+        side; None: every core (one where workers cannot start by fork,
+        :func:`~stewartid.parallel.inheriting_workers`). The results do not depend on it.
 
     Returns
     -------
@@ -377,8 +378,9 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
     names = tuple(dict.fromkeys(names))
     # the physical model first: beside Method B it is the longest task
     tasks = ([PHYSICAL_TASK] if physical is not None else []) + list(names)
-    done = dict(zip(tasks, run_in_order(_run_task, tasks, jobs, shared=work), strict=True))
-    if worker_count(jobs, len(tasks)) > 1:
+    workers = inheriting_workers(jobs, len(tasks))
+    done = dict(zip(tasks, run_in_order(_run_task, tasks, workers, shared=work), strict=True))
+    if workers > 1:
         done = _one_copy_of_segments(done)
     runs = [done[name] for name in names]
     if all(run.result is None for run in runs):

@@ -30,7 +30,7 @@ from stewartid.identification.result import IdentificationResult
 from stewartid.identification.solvers import regressor_names, solve_least_squares
 from stewartid.identification.wavelet.noise import measured_sign_rates
 from stewartid.model.joints import JOINT_TYPES
-from stewartid.parallel import run_in_order, worker_count
+from stewartid.parallel import inheriting_workers, run_in_order
 from stewartid.platform import Platform
 from stewartid.signals.differentiation import (
     DEFAULT_ORDER,
@@ -153,7 +153,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
     noise_correction : bool
         Remove the errors-in-variables bias of pose noise (kernel only).
     jobs : int or None
-        Worker processes building the experiments' rows side by side (None: every core); the
+        Worker processes building the experiments' rows side by side (None: every core; one
+        where workers cannot start by fork, :func:`~stewartid.parallel.inheriting_workers`); the
         results do not depend on it.
 
     Attributes
@@ -252,9 +253,10 @@ class LeastSquaresIdentifier(BaseIdentifier):
         legs = bool(shapes) and uses_leg_coulomb(self.leg_coulomb, platform)
         shared: list[list[np.ndarray]] = [[] for _ in shapes]
         phis, ys, used, noise, segments = [], [], [], [], []
-        if worker_count(self.jobs, n_exp) > 1:
+        workers = inheriting_workers(self.jobs, n_exp)
+        if workers > 1:
             load_kernels(platform)
-        built = run_in_order(_experiment_rows, range(n_exp), self.jobs,
+        built = run_in_order(_experiment_rows, range(n_exp), workers,
                              shared=(self, datasets, platform, shapes, legs))
         for e, (rows, name, rate) in enumerate(built):
             k = len(rows.y)

@@ -41,7 +41,7 @@ from stewartid.identification.wavelet.noise import estimate_noise
 from stewartid.identification.wavelet.point_equations import EXACT_DEGREE, point_equations
 from stewartid.identification.wavelet.weak_form import coulomb_patterns
 from stewartid.model.joints import JOINT_TYPES
-from stewartid.parallel import run_in_order, worker_count
+from stewartid.parallel import inheriting_workers, run_in_order
 from stewartid.platform import COORDINATES, Platform
 from stewartid.signals.wavelets import MotherWavelet, PolynomialWavelet, make_wavelet
 
@@ -119,7 +119,8 @@ class WaveletIdentifier(BaseIdentifier):
     sampling_check : bool
         Widen standard errors where the log's sampling limits them.
     jobs : int or None
-        Worker processes preparing the experiments' equations side by side (None: every core);
+        Worker processes preparing the experiments' equations side by side (None: every core;
+        one where workers cannot start by fork, :func:`~stewartid.parallel.inheriting_workers`);
         the results do not depend on it.
 
     Attributes
@@ -221,9 +222,10 @@ class WaveletIdentifier(BaseIdentifier):
         # a ball screw's Coulomb friction along each leg: one more level, in N
         legs = platform.actuator.kind == "electric"
         equations: dict[str, list] = {model: [] for model in models}
-        if worker_count(self.jobs, len(datasets)) > 1:
+        workers = inheriting_workers(self.jobs, len(datasets))
+        if workers > 1:
             _load_kernels(platform)
-        parts = run_in_order(_experiment_equations, range(len(datasets)), self.jobs,
+        parts = run_in_order(_experiment_equations, range(len(datasets)), workers,
                              shared=(self, datasets, platform, models, legs))
         for part in parts:
             for model in models:

@@ -12,7 +12,7 @@ from stewartid.comparison import MethodFit, PhysicalSection
 from stewartid.datasets.dataset import Dataset
 from stewartid.identification.preparation import prepare
 from stewartid.identification.wavelet.intervals import joint_rates
-from stewartid.parallel import run_in_order
+from stewartid.parallel import inheriting_workers, run_in_order
 from stewartid.platform import Platform
 from stewartid.reports.drawing import ExperimentTrace, plot_excitation, plot_joint_rates
 from stewartid.reports.identification import method_figures as plots
@@ -48,7 +48,8 @@ class FigureDrawer:
         """Draw every figure added, in ``jobs`` worker processes (None: every core); returns
         the files written."""
         pending, self._pending = self._pending, []
-        for written in run_in_order(_draw, range(len(pending)), jobs,
+        for written in run_in_order(_draw, range(len(pending)),
+                                    inheriting_workers(jobs, len(pending)),
                                     shared=(self.folder, pending)):
             self.files += written
         return self.files

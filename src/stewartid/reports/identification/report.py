@@ -37,7 +37,8 @@ def write_report(comparison: Comparison, directory: str | Path, *, sources: Sequ
     notes : sequence of str
         Sentences added to the summary.
     jobs : int or None
-        Worker processes drawing the figures (None: every core); the files do not depend on it.
+        Worker processes drawing the figures (None: every core; one where workers cannot start
+        by fork); the files do not depend on it.
     """
     started = time.perf_counter()
     directory = Path(directory)
