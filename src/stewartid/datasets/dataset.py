@@ -94,7 +94,7 @@ class Dataset:
 
     def __reduce__(self) -> tuple:
         # a copy sent to another process starts without what was derived here
-        return (Dataset, (self.t, self.pose, self.lengths, self.forces, self.name))
+        return (Dataset, tuple(getattr(self, f.name) for f in dataclasses.fields(self) if f.init))
 
     def derived(self, key: Hashable, compute: Callable[[Dataset], Any]) -> Any:
         """``compute(self)``, computed once per ``key`` for this record (leg terms, frequencies,
