@@ -17,7 +17,7 @@ from stewartid.identification.wavelet.intervals import constant_direction_interv
 from stewartid.identification.wavelet.noise import NoiseModel, joint_rate_noise
 from stewartid.platform import COORDINATES
 from stewartid.signals.differentiation import default_window, estimate_frequency
-from stewartid.signals.sign_rates import SIGN_ORDER, coulomb_sign_rates
+from stewartid.signals.sign_rates import SIGN_NOISE, SIGN_ORDER, coulomb_sign_rates
 
 
 class Detection(NamedTuple):
@@ -54,9 +54,9 @@ class Detection(NamedTuple):
 
 
 #: Largest noise of the Coulomb signs' rates relative to their RMS
-#: (:func:`~stewartid.signals.sign_rates.coulomb_sign_rates`), low so that the soft signs
-#: do not chatter.
-SIGN_NOISE_LIMIT = 0.0005
+#: (:func:`~stewartid.signals.sign_rates.coulomb_sign_rates`), the other methods' rule: a lower
+#: limit takes the signs from longer windows, whose rounded reversals bias Mt.
+SIGN_NOISE_LIMIT = SIGN_NOISE
 #: Joints whose rate RMS is below this multiple of its noise level count as idle.
 IDLE_NOISE_RATIO = 2.0
 #: A DOF moved by the experiments that gave intervals less than this fraction of its largest
