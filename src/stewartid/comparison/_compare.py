@@ -217,7 +217,6 @@ def _experiments(experiments: Sequence[Dataset | str | Path], platform: Platform
             for item in experiments]
 
 
-@one_blas_thread()
 def check_jobs(jobs: int | None) -> None:
     """Refuse a worker count that is not a whole number of at least 1 (None: every core)."""
     if jobs is not None and not (isinstance(jobs, int | np.integer) and jobs >= 1):
@@ -287,6 +286,7 @@ def _one_copy_of_segments(done: dict[str, Any]) -> dict[str, Any]:
             for task, item in done.items()}
 
 
+@one_blas_thread()
 def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platform | str | Path,
                     methods: str | Sequence[str] = ALL_METHODS,
                     validate: Sequence[Dataset | str | Path] | None = None,
