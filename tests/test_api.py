@@ -98,6 +98,26 @@ def test_a_worker_count_below_one_is_one_line(example_dir):
     assert len(lines) == 1 and "--jobs" in lines[0], result.output
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("method", ["wavelet", "ls"])
+def test_experiments_prepared_side_by_side_give_the_same_fit(method, example_dir,
+                                                             example_platform):
+    """Worker processes preparing each experiment (jobs=2: Method B's equations, least squares'
+    rows) give the one-process fit to the bit, and the settings recorded do not name the worker
+    count."""
+    import numpy as np
+
+    import stewartid as sid
+    from stewartid.identification.registry import create_identifier
+
+    experiments = sid.read_experiments(example_dir, example_platform)
+    alone, side = (create_identifier(method, jobs=jobs).fit(experiments, example_platform).result_
+                   for jobs in (1, 2))
+    for name in ("M", "B", "std_errors_M", "std_errors_B"):
+        assert np.array_equal(getattr(alone, name), getattr(side, name)), name
+    assert alone.settings == side.settings and "jobs" not in side.settings
+
+
 def test_workers_that_would_start_afresh_are_not_started(monkeypatch):
     """Worker processes pay only when they start with this process's data and kernels (fork);
     where they would start afresh (spawn) a fit runs in one process."""

@@ -334,18 +334,3 @@ def test_pose_noise_in_the_regressors_is_corrected(paper):
             assert np.all(np.abs(z) <= bound), z
         else:
             assert np.sum(z < -2.0) >= 5, z
-
-
-@pytest.mark.slow
-def test_rows_built_side_by_side_give_the_same_fit(example_dir, example_platform):
-    """Worker processes building the experiments' rows (jobs=2) give the one-process fit to the
-    bit, and the settings recorded do not name the worker count."""
-    from stewartid.datasets import read_experiments
-    from stewartid.identification.least_squares import LeastSquaresIdentifier
-
-    experiments = read_experiments(example_dir, example_platform)
-    alone, side = (LeastSquaresIdentifier(jobs=jobs).fit(experiments, example_platform).result_
-                   for jobs in (1, 2))
-    for name in ("M", "B", "std_errors_M", "std_errors_B"):
-        assert np.array_equal(getattr(alone, name), getattr(side, name)), name
-    assert alone.settings == side.settings and "jobs" not in side.settings

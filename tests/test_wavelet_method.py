@@ -444,20 +444,6 @@ def test_friction_law_test_scores_the_diagonals_against_the_normal_point():
     assert not friction_law_test(free, np.full((6, 12), np.nan), law, std)["rejected"]
 
 
-@pytest.mark.slow
-def test_experiments_prepared_side_by_side_give_the_same_fit(example_dir, example_platform):
-    """Worker processes preparing the experiments' equations (jobs=2) give the one-process fit
-    to the bit, and the settings recorded do not name the worker count."""
-    from stewartid.datasets import read_experiments
-
-    experiments = read_experiments(example_dir, example_platform)
-    alone, side = (WaveletIdentifier(jobs=jobs).fit(experiments, example_platform).result_
-                   for jobs in (1, 2))
-    for name in ("M", "B", "std_errors_M", "std_errors_B"):
-        assert np.array_equal(getattr(alone, name), getattr(side, name)), name
-    assert alone.settings == side.settings and "jobs" not in side.settings
-
-
 def test_a_faded_in_sine_is_one_sine():
     """A 1 Hz sine faded in over 2 s of a 5 s record is one sine (the paper's protocol); two
     lines of like amplitude are not."""

@@ -70,6 +70,12 @@ class BaseIdentifier:
                                  f"fit(datasets, platform) before reading {name!r}.")
         raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
+    def _settings(self) -> dict[str, Any]:
+        """The settings a result records: the parameters (tuples as lists), without the worker
+        count, which changes no result."""
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.get_params().items()
+                if k != "jobs"}
+
     def _validate_params(self) -> None:
         """Check the settings against ``_parameter_constraints``; raises ConfigError."""
         validate_parameters(self._parameter_constraints, self.get_params(), type(self).__name__)

@@ -311,8 +311,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
         return IdentificationResult(
             M=theta[:, :6], B=theta[:, 6:12], std_errors_M=std[:, :6], std_errors_B=std[:, 6:12],
             condition_number=solution.condition_number, residual_rms=solution.residual_rms,
-            method=self.method, settings={k: v for k, v in self.get_params().items() if k != "jobs"},
-            diagnostics=diagnostics), {
+            method=self.method, settings=self._settings(), diagnostics=diagnostics), {
             "offsets_": offsets, "coulomb_": levels, "coulomb_std_": levels_std,
             "leg_coulomb_": leg_level, "leg_coulomb_std_": leg_std,
             "coulomb_shape_weights_": shape_weights}

@@ -319,11 +319,6 @@ class WaveletIdentifier(BaseIdentifier):
             M, B, std_M, std_B, bool(self.symmetric), self.pair_selection, clip)
         return chosen
 
-    def _settings(self) -> dict:
-        # the worker count changes no result
-        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.get_params().items()
-                if k != "jobs"}
-
     def _fit(self, datasets: list[Dataset], platform: Platform
              ) -> tuple[IdentificationResult, dict]:
         wavelet = make_wavelet(self.wavelet, **self._wavelet_options())
