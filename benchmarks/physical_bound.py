@@ -266,9 +266,9 @@ def electric_bound(args, rng: np.random.Generator) -> None:
     legs = ("reflected_mass", "viscous[actuator]", "coulomb[actuator]")
     a = platform.actuator
     leg_truth = np.array([a.reflected_mass, a.viscous, a.coulomb])
-    payload_truth = payload_quantities(
-        (reg.standard_parameters(loaded) - reg.standard_parameters(platform))[
-            reg.parameter_index(reg.BODY_PARAMETERS)])
+    payload_body = (reg.standard_parameters(loaded) - reg.standard_parameters(platform))[
+        reg.parameter_index(reg.BODY_PARAMETERS)]
+    payload_truth = payload_quantities(payload_body)
     rows = {}
     for signs in ((False, True) if args.true_signs else (False,)):
         full, payload = [], []
@@ -303,8 +303,7 @@ def electric_bound(args, rng: np.random.Generator) -> None:
               for d in clean_loaded]
     names, covariance = fisher_covariance(platform, logged_states(clean_loaded), sigmas, True,
                                           (), per_row)
-    payload_bound = payload_covariance(payload_truth,
-                                       body_block(names, covariance, "payload."))
+    payload_bound = payload_covariance(payload_body, body_block(names, covariance, "payload."))
     leg_draws = np.abs(rng.normal(size=(args.draws, args.seeds, 3)) * leg_bound)
     leg_worst = worst_of_seeds(100 * leg_draws / leg_truth)
     payload_worst = worst_of_seeds(payload_scores(
