@@ -175,11 +175,11 @@ def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: boo
     rates = np.asarray(rates, dtype=float)
     signs = found.sign_rates
     out = np.empty((len(signs), len(rates), len(groups) + (leg_jacobian is not None), 6))
-    base = signs ** 2 + found.sign_rate_noise ** 2                               # (N, 6, 5)
-    squared_rates = rates[:, None, None] ** 2
+    noise, squared_rates = found.sign_rate_noise ** 2, rates[:, None, None] ** 2
     for start in range(0, len(signs), PATTERN_BLOCK):
         block = slice(start, start + PATTERN_BLOCK)
-        direction = signs[block, None] / np.sqrt(base[block, None] + squared_rates)  # (n, R, 6, 5)
+        w = signs[block]
+        direction = w[:, None] / np.sqrt((w * w + noise)[:, None] + squared_rates)  # (n, R, 6, 5)
         out[block, :, :len(groups)] = joint_type_forces(direction, joint_jacobians[block], groups)
     if leg_jacobian is not None:
         legs, noise = found.leg_sign_rates, found.leg_sign_rate_noise
