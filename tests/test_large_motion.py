@@ -48,11 +48,16 @@ def largest_error(estimator, platform) -> float:
                for m, i, j in PAPER_ENTRIES)
 
 
-def test_remainder_completes_the_equation_of_motion(paper):
+@pytest.mark.parametrize("actuator", [{}, {"reflected_mass": 40.0, "viscous": 2000.0}],
+                         ids=["hydraulic", "reflected mass and leg friction"])
+def test_remainder_completes_the_equation_of_motion(paper, actuator):
     """J_lq^T f - G(q) of the inverse dynamics (viscous friction only) is Mt q_ddot + Bt q_dot
-    + r at random states far from the neutral pose; the viscous part of r comes from the
-    joint-friction kernel on one side and the viscous matrix on the other."""
-    platform = paper.replace(friction__coulomb=0.0)
+    + r at random states far from the neutral pose: r from the numpy regressor, the inverse
+    dynamics from the compiled per-sample model (reflected masses and friction along the legs
+    included), the viscous part from the joint-friction kernel on one side and the regressor's
+    viscous columns on the other."""
+    platform = paper.replace(friction__coulomb=0.0,
+                             **{f"actuator__{key}": value for key, value in actuator.items()})
     rng = np.random.default_rng(3)
     q = platform.neutral_pose + rng.uniform(-1, 1, (40, 6)) * [0.2, 0.2, 0.2, 0.1, 0.1, 0.1]
     q_dot, q_ddot = rng.normal(size=(40, 6)), rng.normal(size=(40, 6)) * 3

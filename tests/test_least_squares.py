@@ -19,6 +19,8 @@ from stewartid.identification.long_run import (
 )
 from stewartid.identification.solvers import integrated_autocorrelation, solve_least_squares
 from stewartid.model.joints import JOINT_TYPES
+from stewartid.model.kinematics import joint_rate_jacobians
+from stewartid.model.regressor import parameter_index, random_states, regressor
 from stewartid.physical.parameter_fit import solve_parameters
 
 
@@ -26,6 +28,21 @@ def _coulomb(levels):
     def force(t, q, qd, J):
         return np.einsum("nsi,s->ni", coulomb_regressors(J, qd, 0.0), levels)
     return force
+
+
+def test_coulomb_regressors_are_the_regressors_coulomb_columns(paper):
+    """S_type = sum J_j^T sign(J_j q_dot) per joint type (joint-axis Jacobians, numpy) against
+    the regressor's Coulomb columns, which build the same forces as wrenches of the leg
+    geometry, at random states and at an exact and a regularised sign."""
+    q, q_dot, _ = random_states(paper, 200, seed=5)
+    columns = parameter_index([f"coulomb[{t}]" for t in JOINT_TYPES])
+    J = joint_rate_jacobians(paper, q)
+    for smoothing in (0.0, 0.02):
+        Y = regressor(paper, q, q_dot, np.zeros_like(q), gravity=False,
+                      coulomb_smoothing=smoothing)
+        expected = Y[..., columns].transpose(0, 2, 1)
+        got = coulomb_regressors(J, q_dot, smoothing)
+        assert np.abs(got - expected).max() <= 1e-12 * np.abs(expected).max()
 
 
 def test_recovers_mt_bt_offsets_and_coulomb_levels(paper):

@@ -10,10 +10,14 @@ from stewartid.datasets.dataset import Dataset
 from stewartid.errors import ConfigError, IdentificationError
 from stewartid.identification.pairs import select_symmetric_pairs
 from stewartid.identification.result import max_error_percent
+from stewartid.identification.wavelet.detection import Detection
 from stewartid.identification.wavelet.estimator import WaveletIdentifier
+from stewartid.identification.wavelet.weak_form import coulomb_patterns
 from stewartid.model.dynamics import ModelTerms
-from stewartid.model.kinematics import leg_lengths
+from stewartid.model.joints import JOINT_TYPES
+from stewartid.model.kinematics import joint_rate_jacobians, leg_jacobian, leg_lengths
 from stewartid.model.linearization import nominal_matrices
+from stewartid.model.regressor import parameter_index, random_states, regressor
 
 AMPLITUDES = np.array([0.01, 0.01, 0.01, 0.005, 0.005, 0.005])
 
@@ -80,6 +84,32 @@ def test_exact_recovery_from_linear_model_with_offsets_and_square_wave(paper, li
     assert np.all(intervals[:, 1] > intervals[:, 0]) and np.all(intervals[1:, 0] >= intervals[:-1, 1])
     assert intervals[0, 0] >= linear_data[0].t[0] and intervals[-1, 1] <= linear_data[0].t[-1]
     assert est.condition_number_ < 100
+
+
+def test_coulomb_patterns_are_the_regressors_soft_sign_columns(paper):
+    """Method B's Coulomb patterns (joint-axis Jacobians, numpy) at each soft-sign rate r
+    against the regressor's Coulomb columns, built as wrenches of the leg geometry, with the
+    regularisation sqrt(sigma^2 + r^2) of rate noise sigma: per joint type, along the legs,
+    and summed over the types when uniform."""
+    q, q_dot, _ = random_states(paper, 300, seed=6)
+    J, J_leg = joint_rate_jacobians(paper, q), leg_jacobian(paper, q)
+    sigma, rates = 0.01, (0.0, 0.03)
+    found = Detection(intervals=np.zeros((0, 2)), info={}, joint_rates=None, rate_noise=None,
+                      q_dot=q_dot, q_ddot=None, sign_rates=np.einsum("nlac,nc->nla", J, q_dot),
+                      sign_rate_noise=np.full((6, 5), sigma),
+                      leg_sign_rates=np.einsum("nlc,nc->nl", J_leg, q_dot),
+                      leg_sign_rate_noise=np.full(6, sigma))
+    patterns = coulomb_patterns(found, J, False, rates, leg_jacobian=J_leg)
+    uniform = coulomb_patterns(found, J, True, rates)
+    columns = parameter_index([f"coulomb[{t}]" for t in JOINT_TYPES] + ["coulomb[actuator]"])
+    for k, r in enumerate(rates):
+        s = np.hypot(sigma, r)
+        Y = regressor(paper, q, q_dot, np.zeros_like(q), gravity=False, coulomb_smoothing=s,
+                      actuator_smoothing=s)
+        expected = Y[..., columns].transpose(0, 2, 1)
+        bound = 1e-12 * np.abs(expected).max()
+        assert np.abs(patterns[:, k] - expected).max() <= bound
+        assert np.abs(uniform[:, k, 0] - expected[:, :3].sum(axis=1)).max() <= bound
 
 
 def test_wavelet_points_lie_inside_their_intervals(paper, linear_truth, linear_data):

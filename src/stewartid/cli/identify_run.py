@@ -8,7 +8,7 @@ import json
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
@@ -37,9 +37,11 @@ from stewartid.identification.result import IdentificationResult, comparison_row
 from stewartid.model.linearization import nominal_matrices
 from stewartid.physical.identified_platform import IDENTIFIED_HEADER, write_identified
 from stewartid.platform import Platform
-from stewartid.reports.identification.report import IdentificationReport, write_report
 from stewartid.validation.heldout import DEFAULT_FOLDS
 from stewartid.verdict.policy import scored_entries
+
+if TYPE_CHECKING:
+    from stewartid.reports.identification.report import IdentificationReport
 
 #: Values of ``identify --model``.
 MODELS = ("physical",)
@@ -286,6 +288,8 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
         require_cvxpy()
     written = None
     if report is not None:
+        from stewartid.reports.identification.report import write_report  # only with --report
+
         comparison = compare_methods(
             datasets, description, method_names(ALL_METHODS) if model else names, records,
             DEFAULT_FOLDS if folds is None else folds, settings=settings,

@@ -24,12 +24,13 @@ from stewartid.identification.friction_shape import (
     shaped_sign,
 )
 from stewartid.identification.pairs import calibrate_by_pairs
-from stewartid.identification.preparation import Experiment, load_kernels, prepare_experiment
+from stewartid.identification.preparation import Experiment, prepare_experiment
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.solvers import regressor_names, solve_least_squares
 from stewartid.identification.wavelet.noise import measured_sign_rates
 from stewartid.model.joints import JOINT_TYPES
+from stewartid.model.kinematics import joint_axis_rates, joint_type_forces
 from stewartid.parallel import inheriting_workers, run_in_order
 from stewartid.platform import Platform
 from stewartid.signals.differentiation import (
@@ -63,15 +64,8 @@ def coulomb_regressors(joint_jacobians: np.ndarray, q_dot: np.ndarray, smoothing
     ``joint_jacobians`` (N, 6, 5, 6); ``smoothing`` s, rad/s, and ``shape`` as
     :func:`~stewartid.identification.friction_shape.shaped_sign`.
     """
-    from stewartid.model import compiled  # numba, which the model remainder loads anyway
-
-    jacobians = np.ascontiguousarray(joint_jacobians)
-    signs = shaped_sign(compiled.batch_joint_rates(jacobians, np.ascontiguousarray(q_dot)),
-                        smoothing, shape)
-    types = np.zeros(5, dtype=np.int64)
-    for k, axes in enumerate(JOINT_TYPES.values()):
-        types[list(axes)] = k
-    return compiled.batch_typed_forces(signs, jacobians, types, len(JOINT_TYPES))
+    signs = shaped_sign(joint_axis_rates(joint_jacobians, q_dot), smoothing, shape)
+    return joint_type_forces(signs, joint_jacobians)
 
 
 #: Filtered rows kept per filter window by default (``decimate``): fewer change the estimates by
@@ -254,8 +248,6 @@ class LeastSquaresIdentifier(BaseIdentifier):
         shared: list[list[np.ndarray]] = [[] for _ in shapes]
         phis, ys, used, noise, segments = [], [], [], [], []
         workers = inheriting_workers(self.jobs, n_exp)
-        if workers > 1:
-            load_kernels(platform)
         built = run_in_order(_experiment_rows, range(n_exp), workers,
                              shared=(self, datasets, platform, shapes, legs))
         for e, (rows, name, rate) in enumerate(built):

@@ -215,24 +215,11 @@ def model_remainder(platform: Platform, q: np.ndarray, sample_rate: float) -> np
 REMAINDER_ORDER, REMAINDER_FRACTION, REMAINDER_STEPS = 5, 2, 8
 
 
-def load_kernels(platform: Platform) -> None:
-    """Load the compiled model kernels the identifiers' preparation uses, once, before worker
-    processes start: they inherit them instead of each loading its own."""
-    from stewartid.model import compiled
-    from stewartid.model.dynamics import ModelTerms
-
-    pose = platform.neutral_pose[None]
-    ModelTerms(platform, pose, np.zeros_like(pose))
-    compiled.batch_joint_rates(np.zeros((1, 6, 5, 6)), np.zeros((1, 6)))
-    compiled.batch_typed_forces(np.zeros((1, 6, 5)), np.zeros((1, 6, 5, 6)),
-                                np.zeros(5, dtype=np.int64), 3)
-
-
 def prepare(datasets: Sequence[Dataset], platform: Platform, gravity: bool = True,
             joints: bool = False, remainder: bool = False) -> list[Experiment]:
     """:func:`prepare_experiment` of every data set."""
     return [prepare_experiment(d, platform, gravity, joints, remainder) for d in datasets]
 
 
-__all__ = ["Experiment", "generalized_force_sensitivity", "load_kernels", "model_remainder",
+__all__ = ["Experiment", "generalized_force_sensitivity", "model_remainder",
            "prepare", "prepare_experiment", "resolve_datasets", "resolve_platform"]

@@ -407,34 +407,3 @@ def batch_leg_friction(params, J_leg, qd, smoothing):
     for k in range(n):
         F[k] = leg_friction(params, J_leg[k], qd[k], smoothing)
     return F
-
-
-def batch_joint_rates(J_joint, qd):
-    """Rates (N, 6, 5) of every joint axis, J_joint (N, 6, 5, 6) times q_dot (N, 6)."""
-    n = qd.shape[0]
-    out = np.zeros((n, 6, 5))
-    for k in range(n):
-        for leg in range(6):
-            for axis in range(5):
-                total = 0.0
-                for c in range(6):
-                    total += J_joint[k, leg, axis, c] * qd[k, c]
-                out[k, leg, axis] = total
-    return out
-
-
-def batch_typed_forces(torques, J_joint, types, n_types):
-    """Generalized forces (N, n_types, 6) of axis torques (N, 6, 5), summed per joint type.
-
-    sum over legs and the axes a with ``types[a]`` = t of torques[k, leg, a] J_joint[k, leg, a, :].
-    """
-    n = torques.shape[0]
-    out = np.zeros((n, n_types, 6))
-    for k in range(n):
-        for leg in range(6):
-            for axis in range(5):
-                torque = torques[k, leg, axis]
-                t = types[axis]
-                for c in range(6):
-                    out[k, t, c] += torque * J_joint[k, leg, axis, c]
-    return out

@@ -5,11 +5,13 @@ frame (x forward, y right, z down; m, rad), R = Rz(rz) Ry(ry) Rx(rx); q_dot are 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import NamedTuple
 
 import numpy as np
 
 from stewartid.errors import KinematicsError
+from stewartid.model.joints import JOINT_TYPES
 from stewartid.model.kernels import rotation_entries
 from stewartid.model.leg_terms import LegTerms, leg_terms, leg_vectors
 from stewartid.platform import Platform
@@ -100,6 +102,47 @@ def joint_rate_jacobians(platform: Platform, q: np.ndarray) -> np.ndarray:
     q2, single = as_batch(q)
     J_joint = compute_leg_terms(platform, q2, joints=True, pose_terms=False)[3]
     return J_joint[0] if single else J_joint
+
+
+def joint_axis_rates(joint_jacobians: np.ndarray, q_dot: np.ndarray) -> np.ndarray:
+    """Rates (N, 6, 5) of every joint axis (rad/s): ``joint_jacobians`` (N, 6, 5, 6) times
+    ``q_dot`` (N, 6)."""
+    n = len(q_dot)
+    rates = np.reshape(joint_jacobians, (n, 30, 6)) @ np.reshape(q_dot, (n, 6, 1))
+    return rates.reshape(n, 6, 5)
+
+
+def joint_type_forces(torques: np.ndarray, joint_jacobians: np.ndarray,
+                      types: Sequence[Sequence[int]] = tuple(JOINT_TYPES.values())
+                      ) -> np.ndarray:
+    """Generalized forces (N, N m) of torques on the joint axes, summed per joint type.
+
+    sum over legs and the axes a of each type of torques[..., leg, a] J[n, leg, a, :].
+
+    Parameters
+    ----------
+    torques : ndarray, shape (N, 6, 5) or (N, R, 6, 5)
+        N m per joint axis (legs, then axes as :data:`~stewartid.model.joints.JOINT_AXES`),
+        R torque sets per sample.
+    joint_jacobians : ndarray, shape (N, 6, 5, 6)
+    types : sequence of sequences of int
+        The axes of each type; :data:`~stewartid.model.joints.JOINT_TYPES` by default.
+
+    Returns
+    -------
+    ndarray, shape (N, T, 6) or (N, R, T, 6)
+        T = ``len(types)``.
+    """
+    n = len(torques)
+    # per sample and axis, the (R, legs) torques times that axis's (legs, 6) Jacobian rows
+    by_axis = (np.moveaxis(np.reshape(torques, (n, -1, 6, 5)), -1, 1)
+               @ joint_jacobians.transpose(0, 2, 1, 3))                       # (N, 5, R, 6)
+    out = np.empty((n, by_axis.shape[2], len(types), 6))
+    for k, axes in enumerate(types):
+        np.copyto(out[:, :, k], by_axis[:, axes[0]])
+        for a in axes[1:]:
+            out[:, :, k] += by_axis[:, a]
+    return out.reshape(*torques.shape[:-2], len(types), 6)
 
 
 def forward_kinematics(platform: Platform, lengths: np.ndarray, initial: np.ndarray | None = None,

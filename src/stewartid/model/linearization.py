@@ -9,10 +9,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewartid.model.dynamics import ModelTerms
 from stewartid.model.joints import GIMBAL_AXES
 from stewartid.model.kernels import model_terms
-from stewartid.model.kinematics import joint_rate_jacobians, leg_jacobian
+from stewartid.model.kinematics import compute_leg_terms, joint_rate_jacobians, leg_jacobian
+from stewartid.model.regressor import (
+    ACTUATOR_PARAMETERS,
+    FRICTION_PARAMETERS,
+    OFFSET_PARAMETERS,
+    parameter_index,
+    regressor_columns,
+    standard_parameters,
+)
 from stewartid.platform import Platform
 
 
@@ -72,13 +79,18 @@ def linearisation_remainder(platform: Platform, q: np.ndarray, q_dot: np.ndarray
     """What the inertial and viscous terms add to their linearisation at ``pose``, (N, 6) (N, N m).
 
     r = [M(q) - Mt] q_ddot + h(q, q_dot) + [Bt(q) - Bt] q_dot: subtracted from measured forces, it
-    keeps the linearised model exact at any amplitude.
+    keeps the linearised model exact at any amplitude. M q_ddot + h + Bt(q) q_dot is the
+    regressor without gravity times the platform's standard parameters, its Coulomb levels and
+    sensor offsets left out (numpy: no compiled kernel to start).
     """
     Mt, Bt = nominal_matrices(platform, pose)
-    terms = ModelTerms(platform, q, q_dot)
-    viscous = _viscous(platform, terms.joint_jacobians, terms.leg_jacobian)
-    return (np.einsum("nij,nj->ni", terms.mass_matrix - Mt, q_ddot) + terms.velocity_product
-            + np.einsum("nij,nj->ni", viscous - Bt, q_dot))
+    parameters = standard_parameters(platform)
+    coulomb = [name for name in FRICTION_PARAMETERS + ACTUATOR_PARAMETERS
+               if name.startswith("coulomb")]
+    parameters[parameter_index(coulomb + list(OFFSET_PARAMETERS))] = 0.0
+    q, q_dot, q_ddot = (np.asarray(x, dtype=float) for x in (q, q_dot, q_ddot))
+    Y = regressor_columns(platform, q.T, q_dot.T, q_ddot.T, gravity=False)   # (6, P, N)
+    return np.tensordot(parameters, Y, axes=(0, 1)).T - q_ddot @ Mt.T - q_dot @ Bt.T
 
 
 def gravity_stiffness(platform: Platform, pose: np.ndarray | None = None,
@@ -86,6 +98,6 @@ def gravity_stiffness(platform: Platform, pose: np.ndarray | None = None,
     """Gravity stiffness K_G = dG/dq (6, 6) at ``pose`` by central differences of the exact G(q)."""
     q0 = platform.neutral_pose if pose is None else np.asarray(pose, dtype=float)
     steps = step * np.eye(6)
-    G_plus = ModelTerms(platform, q0 + steps).gravity
-    G_minus = ModelTerms(platform, q0 - steps).gravity
+    G_plus = compute_leg_terms(platform, q0 + steps).gravity
+    G_minus = compute_leg_terms(platform, q0 - steps).gravity
     return ((G_plus - G_minus) / (2 * step)).T

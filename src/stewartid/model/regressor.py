@@ -8,7 +8,6 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-import scipy.linalg
 
 from stewartid.model import regressor_rows as rows
 from stewartid.model.dynamics import COULOMB_SMOOTHING
@@ -217,6 +216,8 @@ def base_parameters(platform: Platform, samples: int = 100, seed: int = 0,
     ArithmeticError
         If the ordered selection disagrees with the pivoted QR's rank.
     """
+    import scipy.linalg  # slow to import: the identify path does not need it
+
     Y = regressor(platform, *random_states(platform, samples, seed)).reshape(-1, N_STANDARD)
     norms = np.linalg.norm(Y, axis=0)
     zero = norms <= tolerance * norms.max()

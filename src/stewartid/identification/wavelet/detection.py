@@ -15,6 +15,7 @@ from stewartid.errors import DataWarning, IdentificationError
 from stewartid.identification.preparation import Experiment
 from stewartid.identification.wavelet.intervals import constant_direction_intervals, joint_rates
 from stewartid.identification.wavelet.noise import NoiseModel, joint_rate_noise
+from stewartid.model.kinematics import joint_axis_rates
 from stewartid.platform import COORDINATES
 from stewartid.signals.differentiation import default_window, estimate_frequency
 from stewartid.signals.sign_rates import SIGN_NOISE, SIGN_ORDER, coulomb_sign_rates
@@ -200,10 +201,7 @@ def _sign_rates(experiment: Experiment, noise: NoiseModel) -> dict:
     jacobians = experiment.joint_jacobians
     level = joint_rate_noise(noise.pose_covariance, experiment.sample_rate, window, jacobians,
                              experiment.leg_jacobian, SIGN_ORDER)
-    from stewartid.model import compiled  # numba, which the model remainder loads anyway
-
-    return {"sign_rates": compiled.batch_joint_rates(np.ascontiguousarray(jacobians),
-                                                     np.ascontiguousarray(q_dot)),
+    return {"sign_rates": joint_axis_rates(jacobians, q_dot),
             "sign_rate_noise": np.maximum(level[:30].reshape(6, 5), 1e-12),
             "leg_sign_rates": (experiment.leg_jacobian @ q_dot[:, :, None])[:, :, 0],
             "leg_sign_rate_noise": np.maximum(level[30:], 1e-12)}

@@ -13,7 +13,7 @@ from stewartid.datasets.dataset import Dataset
 from stewartid.fields import BOOLEAN, Interval, ListOf, Options, nonnegative, positive, validate_parameters
 from stewartid.identification.base import BaseIdentifier
 from stewartid.identification.pairs import combine_pairs
-from stewartid.identification.preparation import Experiment, load_kernels, prepare_experiment
+from stewartid.identification.preparation import Experiment, prepare_experiment
 from stewartid.identification.registry import Preset, register_method
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.sampling import check_sampling
@@ -223,8 +223,6 @@ class WaveletIdentifier(BaseIdentifier):
         legs = platform.actuator.kind == "electric"
         equations: dict[str, list] = {model: [] for model in models}
         workers = inheriting_workers(self.jobs, len(datasets))
-        if workers > 1:
-            _load_kernels(platform)
         parts = run_in_order(_experiment_equations, range(len(datasets)), workers,
                              shared=(self, datasets, platform, models, legs))
         for part in parts:
@@ -375,15 +373,6 @@ class WaveletIdentifier(BaseIdentifier):
             residual_rms=np.sqrt(np.mean(residual ** 2, axis=0)), method=self.method,
             settings=self._settings(),
             diagnostics=diagnostics), {}
-
-
-def _load_kernels(platform: Platform) -> None:
-    """:func:`~stewartid.identification.preparation.load_kernels` and Method B's own."""
-    from stewartid.identification.wavelet._compiled import soft_sign_patterns
-
-    load_kernels(platform)
-    soft_sign_patterns(np.zeros((1, 6, 5)), np.ones((6, 5)), np.zeros((1, 6, 5, 6)), np.zeros(1),
-                       np.zeros(5, dtype=np.int64), np.zeros((1, 1, 3, 6)))
 
 
 def _experiment_equations(work: tuple, k: int) -> tuple[dict[str, list], dict, np.ndarray,

@@ -11,7 +11,7 @@ import numpy as np
 
 from stewartid.errors import ConfigError, DataError
 from stewartid.model.joints import JOINT_AXES
-from stewartid.model.kinematics import joint_rate_jacobians
+from stewartid.model.kinematics import joint_axis_rates, joint_rate_jacobians
 from stewartid.model.kinematics import leg_jacobian as leg_jacobian_at
 from stewartid.platform import Platform
 
@@ -42,10 +42,7 @@ def joint_rates(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
         joint_jacobians = joint_rate_jacobians(platform, q)
     if leg_jacobian is None:
         leg_jacobian = leg_jacobian_at(platform, q)
-    from stewartid.model import compiled  # numba, which the model remainder loads anyway
-
-    axes = compiled.batch_joint_rates(np.ascontiguousarray(joint_jacobians),
-                                      np.ascontiguousarray(q_dot)).reshape(len(q), 30)
+    axes = joint_axis_rates(joint_jacobians, q_dot).reshape(len(q), 30)
     legs = np.einsum("nlj,nj->nl", leg_jacobian, q_dot)
     return np.concatenate([axes, legs], axis=1)
 

@@ -17,6 +17,7 @@ from numpy.polynomial import polynomial
 from stewartid.identification.preparation import Experiment
 from stewartid.identification.wavelet.detection import Detection
 from stewartid.model.joints import JOINT_TYPES
+from stewartid.model.kinematics import joint_type_forces
 
 
 @lru_cache(maxsize=32)
@@ -153,6 +154,8 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
         noise_gram=gram, coulomb_rows=rows)
 
 
+#: Samples per block of :func:`coulomb_patterns`: its per-sample temporaries stay small.
+PATTERN_BLOCK = 2048
 #: Candidate transition rates r (rad/s) of the Coulomb soft sign (:func:`coulomb_patterns`).
 #: No rate between 0 and 1e-4, where one would fit the sampling error of an exact sign.
 SOFT_SIGN_RATES = (0.0, 1e-4, 3e-4, 1e-3, 3e-3)
@@ -168,20 +171,16 @@ def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: boo
     ``leg_jacobian`` J_lq (N, 6, 6), a last type: a unit force along every leg (a ball screw's
     friction), J_lq^T soft-sign(l_dot) with the same r in m/s.
     """
-    from stewartid.identification.wavelet._compiled import soft_sign_patterns
-
-    types = np.zeros(5, dtype=np.int64)
-    if not uniform:
-        for index, axes in enumerate(JOINT_TYPES.values()):
-            types[list(axes)] = index
+    groups = (tuple(range(5)),) if uniform else tuple(JOINT_TYPES.values())
     rates = np.asarray(rates, dtype=float)
-    n_joint_types = 1 if uniform else len(JOINT_TYPES)
-    out = np.zeros((len(found.sign_rates), len(rates), n_joint_types + (leg_jacobian is not None),
-                    6))
-    joints = out[:, :, :n_joint_types] if leg_jacobian is not None else out
-    soft_sign_patterns(np.ascontiguousarray(found.sign_rates),
-                       np.ascontiguousarray(found.sign_rate_noise),
-                       np.ascontiguousarray(joint_jacobians), rates, types, joints)
+    signs = found.sign_rates
+    out = np.empty((len(signs), len(rates), len(groups) + (leg_jacobian is not None), 6))
+    noise, squared_rates = found.sign_rate_noise ** 2, rates[:, None, None] ** 2
+    for start in range(0, len(signs), PATTERN_BLOCK):
+        block = slice(start, start + PATTERN_BLOCK)
+        w = signs[block]
+        direction = w[:, None] / np.sqrt((w * w + noise)[:, None] + squared_rates)  # (n, R, 6, 5)
+        out[block, :, :len(groups)] = joint_type_forces(direction, joint_jacobians[block], groups)
     if leg_jacobian is not None:
         legs, noise = found.leg_sign_rates, found.leg_sign_rate_noise
         for k, r in enumerate(rates):
