@@ -28,12 +28,7 @@ from stewartid.identification.preparation import Experiment, load_kernels, prepa
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.solvers import regressor_names, solve_least_squares
-from stewartid.identification.stops import (
-    filtered_stop_columns,
-    find_stops,
-    project_out,
-    stop_basis,
-)
+from stewartid.identification.stops import find_stops, project_out, stop_basis
 from stewartid.identification.wavelet.noise import measured_sign_rates, sign_pose_noise
 from stewartid.model.joints import JOINT_TYPES
 from stewartid.parallel import inheriting_workers, run_in_order
@@ -274,8 +269,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
         qd, qdd, offset = qd[step], qdd[step], np.ones(len(y))
         absorbed = 0
         if stops is not None:  # the stops' free friction out of every row
-            basis = stop_basis(filtered_stop_columns(stops.stops, len(exp.t), exp.sample_rate,
-                                                     window, decimate), exp.name)
+            basis = stop_basis(stops, exp.sample_rate, window, decimate, exp.name)
             y, qd, qdd, offset, *coulomb = project_out(basis, y, qd, qdd, offset, *coulomb)
             absorbed = basis.shape[1]
         return _Rows(exp.t[sl], window, decimate, y, qd, qdd, coulomb, noise, offset, absorbed)

@@ -41,7 +41,7 @@ class StopPolicy:
         Legendre terms of a stop: 2 (its impulse and first moment, all a filter much longer than
         the stop sees), plus this many per filter window of stop length.
     largest_share : float
-        Refuse an experiment whose stops take more than this share of its rows' freedom.
+        Refuse an experiment whose legs stand still for more than this share of the samples.
     """
 
     band: float = 3.0
@@ -161,24 +161,27 @@ def filtered_stop_columns(stops: list[Stop], samples: int, sample_rate: float, w
     return np.hstack(columns) if columns else np.zeros((rows, 0))
 
 
-def stop_basis(columns: np.ndarray, name: str, policy: StopPolicy = STOPS) -> np.ndarray:
-    """Orthonormal basis (R, r) of the filtered stop ``columns`` (R, n) of experiment ``name``.
+def stop_basis(found: LegStops, sample_rate: float, window: float, step: int, name: str,
+               policy: StopPolicy = STOPS) -> np.ndarray:
+    """Orthonormal basis (R, r) of the stops' :func:`filtered_stop_columns` in experiment ``name``.
 
     Raises
     ------
     IdentificationError
-        When the stops take more than ``policy.largest_share`` of the rows.
+        When the legs stand still for more than ``policy.largest_share`` of the samples.
     """
+    share = float(found.stopped.mean())
+    if share > policy.largest_share:
+        raise IdentificationError(
+            f"{name}: the legs stand still (rate within its noise) for {100 * share:.0f} % of "
+            f"the samples, more than {100 * policy.largest_share:.0f} %: too little motion is "
+            "left for the friction law; record a faster or larger motion, or set "
+            "leg_stops=False.")
+    columns = filtered_stop_columns(found.stops, len(found.stopped), sample_rate, window, step)
     if columns.shape[1] == 0:
         return columns
     u, s, _ = np.linalg.svd(columns, full_matrices=False)
-    basis = u[:, s > 1e-9 * s[0]]
-    if basis.shape[1] > policy.largest_share * len(columns):
-        raise IdentificationError(
-            f"{name}: the legs stand still (rate within its noise) so often that their stops "
-            f"take {basis.shape[1]} of {len(columns)} rows; record a faster or larger motion, "
-            "or set leg_stops=False.")
-    return basis
+    return u[:, s > 1e-9 * s[0]]
 
 
 def project_out(basis: np.ndarray, *arrays: np.ndarray) -> list[np.ndarray]:

@@ -8,12 +8,7 @@ from typing import Any
 import numpy as np
 
 from stewartid.identification.preparation import Experiment
-from stewartid.identification.stops import (
-    filtered_stop_columns,
-    find_stops,
-    project_out,
-    stop_basis,
-)
+from stewartid.identification.stops import find_stops, project_out, stop_basis
 from stewartid.identification.wavelet.noise import white_noise_covariance
 from stewartid.model import regressor as reg
 from stewartid.model.kinematics import leg_jacobian
@@ -143,8 +138,7 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
         Y, y = filtered[:, 1:-1].transpose(2, 0, 1), filtered[:, 0].T
         absorbed = 0
         if stops is not None:  # the stops' free friction out of every row
-            basis = stop_basis(filtered_stop_columns(stops.stops, n, exp.sample_rate, w, step),
-                               exp.name)
+            basis = stop_basis(stops, exp.sample_rate, w, step, exp.name)
             Y, y = project_out(basis, Y, y)
             absorbed = basis.shape[1]
         Ys.append(Y)
