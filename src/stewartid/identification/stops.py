@@ -180,8 +180,20 @@ def stop_basis(found: LegStops, sample_rate: float, window: float, step: int, na
     columns = filtered_stop_columns(found.stops, len(found.stopped), sample_rate, window, step)
     if columns.shape[1] == 0:
         return columns
-    u, s, _ = np.linalg.svd(columns, full_matrices=False)
-    return u[:, s > 1e-9 * s[0]]
+    from scipy import sparse  # slow to import: only stopped legs need it
+
+    # each column lives on a stop's filter support: a sparse Gram, then its eigenvectors (legs
+    # stopping together give nearly equal columns, which the rank cut leaves out)
+    norms = np.linalg.norm(columns, axis=0)
+    columns = columns[:, norms > 0] / norms[norms > 0]
+    local = sparse.csc_matrix(columns)
+    values, vectors = np.linalg.eigh((local.T @ local).toarray())
+    kept = values > RANK_CUT * values[-1]
+    return local @ (vectors[:, kept] / np.sqrt(values[kept]))
+
+
+#: Smallest eigenvalue of the stops' Gram matrix, relative to the largest, kept in their basis.
+RANK_CUT = 1e-10
 
 
 def project_out(basis: np.ndarray, *arrays: np.ndarray) -> list[np.ndarray]:
