@@ -28,7 +28,8 @@ from stewartid.identification.preparation import Experiment, prepare_experiment
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.solvers import regressor_names, solve_least_squares
-from stewartid.identification.wavelet.noise import measured_sign_rates
+from stewartid.identification.stops import find_stops, project_out, stop_basis
+from stewartid.identification.wavelet.noise import measured_sign_rates, sign_pose_noise
 from stewartid.model.joints import JOINT_TYPES
 from stewartid.model.kinematics import joint_axis_rates, joint_type_forces
 from stewartid.parallel import inheriting_workers, run_in_order
@@ -74,15 +75,20 @@ ROWS_PER_WINDOW = 40
 
 
 def leg_coulomb_regressor(leg_jacobian: np.ndarray, q_dot: np.ndarray, smoothing: float,
-                          shape: str = "algebraic") -> np.ndarray:
+                          shape: str = "algebraic", stopped: np.ndarray | None = None
+                          ) -> np.ndarray:
     """Generalized force per newton of Coulomb friction along every leg, S_leg (N, 1, 6).
 
     S_leg = sum_legs J_l^T sign(J_l q_dot), J_l (N, 6, 6) the rows of the leg Jacobian
     ``leg_jacobian``; ``smoothing`` s in m/s of leg rate, ``shape`` as
-    :func:`~stewartid.identification.friction_shape.shaped_sign`.
+    :func:`~stewartid.identification.friction_shape.shaped_sign`; ``stopped`` (N, 6), the legs'
+    stops (:func:`~stewartid.identification.stops.find_stops`), where the law gives nothing.
     """
     rates = np.einsum("nlc,nc->nl", leg_jacobian, q_dot)
-    return np.einsum("nl,nlc->nc", shaped_sign(rates, smoothing, shape), leg_jacobian)[:, None]
+    signs = shaped_sign(rates, smoothing, shape)
+    if stopped is not None:
+        signs = np.where(stopped, 0.0, signs)
+    return np.einsum("nl,nlc->nc", signs, leg_jacobian)[:, None]
 
 
 def uses_leg_coulomb(setting: bool | None, platform: Platform) -> bool:
@@ -94,7 +100,7 @@ def uses_leg_coulomb(setting: bool | None, platform: Platform) -> bool:
 
 class _Rows(NamedTuple):
     """One experiment's rows: times, support, decimation, force, rates (K, 6), Coulomb regressors,
-    pose-noise Gram."""
+    pose-noise Gram, the offset's regressor (K,) and the rows the legs' stops took."""
 
     t: np.ndarray
     window: float
@@ -104,6 +110,8 @@ class _Rows(NamedTuple):
     q_ddot: np.ndarray
     coulomb: list[np.ndarray]
     noise: np.ndarray | None
+    offset: np.ndarray
+    absorbed: int = 0
 
 
 @register_method(
@@ -137,6 +145,9 @@ class LeastSquaresIdentifier(BaseIdentifier):
         Rate below which a Coulomb sign is attenuated: rad/s of a joint, m/s of a leg.
     coulomb_shape : {'average', 'algebraic', 'erf'}
         Sign shape, or the Akaike-weighted average of both (default).
+    leg_stops : bool
+        With the legs' Coulomb friction, leave the legs' stops out of its sign law and fit their
+        friction freely (:mod:`~stewartid.identification.stops`; kernel only).
     symmetric : bool
         Impose Mt = Mt^T, Bt = Bt^T.
     differentiation : {'kernel', 'savgol'}
@@ -168,7 +179,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
     def __init__(self, window: float | None = None, order: int = DEFAULT_ORDER,
                  gravity: bool = True, coulomb: bool = True, leg_coulomb: bool | None = None,
                  coulomb_smoothing: float = 1e-4,
-                 coulomb_shape: str = "average", symmetric: bool = False,
+                 coulomb_shape: str = "average", leg_stops: bool = True,
+                 symmetric: bool = False,
                  decimate: int | None = None,
                  differentiation: str = "kernel", noise_correction: bool = True,
                  remainder: bool = True, sampling_check: bool = True, jobs: int | None = 1):
@@ -180,6 +192,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
         self.leg_coulomb = leg_coulomb
         self.coulomb_smoothing = coulomb_smoothing
         self.coulomb_shape = coulomb_shape
+        self.leg_stops = leg_stops
         self.symmetric = symmetric
         self.decimate = decimate
         self.differentiation = differentiation
@@ -192,6 +205,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
         "leg_coulomb": [BOOLEAN, None],
         "coulomb_smoothing": [nonnegative()],
         "coulomb_shape": [Options(("average", *COULOMB_SHAPES))],
+        "leg_stops": [BOOLEAN],
         "differentiation": [Options(("kernel", "savgol"))],
         "decimate": [Interval(Integral, 1, None), None],
         "noise_correction": [BOOLEAN],
@@ -200,14 +214,15 @@ class LeastSquaresIdentifier(BaseIdentifier):
     }
 
     def _coulomb_units(self, exp: Experiment, rows: slice, q_dot: np.ndarray, shape: str,
-                       legs: bool) -> np.ndarray:
-        """Coulomb regressors (K, 3 or 4, 6) of ``rows`` of an experiment, signs of ``q_dot``."""
+                       legs: bool, stopped: np.ndarray | None = None) -> np.ndarray:
+        """Coulomb regressors (K, 3 or 4, 6) of ``rows`` of an experiment, signs of ``q_dot``;
+        ``stopped`` as :func:`leg_coulomb_regressor`."""
         units = coulomb_regressors(exp.joint_jacobians[rows], q_dot, self.coulomb_smoothing,
                                    shape)
         if not legs:
             return units
         return np.concatenate([units, leg_coulomb_regressor(
-            exp.leg_jacobian[rows], q_dot, self.coulomb_smoothing, shape)], axis=1)
+            exp.leg_jacobian[rows], q_dot, self.coulomb_smoothing, shape, stopped)], axis=1)
 
     def _experiment_rows(self, exp: Experiment, shapes: tuple[str, ...], legs: bool) -> _Rows:
         """One prepared experiment's rows; ``legs`` adds the legs' Coulomb regressor."""
@@ -219,11 +234,19 @@ class LeastSquaresIdentifier(BaseIdentifier):
             sl = slice(cut, len(exp.t) - cut, decimate)
             coulomb = [self._coulomb_units(exp, sl, qd[sl], shape, legs) for shape in shapes]
             return _Rows(exp.t[sl], window, decimate, exp.generalized_force[sl], qd[sl],
-                         qdd[sl], coulomb, None)
+                         qdd[sl], coulomb, None, np.ones(len(qd[sl])))
         # the Coulomb signs need the rates at every sample, from a window the noise allows
         # (the physical model's rule), so that they do not chatter
-        qd_sign = measured_sign_rates(exp.q, exp.sample_rate, window)
-        units = [self._coulomb_units(exp, slice(None), qd_sign, shape, legs) for shape in shapes]
+        stops = None
+        if legs and self.leg_stops:
+            stops = find_stops(exp.q, exp.leg_jacobian, exp.sample_rate, window,
+                               sign_pose_noise(exp.q, exp.sample_rate, window))
+            qd_sign = stops.q_dot
+        else:
+            qd_sign = measured_sign_rates(exp.q, exp.sample_rate, window)
+        units = [self._coulomb_units(exp, slice(None), qd_sign, shape, legs,
+                                     None if stops is None else stops.stopped)
+                 for shape in shapes]
         signals = np.concatenate(
             [exp.generalized_force] + [u.reshape(len(u), -1) for u in units], axis=1)
         filtered = kernel_filter(signals, exp.sample_rate, window)[0]
@@ -237,7 +260,13 @@ class LeastSquaresIdentifier(BaseIdentifier):
                    for k in range(len(units))]
         noise = (pose_noise_gram(exp.q, exp.sample_rate, window) if self.noise_correction
                  else None)
-        return _Rows(exp.t[sl], window, decimate, y, qd[step], qdd[step], coulomb, noise)
+        qd, qdd, offset = qd[step], qdd[step], np.ones(len(y))
+        absorbed = 0
+        if stops is not None:  # the stops' free friction out of every row
+            basis = stop_basis(stops, exp.sample_rate, window, decimate, exp.name)
+            y, qd, qdd, offset, *coulomb = project_out(basis, y, qd, qdd, offset, *coulomb)
+            absorbed = basis.shape[1]
+        return _Rows(exp.t[sl], window, decimate, y, qd, qdd, coulomb, noise, offset, absorbed)
 
     def _fit(self, datasets: list[Dataset], platform: Platform
              ) -> tuple[IdentificationResult, dict]:
@@ -247,23 +276,25 @@ class LeastSquaresIdentifier(BaseIdentifier):
         legs = bool(shapes) and uses_leg_coulomb(self.leg_coulomb, platform)
         shared: list[list[np.ndarray]] = [[] for _ in shapes]
         phis, ys, used, noise, segments = [], [], [], [], []
+        absorbed = 0
         workers = inheriting_workers(self.jobs, n_exp)
         built = run_in_order(_experiment_rows, range(n_exp), workers,
                              shared=(self, datasets, platform, shapes, legs))
         for e, (rows, name, rate) in enumerate(built):
             k = len(rows.y)
             offsets = np.zeros((k, n_exp))
-            offsets[:, e] = 1.0
+            offsets[:, e] = rows.offset
             phis.append(np.concatenate([rows.q_ddot, rows.q_dot, offsets], axis=1))
             ys.append(rows.y)
             for per_shape, regressors in zip(shared, rows.coulomb, strict=True):
                 per_shape.append(regressors)
-            if rows.noise is not None:
-                noise.append((k, rows.noise))
+            if rows.noise is not None:  # the noise the projected rows keep
+                noise.append((k - rows.absorbed, rows.noise))
+            absorbed += rows.absorbed
             # the filters' support: rows further apart share no noise sample
             segments.append((k, math.ceil(rows.window * rate / rows.decimate) + 1))
             used.append({"name": name, "window_s": rows.window, "decimate": rows.decimate,
-                         "samples": k,
+                         "samples": k, "stop_rows": rows.absorbed,
                          "t_start": float(rows.t[0]), "t_stop": float(rows.t[-1])})
         names = regressor_names("q_ddot", "q_dot") + [f"offset[{x['name']}]" for x in used]
         regressor_noise = None
@@ -277,7 +308,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
             symmetric=self.symmetric, regressor_names=names,
             shared_names=([f"coulomb[{t}]" for t in JOINT_TYPES] + ["coulomb[actuator]"] * legs
                           if shapes else None),
-            autocorrelated=True, regressor_noise=regressor_noise, segments=segments)
+            autocorrelated=True, regressor_noise=regressor_noise, segments=segments,
+            absorbed=absorbed)
             for per_shape in (shared or [None])]
         weights = akaike_weights(solutions)
         solution = average_solutions(solutions, weights)

@@ -120,8 +120,8 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
                         max_condition: float = 1e8,
                         autocorrelated: bool = False,
                         regressor_noise: np.ndarray | None = None,
-                        segments: Sequence[tuple[int, int]] | None = None
-                        ) -> LeastSquaresSolution:
+                        segments: Sequence[tuple[int, int]] | None = None,
+                        absorbed: int = 0) -> LeastSquaresSolution:
     """Least squares for y(k) = theta phi(k) + sum_s c_s S_s(k), with standard errors.
 
     Channels share ``phi`` and are weighted by their residual variance from a first pass.
@@ -143,6 +143,9 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
         Summed regressor-noise covariance, subtracted from phi^T phi.
     segments : sequence of (int, int), optional
         Rows and correlation length per record; variances become at least the score sandwich's.
+    absorbed : int
+        Rows' worth of freedom taken by regressors already projected out of ``phi``, ``y`` and
+        ``shared`` (their coefficients free per channel).
 
     Raises
     ------
@@ -163,7 +166,7 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
     snames = list(shared_names or [f"shared[{j}]" for j in range(s)])
     T = _symmetric_map(p, symmetric)
     n_unknowns = T.shape[1] + s
-    if 6 * K <= n_unknowns:
+    if 6 * (K - absorbed) <= n_unknowns:
         raise IdentificationError(f"only {K} equations per channel for {n_unknowns} unknowns; "
                                   "use longer records or more (a, b) points / experiments.")
 
@@ -213,7 +216,7 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
     scale_y = np.sqrt(np.mean(y ** 2, axis=0))
     scale_y = np.where(scale_y > 0, scale_y, 1.0)
     theta, c, residual, *_ = solve(1.0 / scale_y ** 2)
-    dof = max(K - n_unknowns / 6.0, 1.0)
+    dof = max(K - absorbed - n_unknowns / 6.0, 1.0)
     sigma = np.sqrt(np.sum(residual ** 2, axis=0) / dof)
     # floor: exact (noise-free) data must not produce infinite weights
     sigma = np.maximum(sigma, 1e-12 * scale_y)
@@ -223,8 +226,8 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
            else np.ones(residual.shape[1]))
     sigma2 = np.sum(residual ** 2, axis=0) / dof * tau
     cov_full = float(np.mean(sigma2 / sigma ** 2)) * (Tf @ Ns_inv @ Tf.T)
-    if segments is not None:
-        cov_full = with_larger_variances(Tf @ score_sandwich(
+    if segments is not None:  # the residual lacks the projected-out share of the noise
+        cov_full = with_larger_variances(K / (K - absorbed) * Tf @ score_sandwich(
             Ns_inv, _row_scores(phi, S, residual / sigma ** 2), segments, Tf) @ Tf.T, cov_full)
     std = np.sqrt(np.clip(np.diag(cov_full), 0.0, None))
     return LeastSquaresSolution(

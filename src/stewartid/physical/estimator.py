@@ -128,6 +128,9 @@ class PhysicalIdentifier(BaseIdentifier):
         (:func:`~stewartid.physical.parameter_fit.nearest_consistent`; ``convex`` extra).
     noise_correction : bool
         Remove the pose-noise bias (:func:`~stewartid.physical.noise.regressor_noise`).
+    leg_stops : bool
+        For an electric ``[actuator]``, leave the legs' stops out of their Coulomb sign law and
+        fit their friction freely (:mod:`~stewartid.identification.stops`).
     sampling_check : bool
         Refit at 1/2, 1/3, 1/4 of the rate and add each parameter's change to its variance.
 
@@ -149,7 +152,7 @@ class PhysicalIdentifier(BaseIdentifier):
                  coulomb_smoothing: float = 1e-4, decimate: int | None = None,
                  max_condition: float = 1e5, max_relative_error: float = 0.3,
                  consistent: bool = False, noise_correction: bool = True,
-                 sampling_check: bool = True):
+                 leg_stops: bool = True, sampling_check: bool = True):
         self.payload = payload
         self.window = window
         self.order = order
@@ -160,6 +163,7 @@ class PhysicalIdentifier(BaseIdentifier):
         self.max_relative_error = max_relative_error
         self.consistent = consistent
         self.noise_correction = noise_correction
+        self.leg_stops = leg_stops
         self.sampling_check = sampling_check
 
     _parameter_constraints = {
@@ -172,6 +176,7 @@ class PhysicalIdentifier(BaseIdentifier):
         "max_relative_error": [positive()],
         "consistent": [BOOLEAN],
         "noise_correction": [BOOLEAN],
+        "leg_stops": [BOOLEAN],
         "sampling_check": [BOOLEAN],
     }
 
@@ -181,7 +186,8 @@ class PhysicalIdentifier(BaseIdentifier):
             require_cvxpy()  # before the fit, not after it
         experiments = prepare(datasets, platform, gravity=False)
         data = filtered_regression(experiments, platform, self.window, self.order,
-                                   self.decimate, self.gravity, self.coulomb_smoothing)
+                                   self.decimate, self.gravity, self.coulomb_smoothing,
+                                   self.leg_stops and platform.actuator.kind == "electric")
         model = parameter_model(platform, self.payload)
         names, _, selection, nominal, offset = model
         columns = np.argmax(selection, axis=1)  # selection: rows of the identity
@@ -197,6 +203,9 @@ class PhysicalIdentifier(BaseIdentifier):
                                    data.experiments[0]["row_step"], platform,
                                    SAVGOL_FRACTION, self.order, data.pose_noise,
                                    per_experiment, by_experiment=True)
+            # the noise the projected rows keep
+            full = full * np.array([1 - e["stop_rows"] / e["samples"]
+                                    for e in data.experiments])[:, None, None, None]
             noise = full[:, :, columns][:, :, :, columns]
             target_noise = -full[:, :, columns] @ offset
         # the size of a positive parameter: the whole body's (of a payload's, too)

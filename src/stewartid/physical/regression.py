@@ -8,9 +8,11 @@ from typing import Any
 import numpy as np
 
 from stewartid.identification.preparation import Experiment
+from stewartid.identification.stops import find_stops, project_out, stop_basis
 from stewartid.identification.wavelet.noise import white_noise_covariance
 from stewartid.model import regressor as reg
 from stewartid.model.kinematics import leg_jacobian
+from stewartid.model.regressor_rows import smooth_sign
 from stewartid.platform import Platform
 from stewartid.signals.differentiation import (
     default_window,
@@ -32,7 +34,7 @@ class Regression:
     y : ndarray, shape (K, 6)
         J_lq^T f (N, N m).
     experiments : list of dict
-        Name, window (s), rows used.
+        Name, window (s), rows used, rows the legs' stops took (``stop_rows``).
     pose_noise : list of ndarray, each shape (6, 6)
         Pose white-noise covariance per sample (m^2, rad^2).
     poses : ndarray, shape (K, 6)
@@ -77,7 +79,7 @@ def row_step(window: float, sample_rate: float) -> int:
 def filtered_regression(experiments: list[Experiment], platform: Platform,
                         window: float | None = None, order: int = SAVGOL_ORDER,
                         decimate: int | None = 1, gravity: bool = True,
-                        coulomb_smoothing: float = 1e-4) -> Regression:
+                        coulomb_smoothing: float = 1e-4, leg_stops: bool = False) -> Regression:
     """Regressor Y and generalized force of every experiment, filtered with h; J_lq^T f = Y pi is
     linear in pi, so the filtered equation holds exactly.
 
@@ -96,6 +98,9 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
         Include the gravity columns.
     coulomb_smoothing : float
         rad/s.
+    leg_stops : bool
+        Leave the legs' stops out of their Coulomb sign law and their friction free
+        (:mod:`~stewartid.identification.stops`): the rows lose its filtered signatures.
     """
     Ys, ys, used, pose_noise, poses, force_noise = [], [], [], [], [], []
     windows = [window or default_window(estimate_frequency(exp.q, exp.sample_rate))
@@ -115,6 +120,8 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
         force_noise.append(white_noise_covariance(forces, differentiate(
             forces, exp.sample_rate, w / SAVGOL_FRACTION, order, (0,))[0]))
         sign_rates, sign_window = coulomb_sign_rates(exp.q, exp.sample_rate, w, pose_noise[-1])
+        stops = (find_stops(exp.q, exp.leg_jacobian, exp.sample_rate, w, pose_noise[-1])
+                 if leg_stops else None)
         motion = [np.ascontiguousarray(x.T) for x in (q, q_dot, q_ddot, sign_rates)]
         signals = buffer[:6 * width * n].reshape(6, width, n)
         signals[:, 0] = exp.generalized_force.T
@@ -123,13 +130,23 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
             hi = min(n, lo + REGRESSOR_CHUNK)
             reg.regressor_columns(platform, *(x[:, lo:hi] for x in motion), gravity,
                                   coulomb_smoothing, out=signals[:, 1:-1, lo:hi])
+        if stops is not None:  # no sign law in a stop
+            law = smooth_sign(stops.leg_rates, reg.ACTUATOR_SMOOTHING) * stops.stopped
+            signals[:, 1 + reg.PARAMETERS.index("coulomb[actuator]")] -= np.einsum(
+                "nl,nlc->cn", law, exp.leg_jacobian)
         filtered = kernel_filter_rows(signals, exp.sample_rate, w, step, time_last=True)
-        Ys.append(filtered[:, 1:-1].transpose(2, 0, 1))
-        ys.append(filtered[:, 0].T)
+        Y, y = filtered[:, 1:-1].transpose(2, 0, 1), filtered[:, 0].T
+        absorbed = 0
+        if stops is not None:  # the stops' free friction out of every row
+            basis = stop_basis(stops, exp.sample_rate, w, step, exp.name)
+            Y, y = project_out(basis, Y, y)
+            absorbed = basis.shape[1]
+        Ys.append(Y)
+        ys.append(y)
         poses.append(filtered[:, -1].T)
         used.append({"name": exp.name, "window_s": w, "samples": filtered.shape[-1],
                      "row_step": step, "sign_window_s": sign_window,
-                     "sample_rate": exp.sample_rate})
+                     "sample_rate": exp.sample_rate, "stop_rows": absorbed})
     return Regression(np.concatenate(Ys), np.concatenate(ys), used, pose_noise,
                       np.concatenate(poses), force_noise)
 

@@ -80,9 +80,15 @@ def measured_sign_rates(q: np.ndarray, sample_rate: float, window: float) -> np.
     """Coulomb sign rates (N, 6) of a record with unknown pose noise, estimated against the pose
     smoothed as the regressor is (:func:`~stewartid.signals.sign_rates.coulomb_sign_rates`).
     """
+    return coulomb_sign_rates(q, sample_rate, window, sign_pose_noise(q, sample_rate, window))[0]
+
+
+def sign_pose_noise(q: np.ndarray, sample_rate: float, window: float) -> np.ndarray:
+    """Covariance (6, 6) of the white pose noise of ``q`` (N, 6), against the pose smoothed as the
+    regressor is (a window of ``window`` / 8, s)."""
     smooth = differentiate(q, sample_rate, window / 8, 5, (0,))[0]
-    return coulomb_sign_rates(q, sample_rate, window, white_noise_covariance(q, smooth))[0]
+    return white_noise_covariance(q, smooth)
 
 
 __all__ = ["NoiseModel", "estimate_noise", "joint_rate_noise", "measured_sign_rates",
-           "white_noise_covariance"]
+           "sign_pose_noise", "white_noise_covariance"]
