@@ -1,6 +1,7 @@
 """The shape of Coulomb friction's sign near a reversal, and least squares averaged over it.
 
-Fits with both shapes are averaged by Akaike weights (Burnham and Anderson 2002, ch. 4).
+Fits with both shapes are averaged by Akaike weights (Burnham and Anderson 2002, ch. 4); a fit
+with the exact sign measures how far the soft sign's band moves them.
 """
 
 from __future__ import annotations
@@ -15,14 +16,17 @@ from stewartid.identification.solvers import LeastSquaresSolution
 
 #: The shapes of sign(w) near w = 0, of slope 1/s there.
 COULOMB_SHAPES = ("algebraic", "erf")
+#: The variant of the exact sign, s = 0 (:func:`widened_by_exact_sign`).
+EXACT_SIGN = "exact"
 
 
 def shaped_sign(rates: np.ndarray, smoothing: float, shape: str = "algebraic") -> np.ndarray:
-    """sign(w) regularised over s: ``"algebraic"`` w / sqrt(w^2 + s^2), ``"erf"`` erf(sqrt(pi) w / (2 s)).
+    """sign(w) regularised over s: ``"algebraic"`` w / sqrt(w^2 + s^2), ``"erf"`` erf(sqrt(pi) w / (2 s)),
+    ``"exact"`` sign(w) whatever s.
 
     ``rates`` and ``smoothing`` in rad/s; slope 1/s at 0; s = 0 gives the exact sign.
     """
-    if smoothing == 0:
+    if smoothing == 0 or shape == EXACT_SIGN:
         return np.sign(rates)
     if shape == "algebraic":
         return rates / np.sqrt(rates ** 2 + smoothing ** 2)
@@ -63,4 +67,26 @@ def average_solutions(solutions: Sequence[LeastSquaresSolution], weights: np.nda
         residual_rms=np.sqrt(np.tensordot(w, [s.residual_rms ** 2 for s in solutions], axes=1)))
 
 
-__all__ = ["COULOMB_SHAPES", "akaike_weights", "average_solutions", "shaped_sign"]
+def widened_by_exact_sign(model: LeastSquaresSolution, best: LeastSquaresSolution,
+                          exact: LeastSquaresSolution) -> tuple[LeastSquaresSolution, float]:
+    """``model``, the soft sign's fit, its standard errors widened by the exact sign's.
+
+    How a rig's friction turns over inside the soft sign's band (stiction, a constraint solver's
+    softness) is not the model's law; the exact sign is the band's other end. With p the Akaike
+    weight of ``exact`` against ``best`` (the soft sign's likeliest shape), each standard error s
+    becomes sqrt(s^2 + p max(0, d^2 - s^2)), d the distance of the exact sign's estimate: the
+    part of d beyond the noise, where the data prefer the exact sign. Estimates are unchanged.
+    Returns the widened solution and p.
+    """
+    p = float(akaike_weights([best, exact])[1])
+
+    def widened(value, std, other):
+        return np.sqrt(std ** 2 + p * np.maximum(0.0, (other - value) ** 2 - std ** 2))
+
+    return dataclasses.replace(
+        model, theta_std=widened(model.theta, model.theta_std, exact.theta),
+        shared_std=widened(model.shared, model.shared_std, exact.shared)), p
+
+
+__all__ = ["COULOMB_SHAPES", "EXACT_SIGN", "akaike_weights", "average_solutions", "shaped_sign",
+           "widened_by_exact_sign"]

@@ -19,9 +19,11 @@ from stewartid.fields import BOOLEAN, Interval, Options, nonnegative
 from stewartid.identification.base import DIFFERENTIATION_CONSTRAINTS, BaseIdentifier
 from stewartid.identification.friction_shape import (
     COULOMB_SHAPES,
+    EXACT_SIGN,
     akaike_weights,
     average_solutions,
     shaped_sign,
+    widened_by_exact_sign,
 )
 from stewartid.identification.pairs import calibrate_by_pairs
 from stewartid.identification.preparation import Experiment, prepare_experiment
@@ -144,7 +146,9 @@ class LeastSquaresIdentifier(BaseIdentifier):
     coulomb_smoothing : float
         Rate below which a Coulomb sign is attenuated: rad/s of a joint, m/s of a leg.
     coulomb_shape : {'average', 'algebraic', 'erf'}
-        Sign shape, or the Akaike-weighted average of both (default).
+        Sign shape, or the Akaike-weighted average of both (default). With a smoothing above
+        zero, the standard errors also count a fit with the exact sign
+        (:func:`~stewartid.identification.friction_shape.widened_by_exact_sign`).
     leg_stops : bool
         With the legs' Coulomb friction, leave the legs' stops out of its sign law and fit their
         friction freely (:mod:`~stewartid.identification.stops`; kernel only).
@@ -273,13 +277,16 @@ class LeastSquaresIdentifier(BaseIdentifier):
         n_exp = len(datasets)
         shapes = (() if not self.coulomb else COULOMB_SHAPES if self.coulomb_shape == "average"
                   else (self.coulomb_shape,))
+        # the exact sign beside the soft ones: how far the band's law moves the estimates
+        exact = bool(shapes) and self.coulomb_smoothing > 0
+        variants = shapes + (EXACT_SIGN,) * exact
         legs = bool(shapes) and uses_leg_coulomb(self.leg_coulomb, platform)
-        shared: list[list[np.ndarray]] = [[] for _ in shapes]
+        shared: list[list[np.ndarray]] = [[] for _ in variants]
         phis, ys, used, noise, segments = [], [], [], [], []
         absorbed = 0
         workers = inheriting_workers(self.jobs, n_exp)
         built = run_in_order(_experiment_rows, range(n_exp), workers,
-                             shared=(self, datasets, platform, shapes, legs))
+                             shared=(self, datasets, platform, variants, legs))
         for e, (rows, name, rate) in enumerate(built):
             k = len(rows.y)
             offsets = np.zeros((k, n_exp))
@@ -311,8 +318,13 @@ class LeastSquaresIdentifier(BaseIdentifier):
             autocorrelated=True, regressor_noise=regressor_noise, segments=segments,
             absorbed=absorbed)
             for per_shape in (shared or [None])]
+        exact_solution = solutions.pop() if exact else None
         weights = akaike_weights(solutions)
         solution = average_solutions(solutions, weights)
+        exact_weight = None
+        if exact_solution is not None:
+            solution, exact_weight = widened_by_exact_sign(
+                solution, solutions[int(np.argmax(weights))], exact_solution)
         shape_weights = ({shape: float(w) for shape, w in zip(shapes, weights, strict=True)}
                          if shapes else {})
         theta, std = solution.theta, solution.theta_std.copy()
@@ -330,6 +342,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
                        "coulomb": levels, "coulomb_std": levels_std,
                        "leg_coulomb": leg_level, "leg_coulomb_std": leg_std,
                        "coulomb_shape_weights": shape_weights,
+                       "exact_sign_weight": exact_weight,
                        "n_equations": int(solution.n_equations),
                        "pair_calibration": calibration}
         return IdentificationResult(
