@@ -1,5 +1,6 @@
 """The Coulomb sign's shapes near a reversal, and least squares averaged over them, against
-hand values, finite differences and two plants whose friction has one shape or the other."""
+hand values, finite differences and plants whose friction has one shape or the other, or turns
+over far inside the model's band."""
 
 from __future__ import annotations
 
@@ -11,9 +12,11 @@ import pytest
 from roundoff import EPS
 from stewartid.identification.friction_shape import (
     COULOMB_SHAPES,
+    EXACT_SIGN,
     akaike_weights,
     average_solutions,
     shaped_sign,
+    widened_by_exact_sign,
 )
 from stewartid.identification.registry import create_identifier
 from stewartid.identification.solvers import LeastSquaresSolution
@@ -38,6 +41,11 @@ def test_erf_saturates_faster_than_the_algebraic_sign():
     w = np.array(3e-4)
     assert 1 - shaped_sign(w, 1e-4, "algebraic") == pytest.approx(1 - 3 / np.sqrt(10), rel=1e-9)
     assert 1 - shaped_sign(w, 1e-4, "erf") < 2e-4
+
+
+def test_exact_shape_is_the_sign_whatever_the_smoothing():
+    w = np.array([-1e-9, -1e-6, 0.0, 1e-6, 1e-9])
+    assert np.array_equal(shaped_sign(w, 1e-4, EXACT_SIGN), np.sign(w))
 
 
 def test_unknown_shape_is_refused():
@@ -74,6 +82,25 @@ def test_average_is_the_mixture_mean_and_variance():
     assert np.array_equal(only.theta, a.theta) and np.array_equal(only.theta_std, a.theta_std)
 
 
+def test_exact_sign_widens_by_its_distance_beyond_the_noise():
+    model = _solution(1.0, 1.0, 1.0, 10.0)
+    # the exact sign fits far better: p = 1 / (1 + exp(-60 log 2)) = 1 - 8.7e-19
+    far, near = _solution(4.0, 1.0, 0.5, 10.0), _solution(1.5, 1.0, 0.5, 10.0)
+    out, p = widened_by_exact_sign(model, model, far)
+    assert p == pytest.approx(1.0, abs=1e-15)
+    # distance 3 beyond a standard error of 1: sqrt(1 + (9 - 1)) = 3
+    assert np.allclose(out.theta_std, 3.0, rtol=4 * EPS)
+    assert np.allclose(out.shared_std, 3.0, rtol=4 * EPS)
+    assert np.array_equal(out.theta, model.theta)
+    # a distance within the standard error is the noise's: nothing added
+    out, _ = widened_by_exact_sign(model, model, near)
+    assert np.array_equal(out.theta_std, model.theta_std)
+    # the exact sign fitting worse (p = 8.7e-19) leaves the errors as they were to round-off
+    out, p = widened_by_exact_sign(far, far, model)
+    assert p == pytest.approx(2.0 ** -60, rel=1e-9)
+    assert np.allclose(out.theta_std, 1.0, rtol=4 * EPS)
+
+
 def _sine_logs(platform, simulate, duration):
     return [simulate(platform, multisine_excitation(
         platform, [Sine(k, DEFAULT_AMPLITUDES[k], 1.0)], name=f"exp{k + 1}"), duration)
@@ -97,7 +124,28 @@ def test_our_plant_shows_its_algebraic_sign(paper):
     _, B = nominal_matrices(platform)
     est = create_identifier("ls", sampling_check=False).fit(data, platform)
     assert est.coulomb_shape_weights_["algebraic"] > 0.999
+    assert est.result_.diagnostics["exact_sign_weight"] < 1e-6
     assert np.max(_bt_diagonal_errors(est, B)) < 1e-4
+
+
+@pytest.mark.slow
+def test_friction_sharper_than_the_band_is_in_the_standard_errors(paper):
+    # our plant with its joints' sign turning over within 1e-6 rad/s, a hundredth of the model's
+    # band (a rig's dry friction, MuJoCo's constraint), noise-free three-sine logs: the fit
+    # keeps the Bt diagonal 0.4-1.9 % low, which its noise-free errors put up to 4.2 of them off
+    platform = paper.replace(friction__coulomb=30.0)
+    sines = ((0.3, 0.6, 0.0), (0.7, 0.3, 1.0), (1.5, 0.15, 2.0))
+    data = [simulate_experiment(platform, multisine_excitation(
+        platform, [Sine(k, share * DEFAULT_AMPLITUDES[k], hz, phase) for hz, share, phase in sines],
+        name=f"exp{k + 1}"), 20.0, noise=SensorNoise(), coulomb_smoothing=1e-6)[0]
+        for k in range(6)]
+    M, B = nominal_matrices(platform)
+    est = create_identifier("ls", sampling_check=False).fit(data, platform)
+    assert est.result_.diagnostics["exact_sign_weight"] > 0.99
+    errors = np.concatenate([(est.M_ - M).ravel(), (est.B_ - B).ravel()])
+    stds = np.concatenate([est.std_errors_["M"].ravel(), est.std_errors_["B"].ravel()])
+    assert np.max(_bt_diagonal_errors(est, B)) > 3e-3  # the bias is there
+    assert np.all(np.abs(errors) <= 3.0 * stds)
 
 
 @pytest.mark.slow
