@@ -129,8 +129,11 @@ def test_a_policy_sets_the_floor_and_none_keeps_every_sample():
     kept = average_experiments([record], None)
     assert kept.experiments[0] is record and kept.entry is None
     with pytest.raises(ConfigError, match="'floor_hz' parameter of AveragingPolicy must be a "
-                                          "float in the range \\(0, inf\\). Got -1"):
+                                          "float in the range \\(0, inf\\]. Got -1"):
         AveragingPolicy(floor_hz=-1)
+    with pytest.raises(ConfigError, match="'samples_per_period' parameter .* Got nan"):
+        AveragingPolicy(samples_per_period=float("nan"))
+    assert averaging_factor([record], AveragingPolicy(samples_per_period=float("inf"))) == 1
 
 
 @pytest.mark.slow

@@ -35,9 +35,9 @@ class AveragingPolicy:
     def __post_init__(self) -> None:
         for name in ("floor_hz", "samples_per_period"):
             value = getattr(self, name)
-            if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
+            if not (isinstance(value, int | float) and value > 0):  # inf: never average
                 raise ConfigError(f"The {name!r} parameter of AveragingPolicy must be a float in "
-                                  f"the range (0, inf). Got {value!r} instead.")
+                                  f"the range (0, inf]. Got {value!r} instead.")
 
 
 #: The rule ``identify --average`` applies.
