@@ -138,7 +138,7 @@ def test_a_policy_sets_the_floor_and_none_keeps_every_sample():
 
 @pytest.mark.slow
 def test_a_2_khz_log_and_its_average_identify_the_same_within_their_errors():
-    """The paper's sines at 2 kHz with the reference noise (8 s, Coulomb 30 N m): every compared
+    """The paper's sines at 2 kHz with the reference noise (20 s, Coulomb 30 N m): every compared
     method's 20 entries from the averaged log within 0.3 of the full-rate fit's standard errors,
     which the averaged fit's match within 10 % in the median; the result says what was done."""
     import stewartid as sid
@@ -149,15 +149,16 @@ def test_a_2_khz_log_and_its_average_identify_the_same_within_their_errors():
 
     platform = load_platform("paper").replace(friction__coulomb=30.0,
                                               sensors__sample_rate=2000.0)
-    data = simulate_experiments(platform, coulomb=30.0, duration_s=8.0, seed=2,
+    data = simulate_experiments(platform, coulomb=30.0, duration_s=20.0, seed=2,
                                 noise=reference_noise(platform), jobs=1).datasets
     full = sid.compare_methods(data, platform)
     fast = sid.compare_methods(data, platform, averaging=DEFAULT_AVERAGING)
     assert "averaging" not in full.result.diagnostics and full.averaging is None
     assert fast.result.diagnostics["averaging"]["averaged_samples"] == 2
     assert fast.averaging["rate_hz"] == pytest.approx(1000.0)
+    assert [run.name for run in full.runs] == [run.name for run in fast.runs]
     for one, other in zip(full.runs, fast.runs, strict=True):
-        assert one.name == other.name and one.result is not None and other.result is not None
+        assert one.result is not None and other.result is not None, one.name
         shifts, ratios = [], []
         for matrix, i, j in PAPER_ENTRIES:
             name = "M" if matrix == "M" else "B"
@@ -167,3 +168,36 @@ def test_a_2_khz_log_and_its_average_identify_the_same_within_their_errors():
             ratios.append(getattr(other.result, f"std_errors_{name}")[i, j] / se)
         assert max(shifts) <= 0.3, f"{one.name}: shifted {max(shifts):.3f} SE"
         assert abs(np.median(ratios) - 1.0) <= 0.1, f"{one.name}: SE ratio {np.median(ratios)}"
+
+
+def test_identify_average_says_so_and_records_it(tmp_path, paper):
+    """``identify --average`` on a 2 kHz log of the linear model (1 Hz sines): one line with the
+    rates, ``diagnostics.averaging`` in result.json, the same matrices; without the flag neither."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from linear_model_data import make_experiment, random_matrices
+    from stewartid.cli import app
+    from stewartid.datasets.dataset import write_dataset
+
+    M, B = random_matrices(np.random.default_rng(11))
+    paths = [str(write_dataset(make_experiment(paper, M, B, k, sample_rate=2000.0),
+                               tmp_path / f"exp{k + 1}.parquet")) for k in range(6)]
+    documents = {}
+    for flags in ([], ["--average"]):
+        out = tmp_path / f"result{len(flags)}.json"
+        done = CliRunner().invoke(app, ["identify", "--method", "fourier", "--platform", "paper",
+                                        "--out", str(out), *flags, *paths])
+        assert done.exit_code == 0, done.output
+        said = [line for line in done.output.splitlines() if line.startswith("averaged")]
+        documents[bool(flags)] = json.loads(out.read_text())
+        assert said == ([] if not flags else [
+            "averaged 2 samples into one: 2000 Hz -> 1000 Hz, 1000 samples per period of the "
+            "fastest excitation"])
+    assert "averaging" not in documents[False]["diagnostics"]
+    entry = documents[True]["diagnostics"]["averaging"]
+    assert entry["averaged_samples"] == 2 and entry["rate_hz"] == pytest.approx(1000.0)
+    for name in ("M", "B"):
+        np.testing.assert_allclose(documents[True][name], documents[False][name],
+                                   atol=1e-3 * np.abs(documents[False][name]).max())

@@ -82,9 +82,9 @@ def identify(
         "--average", help="Average records sampled well above what the fits need (2 kHz and "
                           "more) over blocks of samples first, down to no less than 1 kHz and "
                           "400 samples per period of the fastest excitation: about a 1 kHz "
-                          "log's cost. Hydraulic logs keep their estimates within noise; on "
-                          "one sine per experiment of an electric platform Method B moves by "
-                          "up to 0.8 standard errors (docs/user-guide.md).")] = False,
+                          "log's cost. The paper platform's logs keep their estimates within "
+                          "0.15 standard errors; an electric platform's may move further "
+                          "(docs/user-guide.md).")] = False,
     validate: Annotated[list[Path] | None, typer.Option(
         "--validate", metavar="FILE",
         help="--report: a record of another excitation (e.g. the validation record of "

@@ -85,8 +85,7 @@ def describe_averaging(entry: dict[str, Any]) -> str:
         return f"every sample used: {entry['reason']}"
     return (f"averaged {entry['averaged_samples']} samples into one: "
             f"{entry['sample_rate_hz']:.6g} Hz -> {entry['rate_hz']:.6g} Hz, "
-            f"{entry['samples_per_period']:.0f} samples per period of the fastest excitation "
-            "(--full-rate keeps every sample)")
+            f"{entry['samples_per_period']:.0f} samples per period of the fastest excitation")
 
 
 def average_experiments(datasets: Sequence[Dataset],
