@@ -10,12 +10,14 @@ start-up), best CPU time of ``--repeats``, and, where a method takes worker proc
 
 The logs: the paper platform's six experiments of 20 s at 1 kHz with the reference sensor
 noise and 30 N m of Coulomb friction (Parquet), simulated once by this tree, and the same at
-2 kHz.
+2 kHz. ``--average`` adds ``identify --method all --report`` on the 2 kHz log and gives the
+later tree's commands on it ``--average`` (``identify --average``).
 
 Usage::
 
     git worktree add /tmp/before <commit>
     python benchmarks/bench_speed.py --before /tmp/before/src [--repeats 5] [--reproduce]
+        [--average]
 """
 
 from __future__ import annotations
@@ -138,6 +140,9 @@ def main() -> None:
     parser.add_argument("--after", default=str(Path(__file__).resolve().parents[1] / "src"))
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--reproduce", action="store_true", help="also time reproduce")
+    parser.add_argument("--average", action="store_true",
+                        help="also time --method all on the 2 kHz log, and run the later "
+                             "tree's 2 kHz commands with --average")
     args = parser.parse_args()
     env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
     trees = {"before": args.before, "after": args.after}
@@ -154,6 +159,10 @@ def main() -> None:
             "identify --method all --report": ["identify", str(logs["1 kHz"]), "--method",
                                                "all", "--report", str(scratch / "report")],
         }
+        if args.average:
+            commands["identify --method all --report (2 kHz)"] = [
+                "identify", str(logs["2 kHz"]), "--method", "all", "--report",
+                str(scratch / "report")]
         if args.reproduce:
             commands["reproduce"] = ["reproduce", "--out", str(scratch / "reproduce"),
                                      "--force"]
@@ -164,7 +173,10 @@ def main() -> None:
                 for tree, src in trees.items():
                     for folder in ("report", "reproduce"):
                         subprocess.run(["rm", "-rf", str(scratch / folder)], check=True)
-                    runs[tree].append(measured([sys.executable, "-c", RUN, src, *arguments], env))
+                    extra = (["--average"] if args.average and tree == "after"
+                             and "2 kHz" in label else [])
+                    runs[tree].append(measured([sys.executable, "-c", RUN, src, *arguments,
+                                                *extra], env))
             for tree in trees:
                 wall, cpu, memory, pss = (statistics.median(x)
                                           for x in zip(*runs[tree], strict=True))

@@ -43,6 +43,7 @@ _EXPORTS = {
     "reference_noise": "stewartid.simulation.sensors",
     "simulate_experiments": "stewartid.simulation",
     # identification
+    "AveragingPolicy": "stewartid.identification.averaging",
     "IdentificationResult": "stewartid.identification.result",
     "create_identifier": "stewartid.identification.registry",
     "registered_methods": "stewartid.identification.registry",

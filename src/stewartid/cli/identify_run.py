@@ -30,6 +30,7 @@ from stewartid.datasets.meta import nominal_from_meta, platform_for_data
 from stewartid.errors import ConfigError
 from stewartid.files import check_output_file, check_output_folder
 from stewartid.identification import registry
+from stewartid.identification.averaging import DEFAULT_AVERAGING, average_experiments
 from stewartid.identification.delay import (
     parse_delay,
 )
@@ -86,6 +87,9 @@ class IdentifyRun:
     delay_sensitivity : dict or None
         Bias a force delay would put on the Bt diagonal per ms, for single-frequency DOFs
         (:func:`~stewartid.identification.delay.single_frequency_bias`).
+    averaging : dict or None
+        The samples averaged into one before the fits, when asked
+        (:func:`~stewartid.identification.averaging.average_experiments`).
     """
 
     result: IdentificationResult
@@ -97,6 +101,7 @@ class IdentifyRun:
     nominal_source: str
     delay: dict[str, Any] | None = None
     delay_sensitivity: dict[str, Any] | None = None
+    averaging: dict[str, Any] | None = None
 
     def comparison(self) -> list[dict[str, Any]]:
         """The platform's scored entries, identified against nominal."""
@@ -241,12 +246,13 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
                    folds: int | None = None, delay: str | float | None = None,
                    validate: Sequence[str | Path] = (), model: str | None = None,
                    payload: bool = False, platform_out: Path | None = None,
-                   jobs: int | None = None) -> IdentifyRun:
+                   jobs: int | None = None, average: bool = False) -> IdentifyRun:
     """Identify Mt and Bt from experiment files, as ``stewartid identify`` does.
 
     The arguments are the command's options; ``flags`` maps each estimator flag to its setting;
     ``jobs``: worker processes of the comparison or of a method that takes them (None: every
-    core).
+    core); ``average``: records sampled well above what the fits need averaged over blocks of
+    samples first (:func:`~stewartid.identification.averaging.average_experiments`).
     With ``report`` the methods are compared and the report written; with ``model`` the physical
     model is fitted instead of ``method``.
 
@@ -282,6 +288,7 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
                if records_paths else [])
     meta = nominal_from_meta(paths)
     check = plausibility_check(description)
+    policy = DEFAULT_AVERAGING if average else None
     if consistent:
         from stewartid.identification.consistency import require_cvxpy
 
@@ -296,12 +303,15 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
             consistent=consistent and model is None,
             physical=_physical_request(model, method, payload, consistent, settings),
             nominal=None if meta is None else meta[:2],
-            nominal_source=None if meta is None else meta[2], delay=delay, jobs=jobs)
+            nominal_source=None if meta is None else meta[2], delay=delay, averaging=policy,
+            jobs=jobs)
         check(comparison.result)
         written = write_report(comparison, report, sources=[str(p) for p in paths], jobs=jobs)
         result, delay_entry = comparison.result, comparison.delay
-        sensitivity = comparison.delay_sensitivity
+        sensitivity, averaging = comparison.delay_sensitivity, comparison.averaging
     else:
+        averaged = average_experiments(datasets, policy)
+        datasets, averaging = averaged.experiments, averaged.entry  # the full rate's freed
         alignment = align_experiments(datasets, description, delay)
         delay_entry, sensitivity = alignment.entry, alignment.sensitivity
         if model is None and "jobs" in registry.method_spec(method).estimator_class.param_names():
@@ -311,9 +321,10 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
         check(result)
         if delay_entry is not None:
             result = dataclasses.replace(result, delay=delay_entry)
-        if sensitivity is not None:
-            result = dataclasses.replace(result, diagnostics={**result.diagnostics,
-                                                              "delay_sensitivity": sensitivity})
+        added = {"averaging": averaging, "delay_sensitivity": sensitivity}
+        added = {key: value for key, value in added.items() if value is not None}
+        if added:
+            result = dataclasses.replace(result, diagnostics={**result.diagnostics, **added})
     if model is not None and platform_out is not None:
         write_identified(description, result, platform_out, len(datasets))
     M_nominal, B_nominal = meta[:2] if meta is not None else nominal_matrices(description)
@@ -321,7 +332,7 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     if out is not None:
         result.to_json(out)
     return IdentifyRun(result, written, description, len(datasets), M_nominal, B_nominal,
-                       source, delay_entry, sensitivity)
+                       source, delay_entry, sensitivity, averaging)
 
 
 __all__ = ["FlagSetting", "IdentifyRun", "MODELS", "identify_files",

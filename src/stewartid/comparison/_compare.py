@@ -21,6 +21,7 @@ from stewartid.datasets.dataset import Dataset
 from stewartid.datasets.plausibility import check_identified
 from stewartid.errors import ConfigError
 from stewartid.identification import registry
+from stewartid.identification.averaging import AveragingPolicy, average_experiments
 from stewartid.identification.delay import delay_identifiable
 from stewartid.identification.result import IdentificationResult
 from stewartid.model.linearization import nominal_matrices
@@ -104,6 +105,10 @@ class Comparison:
         by, or estimated and found within noise of zero.
     delay_sensitivity : dict or None
         Where the motion cannot tell a force delay from damping, the Bt bias per ms of delay.
+    averaging : dict or None
+        The ``diagnostics["averaging"]`` entry of ``result.json``: the samples averaged into
+        one before the fits (:func:`~stewartid.identification.averaging.average_experiments`);
+        None when not asked.
     notes : tuple of str
         Sentences for the report's summary.
     """
@@ -122,6 +127,7 @@ class Comparison:
     seconds: float = 0.0
     delay: dict[str, Any] | None = None
     delay_sensitivity: dict[str, Any] | None = None
+    averaging: dict[str, Any] | None = None
     notes: tuple[str, ...] = ()
 
     @property
@@ -297,7 +303,9 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
                     check: bool | Callable[[IdentificationResult], None] = True,
                     entries: Sequence[str] | None = None,
                     policy: VerdictPolicy = DEFAULT_POLICY,
-                    delay: str | float | None = None, jobs: int | None = 1) -> Comparison:
+                    delay: str | float | None = None,
+                    averaging: AveragingPolicy | None = None,
+                    jobs: int | None = 1) -> Comparison:
     """Fit every method to the same experiments, validate each on held-out time segments and
     say which to trust; writes no file.
 
@@ -340,6 +348,12 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
         The force channels' delay behind the motion (s; 0: as logged); by default estimated
         where the motion tells it from damping and applied when beyond noise
         (:func:`~stewartid.comparison.align_experiments`).
+    averaging : AveragingPolicy or None
+        Average experiments sampled well above what the fits need over blocks of samples before
+        anything else sees them, as this rule allows (e.g.
+        :data:`~stewartid.identification.averaging.DEFAULT_AVERAGING`;
+        :func:`~stewartid.identification.averaging.average_experiments`); None (default) keeps
+        every sample. The validation records are predicted as logged.
     jobs : int or None
         Worker processes fitting and validating the methods (and the physical model) side by
         side; None: every core (one where workers cannot start by fork,
@@ -360,7 +374,8 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
         platform = load_platform(platform)
     if not (isinstance(folds, int | np.integer) and folds >= 2):
         raise ConfigError(f"the validation needs at least 2 folds; got {folds!r}.")
-    alignment = align_experiments(_experiments(experiments, platform), platform, delay)
+    averaged = average_experiments(_experiments(experiments, platform), averaging)
+    alignment = align_experiments(averaged.experiments, platform, delay)
     datasets = alignment.experiments
     records = _experiments(validate or (), platform)
     if records and alignment.entry is not None and alignment.entry["applied"]:
@@ -398,14 +413,15 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
     comparison = Comparison(
         tuple(runs), verdict, platform, tuple(datasets), tuple(records), folds, nominal[0],
         nominal[1], nominal_source or "", section, physical is not None and physical.required,
-        time.perf_counter() - started, alignment.entry, alignment.sensitivity,
+        time.perf_counter() - started, alignment.entry, alignment.sensitivity, averaged.entry,
         () if alignment.sensitivity is None else (delay_note(alignment.sensitivity),))
+    added = {"averaging": averaged.entry, "delay_sensitivity": alignment.sensitivity}
+    added = {key: value for key, value in added.items() if value is not None}
     fields: dict[str, Any] = {}
     if alignment.entry is not None:
         fields["delay"] = alignment.entry
-    if alignment.sensitivity is not None:
-        fields["diagnostics"] = {**comparison.result.diagnostics,
-                                 "delay_sensitivity": alignment.sensitivity}
+    if added:
+        fields["diagnostics"] = {**comparison.result.diagnostics, **added}
     return comparison.with_result(**fields) if fields else comparison
 
 

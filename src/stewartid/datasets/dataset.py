@@ -111,6 +111,37 @@ class Dataset:
         record._derived[_SOURCE] = (weakref.ref(self), rows)
         return record
 
+    def averaged(self, samples: int) -> Dataset:
+        """The record at 1/``samples`` of its rate: every signal and the time stamps averaged over
+        consecutive blocks of ``samples`` samples (an incomplete last block dropped).
+
+        A block mean of a signal s is s at the block's mean time up to
+        max|s''| T^2 (k^2 - 1) / 24 (T the period, k = ``samples``): for a sine of frequency f
+        a gain sin(k w T / 2) / (k sin(w T / 2)) = 1 - (w T)^2 (k^2 - 1) / 24 + ..., w = 2 pi f,
+        and no phase. White noise of variance s^2 per sample becomes white noise of s^2 / k per
+        sample at the lower rate: the same density at the frequencies below the new Nyquist's.
+
+        Raises
+        ------
+        ConfigError
+            ``samples`` is not a whole number >= 1, or leaves fewer than :data:`MIN_SAMPLES`.
+        """
+        if not (isinstance(samples, int | np.integer) and samples >= 1):
+            raise ConfigError(f"{self.name}: samples averaged must be a whole number >= 1; got "
+                              f"{samples!r}.")
+        if samples == 1:
+            return self
+        blocks = len(self) // samples
+        if blocks < MIN_SAMPLES:
+            raise ConfigError(f"{self.name}: averaging {samples} samples leaves {blocks} of "
+                              f"{len(self)} (at least {MIN_SAMPLES} needed); average fewer.")
+
+        def mean(array: np.ndarray) -> np.ndarray:
+            return array[:blocks * samples].reshape(blocks, samples, *array.shape[1:]).mean(axis=1)
+
+        return Dataset(t=mean(self.t), pose=mean(self.pose), lengths=mean(self.lengths),
+                       forces=mean(self.forces), name=self.name)
+
     def clear_derived(self) -> None:
         """Drop what was derived from this record (:meth:`derived`), and the memory it holds;
         it is computed again when asked."""

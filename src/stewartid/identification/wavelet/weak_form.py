@@ -36,18 +36,58 @@ def _family_coefficients(order: int, size: int) -> tuple[np.ndarray, ...]:
     return tuple(out)
 
 
+#: Samples per span from which the rectangle rule on the samples integrates the test functions
+#: (polynomials of degree 2 order + size + 1) accurately enough: within 1e-4 of the rows' scale
+#: (docs/benchmarks.md, "Averaged fast logs"). A shorter span is integrated against the samples'
+#: local Lagrange interpolant of :data:`STENCIL` samples (degree one less), by Gauss-Legendre
+#: quadrature of :data:`GAUSS_POINTS` nodes between consecutive samples.
+RESOLVED_SAMPLES = 400
+STENCIL = 6
+GAUSS_POINTS = 6
+
+
+def _interpolated_family(t: np.ndarray, start: float, stop: float, order: int, size: int,
+                         h: float) -> tuple[np.ndarray, ...]:
+    """Quadrature weights (n, size + 1) of g, g', g'', g''' on the samples ``t``: their
+    integrals over [start, stop] against the samples' interpolant (:data:`RESOLVED_SAMPLES`)."""
+    half, centre = 0.5 * (stop - start), 0.5 * (start + stop)
+    edges = np.r_[start, t, stop]
+    nodes, weights = np.polynomial.legendre.leggauss(GAUSS_POINTS)
+    width = np.diff(edges)[:, None]
+    points = edges[:-1, None] + 0.5 * width * (nodes + 1)              # (segments, nodes)
+    # one interpolant per segment, on the samples about it
+    first = np.clip(np.arange(len(t) + 1) - STENCIL // 2, 0, len(t) - STENCIL)
+    u = (points - t[first, None]) / h
+    stencil = np.arange(STENCIL)
+    lagrange = np.stack([np.prod([(u - i) / (j - i) for i in stencil if i != j], axis=0)
+                         for j in stencil], axis=-1)               # (segments, nodes, STENCIL)
+    coefficients = _family_coefficients(order, size)
+    vander = polynomial.polyvander((points.ravel() - centre) / half, coefficients[0].shape[0] - 1)
+    values = np.hstack([vander @ c / half ** d for d, c in enumerate(coefficients)])
+    values = values.reshape(*points.shape, -1) * (0.5 * width * weights)[:, :, None]
+    parts = np.einsum("sgj,sgc->sjc", lagrange, values)             # (segments, STENCIL, 4 (K+1))
+    out = np.zeros((len(t), parts.shape[-1]))
+    np.add.at(out, first[:, None] + stencil, parts)
+    return tuple(np.split(out, 4, axis=1))
+
+
 def test_family(t: np.ndarray, start: float, stop: float, order: int, size: int, h: float
                 ) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
-    """The test functions of one span, sampled and scaled by ``h`` for quadrature.
+    """The test functions of one span as quadrature weights on its samples ``t``: sampled and
+    scaled by ``h`` (the rectangle rule), or, on fewer than :data:`RESOLVED_SAMPLES` samples,
+    integrated against their interpolant (:func:`_interpolated_family`).
 
     phi_k = d/dt [(1 - x^2)^p x^k], x = (t - c) / L, orthonormalised; the mean row is the bump
     orthogonalised against them. Returns (phi, phi', phi'') (size, n) and (g, g', g'') (n,).
     """
     half, centre = 0.5 * (stop - start), 0.5 * (start + stop)
-    x = (t - centre) / half
-    vander = polynomial.polyvander(x, _family_coefficients(order, size)[0].shape[0] - 1)
-    g0, g1, g2, g3 = (vander @ c * (h / half ** d)
-                      for d, c in enumerate(_family_coefficients(order, size)))
+    if len(t) < RESOLVED_SAMPLES:
+        g0, g1, g2, g3 = _interpolated_family(t, start, stop, order, size, h)
+    else:
+        x = (t - centre) / half
+        vander = polynomial.polyvander(x, _family_coefficients(order, size)[0].shape[0] - 1)
+        g0, g1, g2, g3 = (vander @ c * (h / half ** d)
+                          for d, c in enumerate(_family_coefficients(order, size)))
     phi0, phi1, phi2 = g1[:, 1:].T, g2[:, 1:].T, g3[:, 1:].T
     u, s, _ = np.linalg.svd(phi0, full_matrices=False)
     transform = (u / s).T  # orthonormal rows
