@@ -37,10 +37,10 @@ def _family_coefficients(order: int, size: int) -> tuple[np.ndarray, ...]:
 
 
 #: Samples per span from which the rectangle rule on the samples integrates the test functions
-#: (polynomials of degree 2 order + size + 1) accurately enough: within 1e-4 of the rows' scale
-#: (docs/benchmarks.md, "Averaged fast logs"). A shorter span is integrated against the samples'
-#: local Lagrange interpolant of :data:`STENCIL` samples (degree one less), by Gauss-Legendre
-#: quadrature of :data:`GAUSS_POINTS` nodes between consecutive samples.
+#: (polynomials of degree 2 order + size + 1) to well below the rows' noise. A shorter span is
+#: integrated against the samples' local Lagrange interpolant of :data:`STENCIL` samples (degree
+#: one less), by Gauss-Legendre quadrature of :data:`GAUSS_POINTS` nodes between consecutive
+#: samples.
 RESOLVED_SAMPLES = 400
 STENCIL = 6
 GAUSS_POINTS = 6
