@@ -134,7 +134,7 @@ def matrix_row(result, M0: np.ndarray, B0: np.ndarray) -> dict:
 def seed_rows(platform, kind: str, engine: str, seed: int, data, loaded_data,
               delays=(None,)) -> list:
     """Rows of one seed: every compared method and the trusted one for each force delay in
-    ``delays`` (None: ``identify``'s default, estimated where the motion tells it), the physical
+    ``delays`` (None: ``identify``'s default; "auto": estimated; or seconds), the physical
     model."""
     M0, B0 = nominal_matrices(platform)
     rows = []
@@ -189,8 +189,11 @@ def summary(rows: list[dict]) -> list[str]:
         group = [r for r in rows if (r["engine"], r["kind"], r.get("delay")) == (engine, kind,
                                                                                   delay)]
         applied = [r["applied_delay_s"] for r in group if r["method"] == "trusted"]
-        delay_text = (f"estimated, applied {1e3 * min(applied):.1f}-{1e3 * max(applied):.1f} ms"
-                      if delay == "default" else f"{delay:g} s (given)")
+        span = (f"applied {1e3 * min(applied):.1f}-{1e3 * max(applied):.1f} ms" if any(applied)
+                else "none applied")
+        delay_text = (f"as identify takes it, {span}" if delay == "default"
+                      else f"estimated (--delay auto), {span}" if delay == "auto"
+                      else f"{delay:g} s (given)")
         for method in [*METHODS, "trusted"]:
             mine = [r for r in group if r["method"] == method]
             if not mine:
@@ -247,8 +250,8 @@ def main() -> None:
     parser.add_argument("--duration", type=float, default=20.0, help="s per experiment")
     parser.add_argument("--kinds", default=",".join(KINDS))
     parser.add_argument("--delays", default="default,0",
-                        help="force delays given to compare_methods: 'default' (estimated as "
-                             "identify does) and/or seconds")
+                        help="force delays given to compare_methods: 'default' (as identify "
+                             "takes them), 'auto' (estimated) and/or seconds")
     parser.add_argument("--no-payload", action="store_true",
                         help="skip the loaded platform's logs and payload mode")
     parser.add_argument("--cache", type=Path, default=Path("electric_study_logs"),
@@ -264,7 +267,8 @@ def main() -> None:
         return
     platform = electric_platform()
     loaded = platform.replace(**{f"payload__{k}": v for k, v in PAYLOAD.items()})
-    delays = [None if v == "default" else float(v) for v in args.delays.split(",")]
+    delays = [None if v == "default" else v if v == "auto" else float(v)
+              for v in args.delays.split(",")]
     rows = []
     for kind in args.kinds.split(","):
         tag = f"{args.engine}-{kind}-{args.duration:g}s"
