@@ -189,7 +189,7 @@ def summary(rows: list[dict]) -> list[str]:
         group = [r for r in rows if (r["engine"], r["kind"], r.get("delay")) == (engine, kind,
                                                                                   delay)]
         applied = [r["applied_delay_s"] for r in group if r["method"] == "trusted"]
-        span = (f"applied {1e3 * min(applied):.1f}-{1e3 * max(applied):.1f} ms" if any(applied)
+        span = (f"applied {1e3 * min(applied):.1f} to {1e3 * max(applied):.1f} ms" if any(applied)
                 else "none applied")
         delay_text = (f"as identify takes it, {span}" if delay == "default"
                       else f"estimated (--delay auto), {span}" if delay == "auto"
