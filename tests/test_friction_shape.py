@@ -176,3 +176,8 @@ def test_report_says_how_the_data_weigh_the_shapes():
     assert "cannot tell the shape" in friction_shape_lines(Result)[0]
     Result.diagnostics = {"coulomb_shape_weights": {"erf": 1.0}}  # one shape asked for
     assert friction_shape_lines(Result) == []
+    Result.diagnostics = {"coulomb_shape_weights": {"algebraic": 0.0, "erf": 1.0},
+                          "exact_sign_weight": 0.97}
+    assert "exact sign at 0.97" in friction_shape_lines(Result)[1]
+    Result.diagnostics["exact_sign_weight"] = 1e-6  # our plant's smooth law: nothing to say
+    assert len(friction_shape_lines(Result)) == 1

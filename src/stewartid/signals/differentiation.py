@@ -242,6 +242,9 @@ def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -
     return _estimate_frequency(x, sample_rate, refine)
 
 
+#: Spread, relative to the most moving channel's, below which a channel holds only round-off.
+ROUND_OFF_SPREAD = 1e-9
+
 #: Frequencies of read-only arrays, by identity, while the array lives.
 _FREQUENCIES: dict[tuple[int, float, bool], tuple[weakref.ref, float]] = {}
 
@@ -258,8 +261,10 @@ def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool) -> floa
     # each channel's transform on contiguous samples (time last): faster, the same numbers
     windowed = np.ascontiguousarray((centered * np.hanning(n)[:, None]).T)
     relative = np.abs(np.fft.rfft(windowed, nfft, axis=1)[:, 1:])
-    # compare channels by spectral peak relative to the channel's own scale: units differ
-    relative /= np.where(spread > 0, spread, np.inf)[:, None]
+    # compare channels by spectral peak relative to the channel's own scale: units differ; a
+    # channel that moves only by round-off (a still DOF of a noise-free record) has no line
+    moving = spread > ROUND_OFF_SPREAD * spread.max()
+    relative /= np.where(moving, spread, np.inf)[:, None]
     # the largest, the lowest frequency and then the first channel of equal ones
     peaks = np.argmax(relative, axis=1)
     values = relative[np.arange(len(peaks)), peaks]

@@ -51,10 +51,20 @@ def friction_shape_lines(result: IdentificationResult) -> list[str]:
     if len(weights) < 2:
         return []
     shown = max(weights.values()) > 0.95
-    return ["Its Coulomb sign near a reversal was fitted with two shapes of one slope; the "
-            "data weigh them " + ", ".join(f"{name} {w:.2f}" for name, w in weights.items())
-            + (" (they show the shape" if shown else " (they cannot tell the shape; the "
-               "spread between the two fits is in its standard errors") + ")."]
+    lines = ["Its Coulomb sign near a reversal was fitted with two shapes of one slope; the "
+             "data weigh them " + ", ".join(f"{name} {w:.2f}" for name, w in weights.items())
+             + (" (they show the shape" if shown else " (they cannot tell the shape; the "
+                "spread between the two fits is in its standard errors") + ")."]
+    sharp = result.diagnostics.get("exact_sign_weight")
+    if sharp is not None and sharp > SHARP_SIGN_NOTED:
+        lines.append(f"The data weigh an exact sign at {sharp:.2f} against the likelier shape: "
+                     "the friction turns over faster than the model's sign (dry friction that "
+                     "sticks), and the distance to that fit is in the standard errors.")
+    return lines
+
+
+#: Weight of the exact sign from which the report says the friction is sharper than the model's.
+SHARP_SIGN_NOTED = 0.05
 
 
 def third_harmonic_lines(result: IdentificationResult) -> list[str]:
