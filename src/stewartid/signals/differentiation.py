@@ -222,8 +222,7 @@ def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -
     """Frequency (Hz) of the dominant sine in ``x`` (N,) or (N, m).
 
     The largest peak of the Hann-windowed, zero-padded spectrum of the most varying channel,
-    refined by a sine fit; ``refine=False``: the plain peak, within half a bin. Never below one
-    period per record: slower content is drift, not the excitation. Computed once for
+    refined by a sine fit; ``refine=False``: the plain peak, within half a bin. Computed once for
     a read-only array (a record's columns): every method asks for it.
 
     Raises
@@ -250,8 +249,7 @@ ROUND_OFF_SPREAD = 1e-9
 _FREQUENCIES: dict[tuple[int, float, bool], tuple[weakref.ref, float]] = {}
 
 
-def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool,
-                        lowest: float = 0.0) -> float:
+def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool) -> float:
     x = np.asarray(x, dtype=float)
     x = x[:, None] if x.ndim == 1 else x
     centered = x - x.mean(axis=0)
@@ -267,26 +265,17 @@ def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool,
     # channel that moves only by round-off (a still DOF of a noise-free record) has no line
     moving = spread > ROUND_OFF_SPREAD * spread.max()
     relative /= np.where(moving, spread, np.inf)[:, None]
-    relative[:, :max(0, math.ceil(lowest * nfft / sample_rate) - 1)] = 0.0
     # the largest, the lowest frequency and then the first channel of equal ones
     peaks = np.argmax(relative, axis=1)
     values = relative[np.arange(len(peaks)), peaks]
     top = np.flatnonzero(values == values.max())
     channel = top[np.argmin(peaks[top])]
     frequency = (peaks[channel] + 1) * sample_rate / nfft
-    if refine:
-        frequency = _refine_frequency(centered[:, channel], sample_rate, frequency, lowest)
-    if frequency * n < sample_rate and lowest == 0.0:
-        # under one period in the record: drift (a sag, a short piece of a slow line), not a
-        # sine; the search starts again at one period per record
-        return _estimate_frequency(x, sample_rate, refine, lowest=sample_rate / n)
-    return frequency
+    return _refine_frequency(centered[:, channel], sample_rate, frequency) if refine else frequency
 
 
-def _refine_frequency(x: np.ndarray, sample_rate: float, frequency: float,
-                      lowest: float = 0.0) -> float:
-    """Frequency near ``frequency``, not below ``lowest``, of the least-squares fit of
-    [sin, cos, 1, t] to ``x``."""
+def _refine_frequency(x: np.ndarray, sample_rate: float, frequency: float) -> float:
+    """Frequency near ``frequency`` of the least-squares fit of [sin, cos, 1, t] to ``x``."""
     t = np.arange(len(x)) / sample_rate
     basis = np.empty((4, len(x)))  # orthonormal rows: the constant and trend, then the sine's
     basis[:2] = np.linalg.qr(np.column_stack([np.ones_like(t), t]))[0].T
@@ -307,7 +296,7 @@ def _refine_frequency(x: np.ndarray, sample_rate: float, frequency: float,
         return float(residual @ residual)
 
     bin_width = sample_rate / len(x)
-    return minimize_bounded(cost, max(frequency - bin_width, 1e-6 * frequency, lowest),
+    return minimize_bounded(cost, max(frequency - bin_width, 1e-6 * frequency),
                             frequency + bin_width, 1e-9 * frequency)
 
 
