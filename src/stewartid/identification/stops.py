@@ -71,6 +71,8 @@ class LegStops(NamedTuple):
     ----------
     q_dot : ndarray, shape (N, 6)
         Pose rates the Coulomb signs are taken from.
+    sign_window : float
+        Their Savitzky-Golay window, s (:func:`~stewartid.signals.sign_rates.coulomb_sign_rates`).
     leg_rates : ndarray, shape (N, 6)
         J_lq q_dot, m/s.
     stopped : ndarray of bool, shape (N, 6)
@@ -79,6 +81,7 @@ class LegStops(NamedTuple):
     """
 
     q_dot: np.ndarray
+    sign_window: float
     leg_rates: np.ndarray
     stopped: np.ndarray
     stops: list[Stop]
@@ -117,7 +120,7 @@ def find_stops(q: np.ndarray, leg_jacobian: np.ndarray, sample_rate: float, wind
             terms = 2 + int(policy.terms_per_window * (stop - start) / (window * sample_rate))
             stops.append(Stop(leg, start, stop, terms))
             stopped[start:stop, leg] = True
-    return LegStops(q_dot, leg_rates, stopped, stops)
+    return LegStops(q_dot, sign_window, leg_rates, stopped, stops)
 
 
 def _runs(mask: np.ndarray, gap: int) -> list[tuple[int, int]]:

@@ -119,9 +119,13 @@ def filtered_regression(experiments: list[Experiment], platform: Platform,
                                  exp.generalized_force[..., None])[..., 0]
         force_noise.append(white_noise_covariance(forces, differentiate(
             forces, exp.sample_rate, w / SAVGOL_FRACTION, order, (0,))[0]))
-        sign_rates, sign_window = coulomb_sign_rates(exp.q, exp.sample_rate, w, pose_noise[-1])
-        stops = (find_stops(exp.q, exp.leg_jacobian, exp.sample_rate, w, pose_noise[-1])
-                 if leg_stops else None)
+        stops = None
+        if leg_stops:  # the stops are found on the sign rates, which they return
+            stops = find_stops(exp.q, exp.leg_jacobian, exp.sample_rate, w, pose_noise[-1])
+            sign_rates, sign_window = stops.q_dot, stops.sign_window
+        else:
+            sign_rates, sign_window = coulomb_sign_rates(exp.q, exp.sample_rate, w,
+                                                         pose_noise[-1])
         motion = [np.ascontiguousarray(x.T) for x in (q, q_dot, q_ddot, sign_rates)]
         signals = buffer[:6 * width * n].reshape(6, width, n)
         signals[:, 0] = exp.generalized_force.T
