@@ -71,7 +71,7 @@ def __getattr__(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
-    return sorted([*globals(), *_EXPORTS])
+    return sorted(__all__)
 
 
 __all__ = ["ConfigError", "DataError", "IdentificationError", "KinematicsError", "Platform",
