@@ -231,6 +231,9 @@ def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -
         When no channel moves.
     """
     if isinstance(x, np.ndarray) and not x.flags.writeable:
+        whole = _WHOLES.get(id(x))
+        if whole is not None and whole[0]() is x:
+            return estimate_frequency(whole[1], sample_rate, refine)
         key = (id(x), float(sample_rate), bool(refine))
         known = _FREQUENCIES.get(key)
         if known is None or known[0]() is not x:
@@ -242,11 +245,27 @@ def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -
     return _estimate_frequency(x, sample_rate, refine)
 
 
+def share_frequency(piece: np.ndarray, whole: np.ndarray) -> None:
+    """Make :func:`estimate_frequency` of the read-only ``piece`` (rows of ``whole``, (n, m))
+    answer ``whole``'s (N, m), while ``piece`` lives.
+
+    A piece cut from a record (a validation fold) moves at the record's excitation, but may hold
+    too few periods of its slowest line for that to be found in it alone.
+    """
+    if piece.flags.writeable or whole.flags.writeable:
+        raise ValueError("share_frequency takes read-only arrays (a record's columns).")
+    key = id(piece)
+    _WHOLES[key] = (weakref.ref(piece, lambda _, key=key: _WHOLES.pop(key, None)), whole)
+
+
 #: Spread, relative to the most moving channel's, below which a channel holds only round-off.
 ROUND_OFF_SPREAD = 1e-9
 
 #: Frequencies of read-only arrays, by identity, while the array lives.
 _FREQUENCIES: dict[tuple[int, float, bool], tuple[weakref.ref, float]] = {}
+
+#: Records whose frequency a piece takes (:func:`share_frequency`), by the piece's identity.
+_WHOLES: dict[int, tuple[weakref.ref, np.ndarray]] = {}
 
 
 def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool) -> float:
@@ -302,4 +321,4 @@ def _refine_frequency(x: np.ndarray, sample_rate: float, frequency: float) -> fl
 
 __all__ = ["DEFAULT_ORDER", "DEFAULT_WINDOW_PERIODS", "convolve_valid", "default_window",
            "differentiate", "estimate_frequency", "kernel_filter", "kernel_taps",
-           "savgol_coefficients", "savgol_gain", "trim", "window_samples"]
+           "savgol_coefficients", "savgol_gain", "share_frequency", "trim", "window_samples"]
