@@ -278,12 +278,20 @@ def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool) -> floa
     n = len(x)
     nfft = 1 << int(np.ceil(np.log2(8 * n if refine else n)))
     # each channel's transform on contiguous samples (time last): faster, the same numbers
-    windowed = np.ascontiguousarray((centered * np.hanning(n)[:, None]).T)
+    hann = np.hanning(n)
+    windowed = np.ascontiguousarray((centered * hann[:, None]).T)
     relative = np.abs(np.fft.rfft(windowed, nfft, axis=1)[:, 1:])
     # compare channels by spectral peak relative to the channel's own scale: units differ; a
-    # channel that moves only by round-off (a still DOF of a noise-free record) has no line
-    moving = spread > ROUND_OFF_SPREAD * spread.max()
-    relative /= np.where(moving, spread, np.inf)[:, None]
+    # channel that moves only by round-off (a still DOF of a noise-free record) has no line.
+    # The scale leaves out white noise (the same power in every bin: the median bin's, the lines
+    # holding few), so that noise does not demote a small channel's line; a channel whose
+    # motion is below its noise has no line either
+    noise = np.median(relative ** 2, axis=1) / (math.log(2) * np.sum(hann ** 2))
+    scale = np.sqrt(np.maximum(spread ** 2 - noise, 0.0))
+    moving = (spread > ROUND_OFF_SPREAD * spread.max()) & (scale ** 2 > noise)
+    if not moving.any():
+        moving, scale = spread > ROUND_OFF_SPREAD * spread.max(), spread
+    relative /= np.where(moving, scale, np.inf)[:, None]
     # the largest, the lowest frequency and then the first channel of equal ones
     peaks = np.argmax(relative, axis=1)
     values = relative[np.arange(len(peaks)), peaks]
