@@ -221,9 +221,10 @@ def trim(window: float, sample_rate: float, order: int = DEFAULT_ORDER) -> int:
 def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -> float:
     """Frequency (Hz) of the dominant sine in ``x`` (N,) or (N, m).
 
-    The largest peak of the Hann-windowed, zero-padded spectrum of the most varying channel,
-    refined by a sine fit; ``refine=False``: the plain peak, within half a bin. Computed once for
-    a read-only array (a record's columns): every method asks for it.
+    The largest peak of the Hann-windowed, zero-padded spectrum of the most varying channel
+    (against its scale less white noise), refined by a sine fit; ``refine=False``: the plain
+    peak, within half a bin. Computed once for a read-only array (a record's columns): every
+    method asks for it; a piece of a record may take the record's (:func:`share_frequency`).
 
     Raises
     ------
