@@ -232,6 +232,25 @@ def test_estimate_frequency_ignores_channels_that_hold_only_round_off():
     assert estimate_frequency(x, fs) == pytest.approx(0.3, rel=1e-2)
 
 
+def test_estimate_frequency_is_not_moved_by_white_noise():
+    # a roll record of three sines beside a lateral DOF moved by coupling, mostly at the fastest
+    # line: that line stands out against the lateral scale more than the roll's largest line
+    # against the roll's. White noise adds to the lateral scale, not to its line, and turned the
+    # choice to the roll's 0.3 Hz; a channel of noise alone holds no line
+    fs = 1000.0
+    t = np.arange(20000) / fs
+    roll = sum(share * 5e-3 * np.sin(2 * np.pi * hz * t + phase)
+               for hz, share, phase in ((0.3, 0.6, 0.0), (0.7, 0.3, 1.0), (1.5, 0.15, 2.0)))
+    lateral = 2e-5 * np.sin(2 * np.pi * 0.7 * t + 0.5) + 7e-5 * np.sin(2 * np.pi * 1.5 * t + 1.0)
+    x = np.column_stack([lateral, roll])
+    rng = np.random.default_rng(0)
+    assert estimate_frequency(x, fs) == pytest.approx(1.5, rel=1e-3)
+    noisy = x + rng.normal(size=x.shape) * [3e-5, 1e-5]
+    assert estimate_frequency(noisy, fs) == pytest.approx(1.5, rel=1e-3)
+    only_noise = np.column_stack([roll, 1e-5 * rng.normal(size=len(t))])
+    assert estimate_frequency(only_noise, fs) == pytest.approx(0.3, rel=1e-2)
+
+
 def test_result_json_round_trip_and_table(tmp_path, paper, truth):
     M, B = truth
     data = [make_experiment(paper, M, B, k) for k in range(6)]

@@ -221,9 +221,10 @@ def trim(window: float, sample_rate: float, order: int = DEFAULT_ORDER) -> int:
 def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -> float:
     """Frequency (Hz) of the dominant sine in ``x`` (N,) or (N, m).
 
-    The largest peak of the Hann-windowed, zero-padded spectrum of the most varying channel,
-    refined by a sine fit; ``refine=False``: the plain peak, within half a bin. Computed once for
-    a read-only array (a record's columns): every method asks for it.
+    The largest peak of the Hann-windowed, zero-padded spectrum of the most varying channel
+    (against its scale less white noise), refined by a sine fit; ``refine=False``: the plain
+    peak, within half a bin. Computed once for a read-only array (a record's columns): every
+    method asks for it; a piece of a record may take the record's (:func:`share_frequency`).
 
     Raises
     ------
@@ -231,6 +232,9 @@ def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -
         When no channel moves.
     """
     if isinstance(x, np.ndarray) and not x.flags.writeable:
+        whole = _WHOLES.get(id(x))
+        if whole is not None and whole[0]() is x:
+            return estimate_frequency(whole[1], sample_rate, refine)
         key = (id(x), float(sample_rate), bool(refine))
         known = _FREQUENCIES.get(key)
         if known is None or known[0]() is not x:
@@ -242,11 +246,27 @@ def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -
     return _estimate_frequency(x, sample_rate, refine)
 
 
+def share_frequency(piece: np.ndarray, whole: np.ndarray) -> None:
+    """Make :func:`estimate_frequency` of the read-only ``piece`` (rows of ``whole``, (n, m))
+    answer ``whole``'s (N, m), while ``piece`` lives.
+
+    A piece cut from a record (a validation fold) moves at the record's excitation, but may hold
+    too few periods of its slowest line for that to be found in it alone.
+    """
+    if piece.flags.writeable or whole.flags.writeable:
+        raise ValueError("share_frequency takes read-only arrays (a record's columns).")
+    key = id(piece)
+    _WHOLES[key] = (weakref.ref(piece, lambda _, key=key: _WHOLES.pop(key, None)), whole)
+
+
 #: Spread, relative to the most moving channel's, below which a channel holds only round-off.
 ROUND_OFF_SPREAD = 1e-9
 
 #: Frequencies of read-only arrays, by identity, while the array lives.
 _FREQUENCIES: dict[tuple[int, float, bool], tuple[weakref.ref, float]] = {}
+
+#: Records whose frequency a piece takes (:func:`share_frequency`), by the piece's identity.
+_WHOLES: dict[int, tuple[weakref.ref, np.ndarray]] = {}
 
 
 def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool) -> float:
@@ -259,12 +279,20 @@ def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool) -> floa
     n = len(x)
     nfft = 1 << int(np.ceil(np.log2(8 * n if refine else n)))
     # each channel's transform on contiguous samples (time last): faster, the same numbers
-    windowed = np.ascontiguousarray((centered * np.hanning(n)[:, None]).T)
+    hann = np.hanning(n)
+    windowed = np.ascontiguousarray((centered * hann[:, None]).T)
     relative = np.abs(np.fft.rfft(windowed, nfft, axis=1)[:, 1:])
     # compare channels by spectral peak relative to the channel's own scale: units differ; a
-    # channel that moves only by round-off (a still DOF of a noise-free record) has no line
-    moving = spread > ROUND_OFF_SPREAD * spread.max()
-    relative /= np.where(moving, spread, np.inf)[:, None]
+    # channel that moves only by round-off (a still DOF of a noise-free record) has no line.
+    # The scale leaves out white noise (the same power in every bin: the median bin's, the lines
+    # holding few), so that noise does not demote a small channel's line; a channel whose
+    # motion is below its noise has no line either
+    noise = np.median(relative ** 2, axis=1) / (math.log(2) * np.sum(hann ** 2))
+    scale = np.sqrt(np.maximum(spread ** 2 - noise, 0.0))
+    moving = (spread > ROUND_OFF_SPREAD * spread.max()) & (scale ** 2 > noise)
+    if not moving.any():
+        moving, scale = spread > ROUND_OFF_SPREAD * spread.max(), spread
+    relative /= np.where(moving, scale, np.inf)[:, None]
     # the largest, the lowest frequency and then the first channel of equal ones
     peaks = np.argmax(relative, axis=1)
     values = relative[np.arange(len(peaks)), peaks]
@@ -302,4 +330,4 @@ def _refine_frequency(x: np.ndarray, sample_rate: float, frequency: float) -> fl
 
 __all__ = ["DEFAULT_ORDER", "DEFAULT_WINDOW_PERIODS", "convolve_valid", "default_window",
            "differentiate", "estimate_frequency", "kernel_filter", "kernel_taps",
-           "savgol_coefficients", "savgol_gain", "trim", "window_samples"]
+           "savgol_coefficients", "savgol_gain", "share_frequency", "trim", "window_samples"]

@@ -345,10 +345,15 @@ def fold_bounds(n: int, folds: int) -> np.ndarray:
 
 def time_piece(dataset: Dataset, start: int, stop: int) -> Dataset:
     """Samples ``start:stop`` of a record, named after their time span; one copy per record and
-    span, which every method's folds share."""
+    span, which every method's folds share. Its excitation frequency is the record's: a fold's
+    piece may hold a single period of the slowest line, too few to find it."""
+    from stewartid.signals.differentiation import share_frequency
+
     def piece(record: Dataset) -> Dataset:
         t = record.t[start:stop]
-        return record.part(slice(start, stop), f"{record.name}[{t[0]:.4g}-{t[-1]:.4g} s]")
+        part = record.part(slice(start, stop), f"{record.name}[{t[0]:.4g}-{t[-1]:.4g} s]")
+        share_frequency(part.pose, record.pose)
+        return part
 
     return dataset.derived(("piece", int(start), int(stop)), piece)
 
