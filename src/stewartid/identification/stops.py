@@ -112,15 +112,28 @@ def find_stops(q: np.ndarray, leg_jacobian: np.ndarray, sample_rate: float, wind
     mean = leg_jacobian.mean(axis=0)
     noise = np.linalg.norm(taps) * np.sqrt(np.clip(
         np.einsum("ij,jk,ik->i", mean, pose_covariance, mean), 0.0, None))
+    stopped, stops = leg_stop_runs(leg_rates, noise, int(policy.merge * window * sample_rate),
+                                   window * sample_rate, 2, policy)
+    return LegStops(q_dot, sign_window, leg_rates, stopped, stops)
+
+
+def leg_stop_runs(leg_rates: np.ndarray, noise: np.ndarray, gap: int, scale: float,
+                  first_terms: int, policy: StopPolicy = STOPS) -> tuple[np.ndarray, list[Stop]]:
+    """Samples inside a stop (N, 6) and the stops of leg rates ``leg_rates`` (N, 6) whose noise
+    levels are ``noise`` (6,), in the same unit.
+
+    Runs at most ``gap`` samples apart are one stop; a stop of n samples carries ``first_terms``
+    + ``policy.terms_per_window`` n / ``scale`` Legendre terms (``scale``: samples the rows
+    resolve).
+    """
     inside = np.abs(leg_rates) <= policy.band * noise
-    gap = int(policy.merge * window * sample_rate)
     stops, stopped = [], np.zeros_like(inside)
     for leg in range(6):
         for start, stop in _runs(inside[:, leg], gap):
-            terms = 2 + int(policy.terms_per_window * (stop - start) / (window * sample_rate))
+            terms = first_terms + int(policy.terms_per_window * (stop - start) / scale)
             stops.append(Stop(leg, start, stop, terms))
             stopped[start:stop, leg] = True
-    return LegStops(q_dot, sign_window, leg_rates, stopped, stops)
+    return stopped, stops
 
 
 def _runs(mask: np.ndarray, gap: int) -> list[tuple[int, int]]:
@@ -209,4 +222,4 @@ def project_out(basis: np.ndarray, *arrays: np.ndarray) -> list[np.ndarray]:
 
 
 __all__ = ["STOPS", "LegStops", "Stop", "StopPolicy", "filtered_stop_columns", "find_stops",
-           "project_out", "stop_basis"]
+           "leg_stop_runs", "project_out", "stop_basis"]

@@ -389,7 +389,7 @@ def _experiment_equations(work: tuple, k: int) -> tuple[dict[str, list], dict, n
                                  leg_jacobian=experiment.leg_jacobian if legs else None)
                 if {"free", "coulomb"} & set(models) else None)
     equations = {model: model_equations(model, experiment, found, int(estimator.wavelet_order),
-                                        int(estimator.test_functions), k, patterns)
+                                        int(estimator.test_functions), k, patterns, legs)
                  for model in models}
     return equations, found.info, experiment.force_sensitivity, np.std(experiment.q, axis=0)
 
