@@ -14,6 +14,7 @@ import pytest
 from tests.test_electric_identification import AMPLITUDES, ELECTRIC, HZ
 
 from stewartid.datasets.dataset import Dataset
+from stewartid.errors import IdentificationError
 from stewartid.identification.stops import Stop
 from stewartid.identification.wavelet.estimator import WaveletIdentifier
 from stewartid.identification.wavelet.windows import STOP_ROW_SHARE, stop_window_length
@@ -122,3 +123,13 @@ def test_windows_leave_rows_beside_the_stops():
     assert length * 240 / 10.0 == pytest.approx(STOP_ROW_SHARE * 6 * 8)
     assert stop_window_length([], 10.0, 8, 2.0) == 2.0
     assert stop_window_length(stops[:2], 10.0, 8, 2.0) == 2.0
+
+
+def test_a_motion_that_barely_moves_is_refused_in_one_line(electric):
+    """Legs within their noise most of the time leave nothing for the friction law: refused as
+    least squares refuses them."""
+    from tests.test_leg_stops import stick_slip_records
+
+    still = stick_slip_records(electric, duration=4.0, dwell=0.6, pose_noise=2e-5, scale=0.05)
+    with pytest.raises(IdentificationError, match="stand still"):
+        WaveletIdentifier(friction="coulomb").fit(still, electric)

@@ -177,6 +177,16 @@ def filtered_stop_columns(stops: list[Stop], samples: int, sample_rate: float, w
     return np.hstack(columns) if columns else np.zeros((rows, 0))
 
 
+def check_motion(share: float, name: str, fix: str, policy: StopPolicy = STOPS) -> None:
+    """Refuse experiment ``name`` when its legs stand still for a ``share`` of the samples above
+    ``policy.largest_share``; ``fix``: what to do about it."""
+    if share > policy.largest_share:
+        raise IdentificationError(
+            f"{name}: the legs stand still (rate within its noise) for {100 * share:.0f} % of "
+            f"the samples, more than {100 * policy.largest_share:.0f} %: too little motion is "
+            f"left for the friction law; {fix}.")
+
+
 def stop_basis(found: LegStops, sample_rate: float, window: float, step: int, name: str,
                policy: StopPolicy = STOPS) -> np.ndarray:
     """Orthonormal basis (R, r) of the stops' :func:`filtered_stop_columns` in experiment ``name``.
@@ -186,13 +196,8 @@ def stop_basis(found: LegStops, sample_rate: float, window: float, step: int, na
     IdentificationError
         When the legs stand still for more than ``policy.largest_share`` of the samples.
     """
-    share = float(found.stopped.mean())
-    if share > policy.largest_share:
-        raise IdentificationError(
-            f"{name}: the legs stand still (rate within its noise) for {100 * share:.0f} % of "
-            f"the samples, more than {100 * policy.largest_share:.0f} %: too little motion is "
-            "left for the friction law; record a faster or larger motion, or set "
-            "leg_stops=False.")
+    check_motion(float(found.stopped.mean()), name,
+                 "record a faster or larger motion, or set leg_stops=False", policy)
     columns = filtered_stop_columns(found.stops, len(found.stopped), sample_rate, window, step)
     if columns.shape[1] == 0:
         return columns
@@ -221,5 +226,5 @@ def project_out(basis: np.ndarray, *arrays: np.ndarray) -> list[np.ndarray]:
     return out
 
 
-__all__ = ["STOPS", "LegStops", "Stop", "StopPolicy", "filtered_stop_columns", "find_stops",
-           "leg_stop_runs", "project_out", "stop_basis"]
+__all__ = ["STOPS", "LegStops", "Stop", "StopPolicy", "check_motion", "filtered_stop_columns",
+           "find_stops", "leg_stop_runs", "project_out", "stop_basis"]

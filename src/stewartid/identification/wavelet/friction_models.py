@@ -14,6 +14,7 @@ from stewartid.datasets.dataset import Dataset
 from stewartid.errors import IdentificationError
 from stewartid.identification.preparation import Experiment
 from stewartid.identification.result import IdentificationResult
+from stewartid.identification.stops import check_motion
 from stewartid.identification.wavelet.detection import (
     SINGLE_SINE_SHARE,
     Detection,
@@ -61,6 +62,8 @@ def model_equations(model: str, experiment: Experiment, found: Detection, order:
         stops, length = None, WINDOW_LENGTH
         if legs:
             stops = window_stops(found, experiment.sample_rate)
+            check_motion(sum(stop.stop - stop.start for stop in stops) / (6 * len(experiment.t)),
+                         experiment.name, "record a faster or larger motion")
             length = stop_window_length(stops, float(experiment.t[-1] - experiment.t[0]),
                                         functions, WINDOW_LENGTH)
         return window_equations(experiment, found, order, functions, k, False, length,
