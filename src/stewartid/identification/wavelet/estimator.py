@@ -388,8 +388,11 @@ def _experiment_equations(work: tuple, k: int) -> tuple[dict[str, list], dict, n
     patterns = (coulomb_patterns(found, experiment.joint_jacobians, False,
                                  leg_jacobian=experiment.leg_jacobian if legs else None)
                 if {"free", "coulomb"} & set(models) else None)
+    # the legs' stops in the law's windows, unless the free interval constants are fitted
+    # beside them (one sine per experiment: the stops fall between the intervals)
+    stops = legs and "free" not in models
     equations = {model: model_equations(model, experiment, found, int(estimator.wavelet_order),
-                                        int(estimator.test_functions), k, patterns, legs)
+                                        int(estimator.test_functions), k, patterns, stops)
                  for model in models}
     return equations, found.info, experiment.force_sensitivity, np.std(experiment.q, axis=0)
 

@@ -55,8 +55,8 @@ def model_equations(model: str, experiment: Experiment, found: Detection, order:
     """The weak-form equations of one experiment under friction model ``model`` (windows or intervals).
 
     ``patterns``: :func:`~stewartid.identification.wavelet.weak_form.coulomb_patterns` of the
-    experiment, shared by the models that use them; ``legs``: the legs carry a Coulomb level,
-    whose stops the windows leave free (:func:`~stewartid.identification.wavelet.windows.window_stops`).
+    experiment, shared by the models that use them; ``legs``: the windows leave the friction in
+    the legs' stops free (:func:`~stewartid.identification.wavelet.windows.window_stops`).
     """
     if model == "coulomb":
         stops, length = None, WINDOW_LENGTH
