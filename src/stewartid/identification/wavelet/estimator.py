@@ -85,9 +85,11 @@ class WaveletIdentifier(BaseIdentifier):
         Orthonormal zero-mean test functions per interval, 1..12 (polynomial, position); None: the
         paper's (a, b) points.
     friction : {"auto", "free", "shared", "uniform", "coulomb"}
-        "coulomb": windows across reversals with per-type Coulomb forces; "free": every interval
-        constant free; "shared": per-experiment offsets and per-type levels; "uniform": one level;
-        "auto": "coulomb", or on one sine per experiment the better of it and "free".
+        "coulomb": windows across reversals with per-type Coulomb forces (electric legs, without
+        "free" beside it: their stops' friction left free, the windows shortened to leave rows
+        beside it); "free": every interval constant free; "shared": per-experiment offsets and
+        per-type levels; "uniform": one level; "auto": "coulomb", or on one sine per experiment
+        the better of it and "free".
     scale_fractions : tuple of float
         Wavelet supports as fractions of the interval, in (0, 1].
     shifts_per_scale : int
