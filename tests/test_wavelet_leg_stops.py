@@ -133,3 +133,53 @@ def test_a_motion_that_barely_moves_is_refused_in_one_line(electric):
     still = stick_slip_records(electric, duration=4.0, dwell=0.6, pose_noise=2e-5, scale=0.05)
     with pytest.raises(IdentificationError, match="stand still"):
         WaveletIdentifier(friction="coulomb").fit(still, electric)
+
+
+def test_stops_eliminated_as_if_they_were_explicit_unknowns(electric):
+    """The Schur complement of the stops' unknowns gives [Mt Bt], the Coulomb levels and their
+    standard errors of the same weighted fit with every stop term an explicit unknown."""
+    from stewartid.identification.preparation import prepare_experiment
+    from stewartid.identification.wavelet.gls import InvariantFit, fit_jointly, standard_errors
+    from stewartid.identification.wavelet.weak_form import stack_equations
+    from stewartid.identification.wavelet.windows import (
+        _designs,
+        window_equations,
+        window_stops,
+    )
+
+    data = pausing_records(electric, records=1, duration=4.0)[0]
+    estimator = WaveletIdentifier()
+    experiment = prepare_experiment(data, electric, True, joints=True, remainder=True)
+    found = estimator._noise_and_intervals(experiment, 1.0)
+    stops = window_stops(found, experiment.sample_rate)
+    length = stop_window_length(stops, 4.0, 8, 2.0)
+    equations = window_equations(experiment, found, 6, 8, 0, False, length, stops=stops)
+    local = []
+    for e in equations:   # the span of each window's stop columns, independent columns
+        u, singular, _ = np.linalg.svd(e.stops.reshape(48, -1), full_matrices=False)
+        local.append(u[:, singular > 1e-9 * singular[0]].reshape(6, 8, -1))
+    assert all(0 < c.shape[2] < 48 for c in local)
+    stacked = stack_equations([e.rows for e in equations])
+    designs = _designs(stacked.regressors, np.stack([e.coulomb[0] for e in equations]))
+    targets = [stacked.targets[:, :, i] for i in range(6)]
+    rng = np.random.default_rng(1)
+    start = InvariantFit(theta=np.zeros((6, 12)), noise=rng.uniform(0.5, 2.0, (len(local), 6)),
+                         pose_share=np.zeros(6))
+    eliminated = fit_jointly(stacked, designs, targets, start, None, 1, local)
+    # every stop term a column of its own window's rows
+    offsets = np.cumsum([0] + [c.shape[2] for c in local])
+    explicit_designs = []
+    for i in range(6):
+        extra = np.zeros((len(local), 8, offsets[-1]))
+        for j, columns in enumerate(local):
+            extra[j, :, offsets[j]:offsets[j + 1]] = columns[i]
+        explicit_designs.append(np.concatenate([designs[i], extra], axis=2))
+    explicit = fit_jointly(stacked, explicit_designs, targets, start, None, 1)
+    u = designs[0].shape[-1]
+    scale = np.abs(explicit.z[:u]).max()
+    assert np.abs(eliminated.z - explicit.z[:u]).max() < 1e-8 * scale
+    assert np.allclose(np.concatenate(eliminated.local_z), explicit.z[u:], rtol=1e-6,
+                       atol=1e-8 * np.abs(explicit.z[u:]).max())
+    np.testing.assert_allclose(standard_errors(designs, targets, eliminated, local),
+                               standard_errors(explicit_designs, targets, explicit)[:u],
+                               rtol=1e-6)
