@@ -15,6 +15,7 @@ import numpy as np
 
 from stewartid.errors import DataWarning, IdentificationError
 from stewartid.identification.solvers import check_rank, regressor_names
+from stewartid.identification.stops import RANK_CUT
 from stewartid.identification.wavelet.variance_components import (
     chi2_excess,
     compensate,
@@ -209,9 +210,10 @@ class JointFit(NamedTuple):
 
 def _pseudo_inverse(gram: np.ndarray) -> np.ndarray:
     """Inverse of a symmetric positive semi-definite ``gram`` on the span of its eigenvalues
-    above 1e-10 of the largest (stops at one instant on two legs can nearly coincide)."""
+    above :data:`~stewartid.identification.stops.RANK_CUT` of the largest (a stop's part of one
+    sample has no first moment; two legs stopping together give nearly equal columns)."""
     values, vectors = np.linalg.eigh(gram)
-    kept = values > 1e-10 * max(values[-1], 1e-300)
+    kept = values > RANK_CUT * max(values[-1], 1e-300)
     return (vectors[:, kept] / values[kept]) @ vectors[:, kept].T
 
 
@@ -247,7 +249,6 @@ def fit_jointly(stacked: StackedEquations, designs: Sequence[np.ndarray],
     ``local``: per equation, columns (6, R, m) of unknowns its rows alone carry, shared by its
     channels (a stopped leg's free friction), eliminated by their Schur complement.
     """
-
     n_unknowns = designs[0].shape[-1]
     rows = designs[0].shape[1]
     gram = stacked.gram[..., :rows, :rows]
