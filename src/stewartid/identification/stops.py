@@ -112,15 +112,28 @@ def find_stops(q: np.ndarray, leg_jacobian: np.ndarray, sample_rate: float, wind
     mean = leg_jacobian.mean(axis=0)
     noise = np.linalg.norm(taps) * np.sqrt(np.clip(
         np.einsum("ij,jk,ik->i", mean, pose_covariance, mean), 0.0, None))
+    stopped, stops = leg_stop_runs(leg_rates, noise, int(policy.merge * window * sample_rate),
+                                   window * sample_rate, 2, policy)
+    return LegStops(q_dot, sign_window, leg_rates, stopped, stops)
+
+
+def leg_stop_runs(leg_rates: np.ndarray, noise: np.ndarray, gap: int, scale: float,
+                  first_terms: int, policy: StopPolicy = STOPS) -> tuple[np.ndarray, list[Stop]]:
+    """Samples inside a stop (N, 6) and the stops of leg rates ``leg_rates`` (N, 6) whose noise
+    levels are ``noise`` (6,), in the same unit.
+
+    Runs at most ``gap`` samples apart are one stop; a stop of n samples carries ``first_terms``
+    + ``policy.terms_per_window`` n / ``scale`` Legendre terms (``scale``: samples the rows
+    resolve).
+    """
     inside = np.abs(leg_rates) <= policy.band * noise
-    gap = int(policy.merge * window * sample_rate)
     stops, stopped = [], np.zeros_like(inside)
     for leg in range(6):
         for start, stop in _runs(inside[:, leg], gap):
-            terms = 2 + int(policy.terms_per_window * (stop - start) / (window * sample_rate))
+            terms = first_terms + int(policy.terms_per_window * (stop - start) / scale)
             stops.append(Stop(leg, start, stop, terms))
             stopped[start:stop, leg] = True
-    return LegStops(q_dot, sign_window, leg_rates, stopped, stops)
+    return stopped, stops
 
 
 def _runs(mask: np.ndarray, gap: int) -> list[tuple[int, int]]:
@@ -164,6 +177,16 @@ def filtered_stop_columns(stops: list[Stop], samples: int, sample_rate: float, w
     return np.hstack(columns) if columns else np.zeros((rows, 0))
 
 
+def check_motion(share: float, name: str, fix: str, policy: StopPolicy = STOPS) -> None:
+    """Refuse experiment ``name`` when its legs stand still for a ``share`` of the samples above
+    ``policy.largest_share``; ``fix``: what to do about it."""
+    if share > policy.largest_share:
+        raise IdentificationError(
+            f"{name}: the legs stand still (rate within its noise) for {100 * share:.0f} % of "
+            f"the samples, more than {100 * policy.largest_share:.0f} %: too little motion is "
+            f"left for the friction law; {fix}.")
+
+
 def stop_basis(found: LegStops, sample_rate: float, window: float, step: int, name: str,
                policy: StopPolicy = STOPS) -> np.ndarray:
     """Orthonormal basis (R, r) of the stops' :func:`filtered_stop_columns` in experiment ``name``.
@@ -173,13 +196,8 @@ def stop_basis(found: LegStops, sample_rate: float, window: float, step: int, na
     IdentificationError
         When the legs stand still for more than ``policy.largest_share`` of the samples.
     """
-    share = float(found.stopped.mean())
-    if share > policy.largest_share:
-        raise IdentificationError(
-            f"{name}: the legs stand still (rate within its noise) for {100 * share:.0f} % of "
-            f"the samples, more than {100 * policy.largest_share:.0f} %: too little motion is "
-            "left for the friction law; record a faster or larger motion, or set "
-            "leg_stops=False.")
+    check_motion(float(found.stopped.mean()), name,
+                 "record a faster or larger motion, or set leg_stops=False", policy)
     columns = filtered_stop_columns(found.stops, len(found.stopped), sample_rate, window, step)
     if columns.shape[1] == 0:
         return columns
@@ -208,5 +226,5 @@ def project_out(basis: np.ndarray, *arrays: np.ndarray) -> list[np.ndarray]:
     return out
 
 
-__all__ = ["STOPS", "LegStops", "Stop", "StopPolicy", "filtered_stop_columns", "find_stops",
-           "project_out", "stop_basis"]
+__all__ = ["STOPS", "LegStops", "Stop", "StopPolicy", "check_motion", "filtered_stop_columns",
+           "find_stops", "leg_stop_runs", "project_out", "stop_basis"]

@@ -85,9 +85,11 @@ class WaveletIdentifier(BaseIdentifier):
         Orthonormal zero-mean test functions per interval, 1..12 (polynomial, position); None: the
         paper's (a, b) points.
     friction : {"auto", "free", "shared", "uniform", "coulomb"}
-        "coulomb": windows across reversals with per-type Coulomb forces; "free": every interval
-        constant free; "shared": per-experiment offsets and per-type levels; "uniform": one level;
-        "auto": "coulomb", or on one sine per experiment the better of it and "free".
+        "coulomb": windows across reversals with per-type Coulomb forces (electric legs, without
+        "free" beside it: their stops' friction left free, the windows shortened to leave rows
+        beside it); "free": every interval constant free; "shared": per-experiment offsets and
+        per-type levels; "uniform": one level; "auto": "coulomb", or on one sine per experiment
+        the better of it and "free".
     scale_fractions : tuple of float
         Wavelet supports as fractions of the interval, in (0, 1].
     shifts_per_scale : int
@@ -388,8 +390,11 @@ def _experiment_equations(work: tuple, k: int) -> tuple[dict[str, list], dict, n
     patterns = (coulomb_patterns(found, experiment.joint_jacobians, False,
                                  leg_jacobian=experiment.leg_jacobian if legs else None)
                 if {"free", "coulomb"} & set(models) else None)
+    # the legs' stops in the law's windows, unless the free interval constants are fitted
+    # beside them (one sine per experiment: the stops fall between the intervals)
+    stops = legs and "free" not in models
     equations = {model: model_equations(model, experiment, found, int(estimator.wavelet_order),
-                                        int(estimator.test_functions), k, patterns)
+                                        int(estimator.test_functions), k, patterns, stops)
                  for model in models}
     return equations, found.info, experiment.force_sensitivity, np.std(experiment.q, axis=0)
 

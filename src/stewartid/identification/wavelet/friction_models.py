@@ -14,6 +14,7 @@ from stewartid.datasets.dataset import Dataset
 from stewartid.errors import IdentificationError
 from stewartid.identification.preparation import Experiment
 from stewartid.identification.result import IdentificationResult
+from stewartid.identification.stops import check_motion
 from stewartid.identification.wavelet.detection import (
     SINGLE_SINE_SHARE,
     Detection,
@@ -24,7 +25,12 @@ from stewartid.identification.wavelet.detection import (
 from stewartid.identification.wavelet.gls import WeakFormSolution
 from stewartid.identification.wavelet.rate_selection import solve_weak_form_over_rates
 from stewartid.identification.wavelet.weak_form import experiment_equations
-from stewartid.identification.wavelet.windows import solve_windows_over_rates, window_equations
+from stewartid.identification.wavelet.windows import (
+    solve_windows_over_rates,
+    stop_window_length,
+    window_equations,
+    window_stops,
+)
 from stewartid.signals.differentiation import estimate_frequency
 from stewartid.verdict.accuracy import predicted_worst_error
 
@@ -44,15 +50,24 @@ def friction_models(setting: str, datasets: Sequence[Dataset]) -> tuple[str, ...
 
 
 def model_equations(model: str, experiment: Experiment, found: Detection, order: int,
-                    functions: int, k: int, patterns: np.ndarray | None = None) -> list:
+                    functions: int, k: int, patterns: np.ndarray | None = None,
+                    legs: bool = False) -> list:
     """The weak-form equations of one experiment under friction model ``model`` (windows or intervals).
 
     ``patterns``: :func:`~stewartid.identification.wavelet.weak_form.coulomb_patterns` of the
-    experiment, shared by the models that use them.
+    experiment, shared by the models that use them; ``legs``: the windows leave the friction in
+    the legs' stops free (:func:`~stewartid.identification.wavelet.windows.window_stops`).
     """
     if model == "coulomb":
-        return window_equations(experiment, found, order, functions, k, False, WINDOW_LENGTH,
-                                patterns)
+        stops, length = None, WINDOW_LENGTH
+        if legs:
+            stops = window_stops(found, experiment.sample_rate)
+            check_motion(sum(stop.stop - stop.start for stop in stops) / (6 * len(experiment.t)),
+                         experiment.name, "record a faster or larger motion")
+            length = stop_window_length(stops, float(experiment.t[-1] - experiment.t[0]),
+                                        functions, WINDOW_LENGTH)
+        return window_equations(experiment, found, order, functions, k, False, length,
+                                patterns, stops)
     return experiment_equations(experiment, found, order, functions, k, model, patterns)
 
 

@@ -15,6 +15,7 @@ import numpy as np
 
 from stewartid.errors import DataWarning, IdentificationError
 from stewartid.identification.solvers import check_rank, regressor_names
+from stewartid.identification.stops import RANK_CUT
 from stewartid.identification.wavelet.variance_components import (
     chi2_excess,
     compensate,
@@ -195,6 +196,8 @@ class JointFit(NamedTuple):
     weights : list of ndarray, shape (n, R, R)
     uncorrected : ndarray of bool, shape (6,)
         Channels left without the errors-in-variables correction.
+    local_z : list of ndarray, shape (m,), or None
+        Each equation's own unknowns (``local`` of :func:`fit_jointly`).
     """
 
     z: np.ndarray
@@ -202,12 +205,50 @@ class JointFit(NamedTuple):
     scale: np.ndarray
     weights: list[np.ndarray]
     uncorrected: np.ndarray
+    local_z: list[np.ndarray] | None = None
+
+
+def _pseudo_inverse(gram: np.ndarray) -> np.ndarray:
+    """Inverse of a symmetric positive semi-definite ``gram`` on the span of its eigenvalues
+    above :data:`~stewartid.identification.stops.RANK_CUT` of the largest (a stop's part of one
+    sample has no first moment; two legs stopping together give nearly equal columns)."""
+    values, vectors = np.linalg.eigh(gram)
+    kept = values > RANK_CUT * max(values[-1], 1e-300)
+    return (vectors[:, kept] / values[kept]) @ vectors[:, kept].T
+
+
+def _eliminate_local(local: Sequence[np.ndarray], designs: Sequence[np.ndarray],
+                     targets: Sequence[np.ndarray], weights: Sequence[np.ndarray]
+                     ) -> tuple[np.ndarray, np.ndarray, list[tuple[np.ndarray, ...]]]:
+    """The Schur complement of the equations' own unknowns: what to subtract from the normal
+    matrix (u, u) and right-hand side (u,), and per equation (C^T W D, C^T W t, its inverse)
+    to recover them."""
+    n_unknowns = designs[0].shape[-1]
+    normal, rhs, parts = np.zeros((n_unknowns, n_unknowns)), np.zeros(n_unknowns), []
+    for j, columns in enumerate(local):                         # (6, R, m)
+        if columns.shape[2] == 0:
+            parts.append(None)
+            continue
+        weighted = [weights[i][j] @ columns[i] for i in range(6)]              # (R, m)
+        inner = sum(columns[i].T @ weighted[i] for i in range(6))
+        cross = sum(weighted[i].T @ designs[i][j] for i in range(6))           # (m, u)
+        own = sum(weighted[i].T @ targets[i][j] for i in range(6))
+        inverse = _pseudo_inverse(inner)
+        normal += cross.T @ inverse @ cross
+        rhs += cross.T @ (inverse @ own)
+        parts.append((cross, own, inverse))
+    return normal, rhs, parts
 
 
 def fit_jointly(stacked: StackedEquations, designs: Sequence[np.ndarray],
                 targets: Sequence[np.ndarray], invariant: InvariantFit,
-                scatter: np.ndarray | None, iterations: int) -> JointFit:
-    """All channels at once, rows weighted by their inverse covariance, noise bias removed."""
+                scatter: np.ndarray | None, iterations: int,
+                local: Sequence[np.ndarray] | None = None) -> JointFit:
+    """All channels at once, rows weighted by their inverse covariance, noise bias removed.
+
+    ``local``: per equation, columns (6, R, m) of unknowns its rows alone carry, shared by its
+    channels (a stopped leg's free friction), eliminated by their Schur complement.
+    """
     n_unknowns = designs[0].shape[-1]
     rows = designs[0].shape[1]
     gram = stacked.gram[..., :rows, :rows]
@@ -231,6 +272,9 @@ def fit_jointly(stacked: StackedEquations, designs: Sequence[np.ndarray],
                 normal[block, block], rhs[block], w, gram, stacked.sigma,
                 stacked.sensitivity[:, i])
             uncorrected[i] = not corrected
+        if local is not None:
+            removed, removed_rhs, parts = _eliminate_local(local, designs, targets, weights)
+            normal, rhs = normal - removed, rhs - removed_rhs
         scale = np.sqrt(np.abs(np.diag(normal)))
         scale = np.where(scale > 0, scale, 1.0)
         try:
@@ -241,17 +285,29 @@ def fit_jointly(stacked: StackedEquations, designs: Sequence[np.ndarray],
                 "few constant-direction intervals for the interval constants shared by "
                 "friction); record longer experiments or leave the constants free "
                 "(friction='free').") from exc
-    return JointFit(z=z, normal=normal, scale=scale, weights=weights, uncorrected=uncorrected)
+    local_z = None if local is None else [
+        np.zeros(0) if part is None else part[2] @ (part[1] - part[0] @ z) for part in parts]
+    return JointFit(z=z, normal=normal, scale=scale, weights=weights, uncorrected=uncorrected,
+                    local_z=local_z)
 
 
 def standard_errors(designs: Sequence[np.ndarray], targets: Sequence[np.ndarray],
-                    fit: JointFit) -> np.ndarray:
-    """Standard errors (u,): the larger of the GLS one and one cluster-robust over intervals."""
+                    fit: JointFit, local: Sequence[np.ndarray] | None = None) -> np.ndarray:
+    """Standard errors (u,): the larger of the GLS one and one cluster-robust over intervals.
+
+    ``local`` as :func:`fit_jointly`'s: each interval's own unknowns, whose scores vanish in
+    their interval, count among the unknowns.
+    """
     n, n_unknowns = len(designs[0]), len(fit.z)
     scores = np.zeros((n, n_unknowns))
     squares, n_rows = 0.0, 0
+    if local is not None:
+        n_unknowns += sum(len(z) for z in fit.local_z)
     for i in range(6):
         residual = targets[i] - designs[i] @ fit.z
+        if local is not None:
+            residual = residual - np.stack([c[i] @ z for c, z in zip(local, fit.local_z,
+                                                                     strict=True)])
         weighted = (fit.weights[i] @ residual[:, :, None])[:, :, 0]
         scores += (weighted[:, None, :] @ designs[i])[:, 0, :]
         squares += float(np.sum(residual * weighted))

@@ -92,8 +92,11 @@ def excess_variance(covariance: np.ndarray, residual: np.ndarray, dof: int) -> f
 
 
 def row_noise(stacked: StackedEquations, designs: Sequence[np.ndarray],
-              targets: Sequence[np.ndarray], z: np.ndarray) -> np.ndarray:
-    """Force-side noise variance (n, 6) per interval and channel: white part plus chi-square excess."""
+              targets: Sequence[np.ndarray], z: np.ndarray, extra: float = 0) -> np.ndarray:
+    """Force-side noise variance (n, 6) per interval and channel: white part plus chi-square excess.
+
+    ``extra``: unknowns per channel fitted beside z (their part already out of ``targets``).
+    """
     n, k_rows = stacked.regressors.shape[:2]
     gram = stacked.gram[..., :k_rows, :k_rows]
     floor = 1e-24 * np.maximum(np.mean(stacked.targets.reshape(-1, 6) ** 2, axis=0), 1e-300)
@@ -104,7 +107,7 @@ def row_noise(stacked: StackedEquations, designs: Sequence[np.ndarray],
                                                   z[12 * i:12 * i + 12]))
         residual = targets[i][:, :k_rows] - designs[i][:, :k_rows] @ z
         excess = excess_variance(stacked.white[:, i, None, None] * np.eye(k_rows) + q_inv,
-                                 residual, residual.size - 12)
+                                 residual, residual.size - 12 - extra)
         noise[:, i] = np.maximum(stacked.white[:, i] + excess, floor[i])
     return noise
 

@@ -9,9 +9,11 @@ from collections.abc import Sequence
 from typing import NamedTuple
 
 import numpy as np
+from numpy.polynomial import legendre
 
 from stewartid.identification.preparation import Experiment
 from stewartid.identification.solvers import check_rank, regressor_names
+from stewartid.identification.stops import STOPS, Stop, StopPolicy, leg_stop_runs
 from stewartid.identification.wavelet.detection import Detection
 from stewartid.identification.wavelet.gls import (
     N_THETA,
@@ -35,10 +37,59 @@ from stewartid.identification.wavelet.weak_form import (
 
 
 class WindowEquations(NamedTuple):
-    """``rows`` (mean row unused) and ``coulomb`` <phi_k, W_type> (n_rates, K, n_types, 6) of one window."""
+    """``rows`` (mean row unused) and ``coulomb`` <phi_k, W_type> (n_rates, K, n_types, 6) of one
+    window; ``stops`` (6, K, m): <phi_k, J_lq[l, i] P_j> of the m Legendre terms P_j of the legs'
+    stops inside it (channel i), each a free force along leg l."""
 
     rows: IntervalEquations
     coulomb: np.ndarray
+    stops: np.ndarray | None = None
+
+
+def window_stops(found: Detection, sample_rate: float, policy: StopPolicy = STOPS
+                 ) -> list[Stop]:
+    """The legs' stops of one experiment as Method B sees them.
+
+    As least squares' (:func:`~stewartid.identification.stops.find_stops`) on Method B's own
+    Coulomb sign rates: a leg is stopped while its rate is within ``policy.band`` noise levels;
+    the differentiation window takes the place of the filter window. Two free terms or more per
+    stop take up the sign law's own impulse and moment there.
+    """
+    window = found.info["differentiation_window"] * sample_rate
+    return leg_stop_runs(found.leg_sign_rates, found.leg_sign_rate_noise,
+                         int(policy.merge * window), window, 2, policy)[1]
+
+
+#: Largest share of a window's rows (6 K) its stops' free terms may take, on average over
+#: the experiment (:func:`stop_window_length`).
+STOP_ROW_SHARE = 0.5
+
+
+def stop_window_length(stops: Sequence[Stop], duration: float, size: int, longest: float
+                       ) -> float:
+    """Window length (s), at most ``longest``, whose stops' terms take on average at most
+    :data:`STOP_ROW_SHARE` of its 6 ``size`` rows, over a record of ``duration`` s."""
+    terms = sum(stop.terms for stop in stops)
+    if terms == 0:
+        return longest
+    return min(longest, STOP_ROW_SHARE * 6 * size * duration / terms)
+
+
+def _stop_columns(stops: Sequence[Stop], sel: slice, phi: np.ndarray,
+                  leg_jacobian: np.ndarray) -> np.ndarray | None:
+    """<phi_k, J_lq[l, i] P_j> (6, K, m) of the stops' parts inside the window ``sel``; None
+    without any."""
+    columns = []
+    for found in stops:
+        start, stop = max(found.start, sel.start), min(found.stop, sel.stop)
+        if stop <= start:
+            continue
+        x = (2.0 * np.arange(stop - start) + 1.0) / (stop - start) - 1.0
+        polynomials = legendre.legvander(x, found.terms - 1)                # (n, terms)
+        local = phi[:, start - sel.start:stop - sel.start]                   # (K, n)
+        legs = leg_jacobian[start:stop, found.leg]                           # (n, 6)
+        columns.append(np.einsum("kn,ni,nj->ikj", local, legs, polynomials))
+    return np.concatenate(columns, axis=2) if columns else None
 
 
 def window_bounds(t: np.ndarray, length: float) -> np.ndarray:
@@ -51,11 +102,13 @@ def window_bounds(t: np.ndarray, length: float) -> np.ndarray:
 
 def window_equations(experiment: Experiment, found: Detection, order: int, size: int,
                      index: int, uniform: bool, length: float,
-                     patterns: np.ndarray | None = None) -> list[WindowEquations]:
+                     patterns: np.ndarray | None = None,
+                     stops: Sequence[Stop] | None = None) -> list[WindowEquations]:
     """The equations of every window of one experiment.
 
     ``order``, ``size``: bump exponent and K; ``length``: window, s; ``patterns``:
-    :func:`coulomb_patterns` of the experiment at every soft-sign rate (computed when not given).
+    :func:`coulomb_patterns` of the experiment at every soft-sign rate (computed when not given);
+    ``stops``: the legs' stops (:func:`window_stops`), whose friction each window leaves free.
     """
     t, q, y = experiment.t, experiment.q, experiment.generalized_force
     if patterns is None:
@@ -73,7 +126,9 @@ def window_equations(experiment: Experiment, found: Detection, order: int, size:
             mean_regressors=np.zeros(12), mean_target=np.zeros(6), weight=0.0,
             coulomb=np.zeros((patterns.shape[2], 6)), experiment=int(index),
             noise_gram=noise_gram((phi0, phi1, phi2), bump))
-        out.append(WindowEquations(rows, project_patterns(phi0, patterns[sel])))
+        out.append(WindowEquations(rows, project_patterns(phi0, patterns[sel]),
+                                   None if not stops else _stop_columns(
+                                       stops, sel, phi0, experiment.leg_jacobian)))
     return out
 
 
@@ -110,13 +165,22 @@ def solve_windows(equations: Sequence[WindowEquations], iterations: int = 3,
     stacked_design = np.concatenate([d.reshape(-1, d.shape[-1]) for d in designs])
     z = np.linalg.lstsq(stacked_design, np.concatenate([t.ravel() for t in targets]),
                         rcond=None)[0]
+    local = None
+    if any(e.stops is not None for e in equations):
+        local = [np.zeros((6, k_rows, 0)) if e.stops is None else e.stops for e in equations]
+    fitted = targets
     for _ in range(max(1, iterations)):
-        noise = row_noise(stacked, designs, targets, z)
+        noise = row_noise(stacked, designs, fitted, z,
+                          0 if local is None else sum(c.shape[2] for c in local) / 6)
         start = InvariantFit(theta=z[:N_THETA].reshape(6, 12), noise=noise,
                              pose_share=np.zeros(6))
-        fit = fit_jointly(stacked, designs, targets, start, None, 1)
+        fit = fit_jointly(stacked, designs, targets, start, None, 1, local)
         z = fit.z
-    std = standard_errors(designs, targets, fit)
+        if local is not None:  # the stops' friction as fitted, for the rows' noise
+            fitted = [targets[i] - np.stack([c[i] @ s for c, s in zip(local, fit.local_z,
+                                                                      strict=True)])
+                      for i in range(6)]
+    std = standard_errors(designs, targets, fit, local)
     return WeakFormSolution(
         theta=z[:N_THETA].reshape(6, 12), theta_std=std[:N_THETA].reshape(6, 12),
         coulomb=z[N_THETA:], coulomb_std=std[N_THETA:],
@@ -134,5 +198,6 @@ def solve_windows_over_rates(equations: Sequence[WindowEquations],
         lambda index: solve_windows(equations, rate_index=index, **settings), rates)
 
 
-__all__ = ["SOFT_SIGN_RATES", "WindowEquations", "coulomb_patterns", "solve_windows",
-           "solve_windows_over_rates", "window_bounds", "window_equations"]
+__all__ = ["SOFT_SIGN_RATES", "STOP_ROW_SHARE", "WindowEquations", "coulomb_patterns",
+           "solve_windows", "solve_windows_over_rates", "window_bounds", "window_equations",
+           "stop_window_length", "window_stops"]
