@@ -232,6 +232,36 @@ def test_estimate_frequency_ignores_channels_that_hold_only_round_off():
     assert estimate_frequency(x, fs) == pytest.approx(0.3, rel=1e-2)
 
 
+def test_estimate_frequency_transforms_only_channels_that_can_hold_the_peak():
+    # pure sines score alike against their own scale, so channels nearly tie (and two tie
+    # exactly): the channels left out by the coarse spectrum's bound must not change the pick
+    # of every channel's full 8x-padded transform, the same rule written out here
+    from stewartid.signals.differentiation import _peak_channels, _refine_frequency
+
+    rng = np.random.default_rng(3)
+    fs = 100.0
+    for _ in range(40):
+        n, m = int(rng.integers(200, 3000)), int(rng.integers(2, 7))
+        t = np.arange(n) / fs
+        x = np.column_stack([rng.choice([1e-3, 1.0, 1e3]) * np.sin(
+            2 * np.pi * rng.uniform(0.3, 20) * t + rng.uniform(0, 6)) for _ in range(m)])
+        x[:, -1] = x[:, 0]
+        x += 1e-3 * rng.standard_normal(x.shape) * np.std(x, axis=0)
+        centred = x - x.mean(axis=0)
+        nfft = 1 << int(np.ceil(np.log2(8 * n)))
+        windowed = (centred * np.hanning(n)[:, None]).T
+        relative = np.abs(np.fft.rfft(windowed, nfft, axis=1)[:, 1:]) / centred.std(axis=0)[:, None]
+        peaks = np.argmax(relative, axis=1)
+        values = relative[np.arange(m), peaks]
+        top = np.flatnonzero(values == values.max())
+        kept = _peak_channels(np.ascontiguousarray(windowed), nfft, centred.std(axis=0))
+        assert set(top) <= set(kept)
+        assert np.all(values[np.setdiff1d(np.arange(m), kept)] < values.max())
+        channel = top[np.argmin(peaks[top])]
+        assert estimate_frequency(x, fs) == _refine_frequency(
+            centred[:, channel], fs, (peaks[channel] + 1) * fs / nfft)
+
+
 def test_result_json_round_trip_and_table(tmp_path, paper, truth):
     M, B = truth
     data = [make_experiment(paper, M, B, k) for k in range(6)]
