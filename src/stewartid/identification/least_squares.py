@@ -51,7 +51,7 @@ def pose_noise_gram(q: np.ndarray, sample_rate: float, window: float) -> np.ndar
     """Covariance (12, 12) of the pose noise a row [q * h'', q * h'] carries."""
     from stewartid.identification.wavelet.noise import white_noise_covariance
 
-    smooth = differentiate(q, sample_rate, window)[0]
+    smooth = differentiate(q, sample_rate, window, derivatives=(0,))[0]
     sigma = white_noise_covariance(q, smooth)
     _, first, second = kernel_taps(sample_rate, window, derivatives=2)
     block = np.zeros((12, 12))
