@@ -173,8 +173,8 @@ def _regressors(dataset: Dataset, scales: np.ndarray, platform: Platform) -> np.
     if not len(lines):
         return np.zeros((0, 12))
     window = min(default_window(float(np.max(lines.frequencies_hz))), dataset.duration / 4)
-    _, velocity, acceleration = differentiate(dataset.pose - dataset.pose.mean(axis=0),
-                                              dataset.sample_rate, window)
+    velocity, acceleration = differentiate(dataset.pose - dataset.pose.mean(axis=0),
+                                           dataset.sample_rate, window, derivatives=(1, 2))
     cut = trim(window, dataset.sample_rate)
     stride = max(1, int(np.ceil((len(dataset) - 2 * cut) / CHECK_SAMPLES)))
     rows = slice(cut, len(dataset) - cut, stride)
