@@ -264,7 +264,8 @@ def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool) -> floa
     # channel that moves only by round-off (a still DOF of a noise-free record) has no line
     scale = np.where(spread > ROUND_OFF_SPREAD * spread.max(), spread, np.inf)
     channels = _peak_channels(windowed, nfft, scale) if refine else np.arange(len(scale))
-    relative = np.abs(np.fft.rfft(windowed[channels], nfft, axis=1)[:, 1:])
+    kept = windowed if len(channels) == len(scale) else windowed[channels]
+    relative = np.abs(np.fft.rfft(kept, nfft, axis=1)[:, 1:])
     relative /= scale[channels, None]
     # the largest, the lowest frequency and then the first channel of equal ones
     peaks = np.argmax(relative, axis=1)
@@ -280,15 +281,16 @@ def _peak_channels(windowed: np.ndarray, nfft: int, scale: np.ndarray) -> np.nda
     """The channels (ascending) of ``windowed`` (m, n) whose largest ``nfft``-point spectral
     peak over ``scale`` (m,) can reach the largest channel's; the others need no transform.
 
-    From a spectrum on half as many points: a real trigonometric polynomial T of degree d, at
-    most A in size and A at its maximum, is at least A cos(d h) a step h away (van der Corput
-    and Schaake 1935: T'^2 + d^2 T^2 <= d^2 A^2). Centred on the record's middle, a channel's
-    spectrum is one in half the frequency, of degree n - 1, so its peak is at most the coarse
-    grid's largest value over cos((n - 1) pi / (2 M)), M the coarse length; any coarse value is
-    a value of the fine spectrum (at an even bin above zero: a lower bound of its peak).
+    From a spectrum on an eighth as many points (at least the record's): a real
+    trigonometric polynomial T of degree d, at most A in size and A at its maximum, is at least
+    A cos(d h) a step h away (van der Corput and Schaake 1935: T'^2 + d^2 T^2 <= d^2 A^2).
+    Centred on the record's middle, a channel's spectrum is one in half the frequency, of degree
+    n - 1, so its peak is at most the coarse grid's largest value over cos((n - 1) pi / (2 M)),
+    M the coarse length; every coarse value is one of the fine spectrum's (every eighth bin;
+    above zero, a lower bound of its peak).
     """
     m, n = windowed.shape
-    coarse = nfft // 2
+    coarse = nfft // 8
     if m == 1 or (n - 1) * np.pi / (2 * coarse) >= np.pi / 2:
         return np.arange(m)
     amplitude = np.abs(np.fft.rfft(windowed, coarse, axis=1)) / scale[:, None]
