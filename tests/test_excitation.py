@@ -54,3 +54,19 @@ def test_spectral_lines_ignore_the_edge_of_the_blanked_low_band():
     lines = spectral_lines(x, rate, fraction=0.0)
     assert lines.frequencies_hz[0] == pytest.approx(0.53, abs=0.01)
     assert lines.largest <= 0.0126 * n / 4 * 1.01
+
+
+def test_channel_lines_are_each_channels_own_lines():
+    # one transform of every channel gives what a transform of each channel alone gives
+    from stewartid.datasets.excitation import channel_lines, spectral_lines
+
+    rng = np.random.default_rng(5)
+    t = np.arange(3000) / 200.0
+    motion = np.column_stack([np.sin(2 * np.pi * f * t) + 0.3 * np.sin(2 * np.pi * 3 * f * t)
+                              for f in (0.4, 1.1, 2.7)]) + 1e-3 * rng.standard_normal((3000, 3))
+    for k, lines in enumerate(channel_lines(motion, 200.0, fraction=0.1)):
+        alone = spectral_lines(motion[:, k], 200.0, fraction=0.1)
+        assert len(lines) == 2
+        assert np.array_equal(lines.frequencies_hz, alone.frequencies_hz)
+        assert np.array_equal(lines.amplitudes, alone.amplitudes)
+        assert lines.largest == alone.largest

@@ -232,6 +232,9 @@ def check_jobs(jobs: int | None) -> None:
 
 #: The physical model's task among the methods' in :func:`compare_methods`.
 PHYSICAL_TASK = "physical model"
+#: The order the workers take the methods in, after the physical model: longest first on the
+#: paper's log (docs/benchmarks.md); results do not depend on it.
+LONGEST_FIRST = ("wavelet", "ls", "fourier")
 
 
 @dataclass
@@ -391,8 +394,10 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
     work = _Work(dict(settings or {}), datasets, platform, folds, consistent, checker,
                  records, identifiable, physical)
     names = tuple(dict.fromkeys(names))
-    # the physical model first: beside Method B it is the longest task
-    tasks = ([PHYSICAL_TASK] if physical is not None else []) + list(names)
+    # the longest tasks first, so that the short ones fill the workers' ends
+    tasks = ([PHYSICAL_TASK] if physical is not None else []) + sorted(
+        names, key=lambda name: LONGEST_FIRST.index(name) if name in LONGEST_FIRST
+        else len(LONGEST_FIRST))
     workers = inheriting_workers(jobs, len(tasks))
     done = dict(zip(tasks, run_in_order(_run_task, tasks, workers, shared=work), strict=True))
     if workers > 1:

@@ -93,13 +93,42 @@ def spectral_lines(motion: np.ndarray, sample_rate: float,
     x = np.asarray(motion, dtype=float)
     x = x[:, None] if x.ndim == 1 else x
     n = len(x)
+    nfft = _padded_length(n)
+    amplitude = np.sqrt(np.sum(np.abs(np.fft.rfft(_windowed(x), nfft, axis=0)) ** 2, axis=1))
+    return _peaks(amplitude, n, nfft, sample_rate, fraction)
+
+
+def channel_lines(motion: np.ndarray, sample_rate: float, fraction: float = LINE_FRACTION
+                  ) -> list[SpectralLines]:
+    """:func:`spectral_lines` of each channel of ``motion`` (N, m) on its own, the same numbers
+    from one transform of every channel."""
+    x = np.asarray(motion, dtype=float)
+    n = len(x)
+    nfft = _padded_length(n)
+    windowed = np.column_stack([_windowed(x[:, [k]]) for k in range(x.shape[1])])
+    # each channel's transform on contiguous samples (time last): the same numbers
+    spectra = np.fft.rfft(np.ascontiguousarray(windowed.T), nfft, axis=1)
+    return [_peaks(np.sqrt(np.abs(spectrum) ** 2), n, nfft, sample_rate, fraction)
+            for spectrum in spectra]
+
+
+def _padded_length(n: int) -> int:
+    """Transform length of a record of ``n`` samples: peak frequencies to an eighth of a bin."""
+    return 1 << int(np.ceil(np.log2(4 * n)))
+
+
+def _windowed(x: np.ndarray) -> np.ndarray:
+    """Channels ``x`` (N, m) less their mean and linear drift, times a Hann window."""
+    n = len(x)
     ramp = np.linspace(-1.0, 1.0, n)
     basis = np.column_stack([np.ones(n), ramp])
     x = x - basis @ np.linalg.lstsq(basis, x, rcond=None)[0]
-    padding = 4  # peak frequencies to an eighth of a bin
-    nfft = 1 << int(np.ceil(np.log2(padding * n)))
-    amplitude = np.sqrt(np.sum(np.abs(np.fft.rfft(x * np.hanning(n)[:, None], nfft, axis=0))
-                               ** 2, axis=1))
+    return x * np.hanning(n)[:, None]
+
+
+def _peaks(amplitude: np.ndarray, n: int, nfft: int, sample_rate: float,
+           fraction: float) -> SpectralLines:
+    """The lines of an amplitude spectrum (``nfft // 2 + 1`` bins) of ``n`` samples."""
     resolution = sample_rate / n
     empty = SpectralLines(np.empty(0), np.empty(0), resolution)
     frequencies = np.arange(len(amplitude)) * sample_rate / nfft
@@ -144,8 +173,8 @@ def _regressors(dataset: Dataset, scales: np.ndarray, platform: Platform) -> np.
     if not len(lines):
         return np.zeros((0, 12))
     window = min(default_window(float(np.max(lines.frequencies_hz))), dataset.duration / 4)
-    _, velocity, acceleration = differentiate(dataset.pose - dataset.pose.mean(axis=0),
-                                              dataset.sample_rate, window)
+    velocity, acceleration = differentiate(dataset.pose - dataset.pose.mean(axis=0),
+                                           dataset.sample_rate, window, derivatives=(1, 2))
     cut = trim(window, dataset.sample_rate)
     stride = max(1, int(np.ceil((len(dataset) - 2 * cut) / CHECK_SAMPLES)))
     rows = slice(cut, len(dataset) - cut, stride)
@@ -238,8 +267,7 @@ def excitation_lines(datasets: Sequence[Dataset], threshold: float = LINE_THRESH
     for dof in range(6):
         # a line below the threshold of its own record's largest is below the threshold of
         # the DOF's largest: the records need report no more
-        records = [spectral_lines(d.pose[:, dof], d.sample_rate, fraction=threshold)
-                   for d in datasets]
+        records = [_pose_lines(d, threshold)[dof] for d in datasets]
         largest = max((r.largest for r in records), default=0.0)
         lines: list[float] = []
         for record in records:
@@ -254,6 +282,12 @@ def excitation_lines(datasets: Sequence[Dataset], threshold: float = LINE_THRESH
     return tuple(found)
 
 
+def _pose_lines(dataset: Dataset, threshold: float) -> list[SpectralLines]:
+    """Each pose coordinate's lines of one record, computed once per record."""
+    return dataset.derived(("pose lines", threshold), lambda d: channel_lines(
+        d.pose, d.sample_rate, fraction=threshold))
+
+
 __all__ = ["LINE_FRACTION", "LINE_MERGE_BINS", "LINE_THRESHOLD", "MIN_RELATIVE_EXCITATION",
-           "SpectralLines", "check_excitation", "check_experiment_set", "dof_scales",
+           "SpectralLines", "channel_lines", "check_excitation", "check_experiment_set", "dof_scales",
            "excitation_lines", "excitation_per_dof", "leg_space_motion", "spectral_lines"]

@@ -9,6 +9,7 @@ The viscous friction along the legs, J_lq^T c J_lq q_dot, is part of Bt.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from numbers import Integral
 from typing import NamedTuple
 
@@ -51,7 +52,7 @@ def pose_noise_gram(q: np.ndarray, sample_rate: float, window: float) -> np.ndar
     """Covariance (12, 12) of the pose noise a row [q * h'', q * h'] carries."""
     from stewartid.identification.wavelet.noise import white_noise_covariance
 
-    smooth = differentiate(q, sample_rate, window)[0]
+    smooth = differentiate(q, sample_rate, window, derivatives=(0,))[0]
     sigma = white_noise_covariance(q, smooth)
     _, first, second = kernel_taps(sample_rate, window, derivatives=2)
     block = np.zeros((12, 12))
@@ -67,8 +68,16 @@ def coulomb_regressors(joint_jacobians: np.ndarray, q_dot: np.ndarray, smoothing
     ``joint_jacobians`` (N, 6, 5, 6); ``smoothing`` s, rad/s, and ``shape`` as
     :func:`~stewartid.identification.friction_shape.shaped_sign`.
     """
-    signs = shaped_sign(joint_axis_rates(joint_jacobians, q_dot), smoothing, shape)
-    return joint_type_forces(signs, joint_jacobians)
+    return shaped_coulomb_regressors(joint_jacobians, q_dot, smoothing, (shape,))[0]
+
+
+def shaped_coulomb_regressors(joint_jacobians: np.ndarray, q_dot: np.ndarray, smoothing: float,
+                              shapes: Sequence[str]) -> list[np.ndarray]:
+    """:func:`coulomb_regressors` of each sign shape of ``shapes``, the joint-axis rates computed
+    once for all."""
+    rates = joint_axis_rates(joint_jacobians, q_dot)
+    return [joint_type_forces(shaped_sign(rates, smoothing, shape), joint_jacobians)
+            for shape in shapes]
 
 
 #: Filtered rows kept per filter window by default (``decimate``): fewer change the estimates by
@@ -217,16 +226,18 @@ class LeastSquaresIdentifier(BaseIdentifier):
         "jobs": [Interval(Integral, 1, None), None],
     }
 
-    def _coulomb_units(self, exp: Experiment, rows: slice, q_dot: np.ndarray, shape: str,
-                       legs: bool, stopped: np.ndarray | None = None) -> np.ndarray:
-        """Coulomb regressors (K, 3 or 4, 6) of ``rows`` of an experiment, signs of ``q_dot``;
-        ``stopped`` as :func:`leg_coulomb_regressor`."""
-        units = coulomb_regressors(exp.joint_jacobians[rows], q_dot, self.coulomb_smoothing,
-                                   shape)
+    def _coulomb_units(self, exp: Experiment, rows: slice, q_dot: np.ndarray,
+                       shapes: Sequence[str], legs: bool, stopped: np.ndarray | None = None
+                       ) -> list[np.ndarray]:
+        """Coulomb regressors (K, 3 or 4, 6) of ``rows`` of an experiment under each sign shape
+        of ``shapes``, signs of ``q_dot``; ``stopped`` as :func:`leg_coulomb_regressor`."""
+        units = shaped_coulomb_regressors(exp.joint_jacobians[rows], q_dot,
+                                          self.coulomb_smoothing, shapes)
         if not legs:
             return units
-        return np.concatenate([units, leg_coulomb_regressor(
+        return [np.concatenate([unit, leg_coulomb_regressor(
             exp.leg_jacobian[rows], q_dot, self.coulomb_smoothing, shape, stopped)], axis=1)
+            for unit, shape in zip(units, shapes, strict=True)]
 
     def _experiment_rows(self, exp: Experiment, shapes: tuple[str, ...], legs: bool) -> _Rows:
         """One prepared experiment's rows; ``legs`` adds the legs' Coulomb regressor."""
@@ -236,7 +247,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
             _, qd, qdd = differentiate(exp.q, exp.sample_rate, window, self.order)
             cut = trim(window, exp.sample_rate, self.order)
             sl = slice(cut, len(exp.t) - cut, decimate)
-            coulomb = [self._coulomb_units(exp, sl, qd[sl], shape, legs) for shape in shapes]
+            coulomb = self._coulomb_units(exp, sl, qd[sl], shapes, legs)
             return _Rows(exp.t[sl], window, decimate, exp.generalized_force[sl], qd[sl],
                          qdd[sl], coulomb, None, np.ones(len(qd[sl])))
         # the Coulomb signs need the rates at every sample, from a window the noise allows
@@ -248,9 +259,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
             qd_sign = stops.q_dot
         else:
             qd_sign = measured_sign_rates(exp.q, exp.sample_rate, window)
-        units = [self._coulomb_units(exp, slice(None), qd_sign, shape, legs,
-                                     None if stops is None else stops.stopped)
-                 for shape in shapes]
+        units = self._coulomb_units(exp, slice(None), qd_sign, shapes, legs,
+                                    None if stops is None else stops.stopped)
         signals = np.concatenate(
             [exp.generalized_force] + [u.reshape(len(u), -1) for u in units], axis=1)
         filtered = kernel_filter(signals, exp.sample_rate, window)[0]
@@ -366,4 +376,4 @@ def _experiment_rows(work: tuple, e: int) -> tuple[_Rows, str, float]:
 
 
 __all__ = ["ROWS_PER_WINDOW", "LeastSquaresIdentifier", "coulomb_regressors",
-           "leg_coulomb_regressor", "uses_leg_coulomb"]
+           "leg_coulomb_regressor", "shaped_coulomb_regressors", "uses_leg_coulomb"]

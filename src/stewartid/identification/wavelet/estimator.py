@@ -31,9 +31,11 @@ from stewartid.identification.wavelet.detection import (
 )
 from stewartid.identification.wavelet.friction_models import (
     choose_friction_fit,
+    chosen_models,
     friction_models,
     law_floor,
     model_equations,
+    one_sine,
     solve_models,
 )
 from stewartid.identification.wavelet.gls import WeakFormSolution
@@ -220,13 +222,16 @@ class WaveletIdentifier(BaseIdentifier):
     def _fit_weak_form(self, datasets: list[Dataset], platform: Platform,
                        wavelet: MotherWavelet) -> tuple[IdentificationResult, dict]:
         """Test-function families per interval, one experiment at a time (long logs fit in memory)."""
-        models = friction_models(self.friction, datasets)
         # a ball screw's Coulomb friction along each leg: one more level, in N
         legs = platform.actuator.kind == "electric"
-        equations: dict[str, list] = {model: [] for model in models}
         workers = inheriting_workers(self.jobs, len(datasets))
+        # each experiment tells whether it is one sine beside its equations (its dominant
+        # frequency is its detection's), and the models follow from all of them
         parts = run_in_order(_experiment_equations, range(len(datasets)), workers,
-                             shared=(self, datasets, platform, models, legs))
+                             shared=(self, datasets, platform, friction_models(self.friction),
+                                     legs))
+        models = chosen_models(self.friction, [part[4] for part in parts])
+        equations: dict[str, list] = {model: [] for model in models}
         for part in parts:
             for model in models:
                 equations[model] += part[0][model]
@@ -378,12 +383,15 @@ class WaveletIdentifier(BaseIdentifier):
 
 
 def _experiment_equations(work: tuple, k: int) -> tuple[dict[str, list], dict, np.ndarray,
-                                                        np.ndarray]:
+                                                        np.ndarray, bool]:
     """Experiment ``k``'s weak-form equations under each friction model, its detection info,
-    force sensitivity (6, 6) and pose spread (6,): one task of
+    force sensitivity (6, 6), pose spread (6,) and whether it is one sine: one task of
     :meth:`WaveletIdentifier._fit_weak_form` (``work``: the estimator, the data sets, the platform,
-    the friction models and whether the legs carry a Coulomb level)."""
+    the friction models and whether the legs carry a Coulomb level). Under "auto" an experiment
+    of more than one sine builds no "free" equations: :func:`chosen_models` drops them."""
     estimator, datasets, platform, models, legs = work
+    single = estimator.friction != "auto" or one_sine(datasets[k])
+    models = [model for model in models if single or model != "free"]
     experiment = prepare_experiment(datasets[k], platform, estimator.gravity, joints=True,
                                     remainder=estimator.remainder)
     found = estimator._noise_and_intervals(experiment, 1.0)
@@ -396,7 +404,8 @@ def _experiment_equations(work: tuple, k: int) -> tuple[dict[str, list], dict, n
     equations = {model: model_equations(model, experiment, found, int(estimator.wavelet_order),
                                         int(estimator.test_functions), k, patterns, stops)
                  for model in models}
-    return equations, found.info, experiment.force_sensitivity, np.std(experiment.q, axis=0)
+    return (equations, found.info, experiment.force_sensitivity, np.std(experiment.q, axis=0),
+            single)
 
 
 __all__ = ["EXACT_DEGREE", "FRICTION_MODELS", "MARGIN_PERIODS", "PAIR_SELECTIONS", "VARIANTS",

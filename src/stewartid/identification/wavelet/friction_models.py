@@ -38,15 +38,24 @@ from stewartid.verdict.accuracy import predicted_worst_error
 WINDOW_LENGTH = 2.0
 
 
-def friction_models(setting: str, datasets: Sequence[Dataset]) -> tuple[str, ...]:
-    """The friction models to fit: "auto" gives "free" and "coulomb" on one sine per experiment."""
+def friction_models(setting: str) -> tuple[str, ...]:
+    """The friction models an experiment's equations are built for: "auto" gives "free" and
+    "coulomb", and :func:`chosen_models` keeps both only on one sine per experiment."""
+    return ("free", "coulomb") if setting == "auto" else (setting,)
+
+
+def one_sine(dataset: Dataset) -> bool:
+    """Whether one sine at the pose's dominant frequency (computed once per record, every
+    method asks for it) explains :data:`SINGLE_SINE_SHARE` of the record's leg motion."""
+    return sine_share(dataset.lengths, 1.0 / float(dataset.t[1] - dataset.t[0]),
+                      estimate_frequency(dataset.pose, dataset.sample_rate)) >= SINGLE_SINE_SHARE
+
+
+def chosen_models(setting: str, single: Sequence[bool]) -> tuple[str, ...]:
+    """The friction models to fit, ``single``: :func:`one_sine` of each experiment under "auto"."""
     if setting != "auto":
         return (setting,)
-    # the pose's dominant frequency: every method asks for it (computed once per record)
-    single = all(sine_share(d.lengths, 1.0 / float(d.t[1] - d.t[0]),
-                            estimate_frequency(d.pose, d.sample_rate)) >= SINGLE_SINE_SHARE
-                 for d in datasets)
-    return ("free", "coulomb") if single else ("coulomb",)
+    return ("free", "coulomb") if all(single) else ("coulomb",)
 
 
 def model_equations(model: str, experiment: Experiment, found: Detection, order: int,

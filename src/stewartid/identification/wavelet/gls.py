@@ -137,7 +137,8 @@ def fit_invariant_rows(stacked: StackedEquations, iterations: int) -> InvariantF
     x, y = stacked.regressors, stacked.targets
     n, k_rows = x.shape[:2]
     sigma, sensitivity, white = stacked.sigma, stacked.sensitivity, stacked.white
-    gram = stacked.gram[..., :k_rows, :k_rows]
+    # contiguous once: every channel's products below reshape it (a slice would be copied)
+    gram = np.ascontiguousarray(stacked.gram[..., :k_rows, :k_rows])
     theta = np.linalg.lstsq(x.reshape(-1, 12), y.reshape(-1, 6), rcond=None)[0].T
     # floor: noise-free data must not give infinite weights
     floor = 1e-24 * np.maximum(np.mean(y.reshape(-1, 6) ** 2, axis=0), 1e-300)
@@ -251,7 +252,7 @@ def fit_jointly(stacked: StackedEquations, designs: Sequence[np.ndarray],
     """
     n_unknowns = designs[0].shape[-1]
     rows = designs[0].shape[1]
-    gram = stacked.gram[..., :rows, :rows]
+    gram = np.ascontiguousarray(stacked.gram[..., :rows, :rows])  # reshaped per channel
     z = np.zeros(n_unknowns)
     z[:N_THETA] = invariant.theta.ravel()
     uncorrected = np.zeros(6, dtype=bool)

@@ -69,7 +69,8 @@ def estimate_noise(experiment: Experiment, window: float) -> NoiseModel:
     q_smooth, q_dot, q_ddot = differentiate(q, rate, window)
     covariance = white_noise_covariance(q, q_smooth)
     y = experiment.generalized_force
-    force_variance = np.diag(white_noise_covariance(y, differentiate(y, rate, window)[0]))
+    force_variance = np.diag(white_noise_covariance(
+        y, differentiate(y, rate, window, derivatives=(0,))[0]))
     rate_noise = joint_rate_noise(covariance, rate, window, experiment.joint_jacobians,
                                   experiment.leg_jacobian)
     return NoiseModel(window=window, q_dot=q_dot, q_ddot=q_ddot, pose_covariance=covariance,

@@ -98,7 +98,7 @@ def row_noise(stacked: StackedEquations, designs: Sequence[np.ndarray],
     ``extra``: unknowns per channel fitted beside z (their part already out of ``targets``).
     """
     n, k_rows = stacked.regressors.shape[:2]
-    gram = stacked.gram[..., :k_rows, :k_rows]
+    gram = np.ascontiguousarray(stacked.gram[..., :k_rows, :k_rows])  # reshaped per channel
     floor = 1e-24 * np.maximum(np.mean(stacked.targets.reshape(-1, 6) ** 2, axis=0), 1e-300)
     noise = np.zeros((n, 6))
     for i in range(6):

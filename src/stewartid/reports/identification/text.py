@@ -36,8 +36,8 @@ def data_rows(datasets: Sequence[Dataset], platform: Platform) -> list[dict[str,
     for d in datasets:
         frequency = estimate_frequency(d.pose, d.sample_rate)
         window = 0.2 / frequency
-        smooth_pose = differentiate(d.pose, d.sample_rate, window)[0]
-        smooth_force = differentiate(d.forces, d.sample_rate, window)[0]
+        smooth_pose = differentiate(d.pose, d.sample_rate, window, derivatives=(0,))[0]
+        smooth_force = differentiate(d.forces, d.sample_rate, window, derivatives=(0,))[0]
         spread = d.pose.std(axis=0) * lever
         excited = int(np.argmax(spread))
         rows.append({
