@@ -270,6 +270,16 @@ _WHOLES: dict[int, tuple[weakref.ref, np.ndarray]] = {}
 
 
 def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool) -> float:
+    centered, relative, nfft, channel, _ = _channel_spectra(x, sample_rate, refine)
+    frequency = (int(np.argmax(relative[channel])) + 1) * sample_rate / nfft
+    return _refine_frequency(centered[:, channel], sample_rate, frequency) if refine else frequency
+
+
+def _channel_spectra(x: np.ndarray, sample_rate: float, refine: bool
+                     ) -> tuple[np.ndarray, np.ndarray, int, int, np.ndarray]:
+    """Centred channels (N, m), their spectra relative to their scale (m, nfft // 2; bin k at
+    (k + 1) sample_rate / nfft), nfft, the channel of the dominant line, each channel's median
+    bin (m,)."""
     x = np.asarray(x, dtype=float)
     x = x[:, None] if x.ndim == 1 else x
     centered = x - x.mean(axis=0)
@@ -287,19 +297,54 @@ def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool) -> floa
     # The scale leaves out white noise (the same power in every bin: the median bin's, the lines
     # holding few), so that noise does not demote a small channel's line; a channel whose
     # motion is below its noise has no line either
-    noise = np.median(relative ** 2, axis=1) / (math.log(2) * np.sum(hann ** 2))
+    median = np.median(relative ** 2, axis=1)
+    noise = median / (math.log(2) * np.sum(hann ** 2))
     scale = np.sqrt(np.maximum(spread ** 2 - noise, 0.0))
     moving = (spread > ROUND_OFF_SPREAD * spread.max()) & (scale ** 2 > noise)
     if not moving.any():
         moving, scale = spread > ROUND_OFF_SPREAD * spread.max(), spread
     relative /= np.where(moving, scale, np.inf)[:, None]
+    median = median / np.where(moving, scale, np.inf) ** 2
     # the largest, the lowest frequency and then the first channel of equal ones
     peaks = np.argmax(relative, axis=1)
     values = relative[np.arange(len(peaks)), peaks]
     top = np.flatnonzero(values == values.max())
-    channel = top[np.argmin(peaks[top])]
-    frequency = (peaks[channel] + 1) * sample_rate / nfft
-    return _refine_frequency(centered[:, channel], sample_rate, frequency) if refine else frequency
+    channel = int(top[np.argmin(peaks[top])])
+    return centered, relative, nfft, channel, median
+
+
+#: Lines below this fraction of the dominant one's amplitude (harmonics, coupling) do not set
+#: :func:`acceleration_frequency`.
+LINE_FLOOR = 0.05
+#: Power, in median bins, a line must exceed (white noise's largest bin of a record is about 16).
+LINE_NOISE_POWER = 50.0
+
+
+def acceleration_frequency(x: np.ndarray, sample_rate: float) -> float:
+    """Frequency (Hz) of the line of largest acceleration (amplitude times f^2) in ``x`` (N,) or
+    (N, m).
+
+    In the channel of :func:`estimate_frequency`'s dominant line, among the spectral peaks of at
+    least :data:`LINE_FLOOR` of its amplitude and above white noise; refined by a sine fit. A
+    record of one sine gives its frequency; three sines of falling amplitude, the fastest.
+
+    Raises
+    ------
+    DataError
+        When no channel moves.
+    """
+    centered, relative, nfft, channel, median = _channel_spectra(x, sample_rate, True)
+    spectrum = relative[channel]
+    inner = spectrum[1:-1]
+    peaks = np.flatnonzero((inner > spectrum[:-2]) & (inner >= spectrum[2:])) + 1
+    peaks = np.append(peaks, int(np.argmax(spectrum)))  # the dominant line, even at an end
+    lines = peaks[(spectrum[peaks] >= LINE_FLOOR * spectrum.max())
+                  & (spectrum[peaks] ** 2 > LINE_NOISE_POWER * median[channel])]
+    if not len(lines):
+        lines = peaks[-1:]
+    fastest = lines[np.argmax(spectrum[lines] * (lines + 1.0) ** 2)]
+    return _refine_frequency(centered[:, channel], sample_rate,
+                             (fastest + 1) * sample_rate / nfft)
 
 
 def _refine_frequency(x: np.ndarray, sample_rate: float, frequency: float) -> float:
@@ -328,6 +373,7 @@ def _refine_frequency(x: np.ndarray, sample_rate: float, frequency: float) -> fl
                             frequency + bin_width, 1e-9 * frequency)
 
 
-__all__ = ["DEFAULT_ORDER", "DEFAULT_WINDOW_PERIODS", "convolve_valid", "default_window",
+__all__ = ["DEFAULT_ORDER", "DEFAULT_WINDOW_PERIODS", "LINE_FLOOR", "LINE_NOISE_POWER",
+           "acceleration_frequency", "convolve_valid", "default_window",
            "differentiate", "estimate_frequency", "kernel_filter", "kernel_taps",
            "savgol_coefficients", "savgol_gain", "share_frequency", "trim", "window_samples"]
