@@ -23,6 +23,7 @@ from stewartid.signals.differentiation import (
     kernel_taps,
     savgol_coefficients,
     savgol_gain,
+    share_frequency,
     window_samples,
 )
 from stewartid.signals.filtered_rows import kernel_filter_rows
@@ -267,6 +268,12 @@ def test_acceleration_frequency_takes_the_line_of_largest_acceleration():
         assert acceleration_frequency(x, fs) == pytest.approx(1.5, rel=1e-2)
     sine = np.sin(2 * np.pi * 0.5 * t) + 0.02 * np.sin(2 * np.pi * 1.5 * t)
     assert acceleration_frequency(sine, fs) == pytest.approx(0.5, rel=1e-3)
+    # a validation fold's piece (one second) takes the record's
+    whole = np.column_stack([pitch, pitch])
+    whole.flags.writeable = False
+    piece = whole[:1000]
+    share_frequency(piece, whole)
+    assert acceleration_frequency(piece, fs) == acceleration_frequency(whole, fs)
 
 
 def test_acceleration_frequency_is_not_taken_by_white_noise():

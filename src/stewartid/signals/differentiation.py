@@ -232,9 +232,9 @@ def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -
         When no channel moves.
     """
     if isinstance(x, np.ndarray) and not x.flags.writeable:
-        whole = _WHOLES.get(id(x))
-        if whole is not None and whole[0]() is x:
-            return estimate_frequency(whole[1], sample_rate, refine)
+        whole = _whole(x)
+        if whole is not x:
+            return estimate_frequency(whole, sample_rate, refine)
         key = (id(x), float(sample_rate), bool(refine))
         known = _FREQUENCIES.get(key)
         if known is None or known[0]() is not x:
@@ -247,8 +247,8 @@ def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -
 
 
 def share_frequency(piece: np.ndarray, whole: np.ndarray) -> None:
-    """Make :func:`estimate_frequency` of the read-only ``piece`` (rows of ``whole``, (n, m))
-    answer ``whole``'s (N, m), while ``piece`` lives.
+    """Make :func:`estimate_frequency` and :func:`acceleration_frequency` of the read-only ``piece``
+    (rows of ``whole``, (n, m)) answer ``whole``'s (N, m), while ``piece`` lives.
 
     A piece cut from a record (a validation fold) moves at the record's excitation, but may hold
     too few periods of its slowest line for that to be found in it alone.
@@ -257,6 +257,12 @@ def share_frequency(piece: np.ndarray, whole: np.ndarray) -> None:
         raise ValueError("share_frequency takes read-only arrays (a record's columns).")
     key = id(piece)
     _WHOLES[key] = (weakref.ref(piece, lambda _, key=key: _WHOLES.pop(key, None)), whole)
+
+
+def _whole(x: np.ndarray) -> np.ndarray:
+    """The record ``x`` was cut from (:func:`share_frequency`), else ``x``."""
+    whole = _WHOLES.get(id(x))
+    return whole[1] if whole is not None and whole[0]() is x else x
 
 
 #: Spread, relative to the most moving channel's, below which a channel holds only round-off.
@@ -326,13 +332,16 @@ def acceleration_frequency(x: np.ndarray, sample_rate: float) -> float:
 
     In the channel of :func:`estimate_frequency`'s dominant line, among the spectral peaks of at
     least :data:`LINE_FLOOR` of its amplitude and above white noise; refined by a sine fit. A
-    record of one sine gives its frequency; three sines of falling amplitude, the fastest.
+    record of one sine gives its frequency; three sines of falling amplitude, the fastest. A piece
+    of a record takes the record's (:func:`share_frequency`).
 
     Raises
     ------
     DataError
         When no channel moves.
     """
+    if isinstance(x, np.ndarray):
+        x = _whole(x)
     centered, relative, nfft, channel, median = _channel_spectra(x, sample_rate, True)
     spectrum = relative[channel]
     inner = spectrum[1:-1]
