@@ -16,12 +16,14 @@ from stewartid.identification.result import IdentificationResult
 from stewartid.reference.published import PAPER_ENTRIES
 from stewartid.signals.differentiation import (
     DEFAULT_ORDER,
+    acceleration_frequency,
     differentiate,
     estimate_frequency,
     kernel_filter,
     kernel_taps,
     savgol_coefficients,
     savgol_gain,
+    share_frequency,
     window_samples,
 )
 from stewartid.signals.filtered_rows import kernel_filter_rows
@@ -277,6 +279,39 @@ def test_estimate_frequency_transforms_only_channels_that_can_hold_the_peak():
         kept = _peak_channels(coarse, n)
         assert set(top) <= set(kept)
         assert np.all(values[np.setdiff1d(np.arange(m), kept)] < values.max())
+
+
+def test_acceleration_frequency_takes_the_line_of_largest_acceleration():
+    # a pitch record of three sines of falling amplitude (0.6, 0.3, 0.15 at 0.3, 0.7, 1.5 Hz):
+    # the 0.3 Hz line is the largest, the 1.5 Hz one carries the most acceleration (0.15 x 1.5^2
+    # against 0.6 x 0.3^2), with and without white noise; a single sine with a 2 % third harmonic
+    # keeps the sine (the harmonic is below LINE_FLOOR)
+    fs = 1000.0
+    t = np.arange(20000) / fs
+    pitch = sum(share * 5e-3 * np.sin(2 * np.pi * hz * t + phase)
+                for hz, share, phase in ((0.3, 0.6, 0.0), (0.7, 0.3, 1.0), (1.5, 0.15, 2.0)))
+    rng = np.random.default_rng(1)
+    for x in (pitch, pitch + 1e-5 * rng.normal(size=len(t))):
+        assert estimate_frequency(x, fs) == pytest.approx(0.3, rel=1e-2)
+        assert acceleration_frequency(x, fs) == pytest.approx(1.5, rel=1e-2)
+    sine = np.sin(2 * np.pi * 0.5 * t) + 0.02 * np.sin(2 * np.pi * 1.5 * t)
+    assert acceleration_frequency(sine, fs) == pytest.approx(0.5, rel=1e-3)
+    # a validation fold's piece (one second) takes the record's
+    whole = np.column_stack([pitch, pitch])
+    whole.flags.writeable = False
+    piece = whole[:1000]
+    share_frequency(piece, whole)
+    assert acceleration_frequency(piece, fs) == acceleration_frequency(whole, fs)
+
+
+def test_acceleration_frequency_is_not_taken_by_white_noise():
+    # noise as large as the sine: its largest bins pass LINE_FLOOR of the sine's line (about
+    # 350 sigma against 250 A on 20 000 Hann-windowed samples) and, weighted by f^2, would
+    # outrank it; they stay below LINE_NOISE_POWER median bins
+    fs = 1000.0
+    t = np.arange(20000) / fs
+    x = np.sin(2 * np.pi * 0.5 * t) + np.random.default_rng(2).normal(size=len(t))
+    assert acceleration_frequency(x, fs) == pytest.approx(0.5, rel=1e-2)
 
 
 def test_result_json_round_trip_and_table(tmp_path, paper, truth):

@@ -232,9 +232,9 @@ def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -
         When no channel moves.
     """
     if isinstance(x, np.ndarray) and not x.flags.writeable:
-        whole = _WHOLES.get(id(x))
-        if whole is not None and whole[0]() is x:
-            return estimate_frequency(whole[1], sample_rate, refine)
+        whole = _whole(x)
+        if whole is not x:
+            return estimate_frequency(whole, sample_rate, refine)
         key = (id(x), float(sample_rate), bool(refine))
         known = _FREQUENCIES.get(key)
         if known is None or known[0]() is not x:
@@ -247,8 +247,8 @@ def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -
 
 
 def share_frequency(piece: np.ndarray, whole: np.ndarray) -> None:
-    """Make :func:`estimate_frequency` of the read-only ``piece`` (rows of ``whole``, (n, m))
-    answer ``whole``'s (N, m), while ``piece`` lives.
+    """Make :func:`estimate_frequency` and :func:`acceleration_frequency` of the read-only ``piece``
+    (rows of ``whole``, (n, m)) answer ``whole``'s (N, m), while ``piece`` lives.
 
     A piece cut from a record (a validation fold) moves at the record's excitation, but may hold
     too few periods of its slowest line for that to be found in it alone.
@@ -257,6 +257,12 @@ def share_frequency(piece: np.ndarray, whole: np.ndarray) -> None:
         raise ValueError("share_frequency takes read-only arrays (a record's columns).")
     key = id(piece)
     _WHOLES[key] = (weakref.ref(piece, lambda _, key=key: _WHOLES.pop(key, None)), whole)
+
+
+def _whole(x: np.ndarray) -> np.ndarray:
+    """The record ``x`` was cut from (:func:`share_frequency`), else ``x``."""
+    whole = _WHOLES.get(id(x))
+    return whole[1] if whole is not None and whole[0]() is x else x
 
 
 #: Spread, relative to the most moving channel's, below which a channel holds only round-off.
@@ -270,6 +276,16 @@ _WHOLES: dict[int, tuple[weakref.ref, np.ndarray]] = {}
 
 
 def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool) -> float:
+    centered, spectrum, nfft, channel, _ = _channel_spectra(x, sample_rate, refine)
+    frequency = (int(np.argmax(spectrum)) + 1) * sample_rate / nfft
+    return _refine_frequency(centered[:, channel], sample_rate, frequency) if refine else frequency
+
+
+def _channel_spectra(x: np.ndarray, sample_rate: float, refine: bool
+                     ) -> tuple[np.ndarray, np.ndarray, int, int, float]:
+    """Centred channels (N, m); the spectrum of the channel of the dominant line relative to its
+    scale (nfft // 2; bin k at (k + 1) sample_rate / nfft); nfft; that channel; its median bin's
+    power on the same scale (white noise's level)."""
     x = np.asarray(x, dtype=float)
     x = x[:, None] if x.ndim == 1 else x
     centered = x - x.mean(axis=0)
@@ -289,7 +305,8 @@ def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool) -> floa
     # The scale leaves out white noise (the same power in every bin: the median bin's, the lines
     # holding few), so that noise does not demote a small channel's line; a channel whose
     # motion is below its noise has no line either
-    noise = np.median(coarse[:, 1:] ** 2, axis=1) / (math.log(2) * np.sum(hann ** 2))
+    median = np.median(coarse[:, 1:] ** 2, axis=1)
+    noise = median / (math.log(2) * np.sum(hann ** 2))
     scale = np.sqrt(np.maximum(spread ** 2 - noise, 0.0))
     moving = (spread > ROUND_OFF_SPREAD * spread.max()) & (scale ** 2 > noise)
     if not moving.any():
@@ -305,10 +322,45 @@ def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool) -> floa
     peaks = np.argmax(relative, axis=1)
     values = relative[np.arange(len(peaks)), peaks]
     top = np.flatnonzero(values == values.max())
-    best = top[np.argmin(peaks[top])]
-    channel = channels[best]
-    frequency = (peaks[best] + 1) * sample_rate / nfft
-    return _refine_frequency(centered[:, channel], sample_rate, frequency) if refine else frequency
+    best = int(top[np.argmin(peaks[top])])
+    channel = int(channels[best])
+    return centered, relative[best], nfft, channel, float(median[channel] / scale[channel] ** 2)
+
+
+#: Lines below this fraction of the dominant one's amplitude (harmonics, coupling) do not set
+#: :func:`acceleration_frequency`.
+LINE_FLOOR = 0.05
+#: Power, in median bins, a line must exceed (white noise's largest bin of a record is about 16).
+LINE_NOISE_POWER = 50.0
+
+
+def acceleration_frequency(x: np.ndarray, sample_rate: float) -> float:
+    """Frequency (Hz) of the line of largest acceleration (amplitude times f^2) in ``x`` (N,) or
+    (N, m).
+
+    In the channel of :func:`estimate_frequency`'s dominant line, among the spectral peaks of at
+    least :data:`LINE_FLOOR` of its amplitude and above white noise; refined by a sine fit. A
+    record of one sine gives its frequency; three sines of falling amplitude, the fastest. A piece
+    of a record takes the record's (:func:`share_frequency`).
+
+    Raises
+    ------
+    DataError
+        When no channel moves.
+    """
+    if isinstance(x, np.ndarray):
+        x = _whole(x)
+    centered, spectrum, nfft, channel, median = _channel_spectra(x, sample_rate, True)
+    inner = spectrum[1:-1]
+    peaks = np.flatnonzero((inner > spectrum[:-2]) & (inner >= spectrum[2:])) + 1
+    peaks = np.append(peaks, int(np.argmax(spectrum)))  # the dominant line, even at an end
+    lines = peaks[(spectrum[peaks] >= LINE_FLOOR * spectrum.max())
+                  & (spectrum[peaks] ** 2 > LINE_NOISE_POWER * median)]
+    if not len(lines):
+        lines = peaks[-1:]
+    fastest = lines[np.argmax(spectrum[lines] * (lines + 1.0) ** 2)]
+    return _refine_frequency(centered[:, channel], sample_rate,
+                             (fastest + 1) * sample_rate / nfft)
 
 
 def _peak_channels(amplitude: np.ndarray, n: int) -> np.ndarray:
@@ -358,6 +410,7 @@ def _refine_frequency(x: np.ndarray, sample_rate: float, frequency: float) -> fl
                             frequency + bin_width, 1e-9 * frequency)
 
 
-__all__ = ["DEFAULT_ORDER", "DEFAULT_WINDOW_PERIODS", "convolve_valid", "default_window",
+__all__ = ["DEFAULT_ORDER", "DEFAULT_WINDOW_PERIODS", "LINE_FLOOR", "LINE_NOISE_POWER",
+           "acceleration_frequency", "convolve_valid", "default_window",
            "differentiate", "estimate_frequency", "kernel_filter", "kernel_taps",
            "savgol_coefficients", "savgol_gain", "share_frequency", "trim", "window_samples"]

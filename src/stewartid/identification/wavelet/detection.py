@@ -17,7 +17,11 @@ from stewartid.identification.wavelet.intervals import constant_direction_interv
 from stewartid.identification.wavelet.noise import NoiseModel, joint_rate_noise
 from stewartid.model.kinematics import joint_axis_rates
 from stewartid.platform import COORDINATES
-from stewartid.signals.differentiation import default_window, estimate_frequency
+from stewartid.signals.differentiation import (
+    acceleration_frequency,
+    default_window,
+    estimate_frequency,
+)
 from stewartid.signals.sign_rates import SIGN_NOISE, SIGN_ORDER, coulomb_sign_rates
 
 
@@ -127,20 +131,23 @@ def excitation_scales(experiment: Experiment, window: float | None, margin: floa
                       margin_periods: float) -> tuple[float, float]:
     """The Savitzky-Golay window and the interval margin of one experiment, s.
 
-    None for either: from the excitation frequency estimated from the pose (margin ``margin_periods``
-    periods).
+    None for either: the window from the pose's line of largest acceleration
+    (:func:`~stewartid.signals.differentiation.acceleration_frequency`: it caps the window of the
+    Coulomb signs' rates, whose rounding of the reversals biases Mt), the margin ``margin_periods``
+    periods of its dominant line.
     """
-    if window is None or margin is None:
-        frequency = estimate_frequency(experiment.q, experiment.sample_rate)
+    if window is None:
+        fastest = acceleration_frequency(experiment.q, experiment.sample_rate)
         duration = float(experiment.t[-1] - experiment.t[0])
-        if window is None and default_window(frequency) > duration:
+        if default_window(fastest) > duration:
             raise IdentificationError(
                 f"{experiment.name}: the record lasts {duration:.3g} s, shorter than the "
-                f"differentiation window ({default_window(frequency):.3g} s) its motion's "
-                f"frequency ({frequency:.3g} Hz found) sets: record a longer experiment, or give "
+                f"differentiation window ({default_window(fastest):.3g} s) its motion's "
+                f"frequency ({fastest:.3g} Hz found) sets: record a longer experiment, or give "
                 "differentiation_window and margin (s).")
-        window = default_window(frequency) if window is None else window
-        margin = margin_periods / frequency if margin is None else margin
+        window = default_window(fastest)
+    if margin is None:
+        margin = margin_periods / estimate_frequency(experiment.q, experiment.sample_rate)
     return window, margin
 
 

@@ -104,7 +104,8 @@ class WaveletIdentifier(BaseIdentifier):
     min_support_samples : int
         Fewest samples the smallest wavelet may cover.
     differentiation_window : float or None
-        Savitzky-Golay window, s; None: a fifth of the dominant period.
+        Savitzky-Golay window, s; None: a fifth of the period of the pose's line of
+        largest acceleration (the fastest of a multi-sine's falling amplitudes).
     hysteresis : float
         A direction is known only while the rate exceeds this many noise levels.
     odd_companion : bool
