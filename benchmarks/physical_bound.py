@@ -35,7 +35,8 @@ Usage::
         [--draws 100000]
     python benchmarks/physical_bound.py --payload-default paper|FILE [--ratio 0.2] [--engine ours|mujoco]
         [--duration 20] [--seeds 8] [--clean DIR]
-    python benchmarks/physical_bound.py --electric sines|alldof [--seeds 4] [--true-signs] --cache DIR
+    python benchmarks/physical_bound.py --electric sines|alldof [--engine ours|mujoco] [--duration 20]
+        [--seeds 4] [--true-signs] --cache DIR
 """
 
 from __future__ import annotations
@@ -258,10 +259,10 @@ def electric_bound(args, rng: np.random.Generator) -> None:
     platform = electric_study.electric_platform()
     loaded = platform.replace(**{f"payload__{k}": v
                                  for k, v in electric_study.PAYLOAD.items()})
-    tag = f"ours-{args.electric}-{args.duration:g}s"
-    clean = electric_study.clean_logs(platform, args.electric, "ours", args.duration,
+    tag = f"{args.engine}-{args.electric}-{args.duration:g}s"
+    clean = electric_study.clean_logs(platform, args.electric, args.engine, args.duration,
                                       args.cache / tag)
-    clean_loaded = electric_study.clean_logs(loaded, args.electric, "ours", args.duration,
+    clean_loaded = electric_study.clean_logs(loaded, args.electric, args.engine, args.duration,
                                              args.cache / f"{tag}-payload")
     legs = ("reflected_mass", "viscous[actuator]", "coulomb[actuator]")
     a = platform.actuator
@@ -308,7 +309,7 @@ def electric_bound(args, rng: np.random.Generator) -> None:
     leg_worst = worst_of_seeds(100 * leg_draws / leg_truth)
     payload_worst = worst_of_seeds(payload_scores(
         draws_of(payload_bound, args.seeds, args.draws, rng), payload_truth, "norm"))
-    print(f"\nelectric.toml, {args.electric}, 6 x {args.duration:g} s, {args.seeds} seeds")
+    print(f"\nelectric.toml, {args.engine}, {args.electric}, 6 x {args.duration:g} s, {args.seeds} seeds")
     print("| quantity | bound SE | bound's worst of the seeds: median (90 %) | signs | "
           "observed: range (signed) | fits' SE (median) | observed worst / bound | "
           "largest z (fits' SE) |")
