@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 import weakref
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -235,15 +236,15 @@ def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -
         whole = _whole(x)
         if whole is not x:
             return estimate_frequency(whole, sample_rate, refine)
-        key = (id(x), float(sample_rate), bool(refine))
-        known = _FREQUENCIES.get(key)
-        if known is None or known[0]() is not x:
-            value = _estimate_frequency(x, sample_rate, refine)
-            _FREQUENCIES[key] = (weakref.ref(x, lambda _, key=key: _FREQUENCIES.pop(key, None)),
-                                 value)
-            return value
-        return known[1]
-    return _estimate_frequency(x, sample_rate, refine)
+        kind = "dominant" if refine else "peak"
+        value = _cached(x, sample_rate, kind)
+        if value is None:
+            value, fastest = _estimate_frequency(x, sample_rate, refine)
+            _store(x, sample_rate, kind, value)
+            if fastest is not None:  # for acceleration_frequency, from the same spectrum
+                _store(x, sample_rate, "fastest", fastest)
+        return value
+    return _estimate_frequency(x, sample_rate, refine)[0]
 
 
 def share_frequency(piece: np.ndarray, whole: np.ndarray) -> None:
@@ -268,17 +269,34 @@ def _whole(x: np.ndarray) -> np.ndarray:
 #: Spread, relative to the most moving channel's, below which a channel holds only round-off.
 ROUND_OFF_SPREAD = 1e-9
 
-#: Frequencies of read-only arrays, by identity, while the array lives.
-_FREQUENCIES: dict[tuple[int, float, bool], tuple[weakref.ref, float]] = {}
+#: Frequencies of read-only arrays, by identity, sample rate and kind, while the array lives.
+_FREQUENCIES: dict[tuple[int, float, str], tuple[weakref.ref, Any]] = {}
 
 #: Records whose frequency a piece takes (:func:`share_frequency`), by the piece's identity.
 _WHOLES: dict[int, tuple[weakref.ref, np.ndarray]] = {}
 
 
-def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool) -> float:
-    centered, spectrum, nfft, channel, _ = _channel_spectra(x, sample_rate, refine)
+def _cached(x: np.ndarray, sample_rate: float, kind: str) -> Any:
+    known = _FREQUENCIES.get((id(x), float(sample_rate), kind))
+    return None if known is None or known[0]() is not x else known[1]
+
+
+def _store(x: np.ndarray, sample_rate: float, kind: str, value: Any) -> None:
+    key = (id(x), float(sample_rate), kind)
+    _FREQUENCIES[key] = (weakref.ref(x, lambda _, key=key: _FREQUENCIES.pop(key, None)), value)
+
+
+def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool
+                        ) -> tuple[float, tuple[np.ndarray, float] | None]:
+    """The dominant frequency and, refined, the start of :func:`acceleration_frequency`'s
+    refinement: the dominant channel (N,) and its line of largest acceleration (Hz)."""
+    centered, spectrum, nfft, channel, median = _channel_spectra(x, sample_rate, refine)
     frequency = (int(np.argmax(spectrum)) + 1) * sample_rate / nfft
-    return _refine_frequency(centered[:, channel], sample_rate, frequency) if refine else frequency
+    if not refine:
+        return frequency, None
+    column = centered[:, channel]
+    fastest = (_fastest_line(spectrum, median) + 1) * sample_rate / nfft
+    return _refine_frequency(column, sample_rate, frequency), (column, fastest)
 
 
 def _channel_spectra(x: np.ndarray, sample_rate: float, refine: bool
@@ -348,9 +366,24 @@ def acceleration_frequency(x: np.ndarray, sample_rate: float) -> float:
     DataError
         When no channel moves.
     """
-    if isinstance(x, np.ndarray):
-        x = _whole(x)
-    centered, spectrum, nfft, channel, median = _channel_spectra(x, sample_rate, True)
+    if not (isinstance(x, np.ndarray) and not x.flags.writeable):
+        column, fastest = _estimate_frequency(x, sample_rate, True)[1]
+        return _refine_frequency(column, sample_rate, fastest)
+    x = _whole(x)
+    value = _cached(x, sample_rate, "acceleration")
+    if value is None:
+        start = _cached(x, sample_rate, "fastest") or _estimate_frequency(x, sample_rate, True)[1]
+        column, fastest = start
+        value = _refine_frequency(column, sample_rate, fastest)
+        _store(x, sample_rate, "acceleration", value)
+        _FREQUENCIES.pop((id(x), float(sample_rate), "fastest"), None)  # the column's memory
+    return value
+
+
+def _fastest_line(spectrum: np.ndarray, median: float) -> int:
+    """Bin of the line of largest acceleration of ``spectrum`` (its channel's, relative to its
+    scale) among its peaks of :data:`LINE_FLOOR` of the largest or more, above ``median``
+    (white noise's bin) by :data:`LINE_NOISE_POWER`."""
     inner = spectrum[1:-1]
     peaks = np.flatnonzero((inner > spectrum[:-2]) & (inner >= spectrum[2:])) + 1
     peaks = np.append(peaks, int(np.argmax(spectrum)))  # the dominant line, even at an end
@@ -358,9 +391,7 @@ def acceleration_frequency(x: np.ndarray, sample_rate: float) -> float:
                   & (spectrum[peaks] ** 2 > LINE_NOISE_POWER * median)]
     if not len(lines):
         lines = peaks[-1:]
-    fastest = lines[np.argmax(spectrum[lines] * (lines + 1.0) ** 2)]
-    return _refine_frequency(centered[:, channel], sample_rate,
-                             (fastest + 1) * sample_rate / nfft)
+    return int(lines[np.argmax(spectrum[lines] * (lines + 1.0) ** 2)])
 
 
 def _peak_channels(amplitude: np.ndarray, n: int) -> np.ndarray:
