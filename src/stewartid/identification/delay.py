@@ -166,7 +166,9 @@ def _filtered_rows(dataset: Dataset, platform: Platform, window: float
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Kernel-filtered rows: q_ddot, q_dot, y (N', 6), shared (N', s + 1, 6) = the Coulomb terms
     (3 joint types, and the legs' for an electric actuator) and -y_dot."""
-    experiment = prepare_experiment(dataset, platform, gravity=True, joints=True)
+    # the model's departure from its linearisation subtracted, as the methods do: on equally
+    # spaced lines its products fall on the lines and pass for a delay
+    experiment = prepare_experiment(dataset, platform, gravity=True, joints=True, remainder=True)
     rate = experiment.sample_rate
     # the Coulomb signs need rates at every sample; they only decide signs
     _, q_dot_sign, _ = differentiate(experiment.q, rate, window / 4, DEFAULT_ORDER)
