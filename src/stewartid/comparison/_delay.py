@@ -88,7 +88,7 @@ def align_experiments(experiments: Sequence[Dataset], platform: Platform,
         return Alignment(aligned, entry, None)
     if platform.actuator.kind == "electric":
         # a servo drive samples its currents and encoders in one cycle; the screw's friction
-        # would bias the estimate (1.1 ms on a synchronous log of the electric example)
+        # would bias the estimate (measured in docs/benchmarks.md, "Electric hexapods")
         return Alignment(experiments, {"seconds": None, "std_error": None, "applied": False,
                                        "source": "not estimated", "reason": ELECTRIC_REASON},
                          None)
