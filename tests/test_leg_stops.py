@@ -129,6 +129,13 @@ def test_least_squares_stays_right_when_the_legs_stick(electric, records):
     assert z.max() < 4
     law = LeastSquaresIdentifier(leg_stops=False).fit(records, electric)
     assert np.abs(law.B_[d, d] / B0[d, d] - 1).max() > 0.3
+    # the report says where the friction was left free, and only then
+    from stewartid.reports.identification.friction_text import stop_lines
+
+    shares = [e["stop_rows"] / e["samples"] for e in fitted.result_.diagnostics["experiments"]]
+    assert 0 < min(shares) and max(shares) < 0.5
+    assert "stood still" in stop_lines(fitted.result_)[0]
+    assert stop_lines(law.result_) == []
 
 
 def test_physical_model_stays_right_when_the_legs_stick(electric, records):

@@ -67,6 +67,18 @@ def friction_shape_lines(result: IdentificationResult) -> list[str]:
 SHARP_SIGN_NOTED = 0.05
 
 
+def stop_lines(result: IdentificationResult) -> list[str]:
+    """Least squares on electric legs: the share of each experiment's rows the legs' stops took,
+    where their friction was left free instead of following the sign law."""
+    shares = [e["stop_rows"] / e["samples"] for e in result.diagnostics.get("experiments") or []
+              if e.get("stop_rows") and e.get("samples")]
+    if not shares:
+        return []
+    return [f"Where a leg stood still (its rate within its noise) its friction was left free, "
+            f"not the sign law's: the stops took {100 * min(shares):.2g}-{100 * max(shares):.2g} % "
+            "of the experiments' rows."]
+
+
 def third_harmonic_lines(result: IdentificationResult) -> list[str]:
     """Method A: whether the force's third harmonic shows Coulomb friction read as viscous."""
     bias = result.diagnostics.get("friction_bias") or {}
@@ -90,7 +102,8 @@ def friction_section(ok: Sequence[MethodFit], platform: Platform) -> list[str]:
             lines.append(" ".join([
                 f"- {run.display_name}: {friction_text(run)} (platform description: "
                 f"{platform.friction.coulomb:g} N·m per joint axis).",
-                *friction_law_lines(run.result), *friction_shape_lines(run.result)]))
+                *friction_law_lines(run.result), *friction_shape_lines(run.result),
+                *stop_lines(run.result)]))
         else:
             lines.append(" ".join([
                 f"- {run.display_name} does not estimate friction (its prediction contains "
@@ -101,4 +114,4 @@ def friction_section(ok: Sequence[MethodFit], platform: Platform) -> list[str]:
 
 
 __all__ = ["friction_law_lines", "friction_section", "friction_shape_lines", "friction_text",
-           "third_harmonic_lines"]
+           "stop_lines", "third_harmonic_lines"]
