@@ -113,6 +113,15 @@ def test_wavelet_stays_right_when_every_leg_sticks(electric):
     z = np.r_[(fitted.M_[d, d] - M0[d, d]) / result.std_errors_M[d, d],
               (fitted.B_[d, d] - B0[d, d]) / result.std_errors_B[d, d]]
     assert np.abs(z).max() < 3
+    # the stops it found cover the pauses, not much more, and the report says so
+    from stewartid.reports.identification.friction_text import stop_lines
+
+    t = pausing_records(electric)[0].t
+    paused = float((pausing_time(t, 0.45, 0.05, 0.06)[3] >= 0).mean())
+    for experiment in result.diagnostics["experiments"]:
+        assert paused <= experiment["stopped_share"] < 2 * paused
+        assert experiment["stop_window_s"] < 2.0
+    assert "stood still" in stop_lines(result)[0]
 
 
 def test_windows_leave_rows_beside_the_stops():

@@ -274,7 +274,9 @@ class WaveletIdentifier(BaseIdentifier):
             "wavelet": wavelet.to_dict(), "test_functions": int(self.test_functions),
             "n_equations": solution.n_equations, "n_intervals": n_intervals,
             "experiments": [{"name": i["name"], "intervals_found": i["intervals_found"],
-                             "intervals": i["intervals"].tolist()} for i in infos],
+                             "intervals": i["intervals"].tolist(),
+                             **{key: i[key] for key in ("stopped_share", "stop_window_s")
+                                if key in i}} for i in infos],
             "pair_choice": chosen, "pair_calibration": self.pair_calibration_,
             "coordinates": list(COORDINATES), "friction_model": friction,
             "soft_sign_rate": rate, "soft_sign_weights": solution.rate_weights,

@@ -65,16 +65,18 @@ def model_equations(model: str, experiment: Experiment, found: Detection, order:
 
     ``patterns``: :func:`~stewartid.identification.wavelet.weak_form.coulomb_patterns` of the
     experiment, shared by the models that use them; ``legs``: the windows leave the friction in
-    the legs' stops free (:func:`~stewartid.identification.wavelet.windows.window_stops`).
+    the legs' stops free (:func:`~stewartid.identification.wavelet.windows.window_stops`), and
+    the detection's info records the legs' share of samples at a stop and the window (s).
     """
     if model == "coulomb":
         stops, length = None, WINDOW_LENGTH
         if legs:
             stops = window_stops(found, experiment.sample_rate)
-            check_motion(sum(stop.stop - stop.start for stop in stops) / (6 * len(experiment.t)),
-                         experiment.name, "record a faster or larger motion")
+            share = sum(stop.stop - stop.start for stop in stops) / (6 * len(experiment.t))
+            check_motion(share, experiment.name, "record a faster or larger motion")
             length = stop_window_length(stops, float(experiment.t[-1] - experiment.t[0]),
                                         functions, WINDOW_LENGTH)
+            found.info.update(stopped_share=share, stop_window_s=length)
         return window_equations(experiment, found, order, functions, k, False, length,
                                 patterns, stops)
     return experiment_equations(experiment, found, order, functions, k, model, patterns)

@@ -68,15 +68,24 @@ SHARP_SIGN_NOTED = 0.05
 
 
 def stop_lines(result: IdentificationResult) -> list[str]:
-    """Least squares on electric legs: the share of each experiment's rows the legs' stops took,
-    where their friction was left free instead of following the sign law."""
-    shares = [e["stop_rows"] / e["samples"] for e in result.diagnostics.get("experiments") or []
-              if e.get("stop_rows") and e.get("samples")]
-    if not shares:
-        return []
-    return [f"Where a leg stood still (its rate within its noise) its friction was left free, "
-            f"not the sign law's: the stops took {100 * min(shares):.2g}-{100 * max(shares):.2g} % "
-            "of the experiments' rows."]
+    """Electric legs: where the legs' stops left their friction free instead of the sign law
+    (least squares: the share of each experiment's rows they took; Method B: the legs' share
+    of samples at a stop and its shortened windows)."""
+    experiments = result.diagnostics.get("experiments") or []
+    rows = [e["stop_rows"] / e["samples"] for e in experiments
+            if e.get("stop_rows") and e.get("samples")]
+    still = [e["stopped_share"] for e in experiments if e.get("stopped_share")]
+    if rows:
+        return [f"Where a leg stood still (its rate within its noise) its friction was left "
+                f"free, not the sign law's: the stops took {100 * min(rows):.2g}-"
+                f"{100 * max(rows):.2g} % of the experiments' rows."]
+    if still:
+        windows = [e["stop_window_s"] for e in experiments if e.get("stopped_share")]
+        return [f"The legs stood still (their rates within their noise) for "
+                f"{100 * min(still):.2g}-{100 * max(still):.2g} % of the samples; its windows "
+                f"left their friction there free, not the sign law's, and were shortened to "
+                f"{min(windows):.2g}-{max(windows):.2g} s to keep rows for it."]
+    return []
 
 
 def third_harmonic_lines(result: IdentificationResult) -> list[str]:
