@@ -220,6 +220,13 @@ def test_estimate_frequency():
     assert estimate_frequency(x, fs) == pytest.approx(0.73, rel=1e-6)
 
 
+def three_sines(t: np.ndarray, amplitude: float) -> np.ndarray:
+    """A DOF's record of three sines of falling amplitude: 0.6, 0.3 and 0.15 of ``amplitude``
+    at 0.3, 0.7 and 1.5 Hz."""
+    return sum(share * amplitude * np.sin(2 * np.pi * hz * t + phase)
+               for hz, share, phase in ((0.3, 0.6, 0.0), (0.7, 0.3, 1.0), (1.5, 0.15, 2.0)))
+
+
 def test_estimate_frequency_ignores_channels_that_hold_only_round_off():
     # a noise-free heave record of three sines: the still DOFs carry the forward kinematics'
     # round-off (spreads of 1e-17), whose one clean line stands out against its own scale more
@@ -227,8 +234,7 @@ def test_estimate_frequency_ignores_channels_that_hold_only_round_off():
     # frequency by under 1 % on 20 s
     fs = 1000.0
     t = np.arange(20000) / fs
-    heave = sum(share * 1e-2 * np.sin(2 * np.pi * hz * t + phase)
-                for hz, share, phase in ((0.3, 0.6, 0.0), (0.7, 0.3, 1.0), (1.5, 0.15, 2.0)))
+    heave = three_sines(t, 1e-2)
     still = 1e-17 * np.sin(2 * np.pi * 7.1 * t)
     x = np.column_stack([still, still, heave, still, still, still])
     assert estimate_frequency(x, fs) == pytest.approx(0.3, rel=1e-2)
@@ -241,8 +247,7 @@ def test_estimate_frequency_is_not_moved_by_white_noise():
     # choice to the roll's 0.3 Hz; a channel of noise alone holds no line
     fs = 1000.0
     t = np.arange(20000) / fs
-    roll = sum(share * 5e-3 * np.sin(2 * np.pi * hz * t + phase)
-               for hz, share, phase in ((0.3, 0.6, 0.0), (0.7, 0.3, 1.0), (1.5, 0.15, 2.0)))
+    roll = three_sines(t, 5e-3)
     lateral = 2e-5 * np.sin(2 * np.pi * 0.7 * t + 0.5) + 7e-5 * np.sin(2 * np.pi * 1.5 * t + 1.0)
     x = np.column_stack([lateral, roll])
     rng = np.random.default_rng(0)
@@ -288,8 +293,7 @@ def test_acceleration_frequency_takes_the_line_of_largest_acceleration():
     # keeps the sine (the harmonic is below LINE_FLOOR)
     fs = 1000.0
     t = np.arange(20000) / fs
-    pitch = sum(share * 5e-3 * np.sin(2 * np.pi * hz * t + phase)
-                for hz, share, phase in ((0.3, 0.6, 0.0), (0.7, 0.3, 1.0), (1.5, 0.15, 2.0)))
+    pitch = three_sines(t, 5e-3)
     rng = np.random.default_rng(1)
     for x in (pitch, pitch + 1e-5 * rng.normal(size=len(t))):
         assert estimate_frequency(x, fs) == pytest.approx(0.3, rel=1e-2)
