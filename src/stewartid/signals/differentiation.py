@@ -296,7 +296,8 @@ def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool
         return frequency, None
     column = centered[:, channel]
     fastest = (_fastest_line(spectrum, median) + 1) * sample_rate / nfft
-    return _refine_frequency(column, sample_rate, frequency), (column, fastest)
+    # a copy: the view would keep every channel alive in the record's cache
+    return _refine_frequency(column, sample_rate, frequency), (column.copy(), fastest)
 
 
 def _channel_spectra(x: np.ndarray, sample_rate: float, refine: bool
