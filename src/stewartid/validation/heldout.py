@@ -18,6 +18,7 @@ from stewartid.errors import DataError, StewartidError
 from stewartid.identification.result import IdentificationResult
 from stewartid.model.joints import FRICTION_TYPES
 from stewartid.platform import Platform
+from stewartid.signals.differentiation import share_frequency
 
 #: Default number of time-segment folds.
 DEFAULT_FOLDS = 3
@@ -347,8 +348,6 @@ def time_piece(dataset: Dataset, start: int, stop: int) -> Dataset:
     """Samples ``start:stop`` of a record, named after their time span; one copy per record and
     span, which every method's folds share. Its excitation frequency is the record's: a fold's
     piece may hold a single period of the slowest line, too few to find it."""
-    from stewartid.signals.differentiation import share_frequency
-
     def piece(record: Dataset) -> Dataset:
         t = record.t[start:stop]
         part = record.part(slice(start, stop), f"{record.name}[{t[0]:.4g}-{t[-1]:.4g} s]")
