@@ -4,7 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.ndimage import maximum_filter1d
 
+from stewartid.datasets.excitation import running_maximum
 from stewartid.errors import ConfigError
 from stewartid.identification.wavelet.intervals import check_intervals, joint_rates
 from stewartid.simulation import Sine, multisine_excitation, paper_experiments
@@ -70,3 +74,13 @@ def test_channel_lines_are_each_channels_own_lines():
         assert np.array_equal(lines.frequencies_hz, alone.frequencies_hz)
         assert np.array_equal(lines.amplitudes, alone.amplitudes)
         assert lines.largest == alone.largest
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(1, 300), st.integers(0, 70), st.integers(0, 2**32 - 1))
+def test_running_maximum_is_scipy_maximum_filter(n, reach, seed):
+    """The spectra's sidelobe test: the largest value within reach, zero beyond the ends."""
+    rng = np.random.default_rng(seed)
+    x = rng.random(n) * (rng.random(n) < 0.3)
+    expected = maximum_filter1d(x, size=2 * reach + 1, mode="constant")
+    np.testing.assert_array_equal(running_maximum(x, reach), expected)

@@ -126,6 +126,23 @@ def _windowed(x: np.ndarray) -> np.ndarray:
     return x * np.hanning(n)[:, None]
 
 
+def running_maximum(x: np.ndarray, reach: int) -> np.ndarray:
+    """Largest of ``x`` (N,) >= 0 within ``reach`` samples of each sample, zero beyond the ends.
+
+    Van Herk and Gil-Werman's two passes over blocks of the window's length: O(N) for any reach,
+    without :mod:`scipy.ndimage` (slow to import) on the command line's path.
+    """
+    width = 2 * reach + 1
+    n = len(x)
+    padded = np.zeros(n + 2 * reach + (-(n + 2 * reach)) % width)
+    padded[reach:reach + n] = x
+    blocks = padded.reshape(-1, width)
+    ahead = np.maximum.accumulate(blocks, axis=1).ravel()
+    behind = np.maximum.accumulate(blocks[:, ::-1], axis=1)[:, ::-1].ravel()
+    # the window [i, i + width) of padded: its tail in one block, its head in the next
+    return np.maximum(behind[:n], ahead[width - 1:width - 1 + n])
+
+
 def _peaks(amplitude: np.ndarray, n: int, nfft: int, sample_rate: float,
            fraction: float) -> SpectralLines:
     """The lines of an amplitude spectrum (``nfft // 2 + 1`` bins) of ``n`` samples."""
@@ -145,12 +162,10 @@ def _peaks(amplitude: np.ndarray, n: int, nfft: int, sample_rate: float,
     peaks = peaks[amplitude[peaks] >= fraction * largest]
     # a sidelobe: a larger peak within reach; the largest peak within reach of every grid
     # point in one pass (a noisy spectrum has thousands of maxima)
-    from scipy.ndimage import maximum_filter1d
-
     reach_bins = int(np.floor(SIDELOBE_BINS * resolution / (sample_rate / nfft) + 1e-9))
     heights_at = np.zeros_like(amplitude)
     heights_at[peaks] = amplitude[peaks]
-    nearby = maximum_filter1d(heights_at, size=2 * reach_bins + 1, mode="constant")
+    nearby = running_maximum(heights_at, reach_bins)
     peaks = peaks[~(SIDELOBE_FRACTION * nearby[peaks] > amplitude[peaks])]
     peaks = peaks[np.argsort(amplitude[peaks])[::-1]]
     # a parabola through the log amplitudes of the peak and its neighbours: the Hann main

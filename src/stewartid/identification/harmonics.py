@@ -8,8 +8,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from scipy.special import chdtri
 
+from stewartid.identification.quantiles import chi2_upper_quantile
 from stewartid.signals.differentiation import savgol_gain
 
 
@@ -101,7 +101,7 @@ def third_harmonic(coefficients: Sequence[np.ndarray | None], noise_covariance: 
         statistic += len(blocks) * float(np.einsum("ki,ij,kj->", mean, precision, mean))
         dof += 2 * rank
         amplitudes.append(np.hypot(mean[0], mean[1]))
-    threshold = float(chdtri(dof, THIRD_HARMONIC_LEVEL)) if dof else np.inf
+    threshold = chi2_upper_quantile(dof, THIRD_HARMONIC_LEVEL) if dof else np.inf
     if not statistic > threshold:
         amplitudes = [np.zeros_like(a) for a in amplitudes]
     return amplitudes, statistic, threshold

@@ -7,6 +7,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from stewartid.identification.quantiles import normal_cdf
 from stewartid.identification.result import IdentificationResult
 from stewartid.reference.published import PAPER_ENTRIES, EntryKey
 
@@ -58,8 +59,6 @@ def expected_worst_error(relative_std: np.ndarray, mean: np.ndarray | None = Non
     float
         In the unit of ``relative_std``.
     """
-    from scipy.special import ndtr
-
     s = np.asarray(relative_std, dtype=float)
     m = np.zeros_like(s) if mean is None else np.abs(np.asarray(mean, dtype=float))
     if not (np.all(np.isfinite(s)) and np.all(np.isfinite(m))):
@@ -70,7 +69,7 @@ def expected_worst_error(relative_std: np.ndarray, mean: np.ndarray | None = Non
         return 0.0
     x = np.linspace(0.0, float(np.max(m + 8.0 * s)), 4001)[:, None]
     scale = np.where(s > 0, s, 1.0)
-    within = np.where(s > 0, ndtr((x - m) / scale) - ndtr((-x - m) / scale), x >= m)
+    within = np.where(s > 0, normal_cdf((x - m) / scale) - normal_cdf((-x - m) / scale), x >= m)
     return float(np.trapezoid(1.0 - np.prod(within, axis=1), x[:, 0]))
 
 

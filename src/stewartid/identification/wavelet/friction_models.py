@@ -13,6 +13,7 @@ import numpy as np
 from stewartid.datasets.dataset import Dataset
 from stewartid.errors import IdentificationError
 from stewartid.identification.preparation import Experiment
+from stewartid.identification.quantiles import normal_upper_quantile
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.stops import check_motion
 from stewartid.identification.wavelet.detection import (
@@ -161,15 +162,13 @@ def friction_law_test(free: np.ndarray, free_std: np.ndarray, law: np.ndarray,
     12 differences in sqrt(s_free^2 + s_law^2) against the Bonferroni point at :data:`FRICTION_LAW_LEVEL`.
     Returns ``{"largest_disagreement", "entry", "threshold", "rejected"}``.
     """
-    from scipy.special import ndtri
-
     def diagonals(x: np.ndarray) -> np.ndarray:   # Mt's, then Bt's
         return np.r_[np.diag(x[:, :6]), np.diag(x[:, 6:12])]
 
     spread = np.hypot(diagonals(free_std), diagonals(law_std))
     scores = np.abs(diagonals(free) - diagonals(law)) / np.maximum(spread, 1e-300)
     labels = [f"{name}t({k + 1},{k + 1})" for name in ("M", "B") for k in range(6)]
-    threshold = float(ndtri(1.0 - FRICTION_LAW_LEVEL / (2 * scores.size)))
+    threshold = normal_upper_quantile(FRICTION_LAW_LEVEL / (2 * scores.size))
     if not np.any(np.isfinite(scores)):   # no error to judge by: nothing contradicts the law
         return {"largest_disagreement": float("nan"), "entry": None, "threshold": threshold,
                 "rejected": False}

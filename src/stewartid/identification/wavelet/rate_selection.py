@@ -9,8 +9,8 @@ import dataclasses
 from collections.abc import Callable, Sequence
 
 import numpy as np
-from scipy.special import chdtri
 
+from stewartid.identification.quantiles import chi2_upper_quantile
 from stewartid.identification.wavelet.gls import WeakFormSolution, solve_weak_form
 from stewartid.identification.wavelet.weak_form import SOFT_SIGN_RATES, IntervalEquations
 
@@ -73,7 +73,7 @@ def solve_weak_form_over_rates(equations: Sequence[IntervalEquations], n_experim
     # likelihood ratio of the levels, and levels a friction can have: one 3 standard errors
     # below zero says the plant's friction does not follow the structure
     gain = rows * (residual_cost(plain) - residual_cost(best))
-    explains = gain > chdtri(len(best.coulomb), VARIATION_TEST_LEVEL)
+    explains = gain > chi2_upper_quantile(len(best.coulomb), VARIATION_TEST_LEVEL)
     if explains and np.all(best.coulomb > -3.0 * best.coulomb_std):
         return best, best_rate
     return plain, None
