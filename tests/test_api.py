@@ -90,6 +90,19 @@ def test_methods_fitted_side_by_side_give_the_same_comparison(tmp_path, example_
                == (tmp_path / "two" / "figures" / name).read_bytes() for name in pictures)
 
 
+def test_a_methods_full_fit_error_comes_before_its_folds():
+    """The full fit and the fold fits run as separate tasks; the method's error is the full
+    fit's, as when they ran one after the other, and its time is both tasks'."""
+    from stewartid.comparison import MethodFit
+    from stewartid.comparison._runs import FoldFits, with_folds
+    from stewartid.errors import DataError
+
+    run = MethodFit("ls", "least squares", "k", error="full fit refused",
+                    exception=DataError("full fit refused"), seconds=1.0)
+    joined = with_folds(run, FoldFits(exception=DataError("fold 1 refused"), seconds=2.0))
+    assert joined.error == "full fit refused" and joined.seconds == 3.0
+
+
 def test_a_worker_count_below_one_is_one_line(example_dir):
     result = CliRunner().invoke(app, ["identify", "--method", "all", "--jobs", "0", "--report",
                                       "unused", str(example_dir)])

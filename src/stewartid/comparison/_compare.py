@@ -13,13 +13,18 @@ from typing import Any
 import numpy as np
 
 from stewartid.comparison._delay import align_experiments, delay_note
-from stewartid.comparison._physical import PhysicalRequest, fit_physical
+from stewartid.comparison._physical import (
+    PhysicalRequest,
+    physical_fit,
+    physical_folds,
+    with_physical_folds,
+)
 from stewartid.comparison._records import MethodFit, PhysicalSection
-from stewartid.comparison._runs import judge, run_method, same_segments
+from stewartid.comparison._runs import fit_method, judge, method_folds, same_segments, with_folds
 from stewartid.datasets.alignment import align_forces
 from stewartid.datasets.dataset import Dataset
 from stewartid.datasets.plausibility import check_identified
-from stewartid.errors import ConfigError
+from stewartid.errors import ConfigError, StewartidError
 from stewartid.identification import registry
 from stewartid.identification.averaging import AveragingPolicy, average_experiments
 from stewartid.identification.delay import delay_identifiable
@@ -230,11 +235,15 @@ def check_jobs(jobs: int | None) -> None:
                           f"more; got {jobs!r}.")
 
 
-#: The physical model's task among the methods' in :func:`compare_methods`.
+#: The physical model's tasks among the methods' in :func:`compare_methods`.
 PHYSICAL_TASK = "physical model"
-#: The order the workers take the methods in, after the physical model: longest first on the
-#: paper's log (docs/benchmarks.md); results do not depend on it.
-LONGEST_FIRST = ("wavelet", "ls", "fourier")
+#: Each method's two tasks: its full fit, and its fits without each time segment.
+FIT, FOLDS = "fit", "folds"
+#: The order the workers take the tasks in, longest first on the paper's log (docs/benchmarks.md),
+#: so that the short ones fill the workers' ends; other methods' tasks follow. Results do not
+#: depend on it.
+LONGEST_FIRST = ((PHYSICAL_TASK, FOLDS), ("wavelet", FOLDS), ("ls", FOLDS), ("wavelet", FIT),
+                 ("ls", FIT), (PHYSICAL_TASK, FIT), ("fourier", FOLDS), ("fourier", FIT))
 
 
 @dataclass
@@ -256,14 +265,41 @@ class _Work:
         default_factory=dict)
 
 
-def _run_task(work: _Work, task: str) -> MethodFit | PhysicalSection:
-    """One method fitted and validated, or the physical model (:data:`PHYSICAL_TASK`)."""
-    if task == PHYSICAL_TASK:
-        return fit_physical(work.datasets, work.platform, work.physical, work.folds,
-                            work.segments, work.records, work.record_cache)
-    return run_method(task, work.settings, work.datasets, work.platform, work.folds,
+def _run_task(work: _Work, task: tuple[str, str]) -> Any:
+    """One task of :func:`compare_methods`: a method's (or the physical model's) full fit or its
+    fold fits; an error the physical model raises is returned, to be raised in task order."""
+    name, part = task
+    start = time.perf_counter()
+    if name == PHYSICAL_TASK:
+        if part == FOLDS:
+            return (physical_folds(work.datasets, work.platform, work.physical, work.folds,
+                                   work.segments), time.perf_counter() - start)
+        try:
+            return physical_fit(work.datasets, work.platform, work.physical, work.folds,
+                                work.segments, work.records, work.record_cache)
+        except StewartidError as exc:
+            return exc
+    if part == FOLDS:
+        return method_folds(name, work.settings, work.datasets, work.platform, work.folds,
+                            work.consistent, work.segments, work.delay_identifiable)
+    return fit_method(name, work.settings, work.datasets, work.platform, work.folds,
                       work.consistent, work.segments, work.check, work.records,
-                      work.record_cache, work.delay_identifiable)
+                      work.record_cache)
+
+
+def _assembled(names: Sequence[str], physical: PhysicalRequest | None,
+               done: Mapping[tuple[str, str], Any]) -> dict[str, Any]:
+    """Each method's and the physical model's two tasks joined, by name; the physical model's
+    error raised (its full fit's first)."""
+    joined: dict[str, Any] = {name: with_folds(done[name, FIT], done[name, FOLDS])
+                              for name in names}
+    if physical is not None:
+        section = done[PHYSICAL_TASK, FIT]
+        if isinstance(section, StewartidError):
+            raise section
+        found, seconds = done[PHYSICAL_TASK, FOLDS]
+        joined[PHYSICAL_TASK] = with_physical_folds(section, found, physical, seconds)
+    return joined
 
 
 def _one_copy_of_segments(done: dict[str, Any]) -> dict[str, Any]:
@@ -394,12 +430,13 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
     work = _Work(dict(settings or {}), datasets, platform, folds, consistent, checker,
                  records, identifiable, physical)
     names = tuple(dict.fromkeys(names))
-    # the longest tasks first, so that the short ones fill the workers' ends
-    tasks = ([PHYSICAL_TASK] if physical is not None else []) + sorted(
-        names, key=lambda name: LONGEST_FIRST.index(name) if name in LONGEST_FIRST
-        else len(LONGEST_FIRST))
+    fitted = (*names, *([PHYSICAL_TASK] if physical is not None else ()))
+    tasks = sorted([(name, part) for name in fitted for part in (FIT, FOLDS)],
+                   key=lambda task: LONGEST_FIRST.index(task) if task in LONGEST_FIRST
+                   else len(LONGEST_FIRST))
     workers = inheriting_workers(jobs, len(tasks))
-    done = dict(zip(tasks, run_in_order(_run_task, tasks, workers, shared=work), strict=True))
+    done = _assembled(names, physical, dict(zip(
+        tasks, run_in_order(_run_task, tasks, workers, shared=work), strict=True)))
     if workers > 1:
         done = _one_copy_of_segments(done)
     runs = [done[name] for name in names]

@@ -25,6 +25,7 @@ from stewartid.physical.validation import (
 from stewartid.platform import Platform
 from stewartid.validation.heldout import (
     Segment,
+    ValidationResult,
     held_out_segments,
     record_segments,
     validation_entry,
@@ -149,25 +150,46 @@ def fit_physical(datasets: Sequence[Dataset], platform: Platform, request: Physi
     StewartidError
         With ``request.required``, when the model cannot be applied.
     """
+    section = physical_fit(datasets, platform, request, folds, segments, records, record_cache)
+    if section.result is None:
+        return section
     start = time.perf_counter()
-    options = {**request.settings, "payload": request.payload,
-               "consistent": request.consistent}
-    gravity = bool(options.get("gravity", True))
+    found = physical_folds(datasets, platform, request, folds, segments)
+    return with_physical_folds(section, found, request, time.perf_counter() - start)
+
+
+def _options(request: PhysicalRequest) -> dict[str, Any]:
+    return {**request.settings, "payload": request.payload, "consistent": request.consistent}
+
+
+def _segments(datasets: Sequence[Dataset], platform: Platform, request: PhysicalRequest,
+              folds: int, segments: dict[tuple[bool, bool], list[Segment]]
+              ) -> tuple[tuple[bool, bool], list[Segment]]:
+    """The physical model's held-out segments and their key in ``segments`` (filled on first use)."""
+    terms = (bool(_options(request).get("gravity", True)), False)  # the full model predicts
+    if terms not in segments:                                      # the nonlinear terms itself
+        segments[terms] = held_out_segments(datasets, platform, folds, *terms)
+    return terms, segments[terms]
+
+
+def physical_fit(datasets: Sequence[Dataset], platform: Platform, request: PhysicalRequest,
+                 folds: int, segments: dict[tuple[bool, bool], list[Segment]],
+                 records: Sequence[Dataset] = (),
+                 record_cache: dict[tuple[bool, bool], list[Segment]] | None = None
+                 ) -> PhysicalSection:
+    """The physical model's full fit, its prediction of ``records`` and its matrices across the
+    workspace, not yet validated on held-out segments (:func:`with_physical_folds`); arguments
+    and errors as :func:`fit_physical`."""
+    start = time.perf_counter()
     try:
-        estimator = PhysicalIdentifier(**options).fit(list(datasets), platform)
+        estimator = PhysicalIdentifier(**_options(request)).fit(list(datasets), platform)
         fixed, count = estimator.fixed_, len(estimator.parameters_)
         if not request.required and len(fixed) > MOST_FIXED * count:
             return PhysicalSection(seconds=time.perf_counter() - start, note=(
                 f"The physical model is not shown: these data fix {len(fixed)} of its {count} "
                 "parameters at the platform file's values (not identifiable from them); "
                 "`identify --model physical` fits and names the rest."))
-        terms = (gravity, False)  # the full model predicts the nonlinear terms itself
-        if terms not in segments:
-            segments[terms] = held_out_segments(datasets, platform, folds, *terms)
-        # the fold fits predict: their standard errors (the sampling check's refits) are never read
-        quick = {**options, "sampling_check": False}
-        validation = cross_validate_physical(lambda: PhysicalIdentifier(**quick), datasets,
-                                             platform, folds, segments[terms])
+        terms, _ = _segments(datasets, platform, request, folds, segments)
         external = None
         if records:
             cache = {} if record_cache is None else record_cache
@@ -181,12 +203,44 @@ def fit_physical(datasets: Sequence[Dataset], platform: Platform, request: Physi
             raise
         return PhysicalSection(seconds=time.perf_counter() - start,
                                note=f"The physical model is not shown: {exc}")
-    result = dataclasses.replace(estimator.result_,
-                                 validation=validation_entry(validation, external))
-    return PhysicalSection(result, estimator.covariance_, curves, validation, external,
+    return PhysicalSection(estimator.result_, estimator.covariance_, curves, None, external,
                            time.perf_counter() - start)
 
 
+def physical_folds(datasets: Sequence[Dataset], platform: Platform, request: PhysicalRequest,
+                   folds: int, segments: dict[tuple[bool, bool], list[Segment]]
+                   ) -> ValidationResult | StewartidError:
+    """The physical model refitted without each time segment, scored on the held-out segments;
+    or the error that stopped the fits (arguments as :func:`fit_physical`)."""
+    try:
+        _, held_out = _segments(datasets, platform, request, folds, segments)
+        # the fold fits predict: their standard errors (the sampling check's refits) are
+        # never read
+        quick = {**_options(request), "sampling_check": False}
+        return cross_validate_physical(lambda: PhysicalIdentifier(**quick), datasets, platform,
+                                       folds, held_out)
+    except StewartidError as exc:
+        return exc
+
+
+def with_physical_folds(section: PhysicalSection, folds: ValidationResult | StewartidError,
+                        request: PhysicalRequest, seconds: float = 0.0) -> PhysicalSection:
+    """The full fit's section (:func:`physical_fit`) validated by its folds
+    (:func:`physical_folds`, which took ``seconds``): the full fit's note first, then the
+    folds' error (raised with ``request.required``)."""
+    if section.result is None:
+        return section
+    if isinstance(folds, StewartidError):
+        if request.required:
+            raise folds
+        return PhysicalSection(seconds=section.seconds + seconds,
+                               note=f"The physical model is not shown: {folds}")
+    result = dataclasses.replace(section.result,
+                                 validation=validation_entry(folds, section.records))
+    return dataclasses.replace(section, result=result, validation=folds,
+                               seconds=section.seconds + seconds)
+
 
 __all__ = ["MOST_FIXED", "SHOWN_COUPLINGS", "WORKSPACE_POINTS", "PhysicalRequest",
-           "fit_physical", "largest_couplings", "workspace"]
+           "fit_physical", "largest_couplings", "physical_fit", "physical_folds",
+           "with_physical_folds", "workspace"]

@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -21,6 +22,7 @@ from stewartid.reference.published import PAPER_ENTRIES, EntryKey
 from stewartid.validation.heldout import (
     CrossValidation,
     Segment,
+    ValidationResult,
     cross_validate,
     held_out_segments,
     in_sample,
@@ -57,6 +59,130 @@ def consistent_result(result: IdentificationResult) -> tuple[IdentificationResul
 
 def _project(result: IdentificationResult) -> IdentificationResult:
     return consistent_result(result)[0]
+
+
+@dataclass(frozen=True)
+class FoldFits:
+    """One method refitted without each time segment and scored on the held-out segments: the
+    half of :func:`run_method` that :func:`~stewartid.comparison.compare_methods` runs beside the
+    full fit, in another process.
+
+    Attributes
+    ----------
+    cross_validation : CrossValidation or None
+    validation : ValidationResult or None
+        Scores of the fold models (the consistent ones with ``consistent=True``).
+    validation_unconstrained : ValidationResult or None
+        Of the unconstrained fold models, with ``consistent=True``.
+    exception : StewartidError or None
+        Why the folds could not be fitted.
+    seconds : float
+    """
+
+    cross_validation: CrossValidation | None = None
+    validation: ValidationResult | None = None
+    validation_unconstrained: ValidationResult | None = None
+    exception: StewartidError | None = None
+    seconds: float = 0.0
+
+
+def _own_settings(name: str, settings: Mapping[str, Any]) -> dict[str, Any]:
+    """The settings the method ``name`` has."""
+    accepted = registry.method_spec(name).estimator_class.param_names()
+    return {k: v for k, v in settings.items() if k in accepted}
+
+
+def _terms(params: Mapping[str, Any]) -> tuple[bool, bool]:
+    """The model terms (``gravity``, ``remainder``) a method with ``params`` removes: the measured
+    side of its held-out prediction."""
+    return bool(params.get("gravity", True)), bool(params.get("remainder", False))
+
+
+def _companion(name: str, own: Mapping[str, Any]) -> Callable[[], Any] | None:
+    """The friction-estimating identifier that lends a method its Coulomb levels, if it has a
+    friction setting."""
+    if "friction" not in registry.method_spec(name).estimator_class.param_names():
+        return None
+    return lambda: registry.estimates_only(name, **{**own, "friction": "uniform"})
+
+
+def method_folds(name: str, settings: Mapping[str, Any], datasets: Sequence[Dataset],
+                 platform: Platform, folds: int, consistent: bool,
+                 segments: dict[tuple[bool, bool], list[Segment]],
+                 delay_identifiable: bool | None = None) -> FoldFits:
+    """The fold fits of one method and their held-out scores (arguments as :func:`run_method`)."""
+    start = time.perf_counter()
+    own = _own_settings(name, settings)
+    terms = _terms(registry.create_identifier(name, **own).get_params())
+    try:
+        if terms not in segments:
+            segments[terms] = held_out_segments(datasets, platform, folds, *terms)
+        # the folds and the companion predict: their standard errors are never read
+        folds_fit = cross_validate(lambda: registry.estimates_only(name, **own), datasets,
+                                   platform, folds, terms[0], segments[terms],
+                                   _companion(name, own), delay_identifiable)
+    except StewartidError as exc:
+        return FoldFits(exception=exc, seconds=time.perf_counter() - start)
+    validation, before = folds_fit.scores(), None
+    if consistent:
+        before, validation = validation, folds_fit.scores(_project)
+    return FoldFits(folds_fit, validation, before, seconds=time.perf_counter() - start)
+
+
+def fit_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Dataset],
+               platform: Platform, folds: int, consistent: bool,
+               segments: dict[tuple[bool, bool], list[Segment]],
+               check: Callable[[IdentificationResult], None] | None = None,
+               records: Sequence[Dataset] = (),
+               record_cache: dict[tuple[bool, bool], list[Segment]] | None = None) -> MethodFit:
+    """The full fit of one method, checked, with its in-sample residuals and its prediction of
+    the validation records, not yet validated on held-out segments (:func:`with_folds`);
+    arguments as :func:`run_method`."""
+    spec = registry.method_spec(name)
+    own = _own_settings(name, settings)
+    start = time.perf_counter()
+    try:
+        estimator = registry.create_identifier(name, **own).fit(list(datasets), platform)
+        if check is not None:
+            check(estimator.result_)
+        terms = _terms(estimator.get_params())
+        if terms not in segments:
+            segments[terms] = held_out_segments(datasets, platform, folds, *terms)
+        unconstrained = with_companion_friction(estimator.result_, _companion(name, own),
+                                                datasets, platform)
+    except StewartidError as exc:
+        return MethodFit(name, spec.display_name, spec.color, error=str(exc),
+                         exception=exc, seconds=time.perf_counter() - start)
+    result, projection = unconstrained, None
+    if consistent:
+        result, projection = consistent_result(unconstrained)
+    external = None
+    if records:
+        cache = {} if record_cache is None else record_cache
+        if terms not in cache:
+            cache[terms] = record_segments(records, platform, *terms)
+        # ``result`` holds the companion's levels: the consistent one keeps the diagnostics
+        external = validate_on_records(result, cache[terms])
+    return MethodFit(name, spec.display_name, spec.color, result=result,
+                     unconstrained=unconstrained, in_sample=in_sample(segments[terms], result),
+                     projection=projection, records=external,
+                     seconds=time.perf_counter() - start, estimator=estimator)
+
+
+def with_folds(run: MethodFit, folds: FoldFits) -> MethodFit:
+    """A method's full fit (:func:`fit_method`) validated by its fold fits (:func:`method_folds`);
+    the full fit's error first, then the folds'."""
+    seconds = run.seconds + folds.seconds
+    if run.result is None:
+        return dataclasses.replace(run, seconds=seconds)
+    if folds.exception is not None:
+        return MethodFit(run.name, run.display_name, run.color, error=str(folds.exception),
+                         exception=folds.exception, seconds=seconds)
+    result = dataclasses.replace(run.result,
+                                 validation=validation_entry(folds.validation, run.records))
+    return dataclasses.replace(run, result=result, validation=folds.validation,
+                               validation_unconstrained=folds.validation_unconstrained,
+                               seconds=seconds, cross_validation=folds.cross_validation)
 
 
 def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Dataset],
@@ -98,50 +224,12 @@ def run_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
         With ``error`` and ``exception`` instead of a result when the method cannot be
         applied to these data (a :class:`~stewartid.errors.StewartidError`).
     """
-    spec = registry.method_spec(name)
-    accepted = spec.estimator_class.param_names()
-    own = {k: v for k, v in settings.items() if k in accepted}
-    start = time.perf_counter()
-    try:
-        estimator = registry.create_identifier(name, **own).fit(list(datasets), platform)
-        if check is not None:
-            check(estimator.result_)
-        params = estimator.get_params()
-        # the measured side of the prediction with the model terms the method removed
-        terms = (bool(params.get("gravity", True)), bool(params.get("remainder", False)))
-        if terms not in segments:
-            segments[terms] = held_out_segments(datasets, platform, folds, *terms)
-        # the folds and the companion predict: their standard errors are never read
-        companion = None
-        if "friction" in accepted:
-            def companion():
-                return registry.estimates_only(name, **{**own, "friction": "uniform"})
-        folds_fit = cross_validate(lambda: registry.estimates_only(name, **own), datasets,
-                                   platform, folds, terms[0], segments[terms], companion,
-                                   delay_identifiable)
-    except StewartidError as exc:
-        return MethodFit(name, spec.display_name, spec.color, error=str(exc),
-                            exception=exc, seconds=time.perf_counter() - start)
-    unconstrained = with_companion_friction(estimator.result_, companion, datasets, platform)
-    validation = folds_fit.scores()
-    result, projection, before = unconstrained, None, None
-    if consistent:
-        result, projection = consistent_result(unconstrained)
-        before, validation = validation, folds_fit.scores(_project)
-    external = None
-    if records:
-        cache = {} if record_cache is None else record_cache
-        if terms not in cache:
-            cache[terms] = record_segments(records, platform, *terms)
-        # ``result`` holds the companion's levels: the consistent one keeps the diagnostics
-        external = validate_on_records(result, cache[terms])
-    result = dataclasses.replace(result, validation=validation_entry(validation, external))
-    return MethodFit(name, spec.display_name, spec.color, result=result,
-                        unconstrained=unconstrained, validation=validation,
-                        validation_unconstrained=before,
-                        in_sample=in_sample(segments[terms], result), projection=projection,
-                        records=external, seconds=time.perf_counter() - start,
-                        cross_validation=folds_fit, estimator=estimator)
+    run = fit_method(name, settings, datasets, platform, folds, consistent, segments, check,
+                     records, record_cache)
+    if run.result is None:
+        return run
+    return with_folds(run, method_folds(name, settings, datasets, platform, folds, consistent,
+                                        segments, delay_identifiable))
 
 
 def same_segments(a: Sequence[Segment], b: Sequence[Segment]) -> bool:
@@ -242,4 +330,5 @@ def judge(runs: Sequence[MethodFit], consistent: bool = False,
                                                compared, consensus.validation.residual_delay)
 
 
-__all__ = ["consensus_run", "consistent_result", "judge", "run_method", "same_segments"]
+__all__ = ["FoldFits", "consensus_run", "consistent_result", "fit_method", "judge", "method_folds",
+           "run_method", "same_segments", "with_folds"]
