@@ -116,6 +116,30 @@ def test_injected_delay_is_recovered_on_noise_free_data(paper, delay):
     assert estimate.std_error < 1e-6
 
 
+def test_the_estimate_is_the_same_on_worker_processes(paper):
+    """The experiments filtered side by side (fork) give the one-process estimate to the bit."""
+    data = experiments(paper, delay=2e-3, noise=20.0)
+    alone, side = (estimate_delay(data, paper, jobs=jobs) for jobs in (1, 2))
+    assert (side.seconds, side.std_error) == (alone.seconds, alone.std_error)
+
+
+def test_aligned_record_takes_the_motions_terms_of_the_logged_one(paper):
+    """Shifted forces keep the motion's samples: the pose's model terms, taken from the logged
+    record's rows, equal those of a record built afresh from the aligned samples."""
+    from stewartid.identification.preparation import prepare_experiment
+
+    logged = experiments(paper, delay=2e-3)[0]
+    whole = prepare_experiment(logged, paper)
+    aligned = shift_forces(logged, 2.5e-3)
+    shared = prepare_experiment(aligned, paper)
+    fresh = prepare_experiment(Dataset(t=aligned.t, pose=np.array(aligned.pose),
+                                       lengths=aligned.lengths, forces=aligned.forces), paper)
+    assert len(whole.leg_jacobian) > len(aligned)
+    np.testing.assert_allclose(shared.leg_jacobian, fresh.leg_jacobian, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(shared.generalized_force, fresh.generalized_force, rtol=1e-13,
+                               atol=1e-9)
+
+
 def test_noisy_estimate_is_within_its_standard_errors(paper):
     # 20 N of white noise per leg force (about the reference noise's share of the dynamics)
     estimate = estimate_delay(experiments(paper, delay=2e-3, noise=20.0), paper)

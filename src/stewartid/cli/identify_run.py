@@ -312,7 +312,7 @@ def identify_files(files: Sequence[str | Path], method: str = "wavelet",
     else:
         averaged = average_experiments(datasets, policy)
         datasets, averaging = averaged.experiments, averaged.entry  # the full rate's freed
-        alignment = align_experiments(datasets, description, delay)
+        alignment = align_experiments(datasets, description, delay, jobs)
         delay_entry, sensitivity = alignment.entry, alignment.sensitivity
         if model is None and "jobs" in registry.method_spec(method).estimator_class.param_names():
             settings = {**settings, "jobs": jobs}

@@ -414,7 +414,7 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
     if not (isinstance(folds, int | np.integer) and folds >= 2):
         raise ConfigError(f"the validation needs at least 2 folds; got {folds!r}.")
     averaged = average_experiments(_experiments(experiments, platform), averaging)
-    alignment = align_experiments(averaged.experiments, platform, delay)
+    alignment = align_experiments(averaged.experiments, platform, delay, jobs)
     datasets = alignment.experiments
     records = _experiments(validate or (), platform)
     if records and alignment.entry is not None and alignment.entry["applied"]:

@@ -58,7 +58,7 @@ ELECTRIC_REASON = ("an electric drive logs its currents and encoder positions in
 
 
 def align_experiments(experiments: Sequence[Dataset], platform: Platform,
-                      delay: str | float | None = None) -> Alignment:
+                      delay: str | float | None = None, jobs: int | None = 1) -> Alignment:
     """Align the force channels with the motion.
 
     Parameters
@@ -71,6 +71,9 @@ def align_experiments(experiments: Sequence[Dataset], platform: Platform,
         the motion can (two or more frequencies in every DOF) and applied when more than
         :data:`DELAY_SIGNIFICANCE` standard errors from zero, else as logged; an electric
         actuator's log as logged (:data:`ELECTRIC_REASON`).
+    jobs : int or None
+        Worker processes of the delay's estimate (None: every core); the result does not
+        depend on it.
 
     Returns
     -------
@@ -84,7 +87,7 @@ def align_experiments(experiments: Sequence[Dataset], platform: Platform,
     """
     experiments = list(experiments)
     if delay is not None:
-        aligned, entry = apply_delay(experiments, platform, delay)
+        aligned, entry = apply_delay(experiments, platform, delay, jobs)
         return Alignment(aligned, entry, None)
     if platform.actuator.kind == "electric":
         # a servo drive samples its currents and encoders in one cycle; the screw's friction
@@ -96,7 +99,7 @@ def align_experiments(experiments: Sequence[Dataset], platform: Platform,
     if sensitivity is not None:
         return Alignment(experiments, None, sensitivity)
     try:
-        estimate = estimate_delay(experiments, platform)
+        estimate = estimate_delay(experiments, platform, jobs=jobs)
     except IdentificationError as exc:
         return Alignment(experiments, {"seconds": None, "std_error": None, "applied": False,
                                        "source": "not estimated", "reason": str(exc)}, None)

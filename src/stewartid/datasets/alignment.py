@@ -45,8 +45,9 @@ def shift_forces(dataset: Dataset, delay: float) -> Dataset:
         forces = dataset.forces[np.flatnonzero(keep) + whole]
     else:
         forces = spline_at(t, dataset.forces, target)
-    return Dataset(t=t[keep], pose=dataset.pose[keep], lengths=dataset.lengths[keep],
-                   forces=forces, name=dataset.name)
+    # the kept samples are one run (t rises): the motion's terms are the record's rows
+    kept = np.flatnonzero(keep)
+    return dataset.part(slice(int(kept[0]), int(kept[-1]) + 1), forces=forces)
 
 
 def align_forces(datasets: Sequence[Dataset], delay: float) -> list[Dataset]:

@@ -103,11 +103,14 @@ class Dataset:
             self._derived[key] = compute(self)
         return self._derived[key]
 
-    def part(self, rows: slice, name: str | None = None) -> Dataset:
+    def part(self, rows: slice, name: str | None = None,
+             forces: np.ndarray | None = None) -> Dataset:
         """The samples ``rows`` of this record as a new record (views of its arrays), which
-        takes what :meth:`pointwise` derives from this one's; named ``name`` (default: its own)."""
+        takes what :meth:`pointwise` derives from this one's; named ``name`` (default: its own);
+        ``forces`` (n, 6) in place of its own (channels aligned with the motion), if given."""
         record = Dataset(t=self.t[rows], pose=self.pose[rows], lengths=self.lengths[rows],
-                         forces=self.forces[rows], name=self.name if name is None else name)
+                         forces=self.forces[rows] if forces is None else forces,
+                         name=self.name if name is None else name)
         record._derived[_SOURCE] = (weakref.ref(self), rows)
         return record
 

@@ -23,6 +23,7 @@ from stewartid.identification.least_squares import (
 )
 from stewartid.identification.preparation import generalized_force_sensitivity, prepare_experiment
 from stewartid.model.linearization import nominal_matrices
+from stewartid.parallel import inheriting_workers, run_in_order
 from stewartid.platform import COORDINATES, Platform
 from stewartid.signals.differentiation import (
     DEFAULT_ORDER,
@@ -226,14 +227,24 @@ def shared_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray,
     return c, np.sqrt(np.clip(np.diag(covariance), 0.0, None))
 
 
+def _experiment_rows(work: tuple, e: int) -> tuple[np.ndarray, ...]:
+    """Experiment ``e``'s kernel-filtered rows, every ``decimate``-th (``work``: the experiments,
+    the platform, the window and ``decimate``): one task of :func:`fit_delay`."""
+    datasets, platform, window, decimate = work
+    return tuple(np.ascontiguousarray(a[::decimate])
+                 for a in _filtered_rows(datasets[e], platform, window))
+
+
 def fit_delay(datasets: Sequence[Dataset], platform: Platform, window: float,
-              decimate: int = 1) -> tuple[float, float]:
-    """One weak-form least-squares fit of the delay (first order in tau); returns delay, std_error in s."""
+              decimate: int = 1, jobs: int | None = 1) -> tuple[float, float]:
+    """One weak-form least-squares fit of the delay (first order in tau); returns delay, std_error
+    in s. ``jobs``: worker processes filtering the experiments side by side (None: every core;
+    :func:`~stewartid.parallel.inheriting_workers`)."""
     n_exp = len(datasets)
     phis, ys, shared, groups = [], [], [], []
-    for e, dataset in enumerate(datasets):
-        q_ddot, q_dot, y, terms = (a[::decimate] for a in _filtered_rows(dataset, platform,
-                                                                          window))
+    rows = run_in_order(_experiment_rows, range(n_exp), inheriting_workers(jobs, n_exp),
+                        shared=(list(datasets), platform, window, decimate))
+    for e, (q_ddot, q_dot, y, terms) in enumerate(rows):
         offsets = np.zeros((len(y), n_exp))
         offsets[:, e] = 1.0
         phis.append(np.concatenate([q_ddot, q_dot, offsets], axis=1))
@@ -248,7 +259,7 @@ def fit_delay(datasets: Sequence[Dataset], platform: Platform, window: float,
 
 
 def estimate_delay(datasets: Sequence[Dataset], platform: Platform, window: float | None = None,
-                   iterations: int = 1) -> DelayEstimate:
+                   iterations: int = 1, jobs: int | None = 1) -> DelayEstimate:
     """Estimate the delay of the force channels relative to the motion, with its standard error.
 
     Parameters
@@ -260,6 +271,9 @@ def estimate_delay(datasets: Sequence[Dataset], platform: Platform, window: floa
         Kernel support, s; default :data:`WINDOW_PERIODS` periods of the highest line.
     iterations : int
         Refits on the aligned experiments (0 keeps the first pass).
+    jobs : int or None
+        Worker processes filtering the experiments side by side (None: every core); the
+        estimate does not depend on it.
 
     Raises
     ------
@@ -279,10 +293,10 @@ def estimate_delay(datasets: Sequence[Dataset], platform: Platform, window: floa
         raise ConfigError(f"The 'window' parameter of estimate_delay must be a positive "
                           f"number of seconds. Got {window!r} instead.")
     decimate = max(1, int(window * min(d.sample_rate for d in datasets) / 20))
-    delay, std = fit_delay(datasets, platform, window, decimate)
+    delay, std = fit_delay(datasets, platform, window, decimate, jobs)
     first = delay
     for _ in range(int(iterations)):
-        step, std = fit_delay(align_forces(datasets, delay), platform, window, decimate)
+        step, std = fit_delay(align_forces(datasets, delay), platform, window, decimate, jobs)
         delay += step
     return DelayEstimate(seconds=delay, std_error=std, first_pass=first, lines_hz=lines,
                          window_s=float(window))
@@ -312,12 +326,12 @@ def parse_delay(value: str | float | None) -> str | float | None:
     return seconds
 
 
-def apply_delay(datasets: Sequence[Dataset], platform: Platform, delay: str | float | None
-                ) -> tuple[list[Dataset], dict[str, Any] | None]:
+def apply_delay(datasets: Sequence[Dataset], platform: Platform, delay: str | float | None,
+                jobs: int | None = 1) -> tuple[list[Dataset], dict[str, Any] | None]:
     """The experiments with their forces aligned with the motion, and the ``"delay"`` result entry.
 
     ``delay``: seconds (positive when forces are logged late), :data:`AUTO` to estimate it, or None
-    to return the data as logged (entry None).
+    to return the data as logged (entry None); ``jobs`` as :func:`estimate_delay`.
 
     Raises
     ------
@@ -331,7 +345,7 @@ def apply_delay(datasets: Sequence[Dataset], platform: Platform, delay: str | fl
     if delay is None:
         return datasets, None
     if delay == AUTO:
-        estimate = estimate_delay(datasets, platform)
+        estimate = estimate_delay(datasets, platform, jobs=jobs)
         return align_forces(datasets, estimate.seconds), estimate.to_dict(applied=True)
     entry = {"seconds": float(delay), "std_error": None, "applied": True, "source": "given"}
     return align_forces(datasets, float(delay)), entry
