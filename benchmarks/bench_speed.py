@@ -11,13 +11,16 @@ start-up), best CPU time of ``--repeats``, and, where a method takes worker proc
 The logs: the paper platform's six experiments of 20 s at 1 kHz with the reference sensor
 noise and 30 N m of Coulomb friction (Parquet), simulated once by this tree, and the same at
 2 kHz. ``--average`` adds ``identify --method all --report`` on the 2 kHz log and gives the
-later tree's commands on it ``--average`` (``identify --average``).
+later tree's commands on it ``--average`` (``identify --average``). ``--log LABEL=DIR[@PLATFORM]``
+(repeatable) adds ``identify --method wavelet`` on a folder of logs already written (a
+three-sine log with late forces, an electric 2 kHz log), with ``--platform PLATFORM`` unless a
+``meta.json`` beside them names it.
 
 Usage::
 
     git worktree add /tmp/before <commit>
     python benchmarks/bench_speed.py --before /tmp/before/src [--repeats 5] [--reproduce]
-        [--average]
+        [--average] [--log three=DIR --log electric=DIR@src/stewartid/data/electric.toml]
 """
 
 from __future__ import annotations
@@ -143,6 +146,8 @@ def main() -> None:
     parser.add_argument("--average", action="store_true",
                         help="also time --method all on the 2 kHz log, and run the later "
                              "tree's 2 kHz commands with --average")
+    parser.add_argument("--log", action="append", default=[], metavar="LABEL=DIR[@PLATFORM]",
+                        help="also time identify --method wavelet on these logs")
     args = parser.parse_args()
     env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
     trees = {"before": args.before, "after": args.after}
@@ -159,6 +164,12 @@ def main() -> None:
             "identify --method all --report": ["identify", str(logs["1 kHz"]), "--method",
                                                "all", "--report", str(scratch / "report")],
         }
+        for entry in args.log:
+            label, _, where = entry.partition("=")
+            folder, _, description = where.partition("@")
+            commands[f"identify --method wavelet ({label})"] = [
+                "identify", folder, "--method", "wavelet",
+                *(["--platform", description] if description else [])]
         if args.average:
             commands["identify --method all --report (2 kHz)"] = [
                 "identify", str(logs["2 kHz"]), "--method", "all", "--report",
