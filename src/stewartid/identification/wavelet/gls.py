@@ -209,11 +209,11 @@ class JointFit(NamedTuple):
     local_z: list[np.ndarray] | None = None
 
 
-def _pseudo_inverse(gram: np.ndarray) -> np.ndarray:
-    """Inverse of a symmetric positive semi-definite ``gram`` on the span of its eigenvalues
-    above :data:`~stewartid.identification.stops.RANK_CUT` of the largest (a stop's part of one
-    sample has no first moment; two legs stopping together give nearly equal columns)."""
-    values, vectors = np.linalg.eigh(gram)
+def _pseudo_inverse(values: np.ndarray, vectors: np.ndarray) -> np.ndarray:
+    """Inverse of a symmetric positive semi-definite matrix from its eigenvalues (m,) and vectors
+    (m, m), on the span of the eigenvalues above :data:`~stewartid.identification.stops.RANK_CUT`
+    of the largest (a stop's part of one sample has no first moment; two legs stopping together
+    give nearly equal columns)."""
     kept = values > RANK_CUT * max(values[-1], 1e-300)
     return (vectors[:, kept] / values[kept]) @ vectors[:, kept].T
 
@@ -223,21 +223,39 @@ def _eliminate_local(local: Sequence[np.ndarray], designs: Sequence[np.ndarray],
                      ) -> tuple[np.ndarray, np.ndarray, list[tuple[np.ndarray, ...]]]:
     """The Schur complement of the equations' own unknowns: what to subtract from the normal
     matrix (u, u) and right-hand side (u,), and per equation (C^T W D, C^T W t, its inverse)
-    to recover them."""
+    to recover them.
+
+    The equations with the same number of own unknowns are taken together, each product in
+    their stack the one of an equation alone; the sums run over the equations in order.
+    """
     n_unknowns = designs[0].shape[-1]
-    normal, rhs, parts = np.zeros((n_unknowns, n_unknowns)), np.zeros(n_unknowns), []
-    for j, columns in enumerate(local):                         # (6, R, m)
-        if columns.shape[2] == 0:
-            parts.append(None)
-            continue
-        weighted = [weights[i][j] @ columns[i] for i in range(6)]              # (R, m)
-        inner = sum(columns[i].T @ weighted[i] for i in range(6))
-        cross = sum(weighted[i].T @ designs[i][j] for i in range(6))           # (m, u)
-        own = sum(weighted[i].T @ targets[i][j] for i in range(6))
-        inverse = _pseudo_inverse(inner)
-        normal += cross.T @ inverse @ cross
-        rhs += cross.T @ (inverse @ own)
-        parts.append((cross, own, inverse))
+    sizes = np.array([columns.shape[2] for columns in local])
+    parts: list = [None] * len(local)
+    terms = {}
+    for size in np.unique(sizes[sizes > 0]):
+        group = np.flatnonzero(sizes == size)
+        columns = np.stack([local[j] for j in group])                        # (g, 6, R, m)
+        inner, cross = np.zeros((len(group), size, size)), np.zeros((len(group), size,
+                                                                     n_unknowns))
+        own = np.zeros((len(group), size, 1))
+        for i in range(6):
+            weighted = weights[i][group] @ columns[:, i]                      # (g, R, m)
+            inner += columns[:, i].transpose(0, 2, 1) @ weighted
+            flipped = weighted.transpose(0, 2, 1)
+            cross += flipped @ designs[i][group]
+            own += flipped @ targets[i][group][:, :, None]
+        values, vectors = np.linalg.eigh(inner)
+        inverse = np.stack([_pseudo_inverse(*pair) for pair in zip(values, vectors,
+                                                                     strict=True)])
+        flipped = cross.transpose(0, 2, 1)
+        removed, removed_rhs = flipped @ inverse @ cross, flipped @ (inverse @ own)
+        for k, j in enumerate(group):
+            parts[j] = (cross[k], own[k, :, 0], inverse[k])
+            terms[j] = (removed[k], removed_rhs[k, :, 0])
+    normal, rhs = np.zeros((n_unknowns, n_unknowns)), np.zeros(n_unknowns)
+    for j in sorted(terms):
+        normal += terms[j][0]
+        rhs += terms[j][1]
     return normal, rhs, parts
 
 
