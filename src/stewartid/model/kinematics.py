@@ -104,10 +104,15 @@ def joint_rate_jacobians(platform: Platform, q: np.ndarray) -> np.ndarray:
     return J_joint[0] if single else J_joint
 
 
-def joint_axis_rates(joint_jacobians: np.ndarray, q_dot: np.ndarray) -> np.ndarray:
+def joint_axis_rates(joint_jacobians: np.ndarray, q_dot: np.ndarray,
+                     out: np.ndarray | None = None) -> np.ndarray:
     """Rates (N, 6, 5) of every joint axis (rad/s): ``joint_jacobians`` (N, 6, 5, 6) times
-    ``q_dot`` (N, 6)."""
+    ``q_dot`` (N, 6); ``out`` (N, 30), written and returned (as (N, 30)) when given."""
     n = len(q_dot)
+    if out is not None:
+        np.matmul(np.reshape(joint_jacobians, (n, 30, 6)), np.reshape(q_dot, (n, 6, 1)),
+                  out=out[:, :, None])
+        return out
     rates = np.reshape(joint_jacobians, (n, 30, 6)) @ np.reshape(q_dot, (n, 6, 1))
     return rates.reshape(n, 6, 5)
 

@@ -42,9 +42,10 @@ def joint_rates(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
         joint_jacobians = joint_rate_jacobians(platform, q)
     if leg_jacobian is None:
         leg_jacobian = leg_jacobian_at(platform, q)
-    axes = joint_axis_rates(joint_jacobians, q_dot).reshape(len(q), 30)
-    legs = np.einsum("nlj,nj->nl", leg_jacobian, q_dot)
-    return np.concatenate([axes, legs], axis=1)
+    rates = np.empty((len(q), 36))
+    joint_axis_rates(joint_jacobians, q_dot, out=rates[:, :30])
+    np.einsum("nlj,nj->nl", leg_jacobian, q_dot, out=rates[:, 30:])
+    return rates
 
 
 def active_joints(rates: np.ndarray, ignore_below: float = 0.0) -> np.ndarray:
