@@ -231,10 +231,10 @@ def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: boo
         joint_type_forces(soft, joint_jacobians[block], groups, out=out[block, :, :len(groups)])
     if leg_jacobian is not None:
         legs = found.leg_sign_rates
-        level = legs ** 2 + found.leg_sign_rate_noise ** 2
+        leg_level = legs ** 2 + found.leg_sign_rate_noise ** 2
         soft = np.empty_like(legs)
         for k, r in enumerate(rates):
-            np.add(level, r ** 2, out=soft)
+            np.add(leg_level, r ** 2, out=soft)
             np.sqrt(soft, out=soft)
             np.divide(legs, soft, out=soft)                                       # (N, 6)
             out[:, k, -1] = (soft[:, None, :] @ leg_jacobian)[:, 0]
