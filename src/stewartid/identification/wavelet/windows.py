@@ -81,9 +81,9 @@ def _stop_columns(stops: Sequence[Stop], sel: slice, phi: np.ndarray,
     without any."""
     columns = []
     for found in stops:
-        start, stop = max(found.start, sel.start), min(found.stop, sel.stop)
-        if stop <= start:
+        if found.stop <= sel.start or found.start >= sel.stop:
             continue
+        start, stop = max(found.start, sel.start), min(found.stop, sel.stop)
         x = (2.0 * np.arange(stop - start) + 1.0) / (stop - start) - 1.0
         polynomials = legendre.legvander(x, found.terms - 1)                # (n, terms)
         local = phi[:, start - sel.start:stop - sel.start]                   # (K, n)
