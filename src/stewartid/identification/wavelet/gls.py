@@ -259,6 +259,20 @@ def _eliminate_local(local: Sequence[np.ndarray], designs: Sequence[np.ndarray],
     return normal, rhs, parts
 
 
+def local_terms(local: Sequence[np.ndarray], local_z: Sequence[np.ndarray]) -> np.ndarray:
+    """What the equations' own unknowns ``local_z`` (m,) add to their rows through their columns
+    ``local`` (6, R, m): (6, n, R), channel first. The equations with the same number of own
+    unknowns are taken together, each product in their stack the one of an equation alone."""
+    out = np.zeros((6, len(local), local[0].shape[1]))
+    sizes = np.array([columns.shape[2] for columns in local])
+    for size in np.unique(sizes[sizes > 0]):
+        group = np.flatnonzero(sizes == size)
+        products = (np.stack([local[j] for j in group])
+                    @ np.stack([local_z[j] for j in group])[:, None, :, None])   # (g, 6, R, 1)
+        out[:, group] = products[..., 0].transpose(1, 0, 2)
+    return out
+
+
 def fit_jointly(stacked: StackedEquations, designs: Sequence[np.ndarray],
                 targets: Sequence[np.ndarray], invariant: InvariantFit,
                 scatter: np.ndarray | None, iterations: int,
@@ -322,11 +336,11 @@ def standard_errors(designs: Sequence[np.ndarray], targets: Sequence[np.ndarray]
     squares, n_rows = 0.0, 0
     if local is not None:
         n_unknowns += sum(len(z) for z in fit.local_z)
+        own = local_terms(local, fit.local_z)
     for i in range(6):
         residual = targets[i] - designs[i] @ fit.z
         if local is not None:
-            residual = residual - np.stack([c[i] @ z for c, z in zip(local, fit.local_z,
-                                                                     strict=True)])
+            residual = residual - own[i]
         weighted = (fit.weights[i] @ residual[:, :, None])[:, :, 0]
         scores += (weighted[:, None, :] @ designs[i])[:, 0, :]
         squares += float(np.sum(residual * weighted))
@@ -421,4 +435,5 @@ VARIATION_PASSES = 2
 
 __all__ = ["VARIATION_PASSES", "InvariantFit", "JointFit", "WeakFormSolution",
            "channel_covariance", "channel_systems", "constant_scatter",
-           "fit_invariant_rows", "fit_jointly", "solve_weak_form", "standard_errors"]
+           "fit_invariant_rows", "fit_jointly", "local_terms", "solve_weak_form",
+           "standard_errors"]

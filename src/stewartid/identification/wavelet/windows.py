@@ -20,6 +20,7 @@ from stewartid.identification.wavelet.gls import (
     InvariantFit,
     WeakFormSolution,
     fit_jointly,
+    local_terms,
     standard_errors,
 )
 from stewartid.identification.wavelet.rate_selection import averaged_over_rates
@@ -177,9 +178,8 @@ def solve_windows(equations: Sequence[WindowEquations], iterations: int = 3,
         fit = fit_jointly(stacked, designs, targets, start, None, 1, local)
         z = fit.z
         if local is not None:  # the stops' friction as fitted, for the rows' noise
-            fitted = [targets[i] - np.stack([c[i] @ s for c, s in zip(local, fit.local_z,
-                                                                      strict=True)])
-                      for i in range(6)]
+            own = local_terms(local, fit.local_z)
+            fitted = [targets[i] - own[i] for i in range(6)]
     std = standard_errors(designs, targets, fit, local)
     return WeakFormSolution(
         theta=z[:N_THETA].reshape(6, 12), theta_std=std[:N_THETA].reshape(6, 12),
