@@ -209,29 +209,36 @@ class JointFit(NamedTuple):
     local_z: list[np.ndarray] | None = None
 
 
-def _pseudo_inverse(values: np.ndarray, vectors: np.ndarray) -> np.ndarray:
-    """Inverse of a symmetric positive semi-definite matrix from its eigenvalues (m,) and vectors
-    (m, m), on the span of the eigenvalues above :data:`~stewartid.identification.stops.RANK_CUT`
-    of the largest (a stop's part of one sample has no first moment; two legs stopping together
-    give nearly equal columns)."""
-    kept = values > RANK_CUT * max(values[-1], 1e-300)
-    return (vectors[:, kept] / values[kept]) @ vectors[:, kept].T
+def _pseudo_inverses(gram: np.ndarray) -> np.ndarray:
+    """Inverses (g, m, m) of symmetric positive semi-definite matrices ``gram`` (g, m, m) on the
+    span of their eigenvalues above :data:`~stewartid.identification.stops.RANK_CUT` of the
+    largest (a stop's part of one sample has no first moment; two legs stopping together give
+    nearly equal columns)."""
+    values, vectors = np.linalg.eigh(gram)                          # ascending
+    ranks = np.sum(values > RANK_CUT * np.maximum(values[:, -1:], 1e-300), axis=1)
+    out = np.empty_like(gram)
+    for rank in np.unique(ranks):
+        these = np.flatnonzero(ranks == rank)
+        kept = np.ascontiguousarray(vectors[these][:, :, gram.shape[1] - rank:])
+        out[these] = (kept / values[these][:, None, gram.shape[1] - rank:]
+                      ) @ kept.transpose(0, 2, 1)
+    return out
 
 
 def _eliminate_local(local: Sequence[np.ndarray], designs: Sequence[np.ndarray],
                      targets: Sequence[np.ndarray], weights: Sequence[np.ndarray]
                      ) -> tuple[np.ndarray, np.ndarray, list[tuple[np.ndarray, ...]]]:
     """The Schur complement of the equations' own unknowns: what to subtract from the normal
-    matrix (u, u) and right-hand side (u,), and per equation (C^T W D, C^T W t, its inverse)
-    to recover them.
+    matrix (u, u) and right-hand side (u,), and per group of equations with as many own
+    unknowns m (indices (g,), C^T W D (g, m, u), C^T W t (g, m, 1), its inverse (g, m, m)) to
+    recover them.
 
-    The equations with the same number of own unknowns are taken together, each product in
-    their stack the one of an equation alone; the sums run over the equations in order.
+    Each product in a group's stack is the one of an equation alone; the sums run over the
+    equations in order.
     """
     n_unknowns = designs[0].shape[-1]
     sizes = np.array([columns.shape[2] for columns in local])
-    parts: list = [None] * len(local)
-    terms = {}
+    groups, terms = [], {}
     for size in np.unique(sizes[sizes > 0]):
         group = np.flatnonzero(sizes == size)
         columns = np.stack([local[j] for j in group])                        # (g, 6, R, m)
@@ -244,19 +251,17 @@ def _eliminate_local(local: Sequence[np.ndarray], designs: Sequence[np.ndarray],
             flipped = weighted.transpose(0, 2, 1)
             cross += flipped @ designs[i][group]
             own += flipped @ targets[i][group][:, :, None]
-        values, vectors = np.linalg.eigh(inner)
-        inverse = np.stack([_pseudo_inverse(*pair) for pair in zip(values, vectors,
-                                                                     strict=True)])
+        inverse = _pseudo_inverses(inner)
         flipped = cross.transpose(0, 2, 1)
         removed, removed_rhs = flipped @ inverse @ cross, flipped @ (inverse @ own)
         for k, j in enumerate(group):
-            parts[j] = (cross[k], own[k, :, 0], inverse[k])
             terms[j] = (removed[k], removed_rhs[k, :, 0])
+        groups.append((group, cross, own, inverse))
     normal, rhs = np.zeros((n_unknowns, n_unknowns)), np.zeros(n_unknowns)
     for j in sorted(terms):
         normal += terms[j][0]
         rhs += terms[j][1]
-    return normal, rhs, parts
+    return normal, rhs, groups
 
 
 def local_terms(local: Sequence[np.ndarray], local_z: Sequence[np.ndarray]) -> np.ndarray:
@@ -318,8 +323,13 @@ def fit_jointly(stacked: StackedEquations, designs: Sequence[np.ndarray],
                 "few constant-direction intervals for the interval constants shared by "
                 "friction); record longer experiments or leave the constants free "
                 "(friction='free').") from exc
-    local_z = None if local is None else [
-        np.zeros(0) if part is None else part[2] @ (part[1] - part[0] @ z) for part in parts]
+    local_z = None
+    if local is not None:
+        local_z = [np.zeros(0)] * len(local)
+        for group, cross, own, inverse in parts:
+            values = inverse @ (own[:, :, 0] - cross @ z)[:, :, None]           # (g, m, 1)
+            for k, j in enumerate(group):
+                local_z[j] = values[k, :, 0]
     return JointFit(z=z, normal=normal, scale=scale, weights=weights, uncorrected=uncorrected,
                     local_z=local_z)
 
