@@ -104,17 +104,22 @@ def joint_rate_jacobians(platform: Platform, q: np.ndarray) -> np.ndarray:
     return J_joint[0] if single else J_joint
 
 
-def joint_axis_rates(joint_jacobians: np.ndarray, q_dot: np.ndarray) -> np.ndarray:
+def joint_axis_rates(joint_jacobians: np.ndarray, q_dot: np.ndarray,
+                     out: np.ndarray | None = None) -> np.ndarray:
     """Rates (N, 6, 5) of every joint axis (rad/s): ``joint_jacobians`` (N, 6, 5, 6) times
-    ``q_dot`` (N, 6)."""
+    ``q_dot`` (N, 6); ``out`` (N, 30), written and returned (as (N, 30)) when given."""
     n = len(q_dot)
+    if out is not None:
+        np.matmul(np.reshape(joint_jacobians, (n, 30, 6)), np.reshape(q_dot, (n, 6, 1)),
+                  out=out[:, :, None])
+        return out
     rates = np.reshape(joint_jacobians, (n, 30, 6)) @ np.reshape(q_dot, (n, 6, 1))
     return rates.reshape(n, 6, 5)
 
 
 def joint_type_forces(torques: np.ndarray, joint_jacobians: np.ndarray,
-                      types: Sequence[Sequence[int]] = tuple(JOINT_TYPES.values())
-                      ) -> np.ndarray:
+                      types: Sequence[Sequence[int]] = tuple(JOINT_TYPES.values()),
+                      out: np.ndarray | None = None) -> np.ndarray:
     """Generalized forces (N, N m) of torques on the joint axes, summed per joint type.
 
     sum over legs and the axes a of each type of torques[..., leg, a] J[n, leg, a, :].
@@ -127,6 +132,8 @@ def joint_type_forces(torques: np.ndarray, joint_jacobians: np.ndarray,
     joint_jacobians : ndarray, shape (N, 6, 5, 6)
     types : sequence of sequences of int
         The axes of each type; :data:`~stewartid.model.joints.JOINT_TYPES` by default.
+    out : ndarray, shape (N, R, T, 6), optional
+        Written and returned (R = 1 for torques (N, 6, 5)).
 
     Returns
     -------
@@ -137,7 +144,8 @@ def joint_type_forces(torques: np.ndarray, joint_jacobians: np.ndarray,
     # per sample and axis, the (R, legs) torques times that axis's (legs, 6) Jacobian rows
     by_axis = (np.moveaxis(np.reshape(torques, (n, -1, 6, 5)), -1, 1)
                @ joint_jacobians.transpose(0, 2, 1, 3))                       # (N, 5, R, 6)
-    out = np.empty((n, by_axis.shape[2], len(types), 6))
+    if out is None:
+        out = np.empty((n, by_axis.shape[2], len(types), 6))
     for k, axes in enumerate(types):
         np.copyto(out[:, :, k], by_axis[:, axes[0]])
         for a in axes[1:]:

@@ -50,12 +50,25 @@ def hermite_uniform(values: np.ndarray, step: int, n: int) -> np.ndarray:
     slopes[1] = np.tensordot(SECOND_SLOPE, values[:5], axes=1)
     slopes[-1] = -np.tensordot(ONE_SIDED_SLOPE, reverse[:5], axes=1)
     slopes[-2] = -np.tensordot(SECOND_SLOPE, reverse[:5], axes=1)
-    index = np.arange(n)
+    out = np.empty((n, values.shape[1]))
+    # the whole segments share one step's weights: broadcast over them, no sample gathered
+    full = min(n, (k - 1) * step) // step
+    out[:full * step].reshape(full, step, values.shape[1])[:] = _hermite(
+        (np.arange(step) / step)[:, None], values[:full, None], slopes[:full, None],
+        values[1:full + 1, None], slopes[1:full + 1, None])
+    index = np.arange(full * step, n)   # a part of a segment, or beyond the last knot
     segment = np.minimum(index // step, k - 2)
-    u = ((index - segment * step) / step)[:, None]
-    return ((1 + 2 * u) * (1 - u) ** 2 * values[segment] + u * (1 - u) ** 2 * slopes[segment]
-            + u ** 2 * (3 - 2 * u) * values[segment + 1]
-            + u ** 2 * (u - 1) * slopes[segment + 1])
+    out[full * step:] = _hermite(((index - segment * step) / step)[:, None], values[segment],
+                                 slopes[segment], values[segment + 1], slopes[segment + 1])
+    return out
+
+
+def _hermite(u: np.ndarray, start: np.ndarray, start_slope: np.ndarray, end: np.ndarray,
+             end_slope: np.ndarray) -> np.ndarray:
+    """The cubic Hermite segment at u in [0, 1] (..., 1), from its end values and slopes times
+    the knot spacing (..., C)."""
+    return ((1 + 2 * u) * (1 - u) ** 2 * start + u * (1 - u) ** 2 * start_slope
+            + u ** 2 * (3 - 2 * u) * end + u ** 2 * (u - 1) * end_slope)
 
 
 __all__ = ["CENTRAL_SLOPE", "ONE_SIDED_SLOPE", "SECOND_SLOPE", "hermite_uniform", "spline_at"]

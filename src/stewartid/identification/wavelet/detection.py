@@ -207,7 +207,7 @@ def _sign_rates(experiment: Experiment, noise: NoiseModel) -> dict:
                                        noise.pose_covariance, SIGN_NOISE_LIMIT)
     jacobians = experiment.joint_jacobians
     level = joint_rate_noise(noise.pose_covariance, experiment.sample_rate, window, jacobians,
-                             experiment.leg_jacobian, SIGN_ORDER)
+                             experiment.leg_jacobian, SIGN_ORDER, noise.mean_jacobian)
     return {"sign_rates": joint_axis_rates(jacobians, q_dot),
             "sign_rate_noise": np.maximum(level[:30].reshape(6, 5), 1e-12),
             "leg_sign_rates": (experiment.leg_jacobian @ q_dot[:, :, None])[:, :, 0],

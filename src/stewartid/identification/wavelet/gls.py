@@ -209,36 +209,73 @@ class JointFit(NamedTuple):
     local_z: list[np.ndarray] | None = None
 
 
-def _pseudo_inverse(gram: np.ndarray) -> np.ndarray:
-    """Inverse of a symmetric positive semi-definite ``gram`` on the span of its eigenvalues
-    above :data:`~stewartid.identification.stops.RANK_CUT` of the largest (a stop's part of one
-    sample has no first moment; two legs stopping together give nearly equal columns)."""
-    values, vectors = np.linalg.eigh(gram)
-    kept = values > RANK_CUT * max(values[-1], 1e-300)
-    return (vectors[:, kept] / values[kept]) @ vectors[:, kept].T
+def _pseudo_inverses(gram: np.ndarray) -> np.ndarray:
+    """Inverses (g, m, m) of symmetric positive semi-definite matrices ``gram`` (g, m, m) on the
+    span of their eigenvalues above :data:`~stewartid.identification.stops.RANK_CUT` of the
+    largest (a stop's part of one sample has no first moment; two legs stopping together give
+    nearly equal columns)."""
+    values, vectors = np.linalg.eigh(gram)                          # ascending
+    ranks = np.sum(values > RANK_CUT * np.maximum(values[:, -1:], 1e-300), axis=1)
+    out = np.empty_like(gram)
+    for rank in np.unique(ranks):
+        these = np.flatnonzero(ranks == rank)
+        kept = np.ascontiguousarray(vectors[these][:, :, gram.shape[1] - rank:])
+        out[these] = (kept / values[these][:, None, gram.shape[1] - rank:]
+                      ) @ kept.transpose(0, 2, 1)
+    return out
 
 
 def _eliminate_local(local: Sequence[np.ndarray], designs: Sequence[np.ndarray],
                      targets: Sequence[np.ndarray], weights: Sequence[np.ndarray]
                      ) -> tuple[np.ndarray, np.ndarray, list[tuple[np.ndarray, ...]]]:
     """The Schur complement of the equations' own unknowns: what to subtract from the normal
-    matrix (u, u) and right-hand side (u,), and per equation (C^T W D, C^T W t, its inverse)
-    to recover them."""
+    matrix (u, u) and right-hand side (u,), and per group of equations with as many own
+    unknowns m (indices (g,), C^T W D (g, m, u), C^T W t (g, m, 1), its inverse (g, m, m)) to
+    recover them.
+
+    Each product in a group's stack is the one of an equation alone; the sums run over the
+    equations in order.
+    """
     n_unknowns = designs[0].shape[-1]
-    normal, rhs, parts = np.zeros((n_unknowns, n_unknowns)), np.zeros(n_unknowns), []
-    for j, columns in enumerate(local):                         # (6, R, m)
-        if columns.shape[2] == 0:
-            parts.append(None)
-            continue
-        weighted = [weights[i][j] @ columns[i] for i in range(6)]              # (R, m)
-        inner = sum(columns[i].T @ weighted[i] for i in range(6))
-        cross = sum(weighted[i].T @ designs[i][j] for i in range(6))           # (m, u)
-        own = sum(weighted[i].T @ targets[i][j] for i in range(6))
-        inverse = _pseudo_inverse(inner)
-        normal += cross.T @ inverse @ cross
-        rhs += cross.T @ (inverse @ own)
-        parts.append((cross, own, inverse))
-    return normal, rhs, parts
+    sizes = np.array([columns.shape[2] for columns in local])
+    groups, terms = [], {}
+    for size in np.unique(sizes[sizes > 0]):
+        group = np.flatnonzero(sizes == size)
+        columns = np.stack([local[j] for j in group])                        # (g, 6, R, m)
+        inner, cross = np.zeros((len(group), size, size)), np.zeros((len(group), size,
+                                                                     n_unknowns))
+        own = np.zeros((len(group), size, 1))
+        for i in range(6):
+            weighted = weights[i][group] @ columns[:, i]                      # (g, R, m)
+            inner += columns[:, i].transpose(0, 2, 1) @ weighted
+            flipped = weighted.transpose(0, 2, 1)
+            cross += flipped @ designs[i][group]
+            own += flipped @ targets[i][group][:, :, None]
+        inverse = _pseudo_inverses(inner)
+        flipped = cross.transpose(0, 2, 1)
+        removed, removed_rhs = flipped @ inverse @ cross, flipped @ (inverse @ own)
+        for k, j in enumerate(group):
+            terms[j] = (removed[k], removed_rhs[k, :, 0])
+        groups.append((group, cross, own, inverse))
+    normal, rhs = np.zeros((n_unknowns, n_unknowns)), np.zeros(n_unknowns)
+    for j in sorted(terms):
+        normal += terms[j][0]
+        rhs += terms[j][1]
+    return normal, rhs, groups
+
+
+def local_terms(local: Sequence[np.ndarray], local_z: Sequence[np.ndarray]) -> np.ndarray:
+    """What the equations' own unknowns ``local_z`` (m,) add to their rows through their columns
+    ``local`` (6, R, m): (6, n, R), channel first. The equations with the same number of own
+    unknowns are taken together, each product in their stack the one of an equation alone."""
+    out = np.zeros((6, len(local), local[0].shape[1]))
+    sizes = np.array([columns.shape[2] for columns in local])
+    for size in np.unique(sizes[sizes > 0]):
+        group = np.flatnonzero(sizes == size)
+        products = (np.stack([local[j] for j in group])
+                    @ np.stack([local_z[j] for j in group])[:, None, :, None])   # (g, 6, R, 1)
+        out[:, group] = products[..., 0].transpose(1, 0, 2)
+    return out
 
 
 def fit_jointly(stacked: StackedEquations, designs: Sequence[np.ndarray],
@@ -286,8 +323,13 @@ def fit_jointly(stacked: StackedEquations, designs: Sequence[np.ndarray],
                 "few constant-direction intervals for the interval constants shared by "
                 "friction); record longer experiments or leave the constants free "
                 "(friction='free').") from exc
-    local_z = None if local is None else [
-        np.zeros(0) if part is None else part[2] @ (part[1] - part[0] @ z) for part in parts]
+    local_z = None
+    if local is not None:
+        local_z = [np.zeros(0)] * len(local)
+        for group, cross, own, inverse in parts:
+            values = inverse @ (own[:, :, 0] - cross @ z)[:, :, None]           # (g, m, 1)
+            for k, j in enumerate(group):
+                local_z[j] = values[k, :, 0]
     return JointFit(z=z, normal=normal, scale=scale, weights=weights, uncorrected=uncorrected,
                     local_z=local_z)
 
@@ -304,11 +346,11 @@ def standard_errors(designs: Sequence[np.ndarray], targets: Sequence[np.ndarray]
     squares, n_rows = 0.0, 0
     if local is not None:
         n_unknowns += sum(len(z) for z in fit.local_z)
+        own = local_terms(local, fit.local_z)
     for i in range(6):
         residual = targets[i] - designs[i] @ fit.z
         if local is not None:
-            residual = residual - np.stack([c[i] @ z for c, z in zip(local, fit.local_z,
-                                                                     strict=True)])
+            residual = residual - own[i]
         weighted = (fit.weights[i] @ residual[:, :, None])[:, :, 0]
         scores += (weighted[:, None, :] @ designs[i])[:, 0, :]
         squares += float(np.sum(residual * weighted))
@@ -403,4 +445,5 @@ VARIATION_PASSES = 2
 
 __all__ = ["VARIATION_PASSES", "InvariantFit", "JointFit", "WeakFormSolution",
            "channel_covariance", "channel_systems", "constant_scatter",
-           "fit_invariant_rows", "fit_jointly", "solve_weak_form", "standard_errors"]
+           "fit_invariant_rows", "fit_jointly", "local_terms", "solve_weak_form",
+           "standard_errors"]

@@ -42,9 +42,10 @@ def joint_rates(platform: Platform, q: np.ndarray, q_dot: np.ndarray,
         joint_jacobians = joint_rate_jacobians(platform, q)
     if leg_jacobian is None:
         leg_jacobian = leg_jacobian_at(platform, q)
-    axes = joint_axis_rates(joint_jacobians, q_dot).reshape(len(q), 30)
-    legs = np.einsum("nlj,nj->nl", leg_jacobian, q_dot)
-    return np.concatenate([axes, legs], axis=1)
+    rates = np.empty((len(q), 36))
+    joint_axis_rates(joint_jacobians, q_dot, out=rates[:, :30])
+    np.einsum("nlj,nj->nl", leg_jacobian, q_dot, out=rates[:, 30:])
+    return rates
 
 
 def active_joints(rates: np.ndarray, ignore_below: float = 0.0) -> np.ndarray:
@@ -97,34 +98,30 @@ def constant_direction_intervals(t: np.ndarray, rates: np.ndarray, margin: float
     threshold = np.broadcast_to(np.asarray(hysteresis, dtype=float), (rates.shape[1],))
     if np.any(threshold < 0):
         raise ConfigError("hysteresis thresholds must be >= 0.")
-    confirmed = np.abs(rates) > threshold
-    mask &= confirmed.any(axis=0)
-    used, confirmed, threshold = rates[:, mask], confirmed[:, mask], threshold[mask]
-    n = len(t)
-    if used.shape[1] == 0 or n < 2:
+    # an inactive joint is never confirmed (whole columns compared: selecting them costs more)
+    confirmed = np.abs(rates) > np.where(mask, threshold, np.inf)
+    positive = rates > 0
+    kept = confirmed.any(axis=0)
+    if not kept.all():
+        confirmed, positive = (np.compress(kept, a, axis=1) for a in (confirmed, positive))
+    n, m = confirmed.shape
+    if m == 0 or n < 2:
         return np.empty((0, 2))
-    index = np.arange(n)[:, None]
-    # last sample (up to each one) at which each joint's direction was confirmed
-    last = np.maximum.accumulate(np.where(confirmed, index, -1), axis=0)
-    state = np.where(last >= 0, np.sign(np.take_along_axis(used, np.maximum(last, 0), 0)),
-                     0.0)
-    valid = np.all(state != 0, axis=1)
-    changed = np.zeros_like(state, dtype=bool)
-    changed[1:] = state[1:] != state[:-1]
-    breaks = np.flatnonzero(changed.any(axis=1) | ~valid)
-    starts = np.concatenate([[0], breaks])
-    ends = np.concatenate([breaks, [n]])  # exclusive
-    out = []
-    for k1, k2 in zip(starts, ends, strict=True):
-        if k2 - k1 < 1 or not valid[k1]:
-            continue
-        stop = k2 - 1
-        if k2 < n and valid[k2]:
-            # end where the reversing joints last confirmed their old direction
-            stop = int(last[k2 - 1, changed[k2]].min())
-        if stop > k1:
-            out.append((t[k1] + margin, t[stop] - margin))
-    out = np.array(out, dtype=float).reshape(-1, 2)
+    # last sample (up to each one) at which each joint's direction was confirmed; a confirmed
+    # rate is beyond a threshold >= 0, so its sign is that direction
+    last = np.where(confirmed, np.arange(n)[:, None], -1)
+    np.maximum.accumulate(last, axis=0, out=last)
+    # every direction is known from the last joint's first confirmation on
+    first = int(np.max(np.argmax(confirmed, axis=0)))
+    known = last[first:]
+    state = np.take(positive.ravel(), known * m + np.arange(m))
+    changed = state[1:] != state[:-1]
+    reversal = np.flatnonzero(changed.any(axis=1))
+    starts = np.concatenate([[first], first + 1 + reversal])
+    # end where the reversing joints last confirmed their old direction
+    stops = np.append(np.where(changed[reversal], known[reversal], n).min(axis=1), n - 1)
+    usable = stops > starts
+    out = np.column_stack([t[starts[usable]] + margin, t[stops[usable]] - margin])
     duration = out[:, 1] - out[:, 0]
     return out[(duration > 0) & (duration >= min_duration)]
 

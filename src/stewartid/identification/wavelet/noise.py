@@ -27,14 +27,25 @@ def white_noise_covariance(q: np.ndarray, smooth: np.ndarray | None = None) -> n
     return d2.T @ d2 / (6.0 * max(len(d2), 1))
 
 
+def mean_rate_jacobian(joint_jacobians: np.ndarray, leg_jacobian: np.ndarray) -> np.ndarray:
+    """Rows (36, 6) of the joint-axis Jacobians (N, 6, 5, 6) then J_lq (N, 6, 6), averaged over
+    the samples."""
+    return np.concatenate([joint_jacobians.mean(axis=0).reshape(30, 6),
+                           leg_jacobian.mean(axis=0)], axis=0)
+
+
 def joint_rate_noise(covariance: np.ndarray, sample_rate: float, window: float,
                      joint_jacobians: np.ndarray, leg_jacobian: np.ndarray,
-                     order: int = DEFAULT_ORDER) -> np.ndarray:
-    """Standard deviation (36,) of each Savitzky-Golay joint rate from pose noise, |c| sqrt(diag(J S J^T))."""
+                     order: int = DEFAULT_ORDER, mean_jacobian: np.ndarray | None = None
+                     ) -> np.ndarray:
+    """Standard deviation (36,) of each Savitzky-Golay joint rate from pose noise, |c| sqrt(diag(J S J^T)).
+
+    ``mean_jacobian``: :func:`mean_rate_jacobian` of the Jacobians, when already computed.
+    """
     n = window_samples(window, sample_rate, order)
     gain = np.linalg.norm(savgol_coefficients(n, order, 1, 1.0 / sample_rate))
-    jac = np.concatenate([joint_jacobians.mean(axis=0).reshape(30, 6),
-                          leg_jacobian.mean(axis=0)], axis=0)
+    jac = (mean_rate_jacobian(joint_jacobians, leg_jacobian) if mean_jacobian is None
+           else mean_jacobian)
     variance = np.einsum("ij,jk,ik->i", jac, covariance, jac)
     return gain * np.sqrt(np.clip(variance, 0.0, None))
 
@@ -53,6 +64,8 @@ class NoiseModel(NamedTuple):
         White generalized-force noise per sample, N^2, N^2 m^2.
     rate_noise : ndarray, shape (36,)
         Pose noise on each joint rate.
+    mean_jacobian : ndarray, shape (36, 6), optional
+        :func:`mean_rate_jacobian` of the experiment, for the noise of other rates.
     """
 
     window: float
@@ -61,6 +74,7 @@ class NoiseModel(NamedTuple):
     pose_covariance: np.ndarray
     force_variance: np.ndarray
     rate_noise: np.ndarray
+    mean_jacobian: np.ndarray | None = None
 
 
 def estimate_noise(experiment: Experiment, window: float) -> NoiseModel:
@@ -71,10 +85,12 @@ def estimate_noise(experiment: Experiment, window: float) -> NoiseModel:
     y = experiment.generalized_force
     force_variance = np.diag(white_noise_covariance(
         y, differentiate(y, rate, window, derivatives=(0,))[0]))
+    mean_jacobian = mean_rate_jacobian(experiment.joint_jacobians, experiment.leg_jacobian)
     rate_noise = joint_rate_noise(covariance, rate, window, experiment.joint_jacobians,
-                                  experiment.leg_jacobian)
+                                  experiment.leg_jacobian, mean_jacobian=mean_jacobian)
     return NoiseModel(window=window, q_dot=q_dot, q_ddot=q_ddot, pose_covariance=covariance,
-                      force_variance=force_variance, rate_noise=rate_noise)
+                      force_variance=force_variance, rate_noise=rate_noise,
+                      mean_jacobian=mean_jacobian)
 
 
 def measured_sign_rates(q: np.ndarray, sample_rate: float, window: float) -> np.ndarray:
@@ -91,5 +107,5 @@ def sign_pose_noise(q: np.ndarray, sample_rate: float, window: float) -> np.ndar
     return white_noise_covariance(q, smooth)
 
 
-__all__ = ["NoiseModel", "estimate_noise", "joint_rate_noise", "measured_sign_rates",
-           "sign_pose_noise", "white_noise_covariance"]
+__all__ = ["NoiseModel", "estimate_noise", "joint_rate_noise", "mean_rate_jacobian",
+           "measured_sign_rates", "sign_pose_noise", "white_noise_covariance"]

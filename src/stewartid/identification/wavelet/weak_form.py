@@ -216,16 +216,28 @@ def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: boo
     signs = found.sign_rates
     out = np.empty((len(signs), len(rates), len(groups) + (leg_jacobian is not None), 6))
     noise, squared_rates = found.sign_rate_noise ** 2, rates[:, None, None] ** 2
+    # one block's temporaries, reused: w^2 + sigma^2, then the soft signs (n, R, 6, 5)
+    level = np.empty((min(len(signs), PATTERN_BLOCK), 6, 5))
+    direction = np.empty((len(level), len(rates), 6, 5))
     for start in range(0, len(signs), PATTERN_BLOCK):
         block = slice(start, start + PATTERN_BLOCK)
         w = signs[block]
-        direction = w[:, None] / np.sqrt((w * w + noise)[:, None] + squared_rates)  # (n, R, 6, 5)
-        out[block, :, :len(groups)] = joint_type_forces(direction, joint_jacobians[block], groups)
+        n = len(w)
+        np.multiply(w, w, out=level[:n])
+        level[:n] += noise
+        soft = np.add(level[:n, None], squared_rates, out=direction[:n])
+        np.sqrt(soft, out=soft)
+        np.divide(w[:, None], soft, out=soft)
+        joint_type_forces(soft, joint_jacobians[block], groups, out=out[block, :, :len(groups)])
     if leg_jacobian is not None:
-        legs, noise = found.leg_sign_rates, found.leg_sign_rate_noise
+        legs = found.leg_sign_rates
+        leg_level = legs ** 2 + found.leg_sign_rate_noise ** 2
+        soft = np.empty_like(legs)
         for k, r in enumerate(rates):
-            direction = legs / np.sqrt(legs ** 2 + noise ** 2 + r ** 2)              # (N, 6)
-            out[:, k, -1] = (direction[:, None, :] @ leg_jacobian)[:, 0]
+            np.add(leg_level, r ** 2, out=soft)
+            np.sqrt(soft, out=soft)
+            np.divide(legs, soft, out=soft)                                       # (N, 6)
+            out[:, k, -1] = (soft[:, None, :] @ leg_jacobian)[:, 0]
     return out
 
 

@@ -20,6 +20,7 @@ from stewartid.identification.wavelet.gls import (
     InvariantFit,
     WeakFormSolution,
     fit_jointly,
+    local_terms,
     standard_errors,
 )
 from stewartid.identification.wavelet.rate_selection import averaged_over_rates
@@ -81,9 +82,9 @@ def _stop_columns(stops: Sequence[Stop], sel: slice, phi: np.ndarray,
     without any."""
     columns = []
     for found in stops:
-        start, stop = max(found.start, sel.start), min(found.stop, sel.stop)
-        if stop <= start:
+        if found.stop <= sel.start or found.start >= sel.stop:
             continue
+        start, stop = max(found.start, sel.start), min(found.stop, sel.stop)
         x = (2.0 * np.arange(stop - start) + 1.0) / (stop - start) - 1.0
         polynomials = legendre.legvander(x, found.terms - 1)                # (n, terms)
         local = phi[:, start - sel.start:stop - sel.start]                   # (K, n)
@@ -177,9 +178,8 @@ def solve_windows(equations: Sequence[WindowEquations], iterations: int = 3,
         fit = fit_jointly(stacked, designs, targets, start, None, 1, local)
         z = fit.z
         if local is not None:  # the stops' friction as fitted, for the rows' noise
-            fitted = [targets[i] - np.stack([c[i] @ s for c, s in zip(local, fit.local_z,
-                                                                      strict=True)])
-                      for i in range(6)]
+            own = local_terms(local, fit.local_z)
+            fitted = [targets[i] - own[i] for i in range(6)]
     std = standard_errors(designs, targets, fit, local)
     return WeakFormSolution(
         theta=z[:N_THETA].reshape(6, 12), theta_std=std[:N_THETA].reshape(6, 12),
