@@ -158,6 +158,8 @@ def plot_residuals(validation: ValidationResult, frequencies_hz: Sequence[float]
     """Each equation's residual over time (experiments end to end) and its spectrum.
 
     ``frequencies_hz``: each experiment's excitation frequency, marked with its harmonics."""
+    from matplotlib.collections import LineCollection
+
     residual = [m - p for m, p in zip(validation.measured, validation.predicted, strict=True)]
     t, values = _concatenated(validation, residual)
     figure = new_figure(figsize=(13, 12))
@@ -166,24 +168,30 @@ def plot_residuals(validation: ValidationResult, frequencies_hz: Sequence[float]
     step = thinning_step(t, 6000)
     rate = 1.0 / (validation.segments[0].t[1] - validation.segments[0].t[0])
     top = 10 * max(frequencies_hz)
+    harmonics = np.unique(np.concatenate([f * np.arange(1, int(top / f) + 1)
+                                          for f in sorted(set(np.round(frequencies_hz, 6)))]))
     for c in range(6):
         axes[c, 0].plot(t[step], values[step, c], color="#444444", lw=0.6)
         axes[c, 0].set_ylabel(f"{COORDINATES[c]} ({FORCE_UNITS[c]})")
-        peaks = []
+        spectra = []
         for piece in (r[:, c] for r in residual):
             window = np.hanning(len(piece))
             amplitude = 2 * np.abs(np.fft.rfft((piece - piece.mean()) * window)) / window.sum()
             frequency = np.fft.rfftfreq(len(piece), 1.0 / rate)
             keep = frequency <= top
-            axes[c, 1].semilogy(frequency[keep], amplitude[keep], lw=0.5, color="#444444",
-                                alpha=0.5)
-            peaks.append(amplitude[keep])
-        _log_floor(axes[c, 1], np.concatenate(peaks), decades=4.0)
-        for f in sorted(set(np.round(frequencies_hz, 6))):
-            for harmonic in range(1, int(top / f) + 1):
-                axes[c, 1].axvline(harmonic * f, color="#d62728", lw=0.5, ls=":")
+            spectra.append(np.column_stack([frequency[keep], amplitude[keep]]))
+        # one artist per panel for the segments' spectra and one for the harmonics, not one
+        # line each (zorder of a line, above the grid); the spectra set the axis range
+        axes[c, 1].set_yscale("log")
+        axes[c, 1].add_collection(LineCollection(spectra, colors="#444444", linewidths=0.5,
+                                                 alpha=0.5, zorder=2))
+        _log_floor(axes[c, 1], np.concatenate([s[:, 1] for s in spectra]), decades=4.0)
+        axes[c, 1].add_collection(LineCollection(
+            [[(f, 0.0), (f, 1.0)] for f in harmonics], colors="#d62728", linewidths=0.5,
+            linestyles=":", zorder=2, transform=axes[c, 1].get_xaxis_transform()),
+            autolim=False)
     axes[0, 0].set_title("Residual (measured − model) over time; experiments end to end")
-    axes[0, 1].set_title("Residual spectrum per segment; dotted: excitation harmonics")
+    axes[0, 1].set_title("Residual spectrum per segment\n(dotted: excitation harmonics)")
     axes[-1, 0].set_xlabel("time across the experiments (s)")
     axes[-1, 1].set_xlabel("frequency (Hz)")
     return save_figure(figure, directory, stem, tight=False)
