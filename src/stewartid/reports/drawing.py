@@ -20,7 +20,7 @@ _DISPLAY = (("mm", 1e3),) * 3 + (("mrad", 1e3),) * 3
 
 #: matplotlib settings of every figure, applied with ``matplotlib.rc_context``.
 STYLE = {"font.size": 10, "axes.titlesize": 11, "axes.labelsize": 10, "legend.fontsize": 9,
-         "svg.fonttype": "none", "svg.hashsalt": "stewartid", "axes.grid": True, "grid.alpha": 0.3}
+         "svg.fonttype": "none", "axes.grid": True, "grid.alpha": 0.3}
 
 @dataclass(frozen=True)
 class ExperimentTrace:
@@ -81,6 +81,8 @@ def save_figure(figure: Any, directory: str | Path, stem: str, dpi: int = 120,
     """Write ``figure`` as ``stem.png`` and ``stem.svg`` in ``directory`` (atomic); returns both paths.
 
     ``tight`` crops to the drawn content; False keeps a fixed-margin layout and saves a layout pass."""
+    import matplotlib
+
     directory = Path(directory)
     box = None
     if tight:
@@ -88,12 +90,13 @@ def save_figure(figure: Any, directory: str | Path, stem: str, dpi: int = 120,
     else:
         _pin_titles(figure)
     paths = []
-    # metadata dates off: the same run gives byte-identical SVG files
+    # metadata dates off and clip ids from a fixed salt: the same run gives the same files
     options = {"png": {"metadata": {"Software": None}, "pil_kwargs": {"compress_level": 3}},
                "svg": {"metadata": {"Date": None}}}
     for kind in ("png", "svg"):
         buffer = io.BytesIO()
-        figure.savefig(buffer, format=kind, dpi=dpi, bbox_inches=box, **options[kind])
+        with matplotlib.rc_context({"svg.hashsalt": "stewartid"}):
+            figure.savefig(buffer, format=kind, dpi=dpi, bbox_inches=box, **options[kind])
         paths.append(write_bytes_atomic(directory / f"{stem}.{kind}", buffer.getvalue()))
     return paths
 
