@@ -80,7 +80,8 @@ def save_figure(figure: Any, directory: str | Path, stem: str, dpi: int = 120,
                 tight: bool = True) -> list[Path]:
     """Write ``figure`` as ``stem.png`` and ``stem.svg`` in ``directory`` (atomic); returns both paths.
 
-    ``tight`` crops to the drawn content; False keeps a fixed-margin layout and saves a layout pass."""
+    ``tight`` crops to the drawn content (the figure keeps the layout it was saved with); False
+    keeps a fixed-margin layout and saves a layout pass."""
     import matplotlib
 
     directory = Path(directory)
