@@ -189,3 +189,56 @@ def test_held_out_figure_labels_its_axis_when_the_bars_share_a_decade(tmp_path):
     svg = next(p for p in paths if p.suffix == ".svg").read_text()
     labels = {float(text) for text in re.findall(r">([0-9][0-9.]*)</text>", svg)}
     assert {0.001, 0.01, 0.1} <= labels
+
+
+def _panels(scale: float, layout: str | None = None):
+    """A two-panel figure with long titles, a legend and data of magnitude ``scale``."""
+    import matplotlib
+
+    from stewartid.reports.drawing import STYLE, new_figure
+
+    with matplotlib.rc_context(STYLE):
+        figure = new_figure(figsize=(6, 2.5), layout=layout)
+        for k, axis in enumerate(figure.subplots(1, 2)):
+            axis.plot(np.linspace(0, 1, 50), scale * (1 + np.sin(np.linspace(0, 6, 50)) / 3),
+                      label="a line")
+            axis.set_title(f"panel {k}: a title as wide as the panel above its data")
+            axis.legend(loc="upper right")
+    return figure
+
+
+def _pixels(path_or_buffer) -> np.ndarray:
+    from PIL import Image
+
+    return np.asarray(Image.open(path_or_buffer).convert("RGBA"))
+
+
+@pytest.mark.parametrize("scale, layout, tight", [(1.0, None, False), (1e-6, None, False),
+                                                 (1.0, None, True), (1.0, "constrained", True)])
+def test_saved_figures_match_matplotlibs_own_placement(tmp_path, scale, layout, tight):
+    """The one layout pass, the one tight box and the pinned titles draw the pixels matplotlib's
+    own savefig draws: titles at the top, raised over an offset text (×1e−6), the same crop."""
+    import matplotlib
+
+    from stewartid.reports.drawing import STYLE, save_figure
+
+    png, svg = save_figure(_panels(scale, layout), tmp_path, "ours", tight=tight)
+    reference = io.BytesIO()
+    with matplotlib.rc_context(STYLE):
+        _panels(scale, layout).savefig(reference, format="png", dpi=120,
+                                       bbox_inches="tight" if tight else None)
+    np.testing.assert_array_equal(_pixels(png), _pixels(reference))
+    assert svg.read_text().rstrip().endswith("</svg>")
+
+
+def test_saved_figures_are_the_same_bytes_from_run_to_run(tmp_path):
+    from xml.etree import ElementTree
+
+    from stewartid.reports.drawing import save_figure
+
+    first = save_figure(_panels(1.0), tmp_path / "one", "figure")
+    second = save_figure(_panels(1.0), tmp_path / "two", "figure")
+    for a, b in zip(first, second, strict=True):
+        assert a.read_bytes() == b.read_bytes(), a.name
+    assert "clip-path" in first[1].read_text()  # clip ids are in the file, and stable
+    assert ElementTree.parse(first[1]).getroot().tag.endswith("svg")

@@ -48,11 +48,21 @@ class FigureDrawer:
         """Draw every figure added, in ``jobs`` worker processes (None: every core); returns
         the files written."""
         pending, self._pending = self._pending, []
-        for written in run_in_order(_draw, range(len(pending)),
-                                    inheriting_workers(jobs, len(pending)),
+        workers = inheriting_workers(jobs, len(pending))
+        if workers > 1:
+            _load_matplotlib()
+        for written in run_in_order(_draw, range(len(pending)), workers,
                                     shared=(self.folder, pending)):
             self.files += written
         return self.files
+
+
+def _load_matplotlib() -> None:
+    """Import matplotlib's figure and both file backends here, once, for the forked workers to
+    inherit: each would otherwise import them itself (about 0.35 s of CPU)."""
+    import matplotlib.backends.backend_agg  # noqa: F401
+    import matplotlib.backends.backend_svg  # noqa: F401
+    import matplotlib.figure  # noqa: F401
 
 
 def _draw(work: tuple[Path, list], k: int) -> list[Path]:

@@ -158,6 +158,8 @@ def plot_residuals(validation: ValidationResult, frequencies_hz: Sequence[float]
     """Each equation's residual over time (experiments end to end) and its spectrum.
 
     ``frequencies_hz``: each experiment's excitation frequency, marked with its harmonics."""
+    from matplotlib.collections import LineCollection
+
     residual = [m - p for m, p in zip(validation.measured, validation.predicted, strict=True)]
     t, values = _concatenated(validation, residual)
     figure = new_figure(figsize=(13, 12))
@@ -166,24 +168,30 @@ def plot_residuals(validation: ValidationResult, frequencies_hz: Sequence[float]
     step = thinning_step(t, 6000)
     rate = 1.0 / (validation.segments[0].t[1] - validation.segments[0].t[0])
     top = 10 * max(frequencies_hz)
+    harmonics = np.unique(np.concatenate([f * np.arange(1, int(top / f) + 1)
+                                          for f in sorted(set(np.round(frequencies_hz, 6)))]))
     for c in range(6):
         axes[c, 0].plot(t[step], values[step, c], color="#444444", lw=0.6)
         axes[c, 0].set_ylabel(f"{COORDINATES[c]} ({FORCE_UNITS[c]})")
-        peaks = []
+        spectra = []
         for piece in (r[:, c] for r in residual):
             window = np.hanning(len(piece))
             amplitude = 2 * np.abs(np.fft.rfft((piece - piece.mean()) * window)) / window.sum()
             frequency = np.fft.rfftfreq(len(piece), 1.0 / rate)
             keep = frequency <= top
-            axes[c, 1].semilogy(frequency[keep], amplitude[keep], lw=0.5, color="#444444",
-                                alpha=0.5)
-            peaks.append(amplitude[keep])
-        _log_floor(axes[c, 1], np.concatenate(peaks), decades=4.0)
-        for f in sorted(set(np.round(frequencies_hz, 6))):
-            for harmonic in range(1, int(top / f) + 1):
-                axes[c, 1].axvline(harmonic * f, color="#d62728", lw=0.5, ls=":")
+            spectra.append(np.column_stack([frequency[keep], amplitude[keep]]))
+        # one artist per panel for the segments' spectra and one for the harmonics, not one
+        # line each (zorder of a line, above the grid); the spectra set the axis range
+        axes[c, 1].set_yscale("log")
+        axes[c, 1].add_collection(LineCollection(spectra, colors="#444444", linewidths=0.5,
+                                                 alpha=0.5, zorder=2))
+        _log_floor(axes[c, 1], np.concatenate([s[:, 1] for s in spectra]), decades=4.0)
+        axes[c, 1].add_collection(LineCollection(
+            [[(f, 0.0), (f, 1.0)] for f in harmonics], colors="#d62728", linewidths=0.5,
+            linestyles=":", zorder=2, transform=axes[c, 1].get_xaxis_transform()),
+            autolim=False)
     axes[0, 0].set_title("Residual (measured − model) over time; experiments end to end")
-    axes[0, 1].set_title("Residual spectrum per segment; dotted: excitation harmonics")
+    axes[0, 1].set_title("Residual spectrum per segment\n(dotted: excitation harmonics)")
     axes[-1, 0].set_xlabel("time across the experiments (s)")
     axes[-1, 1].set_xlabel("frequency (Hz)")
     return save_figure(figure, directory, stem, tight=False)
@@ -297,6 +305,9 @@ def plot_workspace(curves: Workspace, directory: str | Path, stem: str = "worksp
 
     Diagonal and largest couplings as % change from the mean-pose value, ±2 standard errors, the
     description dashed; ``curves`` from :func:`~stewartid.comparison.workspace`."""
+    from matplotlib.collections import LineCollection, PolyCollection
+    from matplotlib.lines import Line2D
+
     figure = new_figure(figsize=(15, 6.5))
     axes = figure.subplots(2, 6, squeeze=False, gridspec_kw={
         "left": 0.05, "right": 0.86, "bottom": 0.1, "top": 0.9, "hspace": 0.4,
@@ -313,17 +324,27 @@ def plot_workspace(curves: Workspace, directory: str | Path, stem: str = "worksp
             found = curves.identified[dof]
             values, std = getattr(found, key), getattr(found, f"std_errors_{key}")
             shown, bands = [0.0], [0.0]
-            for k, entry in enumerate(entries):
+            polygons, lines = [], []
+            for entry in entries:
                 scale = 100.0 / _entry_scale(reference, entry)
                 y = (values[:, entry[0], entry[1]] - reference[entry]) * scale
                 band = 2.0 * std[:, entry[0], entry[1]] * scale
-                label = f"{name}[{COORDINATES[entry[0]]},{COORDINATES[entry[1]]}]"
-                axis.fill_between(x, y - band, y + band, color=colours[k], alpha=0.2, lw=0)
-                axis.plot(x, y, color=colours[k], lw=1.2, label=label)
-                dashed = (nominal[dof, :, entry[0], entry[1]] - reference[entry]) * scale
-                axis.plot(x, dashed, color=colours[k], lw=0.9, ls="--")
-                shown += [np.abs(y).max(), np.abs(dashed).max()]
+                # the outline fill_between draws: (x0, upper), lower forward, upper backward
+                polygons.append(np.column_stack([np.r_[x[0], x, x[-1], x[::-1]],
+                                                 np.r_[y[0] + band[0], y - band,
+                                                       y[-1] + band[-1], (y + band)[::-1]]]))
+                described = (nominal[dof, :, entry[0], entry[1]] - reference[entry]) * scale
+                lines += [np.column_stack([x, y]), np.column_stack([x, described])]
+                shown += [np.abs(y).max(), np.abs(described).max()]
                 bands.append(float(np.median(band)))
+            # one artist for the bands and one for the lines (each entry's curve, then its
+            # description dashed; zorder of a line), not three per entry
+            used = colours[:len(entries)]
+            axis.add_collection(PolyCollection(polygons, facecolors=used, edgecolors=used,
+                                               alpha=0.2, linewidths=0))
+            axis.add_collection(LineCollection(
+                lines, colors=np.repeat(used, 2), linewidths=[1.2, 0.9] * len(entries),
+                linestyles=["-", "--"] * len(entries), zorder=2))
             # the curves set the scale; a band much wider than them runs off the panel
             limit = 1.2 * max(max(shown), float(np.median(bands))) or 1.0
             axis.set_ylim(-limit, limit)
@@ -331,8 +352,10 @@ def plot_workspace(curves: Workspace, directory: str | Path, stem: str = "worksp
             axis.set_title(f"{name} along {COORDINATES[dof]}", fontsize=9)
             if dof == 0:
                 axis.set_ylabel("change from the mean pose (%)")
-        axes[row, -1].legend(loc="center left", bbox_to_anchor=(1.05, 0.5), fontsize=7,
-                             framealpha=0.9)
+        axes[row, -1].legend(
+            [Line2D([], [], color=colour, lw=1.2) for colour in colours[:len(entries)]],
+            [f"{name}[{COORDINATES[i]},{COORDINATES[j]}]" for i, j in entries],
+            loc="center left", bbox_to_anchor=(1.05, 0.5), fontsize=7, framealpha=0.9)
     figure.suptitle("Physical model across the measured poses: band ±2 standard errors; "
                     "dashed: the platform description", fontsize=10)
     return save_figure(figure, directory, stem, tight=False)
