@@ -6,11 +6,13 @@ Fits over soft-sign transition rates averaged by Akaike weight, and whether the 
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from collections.abc import Callable, Sequence
 
 import numpy as np
 from scipy.special import chdtri
 
+from stewartid.errors import DataWarning
 from stewartid.identification._sign_window import widened_by_sign_window
 from stewartid.identification.wavelet.gls import WeakFormSolution, solve_weak_form
 from stewartid.identification.wavelet.weak_form import SOFT_SIGN_RATES, IntervalEquations
@@ -60,8 +62,10 @@ def averaged_over_rates(solve: Callable[[int], WeakFormSolution], rates: Sequenc
                                    theta_std=theta_std, coulomb=coulomb,
                                    coulomb_std=coulomb_std, rate_weights=by_rate)
     if refit is not None:
-        averaged = widened_by_sign_window(averaged, solutions[HALF_WINDOW_RATE], refit(),
-                                          "coulomb")
+        with warnings.catch_warnings():  # what the data lack, the fits above have said
+            warnings.simplefilter("ignore", DataWarning)
+            half = refit()
+        averaged = widened_by_sign_window(averaged, solutions[HALF_WINDOW_RATE], half, "coulomb")
     return averaged, float(rates[int(np.argmax(weights))])
 
 
