@@ -17,7 +17,6 @@ import numpy as np
 
 from stewartid.datasets.dataset import Dataset
 from stewartid.fields import BOOLEAN, Interval, Options, nonnegative
-from stewartid.identification._sign_window import widened_by_sign_window
 from stewartid.identification.base import DIFFERENTIATION_CONSTRAINTS, BaseIdentifier
 from stewartid.identification.friction_shape import (
     COULOMB_SHAPES,
@@ -31,6 +30,7 @@ from stewartid.identification.pairs import calibrate_by_pairs
 from stewartid.identification.preparation import Experiment, prepare_experiment
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
+from stewartid.identification.sign_window import widened_by_sign_window
 from stewartid.identification.solvers import regressor_names, solve_least_squares
 from stewartid.identification.stops import find_stops, project_out, stop_basis
 from stewartid.identification.wavelet.noise import sign_pose_noise

@@ -74,7 +74,7 @@ def with_half_window(patterns: np.ndarray, experiment: Experiment, found: Detect
     and, where the pose noise lengthened the signs' window, after them that of the signs from
     half of it at the rate :data:`~stewartid.identification.wavelet.rate_selection.HALF_WINDOW_RATE`
     (N, R + 1, types, 6): the refit that measures the long window's bias
-    (:mod:`~stewartid.identification._sign_window`). ``legs``: the patterns carry the legs' type.
+    (:mod:`~stewartid.identification.sign_window`). ``legs``: the patterns carry the legs' type.
     """
     window, covariance = found.info["differentiation_window"], found.info["noise_covariance"]
     chosen = sign_window(experiment.q, experiment.sample_rate, window, covariance,

@@ -13,7 +13,7 @@ import numpy as np
 from scipy.special import chdtri
 
 from stewartid.errors import DataWarning
-from stewartid.identification._sign_window import widened_by_sign_window
+from stewartid.identification.sign_window import widened_by_sign_window
 from stewartid.identification.wavelet.gls import WeakFormSolution, solve_weak_form
 from stewartid.identification.wavelet.weak_form import SOFT_SIGN_RATES, IntervalEquations
 
@@ -38,7 +38,7 @@ def averaged_over_rates(solve: Callable[[int], WeakFormSolution], rates: Sequenc
     Mean sum_k w_k theta_k, standard error sqrt(sum_k w_k (s_k^2 + (theta_k - mean)^2)) (Burnham and
     Anderson 2002, sec. 6.3). ``refit()``: the fit at the rate :data:`HALF_WINDOW_RATE` with the
     signs from half their window, by whose distance from that rate's fit the standard errors
-    widen (:func:`~stewartid.identification._sign_window.widened_by_sign_window`). Returns the averaged
+    widen (:func:`~stewartid.identification.sign_window.widened_by_sign_window`). Returns the averaged
     solution (rest from the best candidate, with ``rate_weights``) and the rate of greatest
     weight, rad/s.
     """
