@@ -68,6 +68,7 @@ import stewartid.verdict.rule as rule  # noqa: E402
 from stewartid.comparison import judge, run_method  # noqa: E402
 from stewartid.errors import StewartidError  # noqa: E402
 from stewartid.identification import registry  # noqa: E402
+from stewartid.identification.sign_window import widened_by_sign_window  # noqa: E402
 from stewartid.reference.published import PAPER_ENTRIES, relative_error_percent  # noqa: E402
 from stewartid.verdict.policy import VerdictPolicy  # noqa: E402
 
@@ -97,14 +98,19 @@ def _not_pooled(value, std_error):
     return np.array(value, dtype=float), np.array(std_error, dtype=float)
 
 
-def _least_residual_rate(solve, rates):
+def _least_residual_rate(solve, rates, refit=None):
     """averaged_over_rates with a one-hot weight on the rate of least residual cost: the fit
-    at that rate, its own standard errors."""
+    at that rate, its own standard errors (widened by the signs' half-window refit, as
+    averaged_over_rates widens them)."""
     solutions = [solve(index) for index in range(len(rates))]
     costs = np.array([rate_selection.residual_cost(s) for s in solutions])
     best = int(np.argmin(costs))
     weights = {f"{rate:g}": float(k == best) for k, rate in enumerate(rates)}
-    return dataclasses.replace(solutions[best], rate_weights=weights), float(rates[best])
+    chosen = dataclasses.replace(solutions[best], rate_weights=weights)
+    if refit is not None:
+        chosen = widened_by_sign_window(chosen, solutions[rate_selection.HALF_WINDOW_RATE],
+                                        refit(), "coulomb")
+    return chosen, float(rates[best])
 
 
 def variant_setup(name: str) -> tuple[VerdictPolicy | None, list]:

@@ -34,7 +34,7 @@ import numpy as np
 from stewartid.datasets.dataset import read_datasets
 from stewartid.identification import least_squares
 from stewartid.identification.registry import create_identifier
-from stewartid.identification.wavelet import detection, noise
+from stewartid.identification.wavelet import detection
 from stewartid.model.linearization import nominal_matrices
 from stewartid.platform import load_platform
 from stewartid.signals.differentiation import differentiate
@@ -59,23 +59,19 @@ def sign_rates_from(variant: str, poses: list[np.ndarray]):
         yield
         return
 
-    def rates(q, sample_rate, window, pose_noise, limit=None):
-        limit = {} if limit is None else {"noise_limit": limit}
+    def rates(q, sample_rate, window, pose_noise, limit=None, shorter=0):
+        limit = {"shorter": shorter} | ({} if limit is None else {"noise_limit": limit})
         true = noise_free(poses, q)
         if variant == "true":
             return coulomb_sign_rates(true, sample_rate, window, np.zeros((6, 6)), **limit)
         chosen = coulomb_sign_rates(q, sample_rate, window, pose_noise, **limit)[1]
         return differentiate(true, sample_rate, chosen, SIGN_ORDER, (1,))[0], chosen
 
-    def measured(q, sample_rate, window):
-        smooth = differentiate(q, sample_rate, window / 8, 5, (0,))[0]
-        return rates(q, sample_rate, window, noise.white_noise_covariance(q, smooth))[0]
-
     # noise-free rates carry no noise for Method B's soft signs either
     level = (lambda *args, **kwargs: np.zeros(36)) if variant == "true" else detection.joint_rate_noise
     with (mock.patch.object(detection, "coulomb_sign_rates", rates),
           mock.patch.object(detection, "joint_rate_noise", level),
-          mock.patch.object(least_squares, "measured_sign_rates", measured)):
+          mock.patch.object(least_squares, "coulomb_sign_rates", rates)):
         yield
 
 

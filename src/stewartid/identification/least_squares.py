@@ -30,9 +30,10 @@ from stewartid.identification.pairs import calibrate_by_pairs
 from stewartid.identification.preparation import Experiment, prepare_experiment
 from stewartid.identification.registry import register_method
 from stewartid.identification.result import IdentificationResult
+from stewartid.identification.sign_window import widened_by_sign_window
 from stewartid.identification.solvers import regressor_names, solve_least_squares
 from stewartid.identification.stops import find_stops, project_out, stop_basis
-from stewartid.identification.wavelet.noise import measured_sign_rates, sign_pose_noise
+from stewartid.identification.wavelet.noise import sign_pose_noise
 from stewartid.model.joints import JOINT_TYPES
 from stewartid.model.kinematics import joint_axis_rates, joint_type_forces
 from stewartid.parallel import inheriting_workers, run_in_order
@@ -46,6 +47,7 @@ from stewartid.signals.differentiation import (
     kernel_taps,
     trim,
 )
+from stewartid.signals.sign_rates import coulomb_sign_rates, lengthened_by_noise
 
 
 def pose_noise_gram(q: np.ndarray, sample_rate: float, window: float) -> np.ndarray:
@@ -111,7 +113,8 @@ def uses_leg_coulomb(setting: bool | None, platform: Platform) -> bool:
 
 class _Rows(NamedTuple):
     """One experiment's rows: times, support, decimation, force, rates (K, 6), Coulomb regressors,
-    pose-noise Gram, the offset's regressor (K,) and the rows the legs' stops took."""
+    pose-noise Gram, the offset's regressor (K,), the rows the legs' stops took and, where noise
+    lengthened the signs' window, the first shape's Coulomb regressors from half of it."""
 
     t: np.ndarray
     window: float
@@ -123,6 +126,7 @@ class _Rows(NamedTuple):
     noise: np.ndarray | None
     offset: np.ndarray
     absorbed: int = 0
+    half_window: np.ndarray | None = None
 
 
 @register_method(
@@ -252,17 +256,21 @@ class LeastSquaresIdentifier(BaseIdentifier):
                          qdd[sl], coulomb, None, np.ones(len(qd[sl])))
         # the Coulomb signs need the rates at every sample, from a window the noise allows
         # (the physical model's rule), so that they do not chatter
-        stops = None
+        stops, pose_noise, half = None, sign_pose_noise(exp.q, exp.sample_rate, window), []
         if legs and self.leg_stops:
-            stops = find_stops(exp.q, exp.leg_jacobian, exp.sample_rate, window,
-                               sign_pose_noise(exp.q, exp.sample_rate, window))
+            stops = find_stops(exp.q, exp.leg_jacobian, exp.sample_rate, window, pose_noise)
             qd_sign = stops.q_dot
         else:
-            qd_sign = measured_sign_rates(exp.q, exp.sample_rate, window)
+            qd_sign, sign_window = coulomb_sign_rates(exp.q, exp.sample_rate, window, pose_noise)
+            if lengthened_by_noise(window, sign_window):  # the refit of the signs' window
+                half = self._coulomb_units(
+                    exp, slice(None), coulomb_sign_rates(exp.q, exp.sample_rate, window,
+                                                         pose_noise, shorter=1)[0],
+                    shapes[:1], legs)
         units = self._coulomb_units(exp, slice(None), qd_sign, shapes, legs,
                                     None if stops is None else stops.stopped)
         signals = np.concatenate(
-            [exp.generalized_force] + [u.reshape(len(u), -1) for u in units], axis=1)
+            [exp.generalized_force] + [u.reshape(len(u), -1) for u in units + half], axis=1)
         filtered = kernel_filter(signals, exp.sample_rate, window)[0]
         _, qd, qdd = kernel_filter(exp.q, exp.sample_rate, window, derivatives=2)
         cut = (len(exp.t) - len(qd)) // 2
@@ -271,7 +279,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
         y = filtered[step, :6]
         width = 6 * (len(JOINT_TYPES) + legs)
         coulomb = [filtered[step, 6 + width * k:6 + width * (k + 1)].reshape(len(y), -1, 6)
-                   for k in range(len(units))]
+                   for k in range(len(units) + len(half))]
+        coulomb, half = coulomb[:len(units)], coulomb[len(units):]
         noise = (pose_noise_gram(exp.q, exp.sample_rate, window) if self.noise_correction
                  else None)
         qd, qdd, offset = qd[step], qdd[step], np.ones(len(y))
@@ -280,7 +289,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
             basis = stop_basis(stops, exp.sample_rate, window, decimate, exp.name)
             y, qd, qdd, offset, *coulomb = project_out(basis, y, qd, qdd, offset, *coulomb)
             absorbed = basis.shape[1]
-        return _Rows(exp.t[sl], window, decimate, y, qd, qdd, coulomb, noise, offset, absorbed)
+        return _Rows(exp.t[sl], window, decimate, y, qd, qdd, coulomb, noise, offset, absorbed,
+                     half[0] if half else None)
 
     def _fit(self, datasets: list[Dataset], platform: Platform
              ) -> tuple[IdentificationResult, dict]:
@@ -292,6 +302,10 @@ class LeastSquaresIdentifier(BaseIdentifier):
         variants = shapes + (EXACT_SIGN,) * exact
         legs = bool(shapes) and uses_leg_coulomb(self.leg_coulomb, platform)
         shared: list[list[np.ndarray]] = [[] for _ in variants]
+        # the first shape's regressors with the signs from half their window, where noise
+        # lengthened it (elsewhere the window's own)
+        half: list[np.ndarray] = []
+        lengthened = False
         phis, ys, used, noise, segments = [], [], [], [], []
         absorbed = 0
         workers = inheriting_workers(self.jobs, n_exp)
@@ -305,6 +319,9 @@ class LeastSquaresIdentifier(BaseIdentifier):
             ys.append(rows.y)
             for per_shape, regressors in zip(shared, rows.coulomb, strict=True):
                 per_shape.append(regressors)
+            if rows.coulomb:
+                half.append(rows.coulomb[0] if rows.half_window is None else rows.half_window)
+            lengthened |= rows.half_window is not None
             if rows.noise is not None:  # the noise the projected rows keep
                 noise.append((k - rows.absorbed, rows.noise))
             absorbed += rows.absorbed
@@ -320,14 +337,17 @@ class LeastSquaresIdentifier(BaseIdentifier):
             for count, block in noise:
                 regressor_noise[:12, :12] += count * block
         phi, y = np.concatenate(phis), np.concatenate(ys)
-        solutions = [solve_least_squares(
-            phi, y, None if per_shape is None else np.concatenate(per_shape),
-            symmetric=self.symmetric, regressor_names=names,
-            shared_names=([f"coulomb[{t}]" for t in JOINT_TYPES] + ["coulomb[actuator]"] * legs
-                          if shapes else None),
-            autocorrelated=True, regressor_noise=regressor_noise, segments=segments,
-            absorbed=absorbed)
-            for per_shape in (shared or [None])]
+
+        def solve(per_shape: list[np.ndarray] | None):
+            return solve_least_squares(
+                phi, y, None if per_shape is None else np.concatenate(per_shape),
+                symmetric=self.symmetric, regressor_names=names,
+                shared_names=([f"coulomb[{t}]" for t in JOINT_TYPES]
+                              + ["coulomb[actuator]"] * legs if shapes else None),
+                autocorrelated=True, regressor_noise=regressor_noise, segments=segments,
+                absorbed=absorbed)
+
+        solutions = [solve(per_shape) for per_shape in (shared or [None])]
         exact_solution = solutions.pop() if exact else None
         weights = akaike_weights(solutions)
         solution = average_solutions(solutions, weights)
@@ -335,6 +355,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
         if exact_solution is not None:
             solution, exact_weight = widened_by_exact_sign(
                 solution, solutions[int(np.argmax(weights))], exact_solution)
+        if lengthened:  # the long window's rounding of the reversals, as the half window sees it
+            solution = widened_by_sign_window(solution, solutions[0], solve(half), "shared")
         shape_weights = ({shape: float(w) for shape, w in zip(shapes, weights, strict=True)}
                          if shapes else {})
         theta, std = solution.theta, solution.theta_std.copy()

@@ -17,26 +17,42 @@ SIGN_ORDER, SIGN_FRACTIONS = 3, (1 / 64, 1 / 32, 1 / 16, 1 / 8, 1 / 4, 1 / 2, 1)
 SIGN_NOISE = 0.002
 
 
-def coulomb_sign_rates(q: np.ndarray, sample_rate: float, window: float,
-                       pose_noise: np.ndarray, noise_limit: float = SIGN_NOISE
-                       ) -> tuple[np.ndarray, float]:
-    """The pose rates (N, 6) the Coulomb signs are taken from, and their Savitzky-Golay window (s).
+def sign_window(q: np.ndarray, sample_rate: float, window: float, pose_noise: np.ndarray,
+                noise_limit: float = SIGN_NOISE, shorter: int = 0) -> float:
+    """The Savitzky-Golay window (s) of the rates the Coulomb signs are taken from.
 
     The shortest of :data:`SIGN_FRACTIONS` of ``window`` whose rate noise, from the per-sample pose
-    covariance ``pose_noise`` (6, 6), is within ``noise_limit`` of the rate's RMS; else the whole kernel.
+    covariance ``pose_noise`` (6, 6), is within ``noise_limit`` of the rate's RMS; else the whole
+    kernel. ``shorter``: that many candidates shorter (never below the first), the refit that
+    measures the long window's rounding of the reversals.
     """
     sigma = np.diag(pose_noise)
     # the rates' RMS barely depends on the window: taken once, at an eighth of the kernel
     rms = np.sqrt(np.mean(differentiate(q, sample_rate, window / 8, SIGN_ORDER, (1,))[0] ** 2,
                           axis=0))
-    for fraction in SIGN_FRACTIONS:
-        n = window_samples(window * fraction, sample_rate, SIGN_ORDER)
+    for index in range(len(SIGN_FRACTIONS)):
+        n = window_samples(window * SIGN_FRACTIONS[index], sample_rate, SIGN_ORDER)
         taps = savgol_coefficients(n, SIGN_ORDER, 1, 1 / sample_rate)
         noise = np.sqrt(sigma * np.sum(taps ** 2))
         if np.min(noise / np.maximum(rms, 1e-300)) <= noise_limit:
             break
-    rates = differentiate(q, sample_rate, window * fraction, SIGN_ORDER, (1,))[0]
-    return rates, window * fraction
+    return window * SIGN_FRACTIONS[max(index - shorter, 0)]
 
 
-__all__ = ["SIGN_FRACTIONS", "SIGN_NOISE", "SIGN_ORDER", "coulomb_sign_rates"]
+def coulomb_sign_rates(q: np.ndarray, sample_rate: float, window: float,
+                       pose_noise: np.ndarray, noise_limit: float = SIGN_NOISE,
+                       shorter: int = 0) -> tuple[np.ndarray, float]:
+    """The pose rates (N, 6) the Coulomb signs are taken from, and their Savitzky-Golay window
+    (s, :func:`sign_window` of the arguments)."""
+    chosen = sign_window(q, sample_rate, window, pose_noise, noise_limit, shorter)
+    return differentiate(q, sample_rate, chosen, SIGN_ORDER, (1,))[0], chosen
+
+
+def lengthened_by_noise(window: float, sign_window: float) -> bool:
+    """Whether :func:`coulomb_sign_rates` took a window (s) longer than its shortest candidate
+    of ``window`` (s): the pose noise lengthened it."""
+    return sign_window > window * SIGN_FRACTIONS[0] * (1.0 + 1e-9)
+
+
+__all__ = ["SIGN_FRACTIONS", "SIGN_NOISE", "SIGN_ORDER", "coulomb_sign_rates",
+           "lengthened_by_noise", "sign_window"]

@@ -199,15 +199,21 @@ def detect_intervals(experiment: Experiment, noise: NoiseModel, *, margin: float
                      joint_rates=rates[:, :30].reshape(len(t), 6, 5),
                      rate_noise=np.maximum(rate_noise[:30].reshape(6, 5), 1e-12),
                      q_dot=noise.q_dot, q_ddot=noise.q_ddot,
-                     **_sign_rates(experiment, noise))
+                     **sign_rate_fields(experiment, noise.window, noise.pose_covariance,
+                                        mean_jacobian=noise.mean_jacobian))
 
 
-def _sign_rates(experiment: Experiment, noise: NoiseModel) -> dict:
-    q_dot, window = coulomb_sign_rates(experiment.q, experiment.sample_rate, noise.window,
-                                       noise.pose_covariance, SIGN_NOISE_LIMIT)
+def sign_rate_fields(experiment: Experiment, window: float, pose_covariance: np.ndarray,
+                     shorter: int = 0, mean_jacobian: np.ndarray | None = None) -> dict:
+    """The Coulomb signs' rates and their noise levels, as :class:`Detection` fields, for the
+    kernel ``window`` (s) and the pose noise (6, 6); ``shorter`` as
+    :func:`~stewartid.signals.sign_rates.coulomb_sign_rates`; ``mean_jacobian`` as
+    :func:`~stewartid.identification.wavelet.noise.joint_rate_noise`."""
+    q_dot, window = coulomb_sign_rates(experiment.q, experiment.sample_rate, window,
+                                       pose_covariance, SIGN_NOISE_LIMIT, shorter)
     jacobians = experiment.joint_jacobians
-    level = joint_rate_noise(noise.pose_covariance, experiment.sample_rate, window, jacobians,
-                             experiment.leg_jacobian, SIGN_ORDER, noise.mean_jacobian)
+    level = joint_rate_noise(pose_covariance, experiment.sample_rate, window, jacobians,
+                             experiment.leg_jacobian, SIGN_ORDER, mean_jacobian)
     return {"sign_rates": joint_axis_rates(jacobians, q_dot),
             "sign_rate_noise": np.maximum(level[:30].reshape(6, 5), 1e-12),
             "leg_sign_rates": (experiment.leg_jacobian @ q_dot[:, :, None])[:, :, 0],
@@ -215,4 +221,4 @@ def _sign_rates(experiment: Experiment, noise: NoiseModel) -> dict:
 
 
 __all__ = ["SINGLE_SINE_SHARE", "Detection", "check_coverage", "detect_intervals",
-           "excitation_scales", "raise_no_interval", "sine_share"]
+           "excitation_scales", "raise_no_interval", "sign_rate_fields", "sine_share"]

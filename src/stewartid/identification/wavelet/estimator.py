@@ -37,6 +37,7 @@ from stewartid.identification.wavelet.friction_models import (
     model_equations,
     one_sine,
     solve_models,
+    with_half_window,
 )
 from stewartid.identification.wavelet.gls import WeakFormSolution
 from stewartid.identification.wavelet.noise import estimate_noise
@@ -398,9 +399,10 @@ def _experiment_equations(work: tuple, k: int) -> tuple[dict[str, list], dict, n
     experiment = prepare_experiment(datasets[k], platform, estimator.gravity, joints=True,
                                     remainder=estimator.remainder)
     found = estimator._noise_and_intervals(experiment, 1.0)
-    patterns = (coulomb_patterns(found, experiment.joint_jacobians, False,
-                                 leg_jacobian=experiment.leg_jacobian if legs else None)
-                if {"free", "coulomb"} & set(models) else None)
+    patterns = (with_half_window(coulomb_patterns(
+        found, experiment.joint_jacobians, False,
+        leg_jacobian=experiment.leg_jacobian if legs else None), experiment, found, legs)
+        if {"free", "coulomb"} & set(models) else None)
     # the legs' stops in the law's windows, unless the free interval constants are fitted
     # beside them (one sine per experiment: the stops fall between the intervals)
     stops = legs and "free" not in models

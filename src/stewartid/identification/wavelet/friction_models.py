@@ -16,16 +16,25 @@ from stewartid.identification.preparation import Experiment
 from stewartid.identification.quantiles import normal_upper_quantile
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.stops import check_motion
+from stewartid.identification.wavelet import detection
 from stewartid.identification.wavelet.detection import (
     SINGLE_SINE_SHARE,
     Detection,
     check_coverage,
     raise_no_interval,
+    sign_rate_fields,
     sine_share,
 )
 from stewartid.identification.wavelet.gls import WeakFormSolution
-from stewartid.identification.wavelet.rate_selection import solve_weak_form_over_rates
-from stewartid.identification.wavelet.weak_form import experiment_equations
+from stewartid.identification.wavelet.rate_selection import (
+    HALF_WINDOW_RATE,
+    solve_weak_form_over_rates,
+)
+from stewartid.identification.wavelet.weak_form import (
+    SOFT_SIGN_RATES,
+    coulomb_patterns,
+    experiment_equations,
+)
 from stewartid.identification.wavelet.windows import (
     solve_windows_over_rates,
     stop_window_length,
@@ -33,6 +42,7 @@ from stewartid.identification.wavelet.windows import (
     window_stops,
 )
 from stewartid.signals.differentiation import estimate_frequency
+from stewartid.signals.sign_rates import lengthened_by_noise, sign_window
 from stewartid.verdict.accuracy import predicted_worst_error
 
 #: Window length (s) of ``friction="coulomb"``.
@@ -57,6 +67,26 @@ def chosen_models(setting: str, single: Sequence[bool]) -> tuple[str, ...]:
     if setting != "auto":
         return (setting,)
     return ("free", "coulomb") if all(single) else ("coulomb",)
+
+
+def with_half_window(patterns: np.ndarray, experiment: Experiment, found: Detection,
+                     legs: bool) -> np.ndarray:
+    """``patterns`` (N, R, types, 6) of :func:`~stewartid.identification.wavelet.weak_form.coulomb_patterns`
+    and, where the pose noise lengthened the signs' window, after them that of the signs from
+    half of it at the rate :data:`~stewartid.identification.wavelet.rate_selection.HALF_WINDOW_RATE`
+    (N, R + 1, types, 6): the refit that measures the long window's bias
+    (:mod:`~stewartid.identification.sign_window`). ``legs``: the patterns carry the legs' type.
+    """
+    window, covariance = found.info["differentiation_window"], found.info["noise_covariance"]
+    chosen = sign_window(experiment.q, experiment.sample_rate, window, covariance,
+                         detection.SIGN_NOISE_LIMIT)
+    if not lengthened_by_noise(window, chosen):
+        return patterns
+    half = found._replace(**sign_rate_fields(experiment, window, covariance, shorter=1))
+    return np.concatenate([patterns, coulomb_patterns(
+        half, experiment.joint_jacobians, False,
+        SOFT_SIGN_RATES[HALF_WINDOW_RATE:HALF_WINDOW_RATE + 1],
+        experiment.leg_jacobian if legs else None)], axis=1)
 
 
 def model_equations(model: str, experiment: Experiment, found: Detection, order: int,
@@ -178,4 +208,5 @@ def friction_law_test(free: np.ndarray, free_std: np.ndarray, law: np.ndarray,
 
 
 __all__ = ["FRICTION_LAW_LEVEL", "WINDOW_LENGTH", "choose_friction_fit", "friction_law_test",
-           "friction_models", "law_floor", "model_equations", "solve_model", "solve_models"]
+           "friction_models", "law_floor", "model_equations", "solve_model", "solve_models",
+           "with_half_window"]
