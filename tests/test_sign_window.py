@@ -96,3 +96,13 @@ def test_the_long_windows_bias_of_the_rotational_inertia_is_covered(method, medi
     assert abs(error) / truth > 0.02
     assert abs(error) > 3 * plain.std_errors_M[3, 3]
     assert abs(error) < 3 * widened.std_errors_M[3, 3]
+
+
+@pytest.mark.parametrize("name", ["wavelet", "ls"])
+def test_fits_that_only_predict_skip_the_refit(name):
+    """The validation folds' fits predict and never read their standard errors: no refit."""
+    from stewartid.identification.registry import create_identifier, estimates_only
+
+    assert create_identifier(name).get_params()["sign_window_check"] is True
+    assert estimates_only(name).get_params()["sign_window_check"] is False
+    assert estimates_only(name, sign_window_check=True).get_params()["sign_window_check"] is True

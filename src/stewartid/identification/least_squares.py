@@ -151,6 +151,10 @@ class LeastSquaresIdentifier(BaseIdentifier):
         Subtract the model's nonlinear remainder.
     sampling_check : bool
         Widen standard errors where the log's sampling limits them.
+    sign_window_check : bool
+        Where pose noise lengthened the Coulomb signs' window, refit with the signs from half of
+        it and widen the standard errors by the distance
+        (:mod:`~stewartid.identification.sign_window`).
     coulomb : bool
         Include the three Coulomb regressors.
     leg_coulomb : bool, optional
@@ -200,7 +204,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
                  symmetric: bool = False,
                  decimate: int | None = None,
                  differentiation: str = "kernel", noise_correction: bool = True,
-                 remainder: bool = True, sampling_check: bool = True, jobs: int | None = 1):
+                 remainder: bool = True, sampling_check: bool = True,
+                 sign_window_check: bool = True, jobs: int | None = 1):
         self.window = window
         self.order = order
         self.gravity = gravity
@@ -215,6 +220,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
         self.differentiation = differentiation
         self.noise_correction = noise_correction
         self.sampling_check = sampling_check
+        self.sign_window_check = sign_window_check
         self.jobs = jobs
 
     _parameter_constraints = {
@@ -227,6 +233,7 @@ class LeastSquaresIdentifier(BaseIdentifier):
         "decimate": [Interval(Integral, 1, None), None],
         "noise_correction": [BOOLEAN],
         "sampling_check": [BOOLEAN],
+        "sign_window_check": [BOOLEAN],
         "jobs": [Interval(Integral, 1, None), None],
     }
 
@@ -262,7 +269,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
             qd_sign = stops.q_dot
         else:
             qd_sign, sign_window = coulomb_sign_rates(exp.q, exp.sample_rate, window, pose_noise)
-            if lengthened_by_noise(window, sign_window):  # the refit of the signs' window
+            if self.sign_window_check and lengthened_by_noise(window, sign_window):
+                # the refit of the signs' window
                 half = self._coulomb_units(
                     exp, slice(None), coulomb_sign_rates(exp.q, exp.sample_rate, window,
                                                          pose_noise, shorter=1)[0],

@@ -189,9 +189,11 @@ def create_identifier(name: str, **settings: Any) -> Any:
 
 
 def estimates_only(name: str, **settings: Any) -> Any:
-    """:func:`create_identifier` with the sampling check off unless asked for (it costs extra fits)."""
-    if "sampling_check" in method_spec(name).estimator_class.param_names():
-        settings = {"sampling_check": False, **settings}
+    """:func:`create_identifier` with the refits that only widen standard errors (the sampling
+    check, the Coulomb signs' window check) off unless asked for: they cost extra fits."""
+    accepted = method_spec(name).estimator_class.param_names()
+    settings = {**{check: False for check in ("sampling_check", "sign_window_check")
+                   if check in accepted}, **settings}
     return create_identifier(name, **settings)
 
 

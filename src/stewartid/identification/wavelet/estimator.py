@@ -124,6 +124,10 @@ class WaveletIdentifier(BaseIdentifier):
         Subtract the model's departure from its linearisation.
     sampling_check : bool
         Widen standard errors where the log's sampling limits them.
+    sign_window_check : bool
+        Where pose noise lengthened the Coulomb signs' window, refit with the signs from half of
+        it and widen the standard errors by the distance
+        (:mod:`~stewartid.identification.sign_window`).
     jobs : int or None
         Worker processes preparing the experiments' equations side by side (None: every core;
         one where workers cannot start by fork, :func:`~stewartid.parallel.inheriting_workers`);
@@ -148,7 +152,8 @@ class WaveletIdentifier(BaseIdentifier):
                  odd_companion: bool = False, noise_correction: bool = True,
                  symmetric: bool = False,
                  pair_selection: str = "pooled", gravity: bool = True, remainder: bool = True,
-                 sampling_check: bool = True, jobs: int | None = 1):
+                 sampling_check: bool = True,
+                 sign_window_check: bool = True, jobs: int | None = 1):
         self.wavelet = wavelet
         self.wavelet_order = wavelet_order
         self.truncation = truncation
@@ -170,6 +175,7 @@ class WaveletIdentifier(BaseIdentifier):
         self.gravity = gravity
         self.remainder = remainder
         self.sampling_check = sampling_check
+        self.sign_window_check = sign_window_check
         self.jobs = jobs
 
     # ------------------------------------------------------------------ settings
@@ -187,6 +193,7 @@ class WaveletIdentifier(BaseIdentifier):
         "test_functions": [Interval(Integral, 1, 12, "both"), None],
         "friction": [Options(FRICTION_MODELS)],
         "sampling_check": [BOOLEAN],
+        "sign_window_check": [BOOLEAN],
         "pair_selection": [Options(PAIR_SELECTIONS)],
         "jobs": [Interval(Integral, 1, None), None],
     }
@@ -399,10 +406,12 @@ def _experiment_equations(work: tuple, k: int) -> tuple[dict[str, list], dict, n
     experiment = prepare_experiment(datasets[k], platform, estimator.gravity, joints=True,
                                     remainder=estimator.remainder)
     found = estimator._noise_and_intervals(experiment, 1.0)
-    patterns = (with_half_window(coulomb_patterns(
-        found, experiment.joint_jacobians, False,
-        leg_jacobian=experiment.leg_jacobian if legs else None), experiment, found, legs)
-        if {"free", "coulomb"} & set(models) else None)
+    patterns = None
+    if {"free", "coulomb"} & set(models):
+        patterns = coulomb_patterns(found, experiment.joint_jacobians, False,
+                                    leg_jacobian=experiment.leg_jacobian if legs else None)
+        if estimator.sign_window_check:
+            patterns = with_half_window(patterns, experiment, found, legs)
     # the legs' stops in the law's windows, unless the free interval constants are fitted
     # beside them (one sine per experiment: the stops fall between the intervals)
     stops = legs and "free" not in models
