@@ -20,7 +20,14 @@ from stewartid.comparison._physical import (
     with_physical_folds,
 )
 from stewartid.comparison._records import MethodFit, PhysicalSection
-from stewartid.comparison._runs import fit_method, judge, method_folds, same_segments, with_folds
+from stewartid.comparison._runs import (
+    FoldFits,
+    fit_method,
+    judge,
+    method_folds,
+    same_segments,
+    with_folds,
+)
 from stewartid.datasets.alignment import align_forces
 from stewartid.datasets.dataset import Dataset
 from stewartid.datasets.plausibility import check_identified
@@ -282,17 +289,34 @@ def _run_task(work: _Work, task: tuple[str, str]) -> Any:
     if part == FOLDS:
         return method_folds(name, work.settings, work.datasets, work.platform, work.folds,
                             work.consistent, work.segments, work.delay_identifiable)
-    return fit_method(name, work.settings, work.datasets, work.platform, work.folds,
-                      work.consistent, work.segments, work.check, work.records,
-                      work.record_cache)
+    run = fit_method(name, work.settings, work.datasets, work.platform, work.folds,
+                     work.consistent, work.segments, work.check, work.records,
+                     work.record_cache)
+    if run.in_sample is None:
+        return run
+    # the folds' task returns the same held-out segments: one copy leaves the worker
+    return dataclasses.replace(run, in_sample=dataclasses.replace(
+        run.in_sample, segments=None, measured=None))
+
+
+def _with_segments(run: MethodFit, folds: FoldFits) -> MethodFit:
+    """A full fit's in-sample scores given back the held-out segments :func:`_run_task` left out,
+    from its folds' task (the same segments)."""
+    if run.in_sample is None or run.in_sample.segments is not None or \
+            folds.cross_validation is None:
+        return run
+    segments = folds.cross_validation.segments
+    return dataclasses.replace(run, in_sample=dataclasses.replace(
+        run.in_sample, segments=segments, measured=[s.centred_force for s in segments]))
 
 
 def _assembled(names: Sequence[str], physical: PhysicalRequest | None,
                done: Mapping[tuple[str, str], Any]) -> dict[str, Any]:
     """Each method's and the physical model's two tasks joined, by name; the physical model's
     error raised (its full fit's first)."""
-    joined: dict[str, Any] = {name: with_folds(done[name, FIT], done[name, FOLDS])
-                              for name in names}
+    joined: dict[str, Any] = {
+        name: with_folds(_with_segments(done[name, FIT], done[name, FOLDS]), done[name, FOLDS])
+        for name in names}
     if physical is not None:
         section = done[PHYSICAL_TASK, FIT]
         if isinstance(section, StewartidError):
