@@ -36,13 +36,12 @@ from stewartid.identification.wavelet.friction_models import (
     law_floor,
     model_equations,
     one_sine,
+    patterns_with_half_window,
     solve_models,
-    with_half_window,
 )
 from stewartid.identification.wavelet.gls import WeakFormSolution
 from stewartid.identification.wavelet.noise import estimate_noise
 from stewartid.identification.wavelet.point_equations import EXACT_DEGREE, point_equations
-from stewartid.identification.wavelet.weak_form import coulomb_patterns
 from stewartid.model.joints import JOINT_TYPES
 from stewartid.parallel import inheriting_workers, run_in_order
 from stewartid.platform import COORDINATES, Platform
@@ -406,12 +405,8 @@ def _experiment_equations(work: tuple, k: int) -> tuple[dict[str, list], dict, n
     experiment = prepare_experiment(datasets[k], platform, estimator.gravity, joints=True,
                                     remainder=estimator.remainder)
     found = estimator._noise_and_intervals(experiment, 1.0)
-    patterns = None
-    if {"free", "coulomb"} & set(models):
-        patterns = coulomb_patterns(found, experiment.joint_jacobians, False,
-                                    leg_jacobian=experiment.leg_jacobian if legs else None)
-        if estimator.sign_window_check:
-            patterns = with_half_window(patterns, experiment, found, legs)
+    patterns = (patterns_with_half_window(experiment, found, legs, estimator.sign_window_check)
+                if {"free", "coulomb"} & set(models) else None)
     # the legs' stops in the law's windows, unless the free interval constants are fitted
     # beside them (one sine per experiment: the stops fall between the intervals)
     stops = legs and "free" not in models

@@ -41,6 +41,7 @@ from stewartid.identification.wavelet.windows import (
     window_equations,
     window_stops,
 )
+from stewartid.model.joints import JOINT_TYPES
 from stewartid.signals.differentiation import estimate_frequency
 from stewartid.signals.sign_rates import lengthened_by_noise, sign_window
 from stewartid.verdict.accuracy import predicted_worst_error
@@ -69,24 +70,34 @@ def chosen_models(setting: str, single: Sequence[bool]) -> tuple[str, ...]:
     return ("free", "coulomb") if all(single) else ("coulomb",)
 
 
-def with_half_window(patterns: np.ndarray, experiment: Experiment, found: Detection,
-                     legs: bool) -> np.ndarray:
-    """``patterns`` (N, R, types, 6) of :func:`~stewartid.identification.wavelet.weak_form.coulomb_patterns`
-    and, where the pose noise lengthened the signs' window, after them that of the signs from
-    half of it at the rate :data:`~stewartid.identification.wavelet.rate_selection.HALF_WINDOW_RATE`
+def patterns_with_half_window(experiment: Experiment, found: Detection, legs: bool,
+                              check: bool = True) -> np.ndarray:
+    """The Coulomb patterns (N, R, types, 6) of
+    :func:`~stewartid.identification.wavelet.weak_form.coulomb_patterns` and, with ``check`` where
+    the pose noise lengthened the signs' window, after them that of the signs from half of it at
+    the rate :data:`~stewartid.identification.wavelet.rate_selection.HALF_WINDOW_RATE`
     (N, R + 1, types, 6): the refit that measures the long window's bias
     (:mod:`~stewartid.identification.sign_window`). ``legs``: the patterns carry the legs' type.
+    Both are written into one array (no copy of the first).
     """
-    window, covariance = found.info["differentiation_window"], found.info["noise_covariance"]
-    chosen = sign_window(experiment.q, experiment.sample_rate, window, covariance,
-                         detection.SIGN_NOISE_LIMIT)
-    if not lengthened_by_noise(window, chosen):
-        return patterns
-    half = found._replace(**sign_rate_fields(experiment, window, covariance, shorter=1))
-    return np.concatenate([patterns, coulomb_patterns(
-        half, experiment.joint_jacobians, False,
-        SOFT_SIGN_RATES[HALF_WINDOW_RATE:HALF_WINDOW_RATE + 1],
-        experiment.leg_jacobian if legs else None)], axis=1)
+    half = None
+    if check:
+        window, covariance = found.info["differentiation_window"], found.info["noise_covariance"]
+        chosen = sign_window(experiment.q, experiment.sample_rate, window, covariance,
+                             detection.SIGN_NOISE_LIMIT)
+        if lengthened_by_noise(window, chosen):
+            half = found._replace(**sign_rate_fields(experiment, window, covariance, shorter=1))
+    leg_jacobian = experiment.leg_jacobian if legs else None
+    count = len(SOFT_SIGN_RATES)
+    patterns = np.empty((len(found.sign_rates), count + (half is not None),
+                         len(JOINT_TYPES) + legs, 6))
+    coulomb_patterns(found, experiment.joint_jacobians, False, leg_jacobian=leg_jacobian,
+                     out=patterns[:, :count])
+    if half is not None:
+        coulomb_patterns(half, experiment.joint_jacobians, False,
+                         SOFT_SIGN_RATES[HALF_WINDOW_RATE:HALF_WINDOW_RATE + 1], leg_jacobian,
+                         out=patterns[:, count:])
+    return patterns
 
 
 def model_equations(model: str, experiment: Experiment, found: Detection, order: int,
@@ -208,5 +219,5 @@ def friction_law_test(free: np.ndarray, free_std: np.ndarray, law: np.ndarray,
 
 
 __all__ = ["FRICTION_LAW_LEVEL", "WINDOW_LENGTH", "choose_friction_fit", "friction_law_test",
-           "friction_models", "law_floor", "model_equations", "solve_model", "solve_models",
-           "with_half_window"]
+           "friction_models", "law_floor", "model_equations", "patterns_with_half_window",
+           "solve_model", "solve_models"]

@@ -203,18 +203,23 @@ SOFT_SIGN_RATES = (0.0, 1e-4, 3e-4, 1e-3, 3e-3)
 
 def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: bool,
                      rates: Sequence[float] = SOFT_SIGN_RATES,
-                     leg_jacobian: np.ndarray | None = None) -> np.ndarray:
+                     leg_jacobian: np.ndarray | None = None,
+                     out: np.ndarray | None = None) -> np.ndarray:
     """W_type(t) (N, n_rates, n_types, 6): generalized force of a unit Coulomb torque on each axis of a type.
 
     Soft sign w / sqrt(w^2 + sigma^2 + r^2) of ``found.sign_rates`` at every transition rate r of
     ``rates``, rad/s. Samples lead, so that an interval's rows are one contiguous slice. With
     ``leg_jacobian`` J_lq (N, 6, 6), a last type: a unit force along every leg (a ball screw's
-    friction), J_lq^T soft-sign(l_dot) with the same r in m/s.
+    friction), J_lq^T soft-sign(l_dot) with the same r in m/s. ``out``: the array to write them
+    into (a slice of a larger one), else a new one.
     """
     groups = (tuple(range(5)),) if uniform else tuple(JOINT_TYPES.values())
     rates = np.asarray(rates, dtype=float)
     signs = found.sign_rates
-    out = np.empty((len(signs), len(rates), len(groups) + (leg_jacobian is not None), 6))
+    shape = (len(signs), len(rates), len(groups) + (leg_jacobian is not None), 6)
+    out = np.empty(shape) if out is None else out
+    if out.shape != shape:
+        raise ValueError(f"coulomb_patterns writes {shape}; out has shape {out.shape}.")
     noise, squared_rates = found.sign_rate_noise ** 2, rates[:, None, None] ** 2
     # one block's temporaries, reused: w^2 + sigma^2, then the soft signs (n, R, 6, 5)
     level = np.empty((min(len(signs), PATTERN_BLOCK), 6, 5))
