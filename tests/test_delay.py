@@ -20,7 +20,7 @@ from stewartid.datasets.alignment import align_forces, shift_forces
 from stewartid.datasets.dataset import Dataset, write_dataset
 from stewartid.datasets.excitation import excitation_lines
 from stewartid.errors import ConfigError, IdentificationError
-from stewartid.identification.delay import apply_delay, estimate_delay
+from stewartid.identification.delay import MODEL_FLOOR_S, apply_delay, estimate_delay
 from stewartid.identification.least_squares import LeastSquaresIdentifier
 from stewartid.model.dynamics import ModelTerms
 from stewartid.model.kinematics import leg_lengths
@@ -113,7 +113,9 @@ def test_injected_delay_is_recovered_on_noise_free_data(paper, delay):
     # geometric stiffness term tau K q_dot, both far below 1 microsecond
     estimate = estimate_delay(experiments(paper, delay=delay), paper)
     assert estimate.seconds == pytest.approx(delay, abs=1e-6)
-    assert estimate.std_error < 1e-6
+    assert estimate.own_std_error < 1e-6
+    # the reported one is at least the model's floor
+    assert estimate.std_error == pytest.approx(np.hypot(estimate.own_std_error, MODEL_FLOOR_S))
 
 
 def test_the_estimate_is_the_same_on_worker_processes(paper):
@@ -193,7 +195,7 @@ def test_no_delay_is_found_in_a_nonlinear_plant_moving_every_dof_at_once(paper):
     estimate = estimate_delay(records, plant)
     # noise-free and exactly the model's dynamics: what is left is the integration's error
     assert abs(estimate.seconds) < 1e-6
-    assert estimate.std_error < 1e-6
+    assert estimate.own_std_error < 1e-6
 
 
 # --- command line --------------------------------------------------------------------------

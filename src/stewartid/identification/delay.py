@@ -38,6 +38,12 @@ WINDOW_PERIODS = 0.45
 #: Rate (rad/s) below which a joint's Coulomb sign is attenuated (as the least squares).
 COULOMB_SMOOTHING = 1e-4
 
+#: Smallest standard error of the estimate (s): on noise-free logs without a delay the model's
+#: own approximation (the friction law, the linearisation's remainder) passes for one, which
+#: the noise's standard error alone would call significant (docs/benchmarks.md, "The force
+#: delay's floor").
+MODEL_FLOOR_S = 30e-6
+
 
 @dataclass(frozen=True)
 class DelayEstimate:
@@ -48,11 +54,14 @@ class DelayEstimate:
     seconds : float
         Delay, s; positive when the forces are logged late.
     std_error, first_pass : float
-        Its standard error and the first-pass estimate before alignment, s.
+        Its standard error (the noise's, :data:`MODEL_FLOOR_S` at least) and the first-pass
+        estimate before alignment, s.
     lines_hz : tuple of tuple of float
         Excitation lines per DOF, Hz.
     window_s : float
         Kernel support of the weak form, s.
+    own_std_error : float or None
+        The noise's standard error alone (before the floor), s.
     """
 
     seconds: float
@@ -60,11 +69,13 @@ class DelayEstimate:
     first_pass: float
     lines_hz: tuple[tuple[float, ...], ...]
     window_s: float
+    own_std_error: float | None = None
 
     def to_dict(self, applied: bool = True) -> dict[str, Any]:
         """The ``"delay"`` entry of ``result.json``."""
         return {"seconds": self.seconds, "std_error": self.std_error, "applied": applied,
-                "source": "estimated", "first_pass_seconds": self.first_pass,
+                "source": "estimated", "own_std_error": self.own_std_error,
+                "first_pass_seconds": self.first_pass,
                 "window_s": self.window_s,
                 "lines_hz": {c: list(f) for c, f in zip(COORDINATES, self.lines_hz, strict=True)}}
 
@@ -298,7 +309,8 @@ def estimate_delay(datasets: Sequence[Dataset], platform: Platform, window: floa
     for _ in range(int(iterations)):
         step, std = fit_delay(align_forces(datasets, delay), platform, window, decimate, jobs)
         delay += step
-    return DelayEstimate(seconds=delay, std_error=std, first_pass=first, lines_hz=lines,
+    return DelayEstimate(seconds=delay, std_error=float(np.hypot(std, MODEL_FLOOR_S)),
+                         own_std_error=std, first_pass=first, lines_hz=lines,
                          window_s=float(window))
 
 
