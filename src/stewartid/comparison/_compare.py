@@ -276,14 +276,14 @@ def _run_task(work: _Work, task: tuple[str, str]) -> Any:
     """One task of :func:`compare_methods`: a method's (or the physical model's) full fit or its
     fold fits; an error the physical model raises is returned, to be raised in task order."""
     name, part = task
-    start = time.perf_counter()
     if name == PHYSICAL_TASK:
         if part == FOLDS:
+            start = time.perf_counter()
             return (physical_folds(work.datasets, work.platform, work.physical, work.folds,
                                    work.segments), time.perf_counter() - start)
         try:
-            return physical_fit(work.datasets, work.platform, work.physical, work.folds,
-                                work.segments, work.records, work.record_cache)
+            return physical_fit(work.datasets, work.platform, work.physical, work.records,
+                                work.record_cache)
         except StewartidError as exc:
             return exc
     if part == FOLDS:

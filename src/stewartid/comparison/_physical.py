@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from stewartid.comparison._records import PhysicalSection, Workspace
+from stewartid.comparison._runs import held_out_for
 from stewartid.datasets.dataset import Dataset
 from stewartid.errors import StewartidError
 from stewartid.model.linearization import nominal_matrices
@@ -26,7 +27,6 @@ from stewartid.platform import Platform
 from stewartid.validation.heldout import (
     Segment,
     ValidationResult,
-    held_out_segments,
     record_segments,
     validation_entry,
 )
@@ -150,7 +150,7 @@ def fit_physical(datasets: Sequence[Dataset], platform: Platform, request: Physi
     StewartidError
         With ``request.required``, when the model cannot be applied.
     """
-    section = physical_fit(datasets, platform, request, folds, segments, records, record_cache)
+    section = physical_fit(datasets, platform, request, records, record_cache)
     if section.result is None:
         return section
     start = time.perf_counter()
@@ -162,24 +162,19 @@ def _options(request: PhysicalRequest) -> dict[str, Any]:
     return {**request.settings, "payload": request.payload, "consistent": request.consistent}
 
 
-def _segments(datasets: Sequence[Dataset], platform: Platform, request: PhysicalRequest,
-              folds: int, segments: dict[tuple[bool, bool], list[Segment]]
-              ) -> tuple[tuple[bool, bool], list[Segment]]:
-    """The physical model's held-out segments and their key in ``segments`` (filled on first use)."""
-    terms = (bool(_options(request).get("gravity", True)), False)  # the full model predicts
-    if terms not in segments:                                      # the nonlinear terms itself
-        segments[terms] = held_out_segments(datasets, platform, folds, *terms)
-    return terms, segments[terms]
+def _terms(request: PhysicalRequest) -> tuple[bool, bool]:
+    """The model terms its held-out segments are prepared with: the full model predicts the
+    nonlinear terms itself."""
+    return bool(_options(request).get("gravity", True)), False
 
 
 def physical_fit(datasets: Sequence[Dataset], platform: Platform, request: PhysicalRequest,
-                 folds: int, segments: dict[tuple[bool, bool], list[Segment]],
                  records: Sequence[Dataset] = (),
                  record_cache: dict[tuple[bool, bool], list[Segment]] | None = None
                  ) -> PhysicalSection:
     """The physical model's full fit, its prediction of ``records`` and its matrices across the
-    workspace, not yet validated on held-out segments (:func:`with_physical_folds`); arguments
-    and errors as :func:`fit_physical`."""
+    workspace, not yet validated on held-out segments (:func:`physical_folds`,
+    :func:`with_physical_folds`); arguments and errors as :func:`fit_physical`."""
     start = time.perf_counter()
     try:
         estimator = PhysicalIdentifier(**_options(request)).fit(list(datasets), platform)
@@ -189,7 +184,7 @@ def physical_fit(datasets: Sequence[Dataset], platform: Platform, request: Physi
                 f"The physical model is not shown: these data fix {len(fixed)} of its {count} "
                 "parameters at the platform file's values (not identifiable from them); "
                 "`identify --model physical` fits and names the rest."))
-        terms, _ = _segments(datasets, platform, request, folds, segments)
+        terms = _terms(request)
         external = None
         if records:
             cache = {} if record_cache is None else record_cache
@@ -213,7 +208,7 @@ def physical_folds(datasets: Sequence[Dataset], platform: Platform, request: Phy
     """The physical model refitted without each time segment, scored on the held-out segments;
     or the error that stopped the fits (arguments as :func:`fit_physical`)."""
     try:
-        _, held_out = _segments(datasets, platform, request, folds, segments)
+        held_out = held_out_for(segments, _terms(request), datasets, platform, folds)
         # the fold fits predict: their standard errors (the sampling check's refits) are
         # never read
         quick = {**_options(request), "sampling_check": False}

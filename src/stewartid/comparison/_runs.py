@@ -98,6 +98,16 @@ def _terms(params: Mapping[str, Any]) -> tuple[bool, bool]:
     return bool(params.get("gravity", True)), bool(params.get("remainder", False))
 
 
+def held_out_for(segments: dict[tuple[bool, bool], list[Segment]], terms: tuple[bool, bool],
+                 datasets: Sequence[Dataset], platform: Platform, folds: int) -> list[Segment]:
+    """The held-out segments prepared with the model ``terms`` (``gravity``, ``remainder``) a
+    method removes, from ``segments`` or made there on first use (shared by every task of a
+    process)."""
+    if terms not in segments:
+        segments[terms] = held_out_segments(datasets, platform, folds, *terms)
+    return segments[terms]
+
+
 def _companion(name: str, own: Mapping[str, Any]) -> Callable[[], Any] | None:
     """The friction-estimating identifier that lends a method its Coulomb levels, if it has a
     friction setting."""
@@ -115,11 +125,10 @@ def method_folds(name: str, settings: Mapping[str, Any], datasets: Sequence[Data
     own = _own_settings(name, settings)
     terms = _terms(registry.create_identifier(name, **own).get_params())
     try:
-        if terms not in segments:
-            segments[terms] = held_out_segments(datasets, platform, folds, *terms)
+        held_out = held_out_for(segments, terms, datasets, platform, folds)
         # the folds and the companion predict: their standard errors are never read
         folds_fit = cross_validate(lambda: registry.estimates_only(name, **own), datasets,
-                                   platform, folds, terms[0], segments[terms],
+                                   platform, folds, terms[0], held_out,
                                    _companion(name, own), delay_identifiable)
     except StewartidError as exc:
         return FoldFits(exception=exc, seconds=time.perf_counter() - start)
@@ -146,8 +155,7 @@ def fit_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
         if check is not None:
             check(estimator.result_)
         terms = _terms(estimator.get_params())
-        if terms not in segments:
-            segments[terms] = held_out_segments(datasets, platform, folds, *terms)
+        held_out = held_out_for(segments, terms, datasets, platform, folds)
         unconstrained = with_companion_friction(estimator.result_, _companion(name, own),
                                                 datasets, platform)
     except StewartidError as exc:
@@ -164,7 +172,7 @@ def fit_method(name: str, settings: Mapping[str, Any], datasets: Sequence[Datase
         # ``result`` holds the companion's levels: the consistent one keeps the diagnostics
         external = validate_on_records(result, cache[terms])
     return MethodFit(name, spec.display_name, spec.color, result=result,
-                     unconstrained=unconstrained, in_sample=in_sample(segments[terms], result),
+                     unconstrained=unconstrained, in_sample=in_sample(held_out, result),
                      projection=projection, records=external,
                      seconds=time.perf_counter() - start, estimator=estimator)
 
@@ -330,5 +338,5 @@ def judge(runs: Sequence[MethodFit], consistent: bool = False,
                                                compared, consensus.validation.residual_delay)
 
 
-__all__ = ["FoldFits", "consensus_run", "consistent_result", "fit_method", "judge", "method_folds",
-           "run_method", "same_segments", "with_folds"]
+__all__ = ["FoldFits", "consensus_run", "consistent_result", "fit_method", "held_out_for", "judge",
+           "method_folds", "run_method", "same_segments", "with_folds"]
