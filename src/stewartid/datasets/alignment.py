@@ -38,15 +38,13 @@ def shift_forces(dataset: Dataset, delay: float) -> Dataset:
                           f"{np.count_nonzero(keep)} of {len(t)} samples (at least "
                           f"{MIN_SAMPLES} needed); the delay is given in seconds "
                           "(--delay 0.002 for 2 ms).")
-    shifts = delay / period
-    target = np.clip(t[keep] + delay, t[0], t[-1])
-    if abs(shifts - round(shifts)) < 1e-6:
-        whole = int(round(shifts))
-        forces = dataset.forces[np.flatnonzero(keep) + whole]
-    else:
-        forces = spline_at(t, dataset.forces, target)
     # the kept samples are one run (t rises): the motion's terms are the record's rows
     kept = np.flatnonzero(keep)
+    shifts = delay / period
+    if abs(shifts - round(shifts)) < 1e-6:
+        forces = dataset.forces[kept + int(round(shifts))]
+    else:
+        forces = spline_at(t, dataset.forces, np.clip(t[kept] + delay, t[0], t[-1]))
     return dataset.part(slice(int(kept[0]), int(kept[-1]) + 1), forces=forces)
 
 
