@@ -69,15 +69,21 @@ def averaged_over_rates(solve: Callable[[int], WeakFormSolution], rates: Sequenc
     return averaged, float(rates[int(np.argmax(weights))])
 
 
+def half_window_pick(carried: int, count: int) -> list[int]:
+    """Which of an equation's ``carried`` Coulomb rows the refit with the signs from half their
+    window takes: the half window's, after the ``count`` rates of the long window's, where the
+    equation carries them, else the long window's at :data:`HALF_WINDOW_RATE`."""
+    return [count if carried > count else HALF_WINDOW_RATE]
+
+
 def half_window_rows(equations: Sequence[IntervalEquations], count: int
                      ) -> list[IntervalEquations] | None:
-    """The equations with their Coulomb rows at :data:`HALF_WINDOW_RATE` alone, from the signs
-    of half their window where they carry them (after the ``count`` rates of the long
-    window's), else from the long window's; None where no interval carries them."""
+    """The equations with their Coulomb rows of :func:`half_window_pick` alone; None where no
+    interval carries the half window's."""
     if not any(len(e.coulomb_rows) > count for e in equations):
         return None
     return [dataclasses.replace(e, coulomb_rows=e.coulomb_rows[
-        [count if len(e.coulomb_rows) > count else HALF_WINDOW_RATE]]) for e in equations]
+        half_window_pick(len(e.coulomb_rows), count)]) for e in equations]
 
 
 def solve_weak_form_over_rates(equations: Sequence[IntervalEquations], n_experiments: int,
@@ -111,5 +117,5 @@ def solve_weak_form_over_rates(equations: Sequence[IntervalEquations], n_experim
     return plain, None
 
 
-__all__ = ["HALF_WINDOW_RATE", "VARIATION_TEST_LEVEL", "averaged_over_rates", "half_window_rows",
-           "residual_cost", "solve_weak_form_over_rates"]
+__all__ = ["HALF_WINDOW_RATE", "VARIATION_TEST_LEVEL", "averaged_over_rates", "half_window_pick",
+           "half_window_rows", "residual_cost", "solve_weak_form_over_rates"]

@@ -23,7 +23,7 @@ from stewartid.identification.wavelet.gls import (
     local_terms,
     standard_errors,
 )
-from stewartid.identification.wavelet.rate_selection import HALF_WINDOW_RATE, averaged_over_rates
+from stewartid.identification.wavelet.rate_selection import averaged_over_rates, half_window_pick
 from stewartid.identification.wavelet.variance_components import row_noise
 from stewartid.identification.wavelet.weak_form import (
     SOFT_SIGN_RATES,
@@ -196,15 +196,15 @@ def solve_windows_over_rates(equations: Sequence[WindowEquations],
     """:func:`solve_windows` averaged over transition rates, and the rate of greatest weight.
 
     Where windows carry Coulomb rows from the signs of half their window after the ``rates``'
-    (:func:`~stewartid.identification.wavelet.friction_models.with_half_window`), the standard
-    errors widen by that refit's distance (:func:`averaged_over_rates`).
+    (:func:`~stewartid.identification.wavelet.friction_models.patterns_with_half_window`), the
+    standard errors widen by that refit's distance (:func:`averaged_over_rates`).
     """
     count = len(rates)
 
     def refit() -> WeakFormSolution:
-        return solve_windows([e._replace(coulomb=e.coulomb[
-            [count if len(e.coulomb) > count else HALF_WINDOW_RATE]]) for e in equations],
-            **settings)
+        return solve_windows([e._replace(coulomb=e.coulomb[half_window_pick(len(e.coulomb),
+                                                                             count)])
+                              for e in equations], **settings)
 
     return averaged_over_rates(
         lambda index: solve_windows(equations, rate_index=index, **settings), rates,
