@@ -225,6 +225,13 @@ def _pseudo_inverses(gram: np.ndarray) -> np.ndarray:
     return out
 
 
+def _size_groups(local: Sequence[np.ndarray]) -> list[tuple[int, np.ndarray]]:
+    """The equations (indices, ascending) with as many own unknowns m > 0 in their columns
+    ``local`` (6, R, m), for each m in ascending order."""
+    sizes = np.array([columns.shape[2] for columns in local])
+    return [(int(size), np.flatnonzero(sizes == size)) for size in np.unique(sizes[sizes > 0])]
+
+
 def _eliminate_local(local: Sequence[np.ndarray], designs: Sequence[np.ndarray],
                      targets: Sequence[np.ndarray], weights: Sequence[np.ndarray]
                      ) -> tuple[np.ndarray, np.ndarray, list[tuple[np.ndarray, ...]]]:
@@ -237,10 +244,8 @@ def _eliminate_local(local: Sequence[np.ndarray], designs: Sequence[np.ndarray],
     equations in order.
     """
     n_unknowns = designs[0].shape[-1]
-    sizes = np.array([columns.shape[2] for columns in local])
     groups, terms = [], {}
-    for size in np.unique(sizes[sizes > 0]):
-        group = np.flatnonzero(sizes == size)
+    for size, group in _size_groups(local):
         columns = np.stack([local[j] for j in group])                        # (g, 6, R, m)
         inner, cross = np.zeros((len(group), size, size)), np.zeros((len(group), size,
                                                                      n_unknowns))
@@ -269,9 +274,7 @@ def local_terms(local: Sequence[np.ndarray], local_z: Sequence[np.ndarray]) -> n
     ``local`` (6, R, m): (6, n, R), channel first. The equations with the same number of own
     unknowns are taken together, each product in their stack the one of an equation alone."""
     out = np.zeros((6, len(local), local[0].shape[1]))
-    sizes = np.array([columns.shape[2] for columns in local])
-    for size in np.unique(sizes[sizes > 0]):
-        group = np.flatnonzero(sizes == size)
+    for _, group in _size_groups(local):
         products = (np.stack([local[j] for j in group])
                     @ np.stack([local_z[j] for j in group])[:, None, :, None])   # (g, 6, R, 1)
         out[:, group] = products[..., 0].transpose(1, 0, 2)
