@@ -102,13 +102,13 @@ def spectral_lines(motion: np.ndarray, sample_rate: float,
     return _peaks(amplitude, n, nfft, sample_rate, fraction)
 
 
-def channel_lines(motion: np.ndarray, sample_rate: float, fraction: float = LINE_FRACTION
-                  ) -> list[SpectralLines]:
+def channel_lines(motion: np.ndarray, sample_rate: float, fraction: float = LINE_FRACTION,
+                  padding: int = 4) -> list[SpectralLines]:
     """:func:`spectral_lines` of each channel of ``motion`` (N, m) on its own, the same numbers
-    from one transform of every channel."""
+    from one transform of every channel (``padding`` as there)."""
     x = np.asarray(motion, dtype=float)
     n = len(x)
-    nfft = _padded_length(n)
+    nfft = _padded_length(n, padding)
     windowed = np.column_stack([_windowed(x[:, [k]]) for k in range(x.shape[1])])
     # each channel's transform on contiguous samples (time last): the same numbers
     spectra = np.fft.rfft(np.ascontiguousarray(windowed.T), nfft, axis=1)
@@ -306,8 +306,9 @@ def excitation_lines(datasets: Sequence[Dataset], threshold: float = LINE_THRESH
 
 def _pose_lines(dataset: Dataset, threshold: float) -> list[SpectralLines]:
     """Each pose coordinate's lines of one record, computed once per record."""
+    # counted and compared to the threshold only: the unpadded transform places them well enough
     return dataset.derived(("pose lines", threshold), lambda d: channel_lines(
-        d.pose, d.sample_rate, fraction=threshold))
+        d.pose, d.sample_rate, fraction=threshold, padding=1))
 
 
 __all__ = ["LINE_FRACTION", "LINE_MERGE_BINS", "LINE_THRESHOLD", "MIN_RELATIVE_EXCITATION",

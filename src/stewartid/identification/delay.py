@@ -135,9 +135,11 @@ def single_frequency_bias(datasets: Sequence[Dataset], platform: Platform,
         return None
     frequencies = []
     for k, found in enumerate(lines):
+        if len(found) < 2:  # its one line, or none: a still DOF
+            frequencies.append(found[0] if found else np.nan)
+            continue
         most = max(datasets, key=lambda d: float(np.ptp(d.pose[:, k])))
-        frequencies.append(estimate_frequency(most.pose[:, k], most.sample_rate) if found
-                           else np.nan)
+        frequencies.append(estimate_frequency(most.pose[:, k], most.sample_rate))
     reference = datasets[0]
     bias = delay_bias_per_ms(platform, frequencies, generalized_force_sensitivity(
         platform, reference.pose, reference.forces))
