@@ -207,23 +207,24 @@ def base_parameters(platform: Platform, samples: int = 100, seed: int = 0,
                     tolerance: float = 1e-8) -> BaseParameters:
     """The base parameters of the regressor, found numerically.
 
-    The regressor at ``samples`` random states, columns scaled to unit norm, gets its rank by
-    pivoted QR; a column is kept (in :data:`PARAMETERS` order) when independent of those kept
-    before, the others written as combinations. ``tolerance`` is relative to R's largest diagonal.
+    The regressor at ``samples`` random states, columns scaled to unit norm, gets its rank from
+    its singular values; a column is kept (in :data:`PARAMETERS` order) when independent of those
+    kept before, the others written as combinations. ``tolerance`` is relative to the largest
+    singular value.
 
     Raises
     ------
     ArithmeticError
         If the ordered selection disagrees with the pivoted QR's rank.
     """
-    import scipy.linalg  # slow to import: the identify path does not need it
-
     Y = regressor(platform, *random_states(platform, samples, seed)).reshape(-1, N_STANDARD)
     norms = np.linalg.norm(Y, axis=0)
     zero = norms <= tolerance * norms.max()
     scaled = Y / np.where(zero, 1.0, norms)
-    rdiag = np.abs(np.diag(scipy.linalg.qr(scaled[:, ~zero], mode="r", pivoting=True)[0]))
-    rank = int(np.sum(rdiag > tolerance * rdiag[0]))
+    # numpy's SVD rather than scipy's pivoted QR: scipy.linalg takes longer to import than this
+    # takes to run
+    singular = np.linalg.svd(scaled[:, ~zero], compute_uv=False)
+    rank = int(np.sum(singular > tolerance * singular[0]))
     kept: list[int] = []
     basis = np.zeros((len(Y), 0))
     for k in np.flatnonzero(~zero):

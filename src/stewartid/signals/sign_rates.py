@@ -39,12 +39,22 @@ def sign_window(q: np.ndarray, sample_rate: float, window: float, pose_noise: np
     return window * SIGN_FRACTIONS[max(index - shorter, 0)]
 
 
+def shorter_sign_window(window: float, chosen: float, shorter: int = 1) -> float:
+    """The candidate of :func:`sign_window` ``shorter`` steps below its choice ``chosen`` (s)
+    for the kernel ``window`` (s), never below the first: its ``shorter`` argument, without
+    measuring the rates again."""
+    index = int(np.argmin(np.abs(np.asarray(SIGN_FRACTIONS) - chosen / window)))
+    return window * SIGN_FRACTIONS[max(index - shorter, 0)]
+
+
 def coulomb_sign_rates(q: np.ndarray, sample_rate: float, window: float,
                        pose_noise: np.ndarray, noise_limit: float = SIGN_NOISE,
-                       shorter: int = 0) -> tuple[np.ndarray, float]:
+                       shorter: int = 0, chosen: float | None = None
+                       ) -> tuple[np.ndarray, float]:
     """The pose rates (N, 6) the Coulomb signs are taken from, and their Savitzky-Golay window
-    (s, :func:`sign_window` of the arguments)."""
-    chosen = sign_window(q, sample_rate, window, pose_noise, noise_limit, shorter)
+    (s, :func:`sign_window` of the arguments, or ``chosen`` when given)."""
+    if chosen is None:
+        chosen = sign_window(q, sample_rate, window, pose_noise, noise_limit, shorter)
     return differentiate(q, sample_rate, chosen, SIGN_ORDER, (1,))[0], chosen
 
 
@@ -55,4 +65,4 @@ def lengthened_by_noise(window: float, sign_window: float) -> bool:
 
 
 __all__ = ["SIGN_FRACTIONS", "SIGN_NOISE", "SIGN_ORDER", "coulomb_sign_rates",
-           "lengthened_by_noise", "sign_window"]
+           "lengthened_by_noise", "shorter_sign_window", "sign_window"]

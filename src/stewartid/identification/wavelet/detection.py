@@ -44,6 +44,10 @@ class Detection(NamedTuple):
         The leg-length rates the Coulomb signs along the legs use, m/s.
     leg_sign_rate_noise : ndarray, shape (6,)
         Their noise levels, m/s.
+    sign_window : float
+        The Savitzky-Golay window of the signs' rates, s.
+    mean_jacobian : ndarray, shape (36, 6), or None
+        :func:`~stewartid.identification.wavelet.noise.mean_rate_jacobian` of the experiment.
     """
 
     intervals: np.ndarray
@@ -56,6 +60,8 @@ class Detection(NamedTuple):
     sign_rate_noise: np.ndarray
     leg_sign_rates: np.ndarray
     leg_sign_rate_noise: np.ndarray
+    sign_window: float = float("nan")
+    mean_jacobian: np.ndarray | None = None
 
 
 #: Largest noise of the Coulomb signs' rates relative to their RMS
@@ -198,26 +204,27 @@ def detect_intervals(experiment: Experiment, noise: NoiseModel, *, margin: float
     return Detection(intervals=intervals, info=info,
                      joint_rates=rates[:, :30].reshape(len(t), 6, 5),
                      rate_noise=np.maximum(rate_noise[:30].reshape(6, 5), 1e-12),
-                     q_dot=noise.q_dot, q_ddot=noise.q_ddot,
+                     q_dot=noise.q_dot, q_ddot=noise.q_ddot, mean_jacobian=noise.mean_jacobian,
                      **sign_rate_fields(experiment, noise.window, noise.pose_covariance,
                                         mean_jacobian=noise.mean_jacobian))
 
 
 def sign_rate_fields(experiment: Experiment, window: float, pose_covariance: np.ndarray,
-                     shorter: int = 0, mean_jacobian: np.ndarray | None = None) -> dict:
-    """The Coulomb signs' rates and their noise levels, as :class:`Detection` fields, for the
-    kernel ``window`` (s) and the pose noise (6, 6); ``shorter`` as
-    :func:`~stewartid.signals.sign_rates.coulomb_sign_rates`; ``mean_jacobian`` as
-    :func:`~stewartid.identification.wavelet.noise.joint_rate_noise`."""
+                     mean_jacobian: np.ndarray | None = None, chosen: float | None = None
+                     ) -> dict:
+    """The Coulomb signs' rates, their noise levels and window, as :class:`Detection` fields,
+    for the kernel ``window`` (s) and the pose noise (6, 6); ``mean_jacobian`` as
+    :func:`~stewartid.identification.wavelet.noise.joint_rate_noise`; ``chosen``: the signs'
+    window (s) if already chosen, as :func:`~stewartid.signals.sign_rates.coulomb_sign_rates`."""
     q_dot, window = coulomb_sign_rates(experiment.q, experiment.sample_rate, window,
-                                       pose_covariance, SIGN_NOISE_LIMIT, shorter)
+                                       pose_covariance, SIGN_NOISE_LIMIT, chosen=chosen)
     jacobians = experiment.joint_jacobians
     level = joint_rate_noise(pose_covariance, experiment.sample_rate, window, jacobians,
                              experiment.leg_jacobian, SIGN_ORDER, mean_jacobian)
     return {"sign_rates": joint_axis_rates(jacobians, q_dot),
             "sign_rate_noise": np.maximum(level[:30].reshape(6, 5), 1e-12),
             "leg_sign_rates": (experiment.leg_jacobian @ q_dot[:, :, None])[:, :, 0],
-            "leg_sign_rate_noise": np.maximum(level[30:], 1e-12)}
+            "leg_sign_rate_noise": np.maximum(level[30:], 1e-12), "sign_window": window}
 
 
 __all__ = ["SINGLE_SINE_SHARE", "Detection", "check_coverage", "detect_intervals",

@@ -16,7 +16,6 @@ from stewartid.identification.preparation import Experiment
 from stewartid.identification.quantiles import normal_upper_quantile
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.stops import check_motion
-from stewartid.identification.wavelet import detection
 from stewartid.identification.wavelet.detection import (
     SINGLE_SINE_SHARE,
     Detection,
@@ -43,7 +42,7 @@ from stewartid.identification.wavelet.windows import (
 )
 from stewartid.model.joints import JOINT_TYPES
 from stewartid.signals.differentiation import estimate_frequency
-from stewartid.signals.sign_rates import lengthened_by_noise, sign_window
+from stewartid.signals.sign_rates import lengthened_by_noise, shorter_sign_window
 from stewartid.verdict.accuracy import predicted_worst_error
 
 #: Window length (s) of ``friction="coulomb"``.
@@ -83,10 +82,10 @@ def patterns_with_half_window(experiment: Experiment, found: Detection, legs: bo
     half = None
     if check:
         window, covariance = found.info["differentiation_window"], found.info["noise_covariance"]
-        chosen = sign_window(experiment.q, experiment.sample_rate, window, covariance,
-                             detection.SIGN_NOISE_LIMIT)
-        if lengthened_by_noise(window, chosen):
-            half = found._replace(**sign_rate_fields(experiment, window, covariance, shorter=1))
+        if lengthened_by_noise(window, found.sign_window):
+            half = found._replace(**sign_rate_fields(
+                experiment, window, covariance, found.mean_jacobian,
+                shorter_sign_window(window, found.sign_window)))
     leg_jacobian = experiment.leg_jacobian if legs else None
     count = len(SOFT_SIGN_RATES)
     patterns = np.empty((len(found.sign_rates), count + (half is not None),
