@@ -98,18 +98,17 @@ def _not_pooled(value, std_error):
     return np.array(value, dtype=float), np.array(std_error, dtype=float)
 
 
-def _least_residual_rate(solve, rates, refit=None):
+def _least_residual_rate(solutions, rates, half=None):
     """averaged_over_rates with a one-hot weight on the rate of least residual cost: the fit
     at that rate, its own standard errors (widened by the signs' half-window refit, as
     averaged_over_rates widens them)."""
-    solutions = [solve(index) for index in range(len(rates))]
     costs = np.array([rate_selection.residual_cost(s) for s in solutions])
     best = int(np.argmin(costs))
     weights = {f"{rate:g}": float(k == best) for k, rate in enumerate(rates)}
     chosen = dataclasses.replace(solutions[best], rate_weights=weights)
-    if refit is not None:
+    if half is not None:
         chosen = widened_by_sign_window(chosen, solutions[rate_selection.HALF_WINDOW_RATE],
-                                        refit(), "coulomb")
+                                        half, "coulomb")
     return chosen, float(rates[best])
 
 

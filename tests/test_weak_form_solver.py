@@ -88,7 +88,7 @@ def test_averaging_over_soft_sign_rates_keeps_the_coverage_that_choosing_one_los
     for _ in range(draws):
         fits = _candidate_fits(u + 0.5 * shapes[1] + rng.standard_normal(u.size), u, shapes)
         best = min(fits, key=residual_cost)
-        mean, _ = averaged_over_rates(lambda k, fits=fits: fits[k], rates)
+        mean, _ = averaged_over_rates(fits, rates)
         chosen += abs(best.theta[0] - 1.0) <= 2 * best.theta_std[0]
         averaged += abs(mean.theta[0] - 1.0) <= 2 * mean.theta_std[0]
         assert residual_cost(mean) == residual_cost(best)
@@ -107,7 +107,7 @@ def test_a_rate_the_data_single_out_takes_all_the_weight():
     rates = (0.01, 0.1, 0.3, 1.0)
     shapes = [np.tanh(u / r) for r in rates]
     fits = _candidate_fits(u + 20.0 * shapes[2] + rng.standard_normal(u.size), u, shapes)
-    mean, rate = averaged_over_rates(lambda k: fits[k], rates)
+    mean, rate = averaged_over_rates(fits, rates)
     assert rate == 0.3 and mean.rate_weights["0.3"] > 1 - 1e-9
     assert mean.theta[0] == pytest.approx(fits[2].theta[0], rel=1e-9)
     assert mean.theta_std[0] == pytest.approx(fits[2].theta_std[0], rel=1e-6)

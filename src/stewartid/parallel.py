@@ -6,9 +6,11 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import warnings
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
+from functools import partial
 from typing import Any
 
 from threadpoolctl import threadpool_limits
@@ -87,7 +89,7 @@ def process_pool(workers: int, initializer: Callable[..., Any] | None = None,
         yield pool
 
 
-#: What :func:`run_in_order` hands to every task of a worker (set once per process).
+#: What a :class:`WorkerPool`'s tasks are handed in every worker (set once per process).
 _SHARED: list[Any] = []
 
 
@@ -95,8 +97,85 @@ def _share(value: Any) -> None:
     _SHARED[:] = [value]
 
 
+def _captured(call: Callable[[], Any]) -> tuple[Any, list[tuple[Warning, type[Warning]]]]:
+    """``call()`` in a worker, with the warnings it raised, for the caller's process to raise
+    again (a worker's own would reach neither the caller's filters nor its records)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = call()
+    return result, [(w.message, w.category) for w in caught]
+
+
 def _call_with_shared(function: Callable[[Any, Any], Any], task: Any) -> Any:
-    return function(_SHARED[0], task)
+    return _captured(lambda: function(_SHARED[0], task))
+
+
+class WorkerPool:
+    """Worker processes kept for several rounds of tasks of one computation, started once:
+    :func:`worker_count` of them, started by :func:`process_pool` with ``shared`` (large data
+    every task of :meth:`map_shared` reads) handed to each once. One worker runs the tasks in
+    this process. Results come in task order; warnings a task raises are raised again here.
+
+    Use as a context manager.
+    """
+
+    def __init__(self, workers: int | None, tasks: int, shared: Any = None):
+        self.count = worker_count(workers, tasks)
+        self.shared = shared
+        self._stack = ExitStack()
+        self._pool: Executor | None = None
+
+    def __enter__(self) -> WorkerPool:
+        if self.count > 1:
+            self._pool = self._stack.enter_context(process_pool(self.count, _share,
+                                                                (self.shared,)))
+        else:
+            self._stack.enter_context(threadpool_limits(limits=1))
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self._stack.close()
+
+    def map_shared(self, function: Callable[[Any, Any], Any], tasks: Sequence[Any],
+                   progress: TaskProgress | None = None) -> list[Any]:
+        """``[function(shared, task) for task in tasks]``, ``function`` module-level."""
+        if self._pool is None:
+            return self._in_order([partial(function, self.shared, task) for task in tasks],
+                                  progress)
+        return self._gathered([self._pool.submit(_call_with_shared, function, task)
+                               for task in tasks], progress)
+
+    def call_all(self, calls: Sequence[Callable[[], Any]]) -> list[Any]:
+        """``[call() for call in calls]``, each call picklable (a :func:`functools.partial` of
+        a module-level function)."""
+        if self._pool is None:
+            return self._in_order(calls, None)
+        return self._gathered([self._pool.submit(_captured, call) for call in calls], None)
+
+    @staticmethod
+    def _in_order(calls: Sequence[Callable[[], Any]], progress: TaskProgress | None
+                  ) -> list[Any]:
+        results = []
+        for index, call in enumerate(calls):
+            results.append(call())
+            if progress is not None:
+                progress(index + 1, len(calls), index)
+        return results
+
+    @staticmethod
+    def _gathered(futures: list[Future], progress: TaskProgress | None) -> list[Any]:
+        order = {future: k for k, future in enumerate(futures)}
+        results: list[Any] = [None] * len(futures)
+        raised: list[list] = [[] for _ in futures]
+        for done, future in enumerate(as_completed(futures), start=1):
+            index = order[future]
+            results[index], raised[index] = future.result()
+            if progress is not None:
+                progress(done, len(futures), index)
+        for caught in raised:  # in task order, as one process would have raised them
+            for message, category in caught:
+                warnings.warn(message, category, stacklevel=3)
+        return results
 
 
 def run_in_order(function: Callable[..., Any], tasks: Sequence[Any], workers: int | None = None,
@@ -107,31 +186,17 @@ def run_in_order(function: Callable[..., Any], tasks: Sequence[Any], workers: in
     once per worker) is given; ``progress(done, total, index)`` as tasks finish; the first failure is raised.
     """
     tasks = list(tasks)
-    count = worker_count(workers, len(tasks))
-    results: list[Any] = [None] * len(tasks)
-    if count == 1:
-        with threadpool_limits(limits=1):
-            for index, task in enumerate(tasks):
-                results[index] = function(task) if shared is None else function(shared, task)
-                if progress is not None:
-                    progress(index + 1, len(tasks), index)
-        return results
-    call: Callable[..., Any] = function
-    arguments: list[tuple] = [(task,) for task in tasks]
-    initializer, initargs = None, ()
-    if shared is not None:
-        call, initializer, initargs = _call_with_shared, _share, (shared,)
-        arguments = [(function, task) for task in tasks]
-    with process_pool(count, initializer, initargs) as pool:
-        futures = {pool.submit(call, *args): k for k, args in enumerate(arguments)}
-        for done, future in enumerate(as_completed(futures), start=1):
-            index = futures[future]
-            results[index] = future.result()
-            if progress is not None:
-                progress(done, len(tasks), index)
-    return results
+    with WorkerPool(workers, len(tasks), shared) as pool:
+        if shared is None:
+            return pool.map_shared(_unshared, [(function, task) for task in tasks], progress)
+        return pool.map_shared(function, tasks, progress)
+
+
+def _unshared(_: Any, task: tuple[Callable[[Any], Any], Any]) -> Any:
+    function, argument = task
+    return function(argument)
 
 
 __all__ = ["START_METHOD", "WORKERS_INHERIT", "WORKER_THREADS", "InlineExecutor", "TaskProgress",
-           "inheriting_workers", "limit_worker_threads", "one_blas_thread", "process_pool", "run_in_order",
-           "worker_count"]
+           "WorkerPool", "inheriting_workers", "limit_worker_threads", "one_blas_thread",
+           "process_pool", "run_in_order", "worker_count"]

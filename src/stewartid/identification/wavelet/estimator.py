@@ -43,7 +43,7 @@ from stewartid.identification.wavelet.gls import WeakFormSolution
 from stewartid.identification.wavelet.noise import estimate_noise
 from stewartid.identification.wavelet.point_equations import EXACT_DEGREE, point_equations
 from stewartid.model.joints import JOINT_TYPES
-from stewartid.parallel import inheriting_workers, run_in_order
+from stewartid.parallel import WorkerPool, inheriting_workers
 from stewartid.platform import COORDINATES, Platform
 from stewartid.signals.wavelets import MotherWavelet, PolynomialWavelet, make_wavelet
 
@@ -233,21 +233,23 @@ class WaveletIdentifier(BaseIdentifier):
         # a ball screw's Coulomb friction along each leg: one more level, in N
         legs = platform.actuator.kind == "electric"
         workers = inheriting_workers(self.jobs, len(datasets))
-        # each experiment tells whether it is one sine beside its equations (its dominant
-        # frequency is its detection's), and the models follow from all of them
-        parts = run_in_order(_experiment_equations, range(len(datasets)), workers,
-                             shared=(self, datasets, platform, friction_models(self.friction),
-                                     legs))
-        models = chosen_models(self.friction, [part[4] for part in parts])
-        equations: dict[str, list] = {model: [] for model in models}
-        for part in parts:
-            for model in models:
-                equations[model] += part[0][model]
-        infos, sensitivities, motion = ([part[k] for part in parts] for k in (1, 2, 3))
-        noise = ({"pose_covariance": [i["noise_covariance"] for i in infos],
-                  "force_variance": [i["force_noise_variance"] for i in infos],
-                  "force_sensitivity": sensitivities} if self.noise_correction else {})
-        solved, refused = solve_models(models, equations, infos, motion, noise)
+        # the same workers build the experiments' equations, then solve at the soft-sign rates
+        with WorkerPool(workers, len(datasets), (self, datasets, platform,
+                                                 friction_models(self.friction), legs)) as pool:
+            # each experiment tells whether it is one sine beside its equations (its dominant
+            # frequency is its detection's), and the models follow from all of them
+            parts = pool.map_shared(_experiment_equations, range(len(datasets)))
+            models = chosen_models(self.friction, [part[4] for part in parts])
+            equations: dict[str, list] = {model: [] for model in models}
+            for part in parts:
+                for model in models:
+                    equations[model] += part[0][model]
+            infos, sensitivities, motion = ([part[k] for part in parts] for k in (1, 2, 3))
+            noise = ({"pose_covariance": [i["noise_covariance"] for i in infos],
+                      "force_variance": [i["force_noise_variance"] for i in infos],
+                      "force_sensitivity": sensitivities} if self.noise_correction else {})
+            solved, refused = solve_models(models, equations, infos, motion, noise,
+                                           pool.call_all)
         fits = {model: self._weak_form_result(solution, infos, len(equations[model]), wavelet,
                                               model, rate, legs and model in ("free", "coulomb"))
                 for model, (solution, rate) in solved.items()}

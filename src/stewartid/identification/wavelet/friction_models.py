@@ -6,7 +6,9 @@ The equations and solve of each, and the choice between them on one sine per exp
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from functools import partial
+from typing import Any
 
 import numpy as np
 
@@ -27,6 +29,7 @@ from stewartid.identification.wavelet.detection import (
 from stewartid.identification.wavelet.gls import WeakFormSolution
 from stewartid.identification.wavelet.rate_selection import (
     HALF_WINDOW_RATE,
+    Run,
     solve_weak_form_over_rates,
 )
 from stewartid.identification.wavelet.weak_form import (
@@ -124,31 +127,49 @@ def model_equations(model: str, experiment: Experiment, found: Detection, order:
 
 
 def solve_model(model: str, equations: list, infos: list[dict], motion: list[np.ndarray],
-                noise: dict) -> tuple[WeakFormSolution, float]:
-    """Solve one friction model's equations over the soft-sign rates; returns the solution and its rate."""
+                noise: dict, run: Run | None = None) -> tuple[WeakFormSolution, float]:
+    """Solve one friction model's equations over the soft-sign rates; returns the solution and
+    its rate. ``run``: the fits at the rates side by side
+    (:func:`~stewartid.identification.wavelet.rate_selection.solved_over_rates`)."""
     if not equations:
         raise_no_interval(infos)
     if model == "coulomb":
-        return solve_windows_over_rates(equations, **noise)
+        return solve_windows_over_rates(equations, run=run, **noise)
     check_coverage([i["name"] for i in infos], np.array(motion),
                    [sum(e.experiment == k for e in equations) for k in range(len(infos))])
-    return solve_weak_form_over_rates(equations, len(infos), model != "free", **noise)
+    return solve_weak_form_over_rates(equations, len(infos), model != "free", run, **noise)
 
 
 def solve_models(models: Sequence[str], equations: Mapping[str, list], infos: list[dict],
-                 motion: list[np.ndarray], noise: dict
+                 motion: list[np.ndarray], noise: dict, run: Run | None = None
                  ) -> tuple[dict[str, tuple[WeakFormSolution, float]], dict[str, str]]:
-    """:func:`solve_model` of every model: (solved, refused) dicts; raises the first refusal if all fail."""
+    """:func:`solve_model` of every model: (solved, refused) dicts; raises the first refusal if
+    all fail. ``run``: several models side by side, each with its equations sent once, else one
+    model's fits at the soft-sign rates."""
+    calls = [partial(solve_model, model, equations[model], infos, motion, noise)
+             for model in models]
+    if run is not None and len(models) > 1:
+        outcomes = run([partial(_attempted, call) for call in calls])
+    else:
+        outcomes = [_attempted(partial(call, run=run)) for call in calls]
     solved, refused, first = {}, {}, None
-    for model in models:
-        try:
-            solved[model] = solve_model(model, equations[model], infos, motion, noise)
-        except (IdentificationError, np.linalg.LinAlgError) as error:  # singular: unexcited
+    for model, (solution, error) in zip(models, outcomes, strict=True):
+        if error is None:
+            solved[model] = solution
+        else:
             first = first or error
             refused[model] = str(error).splitlines()[0]
     if not solved:
         raise first
     return solved, refused
+
+
+def _attempted(call: Callable[[], Any]) -> tuple[Any, Exception | None]:
+    """``call()``'s result, or the refusal it raised (singular: unexcited)."""
+    try:
+        return call(), None
+    except (IdentificationError, np.linalg.LinAlgError) as error:
+        return None, error
 
 
 def choose_friction_fit(results: Mapping[str, IdentificationResult],

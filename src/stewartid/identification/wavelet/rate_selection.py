@@ -8,6 +8,8 @@ from __future__ import annotations
 import dataclasses
 import warnings
 from collections.abc import Callable, Sequence
+from functools import partial
+from typing import Any
 
 import numpy as np
 
@@ -16,6 +18,9 @@ from stewartid.identification.quantiles import chi2_upper_quantile
 from stewartid.identification.sign_window import widened_by_sign_window
 from stewartid.identification.wavelet.gls import WeakFormSolution, solve_weak_form
 from stewartid.identification.wavelet.weak_form import SOFT_SIGN_RATES, IntervalEquations
+
+#: Runs zero-argument calls and returns their results in order (in this process or on workers).
+Run = Callable[[Sequence[Callable[[], Any]]], list]
 
 #: Size of the likelihood-ratio test of :func:`solve_weak_form_over_rates`.
 VARIATION_TEST_LEVEL = 0.01
@@ -30,19 +35,19 @@ def residual_cost(solution: WeakFormSolution) -> float:
     return float(np.sum(np.log(solution.noise_std ** 2)))
 
 
-def averaged_over_rates(solve: Callable[[int], WeakFormSolution], rates: Sequence[float],
-                        refit: Callable[[], WeakFormSolution] | None = None
+def averaged_over_rates(solutions: Sequence[WeakFormSolution], rates: Sequence[float],
+                        half: WeakFormSolution | None = None
                         ) -> tuple[WeakFormSolution, float]:
-    """``solve(index)`` at every transition rate, averaged with Akaike weights exp(-n (c_k - min c) / 2).
+    """The fits ``solutions`` at every transition rate of ``rates``, averaged with Akaike
+    weights exp(-n (c_k - min c) / 2).
 
     Mean sum_k w_k theta_k, standard error sqrt(sum_k w_k (s_k^2 + (theta_k - mean)^2)) (Burnham and
-    Anderson 2002, sec. 6.3). ``refit()``: the fit at the rate :data:`HALF_WINDOW_RATE` with the
+    Anderson 2002, sec. 6.3). ``half``: the fit at the rate :data:`HALF_WINDOW_RATE` with the
     signs from half their window, by whose distance from that rate's fit the standard errors
     widen (:func:`~stewartid.identification.sign_window.widened_by_sign_window`). Returns the averaged
     solution (rest from the best candidate, with ``rate_weights``) and the rate of greatest
     weight, rad/s.
     """
-    solutions = [solve(index) for index in range(len(rates))]
     costs = np.array([residual_cost(solution) for solution in solutions])
     rows = np.array([solution.n_equations for solution in solutions], dtype=float)
     weights = np.exp(-0.5 * rows * (costs - costs.min()))
@@ -61,12 +66,34 @@ def averaged_over_rates(solve: Callable[[int], WeakFormSolution], rates: Sequenc
     averaged = dataclasses.replace(solutions[int(np.argmin(costs))], theta=theta,
                                    theta_std=theta_std, coulomb=coulomb,
                                    coulomb_std=coulomb_std, rate_weights=by_rate)
-    if refit is not None:
-        with warnings.catch_warnings():  # what the data lack, the fits above have said
-            warnings.simplefilter("ignore", DataWarning)
-            half = refit()
+    if half is not None:
         averaged = widened_by_sign_window(averaged, solutions[HALF_WINDOW_RATE], half, "coulomb")
     return averaged, float(rates[int(np.argmax(weights))])
+
+
+def solved_over_rates(solve: Callable[..., WeakFormSolution], count: int,
+                      refit: Callable[[], WeakFormSolution] | None, run: Run | None
+                      ) -> tuple[list[WeakFormSolution], WeakFormSolution | None]:
+    """``solve(rate_index=k)`` for the first ``count`` rates and ``refit()``, side by side by
+    ``run`` (:meth:`~stewartid.parallel.WorkerPool.call_all`; None: one after the other);
+    ``solve`` and ``refit`` picklable. The refit's warnings are left out: what the data lack,
+    the fits at every rate have said."""
+    calls = [partial(solve, rate_index=k) for k in range(count)]
+    if refit is not None:
+        calls.append(partial(_without_data_warnings, refit))
+    solutions = (run or in_sequence)(calls)
+    return solutions[:count], (solutions[count] if refit is not None else None)
+
+
+def in_sequence(calls: Sequence[Callable[[], Any]]) -> list[Any]:
+    """``[call() for call in calls]``: :func:`solved_over_rates` in this process."""
+    return [call() for call in calls]
+
+
+def _without_data_warnings(call: Callable[[], WeakFormSolution]) -> WeakFormSolution:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DataWarning)
+        return call()
 
 
 def half_window_pick(carried: int, count: int) -> list[int]:
@@ -87,12 +114,13 @@ def half_window_rows(equations: Sequence[IntervalEquations], count: int
 
 
 def solve_weak_form_over_rates(equations: Sequence[IntervalEquations], n_experiments: int,
-                               shared_friction: bool = True, **settings
-                               ) -> tuple[WeakFormSolution, float | None]:
+                               shared_friction: bool = True, run: Run | None = None,
+                               **settings) -> tuple[WeakFormSolution, float | None]:
     """:func:`~stewartid.identification.wavelet.gls.solve_weak_form` with Coulomb rows averaged over rates.
 
     Levels are kept only if a likelihood-ratio test at :data:`VARIATION_TEST_LEVEL` accepts them and
-    none is 3 standard errors below zero. Returns (solution, rate of greatest weight or None).
+    none is 3 standard errors below zero. ``run`` as :func:`solved_over_rates`. Returns
+    (solution, rate of greatest weight or None).
     """
     if shared_friction:  # the mean rows carry the levels
         return solve_weak_form(equations, n_experiments, True, **settings), None
@@ -100,13 +128,12 @@ def solve_weak_form_over_rates(equations: Sequence[IntervalEquations], n_experim
     plain = solve_weak_form(equations, n_experiments, False, shared=shared, **settings)
     rates = SOFT_SIGN_RATES[:len(equations[0].coulomb_rows)]
     half = half_window_rows(equations, len(rates))
-    refit = None if half is None else (
-        lambda: solve_weak_form(half, n_experiments, False, variation=True, shared=shared,
-                                **settings))
-    best, best_rate = averaged_over_rates(
-        lambda index: solve_weak_form(equations, n_experiments, False, rate_index=index,
-                                      variation=True, shared=shared, **settings),
-        rates, refit)
+    solve = partial(solve_weak_form, equations, n_experiments, False, variation=True,
+                    shared=shared, **settings)
+    refit = None if half is None else partial(solve_weak_form, half, n_experiments, False,
+                                              variation=True, shared=shared, **settings)
+    solutions, refitted = solved_over_rates(solve, len(rates), refit, run)
+    best, best_rate = averaged_over_rates(solutions, rates, refitted)
     rows = plain.n_equations
     # likelihood ratio of the levels, and levels a friction can have: one 3 standard errors
     # below zero says the plant's friction does not follow the structure
@@ -117,5 +144,6 @@ def solve_weak_form_over_rates(equations: Sequence[IntervalEquations], n_experim
     return plain, None
 
 
-__all__ = ["HALF_WINDOW_RATE", "VARIATION_TEST_LEVEL", "averaged_over_rates", "half_window_pick",
-           "half_window_rows", "residual_cost", "solve_weak_form_over_rates"]
+__all__ = ["HALF_WINDOW_RATE", "VARIATION_TEST_LEVEL", "Run", "averaged_over_rates",
+           "half_window_pick", "half_window_rows", "in_sequence", "residual_cost",
+           "solve_weak_form_over_rates", "solved_over_rates"]

@@ -6,6 +6,7 @@ Mt <phi'', q> - Bt <phi', q> + sum_types F_type <phi, W_type> = <phi, y>.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import partial
 from typing import NamedTuple
 
 import numpy as np
@@ -23,7 +24,12 @@ from stewartid.identification.wavelet.gls import (
     local_terms,
     standard_errors,
 )
-from stewartid.identification.wavelet.rate_selection import averaged_over_rates, half_window_pick
+from stewartid.identification.wavelet.rate_selection import (
+    Run,
+    averaged_over_rates,
+    half_window_pick,
+    solved_over_rates,
+)
 from stewartid.identification.wavelet.variance_components import row_noise
 from stewartid.identification.wavelet.weak_form import (
     SOFT_SIGN_RATES,
@@ -191,24 +197,23 @@ def solve_windows(equations: Sequence[WindowEquations], iterations: int = 3,
 
 
 def solve_windows_over_rates(equations: Sequence[WindowEquations],
-                             rates: Sequence[float] = SOFT_SIGN_RATES, **settings
-                             ) -> tuple[WeakFormSolution, float]:
+                             rates: Sequence[float] = SOFT_SIGN_RATES, run: Run | None = None,
+                             **settings) -> tuple[WeakFormSolution, float]:
     """:func:`solve_windows` averaged over transition rates, and the rate of greatest weight.
 
     Where windows carry Coulomb rows from the signs of half their window after the ``rates``'
     (:func:`~stewartid.identification.wavelet.friction_models.patterns_with_half_window`), the
-    standard errors widen by that refit's distance (:func:`averaged_over_rates`).
+    standard errors widen by that refit's distance (:func:`averaged_over_rates`). ``run`` as
+    :func:`~stewartid.identification.wavelet.rate_selection.solved_over_rates`.
     """
     count = len(rates)
-
-    def refit() -> WeakFormSolution:
-        return solve_windows([e._replace(coulomb=e.coulomb[half_window_pick(len(e.coulomb),
-                                                                             count)])
-                              for e in equations], **settings)
-
-    return averaged_over_rates(
-        lambda index: solve_windows(equations, rate_index=index, **settings), rates,
-        refit if any(len(e.coulomb) > count for e in equations) else None)
+    refit = None
+    if any(len(e.coulomb) > count for e in equations):
+        refit = partial(solve_windows, [e._replace(coulomb=e.coulomb[half_window_pick(
+            len(e.coulomb), count)]) for e in equations], **settings)
+    solutions, half = solved_over_rates(partial(solve_windows, equations, **settings), count,
+                                        refit, run)
+    return averaged_over_rates(solutions, rates, half)
 
 
 __all__ = ["SOFT_SIGN_RATES", "STOP_ROW_SHARE", "WindowEquations", "coulomb_patterns",

@@ -1,0 +1,56 @@
+"""The worker pool: results in task order whichever worker finishes first, warnings raised again
+in the calling process (where filters and records see them), failures passed on."""
+
+from __future__ import annotations
+
+import time
+import warnings
+from functools import partial
+
+import pytest
+
+from stewartid.parallel import WORKERS_INHERIT, WorkerPool, run_in_order
+
+needs_fork = pytest.mark.skipif(not WORKERS_INHERIT, reason="workers start by fork only")
+
+
+def _offset_square(shared: int, task: int) -> int:
+    time.sleep(0.02 * (4 - task))   # the first tasks finish last
+    return shared + task * task
+
+
+def _warned(label: str) -> str:
+    warnings.warn(f"careful: {label}", UserWarning, stacklevel=1)
+    return label
+
+
+def _refused(label: str) -> str:
+    raise ValueError(f"refused {label}")
+
+
+@needs_fork
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_pool_keeps_task_order_over_rounds(workers):
+    with WorkerPool(workers, 4, shared=100) as pool:
+        first = pool.map_shared(_offset_square, range(4))
+        second = pool.call_all([partial(_offset_square, 1, k) for k in range(4)])
+    assert first == [100, 101, 104, 109]
+    assert second == [1, 2, 5, 10]
+
+
+@needs_fork
+@pytest.mark.parametrize("workers", [1, 2])
+def test_warnings_of_workers_are_raised_here_in_task_order(workers):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with WorkerPool(workers, 3) as pool:
+            assert pool.call_all([partial(_warned, k) for k in "abc"]) == list("abc")
+    assert [str(w.message) for w in caught] == ["careful: a", "careful: b", "careful: c"]
+    assert {w.category for w in caught} == {UserWarning}
+
+
+@needs_fork
+def test_a_failed_task_raises_its_error():
+    with pytest.raises(ValueError, match="refused b"), WorkerPool(2, 3) as pool:
+        pool.call_all([partial(_warned, "a"), partial(_refused, "b"), partial(_warned, "c")])
+    assert run_in_order(abs, [-1, 2, -3], workers=2) == [1, 2, 3]
