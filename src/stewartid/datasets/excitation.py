@@ -125,9 +125,9 @@ def _padded_length(n: int, padding: int = 4) -> int:
 def _windowed(x: np.ndarray) -> np.ndarray:
     """Channels ``x`` (N, m) less their mean and linear drift, times a Hann window."""
     n = len(x)
-    ramp = np.linspace(-1.0, 1.0, n)
-    basis = np.column_stack([np.ones(n), ramp])
-    x = x - basis @ np.linalg.lstsq(basis, x, rcond=None)[0]
+    ramp = np.linspace(-1.0, 1.0, n)   # symmetric: orthogonal to the constant
+    x = x - x.mean(axis=0)
+    x = x - np.outer(ramp, (ramp @ x) / max(float(ramp @ ramp), 1e-300))
     return x * np.hanning(n)[:, None]
 
 
@@ -278,18 +278,19 @@ LINE_THRESHOLD = 0.1
 LINE_MERGE_BINS = 3.0
 
 
-def excitation_lines(datasets: Sequence[Dataset], threshold: float = LINE_THRESHOLD
-                     ) -> tuple[tuple[float, ...], ...]:
+def excitation_lines(datasets: Sequence[Dataset], threshold: float = LINE_THRESHOLD,
+                     padding: int = 4) -> tuple[tuple[float, ...], ...]:
     """Distinct excitation frequencies (Hz, ascending) of each DOF over all experiments.
 
     A line counts when its position-spectrum amplitude is at least ``threshold`` of the DOF's
-    largest; lines within :data:`LINE_MERGE_BINS` resolutions are one.
+    largest; lines within :data:`LINE_MERGE_BINS` resolutions are one. ``padding`` as
+    :func:`spectral_lines`: 1 to count the lines, the default to place them.
     """
     found = []
     for dof in range(6):
         # a line below the threshold of its own record's largest is below the threshold of
         # the DOF's largest: the records need report no more
-        records = [_pose_lines(d, threshold)[dof] for d in datasets]
+        records = [_pose_lines(d, threshold, padding)[dof] for d in datasets]
         largest = max((r.largest for r in records), default=0.0)
         lines: list[float] = []
         for record in records:
@@ -304,11 +305,10 @@ def excitation_lines(datasets: Sequence[Dataset], threshold: float = LINE_THRESH
     return tuple(found)
 
 
-def _pose_lines(dataset: Dataset, threshold: float) -> list[SpectralLines]:
+def _pose_lines(dataset: Dataset, threshold: float, padding: int) -> list[SpectralLines]:
     """Each pose coordinate's lines of one record, computed once per record."""
-    # counted and compared to the threshold only: the unpadded transform places them well enough
-    return dataset.derived(("pose lines", threshold), lambda d: channel_lines(
-        d.pose, d.sample_rate, fraction=threshold, padding=1))
+    return dataset.derived(("pose lines", threshold, padding), lambda d: channel_lines(
+        d.pose, d.sample_rate, fraction=threshold, padding=padding))
 
 
 __all__ = ["LINE_FRACTION", "LINE_MERGE_BINS", "LINE_THRESHOLD", "MIN_RELATIVE_EXCITATION",
