@@ -57,14 +57,19 @@ def filtered_noise_covariance(X: np.ndarray, weights: np.ndarray,
     for (rows, _), (S, rho) in zip(segments, noises, strict=True):
         part = Z[start:start + rows]
         start += rows
-        # sum_j rho(|k - j|) Z_j: one symmetric convolution along the rows, zero outside
-        near = rho[:rows]
-        taps = np.concatenate([near[:0:-1], near])
-        from scipy.ndimage import convolve1d  # slow to import: only these scores need it
-
-        smeared = convolve1d(part, taps, axis=0, mode="constant")
-        B += np.einsum("kcp,cd,kdq->pq", part, S, smeared, optimize=True)
+        B += np.einsum("kcp,cd,kdq->pq", part, S, _smeared(part, rho[:rows]), optimize=True)
     return B
+
+
+def _smeared(part: np.ndarray, near: np.ndarray) -> np.ndarray:
+    """sum_j rho(|k - j|) part_j (K, ...) with ``near`` rho(0), rho(1), ... (at most K lags):
+    a symmetric convolution along the rows, zero outside, a few lags long (numpy: scipy.ndimage
+    costs more to import than this to run)."""
+    smeared = near[0] * part
+    for lag in range(1, len(near)):
+        smeared[lag:] += near[lag] * part[:-lag]
+        smeared[:-lag] += near[lag] * part[lag:]
+    return smeared
 
 
 def nearest_psd(matrix: np.ndarray) -> np.ndarray:
