@@ -128,9 +128,10 @@ class WaveletIdentifier(BaseIdentifier):
         it and widen the standard errors by the distance
         (:mod:`~stewartid.identification.sign_window`).
     jobs : int or None
-        Worker processes preparing the experiments' equations side by side (None: every core;
-        one where workers cannot start by fork, :func:`~stewartid.parallel.inheriting_workers`);
-        the results do not depend on it.
+        Worker processes preparing the experiments' equations side by side, then solving the
+        friction models (or one model's soft-sign rates) side by side (None: every core; one
+        where workers cannot start by fork, :func:`~stewartid.parallel.inheriting_workers`); the
+        results do not depend on it.
 
     Attributes
     ----------
