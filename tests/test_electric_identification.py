@@ -127,6 +127,19 @@ def test_method_b_fits_the_legs_coulomb_friction_on_all_dofs(electric, records):
     assert abs(leg / 60.0 - 1) < 0.05
 
 
+def test_method_b_solves_its_soft_sign_rates_side_by_side_to_the_bit(electric, records):
+    """One friction model (the windows): its fits at the soft-sign rates and its half-window
+    refit on two workers give the one-process result to the bit."""
+    from stewartid.identification.wavelet import WaveletIdentifier
+
+    alone, side = (WaveletIdentifier(jobs=jobs).fit(records, electric).result_
+                   for jobs in (1, 2))
+    assert side.diagnostics["friction_model"] == "coulomb"
+    for name in ("M", "B", "std_errors_M", "std_errors_B"):
+        assert np.array_equal(getattr(alone, name), getattr(side, name)), name
+    assert alone.diagnostics["soft_sign_weights"] == side.diagnostics["soft_sign_weights"]
+
+
 def test_least_squares_leaves_hydraulic_legs_alone(paper):
     from stewartid.identification.least_squares import uses_leg_coulomb
 
