@@ -197,7 +197,7 @@ def test_csv_reader_names_and_values_as_pandas(tmp_path, dataset):
 
 
 def test_median_equals_numpys_to_the_last_bit():
-    from stewartid.datasets.arrays import median
+    from stewartid.arrays import median
 
     rng = np.random.default_rng(2)
     for n in (1, 2, 3, 10, 11, 4000, 4001):
@@ -205,4 +205,11 @@ def test_median_equals_numpys_to_the_last_bit():
         values[: n // 3] = values[0]  # ties
         assert median(values) == np.median(values)
         assert median(values.reshape(n, 1)) == np.median(values)
+        table = rng.standard_normal((n, 5)) * 1e3
+        table[: n // 3, 1] = table[0, 1]
+        for axis in (0, 1):
+            assert np.array_equal(median(table, axis), np.median(table, axis=axis))
     assert np.isnan(median(np.array([1.0, np.nan, 2.0])))
+    with_nan = np.ones((4, 3))
+    with_nan[2, 1] = np.nan
+    assert np.array_equal(median(with_nan, 0), np.median(with_nan, axis=0), equal_nan=True)

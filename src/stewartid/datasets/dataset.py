@@ -16,8 +16,8 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.csv
 
+from stewartid.arrays import median
 from stewartid.datasets import plausibility as checks
-from stewartid.datasets.arrays import median
 from stewartid.datasets.columns import shown_value, to_numbers
 from stewartid.datasets.distinct import check_distinct_experiments, check_distinct_paths
 from stewartid.datasets.log_format import CURRENT_COLUMNS, LogFormat, read_table

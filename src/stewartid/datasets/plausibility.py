@@ -10,7 +10,7 @@ import warnings
 
 import numpy as np
 
-from stewartid.datasets.arrays import median
+from stewartid.arrays import median
 from stewartid.errors import DataError, DataWarning
 from stewartid.model.kinematics import compute_leg_terms, leg_lengths
 from stewartid.model.linearization import nominal_matrices

@@ -9,6 +9,8 @@ from typing import Any
 
 import numpy as np
 
+from stewartid.arrays import median
+
 
 def symmetric_pair_scores(matrix: np.ndarray, std: np.ndarray) -> np.ndarray:
     """|a_ij - a_ji| / sqrt(s_ij^2 + s_ji^2) of every off-diagonal pair (i < j), row-major."""
@@ -40,7 +42,7 @@ def pair_calibration(scores: np.ndarray, clip: bool = False) -> dict[str, Any]:
         return {"pairs": 0, "birge_ratio": nan, "scale": nan, "largest": nan, "outliers": 0,
                 "factor": 1.0}
     ratio = float(np.sqrt(np.mean(scores ** 2)))
-    scale = float(np.median(scores) / HALF_NORMAL_MEDIAN)
+    scale = median(scores) / HALF_NORMAL_MEDIAN
     # from the robust scale up: a few pairs far out cannot hold the ratio above them
     inside = np.zeros(scores.size, dtype=bool)
     clipped = scale if clip else ratio

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from stewartid.arrays import median
 from stewartid.datasets.dataset import MIN_SAMPLES, Dataset
 from stewartid.errors import StewartidError
 from stewartid.identification.result import IdentificationResult
@@ -78,7 +79,7 @@ def _compare(result: IdentificationResult, half: IdentificationResult) -> tuple[
     usable = np.isfinite(std) & np.isfinite(other_std) & (std > 0) & (other_std > 0)
     if not usable.any():
         return float("nan"), float("nan")
-    return (float(np.median(other_std[usable] / std[usable])),
+    return (median(other_std[usable] / std[usable]),
             float(np.max(np.abs(value - other)[usable] / other_std[usable])))
 
 

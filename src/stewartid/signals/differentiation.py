@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from stewartid.arrays import median as array_median
 from stewartid.errors import ConfigError, DataError
 from stewartid.signals.brent import minimize_bounded
 
@@ -324,7 +325,7 @@ def _channel_spectra(x: np.ndarray, sample_rate: float, refine: bool
     # The scale leaves out white noise (the same power in every bin: the median bin's, the lines
     # holding few), so that noise does not demote a small channel's line; a channel whose
     # motion is below its noise has no line either
-    median = np.median(coarse[:, 1:] ** 2, axis=1)
+    median = array_median(coarse[:, 1:] ** 2, axis=1)
     noise = median / (math.log(2) * np.sum(hann ** 2))
     scale = np.sqrt(np.maximum(spread ** 2 - noise, 0.0))
     moving = (spread > ROUND_OFF_SPREAD * spread.max()) & (scale ** 2 > noise)

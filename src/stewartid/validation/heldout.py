@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from stewartid.arrays import median
 from stewartid.datasets.dataset import Dataset
 from stewartid.errors import DataError, StewartidError
 from stewartid.identification.result import IdentificationResult
@@ -289,7 +290,7 @@ def residual_delay(segments: Sequence[Segment], predicted: Sequence[np.ndarray],
     from stewartid.identification.delay import shared_least_squares
 
     windows = [s.window for s in segments if np.isfinite(s.window)]
-    rate = min(1.0 / float(np.median(np.diff(s.t))) for s in segments)
+    rate = min(1.0 / median(np.diff(s.t)) for s in segments)
     window = min(windows) if windows else 20.0 / rate
     # as the delay estimator: 20 rows per kernel support carry what the filter leaves
     step = max(1, int(window * rate / 20))

@@ -11,6 +11,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from stewartid.arrays import median
 from stewartid.errors import DataWarning, IdentificationError
 from stewartid.identification.preparation import Experiment
 from stewartid.identification.wavelet.intervals import constant_direction_intervals, joint_rates
@@ -191,7 +192,7 @@ def detect_intervals(experiment: Experiment, noise: NoiseModel, *, margin: float
                                                              hysteresis * rate_noise))
     lengths = found[:, 1] - found[:, 0]
     shortest = (min_interval if min_interval is not None
-                else 0.5 * float(np.median(lengths)) if len(lengths) else 0.0)
+                else 0.5 * median(lengths) if len(lengths) else 0.0)
     needed = min_support_samples * period / smallest
     intervals = found[lengths >= max(shortest, needed)]
     info = {"name": experiment.name, "intervals_found": int(len(found)),

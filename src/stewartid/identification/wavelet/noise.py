@@ -6,6 +6,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from stewartid.arrays import median
 from stewartid.identification.preparation import Experiment
 from stewartid.signals.differentiation import (
     DEFAULT_ORDER,
@@ -23,7 +24,7 @@ def white_noise_covariance(q: np.ndarray, smooth: np.ndarray | None = None) -> n
     """
     r = q if smooth is None else q - smooth
     d2 = r[2:] - 2.0 * r[1:-1] + r[:-2]
-    d2 = d2 - np.median(d2, axis=0)
+    d2 = d2 - median(d2, axis=0)
     return d2.T @ d2 / (6.0 * max(len(d2), 1))
 
 
