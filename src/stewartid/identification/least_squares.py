@@ -379,16 +379,18 @@ class LeastSquaresIdentifier(BaseIdentifier):
                 regressor_noise[:12, :12] += count * block
         phi, y = np.concatenate(phis), np.concatenate(ys)
 
-        def solve(per_shape: list[np.ndarray] | None):
+        def solve(per_shape: list[np.ndarray] | None, standard_errors: bool = True):
             return solve_least_squares(
                 phi, y, None if per_shape is None else np.concatenate(per_shape),
                 symmetric=self.symmetric, regressor_names=names,
                 shared_names=([f"coulomb[{t}]" for t in JOINT_TYPES]
                               + ["coulomb[actuator]"] * legs if shapes else None),
                 autocorrelated=True, regressor_noise=regressor_noise, segments=segments,
-                absorbed=absorbed)
+                absorbed=absorbed, standard_errors=standard_errors)
 
-        solutions = [solve(per_shape) for per_shape in (shared or [None])]
+        # the exact sign's fit and the half window's refit only move the others' errors
+        solutions = [solve(per_shape, k < len(shapes) or not shapes)
+                     for k, per_shape in enumerate(shared or [None])]
         exact_solution = solutions.pop() if exact else None
         weights = akaike_weights(solutions)
         solution = average_solutions(solutions, weights)
@@ -397,7 +399,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
             solution, exact_weight = widened_by_exact_sign(
                 solution, solutions[int(np.argmax(weights))], exact_solution)
         if lengthened:  # the long window's rounding of the reversals, as the half window sees it
-            solution = widened_by_sign_window(solution, solutions[0], solve(half), "shared")
+            solution = widened_by_sign_window(solution, solutions[0], solve(half, False),
+                                              "shared")
         shape_weights = ({shape: float(w) for shape, w in zip(shapes, weights, strict=True)}
                          if shapes else {})
         theta, std = solution.theta, solution.theta_std.copy()
