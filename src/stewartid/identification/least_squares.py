@@ -43,7 +43,6 @@ from stewartid.signals.differentiation import (
     default_window,
     differentiate,
     estimate_frequency,
-    kernel_filter,
     kernel_taps,
     trim,
 )
@@ -314,17 +313,17 @@ class LeastSquaresIdentifier(BaseIdentifier):
                             out=signals[:, 6:].reshape(len(exp.t), len(sets), levels, 6))
         # only every decimate-th row is kept: direct sums cost less than FFTs of every row
         filtered = kernel_filter_rows(signals, exp.sample_rate, window, decimate)
-        _, qd, qdd = kernel_filter(exp.q, exp.sample_rate, window, derivatives=2)
-        cut = (len(exp.t) - len(qd)) // 2
+        qd, qdd = (kernel_filter_rows(exp.q, exp.sample_rate, window, decimate, derivative=k)
+                   for k in (1, 2))
+        cut = len(kernel_taps(exp.sample_rate, window)[0]) // 2
         sl = slice(cut, len(exp.t) - cut, decimate)
-        step = slice(None, None, decimate)
         y = filtered[:, :6]
         coulomb = [filtered[:, 6 + width * k:6 + width * (k + 1)].reshape(len(y), -1, 6)
                    for k in range(len(sets))]
         coulomb, half = coulomb[:len(shapes)], coulomb[len(shapes):]
         noise = (pose_noise_gram(exp.q, exp.sample_rate, window) if self.noise_correction
                  else None)
-        qd, qdd, offset = qd[step], qdd[step], np.ones(len(y))
+        offset = np.ones(len(y))
         absorbed = 0
         if stops is not None:  # the stops' free friction out of every row
             basis = stop_basis(stops, exp.sample_rate, window, decimate, exp.name)
