@@ -47,7 +47,12 @@ from stewartid.signals.differentiation import (
     trim,
 )
 from stewartid.signals.filtered_rows import kernel_filter_rows
-from stewartid.signals.sign_rates import coulomb_sign_rates, lengthened_by_noise
+from stewartid.signals.sign_rates import (
+    coulomb_sign_rates,
+    lengthened_by_noise,
+    shorter_sign_window,
+    sign_rates,
+)
 
 
 def pose_noise_gram(q: np.ndarray, sample_rate: float, window: float) -> np.ndarray:
@@ -301,8 +306,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
         # the signs' window), filtered with the force in one buffer
         q_dots, sets = [qd_sign] * len(shapes), list(shapes)
         if refit:
-            q_dots.append(coulomb_sign_rates(exp.q, exp.sample_rate, window, pose_noise,
-                                             shorter=1)[0])
+            q_dots.append(sign_rates(exp.q, exp.sample_rate,
+                                     shorter_sign_window(window, sign_window)))
             sets.append(shapes[0])
         levels = len(JOINT_TYPES) + legs
         width = 6 * levels
