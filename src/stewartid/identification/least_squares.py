@@ -392,9 +392,10 @@ class LeastSquaresIdentifier(BaseIdentifier):
                 autocorrelated=True, regressor_noise=regressor_noise, segments=segments,
                 absorbed=absorbed, standard_errors=standard_errors)
 
-        # the exact sign's fit and the half window's refit only move the others' errors
-        solutions = [solve(per_shape, k < len(shapes) or not shapes)
-                     for k, per_shape in enumerate(shared or [None])]
+        # the exact sign's fit (the last) and the half window's refit only move the shapes'
+        # errors: their estimates suffice
+        solutions = ([solve(per_shape, standard_errors=k < len(shapes))
+                      for k, per_shape in enumerate(shared)] if shared else [solve(None)])
         exact_solution = solutions.pop() if exact else None
         weights = akaike_weights(solutions)
         solution = average_solutions(solutions, weights)
@@ -403,8 +404,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
             solution, exact_weight = widened_by_exact_sign(
                 solution, solutions[int(np.argmax(weights))], exact_solution)
         if lengthened:  # the long window's rounding of the reversals, as the half window sees it
-            solution = widened_by_sign_window(solution, solutions[0], solve(half, False),
-                                              "shared")
+            solution = widened_by_sign_window(
+                solution, solutions[0], solve(half, standard_errors=False), "shared")
         shape_weights = ({shape: float(w) for shape, w in zip(shapes, weights, strict=True)}
                          if shapes else {})
         theta, std = solution.theta, solution.theta_std.copy()
