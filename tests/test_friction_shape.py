@@ -43,6 +43,26 @@ def test_erf_saturates_faster_than_the_algebraic_sign():
     assert 1 - shaped_sign(w, 1e-4, "erf") < 2e-4
 
 
+def test_erf_shape_is_erf_across_and_past_its_saturation():
+    """The band shortcut against erf at every point: the standard library's exactly (the same
+    function), scipy's within its last bit or two (two implementations accurate to an ulp)."""
+    import math
+
+    from scipy.special import erf
+
+    s = 1e-4
+    # rates across the band, around the saturation point (|w| = 5.93 * 2 s / sqrt(pi) = 6.7e-4)
+    # and far beyond, both signs, zero, NaN and infinities
+    w = np.concatenate([np.linspace(-1e-3, 1e-3, 4001), np.geomspace(1e-12, 1e3, 3001),
+                        -np.geomspace(1e-12, 1e3, 3001), [0.0, -0.0, np.nan, np.inf, -np.inf]])
+    x = np.sqrt(np.pi) / (2 * s) * w
+    got = shaped_sign(w, s, "erf")
+    assert np.array_equal(got, [math.erf(v) for v in x], equal_nan=True)
+    assert np.array_equal(np.signbit(got), np.signbit(x))
+    assert np.allclose(got, erf(x), rtol=4 * EPS, atol=0.0, equal_nan=True)
+    assert shaped_sign(np.array(2e-4), s, "erf") == math.erf(np.sqrt(np.pi))
+
+
 def test_exact_shape_is_the_sign_whatever_the_smoothing():
     w = np.array([-1e-9, -1e-6, 0.0, 1e-6, 1e-9])
     assert np.array_equal(shaped_sign(w, 1e-4, EXACT_SIGN), np.sign(w))

@@ -84,6 +84,22 @@ def test_solver_standard_errors_match_scatter():
     assert np.std(errors) == pytest.approx(1.0, abs=0.1)
 
 
+def test_solver_without_standard_errors_gives_the_same_fit():
+    # shared columns and autocorrelated, segmented residuals: every branch the errors skip
+    rng = np.random.default_rng(3)
+    phi = np.column_stack([rng.normal(size=(600, 12)), np.ones(600)])
+    shared = rng.normal(size=(600, 2, 6))
+    y = (phi @ rng.normal(size=(6, 13)).T + np.einsum("ksi,s->ki", shared, [0.5, -2.0])
+         + np.cumsum(rng.normal(size=(600, 6)), axis=0) * 0.1)
+    full = solve_least_squares(phi, y, shared, autocorrelated=True, segments=[(300, 20)] * 2)
+    bare = solve_least_squares(phi, y, shared, autocorrelated=True, segments=[(300, 20)] * 2,
+                               standard_errors=False)
+    for name in ("theta", "shared", "residual_rms", "effective_equations"):
+        assert np.array_equal(getattr(bare, name), getattr(full, name)), name
+    assert bare.condition_number == full.condition_number
+    assert np.isnan(bare.theta_std).all() and np.isnan(bare.shared_std).all()
+
+
 def test_solver_names_the_unexcited_dof():
     rng = np.random.default_rng(1)
     phi = rng.normal(size=(100, 12))

@@ -7,7 +7,13 @@ import numpy as np
 import pytest
 
 from stewartid.signals.differentiation import differentiate
-from stewartid.signals.sign_rates import SIGN_FRACTIONS, SIGN_ORDER, coulomb_sign_rates
+from stewartid.signals.sign_rates import (
+    SIGN_FRACTIONS,
+    SIGN_ORDER,
+    coulomb_sign_rates,
+    shorter_sign_window,
+    sign_window,
+)
 
 RATE = 1000.0
 WINDOW = 0.4
@@ -50,3 +56,17 @@ def test_noise_lengthens_the_window_up_to_the_whole_kernel():
         windows.append(window)
     assert windows == sorted(windows) and windows[0] < windows[-1]
     assert windows[-1] == pytest.approx(WINDOW * SIGN_FRACTIONS[-1])
+
+
+def test_the_shorter_window_from_the_choice_is_the_search_with_shorter():
+    # every candidate chosen (noise from none to the whole kernel's), one and two places shorter
+    _, pose, _ = kinked_pose()
+    chosen = set()
+    for sigma in [0.0, *np.geomspace(1e-9, 1e-2, 30)]:
+        noise = sigma ** 2 * np.eye(6)
+        window = sign_window(pose, RATE, WINDOW, noise)
+        chosen.add(window)
+        for shorter in (1, 2):
+            assert shorter_sign_window(WINDOW, window, shorter) == sign_window(
+                pose, RATE, WINDOW, noise, shorter=shorter)
+    assert len(chosen) == len(SIGN_FRACTIONS)

@@ -17,12 +17,7 @@ from stewartid.identification.registry import create_identifier
 from stewartid.identification.wavelet import rate_selection
 from stewartid.model.linearization import nominal_matrices
 from stewartid.platform import load_platform
-from stewartid.signals.sign_rates import (
-    SIGN_FRACTIONS,
-    coulomb_sign_rates,
-    lengthened_by_noise,
-    shorter_sign_window,
-)
+from stewartid.signals.sign_rates import SIGN_FRACTIONS, coulomb_sign_rates, lengthened_by_noise
 from stewartid.simulation import degrade
 from stewartid.simulation.sensors import reference_noise
 
@@ -49,19 +44,6 @@ def test_the_refit_takes_the_next_shorter_window_never_below_the_first():
         else:
             assert chosen == half == pytest.approx(window * SIGN_FRACTIONS[0])
     assert lengthened_by_noise(window, chosen)   # the noisy one
-
-
-@pytest.mark.parametrize("noise", [1e-12, 1e-6, 3e-5, 1e-4, 1e-3, 1e-1])
-def test_the_shorter_window_from_the_choice_is_the_one_measured_again(noise):
-    """What the refit takes from the first choice equals what measuring the rates again with
-    ``shorter`` gives, from the shortest candidate to the whole kernel."""
-    t = np.arange(20001) / 1000.0
-    pose = np.tile(0.01 * np.sin(2 * np.pi * 0.5 * t)[:, None], (1, 6))
-    window, covariance = 0.4, noise ** 2 * np.eye(6)
-    _, chosen = coulomb_sign_rates(pose, 1000.0, window, covariance)
-    for shorter in (1, 2):
-        _, again = coulomb_sign_rates(pose, 1000.0, window, covariance, shorter=shorter)
-        assert shorter_sign_window(window, chosen, shorter) == again
 
 
 @pytest.mark.parametrize("method", ["ls", "wavelet"])

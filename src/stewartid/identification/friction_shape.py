@@ -18,6 +18,9 @@ from stewartid.identification.solvers import LeastSquaresSolution
 COULOMB_SHAPES = ("algebraic", "erf")
 #: The variant of the exact sign, s = 0 (:func:`widened_by_exact_sign`).
 EXACT_SIGN = "exact"
+#: erf(x) rounds to +-1 from here on (1 - erf(5.93) = 5.0e-17, under half the spacing of the
+#: doubles below 1).
+ERF_SATURATION = 5.93
 
 
 def shaped_sign(rates: np.ndarray, smoothing: float, shape: str = "algebraic") -> np.ndarray:
@@ -31,9 +34,14 @@ def shaped_sign(rates: np.ndarray, smoothing: float, shape: str = "algebraic") -
     if shape == "algebraic":
         return rates / np.sqrt(rates ** 2 + smoothing ** 2)
     if shape == "erf":
-        from scipy.special import erf
-
-        return erf(math.sqrt(math.pi) / (2.0 * smoothing) * rates)
+        # the standard library's erf, not scipy's (slow to import, in every worker of a fit),
+        # called only where the double is not exactly +-1
+        scaled = np.asarray(math.sqrt(math.pi) / (2.0 * smoothing) * rates, dtype=float)
+        signs = np.sign(scaled, out=np.empty_like(scaled))
+        band = np.abs(scaled) < ERF_SATURATION
+        inside = scaled[band].tolist()
+        signs[band] = np.fromiter(map(math.erf, inside), float, count=len(inside))
+        return signs
     raise ValueError(f"unknown Coulomb shape {shape!r}; one of {', '.join(COULOMB_SHAPES)}")
 
 

@@ -43,11 +43,16 @@ from stewartid.signals.differentiation import (
     default_window,
     differentiate,
     estimate_frequency,
-    kernel_filter,
     kernel_taps,
     trim,
 )
-from stewartid.signals.sign_rates import coulomb_sign_rates, lengthened_by_noise
+from stewartid.signals.filtered_rows import kernel_filter_rows
+from stewartid.signals.sign_rates import (
+    coulomb_sign_rates,
+    lengthened_by_noise,
+    shorter_sign_window,
+    sign_rates,
+)
 
 
 def pose_noise_gram(q: np.ndarray, sample_rate: float, window: float) -> np.ndarray:
@@ -70,16 +75,35 @@ def coulomb_regressors(joint_jacobians: np.ndarray, q_dot: np.ndarray, smoothing
     ``joint_jacobians`` (N, 6, 5, 6); ``smoothing`` s, rad/s, and ``shape`` as
     :func:`~stewartid.identification.friction_shape.shaped_sign`.
     """
-    return shaped_coulomb_regressors(joint_jacobians, q_dot, smoothing, (shape,))[0]
+    return shaped_coulomb_regressors(joint_jacobians, [q_dot], smoothing, (shape,))[:, 0]
 
 
-def shaped_coulomb_regressors(joint_jacobians: np.ndarray, q_dot: np.ndarray, smoothing: float,
-                              shapes: Sequence[str]) -> list[np.ndarray]:
-    """:func:`coulomb_regressors` of each sign shape of ``shapes``, the joint-axis rates computed
-    once for all."""
-    rates = joint_axis_rates(joint_jacobians, q_dot)
-    return [joint_type_forces(shaped_sign(rates, smoothing, shape), joint_jacobians)
-            for shape in shapes]
+def shaped_coulomb_regressors(joint_jacobians: np.ndarray, q_dots: Sequence[np.ndarray],
+                              smoothing: float, shapes: Sequence[str],
+                              out: np.ndarray | None = None) -> np.ndarray:
+    """:func:`coulomb_regressors` (N, R, 3, 6) of R sets of signs: the rates ``q_dots[r]`` (N, 6)
+    under the sign shape ``shapes[r]``.
+
+    The joint-axis rates once per run of the same rate array, and one product for every set;
+    ``out`` (N, R, 3, 6), written and returned when given.
+    """
+    n = len(joint_jacobians)
+    if out is None:
+        out = np.empty((n, len(shapes), len(JOINT_TYPES), 6))
+    signs = np.empty((min(n, COULOMB_CHUNK), len(shapes), 6, 5))
+    for lo in range(0, n, COULOMB_CHUNK):  # blocks keep the temporaries in cache
+        hi = min(n, lo + COULOMB_CHUNK)
+        jacobians = joint_jacobians[lo:hi]
+        for r, (q_dot, shape) in enumerate(zip(q_dots, shapes, strict=True)):
+            if r == 0 or q_dot is not q_dots[r - 1]:
+                rates = joint_axis_rates(jacobians, q_dot[lo:hi])
+            signs[:hi - lo, r] = shaped_sign(rates, smoothing, shape)
+        joint_type_forces(signs[:hi - lo], jacobians, out=out[lo:hi])
+    return out
+
+
+#: Samples per block of :func:`shaped_coulomb_regressors`.
+COULOMB_CHUNK = 1000
 
 
 #: Filtered rows kept per filter window by default (``decimate``): fewer change the estimates by
@@ -237,18 +261,23 @@ class LeastSquaresIdentifier(BaseIdentifier):
         "jobs": [Interval(Integral, 1, None), None],
     }
 
-    def _coulomb_units(self, exp: Experiment, rows: slice, q_dot: np.ndarray,
-                       shapes: Sequence[str], legs: bool, stopped: np.ndarray | None = None
-                       ) -> list[np.ndarray]:
-        """Coulomb regressors (K, 3 or 4, 6) of ``rows`` of an experiment under each sign shape
-        of ``shapes``, signs of ``q_dot``; ``stopped`` as :func:`leg_coulomb_regressor`."""
-        units = shaped_coulomb_regressors(exp.joint_jacobians[rows], q_dot,
-                                          self.coulomb_smoothing, shapes)
-        if not legs:
-            return units
-        return [np.concatenate([unit, leg_coulomb_regressor(
-            exp.leg_jacobian[rows], q_dot, self.coulomb_smoothing, shape, stopped)], axis=1)
-            for unit, shape in zip(units, shapes, strict=True)]
+    def _coulomb_units(self, exp: Experiment, rows: slice, q_dots: Sequence[np.ndarray],
+                       shapes: Sequence[str], legs: bool, stopped: np.ndarray | None = None,
+                       out: np.ndarray | None = None) -> np.ndarray:
+        """Coulomb regressors (K, R, 3 or 4, 6) of ``rows`` of an experiment, R sets of signs as
+        :func:`shaped_coulomb_regressors`; ``stopped`` as :func:`leg_coulomb_regressor`; ``out``
+        written and returned when given."""
+        if out is None:
+            out = np.empty((len(exp.t[rows]), len(shapes), len(JOINT_TYPES) + legs, 6))
+        if not shapes:
+            return out
+        shaped_coulomb_regressors(exp.joint_jacobians[rows], q_dots, self.coulomb_smoothing,
+                                  shapes, out=out[:, :, :len(JOINT_TYPES)])
+        if legs:
+            for r, (q_dot, shape) in enumerate(zip(q_dots, shapes, strict=True)):
+                out[:, r, -1] = leg_coulomb_regressor(exp.leg_jacobian[rows], q_dot,
+                                                      self.coulomb_smoothing, shape, stopped)[:, 0]
+        return out
 
     def _experiment_rows(self, exp: Experiment, shapes: tuple[str, ...], legs: bool) -> _Rows:
         """One prepared experiment's rows; ``legs`` adds the legs' Coulomb regressor."""
@@ -258,40 +287,48 @@ class LeastSquaresIdentifier(BaseIdentifier):
             _, qd, qdd = differentiate(exp.q, exp.sample_rate, window, self.order)
             cut = trim(window, exp.sample_rate, self.order)
             sl = slice(cut, len(exp.t) - cut, decimate)
-            coulomb = self._coulomb_units(exp, sl, qd[sl], shapes, legs)
+            units = self._coulomb_units(exp, sl, [qd[sl]] * len(shapes), shapes, legs)
             return _Rows(exp.t[sl], window, decimate, exp.generalized_force[sl], qd[sl],
-                         qdd[sl], coulomb, None, np.ones(len(qd[sl])))
+                         qdd[sl], list(units.transpose(1, 0, 2, 3)), None, np.ones(len(qd[sl])))
         # the Coulomb signs need the rates at every sample, from a window the noise allows
         # (the physical model's rule), so that they do not chatter
-        stops, pose_noise, half = None, sign_pose_noise(exp.q, exp.sample_rate, window), []
-        if legs and self.leg_stops:
-            stops = find_stops(exp.q, exp.leg_jacobian, exp.sample_rate, window, pose_noise)
-            qd_sign = stops.q_dot
-        else:
-            qd_sign, sign_window = coulomb_sign_rates(exp.q, exp.sample_rate, window, pose_noise)
-            if self.sign_window_check and lengthened_by_noise(window, sign_window):
-                # the refit of the signs' window
-                half = self._coulomb_units(
-                    exp, slice(None), coulomb_sign_rates(exp.q, exp.sample_rate, window,
-                                                         pose_noise, shorter=1)[0],
-                    shapes[:1], legs)
-        units = self._coulomb_units(exp, slice(None), qd_sign, shapes, legs,
-                                    None if stops is None else stops.stopped)
-        signals = np.concatenate(
-            [exp.generalized_force] + [u.reshape(len(u), -1) for u in units + half], axis=1)
-        filtered = kernel_filter(signals, exp.sample_rate, window)[0]
-        _, qd, qdd = kernel_filter(exp.q, exp.sample_rate, window, derivatives=2)
-        cut = (len(exp.t) - len(qd)) // 2
+        stops, qd_sign, refit = None, None, False
+        if shapes:
+            pose_noise = sign_pose_noise(exp.q, exp.sample_rate, window)
+            if legs and self.leg_stops:
+                stops = find_stops(exp.q, exp.leg_jacobian, exp.sample_rate, window, pose_noise)
+                qd_sign = stops.q_dot
+            else:
+                qd_sign, sign_window = coulomb_sign_rates(exp.q, exp.sample_rate, window,
+                                                          pose_noise)
+                refit = self.sign_window_check and lengthened_by_noise(window, sign_window)
+        # the signs of every shape, then the first shape's from the half window (the refit of
+        # the signs' window), filtered with the force in one buffer
+        q_dots, sets = [qd_sign] * len(shapes), list(shapes)
+        if refit:
+            q_dots.append(sign_rates(exp.q, exp.sample_rate,
+                                     shorter_sign_window(window, sign_window)))
+            sets.append(shapes[0])
+        levels = len(JOINT_TYPES) + legs
+        width = 6 * levels
+        signals = np.empty((len(exp.t), 6 + width * len(sets)))
+        signals[:, :6] = exp.generalized_force
+        self._coulomb_units(exp, slice(None), q_dots, sets, legs,
+                            None if stops is None else stops.stopped,
+                            out=signals[:, 6:].reshape(len(exp.t), len(sets), levels, 6))
+        # only every decimate-th row is kept: direct sums cost less than FFTs of every row
+        filtered = kernel_filter_rows(signals, exp.sample_rate, window, decimate)
+        qd, qdd = (kernel_filter_rows(exp.q, exp.sample_rate, window, decimate, derivative=k)
+                   for k in (1, 2))
+        cut = len(kernel_taps(exp.sample_rate, window)[0]) // 2
         sl = slice(cut, len(exp.t) - cut, decimate)
-        step = slice(None, None, decimate)
-        y = filtered[step, :6]
-        width = 6 * (len(JOINT_TYPES) + legs)
-        coulomb = [filtered[step, 6 + width * k:6 + width * (k + 1)].reshape(len(y), -1, 6)
-                   for k in range(len(units) + len(half))]
-        coulomb, half = coulomb[:len(units)], coulomb[len(units):]
+        y = filtered[:, :6]
+        coulomb = [filtered[:, 6 + width * k:6 + width * (k + 1)].reshape(len(y), -1, 6)
+                   for k in range(len(sets))]
+        coulomb, half = coulomb[:len(shapes)], coulomb[len(shapes):]
         noise = (pose_noise_gram(exp.q, exp.sample_rate, window) if self.noise_correction
                  else None)
-        qd, qdd, offset = qd[step], qdd[step], np.ones(len(y))
+        offset = np.ones(len(y))
         absorbed = 0
         if stops is not None:  # the stops' free friction out of every row
             basis = stop_basis(stops, exp.sample_rate, window, decimate, exp.name)
@@ -346,16 +383,19 @@ class LeastSquaresIdentifier(BaseIdentifier):
                 regressor_noise[:12, :12] += count * block
         phi, y = np.concatenate(phis), np.concatenate(ys)
 
-        def solve(per_shape: list[np.ndarray] | None):
+        def solve(per_shape: list[np.ndarray] | None, standard_errors: bool = True):
             return solve_least_squares(
                 phi, y, None if per_shape is None else np.concatenate(per_shape),
                 symmetric=self.symmetric, regressor_names=names,
                 shared_names=([f"coulomb[{t}]" for t in JOINT_TYPES]
                               + ["coulomb[actuator]"] * legs if shapes else None),
                 autocorrelated=True, regressor_noise=regressor_noise, segments=segments,
-                absorbed=absorbed)
+                absorbed=absorbed, standard_errors=standard_errors)
 
-        solutions = [solve(per_shape) for per_shape in (shared or [None])]
+        # the exact sign's fit (the last) and the half window's refit only move the shapes'
+        # errors: their estimates suffice
+        solutions = ([solve(per_shape, standard_errors=k < len(shapes))
+                      for k, per_shape in enumerate(shared)] if shared else [solve(None)])
         exact_solution = solutions.pop() if exact else None
         weights = akaike_weights(solutions)
         solution = average_solutions(solutions, weights)
@@ -364,7 +404,8 @@ class LeastSquaresIdentifier(BaseIdentifier):
             solution, exact_weight = widened_by_exact_sign(
                 solution, solutions[int(np.argmax(weights))], exact_solution)
         if lengthened:  # the long window's rounding of the reversals, as the half window sees it
-            solution = widened_by_sign_window(solution, solutions[0], solve(half), "shared")
+            solution = widened_by_sign_window(
+                solution, solutions[0], solve(half, standard_errors=False), "shared")
         shape_weights = ({shape: float(w) for shape, w in zip(shapes, weights, strict=True)}
                          if shapes else {})
         theta, std = solution.theta, solution.theta_std.copy()

@@ -121,7 +121,8 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
                         autocorrelated: bool = False,
                         regressor_noise: np.ndarray | None = None,
                         segments: Sequence[tuple[int, int]] | None = None,
-                        absorbed: int = 0) -> LeastSquaresSolution:
+                        absorbed: int = 0, standard_errors: bool = True
+                        ) -> LeastSquaresSolution:
     """Least squares for y(k) = theta phi(k) + sum_s c_s S_s(k), with standard errors.
 
     Channels share ``phi`` and are weighted by their residual variance from a first pass.
@@ -146,6 +147,9 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
     absorbed : int
         Rows' worth of freedom taken by regressors already projected out of ``phi``, ``y`` and
         ``shared`` (their coefficients free per channel).
+    standard_errors : bool
+        False: the estimates and residuals only, ``theta_std`` and ``shared_std`` NaN (a fit
+        that only moves another's errors).
 
     Raises
     ------
@@ -221,9 +225,15 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
     # floor: exact (noise-free) data must not produce infinite weights
     sigma = np.maximum(sigma, 1e-12 * scale_y)
     theta, c, residual, N, Tf, condition, scale = solve(1.0 / sigma ** 2)
-    Ns_inv = np.linalg.inv(N / np.outer(scale, scale)) / np.outer(scale, scale)
     tau = (np.array([integrated_autocorrelation(r) for r in residual.T]) if autocorrelated
            else np.ones(residual.shape[1]))
+    residual_rms = np.sqrt(np.mean(residual ** 2, axis=0))
+    if not standard_errors:
+        return LeastSquaresSolution(
+            theta=theta, theta_std=np.full_like(theta, np.nan), shared=c,
+            shared_std=np.full_like(c, np.nan), condition_number=condition,
+            residual_rms=residual_rms, n_equations=K, effective_equations=K / tau)
+    Ns_inv = np.linalg.inv(N / np.outer(scale, scale)) / np.outer(scale, scale)
     sigma2 = np.sum(residual ** 2, axis=0) / dof * tau
     cov_full = float(np.mean(sigma2 / sigma ** 2)) * (Tf @ Ns_inv @ Tf.T)
     if segments is not None:  # the residual lacks the projected-out share of the noise
@@ -232,7 +242,7 @@ def solve_least_squares(phi: np.ndarray, y: np.ndarray, shared: np.ndarray | Non
     std = np.sqrt(np.clip(np.diag(cov_full), 0.0, None))
     return LeastSquaresSolution(
         theta=theta, theta_std=std[:6 * p].reshape(6, p), shared=c, shared_std=std[6 * p:],
-        condition_number=condition, residual_rms=np.sqrt(np.mean(residual ** 2, axis=0)),
+        condition_number=condition, residual_rms=residual_rms,
         n_equations=K, effective_equations=K / tau)
 
 

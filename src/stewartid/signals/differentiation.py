@@ -127,23 +127,25 @@ def convolve_valid(x: np.ndarray, kernels: Sequence[np.ndarray],
     length = len(kernels[0])
     tail = x.shape[1:]
     flat = x.reshape(len(x), -1)
+    columns = flat.shape[1]
     n_out = len(x) - length + 1
     nfft = max(1024, 1 << int(math.ceil(math.log2(8 * length))))
     step = nfft - length + 1
-    spectra = [np.fft.rfft(k, nfft)[:, None] for k in kernels]
-    outputs = [np.empty((n_out, flat.shape[1])) for _ in kernels]
-    per_group = max(1, block_bytes // (8 * nfft * max(flat.shape[1], 1)))
+    spectra = [np.fft.rfft(k, nfft) for k in kernels]
+    outputs = [np.empty((n_out, columns)) for _ in kernels]
+    per_group = max(1, block_bytes // (8 * nfft * max(columns, 1)))
     for start in range(0, n_out, per_group * step):
         stop = min(n_out, start + per_group * step)
         blocks = -(-(stop - start) // step)
         segment = flat[start:stop + length - 1]
-        padded = np.zeros(((blocks - 1) * step + nfft, flat.shape[1]))
-        padded[:len(segment)] = segment
-        windows = np.lib.stride_tricks.sliding_window_view(padded, nfft, axis=0)[::step]
-        transformed = np.fft.rfft(windows, axis=-1)  # (blocks, columns, nfft // 2 + 1)
+        # time on the last axis: every transform reads and writes contiguous samples
+        padded = np.zeros((columns, (blocks - 1) * step + nfft))
+        padded[:, :len(segment)] = segment.T
+        windows = np.lib.stride_tricks.sliding_window_view(padded, nfft, axis=1)[:, ::step]
+        transformed = np.fft.rfft(windows, axis=-1)  # (columns, blocks, nfft // 2 + 1)
         for spectrum, out in zip(spectra, outputs, strict=True):
-            y = np.fft.irfft(transformed * spectrum.T[None], nfft, axis=-1)[..., length - 1:]
-            out[start:stop] = y.transpose(0, 2, 1).reshape(-1, flat.shape[1])[:stop - start]
+            y = np.fft.irfft(transformed * spectrum, nfft, axis=-1)[..., length - 1:]
+            out[start:stop] = y.reshape(columns, -1)[:, :stop - start].T
     return [out.reshape((n_out,) + tail) for out in outputs]
 
 

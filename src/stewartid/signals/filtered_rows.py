@@ -11,23 +11,33 @@ BLOCK_ROWS = 24
 
 
 def kernel_filter_rows(x: np.ndarray, sample_rate: float, window: float, step: int = 1,
-                       exponent: int = KERNEL_EXPONENT, time_last: bool = False) -> np.ndarray:
-    """``kernel_filter(x, ...)[0][::step]`` by direct sums, for many columns and few rows.
+                       exponent: int = KERNEL_EXPONENT, time_last: bool = False,
+                       derivative: int = 0) -> np.ndarray:
+    """``kernel_filter(x, ..., derivatives=derivative)[derivative][::step]`` by direct sums, for
+    many columns and few rows.
 
     Blocks of kept rows go through one banded matrix product. ``x`` (N, ...), or (..., N) with time
-    on the last axis of input and result when ``time_last``; ``window`` W in s, ``exponent`` p >= 3.
+    on the last axis of input and result when ``time_last``; ``window`` W in s, ``exponent`` p >= 3;
+    ``derivative`` 0, 1 or 2: rows of x * h, x * h' or x * h'' (x, x/s, x/s^2).
     Rows are aligned with samples L//2, L//2 + step, ...
     """
     x = np.asarray(x, dtype=float)
-    taps = kernel_taps(sample_rate, window, 0, exponent)[0]
+    kernel = kernel_taps(sample_rate, window, derivative, exponent)[derivative]
+    taps = kernel[::-1]  # a convolution (h and h'' are even, h' odd)
     length = len(taps)
     samples = x.shape[-1] if time_last else len(x)
     require_window(samples, length, window)
     flat = x.reshape(-1, samples) if time_last else x.reshape(samples, -1)
+    offset = None
+    if derivative:
+        # the mean filtered apart, as in kernel_filter: a derivative's round-off then scales
+        # with the motion, not with the position (metres of heave under millimetres of motion)
+        offset = flat.mean(axis=1 if time_last else 0)
+        flat = flat - (offset[:, None] if time_last else offset)
     starts = np.arange(0, samples - length + 1, step)
     out = np.empty((flat.shape[0], len(starts)) if time_last else (len(starts), flat.shape[1]))
-    # blocks of rows as one banded matrix product (the taps are symmetric: no flip); 24 rows
-    # a block: the zeros of the band cost more in larger blocks than BLAS gains from them
+    # blocks of rows as one banded matrix product; 24 rows a block: the zeros of the band cost
+    # more in larger blocks than BLAS gains from them
     block = max(1, min(len(starts), length // step, BLOCK_ROWS))
     span = (block - 1) * step + length
     band = np.zeros((block, span))
@@ -41,6 +51,8 @@ def kernel_filter_rows(x: np.ndarray, sample_rate: float, window: float, step: i
             out[:, first:first + rows] = flat[:, start:stop] @ band[:rows, :stop - start].T
         else:
             out[first:first + rows] = band[:rows, :stop - start] @ flat[start:stop]
+    if offset is not None:
+        out += (offset[:, None] if time_last else offset) * np.sum(kernel)
     if time_last:
         return out.reshape(x.shape[:-1] + (len(starts),))
     return out.reshape((len(out),) + x.shape[1:])

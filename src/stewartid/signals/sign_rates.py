@@ -39,23 +39,27 @@ def sign_window(q: np.ndarray, sample_rate: float, window: float, pose_noise: np
     return window * SIGN_FRACTIONS[max(index - shorter, 0)]
 
 
-def shorter_sign_window(window: float, chosen: float, shorter: int = 1) -> float:
-    """The candidate of :func:`sign_window` ``shorter`` steps below its choice ``chosen`` (s)
-    for the kernel ``window`` (s), never below the first: its ``shorter`` argument, without
-    measuring the rates again."""
-    index = int(np.argmin(np.abs(np.asarray(SIGN_FRACTIONS) - chosen / window)))
-    return window * SIGN_FRACTIONS[max(index - shorter, 0)]
-
-
 def coulomb_sign_rates(q: np.ndarray, sample_rate: float, window: float,
                        pose_noise: np.ndarray, noise_limit: float = SIGN_NOISE,
-                       shorter: int = 0, chosen: float | None = None
-                       ) -> tuple[np.ndarray, float]:
+                       shorter: int = 0) -> tuple[np.ndarray, float]:
     """The pose rates (N, 6) the Coulomb signs are taken from, and their Savitzky-Golay window
-    (s, :func:`sign_window` of the arguments, or ``chosen`` when given)."""
-    if chosen is None:
-        chosen = sign_window(q, sample_rate, window, pose_noise, noise_limit, shorter)
-    return differentiate(q, sample_rate, chosen, SIGN_ORDER, (1,))[0], chosen
+    (s, :func:`sign_window` of the arguments)."""
+    chosen = sign_window(q, sample_rate, window, pose_noise, noise_limit, shorter)
+    return sign_rates(q, sample_rate, chosen), chosen
+
+
+def sign_rates(q: np.ndarray, sample_rate: float, sign_window: float) -> np.ndarray:
+    """The pose rates (N, 6) of ``q`` (N, 6) over a Savitzky-Golay window of ``sign_window`` s,
+    the Coulomb signs' order."""
+    return differentiate(q, sample_rate, sign_window, SIGN_ORDER, (1,))[0]
+
+
+def shorter_sign_window(window: float, sign_window: float, shorter: int = 1) -> float:
+    """The candidate of ``window`` (s) ``shorter`` places shorter than ``sign_window`` (s, one of
+    them), never below the first: :func:`sign_window` with ``shorter`` from its choice without,
+    for a refit that need not search the candidates again."""
+    index = int(np.argmin(np.abs(window * np.asarray(SIGN_FRACTIONS) - sign_window)))
+    return window * SIGN_FRACTIONS[max(index - shorter, 0)]
 
 
 def lengthened_by_noise(window: float, sign_window: float) -> bool:
@@ -65,4 +69,4 @@ def lengthened_by_noise(window: float, sign_window: float) -> bool:
 
 
 __all__ = ["SIGN_FRACTIONS", "SIGN_NOISE", "SIGN_ORDER", "coulomb_sign_rates",
-           "lengthened_by_noise", "shorter_sign_window", "sign_window"]
+           "lengthened_by_noise", "shorter_sign_window", "sign_rates", "sign_window"]

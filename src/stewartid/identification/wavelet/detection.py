@@ -23,7 +23,12 @@ from stewartid.signals.differentiation import (
     default_window,
     estimate_frequency,
 )
-from stewartid.signals.sign_rates import SIGN_NOISE, SIGN_ORDER, coulomb_sign_rates
+from stewartid.signals.sign_rates import (
+    SIGN_NOISE,
+    SIGN_ORDER,
+    coulomb_sign_rates,
+    sign_rates,
+)
 
 
 class Detection(NamedTuple):
@@ -216,9 +221,12 @@ def sign_rate_fields(experiment: Experiment, window: float, pose_covariance: np.
     """The Coulomb signs' rates, their noise levels and window, as :class:`Detection` fields,
     for the kernel ``window`` (s) and the pose noise (6, 6); ``mean_jacobian`` as
     :func:`~stewartid.identification.wavelet.noise.joint_rate_noise`; ``chosen``: the signs'
-    window (s) if already chosen, as :func:`~stewartid.signals.sign_rates.coulomb_sign_rates`."""
-    q_dot, window = coulomb_sign_rates(experiment.q, experiment.sample_rate, window,
-                                       pose_covariance, SIGN_NOISE_LIMIT, chosen=chosen)
+    window (s) if already chosen (:func:`~stewartid.signals.sign_rates.sign_rates` then)."""
+    if chosen is None:
+        q_dot, window = coulomb_sign_rates(experiment.q, experiment.sample_rate, window,
+                                           pose_covariance, SIGN_NOISE_LIMIT)
+    else:
+        q_dot, window = sign_rates(experiment.q, experiment.sample_rate, chosen), chosen
     jacobians = experiment.joint_jacobians
     level = joint_rate_noise(pose_covariance, experiment.sample_rate, window, jacobians,
                              experiment.leg_jacobian, SIGN_ORDER, mean_jacobian)
