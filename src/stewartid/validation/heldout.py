@@ -459,6 +459,11 @@ def validation_entry(held_out: ValidationResult, records: ValidationResult | Non
     return entry
 
 
+#: Eigenvalues of the Coulomb regressors' normal matrix below this fraction of the largest are
+#: taken as zero by :func:`friction_signature` (a joint type that never moves).
+SIGNATURE_RANK_CUT = 1e-12
+
+
 def friction_signature(validation: ValidationResult) -> float:
     """Share of the held-out residual shaped like Coulomb joint friction: 0 none, near 1
     mostly friction the model lacks (RMS-scaled residuals fitted with the three Coulomb regressors).
@@ -467,16 +472,23 @@ def friction_signature(validation: ValidationResult) -> float:
     scale = np.sqrt(np.mean(measured ** 2, axis=0))
     scale = np.where(scale > 0, scale, 1.0)
     residual = (measured - np.concatenate(validation.predicted)) / scale
-    regressors = np.concatenate([s.coulomb - s.coulomb.mean(axis=0)
-                                 for s in validation.segments]) / scale
-    design = np.transpose(regressors, (0, 2, 1)).reshape(-1, regressors.shape[1])
-    target = residual.reshape(-1)
-    energy = float(target @ target)
+    energy = float(np.sum(residual ** 2))
     if energy == 0:
         return 0.0
-    coefficients, *_ = np.linalg.lstsq(design, target, rcond=None)
-    left = target - design @ coefficients
-    return float(1.0 - left @ left / energy)
+    # the fitted share from the regressors' normal equations (a few columns over many rows),
+    # summed segment by segment and channel by channel: R_c^T R_c and R_c^T r_c
+    types = validation.segments[0].coulomb.shape[1]
+    gram, rhs, start = np.zeros((types, types)), np.zeros(types), 0
+    for segment in validation.segments:
+        rows = segment.coulomb - segment.coulomb.mean(axis=0)             # (n, types, 6)
+        columns = np.ascontiguousarray((rows / scale).transpose(2, 1, 0))  # (6, types, n)
+        gram += (columns @ columns.transpose(0, 2, 1)).sum(axis=0)
+        rhs += np.einsum("ctn,nc->t", columns, residual[start:start + len(rows)])
+        start += len(rows)
+    values, vectors = np.linalg.eigh(gram)
+    kept = values > SIGNATURE_RANK_CUT * max(values[-1], 0.0)
+    projected = vectors[:, kept].T @ rhs
+    return float(np.sum(projected ** 2 / values[kept]) / energy)
 
 
 def in_sample(segments: Sequence[Segment], result: IdentificationResult) -> ValidationResult:
