@@ -39,6 +39,7 @@ from stewartid.identification.result import IdentificationResult
 from stewartid.model.linearization import nominal_matrices
 from stewartid.parallel import inheriting_workers, one_blas_thread, run_in_order
 from stewartid.platform import Platform, load_platform
+from stewartid.signals.differentiation import acceleration_frequency
 from stewartid.validation.heldout import DEFAULT_FOLDS, ResidualDelay, Segment, ValidationResult
 from stewartid.verdict.policy import (
     DEFAULT_POLICY,
@@ -459,6 +460,9 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
                    key=lambda task: LONGEST_FIRST.index(task) if task in LONGEST_FIRST
                    else len(LONGEST_FIRST))
     workers = inheriting_workers(jobs, len(tasks))
+    if workers > 1:  # every task asks for the records' frequencies: found once, inherited
+        for dataset in datasets:
+            acceleration_frequency(dataset.pose, dataset.sample_rate)
     done = _assembled(names, physical, dict(zip(
         tasks, run_in_order(_run_task, tasks, workers, shared=work), strict=True)))
     if workers > 1:
