@@ -51,10 +51,18 @@ class FigureDrawer:
         workers = inheriting_workers(jobs, len(pending))
         if workers > 1:
             _load_matplotlib()
-        for written in run_in_order(_draw, range(len(pending)), workers,
-                                    shared=(self.folder, pending)):
-            self.files += written
+        # the longest first, so that the workers finish together; the files in report order
+        order = sorted(range(len(pending)), key=lambda k: DRAWN_FIRST.index(pending[k][0])
+                       if pending[k][0] in DRAWN_FIRST else len(DRAWN_FIRST))
+        written = dict(zip(order, run_in_order(_draw, order, workers,
+                                               shared=(self.folder, pending)), strict=True))
+        for k in range(len(pending)):
+            self.files += written[k]
         return self.files
+
+
+#: The figures that take longest to draw (many panels and lines), in that order.
+DRAWN_FIRST = ("excitation", "residuals", "workspace", "spectrum", "validation", "joint_rates")
 
 
 def _load_matplotlib() -> None:
