@@ -217,16 +217,18 @@ def excitation_per_dof(datasets: Sequence[Dataset], platform: Platform) -> np.nd
     for kind in (slice(0, 6), slice(6, 12)):
         if np.max(norms[kind], initial=0.0) > 0:
             phi[:, kind] /= np.max(norms[kind])
+    # on the Gram matrix (pivoted Cholesky): each step's diagonal is the remaining columns'
+    # squared norms after projecting out those picked, to round-off of the largest norm's
+    # square (far below the MIN_RELATIVE_EXCITATION squared this decides on)
+    gram = phi.T @ phi
     remaining = list(range(12))
     while remaining:
-        sizes = np.linalg.norm(phi[:, remaining], axis=0)
+        sizes = np.sqrt(np.clip(np.diag(gram)[remaining], 0.0, None))
         pick = remaining.pop(int(np.argmax(sizes)))
         independent[pick] = np.max(sizes)
         if not remaining or independent[pick] == 0:
             break
-        direction = phi[:, pick] / independent[pick]
-        for _ in range(2):  # twice: orthogonal to round-off even after large cancellations
-            phi[:, remaining] -= np.outer(direction, direction @ phi[:, remaining])
+        gram -= np.outer(gram[:, pick], gram[pick]) / gram[pick, pick]
     return np.minimum(independent[:6], independent[6:])
 
 
