@@ -14,7 +14,13 @@ from stewartid.datasets.distinct import check_distinct_experiments
 from stewartid.errors import DataError
 from stewartid.model.kinematics import compute_leg_terms
 from stewartid.platform import COORDINATES, Platform
-from stewartid.signals.differentiation import default_window, differentiate, trim
+from stewartid.signals.differentiation import (
+    DEFAULT_ORDER,
+    default_window,
+    savgol_coefficients,
+    window_samples,
+)
+from stewartid.signals.filtered_rows import convolved_rows
 
 #: A spectral line counts when its amplitude reaches this fraction of the largest line's:
 #: above the Hann window's highest sidelobe (2.7 % of its line).
@@ -195,12 +201,13 @@ def _regressors(dataset: Dataset, scales: np.ndarray, platform: Platform) -> np.
     if not len(lines):
         return np.zeros((0, 12))
     window = min(default_window(float(np.max(lines.frequencies_hz))), dataset.duration / 4)
-    velocity, acceleration = differentiate(dataset.pose - dataset.pose.mean(axis=0),
-                                           dataset.sample_rate, window, derivatives=(1, 2))
-    cut = trim(window, dataset.sample_rate)
-    stride = max(1, int(np.ceil((len(dataset) - 2 * cut) / CHECK_SAMPLES)))
-    rows = slice(cut, len(dataset) - cut, stride)
-    return np.concatenate([velocity[rows] * scales, acceleration[rows] * scales], axis=1)
+    taps = window_samples(window, dataset.sample_rate)
+    stride = max(1, int(np.ceil((len(dataset) - 2 * (taps // 2)) / CHECK_SAMPLES)))
+    # the Savitzky-Golay derivatives at the kept rows only, by direct sums
+    centred = dataset.pose - dataset.pose.mean(axis=0)
+    velocity, acceleration = (convolved_rows(centred, savgol_coefficients(
+        taps, DEFAULT_ORDER, k, 1.0 / dataset.sample_rate), stride) for k in (1, 2))
+    return np.concatenate([velocity * scales, acceleration * scales], axis=1)
 
 
 def excitation_per_dof(datasets: Sequence[Dataset], platform: Platform) -> np.ndarray:

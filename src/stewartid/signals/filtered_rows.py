@@ -23,17 +23,25 @@ def kernel_filter_rows(x: np.ndarray, sample_rate: float, window: float, step: i
     """
     x = np.asarray(x, dtype=float)
     kernel = kernel_taps(sample_rate, window, derivative, exponent)[derivative]
-    taps = kernel[::-1]  # a convolution (h and h'' are even, h' odd)
+    samples = x.shape[-1] if time_last else len(x)
+    require_window(samples, len(kernel), window)
+    if not derivative:
+        return convolved_rows(x, kernel, step, time_last)
+    # the mean filtered apart, as in kernel_filter: a derivative's round-off then scales with
+    # the motion, not with the position (metres of heave under millimetres of motion)
+    offset = x.mean(axis=-1, keepdims=True) if time_last else x.mean(axis=0)
+    return convolved_rows(x - offset, kernel, step, time_last) + offset * np.sum(kernel)
+
+
+def convolved_rows(x: np.ndarray, kernel: np.ndarray, step: int = 1,
+                   time_last: bool = False) -> np.ndarray:
+    """``np.convolve(x, kernel, "valid")[::step]`` along time, by direct sums: kept row k at
+    samples k step ... k step + L - 1 of ``x`` (N, ...), or (..., N) with time on the last axis
+    of input and result when ``time_last``; ``kernel`` (L,) with L <= N."""
+    taps = np.asarray(kernel, dtype=float)[::-1]
     length = len(taps)
     samples = x.shape[-1] if time_last else len(x)
-    require_window(samples, length, window)
     flat = x.reshape(-1, samples) if time_last else x.reshape(samples, -1)
-    offset = None
-    if derivative:
-        # the mean filtered apart, as in kernel_filter: a derivative's round-off then scales
-        # with the motion, not with the position (metres of heave under millimetres of motion)
-        offset = flat.mean(axis=1 if time_last else 0)
-        flat = flat - (offset[:, None] if time_last else offset)
     starts = np.arange(0, samples - length + 1, step)
     out = np.empty((flat.shape[0], len(starts)) if time_last else (len(starts), flat.shape[1]))
     # blocks of rows as one banded matrix product; 24 rows a block: the zeros of the band cost
@@ -51,11 +59,9 @@ def kernel_filter_rows(x: np.ndarray, sample_rate: float, window: float, step: i
             out[:, first:first + rows] = flat[:, start:stop] @ band[:rows, :stop - start].T
         else:
             out[first:first + rows] = band[:rows, :stop - start] @ flat[start:stop]
-    if offset is not None:
-        out += (offset[:, None] if time_last else offset) * np.sum(kernel)
     if time_last:
         return out.reshape(x.shape[:-1] + (len(starts),))
     return out.reshape((len(out),) + x.shape[1:])
 
 
-__all__ = ["BLOCK_ROWS", "kernel_filter_rows"]
+__all__ = ["BLOCK_ROWS", "convolved_rows", "kernel_filter_rows"]
