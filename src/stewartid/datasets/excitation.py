@@ -112,12 +112,23 @@ def channel_lines(motion: np.ndarray, sample_rate: float, fraction: float = LINE
                   padding: int = 4) -> list[SpectralLines]:
     """:func:`spectral_lines` of each channel of ``motion`` (N, m) on its own, the same numbers
     from one transform of every channel (``padding`` as there)."""
+    spectra, nfft = _channel_spectra(motion, padding)
+    return _lines_of(spectra, len(motion), nfft, sample_rate, fraction)
+
+
+def _channel_spectra(motion: np.ndarray, padding: int) -> tuple[np.ndarray, int]:
+    """Each channel's Hann-windowed transform (m, nfft // 2 + 1) of ``motion`` (N, m), mean and
+    drift removed, and the transform's length."""
     x = np.asarray(motion, dtype=float)
-    n = len(x)
-    nfft = _padded_length(n, padding)
+    nfft = _padded_length(len(x), padding)
     windowed = np.column_stack([_windowed(x[:, [k]]) for k in range(x.shape[1])])
     # each channel's transform on contiguous samples (time last): the same numbers
-    spectra = np.fft.rfft(np.ascontiguousarray(windowed.T), nfft, axis=1)
+    return np.fft.rfft(np.ascontiguousarray(windowed.T), nfft, axis=1), nfft
+
+
+def _lines_of(spectra: np.ndarray, n: int, nfft: int, sample_rate: float,
+              fraction: float) -> list[SpectralLines]:
+    """:func:`channel_lines` from the channels' transforms (:func:`_channel_spectra`)."""
     return [_peaks(np.sqrt(np.abs(spectrum) ** 2), n, nfft, sample_rate, fraction)
             for spectrum in spectra]
 
@@ -193,11 +204,18 @@ def _peaks(amplitude: np.ndarray, n: int, nfft: int, sample_rate: float,
                          resolution, float(heights.max()))
 
 
-def _regressors(dataset: Dataset, scales: np.ndarray, platform: Platform) -> np.ndarray:
-    """Strided, scaled [q_dot, q_ddot] of one experiment, shape (n, 12)."""
+def _regressors(dataset: Dataset, jacobian: np.ndarray, scales: np.ndarray) -> np.ndarray:
+    """Strided, scaled [q_dot, q_ddot] of one experiment, shape (n, 12); ``jacobian``: J_lq(q0).
+
+    The pose channels' unpadded transforms give the leg-space motion's fastest line (the
+    transform is linear: J_lq(q0) times the pose's) and, kept with the record, the pose lines
+    :func:`excitation_lines` counts."""
+    spectra, nfft = _channel_spectra(dataset.pose, COUNTING_PADDING)
+    dataset.derived(("pose lines", LINE_THRESHOLD, COUNTING_PADDING), lambda d: _lines_of(
+        spectra, len(d), nfft, d.sample_rate, LINE_THRESHOLD))
     # the fastest line sets the differentiation window, which needs it only roughly
-    lines = spectral_lines(leg_space_motion(dataset.pose, platform), dataset.sample_rate,
-                           padding=1)
+    amplitude = np.sqrt(np.sum(np.abs(jacobian @ spectra) ** 2, axis=0))
+    lines = _peaks(amplitude, len(dataset), nfft, dataset.sample_rate, LINE_FRACTION)
     if not len(lines):
         return np.zeros((0, 12))
     window = min(default_window(float(np.max(lines.frequencies_hz))), dataset.duration / 4)
@@ -217,8 +235,9 @@ def excitation_per_dof(datasets: Sequence[Dataset], platform: Platform) -> np.nd
     Gram-Schmidt); a DOF's measure is the smaller unexplained norm of its two. Standard errors of
     column k of Mt and Bt scale with its inverse.
     """
-    scales = dof_scales(platform)
-    phi = np.concatenate([_regressors(d, scales, platform) for d in datasets])
+    _, jacobian, _, _ = compute_leg_terms(platform, platform.neutral_pose[None].copy())
+    scales = np.linalg.norm(jacobian[0], axis=0)   # dof_scales
+    phi = np.concatenate([_regressors(d, jacobian[0], scales) for d in datasets])
     independent = np.zeros(12)
     norms = np.linalg.norm(phi, axis=0)
     for kind in (slice(0, 6), slice(6, 12)):
@@ -283,6 +302,10 @@ def check_experiment_set(datasets: Sequence[Dataset], platform: Platform) -> Non
 #: this fraction of the DOF's largest line (over all experiments).
 LINE_THRESHOLD = 0.1
 
+#: The transform padding (:func:`spectral_lines`) of the lines :func:`excitation_lines` only
+#: counts: the unpadded transform, several times cheaper, places them well enough for that.
+COUNTING_PADDING = 1
+
 #: Lines closer than this many frequency resolutions (1 / record length) are one line.
 LINE_MERGE_BINS = 3.0
 
@@ -320,6 +343,7 @@ def _pose_lines(dataset: Dataset, threshold: float, padding: int) -> list[Spectr
         d.pose, d.sample_rate, fraction=threshold, padding=padding))
 
 
-__all__ = ["LINE_FRACTION", "LINE_MERGE_BINS", "LINE_THRESHOLD", "MIN_RELATIVE_EXCITATION",
-           "SpectralLines", "channel_lines", "check_excitation", "check_experiment_set", "dof_scales",
-           "excitation_lines", "excitation_per_dof", "leg_space_motion", "spectral_lines"]
+__all__ = ["COUNTING_PADDING", "LINE_FRACTION", "LINE_MERGE_BINS", "LINE_THRESHOLD",
+           "MIN_RELATIVE_EXCITATION", "SpectralLines", "channel_lines", "check_excitation",
+           "check_experiment_set", "dof_scales", "excitation_lines", "excitation_per_dof",
+           "leg_space_motion", "spectral_lines"]

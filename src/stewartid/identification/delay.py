@@ -14,7 +14,7 @@ import numpy as np
 
 from stewartid.datasets.alignment import align_forces
 from stewartid.datasets.dataset import Dataset
-from stewartid.datasets.excitation import excitation_lines
+from stewartid.datasets.excitation import COUNTING_PADDING, excitation_lines
 from stewartid.errors import ConfigError, IdentificationError
 from stewartid.identification.least_squares import (
     coulomb_regressors,
@@ -109,11 +109,6 @@ def delay_bias_per_ms(platform: Platform | np.ndarray, frequencies_hz: Sequence[
     return 1e-3 * (w ** 2 * np.diag(M) + np.diag(K))
 
 
-#: The transform padding of the excitation lines where they are only counted (and a single
-#: line's frequency sets a bias per ms): the unpadded transform, several times cheaper.
-COUNTING = 1
-
-
 def single_frequency_dofs(lines: Sequence[Sequence[float]]) -> list[int]:
     """The DOFs (0-5) whose excitation lines are fewer than two: where a force delay and
     damping cannot be told apart."""
@@ -123,7 +118,7 @@ def single_frequency_dofs(lines: Sequence[Sequence[float]]) -> list[int]:
 def delay_identifiable(datasets: Sequence[Dataset]) -> bool:
     """Whether the experiments tell a force delay from damping: two or more excitation lines
     in every DOF (what :func:`estimate_delay` requires)."""
-    return not single_frequency_dofs(excitation_lines(datasets, padding=COUNTING))
+    return not single_frequency_dofs(excitation_lines(datasets, padding=COUNTING_PADDING))
 
 
 def single_frequency_bias(datasets: Sequence[Dataset], platform: Platform,
@@ -134,7 +129,7 @@ def single_frequency_bias(datasets: Sequence[Dataset], platform: Platform,
     Returns None when every DOF moves at two or more frequencies, else ``{"dofs", "frequencies_hz",
     "bt_diagonal_per_ms"}``. ``lines``: the excitation lines per DOF, if already found.
     """
-    lines = excitation_lines(datasets, padding=COUNTING) if lines is None else lines
+    lines = excitation_lines(datasets, padding=COUNTING_PADDING) if lines is None else lines
     single = single_frequency_dofs(lines)
     if not single:
         return None
@@ -370,7 +365,7 @@ def apply_delay(datasets: Sequence[Dataset], platform: Platform, delay: str | fl
     return align_forces(datasets, float(delay)), entry
 
 
-__all__ = ["AUTO", "COUNTING", "DelayEstimate", "apply_delay", "check_delay_identifiable",
+__all__ = ["AUTO", "DelayEstimate", "apply_delay", "check_delay_identifiable",
            "delay_bias_per_ms", "delay_identifiable", "describe_bias", "estimate_delay",
            "fit_delay", "parse_delay", "shared_least_squares", "single_frequency_bias",
            "single_frequency_dofs"]
