@@ -64,9 +64,9 @@ def identify(
                              "extra.")] = False,
     jobs: Annotated[int | None, typer.Option(
         "--jobs", metavar="N", help="Worker processes: the methods fitted side by side with "
-        "--report, the experiments prepared side by side by Method B and least squares "
-        "(default: every core, where workers start by fork); the results do not depend on "
-        "it.")] = None,
+        "--report, the experiments prepared side by side by Method B and least squares, and "
+        "Method B's friction models solved side by side (default: every core, where workers "
+        "start by fork); the results do not depend on it.")] = None,
     folds: Annotated[int | None, typer.Option(
         "--folds", metavar="N", help="--report: time segments per experiment for the validation "
                         "(default 3).")] = None,
