@@ -68,16 +68,19 @@ class SpectralLines:
         return ", ".join(f"{f:.{decimals}f}" for f in np.sort(self.frequencies_hz)) + " Hz"
 
 
+def neutral_jacobian(platform: Platform) -> np.ndarray:
+    """J_lq(q0), shape (6, 6): leg-length change per unit motion at the neutral pose."""
+    return compute_leg_terms(platform, platform.neutral_pose[None].copy())[1][0]
+
+
 def dof_scales(platform: Platform) -> np.ndarray:
     """Column norms of J_lq(q0), shape (6,): leg-length change per unit motion (m/m, m/rad)."""
-    _, jacobian, _, _ = compute_leg_terms(platform, platform.neutral_pose[None].copy())
-    return np.linalg.norm(jacobian[0], axis=0)
+    return np.linalg.norm(neutral_jacobian(platform), axis=0)
 
 
 def leg_space_motion(pose: np.ndarray, platform: Platform) -> np.ndarray:
     """Pose (N, 6), m, rad, as the leg-length change it causes, J_lq(q0) (q - mean q), (N, 6) m."""
-    _, jacobian, _, _ = compute_leg_terms(platform, platform.neutral_pose[None].copy())
-    return (pose - pose.mean(axis=0)) @ jacobian[0].T
+    return (pose - pose.mean(axis=0)) @ neutral_jacobian(platform).T
 
 
 def spectral_lines(motion: np.ndarray, sample_rate: float,
@@ -235,9 +238,9 @@ def excitation_per_dof(datasets: Sequence[Dataset], platform: Platform) -> np.nd
     Gram-Schmidt); a DOF's measure is the smaller unexplained norm of its two. Standard errors of
     column k of Mt and Bt scale with its inverse.
     """
-    _, jacobian, _, _ = compute_leg_terms(platform, platform.neutral_pose[None].copy())
-    scales = np.linalg.norm(jacobian[0], axis=0)   # dof_scales
-    phi = np.concatenate([_regressors(d, jacobian[0], scales) for d in datasets])
+    jacobian = neutral_jacobian(platform)
+    scales = np.linalg.norm(jacobian, axis=0)
+    phi = np.concatenate([_regressors(d, jacobian, scales) for d in datasets])
     independent = np.zeros(12)
     norms = np.linalg.norm(phi, axis=0)
     for kind in (slice(0, 6), slice(6, 12)):
@@ -346,4 +349,4 @@ def _pose_lines(dataset: Dataset, threshold: float, padding: int) -> list[Spectr
 __all__ = ["COUNTING_PADDING", "LINE_FRACTION", "LINE_MERGE_BINS", "LINE_THRESHOLD",
            "MIN_RELATIVE_EXCITATION", "SpectralLines", "channel_lines", "check_excitation",
            "check_experiment_set", "dof_scales", "excitation_lines", "excitation_per_dof",
-           "leg_space_motion", "spectral_lines"]
+           "leg_space_motion", "neutral_jacobian", "spectral_lines"]
