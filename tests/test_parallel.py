@@ -11,7 +11,9 @@ import pytest
 
 from stewartid.parallel import WORKERS_INHERIT, WorkerPool, run_in_order
 
-needs_fork = pytest.mark.skipif(not WORKERS_INHERIT, reason="workers start by fork only")
+#: Two workers on a platform that starts them by fork (the inline pool runs everywhere).
+TWO_FORKED = pytest.param(2, marks=pytest.mark.skipif(
+    not WORKERS_INHERIT, reason="the test's tasks reach forked workers only"))
 
 
 def _offset_square(shared: int, task: int) -> int:
@@ -28,8 +30,7 @@ def _refused(label: str) -> str:
     raise ValueError(f"refused {label}")
 
 
-@needs_fork
-@pytest.mark.parametrize("workers", [1, 2])
+@pytest.mark.parametrize("workers", [1, TWO_FORKED])
 def test_a_pool_keeps_task_order_over_rounds(workers):
     with WorkerPool(workers, 4, shared=100) as pool:
         first = pool.map_shared(_offset_square, range(4))
@@ -38,8 +39,7 @@ def test_a_pool_keeps_task_order_over_rounds(workers):
     assert second == [1, 2, 5, 10]
 
 
-@needs_fork
-@pytest.mark.parametrize("workers", [1, 2])
+@pytest.mark.parametrize("workers", [1, TWO_FORKED])
 def test_warnings_of_workers_are_raised_here_in_task_order(workers):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -49,8 +49,8 @@ def test_warnings_of_workers_are_raised_here_in_task_order(workers):
     assert {w.category for w in caught} == {UserWarning}
 
 
-@needs_fork
-def test_a_failed_task_raises_its_error():
-    with pytest.raises(ValueError, match="refused b"), WorkerPool(2, 3) as pool:
-        pool.call_all([partial(_warned, "a"), partial(_refused, "b"), partial(_warned, "c")])
-    assert run_in_order(abs, [-1, 2, -3], workers=2) == [1, 2, 3]
+@pytest.mark.parametrize("workers", [1, TWO_FORKED])
+def test_a_failed_task_raises_its_error(workers):
+    with pytest.raises(ValueError, match="refused b"), WorkerPool(workers, 3) as pool:
+        pool.call_all([partial(abs, -1), partial(_refused, "b"), partial(abs, -3)])
+    assert run_in_order(abs, [-1, 2, -3], workers=workers) == [1, 2, 3]
