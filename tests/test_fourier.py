@@ -310,6 +310,24 @@ def test_estimate_frequency_transforms_only_channels_that_can_hold_the_peak():
         assert np.all(values[np.setdiff1d(np.arange(m), kept)] < values.max())
 
 
+def test_a_records_plain_peak_is_the_same_whether_asked_first_or_after_the_refined_frequency():
+    # a read-only record's refined estimate leaves its plain peak (refine=False) in the cache,
+    # from its coarse spectrum: it must be what the plain estimate computes on its own
+    rng = np.random.default_rng(5)
+    fs = 500.0
+    for _ in range(30):
+        n, m = int(rng.integers(300, 5000)), int(rng.integers(1, 7))
+        t = np.arange(n) / fs
+        x = np.column_stack([rng.choice([1e-3, 1.0]) * np.sin(
+            2 * np.pi * rng.uniform(0.5, 30) * t + rng.uniform(0, 6)) for _ in range(m)])
+        x += 1e-2 * rng.standard_normal(x.shape) * np.std(x, axis=0)
+        plain = estimate_frequency(x.copy(), fs, refine=False)
+        record = x.copy()
+        record.flags.writeable = False
+        estimate_frequency(record, fs)
+        assert estimate_frequency(record, fs, refine=False) == plain
+
+
 def test_acceleration_frequency_takes_the_line_of_largest_acceleration():
     # a pitch record of three sines of falling amplitude (0.6, 0.3, 0.15 at 0.3, 0.7, 1.5 Hz):
     # the 0.3 Hz line is the largest, the 1.5 Hz one carries the most acceleration (0.15 x 1.5^2

@@ -242,10 +242,11 @@ def estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool = True) -
         kind = "dominant" if refine else "peak"
         value = _cached(x, sample_rate, kind)
         if value is None:
-            value, fastest = _estimate_frequency(x, sample_rate, refine)
+            value, fastest, peak = _estimate_frequency(x, sample_rate, refine)
             _store(x, sample_rate, kind, value)
             if fastest is not None:  # for acceleration_frequency, from the same spectrum
                 _store(x, sample_rate, "fastest", fastest)
+                _store(x, sample_rate, "peak", peak)  # its coarse grid is the plain peak's
         return value
     return _estimate_frequency(x, sample_rate, refine)[0]
 
@@ -290,24 +291,26 @@ def _store(x: np.ndarray, sample_rate: float, kind: str, value: Any) -> None:
 
 
 def _estimate_frequency(x: np.ndarray, sample_rate: float, refine: bool
-                        ) -> tuple[float, tuple[np.ndarray, float] | None]:
-    """The dominant frequency and, refined, the start of :func:`acceleration_frequency`'s
-    refinement: the dominant channel (N,) and its line of largest acceleration (Hz)."""
-    centered, spectrum, nfft, channel, median = _channel_spectra(x, sample_rate, refine)
+                        ) -> tuple[float, tuple[np.ndarray, float] | None, float]:
+    """The dominant frequency; refined, the start of :func:`acceleration_frequency`'s
+    refinement (the dominant channel (N,) and its line of largest acceleration, Hz), else None;
+    the plain peak (``refine=False``'s frequency)."""
+    centered, spectrum, nfft, channel, median, peak = _channel_spectra(x, sample_rate, refine)
     frequency = (int(np.argmax(spectrum)) + 1) * sample_rate / nfft
     if not refine:
-        return frequency, None
+        return frequency, None, frequency
     column = centered[:, channel]
     fastest = (_fastest_line(spectrum, median) + 1) * sample_rate / nfft
     # a copy: the view would keep every channel alive in the record's cache
-    return _refine_frequency(column, sample_rate, frequency), (column.copy(), fastest)
+    return _refine_frequency(column, sample_rate, frequency), (column.copy(), fastest), peak
 
 
 def _channel_spectra(x: np.ndarray, sample_rate: float, refine: bool
-                     ) -> tuple[np.ndarray, np.ndarray, int, int, float]:
+                     ) -> tuple[np.ndarray, np.ndarray, int, int, float, float]:
     """Centred channels (N, m); the spectrum of the channel of the dominant line relative to its
     scale (nfft // 2; bin k at (k + 1) sample_rate / nfft); nfft; that channel; its median bin's
-    power on the same scale (white noise's level)."""
+    power on the same scale (white noise's level); the dominant line's frequency on the coarse
+    grid (Hz; ``refine=False``'s grid)."""
     x = np.asarray(x, dtype=float)
     x = x[:, None] if x.ndim == 1 else x
     centered = x - x.mean(axis=0)
@@ -321,7 +324,8 @@ def _channel_spectra(x: np.ndarray, sample_rate: float, refine: bool
     windowed = np.ascontiguousarray((centered * hann[:, None]).T)
     # a first spectrum on an eighth of the refined points (at least the record's): it gives each
     # channel's white-noise level and rules out channels whose peak cannot be the largest
-    coarse = np.abs(np.fft.rfft(windowed, nfft // 8 if refine else nfft, axis=1))
+    coarse_points = nfft // 8 if refine else nfft
+    coarse = np.abs(np.fft.rfft(windowed, coarse_points, axis=1))
     # compare channels by spectral peak relative to the channel's own scale: units differ; a
     # channel that moves only by round-off (a still DOF of a noise-free record) has no line.
     # The scale leaves out white noise (the same power in every bin: the median bin's, the lines
@@ -334,19 +338,27 @@ def _channel_spectra(x: np.ndarray, sample_rate: float, refine: bool
     if not moving.any():
         moving, scale = spread > ROUND_OFF_SPREAD * spread.max(), spread
     scale = np.where(moving, scale, np.inf)
+    on_coarse = coarse[:, 1:] / scale[:, None]
+    best = _dominant(on_coarse)
+    peak = (int(np.argmax(on_coarse[best])) + 1) * sample_rate / coarse_points
+    channels, relative = np.arange(len(scale)), on_coarse
     if refine:
         channels = _peak_channels(coarse / scale[:, None], n)
         relative = np.abs(np.fft.rfft(windowed[channels], nfft, axis=1)[:, 1:])
         relative /= scale[channels, None]
-    else:
-        channels, relative = np.arange(len(scale)), coarse[:, 1:] / scale[:, None]
-    # the largest, the lowest frequency and then the first channel of equal ones
+        best = _dominant(relative)
+    channel = int(channels[best])
+    return (centered, relative[best], nfft, channel, float(median[channel] / scale[channel] ** 2),
+            peak)
+
+
+def _dominant(relative: np.ndarray) -> int:
+    """The row of ``relative`` (channels' spectra) holding the largest value, of equal ones the
+    lowest frequency and then the first row."""
     peaks = np.argmax(relative, axis=1)
     values = relative[np.arange(len(peaks)), peaks]
     top = np.flatnonzero(values == values.max())
-    best = int(top[np.argmin(peaks[top])])
-    channel = int(channels[best])
-    return centered, relative[best], nfft, channel, float(median[channel] / scale[channel] ** 2)
+    return int(top[np.argmin(peaks[top])])
 
 
 #: Lines below this fraction of the dominant one's amplitude (harmonics, coupling) do not set
