@@ -3,6 +3,9 @@ in the calling process (where filters and records see them), failures passed on.
 
 from __future__ import annotations
 
+import multiprocessing
+import os
+import platform
 import time
 import warnings
 from functools import partial
@@ -54,3 +57,34 @@ def test_a_failed_task_raises_its_error(workers):
     with pytest.raises(ValueError, match="refused b"), WorkerPool(workers, 3) as pool:
         pool.call_all([partial(abs, -1), partial(_refused, "b"), partial(abs, -3)])
     assert run_in_order(abs, [-1, 2, -3], workers=workers) == [1, 2, 3]
+
+
+def _resident_after_freeing(megabytes: int) -> tuple[int, int]:
+    """This process's resident pages before and after a freshly written array of ``megabytes``
+    is freed."""
+    import numpy as np
+
+    def resident() -> int:
+        with open("/proc/self/statm") as statm:
+            return int(statm.read().split()[1])
+
+    block = np.ones(megabytes * (1 << 20) // 8)
+    holding = resident()
+    del block
+    return holding, resident()
+
+
+@pytest.mark.skipif(not WORKERS_INHERIT or platform.libc_ver()[0] != "glibc"
+                    or not os.path.exists("/proc/self/statm"),
+                    reason="glibc's allocator and /proc only")
+def test_workers_keep_freed_memory_for_their_next_task():
+    # a record's array freed in a worker stays mapped there for the next task (no page faults
+    # to take it again); in a process with the allocator's defaults the system takes it back
+    pages = (64 << 20) // os.sysconf("SC_PAGE_SIZE")
+    with WorkerPool(2, 2) as pool:
+        kept = pool.call_all([partial(_resident_after_freeing, 64)] * 2)
+    for holding, after in kept:
+        assert after > holding - pages // 8
+    with multiprocessing.get_context("spawn").Pool(1) as fresh:
+        holding, after = fresh.apply(_resident_after_freeing, (64,))
+    assert after < holding - pages // 2

@@ -4,6 +4,7 @@ for any worker count), every core by default, results in task order, progress pe
 
 from __future__ import annotations
 
+import ctypes
 import multiprocessing
 import os
 import warnings
@@ -46,10 +47,32 @@ def inheriting_workers(workers: int | None, tasks: int) -> int:
 
 def limit_worker_threads(initializer: Callable[..., Any] | None = None,
                          *initargs: Any) -> None:
-    """Worker initializer: one BLAS/OpenMP thread here, then ``initializer(*initargs)``."""
+    """Worker initializer: one BLAS/OpenMP thread here, freed memory kept for the next task
+    (:func:`keep_freed_memory`), then ``initializer(*initargs)``."""
     threadpool_limits(limits=1)
+    keep_freed_memory()
     if initializer is not None:
         initializer(*initargs)
+
+
+#: glibc's mallopt parameters: the trim threshold, the top pad and the mmap threshold.
+_M_TRIM_THRESHOLD, _M_TOP_PAD, _M_MMAP_THRESHOLD = -1, -2, -3
+
+
+def keep_freed_memory() -> bool:
+    """Have glibc's allocator keep this process's freed memory for its next allocations: a
+    worker's tasks allocate and free records' worth of arrays, and memory given back to the
+    system costs a page fault per page when taken again. Only for worker processes, which
+    end with their pool; returns False where the C library is not glibc.
+    """
+    try:
+        mallopt = ctypes.CDLL(None).mallopt
+    except (OSError, AttributeError):
+        return False
+    # every array from the heap (no mmap threshold below 1 GiB), and what is freed at its top
+    # kept there (trim threshold, top pad)
+    return all(mallopt(param, value) == 1 for param, value in (
+        (_M_MMAP_THRESHOLD, 1 << 30), (_M_TRIM_THRESHOLD, 1 << 30), (_M_TOP_PAD, 1 << 26)))
 
 
 def one_blas_thread() -> Any:
@@ -198,5 +221,5 @@ def _unshared(_: Any, task: tuple[Callable[[Any], Any], Any]) -> Any:
 
 
 __all__ = ["START_METHOD", "WORKERS_INHERIT", "WORKER_THREADS", "InlineExecutor", "TaskProgress",
-           "WorkerPool", "inheriting_workers", "limit_worker_threads", "one_blas_thread",
+           "WorkerPool", "inheriting_workers", "keep_freed_memory", "limit_worker_threads", "one_blas_thread",
            "process_pool", "run_in_order", "worker_count"]
