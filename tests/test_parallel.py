@@ -10,6 +10,7 @@ import time
 import warnings
 from functools import partial
 
+import numpy as np
 import pytest
 
 from stewartid.parallel import WORKERS_INHERIT, WorkerPool, run_in_order
@@ -62,8 +63,6 @@ def test_a_failed_task_raises_its_error(workers):
 def _resident_after_freeing(megabytes: int) -> tuple[int, int]:
     """This process's resident pages before and after a freshly written array of ``megabytes``
     is freed."""
-    import numpy as np
-
     def resident() -> int:
         with open("/proc/self/statm") as statm:
             return int(statm.read().split()[1])
@@ -88,3 +87,20 @@ def test_workers_keep_freed_memory_for_their_next_task():
     with multiprocessing.get_context("spawn").Pool(1) as fresh:
         holding, after = fresh.apply(_resident_after_freeing, (64,))
     assert after < holding - pages // 2
+
+
+#: numpy 2's switch of huge pages for large arrays, where it has one.
+_HUGE_PAGES = getattr(getattr(np, "_core", None), "multiarray", None)
+
+
+def _numpy_huge_pages() -> bool:
+    return bool(_HUGE_PAGES._get_madvise_hugepage())
+
+
+@pytest.mark.skipif(not WORKERS_INHERIT or not hasattr(_HUGE_PAGES, "_get_madvise_hugepage"),
+                    reason="forked workers and numpy 2's huge-page switch only")
+def test_workers_put_arrays_on_ordinary_pages_and_leave_the_caller_alone():
+    before = _numpy_huge_pages()
+    with WorkerPool(2, 2) as pool:
+        assert pool.call_all([_numpy_huge_pages] * 2) == [False, False]
+    assert _numpy_huge_pages() == before

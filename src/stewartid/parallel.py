@@ -14,6 +14,7 @@ from contextlib import ExitStack, contextmanager
 from functools import partial
 from typing import Any
 
+import numpy as np
 from threadpoolctl import threadpool_limits
 
 #: Thread counts of the numerical libraries in worker processes started by another library
@@ -60,11 +61,17 @@ _M_TRIM_THRESHOLD, _M_TOP_PAD, _M_MMAP_THRESHOLD = -1, -2, -3
 
 
 def keep_freed_memory() -> bool:
-    """Have glibc's allocator keep this process's freed memory for its next allocations: a
-    worker's tasks allocate and free records' worth of arrays, and memory given back to the
-    system costs a page fault per page when taken again. Only for worker processes, which
-    end with their pool; returns False where the C library is not glibc.
+    """Have glibc's allocator keep this process's freed memory for its next allocations, on
+    ordinary pages: a worker's tasks allocate and free records' worth of arrays, and memory
+    given back to the system costs a page fault per page when taken again. Only for worker
+    processes, which end with their pool; returns False where the C library is not glibc.
     """
+    # numpy asks for huge pages for large arrays; arrays written once or twice and then freed
+    # gain little from them, and a huge page's first touch zeroes and backs all 2 MiB at once
+    # (docs/benchmarks.md, "Memory in the workers")
+    core = getattr(np, "_core", None) or np.core  # numpy 2, then 1.26
+    if hasattr(core.multiarray, "_set_madvise_hugepage"):
+        core.multiarray._set_madvise_hugepage(False)
     try:
         mallopt = ctypes.CDLL(None).mallopt
     except (OSError, AttributeError):
