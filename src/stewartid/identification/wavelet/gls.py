@@ -233,17 +233,18 @@ def _size_groups(local: Sequence[np.ndarray]) -> list[tuple[int, np.ndarray]]:
 
 
 def _eliminate_local(local: Sequence[np.ndarray], designs: Sequence[np.ndarray],
-                     targets: Sequence[np.ndarray], weights: Sequence[np.ndarray]
+                     targets: Sequence[np.ndarray], weights: Sequence[np.ndarray],
+                     carried: Sequence[np.ndarray], n_unknowns: int
                      ) -> tuple[np.ndarray, np.ndarray, list[tuple[np.ndarray, ...]]]:
     """The Schur complement of the equations' own unknowns: what to subtract from the normal
     matrix (u, u) and right-hand side (u,), and per group of equations with as many own
     unknowns m (indices (g,), C^T W D (g, m, u), C^T W t (g, m, 1), its inverse (g, m, m)) to
-    recover them.
+    recover them. ``designs``: each channel's on the unknowns ``carried`` (u indices) its rows
+    carry.
 
     Each product in a group's stack is the one of an equation alone; the sums run over the
     equations in order.
     """
-    n_unknowns = designs[0].shape[-1]
     groups, terms = [], {}
     for size, group in _size_groups(local):
         columns = np.stack([local[j] for j in group])                        # (g, 6, R, m)
@@ -254,7 +255,7 @@ def _eliminate_local(local: Sequence[np.ndarray], designs: Sequence[np.ndarray],
             weighted = weights[i][group] @ columns[:, i]                      # (g, R, m)
             inner += columns[:, i].transpose(0, 2, 1) @ weighted
             flipped = weighted.transpose(0, 2, 1)
-            cross += flipped @ designs[i][group]
+            cross[:, :, carried[i]] += flipped @ designs[i][group]
             own += flipped @ targets[i][group][:, :, None]
         inverse = _pseudo_inverses(inner)
         flipped = cross.transpose(0, 2, 1)
@@ -296,6 +297,10 @@ def fit_jointly(stacked: StackedEquations, designs: Sequence[np.ndarray],
     z = np.zeros(n_unknowns)
     z[:N_THETA] = invariant.theta.ravel()
     uncorrected = np.zeros(6, dtype=bool)
+    # each channel's products on the unknowns its rows carry (its own 12, the shared levels and
+    # offsets): the others' columns are zero in its design
+    carried = [np.flatnonzero(np.any(design, axis=(0, 1))) for design in designs]
+    compact = [design[:, :, kept] for design, kept in zip(designs, carried, strict=True)]
     for _ in range(max(1, iterations) if scatter is not None else 1):
         normal = np.zeros((n_unknowns, n_unknowns))
         rhs = np.zeros(n_unknowns)
@@ -306,15 +311,16 @@ def fit_jointly(stacked: StackedEquations, designs: Sequence[np.ndarray],
                                                  z[block], None if scatter is None
                                                  else scatter[i]))
             weights.append(w)
-            part, part_rhs = _weighted_normal(designs[i], w, targets[i])
-            normal += part
-            rhs += part_rhs
+            part, part_rhs = _weighted_normal(compact[i], w, targets[i])
+            normal[np.ix_(carried[i], carried[i])] += part
+            rhs[carried[i]] += part_rhs
             normal[block, block], rhs[block], corrected = compensate(
                 normal[block, block], rhs[block], w, gram, stacked.sigma,
                 stacked.sensitivity[:, i])
             uncorrected[i] = not corrected
         if local is not None:
-            removed, removed_rhs, parts = _eliminate_local(local, designs, targets, weights)
+            removed, removed_rhs, parts = _eliminate_local(local, compact, targets, weights,
+                                                           carried, n_unknowns)
             normal, rhs = normal - removed, rhs - removed_rhs
         scale = np.sqrt(np.abs(np.diag(normal)))
         scale = np.where(scale > 0, scale, 1.0)
