@@ -69,9 +69,11 @@ def keep_freed_memory() -> bool:
     # numpy asks for huge pages for large arrays; arrays written once or twice and then freed
     # gain little from them, and a huge page's first touch zeroes and backs all 2 MiB at once
     # (docs/benchmarks.md, "Memory in the workers")
-    core = getattr(np, "_core", None) or np.core  # numpy 2, then 1.26
-    if hasattr(core.multiarray, "_set_madvise_hugepage"):
-        core.multiarray._set_madvise_hugepage(False)
+    multiarray = getattr(getattr(np, "_core", None), "multiarray", None)
+    if multiarray is None:  # numpy 1.26
+        multiarray = np.core.multiarray
+    if hasattr(multiarray, "_set_madvise_hugepage"):
+        multiarray._set_madvise_hugepage(False)
     try:
         mallopt = ctypes.CDLL(None).mallopt
     except (OSError, AttributeError):
