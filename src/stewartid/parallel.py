@@ -230,5 +230,5 @@ def _unshared(_: Any, task: tuple[Callable[[Any], Any], Any]) -> Any:
 
 
 __all__ = ["START_METHOD", "WORKERS_INHERIT", "WORKER_THREADS", "InlineExecutor", "TaskProgress",
-           "WorkerPool", "inheriting_workers", "keep_freed_memory", "limit_worker_threads", "one_blas_thread",
-           "process_pool", "run_in_order", "worker_count"]
+           "WorkerPool", "inheriting_workers", "keep_freed_memory", "limit_worker_threads",
+           "one_blas_thread", "process_pool", "run_in_order", "worker_count"]

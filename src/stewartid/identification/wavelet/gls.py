@@ -239,8 +239,8 @@ def _eliminate_local(local: Sequence[np.ndarray], designs: Sequence[np.ndarray],
     """The Schur complement of the equations' own unknowns: what to subtract from the normal
     matrix (u, u) and right-hand side (u,), and per group of equations with as many own
     unknowns m (indices (g,), C^T W D (g, m, u), C^T W t (g, m, 1), its inverse (g, m, m)) to
-    recover them. ``designs``: each channel's on the unknowns ``carried`` (u indices) its rows
-    carry.
+    recover them. ``designs[i]``: channel i's design on the unknowns its rows carry, whose
+    indices among the ``n_unknowns`` (u) are ``carried[i]``.
 
     Each product in a group's stack is the one of an equation alone; the sums run over the
     equations in order.
