@@ -282,6 +282,15 @@ def test_estimate_frequency_is_not_moved_by_white_noise():
     assert estimate_frequency(only_noise, fs) == pytest.approx(0.3, rel=1e-2)
 
 
+def random_sines(rng: np.random.Generator, n: int, m: int, fs: float,
+                 amplitudes: list[float], band: tuple[float, float]) -> np.ndarray:
+    """``m`` channels (n, m) at ``fs`` Hz, each one sine of an amplitude drawn from
+    ``amplitudes``, a frequency uniform in ``band`` (Hz) and a random phase."""
+    t = np.arange(n) / fs
+    return np.column_stack([rng.choice(amplitudes) * np.sin(
+        2 * np.pi * rng.uniform(*band) * t + rng.uniform(0, 6)) for _ in range(m)])
+
+
 def test_estimate_frequency_transforms_only_channels_that_can_hold_the_peak():
     # pure sines score alike against their own scale, so channels nearly tie (two share
     # a sine): the channels left out by the coarse spectrum's bound must not hold the largest
@@ -292,9 +301,7 @@ def test_estimate_frequency_transforms_only_channels_that_can_hold_the_peak():
     fs = 100.0
     for _ in range(40):
         n, m = int(rng.integers(200, 3000)), int(rng.integers(2, 7))
-        t = np.arange(n) / fs
-        x = np.column_stack([rng.choice([1e-3, 1.0, 1e3]) * np.sin(
-            2 * np.pi * rng.uniform(0.3, 20) * t + rng.uniform(0, 6)) for _ in range(m)])
+        x = random_sines(rng, n, m, fs, [1e-3, 1.0, 1e3], (0.3, 20))
         x[:, -1] = x[:, 0]
         x += 1e-3 * rng.standard_normal(x.shape) * np.std(x, axis=0)
         centred = x - x.mean(axis=0)
@@ -317,9 +324,7 @@ def test_a_records_plain_peak_is_the_same_whether_asked_first_or_after_the_refin
     fs = 500.0
     for _ in range(30):
         n, m = int(rng.integers(300, 5000)), int(rng.integers(1, 7))
-        t = np.arange(n) / fs
-        x = np.column_stack([rng.choice([1e-3, 1.0]) * np.sin(
-            2 * np.pi * rng.uniform(0.5, 30) * t + rng.uniform(0, 6)) for _ in range(m)])
+        x = random_sines(rng, n, m, fs, [1e-3, 1.0], (0.5, 30))
         x += 1e-2 * rng.standard_normal(x.shape) * np.std(x, axis=0)
         plain = estimate_frequency(x.copy(), fs, refine=False)
         record = x.copy()
