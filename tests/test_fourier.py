@@ -244,6 +244,20 @@ def test_estimate_frequency():
     assert estimate_frequency(x, fs) == pytest.approx(0.73, rel=1e-6)
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_estimate_frequency_finds_a_trending_sine_to_the_minimiser_tolerance(seed):
+    # the refinement's least-squares fit of [sin, cos, 1, t] is exact at the true frequency of
+    # a sine on a linear drift; Brent stops within sqrt(eps) ~ 1.5e-8 relative of it. Records
+    # of 1 or 2 kHz, whole and broken periods
+    rng = np.random.default_rng(seed)
+    fs = float(rng.choice([1000.0, 2000.0]))
+    t = np.arange(int(rng.integers(5000, 40001))) / fs
+    frequency = rng.uniform(0.2, 8.0)
+    x = (rng.uniform(1e-3, 1) * np.sin(2 * np.pi * frequency * t + rng.uniform(0, 6))
+         + rng.uniform(-1e-2, 1e-2) * t + rng.uniform(-1, 1))
+    assert estimate_frequency(x, fs) == pytest.approx(frequency, rel=1e-7)
+
+
 def three_sines(t: np.ndarray, amplitude: float) -> np.ndarray:
     """A DOF's record of three sines of falling amplitude: 0.6, 0.3 and 0.15 of ``amplitude``
     at 0.3, 0.7 and 1.5 Hz."""

@@ -434,23 +434,28 @@ def _peak_channels(amplitude: np.ndarray, n: int) -> np.ndarray:
 def _refine_frequency(x: np.ndarray, sample_rate: float, frequency: float) -> float:
     """Frequency near ``frequency`` of the least-squares fit of [sin, cos, 1, t] to ``x``."""
     t = np.arange(len(x)) / sample_rate
-    basis = np.empty((4, len(x)))  # orthonormal rows: the constant and trend, then the sine's
-    basis[:2] = np.linalg.qr(np.column_stack([np.ones_like(t), t]))[0].T
+    trend = np.linalg.qr(np.column_stack([np.ones_like(t), t]))[0].T  # (2, N) orthonormal
+    target = x
+    for _ in range(2):  # x less its constant and trend, twice
+        target = target - (trend @ target) @ trend
+    energy = float(target @ target)
 
-    def orthogonal(v, rows):  # v less its projection on the rows, twice
-        for _ in range(2):
-            v = v - (rows @ v) @ rows
-        return v
-
-    target = orthogonal(x, basis[:2])
+    n = len(x)
+    block = max(1, math.isqrt(n))
+    within, starts = np.arange(block) / sample_rate, np.arange(0, n, block) / sample_rate
 
     def cost(f: float) -> float:
-        phase = 2 * np.pi * f * t
-        for k, column in enumerate((np.sin(phase), np.cos(phase)), start=2):
-            v = orthogonal(column, basis[:k])
-            basis[k] = v / np.linalg.norm(v)
-        residual = orthogonal(target, basis[2:])
-        return float(residual @ residual)
+        # e^(i w t) at every sample as (block start) x (offset in block): two short sets of
+        # sines and cosines instead of one per sample
+        turn = np.outer(np.exp(2j * np.pi * f * starts), np.exp(2j * np.pi * f * within))
+        wave = turn.ravel()[:n]
+        columns = np.vstack([wave.imag, wave.real])
+        # the residual's energy, from the sine's and cosine's products only: the columns less
+        # their projection on the trend have the Gram matrix columns columns^T - p p^T
+        fit = columns @ target
+        projection = columns @ trend.T
+        gram = columns @ columns.T - projection @ projection.T
+        return energy - float(fit @ np.linalg.solve(gram, fit))
 
     bin_width = sample_rate / len(x)
     return minimize_bounded(cost, max(frequency - bin_width, 1e-6 * frequency),

@@ -43,7 +43,6 @@ from stewartid.identification.wavelet.windows import (
     window_equations,
     window_stops,
 )
-from stewartid.model.joints import JOINT_TYPES
 from stewartid.signals.differentiation import estimate_frequency
 from stewartid.signals.sign_rates import lengthened_by_noise, shorter_sign_window
 from stewartid.verdict.accuracy import predicted_worst_error
@@ -80,7 +79,7 @@ def patterns_with_half_window(experiment: Experiment, found: Detection, legs: bo
     the rate :data:`~stewartid.identification.wavelet.rate_selection.HALF_WINDOW_RATE`
     (N, R + 1, types, 6): the refit that measures the long window's bias
     (:mod:`~stewartid.identification.sign_window`). ``legs``: the patterns carry the legs' type.
-    Both are written into one array (no copy of the first).
+    Both come from one pass over the joints' Jacobians.
     """
     half = None
     if check:
@@ -89,17 +88,10 @@ def patterns_with_half_window(experiment: Experiment, found: Detection, legs: bo
             half = found._replace(**sign_rate_fields(
                 experiment, window, covariance, found.mean_jacobian,
                 shorter_sign_window(window, found.sign_window)))
-    leg_jacobian = experiment.leg_jacobian if legs else None
-    count = len(SOFT_SIGN_RATES)
-    patterns = np.empty((len(found.sign_rates), count + (half is not None),
-                         len(JOINT_TYPES) + legs, 6))
-    coulomb_patterns(found, experiment.joint_jacobians, False, leg_jacobian=leg_jacobian,
-                     out=patterns[:, :count])
-    if half is not None:
-        coulomb_patterns(half, experiment.joint_jacobians, False,
-                         SOFT_SIGN_RATES[HALF_WINDOW_RATE:HALF_WINDOW_RATE + 1], leg_jacobian,
-                         out=patterns[:, count:])
-    return patterns
+    also = (() if half is None else
+            ((half, SOFT_SIGN_RATES[HALF_WINDOW_RATE:HALF_WINDOW_RATE + 1]),))
+    return coulomb_patterns(found, experiment.joint_jacobians, False,
+                            leg_jacobian=experiment.leg_jacobian if legs else None, also=also)
 
 
 def model_equations(model: str, experiment: Experiment, found: Detection, order: int,

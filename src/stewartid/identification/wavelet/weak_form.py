@@ -204,45 +204,57 @@ SOFT_SIGN_RATES = (0.0, 1e-4, 3e-4, 1e-3, 3e-3)
 def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: bool,
                      rates: Sequence[float] = SOFT_SIGN_RATES,
                      leg_jacobian: np.ndarray | None = None,
-                     out: np.ndarray | None = None) -> np.ndarray:
+                     out: np.ndarray | None = None,
+                     also: Sequence[tuple[Detection, Sequence[float]]] = ()) -> np.ndarray:
     """W_type(t) (N, n_rates, n_types, 6): generalized force of a unit Coulomb torque on each axis of a type.
 
     Soft sign w / sqrt(w^2 + sigma^2 + r^2) of ``found.sign_rates`` at every transition rate r of
     ``rates``, rad/s. Samples lead, so that an interval's rows are one contiguous slice. With
     ``leg_jacobian`` J_lq (N, 6, 6), a last type: a unit force along every leg (a ball screw's
-    friction), J_lq^T soft-sign(l_dot) with the same r in m/s. ``out``: the array to write them
-    into (a slice of a larger one), else a new one.
+    friction), J_lq^T soft-sign(l_dot) with the same r in m/s. ``also``: further signs (of the
+    same samples) and their rates, whose patterns follow along the rate axis (one pass over the
+    Jacobians for all). ``out``: the array to write them into (a slice of a larger one), else a
+    new one.
     """
     groups = (tuple(range(5)),) if uniform else tuple(JOINT_TYPES.values())
-    rates = np.asarray(rates, dtype=float)
-    signs = found.sign_rates
-    shape = (len(signs), len(rates), len(groups) + (leg_jacobian is not None), 6)
+    sets = [(signs, np.asarray(set_rates, dtype=float))
+            for signs, set_rates in ((found, rates), *also)]
+    count = sum(len(set_rates) for _, set_rates in sets)
+    n_samples = len(found.sign_rates)
+    shape = (n_samples, count, len(groups) + (leg_jacobian is not None), 6)
     out = np.empty(shape) if out is None else out
     if out.shape != shape:
         raise ValueError(f"coulomb_patterns writes {shape}; out has shape {out.shape}.")
-    noise, squared_rates = found.sign_rate_noise ** 2, rates[:, None, None] ** 2
     # one block's temporaries, reused: w^2 + sigma^2, then the soft signs (n, R, 6, 5)
-    level = np.empty((min(len(signs), PATTERN_BLOCK), 6, 5))
-    direction = np.empty((len(level), len(rates), 6, 5))
-    for start in range(0, len(signs), PATTERN_BLOCK):
+    level = np.empty((min(n_samples, PATTERN_BLOCK), 6, 5))
+    direction = np.empty((len(level), count, 6, 5))
+    for start in range(0, n_samples, PATTERN_BLOCK):
         block = slice(start, start + PATTERN_BLOCK)
-        w = signs[block]
-        n = len(w)
-        np.multiply(w, w, out=level[:n])
-        level[:n] += noise
-        soft = np.add(level[:n, None], squared_rates, out=direction[:n])
-        np.sqrt(soft, out=soft)
-        np.divide(w[:, None], soft, out=soft)
-        joint_type_forces(soft, joint_jacobians[block], groups, out=out[block, :, :len(groups)])
-    if leg_jacobian is not None:
-        legs = found.leg_sign_rates
-        leg_level = legs ** 2 + found.leg_sign_rate_noise ** 2
-        soft = np.empty_like(legs)
-        for k, r in enumerate(rates):
-            np.add(leg_level, r ** 2, out=soft)
+        first = 0
+        for signs, set_rates in sets:
+            w = signs.sign_rates[block]
+            n = len(w)
+            np.multiply(w, w, out=level[:n])
+            level[:n] += signs.sign_rate_noise ** 2
+            soft = np.add(level[:n, None], set_rates[:, None, None] ** 2,
+                          out=direction[:n, first:first + len(set_rates)])
             np.sqrt(soft, out=soft)
-            np.divide(legs, soft, out=soft)                                       # (N, 6)
-            out[:, k, -1] = (soft[:, None, :] @ leg_jacobian)[:, 0]
+            np.divide(w[:, None], soft, out=soft)
+            first += len(set_rates)
+        joint_type_forces(direction[:n], joint_jacobians[block], groups,
+                          out=out[block, :, :len(groups)])
+    if leg_jacobian is not None:
+        first = 0
+        for signs, set_rates in sets:
+            legs = signs.leg_sign_rates
+            leg_level = legs ** 2 + signs.leg_sign_rate_noise ** 2
+            soft = np.empty_like(legs)
+            for k, r in enumerate(set_rates, start=first):
+                np.add(leg_level, r ** 2, out=soft)
+                np.sqrt(soft, out=soft)
+                np.divide(legs, soft, out=soft)                                   # (N, 6)
+                out[:, k, -1] = (soft[:, None, :] @ leg_jacobian)[:, 0]
+            first += len(set_rates)
     return out
 
 
