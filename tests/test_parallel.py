@@ -104,3 +104,12 @@ def test_workers_put_arrays_on_ordinary_pages_and_leave_the_caller_alone():
     with WorkerPool(2, 2) as pool:
         assert pool.call_all([_numpy_huge_pages] * 2) == [False, False]
     assert _numpy_huge_pages() == before
+
+
+def test_longest_first_puts_the_named_tasks_ahead_in_their_order_and_keeps_the_rest():
+    from stewartid.parallel import longest_first
+
+    tasks = ["a", "b", "c", "d", "e"]
+    assert longest_first(tasks, ("d", "b")) == ["d", "b", "a", "c", "e"]
+    assert longest_first(range(4), ("y", "w"), key=lambda k: "wxyz"[k]) == [2, 0, 1, 3]
+    assert longest_first(tasks, ()) == tasks

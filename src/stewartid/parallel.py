@@ -210,6 +210,15 @@ class WorkerPool:
         return results
 
 
+def longest_first(tasks: Sequence[Any], first: Sequence[Any],
+                  key: Callable[[Any], Any] = lambda task: task) -> list[Any]:
+    """``tasks`` with those whose ``key`` is in ``first`` (the longest, longest first) ahead, in
+    that order, then the others as they came: workers given the long tasks early finish
+    together."""
+    return sorted(tasks, key=lambda task: (first.index(key(task)) if key(task) in first
+                                           else len(first)))
+
+
 def run_in_order(function: Callable[..., Any], tasks: Sequence[Any], workers: int | None = None,
                  progress: TaskProgress | None = None, shared: Any = None) -> list[Any]:
     """``[function(task) for task in tasks]`` on :func:`worker_count` processes, in task order.
@@ -231,4 +240,4 @@ def _unshared(_: Any, task: tuple[Callable[[Any], Any], Any]) -> Any:
 
 __all__ = ["START_METHOD", "WORKERS_INHERIT", "WORKER_THREADS", "InlineExecutor", "TaskProgress",
            "WorkerPool", "inheriting_workers", "keep_freed_memory", "limit_worker_threads",
-           "one_blas_thread", "process_pool", "run_in_order", "worker_count"]
+           "longest_first", "one_blas_thread", "process_pool", "run_in_order", "worker_count"]

@@ -37,7 +37,7 @@ from stewartid.identification.averaging import AveragingPolicy, average_experime
 from stewartid.identification.delay import delay_identifiable
 from stewartid.identification.result import IdentificationResult
 from stewartid.model.linearization import nominal_matrices
-from stewartid.parallel import inheriting_workers, one_blas_thread, run_in_order
+from stewartid.parallel import inheriting_workers, longest_first, one_blas_thread, run_in_order
 from stewartid.platform import Platform, load_platform
 from stewartid.signals.differentiation import acceleration_frequency
 from stewartid.validation.heldout import DEFAULT_FOLDS, ResidualDelay, Segment, ValidationResult
@@ -456,9 +456,8 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
                  records, identifiable, physical)
     names = tuple(dict.fromkeys(names))
     fitted = (*names, *([PHYSICAL_TASK] if physical is not None else ()))
-    tasks = sorted([(name, part) for name in fitted for part in (FIT, FOLDS)],
-                   key=lambda task: LONGEST_FIRST.index(task) if task in LONGEST_FIRST
-                   else len(LONGEST_FIRST))
+    tasks = longest_first([(name, part) for name in fitted for part in (FIT, FOLDS)],
+                          LONGEST_FIRST)
     workers = inheriting_workers(jobs, len(tasks))
     if workers > 1:  # every task asks for the records' frequencies: found once, inherited
         for dataset in datasets:

@@ -214,8 +214,7 @@ def _regressors(dataset: Dataset, jacobian: np.ndarray, scales: np.ndarray) -> n
     transform is linear: J_lq(q0) times the pose's) and, kept with the record, the pose lines
     :func:`excitation_lines` counts."""
     spectra, nfft = _channel_spectra(dataset.pose, COUNTING_PADDING)
-    dataset.derived(("pose lines", LINE_THRESHOLD, COUNTING_PADDING), lambda d: _lines_of(
-        spectra, len(d), nfft, d.sample_rate, LINE_THRESHOLD))
+    _pose_lines(dataset, LINE_THRESHOLD, COUNTING_PADDING, (spectra, nfft))
     # the fastest line sets the differentiation window, which needs it only roughly
     amplitude = np.sqrt(np.sum(np.abs(jacobian @ spectra) ** 2, axis=0))
     lines = _peaks(amplitude, len(dataset), nfft, dataset.sample_rate, LINE_FRACTION)
@@ -340,10 +339,18 @@ def excitation_lines(datasets: Sequence[Dataset], threshold: float = LINE_THRESH
     return tuple(found)
 
 
-def _pose_lines(dataset: Dataset, threshold: float, padding: int) -> list[SpectralLines]:
-    """Each pose coordinate's lines of one record, computed once per record."""
-    return dataset.derived(("pose lines", threshold, padding), lambda d: channel_lines(
-        d.pose, d.sample_rate, fraction=threshold, padding=padding))
+def _pose_lines(dataset: Dataset, threshold: float, padding: int,
+                transformed: tuple[np.ndarray, int] | None = None) -> list[SpectralLines]:
+    """Each pose coordinate's lines of one record, computed once per record; ``transformed``:
+    the pose's transforms at that padding and their length (:func:`_channel_spectra`), if at
+    hand."""
+    def lines(d: Dataset) -> list[SpectralLines]:
+        if transformed is None:
+            return channel_lines(d.pose, d.sample_rate, fraction=threshold, padding=padding)
+        spectra, nfft = transformed
+        return _lines_of(spectra, len(d), nfft, d.sample_rate, threshold)
+
+    return dataset.derived(("pose lines", threshold, padding), lines)
 
 
 __all__ = ["COUNTING_PADDING", "LINE_FRACTION", "LINE_MERGE_BINS", "LINE_THRESHOLD",

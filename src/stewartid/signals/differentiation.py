@@ -457,7 +457,7 @@ def _refine_frequency(x: np.ndarray, sample_rate: float, frequency: float) -> fl
         gram = columns @ columns.T - projection @ projection.T
         return energy - float(fit @ np.linalg.solve(gram, fit))
 
-    bin_width = sample_rate / len(x)
+    bin_width = sample_rate / n
     return minimize_bounded(cost, max(frequency - bin_width, 1e-6 * frequency),
                             frequency + bin_width, 1e-9 * frequency)
 

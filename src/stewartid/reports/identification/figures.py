@@ -12,7 +12,7 @@ from stewartid.comparison import MethodFit, PhysicalSection
 from stewartid.datasets.dataset import Dataset
 from stewartid.identification.preparation import prepare
 from stewartid.identification.wavelet.intervals import joint_rates
-from stewartid.parallel import inheriting_workers, run_in_order
+from stewartid.parallel import inheriting_workers, longest_first, run_in_order
 from stewartid.platform import Platform
 from stewartid.reports.drawing import ExperimentTrace, plot_excitation, plot_joint_rates
 from stewartid.reports.identification import method_figures as plots
@@ -52,8 +52,7 @@ class FigureDrawer:
         if workers > 1:
             _load_matplotlib()
         # the longest first, so that the workers finish together; the files in report order
-        order = sorted(range(len(pending)), key=lambda k: DRAWN_FIRST.index(pending[k][0])
-                       if pending[k][0] in DRAWN_FIRST else len(DRAWN_FIRST))
+        order = longest_first(range(len(pending)), DRAWN_FIRST, key=lambda k: pending[k][0])
         written = dict(zip(order, run_in_order(_draw, order, workers,
                                                shared=(self.folder, pending)), strict=True))
         for k in range(len(pending)):
