@@ -283,7 +283,8 @@ def test_report_on_the_independent_example(tmp_path, example_dir, example_platfo
     from stewartid.datasets.dataset import expand_paths, read_datasets
 
     data = read_datasets(expand_paths([example_dir]), example_platform)
-    run = compare_methods(data, example_platform, methods="wavelet", consistent=True).runs[0]
+    run = compare_methods(data, example_platform, methods="wavelet", consistent=True,
+                          folds=2).runs[0]
     # noise-free data: the model predicts held-out force to better than 1 %
     assert np.all(run.validation.vaf_percent >= 99.0)
     change = np.maximum(np.abs(run.result.M - run.unconstrained.M) / run.unconstrained.std_errors_M,
@@ -328,7 +329,8 @@ def test_report_on_own_noisy_plant(tmp_path, paper):
 
     run = simulate_experiments(paper, coulomb=5.0, duration_s=10.0,
                                noise=reference_noise(paper), seed=2)
-    report = write_report(compare_methods(run.datasets, paper, methods=("wavelet",)), tmp_path)
+    report = write_report(compare_methods(run.datasets, paper, methods=("wavelet",), folds=2),
+                          tmp_path)
     text = (tmp_path / "report.md").read_text()
     for section in ("## Data", "## Joint rates", "## Identified Mt and Bt", "## Residuals",
                     "## Validation on held-out data", "## Physical consistency", "## Friction"):
