@@ -41,7 +41,12 @@ def check_distinct_paths(files: Sequence[Path]) -> None:
 
 
 def experiment_digest(dataset: Dataset) -> str:
-    """SHA-256 of an experiment's pose and forces, whatever its times, name or format."""
+    """SHA-256 of an experiment's pose and forces, whatever its times, name or format; once per
+    record (reading and the checks before a fit both ask)."""
+    return dataset.derived(("digest",), _digest)
+
+
+def _digest(dataset: Dataset) -> str:
     numbers = np.ascontiguousarray(np.concatenate([dataset.pose, dataset.forces], axis=1))
     return hashlib.sha256(numbers.tobytes()).hexdigest()
 
