@@ -175,8 +175,8 @@ def main(argv: list[str] | None = None) -> None:
         with threadpool_limits(limits=1, user_api="blas"):
             app(args=argv, prog_name="stewartid")
     finally:
-        # the interpreter's shutdown would walk every object the command left (tens of ms on
-        # an identification); memory is handed back with the process anyway
+        # the interpreter's shutdown would walk every object the command left; the process
+        # hands its memory back anyway
         gc.freeze()
 
 
