@@ -367,8 +367,8 @@ def test_validation_records_see_a_wrong_parameter(tmp_path, linear_data, paper):
     assert len(document["validation"]["records"]["vaf_percent"]) == 6
     comparison = compare_methods(data, paper, methods=("ls",), settings={"coulomb": False},
                                  folds=3, validate=records[1:])
-    other = write_report(comparison, tmp_path / "w")
-    worse = other.runs[0].records.vaf_percent
+    # the records' validation is the comparison's; the report above shows how it is written
+    worse = comparison.runs[0].records.vaf_percent
     assert min(worse[0], worse[4]) < 99.0 and min(worse[0], worse[4]) < min(
         run.records.vaf_percent[0], run.records.vaf_percent[4]) - 1.0
 
