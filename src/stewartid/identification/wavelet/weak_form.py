@@ -204,7 +204,6 @@ SOFT_SIGN_RATES = (0.0, 1e-4, 3e-4, 1e-3, 3e-3)
 def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: bool,
                      rates: Sequence[float] = SOFT_SIGN_RATES,
                      leg_jacobian: np.ndarray | None = None,
-                     out: np.ndarray | None = None,
                      also: Sequence[tuple[Detection, Sequence[float]]] = ()) -> np.ndarray:
     """W_type(t) (N, n_rates, n_types, 6): generalized force of a unit Coulomb torque on each axis of a type.
 
@@ -213,30 +212,28 @@ def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: boo
     ``leg_jacobian`` J_lq (N, 6, 6), a last type: a unit force along every leg (a ball screw's
     friction), J_lq^T soft-sign(l_dot) with the same r in m/s. ``also``: further signs (of the
     same samples) and their rates, whose patterns follow along the rate axis (one pass over the
-    Jacobians for all). ``out``: the array to write them into (a slice of a larger one), else a
-    new one.
+    Jacobians for all).
     """
     groups = (tuple(range(5)),) if uniform else tuple(JOINT_TYPES.values())
     sets = [(signs, np.asarray(set_rates, dtype=float))
             for signs, set_rates in ((found, rates), *also)]
     count = sum(len(set_rates) for _, set_rates in sets)
     n_samples = len(found.sign_rates)
-    shape = (n_samples, count, len(groups) + (leg_jacobian is not None), 6)
-    out = np.empty(shape) if out is None else out
-    if out.shape != shape:
-        raise ValueError(f"coulomb_patterns writes {shape}; out has shape {out.shape}.")
+    out = np.empty((n_samples, count, len(groups) + (leg_jacobian is not None), 6))
+    squares = [(signs.sign_rate_noise ** 2, set_rates[:, None, None] ** 2)
+               for signs, set_rates in sets]
     # one block's temporaries, reused: w^2 + sigma^2, then the soft signs (n, R, 6, 5)
     level = np.empty((min(n_samples, PATTERN_BLOCK), 6, 5))
     direction = np.empty((len(level), count, 6, 5))
     for start in range(0, n_samples, PATTERN_BLOCK):
         block = slice(start, start + PATTERN_BLOCK)
         first = 0
-        for signs, set_rates in sets:
+        for (signs, set_rates), (noise, squared_rates) in zip(sets, squares, strict=True):
             w = signs.sign_rates[block]
             n = len(w)
             np.multiply(w, w, out=level[:n])
-            level[:n] += signs.sign_rate_noise ** 2
-            soft = np.add(level[:n, None], set_rates[:, None, None] ** 2,
+            level[:n] += noise
+            soft = np.add(level[:n, None], squared_rates,
                           out=direction[:n, first:first + len(set_rates)])
             np.sqrt(soft, out=soft)
             np.divide(w[:, None], soft, out=soft)
