@@ -20,6 +20,7 @@ from stewartid.identification.stops import (
     filtered_stop_columns,
     find_stops,
     project_out,
+    span_basis,
 )
 from stewartid.model.dynamics import COULOMB_SMOOTHING, inverse_dynamics
 from stewartid.model.kinematics import leg_jacobian, leg_lengths
@@ -82,6 +83,23 @@ def stick_slip_records(platform, sample_rate=500.0, duration=6.0, dwell=0.06, po
 @pytest.fixture(scope="module")
 def records(electric):
     return stick_slip_records(electric)
+
+
+def test_span_basis_is_orthonormal_and_spans_the_columns_less_their_near_duplicates():
+    """Columns of very different scales, one a copy of another up to 1e-7 of it, one zero: the
+    basis is orthonormal, its projector is the SVD's on the singular values kept, and the
+    near-duplicate adds no direction while the small but independent column keeps its own."""
+    rng = np.random.default_rng(3)
+    independent = rng.normal(size=(48, 4)) * np.array([1e3, 1.0, 1e-4, 5.0])
+    twin = independent[:, :1] * (1.0 + 1e-7 * rng.normal(size=(48, 1)))
+    columns = np.hstack([independent, twin, np.zeros((48, 1))])
+    basis = span_basis(columns)
+    assert basis.shape == (48, 4)
+    np.testing.assert_allclose(basis.T @ basis, np.eye(4), atol=1e-12)
+    left, _, _ = np.linalg.svd(independent, full_matrices=False)
+    # the kept directions lean towards the twin by its 1e-7 difference at most
+    np.testing.assert_allclose(basis @ basis.T, left @ left.T, atol=1e-6)
+    assert span_basis(np.zeros((48, 2))).shape == (48, 0)
 
 
 def test_stops_are_found_where_the_legs_stand_still(electric, records):

@@ -206,11 +206,25 @@ def stop_basis(found: LegStops, sample_rate: float, window: float, step: int, na
     # each column lives on a stop's filter support: a sparse Gram, then its eigenvectors (legs
     # stopping together give nearly equal columns, which the rank cut leaves out)
     norms = np.linalg.norm(columns, axis=0)
-    columns = columns[:, norms > 0] / norms[norms > 0]
-    local = sparse.csc_matrix(columns)
-    values, vectors = np.linalg.eigh((local.T @ local).toarray())
+    local = sparse.csc_matrix(columns[:, norms > 0] / norms[norms > 0])
+    return local @ _span_coefficients((local.T @ local).toarray())
+
+
+def span_basis(columns: np.ndarray) -> np.ndarray:
+    """Orthonormal basis (R, r) of the span of ``columns`` (R, m), each scaled to unit length
+    first; directions whose Gram eigenvalue is below :data:`RANK_CUT` of the largest are left out
+    (nearly equal columns of legs stopping together, a stop's part too short for its terms)."""
+    norms = np.linalg.norm(columns, axis=0)
+    unit = columns[:, norms > 0] / norms[norms > 0]
+    return unit @ _span_coefficients(unit.T @ unit) if unit.shape[1] else unit
+
+
+def _span_coefficients(gram: np.ndarray) -> np.ndarray:
+    """Coefficients (m, r) turning unit columns of Gram matrix ``gram`` (m, m) into an
+    orthonormal basis of their span (:func:`span_basis`)."""
+    values, vectors = np.linalg.eigh(gram)
     kept = values > RANK_CUT * values[-1]
-    return local @ (vectors[:, kept] / np.sqrt(values[kept]))
+    return vectors[:, kept] / np.sqrt(values[kept])
 
 
 #: Smallest eigenvalue of the stops' Gram matrix, relative to the largest, kept in their basis.
@@ -227,4 +241,4 @@ def project_out(basis: np.ndarray, *arrays: np.ndarray) -> list[np.ndarray]:
 
 
 __all__ = ["STOPS", "LegStops", "Stop", "StopPolicy", "check_motion", "filtered_stop_columns",
-           "find_stops", "leg_stop_runs", "project_out", "stop_basis"]
+           "find_stops", "leg_stop_runs", "project_out", "span_basis", "stop_basis"]

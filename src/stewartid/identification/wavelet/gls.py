@@ -15,7 +15,6 @@ import numpy as np
 
 from stewartid.errors import DataWarning, IdentificationError
 from stewartid.identification.solvers import check_rank, regressor_names
-from stewartid.identification.stops import RANK_CUT
 from stewartid.identification.wavelet.variance_components import (
     chi2_excess,
     compensate,
@@ -209,22 +208,6 @@ class JointFit(NamedTuple):
     local_z: list[np.ndarray] | None = None
 
 
-def _pseudo_inverses(gram: np.ndarray) -> np.ndarray:
-    """Inverses (g, m, m) of symmetric positive semi-definite matrices ``gram`` (g, m, m) on the
-    span of their eigenvalues above :data:`~stewartid.identification.stops.RANK_CUT` of the
-    largest (a stop's part of one sample has no first moment; two legs stopping together give
-    nearly equal columns)."""
-    values, vectors = np.linalg.eigh(gram)                          # ascending
-    ranks = np.sum(values > RANK_CUT * np.maximum(values[:, -1:], 1e-300), axis=1)
-    out = np.empty_like(gram)
-    for rank in np.unique(ranks):
-        these = np.flatnonzero(ranks == rank)
-        kept = np.ascontiguousarray(vectors[these][:, :, gram.shape[1] - rank:])
-        out[these] = (kept / values[these][:, None, gram.shape[1] - rank:]
-                      ) @ kept.transpose(0, 2, 1)
-    return out
-
-
 def _size_groups(local: Sequence[np.ndarray]) -> list[tuple[int, np.ndarray]]:
     """The equations (indices, ascending) with as many own unknowns m > 0 in their columns
     ``local`` (6, R, m), for each m in ascending order."""
@@ -238,7 +221,7 @@ def _eliminate_local(local: Sequence[np.ndarray], designs: Sequence[np.ndarray],
                      ) -> tuple[np.ndarray, np.ndarray, list[tuple[np.ndarray, ...]]]:
     """The Schur complement of the equations' own unknowns: what to subtract from the normal
     matrix (u, u) and right-hand side (u,), and per group of equations with as many own
-    unknowns m (indices (g,), C^T W D (g, m, u), C^T W t (g, m, 1), its inverse (g, m, m)) to
+    unknowns m (indices (g,), C^T W D (g, m, u), C^T W t (g, m, 1), (C^T W C)^-1 (g, m, m)) to
     recover them. ``designs[i]``: channel i's design on the unknowns its rows carry, whose
     indices among the ``n_unknowns`` (u) are ``carried[i]``.
 
@@ -257,7 +240,7 @@ def _eliminate_local(local: Sequence[np.ndarray], designs: Sequence[np.ndarray],
             flipped = weighted.transpose(0, 2, 1)
             cross[:, :, carried[i]] += flipped @ designs[i][group]
             own += flipped @ targets[i][group][:, :, None]
-        inverse = _pseudo_inverses(inner)
+        inverse = np.linalg.inv(inner)
         flipped = cross.transpose(0, 2, 1)
         removed, removed_rhs = flipped @ inverse @ cross, flipped @ (inverse @ own)
         for k, j in enumerate(group):
@@ -289,7 +272,8 @@ def fit_jointly(stacked: StackedEquations, designs: Sequence[np.ndarray],
     """All channels at once, rows weighted by their inverse covariance, noise bias removed.
 
     ``local``: per equation, columns (6, R, m) of unknowns its rows alone carry, shared by its
-    channels (a stopped leg's free friction), eliminated by their Schur complement.
+    channels (a stopped leg's free friction), linearly independent (a basis of their span:
+    :func:`~stewartid.identification.stops.span_basis`), eliminated by their Schur complement.
     """
     n_unknowns = designs[0].shape[-1]
     rows = designs[0].shape[1]

@@ -14,7 +14,7 @@ from numpy.polynomial import legendre
 
 from stewartid.identification.preparation import Experiment
 from stewartid.identification.solvers import check_rank, regressor_names
-from stewartid.identification.stops import STOPS, Stop, StopPolicy, leg_stop_runs
+from stewartid.identification.stops import STOPS, Stop, StopPolicy, leg_stop_runs, span_basis
 from stewartid.identification.wavelet.detection import Detection
 from stewartid.identification.wavelet.gls import (
     N_THETA,
@@ -45,8 +45,9 @@ from stewartid.identification.wavelet.weak_form import (
 
 class WindowEquations(NamedTuple):
     """``rows`` (mean row unused) and ``coulomb`` <phi_k, W_type> (n_rates, K, n_types, 6) of one
-    window; ``stops`` (6, K, m): <phi_k, J_lq[l, i] P_j> of the m Legendre terms P_j of the legs'
-    stops inside it (channel i), each a free force along leg l."""
+    window; ``stops`` (6, K, r): an orthonormal basis of the span of <phi_k, J_lq[l, i] P_j>,
+    the Legendre terms P_j of the legs' stops inside it (channel i), each a free force along
+    leg l."""
 
     rows: IntervalEquations
     coulomb: np.ndarray
@@ -84,7 +85,8 @@ def stop_window_length(stops: Sequence[Stop], duration: float, size: int, longes
 
 def _stop_columns(stops: Sequence[Stop], sel: slice, phi: np.ndarray,
                   leg_jacobian: np.ndarray) -> np.ndarray | None:
-    """<phi_k, J_lq[l, i] P_j> (6, K, m) of the stops' parts inside the window ``sel``; None
+    """An orthonormal basis (6, K, r) of the span of <phi_k, J_lq[l, i] P_j> of the stops'
+    parts inside the window ``sel`` (:func:`~stewartid.identification.stops.span_basis`); None
     without any."""
     columns = []
     for found in stops:
@@ -96,7 +98,10 @@ def _stop_columns(stops: Sequence[Stop], sel: slice, phi: np.ndarray,
         local = phi[:, start - sel.start:stop - sel.start]                   # (K, n)
         legs = leg_jacobian[start:stop, found.leg]                           # (n, 6)
         columns.append(np.einsum("kn,ni,nj->ikj", local, legs, polynomials))
-    return np.concatenate(columns, axis=2) if columns else None
+    if not columns:
+        return None
+    columns = np.concatenate(columns, axis=2)
+    return span_basis(columns.reshape(-1, columns.shape[2])).reshape(*columns.shape[:2], -1)
 
 
 def window_bounds(t: np.ndarray, length: float) -> np.ndarray:
