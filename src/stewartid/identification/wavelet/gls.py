@@ -224,33 +224,41 @@ def _eliminate_local(local: Sequence[np.ndarray], designs: Sequence[np.ndarray],
     unknowns m (indices (g,), C^T W D (g, m, u), C^T W t (g, m, 1), (C^T W C)^-1 (g, m, m)) to
     recover them. ``designs[i]``: channel i's design on the unknowns its rows carry, whose
     indices among the ``n_unknowns`` (u) are ``carried[i]``.
-
-    Each product in a group's stack is the one of an equation alone; the sums run over the
-    equations in order.
     """
-    groups, terms = [], {}
+    runs = [_runs(indices) for indices in carried]
+    groups = []
+    normal, rhs = np.zeros((n_unknowns, n_unknowns)), np.zeros(n_unknowns)
     for size, group in _size_groups(local):
         columns = np.stack([local[j] for j in group])                        # (g, 6, R, m)
-        inner, cross = np.zeros((len(group), size, size)), np.zeros((len(group), size,
-                                                                     n_unknowns))
+        inner = np.zeros((len(group), size, size))
+        cross = np.zeros((len(group), size, n_unknowns))
         own = np.zeros((len(group), size, 1))
         for i in range(6):
             weighted = weights[i][group] @ columns[:, i]                      # (g, R, m)
             inner += columns[:, i].transpose(0, 2, 1) @ weighted
             flipped = weighted.transpose(0, 2, 1)
-            cross[:, :, carried[i]] += flipped @ designs[i][group]
+            products = flipped @ designs[i][group]                           # (g, m, carried)
+            for first, last, at in runs[i]:
+                cross[:, :, first:last] += products[:, :, at:at + last - first]
             own += flipped @ targets[i][group][:, :, None]
         inverse = np.linalg.inv(inner)
-        flipped = cross.transpose(0, 2, 1)
-        removed, removed_rhs = flipped @ inverse @ cross, flipped @ (inverse @ own)
-        for k, j in enumerate(group):
-            terms[j] = (removed[k], removed_rhs[k, :, 0])
+        # sum over the group of C^T W D' (C^T W C)^-1 C^T W [D t]: one product of the stacks
+        solved = inverse @ np.concatenate([cross, own], axis=2)              # (g, m, u + 1)
+        removed = cross.reshape(-1, n_unknowns).T @ solved.reshape(-1, n_unknowns + 1)
+        normal += removed[:, :-1]
+        rhs += removed[:, -1]
         groups.append((group, cross, own, inverse))
-    normal, rhs = np.zeros((n_unknowns, n_unknowns)), np.zeros(n_unknowns)
-    for j in sorted(terms):
-        normal += terms[j][0]
-        rhs += terms[j][1]
     return normal, rhs, groups
+
+
+def _runs(indices: np.ndarray) -> list[tuple[int, int, int]]:
+    """Runs of consecutive values in the ascending ``indices``: (first, last + 1, position of
+    the first in ``indices``) each."""
+    breaks = np.flatnonzero(np.diff(indices) != 1) + 1
+    starts = np.concatenate([[0], breaks])
+    stops = np.concatenate([breaks, [len(indices)]])
+    return [(int(indices[a]), int(indices[b - 1]) + 1, int(a))
+            for a, b in zip(starts, stops, strict=True) if b > a]
 
 
 def local_terms(local: Sequence[np.ndarray], local_z: Sequence[np.ndarray]) -> np.ndarray:

@@ -243,14 +243,11 @@ def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: boo
     if leg_jacobian is not None:
         first = 0
         for signs, set_rates in sets:
-            legs = signs.leg_sign_rates
-            leg_level = legs ** 2 + signs.leg_sign_rate_noise ** 2
-            soft = np.empty_like(legs)
-            for k, r in enumerate(set_rates, start=first):
-                np.add(leg_level, r ** 2, out=soft)
-                np.sqrt(soft, out=soft)
-                np.divide(legs, soft, out=soft)                                   # (N, 6)
-                out[:, k, -1] = (soft[:, None, :] @ leg_jacobian)[:, 0]
+            legs = signs.leg_sign_rates[:, None]                                  # (N, 1, 6)
+            soft = legs ** 2 + signs.leg_sign_rate_noise ** 2 + set_rates[:, None] ** 2
+            np.sqrt(soft, out=soft)
+            np.divide(legs, soft, out=soft)                                       # (N, R, 6)
+            out[:, first:first + len(set_rates), -1] = soft @ leg_jacobian
             first += len(set_rates)
     return out
 
