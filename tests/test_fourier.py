@@ -331,6 +331,48 @@ def test_estimate_frequency_transforms_only_channels_that_can_hold_the_peak():
         assert np.all(values[np.setdiff1d(np.arange(m), kept)] < values.max())
 
 
+def test_zoomed_bins_are_the_padded_transforms_bins():
+    # the chirp transform of a band against numpy's whole transform, bands at either end included;
+    # both sum n terms of |x|: round-off of the order of n eps max|x| each
+    from stewartid.signals.differentiation import _zoom_spectrum
+
+    rng = np.random.default_rng(8)
+    for _ in range(20):
+        n = int(rng.integers(50, 5000))
+        nfft = 1 << int(np.ceil(np.log2(8 * n)))
+        x = rng.standard_normal(n)
+        full = np.fft.rfft(x, nfft)
+        count = int(rng.integers(1, 200))
+        for first in (0, int(rng.integers(0, nfft // 2 - count)), nfft // 2 + 1 - count):
+            zoomed = _zoom_spectrum(x, nfft, first, count)
+            bound = 100 * n * np.finfo(float).eps * np.abs(x).max()
+            assert np.abs(zoomed - full[first:first + count]).max() < bound
+
+
+def test_the_fine_winner_is_the_channel_of_the_largest_peak_of_every_whole_transform():
+    # channels that nearly tie (pure sines against their own scale, two sharing one, a channel of
+    # two lines far apart): the zoomed bands pick the row _dominant picks from whole transforms
+    from stewartid.signals.differentiation import _dominant, _fine_winner, _peak_channels
+
+    rng = np.random.default_rng(4)
+    fs = 100.0
+    for _ in range(40):
+        n, m = int(rng.integers(200, 3000)), int(rng.integers(2, 7))
+        x = random_sines(rng, n, m, fs, [1e-3, 1.0, 1e3], (0.3, 20))
+        x[:, -1] = x[:, 0]
+        x[:, 0] += 0.9 * np.std(x[:, 0]) * np.sqrt(2) * np.sin(2 * np.pi * 31.0 * np.arange(n) / fs)
+        x += 1e-3 * rng.standard_normal(x.shape) * np.std(x, axis=0)
+        centred = x - x.mean(axis=0)
+        scale = centred.std(axis=0)
+        nfft = 1 << int(np.ceil(np.log2(8 * n)))
+        windowed = (centred * np.hanning(n)[:, None]).T
+        coarse = np.abs(np.fft.rfft(windowed, nfft // 8, axis=1)) / scale[:, None]
+        kept = _peak_channels(coarse, n)
+        relative = np.abs(np.fft.rfft(windowed[kept], nfft, axis=1)[:, 1:]) / scale[kept, None]
+        winner = _fine_winner(windowed[kept], coarse[kept], scale[kept], nfft)
+        assert winner.start == _dominant(relative)
+
+
 def test_a_records_plain_peak_is_the_same_whether_asked_first_or_after_the_refined_frequency():
     # a read-only record's refined estimate leaves its plain peak (refine=False) in the cache,
     # from its coarse spectrum: it must be what the plain estimate computes on its own
