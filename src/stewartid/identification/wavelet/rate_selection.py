@@ -71,18 +71,18 @@ def averaged_over_rates(solutions: Sequence[WeakFormSolution], rates: Sequence[f
     return averaged, float(rates[int(np.argmax(weights))])
 
 
-def solved_over_rates(solve: Callable[..., WeakFormSolution], count: int,
+def solved_over_rates(fits: Sequence[Callable[[], WeakFormSolution]],
                       refit: Callable[[], WeakFormSolution] | None, run: Run | None
                       ) -> tuple[list[WeakFormSolution], WeakFormSolution | None]:
-    """``solve(rate_index=k)`` for the first ``count`` rates and ``refit()``, side by side by
-    ``run`` (:meth:`~stewartid.parallel.WorkerPool.call_all`; None: one after the other);
-    ``solve`` and ``refit`` picklable. The refit's warnings are left out: what the data lack,
-    the fits at every rate have said."""
-    calls = [partial(solve, rate_index=k) for k in range(count)]
+    """The ``fits`` (one per rate) and ``refit()``, side by side by ``run``
+    (:meth:`~stewartid.parallel.WorkerPool.call_all`; None: one after the other), each
+    picklable. The refit's warnings are left out: what the data lack, the fits at every rate
+    have said."""
+    calls = list(fits)
     if refit is not None:
         calls.append(partial(_without_data_warnings, refit))
     solutions = (run or in_sequence)(calls)
-    return solutions[:count], (solutions[count] if refit is not None else None)
+    return solutions[:len(fits)], (solutions[len(fits)] if refit is not None else None)
 
 
 def in_sequence(calls: Sequence[Callable[[], Any]]) -> list[Any]:
@@ -132,7 +132,8 @@ def solve_weak_form_over_rates(equations: Sequence[IntervalEquations], n_experim
                     shared=shared, **settings)
     refit = None if half is None else partial(solve_weak_form, half, n_experiments, False,
                                               variation=True, shared=shared, **settings)
-    solutions, refitted = solved_over_rates(solve, len(rates), refit, run)
+    solutions, refitted = solved_over_rates([partial(solve, rate_index=k)
+                                             for k in range(len(rates))], refit, run)
     best, best_rate = averaged_over_rates(solutions, rates, refitted)
     rows = plain.n_equations
     # likelihood ratio of the levels, and levels a friction can have: one 3 standard errors

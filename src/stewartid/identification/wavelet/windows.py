@@ -216,8 +216,10 @@ def solve_windows_over_rates(equations: Sequence[WindowEquations],
     if any(len(e.coulomb) > count for e in equations):
         refit = partial(solve_windows, [e._replace(coulomb=e.coulomb[half_window_pick(
             len(e.coulomb), count)]) for e in equations], **settings)
-    solutions, half = solved_over_rates(partial(solve_windows, equations, **settings), count,
-                                        refit, run)
+    # each fit given its rate's Coulomb rows alone: a worker receives what it solves
+    fits = [partial(solve_windows, [e._replace(coulomb=e.coulomb[k:k + 1]) for e in equations],
+                    **settings) for k in range(count)]
+    solutions, half = solved_over_rates(fits, refit, run)
     return averaged_over_rates(solutions, rates, half)
 
 
