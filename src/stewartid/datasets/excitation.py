@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -148,7 +149,15 @@ def _windowed(x: np.ndarray) -> np.ndarray:
     ramp = np.linspace(-1.0, 1.0, n)   # symmetric: orthogonal to the constant
     x = x - x.mean(axis=0)
     x = x - np.outer(ramp, (ramp @ x) / max(float(ramp @ ramp), 1e-300))
-    return x * np.hanning(n)[:, None]
+    return x * _hann(n)[:, None]
+
+
+@lru_cache(maxsize=4)
+def _hann(n: int) -> np.ndarray:
+    """``np.hanning(n)``, read-only: every channel of a record's check takes the same window."""
+    window = np.hanning(n)
+    window.flags.writeable = False
+    return window
 
 
 def running_maximum(x: np.ndarray, reach: int) -> np.ndarray:

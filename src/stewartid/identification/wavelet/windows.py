@@ -97,7 +97,8 @@ def _stop_columns(stops: Sequence[Stop], sel: slice, phi: np.ndarray,
         polynomials = legendre.legvander(x, found.terms - 1)                # (n, terms)
         local = phi[:, start - sel.start:stop - sel.start]                   # (K, n)
         legs = leg_jacobian[start:stop, found.leg]                           # (n, 6)
-        columns.append(np.einsum("kn,ni,nj->ikj", local, legs, polynomials))
+        products = (legs[:, :, None] * polynomials[:, None, :]).reshape(len(legs), -1)
+        columns.append((local @ products).reshape(len(local), 6, -1).transpose(1, 0, 2))
     if not columns:
         return None
     columns = np.concatenate(columns, axis=2)
