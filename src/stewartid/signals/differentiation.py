@@ -344,7 +344,7 @@ def _channel_spectra(x: np.ndarray, sample_rate: float, refine: bool
     channels, relative = np.arange(len(scale)), on_coarse
     if refine:
         channels = _peak_channels(coarse / scale[:, None], n)
-        if len(channels) > 1:  # the finer transform of the winner only
+        if len(channels) > 2:  # the winner alone transformed whole (two cost what they save)
             channels = channels[_fine_winner(windowed[channels], coarse[channels] / scale[
                 channels, None], scale[channels], nfft)]
         relative = np.abs(np.fft.rfft(windowed[channels], nfft, axis=1)[:, 1:])
@@ -443,44 +443,40 @@ def _fine_winner(windowed: np.ndarray, amplitude: np.ndarray, scale: np.ndarray,
     ``amplitude`` (m, M/2 + 1): each channel's coarse spectrum over its scale on M points. By
     :func:`_peak_channels`' bound, a peak that can be the largest lies within half a coarse bin of
     a coarse value of at least the largest coarse value times cos((n - 1) pi / (2 M)): only the
-    fine bins about those are evaluated (:func:`_zoom_spectrum`), unless they span most of it.
+    fine bins about those, of every channel, are evaluated (:func:`_zoom_spectrum`), unless
+    they span most of the spectrum.
     """
     m, n = windowed.shape
     coarse = 2 * (amplitude.shape[1] - 1)
     step, half = nfft // coarse, nfft // 2
-    reach = np.cos((n - 1) * np.pi / (2 * coarse))
-    floor = amplitude[:, 1:].max() * reach * (1 - 1e-9)
-    peaks = []  # (value, bin, row) of each channel, largest value first
-    for row in range(m):
-        near = np.flatnonzero(amplitude[row] * (1 + 1e-9) >= floor)
-        first = max(1, step * int(near[0]) - step // 2) if len(near) else 1
-        last = min(half, step * int(near[-1]) + step // 2) if len(near) else half
-        if len(near) and last - first < n:
-            spectrum = np.abs(_zoom_spectrum(windowed[row], nfft, first, last - first + 1))
-        else:
-            first, spectrum = 1, np.abs(np.fft.rfft(windowed[row], nfft)[1:])
-        peak = int(np.argmax(spectrum))
-        peaks.append((-spectrum[peak] / scale[row], first + peak, row))
-    row = min(peaks)[2]
+    floor = amplitude[:, 1:].max() * np.cos((n - 1) * np.pi / (2 * coarse)) * (1 - 1e-9)
+    near = np.flatnonzero(np.any(amplitude * (1 + 1e-9) >= floor, axis=0))
+    first = max(1, step * int(near[0]) - step // 2)
+    last = min(half, step * int(near[-1]) + step // 2)
+    if last - first < n:
+        spectra = np.abs(_zoom_spectrum(windowed, nfft, first, last - first + 1))
+    else:
+        first, spectra = 1, np.abs(np.fft.rfft(windowed, nfft, axis=1)[:, 1:])
+    row = _dominant(spectra / scale[:, None])
     return slice(row, row + 1)
 
 
 def _zoom_spectrum(x: np.ndarray, nfft: int, first: int, count: int) -> np.ndarray:
-    """Bins ``first`` .. ``first + count - 1`` of the ``nfft``-point transform of ``x`` (n,)
-    (zero-padded), sum_t x[t] exp(-2 pi i j t / nfft), by Bluestein's chirp transform: three
-    transforms of about n + count points instead of one of ``nfft``."""
-    n = len(x)
+    """Bins ``first`` .. ``first + count - 1`` (..., count) of the ``nfft``-point transform of
+    each row of ``x`` (..., n) (zero-padded), sum_t x[t] exp(-2 pi i j t / nfft), by Bluestein's
+    chirp transform: transforms of about n + count points instead of ``nfft``."""
+    n = x.shape[-1]
     size = 1 << int(math.ceil(math.log2(n + count - 1)))
     k = np.arange(max(n, count), dtype=np.int64)
-    # exp(-i pi k^2 / nfft), k^2 reduced modulo 2 nfft in integers: phases exact for any k
+    # exp(-i pi k^2 / nfft), k^2 reduced modulo 2 nfft in integers: phases exact for any k;
+    # the signal's also carries the shift to the band, exp(-2 pi i first k / nfft)
     chirp = np.exp(-1j * np.pi * ((k * k) % (2 * nfft)) / nfft)
-    shift = np.exp(-2j * np.pi * ((first * k[:n]) % nfft) / nfft)
-    signal = np.zeros(size, dtype=complex)
-    signal[:n] = x * shift * chirp[:n]
+    shifted = np.exp(-1j * np.pi * ((k[:n] * (k[:n] + 2 * first)) % (2 * nfft)) / nfft)
     kernel = np.zeros(size, dtype=complex)
     kernel[:count] = chirp[:count].conj()
     kernel[size - n + 1:] = chirp[1:n][::-1].conj()
-    return np.fft.ifft(np.fft.fft(signal) * np.fft.fft(kernel))[:count] * chirp[:count]
+    transformed = np.fft.fft(x * shifted, size) * np.fft.fft(kernel)
+    return np.fft.ifft(transformed)[..., :count] * chirp[:count]
 
 
 def _refine_frequency(x: np.ndarray, sample_rate: float, frequency: float) -> float:
