@@ -12,7 +12,7 @@ from stewartid.identification.pairs import select_symmetric_pairs
 from stewartid.identification.result import max_error_percent
 from stewartid.identification.wavelet.detection import Detection
 from stewartid.identification.wavelet.estimator import WaveletIdentifier
-from stewartid.identification.wavelet.weak_form import coulomb_patterns
+from stewartid.identification.wavelet.weak_form import PatternsBySamples, coulomb_patterns
 from stewartid.model.dynamics import ModelTerms
 from stewartid.model.joints import JOINT_TYPES
 from stewartid.model.kinematics import joint_rate_jacobians, leg_jacobian, leg_lengths
@@ -105,6 +105,11 @@ def test_coulomb_patterns_are_the_regressors_soft_sign_columns(paper):
     patterns = coulomb_patterns(found, J, False, rates, leg_jacobian=J_leg,
                                 also=((half_speed, rates[1:]),))
     uniform = coulomb_patterns(found, J, True, rates)
+    # the same, computed for the samples a slice asks for
+    by_samples = PatternsBySamples(found, J, False, rates, leg_jacobian=J_leg,
+                                   also=((half_speed, rates[1:]),))
+    assert by_samples.shape == patterns.shape
+    rows = slice(37, 251)
     columns = parameter_index([f"coulomb[{t}]" for t in JOINT_TYPES] + ["coulomb[actuator]"])
     for k, (speed, r) in enumerate([(1.0, r) for r in rates] + [(0.5, r) for r in rates[1:]]):
         s = np.hypot(sigma, r)
@@ -113,6 +118,7 @@ def test_coulomb_patterns_are_the_regressors_soft_sign_columns(paper):
         expected = Y[..., columns].transpose(0, 2, 1)
         bound = 1e-12 * np.abs(expected).max()
         assert np.abs(patterns[:, k] - expected).max() <= bound
+        assert np.abs(by_samples[rows][:, k] - expected[rows]).max() <= bound
         if speed == 1.0:
             assert np.abs(uniform[:, k, 0] - expected[:, :3].sum(axis=1)).max() <= bound
 

@@ -410,6 +410,8 @@ def _experiment_equations(work: tuple, k: int) -> tuple[dict[str, list], dict, n
     found = estimator._noise_and_intervals(experiment, 1.0)
     patterns = (patterns_with_half_window(experiment, found, legs, estimator.sign_window_check)
                 if {"free", "coulomb"} & set(models) else None)
+    if patterns is not None and len(models) > 1:  # intervals and windows overlap: all at once
+        patterns = patterns[:]
     # the legs' stops in the law's windows, unless the free interval constants are fitted
     # beside them (one sine per experiment: the stops fall between the intervals)
     stops = legs and "free" not in models

@@ -34,7 +34,7 @@ from stewartid.identification.wavelet.rate_selection import (
 )
 from stewartid.identification.wavelet.weak_form import (
     SOFT_SIGN_RATES,
-    coulomb_patterns,
+    PatternsBySamples,
     experiment_equations,
 )
 from stewartid.identification.wavelet.windows import (
@@ -72,14 +72,15 @@ def chosen_models(setting: str, single: Sequence[bool]) -> tuple[str, ...]:
 
 
 def patterns_with_half_window(experiment: Experiment, found: Detection, legs: bool,
-                              check: bool = True) -> np.ndarray:
+                              check: bool = True) -> PatternsBySamples:
     """The Coulomb patterns (N, R, types, 6) of
     :func:`~stewartid.identification.wavelet.weak_form.coulomb_patterns` and, with ``check`` where
     the pose noise lengthened the signs' window, after them that of the signs from half of it at
     the rate :data:`~stewartid.identification.wavelet.rate_selection.HALF_WINDOW_RATE`
     (N, R + 1, types, 6): the refit that measures the long window's bias
     (:mod:`~stewartid.identification.sign_window`). ``legs``: the patterns carry the legs' type.
-    Both come from one pass over the joints' Jacobians.
+    Both come from one pass over the joints' Jacobians, for the samples asked
+    (:class:`~stewartid.identification.wavelet.weak_form.PatternsBySamples`).
     """
     half = None
     if check:
@@ -90,17 +91,19 @@ def patterns_with_half_window(experiment: Experiment, found: Detection, legs: bo
                 shorter_sign_window(window, found.sign_window)))
     also = (() if half is None else
             ((half, SOFT_SIGN_RATES[HALF_WINDOW_RATE:HALF_WINDOW_RATE + 1]),))
-    return coulomb_patterns(found, experiment.joint_jacobians, False,
-                            leg_jacobian=experiment.leg_jacobian if legs else None, also=also)
+    return PatternsBySamples(found, experiment.joint_jacobians, False,
+                             leg_jacobian=experiment.leg_jacobian if legs else None, also=also)
 
 
 def model_equations(model: str, experiment: Experiment, found: Detection, order: int,
-                    functions: int, k: int, patterns: np.ndarray | None = None,
+                    functions: int, k: int,
+                    patterns: np.ndarray | PatternsBySamples | None = None,
                     legs: bool = False) -> list:
     """The weak-form equations of one experiment under friction model ``model`` (windows or intervals).
 
     ``patterns``: :func:`~stewartid.identification.wavelet.weak_form.coulomb_patterns` of the
-    experiment, shared by the models that use them; ``legs``: the windows leave the friction in
+    experiment (or its rows on demand), shared by the models that use them; ``legs``: the
+    windows leave the friction in
     the legs' stops free (:func:`~stewartid.identification.wavelet.windows.window_stops`), and
     the detection's info records the legs' share of samples at a stop and the window (s).
     """

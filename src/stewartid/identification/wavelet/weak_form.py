@@ -139,7 +139,8 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
                        joint_rates: np.ndarray,
                        rate_noise: np.ndarray, interval: Sequence[float], order: int, size: int,
                        experiment: int = 0, uniform: bool = False,
-                       patterns: np.ndarray | None = None) -> IntervalEquations | None:
+                       patterns: np.ndarray | PatternsBySamples | None = None
+                       ) -> IntervalEquations | None:
     """Weak-form equations of one interval; None when it holds fewer than 4 (K + 1) samples.
 
     Parameters
@@ -163,8 +164,8 @@ def interval_equations(t: np.ndarray, q: np.ndarray, y: np.ndarray,
     experiment : int
     uniform : bool
         One Coulomb level for every joint axis.
-    patterns : ndarray, shape (N, n_rates, n_types, 6), optional
-        :func:`coulomb_patterns`, for ``coulomb_rows``.
+    patterns : ndarray, shape (N, n_rates, n_types, 6), or PatternsBySamples, optional
+        :func:`coulomb_patterns` (or its rows on demand), for ``coulomb_rows``.
     """
     start, stop = float(interval[0]), float(interval[1])
     sel = inside(t, start, stop)
@@ -252,6 +253,38 @@ def coulomb_patterns(found: Detection, joint_jacobians: np.ndarray, uniform: boo
     return out
 
 
+@dataclass(frozen=True)
+class PatternsBySamples:
+    """:func:`coulomb_patterns` of one experiment, computed for the samples a slice asks for:
+    ``patterns[rows]`` gives the numbers of the whole (N, n_rates, n_types, 6) array's rows, which
+    is never held (an experiment's windows each take theirs, one at a time)."""
+
+    found: Detection
+    joint_jacobians: np.ndarray
+    uniform: bool
+    rates: Sequence[float] = SOFT_SIGN_RATES
+    leg_jacobian: np.ndarray | None = None
+    also: tuple[tuple[Detection, Sequence[float]], ...] = ()
+
+    @property
+    def shape(self) -> tuple[int, int, int, int]:
+        """The whole array's shape."""
+        types = (1 if self.uniform else len(JOINT_TYPES)) + (self.leg_jacobian is not None)
+        rates = len(self.rates) + sum(len(rates) for _, rates in self.also)
+        return len(self.joint_jacobians), rates, types, 6
+
+    def __getitem__(self, rows: slice) -> np.ndarray:
+        def part(signs: Detection) -> Detection:
+            legs = signs.leg_sign_rates
+            return signs._replace(sign_rates=signs.sign_rates[rows],
+                                  leg_sign_rates=None if legs is None else legs[rows])
+
+        return coulomb_patterns(part(self.found), self.joint_jacobians[rows], self.uniform,
+                                self.rates, leg_jacobian=(None if self.leg_jacobian is None
+                                              else self.leg_jacobian[rows]),
+                                also=tuple((part(signs), rates) for signs, rates in self.also))
+
+
 def _by_type(pattern: np.ndarray, uniform: bool) -> np.ndarray:
     """Per-axis pattern (n, 5, 6) summed per joint type: (n, n_types, 6), or (n, 1, 6) if ``uniform``."""
     by_type = np.stack([pattern[:, axes[0]:axes[-1] + 1].sum(axis=1)
@@ -281,7 +314,8 @@ def noise_gram(phi: Sequence[np.ndarray], bump: Sequence[np.ndarray]) -> np.ndar
 
 
 def experiment_equations(experiment: Experiment, found: Detection, order: int, size: int,
-                         index: int, friction: str, patterns: np.ndarray | None = None
+                         index: int, friction: str,
+                         patterns: np.ndarray | PatternsBySamples | None = None
                          ) -> list[IntervalEquations]:
     """The weak-form equations of every usable interval of one experiment.
 
@@ -370,6 +404,6 @@ def _per_interval(values: np.ndarray | None, owner: np.ndarray, shape: tuple[int
     return np.asarray(values, dtype=float)[owner]
 
 
-__all__ = ["SOFT_SIGN_RATES", "IntervalEquations", "StackedEquations", "coulomb_patterns",
-           "experiment_equations", "inside", "interval_equations", "noise_gram",
-           "project_patterns", "stack_equations", "test_family"]
+__all__ = ["SOFT_SIGN_RATES", "IntervalEquations", "PatternsBySamples", "StackedEquations",
+           "coulomb_patterns", "experiment_equations", "inside", "interval_equations",
+           "noise_gram", "project_patterns", "stack_equations", "test_family"]

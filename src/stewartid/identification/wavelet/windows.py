@@ -34,6 +34,7 @@ from stewartid.identification.wavelet.variance_components import row_noise
 from stewartid.identification.wavelet.weak_form import (
     SOFT_SIGN_RATES,
     IntervalEquations,
+    PatternsBySamples,
     coulomb_patterns,
     inside,
     noise_gram,
@@ -115,12 +116,14 @@ def window_bounds(t: np.ndarray, length: float) -> np.ndarray:
 
 def window_equations(experiment: Experiment, found: Detection, order: int, size: int,
                      index: int, uniform: bool, length: float,
-                     patterns: np.ndarray | None = None,
+                     patterns: np.ndarray | PatternsBySamples | None = None,
                      stops: Sequence[Stop] | None = None) -> list[WindowEquations]:
     """The equations of every window of one experiment.
 
     ``order``, ``size``: bump exponent and K; ``length``: window, s; ``patterns``:
-    :func:`coulomb_patterns` of the experiment at every soft-sign rate (computed when not given);
+    :func:`coulomb_patterns` of the experiment at every soft-sign rate, or its rows on demand
+    (:class:`~stewartid.identification.wavelet.weak_form.PatternsBySamples`; computed when not
+    given);
     ``stops``: the legs' stops (:func:`window_stops`), whose friction each window leaves free.
     """
     t, q, y = experiment.t, experiment.q, experiment.generalized_force
