@@ -44,6 +44,22 @@ def test_a_pool_keeps_task_order_over_rounds(workers):
 
 
 @pytest.mark.parametrize("workers", [1, TWO_FORKED])
+def test_started_tasks_run_while_this_process_works_and_come_back_in_order(workers):
+    # tasks started before this process's own work, then a second batch after it: every
+    # result in its batch's order, the first failure of a batch raised by its gather
+    with WorkerPool(workers, 4) as pool:
+        early = pool.submit_all([partial(_offset_square, 10, k) for k in range(4)])
+        own = sum(k * k for k in range(1000))
+        late = pool.submit_all([partial(_offset_square, 20, k) for k in range(2)])
+        assert pool.gather(late) == [20, 21]
+        assert pool.gather(early) == [10, 11, 14, 19]
+        failing = pool.submit_all([partial(abs, -1), partial(_refused, "b")])
+        with pytest.raises(ValueError, match="refused b"):
+            pool.gather(failing)
+    assert own == 332833500
+
+
+@pytest.mark.parametrize("workers", [1, TWO_FORKED])
 def test_warnings_of_workers_are_raised_here_in_task_order(workers):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

@@ -184,6 +184,20 @@ class WorkerPool:
             return self._in_order(calls, None)
         return self._gathered([self._pool.submit(_captured, call) for call in calls], None)
 
+    def submit_all(self, calls: Sequence[Callable[[], Any]]) -> list[Future]:
+        """Start ``calls`` (as :meth:`call_all`) and return at once, with their futures for
+        :meth:`gather`: this process can work meanwhile. One worker: each runs now, here."""
+        if self._pool is None:
+            return [InlineExecutor().submit(call) for call in calls]
+        return [self._pool.submit(_captured, call) for call in calls]
+
+    def gather(self, futures: Sequence[Future]) -> list[Any]:
+        """The results of :meth:`submit_all`'s ``futures``, in their order; the first failure
+        is raised."""
+        if self._pool is None:
+            return [future.result() for future in futures]
+        return self._gathered(list(futures), None)
+
     @staticmethod
     def _in_order(calls: Sequence[Callable[[], Any]], progress: TaskProgress | None
                   ) -> list[Any]:

@@ -249,8 +249,7 @@ class WaveletIdentifier(BaseIdentifier):
             noise = ({"pose_covariance": [i["noise_covariance"] for i in infos],
                       "force_variance": [i["force_noise_variance"] for i in infos],
                       "force_sensitivity": sensitivities} if self.noise_correction else {})
-            solved, refused = solve_models(models, equations, infos, motion, noise,
-                                           pool.call_all)
+            solved, refused = solve_models(models, equations, infos, motion, noise, pool)
         fits = {model: self._weak_form_result(solution, infos, len(equations[model]), wavelet,
                                               model, rate, legs and model in ("free", "coulomb"))
                 for model, (solution, rate) in solved.items()}

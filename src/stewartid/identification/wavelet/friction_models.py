@@ -30,6 +30,7 @@ from stewartid.identification.wavelet.gls import WeakFormSolution
 from stewartid.identification.wavelet.rate_selection import (
     HALF_WINDOW_RATE,
     Run,
+    plain_fit,
     solve_weak_form_over_rates,
 )
 from stewartid.identification.wavelet.weak_form import (
@@ -43,6 +44,7 @@ from stewartid.identification.wavelet.windows import (
     window_equations,
     window_stops,
 )
+from stewartid.parallel import WorkerPool
 from stewartid.signals.differentiation import estimate_frequency
 from stewartid.signals.sign_rates import lengthened_by_noise, shorter_sign_window
 from stewartid.verdict.accuracy import predicted_worst_error
@@ -122,31 +124,38 @@ def model_equations(model: str, experiment: Experiment, found: Detection, order:
 
 
 def solve_model(model: str, equations: list, infos: list[dict], motion: list[np.ndarray],
-                noise: dict, run: Run | None = None) -> tuple[WeakFormSolution, float]:
+                noise: dict, run: Run | None = None, start: tuple | None = None
+                ) -> tuple[WeakFormSolution, float]:
     """Solve one friction model's equations over the soft-sign rates; returns the solution and
     its rate. ``run``: the fits at the rates side by side
-    (:func:`~stewartid.identification.wavelet.rate_selection.solved_over_rates`)."""
+    (:func:`~stewartid.identification.wavelet.rate_selection.solved_over_rates`); ``start``: the
+    free constants' :func:`~stewartid.identification.wavelet.rate_selection.plain_fit`, where
+    computed already."""
     if not equations:
         raise_no_interval(infos)
     if model == "coulomb":
         return solve_windows_over_rates(equations, run=run, **noise)
     check_coverage([i["name"] for i in infos], np.array(motion),
                    [sum(e.experiment == k for e in equations) for k in range(len(infos))])
-    return solve_weak_form_over_rates(equations, len(infos), model != "free", run, **noise)
+    return solve_weak_form_over_rates(equations, len(infos), model != "free", run, start,
+                                      **noise)
 
 
 def solve_models(models: Sequence[str], equations: Mapping[str, list], infos: list[dict],
-                 motion: list[np.ndarray], noise: dict, run: Run | None = None
+                 motion: list[np.ndarray], noise: dict, pool: WorkerPool | None = None
                  ) -> tuple[dict[str, tuple[WeakFormSolution, float]], dict[str, str]]:
     """:func:`solve_model` of every model: (solved, refused) dicts; raises the first refusal if
-    all fail. ``run``: several models side by side, each with its equations sent once, else one
-    model's fits at the soft-sign rates."""
+    all fail. ``pool``: the fits side by side (two models: :func:`_side_by_side`), else one
+    after the other.
+    """
     calls = [partial(solve_model, model, equations[model], infos, motion, noise)
              for model in models]
-    if run is not None and len(models) > 1:
-        outcomes = run([partial(_attempted, call) for call in calls])
+    if pool is None:
+        outcomes = [_attempted(call) for call in calls]
+    elif len(models) > 1 and models[0] == "free":  # the free constants and the law
+        outcomes = _side_by_side(calls, pool, equations["free"], len(infos), noise)
     else:
-        outcomes = [_attempted(partial(call, run=run)) for call in calls]
+        outcomes = [_attempted(partial(call, run=pool.call_all)) for call in calls]
     solved, refused, first = {}, {}, None
     for model, (solution, error) in zip(models, outcomes, strict=True):
         if error is None:
@@ -157,6 +166,21 @@ def solve_models(models: Sequence[str], equations: Mapping[str, list], infos: li
     if not solved:
         raise first
     return solved, refused
+
+
+def _side_by_side(calls: Sequence[Callable[..., Any]], pool: WorkerPool, free: list,
+                  n_experiments: int, noise: dict) -> list[tuple[Any, Exception | None]]:
+    """The outcomes (:func:`_attempted`) of the free constants' solve ``calls[0]`` (equations
+    ``free``) and the other models' ``calls[1:]`` on ``pool``: the others' whole solves and the
+    free constants' first fit start side by side, then that fit's soft-sign rates follow on the
+    workers as they come free (the free constants cost about three times the law's windows)."""
+    pending = pool.submit_all([partial(_attempted, call) for call in calls[1:]])
+    bare = [dataclasses.replace(e, coulomb_rows=None) for e in free]  # the plain fit's rows
+    (start, error), = pool.gather(pool.submit_all([partial(
+        _attempted, partial(plain_fit, bare, n_experiments, **noise))]))
+    outcome = _attempted(partial(calls[0], run=lambda fits: pool.gather(pool.submit_all(fits)),
+                                 start=None if error is not None else start))
+    return [outcome, *pool.gather(pending)]
 
 
 def _attempted(call: Callable[[], Any]) -> tuple[Any, Exception | None]:

@@ -113,27 +113,37 @@ def half_window_rows(equations: Sequence[IntervalEquations], count: int
         half_window_pick(len(e.coulomb_rows), count)]) for e in equations]
 
 
+def plain_fit(equations: Sequence[IntervalEquations], n_experiments: int, **settings
+              ) -> tuple[WeakFormSolution, dict]:
+    """The free interval constants' fit without Coulomb rows, and the work it shares with the
+    fits at the soft-sign rates (:func:`solve_weak_form_over_rates`)."""
+    shared: dict = {}
+    return solve_weak_form(equations, n_experiments, False, shared=shared, **settings), shared
+
+
 def solve_weak_form_over_rates(equations: Sequence[IntervalEquations], n_experiments: int,
                                shared_friction: bool = True, run: Run | None = None,
+                               start: tuple[WeakFormSolution, dict] | None = None,
                                **settings) -> tuple[WeakFormSolution, float | None]:
     """:func:`~stewartid.identification.wavelet.gls.solve_weak_form` with Coulomb rows averaged over rates.
 
     Levels are kept only if a likelihood-ratio test at :data:`VARIATION_TEST_LEVEL` accepts them and
-    none is 3 standard errors below zero. ``run`` as :func:`solved_over_rates`. Returns
-    (solution, rate of greatest weight or None).
+    none is 3 standard errors below zero. ``run`` as :func:`solved_over_rates`; ``start``:
+    :func:`plain_fit` of the same equations, where it was computed already. Returns (solution,
+    rate of greatest weight or None).
     """
     if shared_friction:  # the mean rows carry the levels
         return solve_weak_form(equations, n_experiments, True, **settings), None
-    shared: dict = {}
-    plain = solve_weak_form(equations, n_experiments, False, shared=shared, **settings)
+    plain, shared = start or plain_fit(equations, n_experiments, **settings)
     rates = SOFT_SIGN_RATES[:len(equations[0].coulomb_rows)]
     half = half_window_rows(equations, len(rates))
-    solve = partial(solve_weak_form, equations, n_experiments, False, variation=True,
-                    shared=shared, **settings)
     refit = None if half is None else partial(solve_weak_form, half, n_experiments, False,
                                               variation=True, shared=shared, **settings)
-    solutions, refitted = solved_over_rates([partial(solve, rate_index=k)
-                                             for k in range(len(rates))], refit, run)
+    # each fit given its rate's Coulomb rows alone: a worker receives what it solves
+    fits = [partial(solve_weak_form, [dataclasses.replace(e, coulomb_rows=e.coulomb_rows[k:k + 1])
+                                      for e in equations], n_experiments, False,
+                    variation=True, shared=shared, **settings) for k in range(len(rates))]
+    solutions, refitted = solved_over_rates(fits, refit, run)
     best, best_rate = averaged_over_rates(solutions, rates, refitted)
     rows = plain.n_equations
     # likelihood ratio of the levels, and levels a friction can have: one 3 standard errors
@@ -146,5 +156,5 @@ def solve_weak_form_over_rates(equations: Sequence[IntervalEquations], n_experim
 
 
 __all__ = ["HALF_WINDOW_RATE", "VARIATION_TEST_LEVEL", "Run", "averaged_over_rates",
-           "half_window_pick", "half_window_rows", "in_sequence", "residual_cost",
+           "half_window_pick", "half_window_rows", "in_sequence", "plain_fit", "residual_cost",
            "solve_weak_form_over_rates", "solved_over_rates"]
