@@ -175,12 +175,23 @@ def _side_by_side(calls: Sequence[Callable[..., Any]], pool: WorkerPool, free: l
     free constants' first fit start side by side, then that fit's soft-sign rates follow on the
     workers as they come free (the free constants cost about three times the law's windows)."""
     pending = pool.submit_all([partial(_attempted, call) for call in calls[1:]])
-    bare = [dataclasses.replace(e, coulomb_rows=None) for e in free]  # the plain fit's rows
-    (start, error), = pool.gather(pool.submit_all([partial(
-        _attempted, partial(plain_fit, bare, n_experiments, **noise))]))
+    start = None
+    if free:  # else the solve refuses at once
+        bare = [dataclasses.replace(e, coulomb_rows=None) for e in free]  # the plain fit's rows
+        (start, error), = pool.gather(pool.submit_all([partial(
+            _anything_attempted, partial(plain_fit, bare, n_experiments, **noise))]))
+        start = None if error is not None else start  # the solve meets it again, in its turn
     outcome = _attempted(partial(calls[0], run=lambda fits: pool.gather(pool.submit_all(fits)),
-                                 start=None if error is not None else start))
+                                 start=start))
     return [outcome, *pool.gather(pending)]
+
+
+def _anything_attempted(call: Callable[[], Any]) -> tuple[Any, Exception | None]:
+    """``call()``'s result, or whatever it raised."""
+    try:
+        return call(), None
+    except Exception as error:  # handed back, to be met again where the solve meets it
+        return None, error
 
 
 def _attempted(call: Callable[[], Any]) -> tuple[Any, Exception | None]:
