@@ -305,6 +305,27 @@ def random_sines(rng: np.random.Generator, n: int, m: int, fs: float,
         2 * np.pi * rng.uniform(*band) * t + rng.uniform(0, 6)) for _ in range(m)])
 
 
+def near_ties(rng: np.random.Generator, second_line: bool = False
+              ) -> tuple[int, np.ndarray, np.ndarray, int, np.ndarray]:
+    """Channels whose peaks nearly tie against their own scale (pure sines, the last a copy of
+    the first; with ``second_line`` the first also carries a line at 31 Hz) with 0.1 % noise, at
+    100 Hz: samples n, the Hann-windowed channels (m, n), their scales (m,), the 8x-padded
+    length and each channel's coarse spectrum over its scale (m, nfft / 16 + 1)."""
+    fs = 100.0
+    n, m = int(rng.integers(200, 3000)), int(rng.integers(2, 7))
+    x = random_sines(rng, n, m, fs, [1e-3, 1.0, 1e3], (0.3, 20))
+    x[:, -1] = x[:, 0]
+    if second_line:
+        x[:, 0] += 0.9 * np.std(x[:, 0]) * np.sqrt(2) * np.sin(2 * np.pi * 31.0 * np.arange(n) / fs)
+    x += 1e-3 * rng.standard_normal(x.shape) * np.std(x, axis=0)
+    centred = x - x.mean(axis=0)
+    scale = centred.std(axis=0)
+    nfft = 1 << int(np.ceil(np.log2(8 * n)))
+    windowed = (centred * np.hanning(n)[:, None]).T
+    coarse = np.abs(np.fft.rfft(windowed, nfft // 8, axis=1)) / scale[:, None]
+    return n, windowed, scale, nfft, coarse
+
+
 def test_estimate_frequency_transforms_only_channels_that_can_hold_the_peak():
     # pure sines score alike against their own scale, so channels nearly tie (two share
     # a sine): the channels left out by the coarse spectrum's bound must not hold the largest
@@ -312,20 +333,13 @@ def test_estimate_frequency_transforms_only_channels_that_can_hold_the_peak():
     from stewartid.signals.differentiation import _peak_channels
 
     rng = np.random.default_rng(3)
-    fs = 100.0
     for _ in range(40):
-        n, m = int(rng.integers(200, 3000)), int(rng.integers(2, 7))
-        x = random_sines(rng, n, m, fs, [1e-3, 1.0, 1e3], (0.3, 20))
-        x[:, -1] = x[:, 0]
-        x += 1e-3 * rng.standard_normal(x.shape) * np.std(x, axis=0)
-        centred = x - x.mean(axis=0)
-        nfft = 1 << int(np.ceil(np.log2(8 * n)))
-        windowed = (centred * np.hanning(n)[:, None]).T
-        relative = np.abs(np.fft.rfft(windowed, nfft, axis=1)[:, 1:]) / centred.std(axis=0)[:, None]
+        n, windowed, scale, nfft, coarse = near_ties(rng)
+        m = len(windowed)
+        relative = np.abs(np.fft.rfft(windowed, nfft, axis=1)[:, 1:]) / scale[:, None]
         peaks = np.argmax(relative, axis=1)
         values = relative[np.arange(m), peaks]
         top = np.flatnonzero(values == values.max())
-        coarse = np.abs(np.fft.rfft(windowed, nfft // 8, axis=1)) / centred.std(axis=0)[:, None]
         kept = _peak_channels(coarse, n)
         assert set(top) <= set(kept)
         assert np.all(values[np.setdiff1d(np.arange(m), kept)] < values.max())
@@ -355,18 +369,8 @@ def test_the_fine_winner_is_the_channel_of_the_largest_peak_of_every_whole_trans
     from stewartid.signals.differentiation import _dominant, _fine_winner, _peak_channels
 
     rng = np.random.default_rng(4)
-    fs = 100.0
     for _ in range(40):
-        n, m = int(rng.integers(200, 3000)), int(rng.integers(2, 7))
-        x = random_sines(rng, n, m, fs, [1e-3, 1.0, 1e3], (0.3, 20))
-        x[:, -1] = x[:, 0]
-        x[:, 0] += 0.9 * np.std(x[:, 0]) * np.sqrt(2) * np.sin(2 * np.pi * 31.0 * np.arange(n) / fs)
-        x += 1e-3 * rng.standard_normal(x.shape) * np.std(x, axis=0)
-        centred = x - x.mean(axis=0)
-        scale = centred.std(axis=0)
-        nfft = 1 << int(np.ceil(np.log2(8 * n)))
-        windowed = (centred * np.hanning(n)[:, None]).T
-        coarse = np.abs(np.fft.rfft(windowed, nfft // 8, axis=1)) / scale[:, None]
+        n, windowed, scale, nfft, coarse = near_ties(rng, second_line=True)
         kept = _peak_channels(coarse, n)
         relative = np.abs(np.fft.rfft(windowed[kept], nfft, axis=1)[:, 1:]) / scale[kept, None]
         winner = _fine_winner(windowed[kept], coarse[kept], scale[kept], nfft)

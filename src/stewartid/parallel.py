@@ -182,7 +182,7 @@ class WorkerPool:
         a module-level function)."""
         if self._pool is None:
             return self._in_order(calls, None)
-        return self._gathered([self._pool.submit(_captured, call) for call in calls], None)
+        return self.gather(self.submit_all(calls))
 
     def submit_all(self, calls: Sequence[Callable[[], Any]]) -> list[Future]:
         """Start ``calls`` (as :meth:`call_all`) and return at once, with their futures for

@@ -205,8 +205,7 @@ def stop_basis(found: LegStops, sample_rate: float, window: float, step: int, na
 
     # each column lives on a stop's filter support: a sparse Gram, then its eigenvectors (legs
     # stopping together give nearly equal columns, which the rank cut leaves out)
-    norms = np.linalg.norm(columns, axis=0)
-    local = sparse.csc_matrix(columns[:, norms > 0] / norms[norms > 0])
+    local = sparse.csc_matrix(_unit_columns(columns))
     return local @ _span_coefficients((local.T @ local).toarray())
 
 
@@ -214,9 +213,14 @@ def span_basis(columns: np.ndarray) -> np.ndarray:
     """Orthonormal basis (R, r) of the span of ``columns`` (R, m), each scaled to unit length
     first; directions whose Gram eigenvalue is below :data:`RANK_CUT` of the largest are left out
     (nearly equal columns of legs stopping together, a stop's part too short for its terms)."""
-    norms = np.linalg.norm(columns, axis=0)
-    unit = columns[:, norms > 0] / norms[norms > 0]
+    unit = _unit_columns(columns)
     return unit @ _span_coefficients(unit.T @ unit) if unit.shape[1] else unit
+
+
+def _unit_columns(columns: np.ndarray) -> np.ndarray:
+    """The nonzero ``columns`` (R, m), each scaled to unit length."""
+    norms = np.linalg.norm(columns, axis=0)
+    return columns[:, norms > 0] / norms[norms > 0]
 
 
 def _span_coefficients(gram: np.ndarray) -> np.ndarray:

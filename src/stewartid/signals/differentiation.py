@@ -446,7 +446,7 @@ def _fine_winner(windowed: np.ndarray, amplitude: np.ndarray, scale: np.ndarray,
     fine bins about those, of every channel, are evaluated (:func:`_zoom_spectrum`), unless
     they span most of the spectrum.
     """
-    m, n = windowed.shape
+    n = windowed.shape[1]
     coarse = 2 * (amplitude.shape[1] - 1)
     step, half = nfft // coarse, nfft // 2
     floor = amplitude[:, 1:].max() * np.cos((n - 1) * np.pi / (2 * coarse)) * (1 - 1e-9)
@@ -456,7 +456,7 @@ def _fine_winner(windowed: np.ndarray, amplitude: np.ndarray, scale: np.ndarray,
     if last - first < n:
         spectra = np.abs(_zoom_spectrum(windowed, nfft, first, last - first + 1))
     else:
-        first, spectra = 1, np.abs(np.fft.rfft(windowed, nfft, axis=1)[:, 1:])
+        spectra = np.abs(np.fft.rfft(windowed, nfft, axis=1)[:, 1:])
     row = _dominant(spectra / scale[:, None])
     return slice(row, row + 1)
 

@@ -178,27 +178,22 @@ def _side_by_side(calls: Sequence[Callable[..., Any]], pool: WorkerPool, free: l
     start = None
     if free:  # else the solve refuses at once
         bare = [dataclasses.replace(e, coulomb_rows=None) for e in free]  # the plain fit's rows
-        (start, error), = pool.gather(pool.submit_all([partial(
-            _anything_attempted, partial(plain_fit, bare, n_experiments, **noise))]))
-        start = None if error is not None else start  # the solve meets it again, in its turn
-    outcome = _attempted(partial(calls[0], run=lambda fits: pool.gather(pool.submit_all(fits)),
-                                 start=start))
-    return [outcome, *pool.gather(pending)]
+        # any failure of it is met again by the solve, in its turn
+        (start, _), = pool.gather(pool.submit_all([partial(
+            _attempted, partial(plain_fit, bare, n_experiments, **noise), Exception)]))
+    return [_attempted(partial(calls[0], run=pool.call_all, start=start)),
+            *pool.gather(pending)]
 
 
-def _anything_attempted(call: Callable[[], Any]) -> tuple[Any, Exception | None]:
-    """``call()``'s result, or whatever it raised."""
+def _attempted(call: Callable[[], Any],
+               errors: type[Exception] | tuple[type[Exception], ...] = (
+                   IdentificationError, np.linalg.LinAlgError)
+               ) -> tuple[Any, Exception | None]:
+    """``call()``'s result, or the ``errors`` it raised (by default a refusal; singular:
+    unexcited)."""
     try:
         return call(), None
-    except Exception as error:  # handed back, to be met again where the solve meets it
-        return None, error
-
-
-def _attempted(call: Callable[[], Any]) -> tuple[Any, Exception | None]:
-    """``call()``'s result, or the refusal it raised (singular: unexcited)."""
-    try:
-        return call(), None
-    except (IdentificationError, np.linalg.LinAlgError) as error:
+    except errors as error:
         return None, error
 
 
