@@ -111,3 +111,69 @@ def test_a_rate_the_data_single_out_takes_all_the_weight():
     assert rate == 0.3 and mean.rate_weights["0.3"] > 1 - 1e-9
     assert mean.theta[0] == pytest.approx(fits[2].theta[0], rel=1e-9)
     assert mean.theta_std[0] == pytest.approx(fits[2].theta_std[0], rel=1e-6)
+
+
+def test_the_plain_fits_bias_from_left_out_coulomb_rows_is_its_level_sensitivity():
+    """Invariant rows y = X theta + R_r c of 40 intervals (R_r a Coulomb torque's rows at the
+    second of two soft-sign rates, c three joint types' levels; some intervals carry a third
+    set, as the signs from half their window add), fitted for [Mt Bt] alone: the fit is off by
+    exactly S_r c, S its ``level_sensitivity`` (the fit is linear in the rows it is given), to
+    round-off, in every entry; the first rate's S does not explain it."""
+    from stewartid.identification.wavelet.gls import solve_weak_form
+    from stewartid.identification.wavelet.weak_form import IntervalEquations
+
+    rng = np.random.default_rng(11)
+    n, k, types = 40, 8, 3
+    theta = rng.normal(size=(6, 12))
+    levels = np.array([3.0, -2.0, 1.5])
+    equations = []
+    for index in range(n):
+        x = rng.normal(size=(k, 12))
+        rows = rng.normal(size=(2 + index % 3 // 2, k, types, 6))
+        equations.append(IntervalEquations(
+            regressors=x, targets=x @ theta.T + np.einsum("kti,t->ki", rows[1], levels),
+            mean_regressors=np.zeros(12), mean_target=np.zeros(6), weight=1.0,
+            coulomb=np.zeros((types, 6)), experiment=index % 2,
+            noise_gram=np.zeros((3, 3, k + 1, k + 1)), coulomb_rows=rows))
+    plain = solve_weak_form(equations, 2, shared_friction=False)
+    bias = plain.level_sensitivity @ levels                                  # (2, 6, 12)
+    assert plain.level_sensitivity.shape == (2, 6, 12, types)
+    scale = np.abs(bias[1]).max()
+    assert np.abs(plain.theta - theta - bias[1]).max() < 1e-9 * scale
+    assert np.abs(plain.theta - theta - bias[0]).max() > 0.1 * scale
+    # fitted with the levels, nothing is left out: no sensitivity
+    assert solve_weak_form(equations, 2, shared_friction=False,
+                           variation=True).level_sensitivity is None
+
+
+def test_the_laws_levels_widen_the_plain_fit_only_where_they_explain_the_disagreement():
+    """The plain fit off the law fit by the bias S c its left-out rows predict (at the law's
+    rate, plus unit noise) gets errors sqrt(s^2 + (S c)^2); beside a law fit that departs from
+    it elsewhere by 10 standard errors (a friction the law does not describe), or with the
+    levels kept (no sensitivity), it is left as it is."""
+    from stewartid.identification.wavelet.friction_models import constants_floor
+    from stewartid.identification.wavelet.gls import WeakFormSolution
+
+    rng = np.random.default_rng(5)
+    truth, std = rng.normal(size=(6, 12)), np.full((6, 12), 0.1)
+    sensitivity = 0.05 * rng.normal(size=(5, 6, 12, 3))
+    levels = np.array([9.0, 8.0, 10.0])
+    bias = sensitivity[2] @ levels
+
+    def solution(theta, coulomb, level_sensitivity=None):
+        return WeakFormSolution(
+            theta=theta, theta_std=std, coulomb=coulomb, coulomb_std=0.1 * np.ones(3),
+            offsets=np.zeros((1, 6)), noise_std=np.ones(6), pose_noise_share=np.zeros(6),
+            constant_scatter=np.zeros(6), condition_number=1.0, n_equations=100,
+            level_sensitivity=level_sensitivity)
+
+    law = solution(truth + 0.1 * rng.normal(size=(6, 12)), levels)
+    plain = solution(truth + bias + 0.1 * rng.normal(size=(6, 12)), np.full(3, np.nan),
+                     sensitivity)
+    floored = constants_floor(plain, law, 3e-4)          # SOFT_SIGN_RATES[2]
+    assert np.allclose(floored.theta_std, np.hypot(std, bias))
+    assert np.array_equal(floored.theta, plain.theta)
+    elsewhere = solution(law.theta + 1.4 * rng.choice([-1.0, 1.0], size=(6, 12)), levels)
+    assert constants_floor(plain, elsewhere, 3e-4) is plain
+    kept = solution(plain.theta, levels)
+    assert constants_floor(kept, law, 3e-4) is kept

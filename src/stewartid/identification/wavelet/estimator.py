@@ -32,6 +32,7 @@ from stewartid.identification.wavelet.detection import (
 from stewartid.identification.wavelet.friction_models import (
     choose_friction_fit,
     chosen_models,
+    constants_floor,
     friction_models,
     law_floor,
     model_equations,
@@ -250,11 +251,20 @@ class WaveletIdentifier(BaseIdentifier):
                       "force_variance": [i["force_noise_variance"] for i in infos],
                       "force_sensitivity": sensitivities} if self.noise_correction else {})
             solved, refused = solve_models(models, equations, infos, motion, noise, pool)
-        fits = {model: self._weak_form_result(solution, infos, len(equations[model]), wavelet,
-                                              model, rate, legs and model in ("free", "coulomb"))
-                for model, (solution, rate) in solved.items()}
-        if "free" in fits and "coulomb" in fits:  # the law's bias, before the choice
+
+        def result_of(model: str) -> tuple[IdentificationResult, dict]:
+            solution, rate = solved[model]
+            return self._weak_form_result(solution, infos, len(equations[model]), wavelet,
+                                          model, rate, legs and model in ("free", "coulomb"))
+
+        fits = {model: result_of(model) for model in solved}
+        if "free" in fits and "coulomb" in fits:
+            # before the choice: the law's bias, as the free constants' fit measures it, then
+            # that fit's own, from the Coulomb torques it leaves out at the law's levels
             fits["coulomb"] = (law_floor(fits["coulomb"][0], fits["free"][0]), fits["coulomb"][1])
+            solved["free"] = (constants_floor(solved["free"][0], *solved["coulomb"]),
+                              solved["free"][1])
+            fits["free"] = result_of("free")
         chosen, why = choose_friction_fit({model: fit[0] for model, fit in fits.items()},
                                           {model: solution for model, (solution, _) in
                                            solved.items()})

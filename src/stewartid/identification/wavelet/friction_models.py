@@ -15,7 +15,7 @@ import numpy as np
 from stewartid.datasets.dataset import Dataset
 from stewartid.errors import IdentificationError
 from stewartid.identification.preparation import Experiment
-from stewartid.identification.quantiles import normal_upper_quantile
+from stewartid.identification.quantiles import chi2_upper_quantile, normal_upper_quantile
 from stewartid.identification.result import IdentificationResult
 from stewartid.identification.stops import check_motion
 from stewartid.identification.wavelet.detection import (
@@ -177,10 +177,9 @@ def _side_by_side(calls: Sequence[Callable[..., Any]], pool: WorkerPool, free: l
     pending = pool.submit_all([partial(_attempted, call) for call in calls[1:]])
     start = None
     if free:  # else the solve refuses at once
-        bare = [dataclasses.replace(e, coulomb_rows=None) for e in free]  # the plain fit's rows
         # any failure of it is met again by the solve, in its turn
         (start, _), = pool.gather(pool.submit_all([partial(
-            _attempted, partial(plain_fit, bare, n_experiments, **noise), Exception)]))
+            _attempted, partial(plain_fit, free, n_experiments, **noise), Exception)]))
     return [_attempted(partial(calls[0], run=pool.call_all, start=start)),
             *pool.gather(pending)]
 
@@ -236,6 +235,37 @@ def law_floor(law: IdentificationResult, free: IdentificationResult) -> Identifi
         std_errors_B=widened(law.B, law.std_errors_B, free.B, free.std_errors_B))
 
 
+def constants_floor(free: WeakFormSolution, law: WeakFormSolution, law_rate: float
+                    ) -> WeakFormSolution:
+    """The free constants' fit, its standard errors widened by the bias of the Coulomb torques
+    its invariant rows leave out, at the levels the law fit measures.
+
+    Where the levels' likelihood-ratio test drops them (noisy signs attenuate them), the free
+    constants' fit is the plain one: a constant per interval, which does not absorb the
+    generalized force of a constant joint torque changing with the pose along large motions.
+    Its bias is b = S c (``level_sensitivity`` S at the law's soft-sign rate, c the law's
+    levels); each error becomes sqrt(s^2 + b^2). The law's levels are trusted only where b
+    accounts for the two fits' disagreement d over the u = 72 entries of [Mt Bt], s_d^2 =
+    s_free^2 + s_law^2: sum ((d - b) / s_d)^2 lies within the chi-square point of u degrees of
+    freedom at :data:`FRICTION_LAW_LEVEL`, below sum (d / s_d)^2 by more than that of one (a
+    law that does not hold gives levels that predict a bias the data do not show). Other fits
+    are returned as they are.
+    """
+    sensitivity = free.level_sensitivity
+    if (sensitivity is None or sensitivity.shape[-1] != len(law.coulomb)
+            or law_rate not in SOFT_SIGN_RATES[:len(sensitivity)]
+            or not np.all(np.isfinite(law.coulomb))):
+        return free
+    bias = sensitivity[SOFT_SIGN_RATES.index(law_rate)] @ law.coulomb
+    spread = np.maximum(np.hypot(free.theta_std, law.theta_std[:, :12]), 1e-300)
+    apart = (free.theta - law.theta[:, :12]) / spread
+    left = np.sum((apart - bias / spread) ** 2)
+    if not (np.sum(apart ** 2) - left > chi2_upper_quantile(1, FRICTION_LAW_LEVEL)
+            and left <= chi2_upper_quantile(apart.size, FRICTION_LAW_LEVEL)):
+        return free
+    return dataclasses.replace(free, theta_std=np.hypot(free.theta_std, bias))
+
+
 #: Family-wise level of :func:`friction_law_test` over the 12 diagonal entries of Mt and Bt.
 FRICTION_LAW_LEVEL = 0.01
 
@@ -263,6 +293,6 @@ def friction_law_test(free: np.ndarray, free_std: np.ndarray, law: np.ndarray,
             "threshold": threshold, "rejected": bool(scores[worst] > threshold)}
 
 
-__all__ = ["FRICTION_LAW_LEVEL", "WINDOW_LENGTH", "choose_friction_fit", "friction_law_test",
-           "friction_models", "law_floor", "model_equations", "patterns_with_half_window",
-           "solve_model", "solve_models"]
+__all__ = ["FRICTION_LAW_LEVEL", "WINDOW_LENGTH", "choose_friction_fit", "constants_floor",
+           "friction_law_test", "friction_models", "law_floor", "model_equations",
+           "patterns_with_half_window", "solve_model", "solve_models"]

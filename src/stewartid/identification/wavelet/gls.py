@@ -57,6 +57,11 @@ class WeakFormSolution:
         Rows per channel.
     rate_weights : dict of str to float, optional
         Weight per soft-sign rate averaged over; None for a single fit.
+    level_sensitivity : ndarray, shape (n_rates, 6, 12, n_types), optional
+        The fit with free interval constants and no Coulomb levels (:func:`solve_weak_form`'s
+        plain fit, on equations that carry Coulomb rows): d theta / d c, how [Mt Bt] moves per
+        N m of each joint type's Coulomb torque its invariant rows leave out, at each
+        soft-sign rate of their rows; else None.
     """
 
     theta: np.ndarray
@@ -70,6 +75,7 @@ class WeakFormSolution:
     condition_number: float
     n_equations: int
     rate_weights: dict[str, float] | None = None
+    level_sensitivity: np.ndarray | None = None
 
 
 def _weighted_normal(design: np.ndarray, weights: np.ndarray, target: np.ndarray
@@ -422,6 +428,13 @@ def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
                       f"power); longer intervals or less pose noise remove it", DataWarning,
                       stacklevel=3)
     std = standard_errors(designs, targets, fit)
+    sensitivity = None
+    if not (shared_friction or variation) and all(e.coulomb_rows is not None
+                                                   for e in equations):
+        # the rates every interval carries (some add the signs from half their window)
+        rates = min(len(e.coulomb_rows) for e in equations)
+        sensitivity = level_sensitivity(fit, stacked.regressors,
+                                        np.stack([e.coulomb_rows[:rates] for e in equations]))
     z, n_types = fit.z, stacked.coulomb.shape[1]
     levels = N_THETA + (6 * n_experiments if shared_friction else 0)
     if shared_friction:
@@ -437,7 +450,29 @@ def solve_weak_form(equations: Sequence[IntervalEquations], n_experiments: int,
         coulomb=coulomb, coulomb_std=coulomb_std, offsets=offsets,
         noise_std=np.sqrt(invariant.noise.mean(axis=0)), pose_noise_share=invariant.pose_share,
         constant_scatter=np.zeros(6) if scatter is None else scatter,
-        condition_number=condition, n_equations=int(n * k_rows))
+        condition_number=condition, n_equations=int(n * k_rows),
+        level_sensitivity=sensitivity)
+
+
+def level_sensitivity(fit: JointFit, regressors: np.ndarray, coulomb_rows: np.ndarray
+                      ) -> np.ndarray:
+    """d theta / d c (n_rates, 6, 12, n_types) of a fit of [Mt Bt] alone on invariant rows
+    ``regressors`` (n, K, 12) whose Coulomb rows ``coulomb_rows`` (n, n_rates, K, n_types, 6) it
+    leaves out: (X^T W X)^-1 X^T W R per channel, its weights and normal matrix.
+
+    A constant Coulomb torque on a joint gives a generalized force that follows the pose inside
+    an interval, which a free constant per interval does not absorb: c times this is the bias
+    it puts on the fit.
+    """
+    n_rates, n_types = coulomb_rows.shape[1], coulomb_rows.shape[3]
+    cross = np.zeros((n_rates, N_THETA, n_types))
+    for i in range(6):
+        weighted = fit.weights[i] @ regressors                                   # (n, K, 12)
+        cross[:, 12 * i:12 * i + 12] = np.einsum("nkr,nqkt->qrt", weighted,
+                                                 coulomb_rows[..., i])
+    outer = np.outer(fit.scale, fit.scale)
+    inverse = np.linalg.inv(fit.normal / outer) / outer
+    return (inverse @ cross).reshape(n_rates, 6, 12, n_types)
 
 
 #: Passes of :func:`solve_weak_form` with the noise re-measured from the joint fit.
@@ -446,5 +481,5 @@ VARIATION_PASSES = 2
 
 __all__ = ["VARIATION_PASSES", "InvariantFit", "JointFit", "WeakFormSolution",
            "channel_covariance", "channel_systems", "constant_scatter",
-           "fit_invariant_rows", "fit_jointly", "local_terms", "solve_weak_form",
-           "standard_errors"]
+           "fit_invariant_rows", "fit_jointly", "level_sensitivity", "local_terms",
+           "solve_weak_form", "standard_errors"]
