@@ -257,8 +257,8 @@ def constants_floor(free: WeakFormSolution, law: WeakFormSolution, law_rate: flo
             or not np.all(np.isfinite(law.coulomb))):
         return free
     bias = sensitivity[SOFT_SIGN_RATES.index(law_rate)] @ law.coulomb
-    spread = np.maximum(np.hypot(free.theta_std, law.theta_std[:, :12]), 1e-300)
-    apart = (free.theta - law.theta[:, :12]) / spread
+    spread = np.maximum(np.hypot(free.theta_std, law.theta_std), 1e-300)
+    apart = (free.theta - law.theta) / spread
     left = np.sum((apart - bias / spread) ** 2)
     if not (np.sum(apart ** 2) - left > chi2_upper_quantile(1, FRICTION_LAW_LEVEL)
             and left <= chi2_upper_quantile(apart.size, FRICTION_LAW_LEVEL)):
