@@ -148,9 +148,9 @@ def test_the_plain_fits_bias_from_left_out_coulomb_rows_is_its_level_sensitivity
 
 def test_the_laws_levels_widen_the_plain_fit_only_where_they_explain_the_disagreement():
     """The plain fit off the law fit by the bias S c its left-out rows predict (at the law's
-    rate, plus unit noise) gets errors sqrt(s^2 + (S c)^2); beside a law fit that departs from
-    it elsewhere by 10 standard errors (a friction the law does not describe), or with the
-    levels kept (no sensitivity), it is left as it is."""
+    rate, plus noise of one standard error) gets errors sqrt(s^2 + (S c)^2); beside a law fit
+    that departs from it elsewhere by 10 standard errors (a friction the law does not
+    describe), or with the levels kept (no sensitivity), it is left as it is."""
     from stewartid.identification.wavelet.friction_models import constants_floor
     from stewartid.identification.wavelet.gls import WeakFormSolution
 
