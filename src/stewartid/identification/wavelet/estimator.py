@@ -262,9 +262,10 @@ class WaveletIdentifier(BaseIdentifier):
             # before the choice: the law's bias, as the free constants' fit measures it, then
             # that fit's own, from the Coulomb torques it leaves out at the law's levels
             fits["coulomb"] = (law_floor(fits["coulomb"][0], fits["free"][0]), fits["coulomb"][1])
-            solved["free"] = (constants_floor(solved["free"][0], *solved["coulomb"]),
-                              solved["free"][1])
-            fits["free"] = result_of("free")
+            floored = constants_floor(solved["free"][0], *solved["coulomb"])
+            if floored is not solved["free"][0]:
+                solved["free"] = (floored, solved["free"][1])
+                fits["free"] = result_of("free")
         chosen, why = choose_friction_fit({model: fit[0] for model, fit in fits.items()},
                                           {model: solution for model, (solution, _) in
                                            solved.items()})

@@ -362,9 +362,7 @@ def standard_errors(designs: Sequence[np.ndarray], targets: Sequence[np.ndarray]
         scores += (weighted[:, None, :] @ designs[i])[:, 0, :]
         squares += float(np.sum(residual * weighted))
         n_rows += residual.size
-    # the equilibrated normal matrix is well conditioned (checked above): an inverse
-    outer = np.outer(fit.scale, fit.scale)
-    bread = np.linalg.inv(fit.normal / outer) / outer
+    bread = _inverse_normal(fit)
     model_cov = bread * max(squares / max(n_rows - n_unknowns, 1), 1e-300)
     g = n
     robust_cov = (g / max(g - 1, 1) * (n_rows - 1) / max(n_rows - n_unknowns, 1)
@@ -470,9 +468,14 @@ def level_sensitivity(fit: JointFit, regressors: np.ndarray, coulomb_rows: np.nd
         weighted = fit.weights[i] @ regressors                                   # (n, K, 12)
         cross[:, 12 * i:12 * i + 12] = np.einsum("nkr,nqkt->qrt", weighted,
                                                  coulomb_rows[..., i])
+    return (_inverse_normal(fit) @ cross).reshape(n_rates, 6, 12, n_types)
+
+
+def _inverse_normal(fit: JointFit) -> np.ndarray:
+    """(X^T W X)^-1 of ``fit``, through its equilibrated normal matrix, which is well
+    conditioned (checked before the fit): an inverse."""
     outer = np.outer(fit.scale, fit.scale)
-    inverse = np.linalg.inv(fit.normal / outer) / outer
-    return (inverse @ cross).reshape(n_rates, 6, 12, n_types)
+    return np.linalg.inv(fit.normal / outer) / outer
 
 
 #: Passes of :func:`solve_weak_form` with the noise re-measured from the joint fit.
