@@ -12,12 +12,14 @@ reversals, not the noise in the signs.
 The noise: the reference sensor noise of the platform per seed, as ``coverage_study.py`` adds
 it, or with ``--pose-only`` its pose part alone (the force noise set to zero: the bias with less
 spread). Printed per method and variant: the mean error (%) of Mt(1,1)..(6,6) over the seeds,
-its standard error of the mean, and the largest |error| / standard error of the fits.
+its standard error of the mean, and the largest |error| / standard error of the fits; with
+``--per-seed`` also each seed's largest |error| of the Mt diagonal (%) and the standard error of
+Mt(4,4) (% of nominal), the figures of the acceptance's worst seed.
 
 Usage::
 
     python benchmarks/pose_noise_bias.py --logs DIR --platform paper|FILE [--seeds 6]
-        [--pose-only] [--methods ls,wavelet]
+        [--pose-only] [--methods ls,wavelet] [--per-seed]
 """
 
 from __future__ import annotations
@@ -82,6 +84,8 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, default=6)
     parser.add_argument("--pose-only", action="store_true", help="no force noise")
     parser.add_argument("--methods", default="ls,wavelet")
+    parser.add_argument("--per-seed", action="store_true",
+                        help="also each seed's largest Mt diagonal error and Mt(4,4)'s SE")
     args = parser.parse_args()
     platform = load_platform(args.platform)
     clean = read_datasets(sorted(args.logs.glob("exp*.csv")), platform)
@@ -93,6 +97,7 @@ def main() -> None:
     methods = args.methods.split(",")
     errors = {(m, v): [] for m in methods for v in VARIANTS}
     scores = {(m, v): [] for m in methods for v in VARIANTS}
+    spreads = {(m, v): [] for m in methods for v in VARIANTS}
     start, cpu = time.perf_counter(), time.process_time()
     for seed in range(args.seeds):
         data = [degrade(d, platform, sensors, np.random.default_rng(seed + 101 * k))
@@ -104,6 +109,7 @@ def main() -> None:
                 fitted = np.diag(result.M)
                 errors[method, variant].append(100 * (fitted - truth) / truth)
                 scores[method, variant].append((fitted - truth) / np.diag(result.std_errors_M))
+                spreads[method, variant].append(100 * result.std_errors_M[3, 3] / truth[3])
     for (method, variant), values in errors.items():
         values = np.array(values)
         sem = values.std(axis=0, ddof=1) / np.sqrt(len(values)) if len(values) > 1 else 0 * truth
@@ -111,6 +117,10 @@ def main() -> None:
         print(f"{method:8s} {variant:20s} Mt diagonal mean % "
               + " ".join(f"{m:+.2f}±{s:.2f}" for m, s in zip(values.mean(axis=0), sem, strict=True))
               + f" | worst {worst:.1f} SE")
+        if args.per_seed:
+            print(" " * 29 + "per seed: largest |Mt diagonal error| % (SE of Mt(4,4) %) "
+                  + " ".join(f"{np.max(np.abs(e)):.2f} ({s:.2f})"
+                             for e, s in zip(values, spreads[method, variant], strict=True)))
     print(f"{time.perf_counter() - start:.0f} s wall, {time.process_time() - cpu:.0f} s CPU")
 
 
