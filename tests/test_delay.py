@@ -98,6 +98,18 @@ def test_a_delay_longer_than_the_record_is_refused(paper):
         align_forces(experiments(paper)[:1], 7.99)
 
 
+def test_a_given_delay_of_a_quarter_period_of_the_fastest_line_is_refused(paper):
+    """Milliseconds written as seconds: the fastest line is MULTISINE's 2.3 Hz, a quarter of
+    its period 0.1087 s; a delay just under it is applied, at or beyond it refused."""
+    data = experiments(paper)
+    aligned, entry = apply_delay(data, paper, 0.1)
+    assert entry["seconds"] == 0.1 and len(aligned[0]) == len(data[0]) - int(0.1 * RATE)
+    for seconds in (0.11, 2.0, -2.0):
+        with pytest.raises(ConfigError, match=r"of the period of the motion's fastest line "
+                                              r"\(2\.3 Hz, 0\.43\d s\).* under 0\.109 s here"):
+            apply_delay(data, paper, seconds)
+
+
 # --- estimation ----------------------------------------------------------------------------
 
 def test_every_dof_shows_its_three_lines(paper):
@@ -259,12 +271,16 @@ def test_identify_with_a_zero_delay_uses_the_forces_as_logged(tmp_path, late_fil
 
 
 @pytest.mark.parametrize("value, message", [("2ms", "--delay must be a number of seconds"),
-                                            ("nan", "--delay must be a number of seconds")])
+                                            ("nan", "--delay must be a number of seconds"),
+                                            ("2", "a force delay of 2 s is 460 % of the period")])
 def test_identify_refuses_a_bad_delay(tmp_path, late_files, value, message):
+    out = tmp_path / "result.json"
     result = CliRunner().invoke(app, ["identify", "--method", "ls", "--platform", "paper",
-                                      "--delay", value, *map(str, late_files)])
+                                      "--delay", value, "--out", str(out),
+                                      *map(str, late_files)])
     assert result.exit_code == 2
-    assert message in result.output
+    assert message in result.output and "Traceback" not in result.output
+    assert not out.exists()
 
 
 @pytest.mark.slow

@@ -319,6 +319,32 @@ def estimate_delay(datasets: Sequence[Dataset], platform: Platform, window: floa
 #: ``delay`` value of :func:`apply_delay` (and ``identify --delay``) that estimates it first.
 AUTO = "auto"
 
+#: Largest given delay, in periods of the motion's fastest line: a force channel a quarter
+#: period late is 90 degrees out of phase with that line, where filters and buses delay by ms.
+GIVEN_DELAY_PERIODS = 0.25
+
+
+def check_given_delay(datasets: Sequence[Dataset], seconds: float) -> None:
+    """Refuse a given delay of :data:`GIVEN_DELAY_PERIODS` or more of the period of the motion's
+    fastest line (:func:`~stewartid.datasets.excitation.excitation_lines`): most often
+    milliseconds written as seconds.
+
+    Raises
+    ------
+    ConfigError
+        Naming the delay, the line and its period, and the unit.
+    """
+    fastest = max((max(lines) for lines in excitation_lines(datasets, padding=COUNTING_PADDING)
+                   if lines), default=0.0)
+    if fastest <= 0 or abs(seconds) < GIVEN_DELAY_PERIODS / fastest:
+        return
+    raise ConfigError(
+        f"a force delay of {seconds:g} s is {100 * abs(seconds) * fastest:.3g} % of the period of "
+        f"the motion's fastest line ({fastest:.3g} Hz, {1 / fastest:.3g} s): forces that far off "
+        f"are out of phase with the motion, where a force channel lags by milliseconds; give the "
+        f"delay in seconds, under {GIVEN_DELAY_PERIODS / fastest:.3g} s here (--delay 0.002 for "
+        "2 ms).")
+
 
 def parse_delay(value: str | float | None) -> str | float | None:
     """A delay setting: None, :data:`AUTO`, or a finite number of seconds (also as text).
@@ -350,7 +376,8 @@ def apply_delay(datasets: Sequence[Dataset], platform: Platform, delay: str | fl
     Raises
     ------
     ConfigError
-        A delay that is neither a number nor 'auto', or one longer than the records.
+        A delay that is neither a number nor 'auto', one longer than the records, or one of a
+        quarter period of the motion or more (:func:`check_given_delay`).
     IdentificationError
         'auto' where the delay cannot be estimated.
     """
@@ -361,11 +388,12 @@ def apply_delay(datasets: Sequence[Dataset], platform: Platform, delay: str | fl
     if delay == AUTO:
         estimate = estimate_delay(datasets, platform, jobs=jobs)
         return align_forces(datasets, estimate.seconds), estimate.to_dict(applied=True)
+    check_given_delay(datasets, float(delay))
     entry = {"seconds": float(delay), "std_error": None, "applied": True, "source": "given"}
     return align_forces(datasets, float(delay)), entry
 
 
-__all__ = ["AUTO", "DelayEstimate", "apply_delay", "check_delay_identifiable",
-           "delay_bias_per_ms", "delay_identifiable", "describe_bias", "estimate_delay",
-           "fit_delay", "parse_delay", "shared_least_squares", "single_frequency_bias",
-           "single_frequency_dofs"]
+__all__ = ["AUTO", "GIVEN_DELAY_PERIODS", "DelayEstimate", "apply_delay",
+           "check_delay_identifiable", "check_given_delay", "delay_bias_per_ms",
+           "delay_identifiable", "describe_bias", "estimate_delay", "fit_delay", "parse_delay",
+           "shared_least_squares", "single_frequency_bias", "single_frequency_dofs"]
