@@ -15,11 +15,11 @@ from stewartid.datasets.dataset import Dataset, read_datasets, write_dataset
 from stewartid.datasets.excitation import (
     MIN_RELATIVE_EXCITATION,
     check_excitation,
-    check_experiment_set,
     dof_scales,
     excitation_per_dof,
     spectral_lines,
 )
+from stewartid.datasets.set_checks import check_experiment_set
 from stewartid.errors import DataError, IdentificationError
 from stewartid.identification.fourier import FourierIdentifier
 from stewartid.model.kinematics import leg_lengths

@@ -24,9 +24,9 @@ from stewartid.comparison import (
 )
 from stewartid.datasets import read_experiments
 from stewartid.datasets.dataset import expand_paths
-from stewartid.datasets.excitation import check_experiment_set
 from stewartid.datasets.log_format import load_log_format
 from stewartid.datasets.meta import nominal_from_meta, platform_for_data
+from stewartid.datasets.set_checks import check_experiment_set
 from stewartid.errors import ConfigError
 from stewartid.files import check_output_file, check_output_folder
 from stewartid.identification import registry

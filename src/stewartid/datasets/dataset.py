@@ -219,8 +219,8 @@ def _check_time(t: np.ndarray, where: str) -> bool:
     if np.any(dt <= 0):
         bad = int(np.argmax(dt <= 0)) + 1
         raise DataError(f"{where}: column 't' must be strictly increasing; row {bad} has "
-                        f"t = {t[bad]!r} after t = {t[bad - 1]!r} (sort the rows and drop "
-                        "duplicate time stamps).")
+                        f"t = {float(t[bad])!r} after t = {float(t[bad - 1])!r} (sort the rows "
+                        "and drop duplicate time stamps).")
     period = median(dt)
     low, high = SAMPLE_RATE_RANGE_HZ
     if not low <= 1.0 / period <= high:

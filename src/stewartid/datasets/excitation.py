@@ -7,11 +7,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 
 from stewartid.datasets.dataset import Dataset
-from stewartid.datasets.distinct import check_distinct_experiments
 from stewartid.errors import DataError
 from stewartid.model.kinematics import compute_leg_terms
 from stewartid.platform import COORDINATES, Platform
@@ -216,27 +216,54 @@ def _peaks(amplitude: np.ndarray, n: int, nfft: int, sample_rate: float,
                          resolution, float(heights.max()))
 
 
-def _regressors(dataset: Dataset, jacobian: np.ndarray, scales: np.ndarray) -> np.ndarray:
-    """Strided, scaled [q_dot, q_ddot] of one experiment, shape (n, 12); ``jacobian``: J_lq(q0).
+class MotionRows(NamedTuple):
+    """A record's evenly strided rows and the pose's rates there: what the checks of an
+    experiment set read (:func:`motion_rows`).
+
+    Attributes
+    ----------
+    rows : ndarray, shape (n,)
+        Sample indices, at most :data:`CHECK_SAMPLES`.
+    velocity, acceleration : ndarray, shape (n, 6)
+        Savitzky-Golay rates of the pose there (m/s, rad/s; m/s², rad/s²).
+    """
+
+    rows: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+
+
+def motion_rows(dataset: Dataset, platform: Platform) -> MotionRows | None:
+    """The record's :class:`MotionRows`, computed once per record and platform; None for a
+    record without a spectral line (no motion to differentiate).
 
     The pose channels' unpadded transforms give the leg-space motion's fastest line (the
-    transform is linear: J_lq(q0) times the pose's) and, kept with the record, the pose lines
-    :func:`excitation_lines` counts."""
+    transform is linear: J_lq(q0) times the pose's), which sets the differentiation window, and,
+    kept with the record, the pose lines :func:`excitation_lines` counts.
+    """
+    jacobian = neutral_jacobian(platform)
+    return dataset.derived(("motion rows", jacobian.tobytes()),
+                           lambda record: _motion_rows(record, jacobian))
+
+
+def _motion_rows(dataset: Dataset, jacobian: np.ndarray) -> MotionRows | None:
     spectra, nfft = _channel_spectra(dataset.pose, COUNTING_PADDING)
     _pose_lines(dataset, LINE_THRESHOLD, COUNTING_PADDING, (spectra, nfft))
     # the fastest line sets the differentiation window, which needs it only roughly
     amplitude = np.sqrt(np.sum(np.abs(jacobian @ spectra) ** 2, axis=0))
     lines = _peaks(amplitude, len(dataset), nfft, dataset.sample_rate, LINE_FRACTION)
     if not len(lines):
-        return np.zeros((0, 12))
+        return None
     window = min(default_window(float(np.max(lines.frequencies_hz))), dataset.duration / 4)
     taps = window_samples(window, dataset.sample_rate)
     stride = max(1, int(np.ceil((len(dataset) - 2 * (taps // 2)) / CHECK_SAMPLES)))
-    # the Savitzky-Golay derivatives at the kept rows only, by direct sums
+    # the Savitzky-Golay derivatives at the kept rows only, by direct sums; kept row k is the
+    # centre of samples k stride ... k stride + taps - 1
     centred = dataset.pose - dataset.pose.mean(axis=0)
     velocity, acceleration = (convolved_rows(centred, savgol_coefficients(
         taps, DEFAULT_ORDER, k, 1.0 / dataset.sample_rate), stride) for k in (1, 2))
-    return np.concatenate([velocity * scales, acceleration * scales], axis=1)
+    rows = np.arange(len(velocity)) * stride + (taps - 1) // 2
+    return MotionRows(rows, velocity, acceleration)
 
 
 def excitation_per_dof(datasets: Sequence[Dataset], platform: Platform) -> np.ndarray:
@@ -246,9 +273,11 @@ def excitation_per_dof(datasets: Sequence[Dataset], platform: Platform) -> np.nd
     Gram-Schmidt); a DOF's measure is the smaller unexplained norm of its two. Standard errors of
     column k of Mt and Bt scale with its inverse.
     """
-    jacobian = neutral_jacobian(platform)
-    scales = np.linalg.norm(jacobian, axis=0)
-    phi = np.concatenate([_regressors(d, jacobian, scales) for d in datasets])
+    scales = dof_scales(platform)
+    # strided, scaled [q_dot, q_ddot] of every experiment, (n, 12)
+    found = [motion_rows(d, platform) for d in datasets]
+    phi = np.concatenate([np.concatenate([m.velocity * scales, m.acceleration * scales], axis=1)
+                          if m is not None else np.zeros((0, 12)) for m in found])
     independent = np.zeros(12)
     norms = np.linalg.norm(phi, axis=0)
     for kind in (slice(0, 6), slice(6, 12)):
@@ -295,18 +324,6 @@ def check_excitation(datasets: Sequence[Dataset], platform: Platform) -> None:
     raise DataError(f"no experiment {verb} {names} enough to identify {columns} of Mt and Bt "
                     f"({detail}); add an experiment exciting {names}, e.g. from "
                     "`stewartid design`.")
-
-
-def check_experiment_set(datasets: Sequence[Dataset], platform: Platform) -> None:
-    """Checks before any fit: no experiment twice
-    (:func:`~stewartid.datasets.distinct.check_distinct_experiments`), every DOF excited.
-
-    Raises
-    ------
-    DataError
-    """
-    check_distinct_experiments(datasets, [d.name for d in datasets])
-    check_excitation(datasets, platform)
 
 
 #: In :func:`excitation_lines`, a spectral line of a DOF's motion counts when it is at least
@@ -362,7 +379,8 @@ def _pose_lines(dataset: Dataset, threshold: float, padding: int,
     return dataset.derived(("pose lines", threshold, padding), lines)
 
 
-__all__ = ["COUNTING_PADDING", "LINE_FRACTION", "LINE_MERGE_BINS", "LINE_THRESHOLD",
-           "MIN_RELATIVE_EXCITATION", "SpectralLines", "channel_lines", "check_excitation",
-           "check_experiment_set", "dof_scales", "excitation_lines", "excitation_per_dof",
-           "leg_space_motion", "neutral_jacobian", "spectral_lines"]
+__all__ = ["CHECK_SAMPLES", "COUNTING_PADDING", "LINE_FRACTION", "LINE_MERGE_BINS",
+           "LINE_THRESHOLD", "MIN_RELATIVE_EXCITATION", "MotionRows", "SpectralLines",
+           "channel_lines", "check_excitation", "dof_scales", "excitation_lines",
+           "excitation_per_dof", "leg_space_motion", "motion_rows", "neutral_jacobian",
+           "spectral_lines"]

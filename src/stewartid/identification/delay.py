@@ -319,31 +319,30 @@ def estimate_delay(datasets: Sequence[Dataset], platform: Platform, window: floa
 #: ``delay`` value of :func:`apply_delay` (and ``identify --delay``) that estimates it first.
 AUTO = "auto"
 
-#: Largest given delay, in periods of the motion's fastest line: a force channel a quarter
-#: period late is 90 degrees out of phase with that line, where filters and buses delay by ms.
+#: Largest given delay, in periods of the motion's dominant line: a force channel a quarter
+#: period late is 90 degrees out of phase with the motion, where filters and buses delay by ms.
 GIVEN_DELAY_PERIODS = 0.25
 
 
 def check_given_delay(datasets: Sequence[Dataset], seconds: float) -> None:
     """Refuse a given delay of :data:`GIVEN_DELAY_PERIODS` or more of the period of the motion's
-    fastest line (:func:`~stewartid.datasets.excitation.excitation_lines`): most often
-    milliseconds written as seconds.
+    dominant line (the fastest of the records' :func:`estimate_frequency`, which every method
+    reads too): most often milliseconds written as seconds.
 
     Raises
     ------
     ConfigError
         Naming the delay, the line and its period, and the unit.
     """
-    fastest = max((max(lines) for lines in excitation_lines(datasets, padding=COUNTING_PADDING)
-                   if lines), default=0.0)
-    if fastest <= 0 or abs(seconds) < GIVEN_DELAY_PERIODS / fastest:
+    dominant = max(estimate_frequency(d.pose, d.sample_rate) for d in datasets)
+    if abs(seconds) < GIVEN_DELAY_PERIODS / dominant:
         return
     raise ConfigError(
-        f"a force delay of {seconds:g} s is {100 * abs(seconds) * fastest:.3g} % of the period of "
-        f"the motion's fastest line ({fastest:.3g} Hz, {1 / fastest:.3g} s): forces that far off "
-        f"are out of phase with the motion, where a force channel lags by milliseconds; give the "
-        f"delay in seconds, under {GIVEN_DELAY_PERIODS / fastest:.3g} s here (--delay 0.002 for "
-        "2 ms).")
+        f"a force delay of {seconds:g} s is {100 * abs(seconds) * dominant:.3g} % of the period "
+        f"of the motion's dominant line ({dominant:.3g} Hz, {1 / dominant:.3g} s): forces that "
+        f"far off are out of phase with the motion, where a force channel lags by milliseconds; "
+        f"give the delay in seconds, under {GIVEN_DELAY_PERIODS / dominant:.3g} s here (--delay "
+        "0.002 for 2 ms).")
 
 
 def parse_delay(value: str | float | None) -> str | float | None:

@@ -1,0 +1,103 @@
+"""The checks a set of experiments passes before any fit: no experiment twice, every DOF
+excited, and force channels numbered as the legs they measure.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Sequence
+
+import numpy as np
+
+from stewartid.datasets.dataset import Dataset
+from stewartid.datasets.distinct import check_distinct_experiments
+from stewartid.datasets.excitation import check_excitation, motion_rows, neutral_jacobian
+from stewartid.errors import DataError
+from stewartid.model.linearization import nominal_matrices
+from stewartid.platform import Platform
+
+#: A renumbering of the force channels is named when it raises their correlation with the
+#: leg forces the platform's model predicts by this much (summed over the six channels, mean
+#: over the experiments). On a correct log the logged numbering is the best, or ties with the
+#: renumberings a symmetric motion cannot tell from it.
+CHANNEL_ORDER_GAIN = 0.5
+#: ... and when the renumbered channels follow their legs at least this well (mean correlation).
+CHANNEL_ORDER_FIT = 0.3
+
+#: Every numbering of six channels, the logged one first.
+_NUMBERINGS = np.array(list(itertools.permutations(range(6))))
+
+
+def force_channel_correlation(dataset: Dataset, platform: Platform) -> np.ndarray | None:
+    """Correlation (6, 6) of logged force channel i with the force of leg j that the nominal
+    linear model predicts from the motion, J_lq(q0)^-T (Mt q'' + Bt q'), over the record's
+    :func:`~stewartid.datasets.excitation.motion_rows` (means removed: the static load and
+    Coulomb friction's mean do not enter); None for a record without motion. A channel or leg
+    that does not vary correlates 0.
+    """
+    return _correlation(dataset, platform, *nominal_matrices(platform),
+                        neutral_jacobian(platform))
+
+
+def _correlation(dataset: Dataset, platform: Platform, M: np.ndarray, B: np.ndarray,
+                 jacobian: np.ndarray) -> np.ndarray | None:
+    found = motion_rows(dataset, platform)
+    if found is None:
+        return None
+    predicted = np.linalg.solve(jacobian.T,
+                                (found.acceleration @ M.T + found.velocity @ B.T).T).T
+    logged = dataset.forces[found.rows]
+    logged, predicted = logged - logged.mean(axis=0), predicted - predicted.mean(axis=0)
+    norms = np.outer(np.linalg.norm(logged, axis=0), np.linalg.norm(predicted, axis=0))
+    products = logged.T @ predicted
+    return np.divide(products, norms, out=np.zeros((6, 6)), where=norms > 0)
+
+
+def check_force_channels(datasets: Sequence[Dataset], platform: Platform) -> None:
+    """Refuse force channels numbered differently from the legs: the numbering of the channels
+    whose varying parts follow the predicted leg forces best
+    (:func:`force_channel_correlation`, summed over the experiments) against the logged one.
+
+    Raises
+    ------
+    DataError
+        Naming the channels, the legs they follow and the ``--columns`` mapping.
+    """
+    model = (*nominal_matrices(platform), neutral_jacobian(platform))
+    found = [r for r in (_correlation(d, platform, *model) for d in datasets) if r is not None]
+    if not found:
+        return
+    scores = sum(r[np.arange(6), _NUMBERINGS].sum(axis=1) for r in found) / len(found)
+    best = int(np.argmax(scores))
+    if scores[best] - scores[0] < CHANNEL_ORDER_GAIN or scores[best] < 6 * CHANNEL_ORDER_FIT:
+        return
+    legs = _NUMBERINGS[best]
+    # an electric actuator's log holds motor currents i1..i6, read as forces
+    column, kind = ("i", "current") if platform.actuator.kind == "electric" else ("f", "force")
+    moved = [k for k in range(6) if legs[k] != k]
+    follows = ", ".join(f"{column}{k + 1} follows leg {legs[k] + 1}" for k in moved)
+    mapping = ",".join(f"{column}{legs[k] + 1}={column}{k + 1}" for k in moved)
+    raise DataError(
+        f"the {kind} channels are numbered differently from the legs: {follows} (mean "
+        f"correlation with the leg forces platform '{platform.name}' predicts from the motion "
+        f"{scores[best] / 6:.2f} renumbered, {scores[0] / 6:.2f} as logged); map them with "
+        f"--columns {mapping} (docs/conventions.md numbers the legs).")
+
+
+def check_experiment_set(datasets: Sequence[Dataset], platform: Platform) -> None:
+    """Checks before any fit: no experiment twice
+    (:func:`~stewartid.datasets.distinct.check_distinct_experiments`), every DOF excited
+    (:func:`~stewartid.datasets.excitation.check_excitation`), the force channels numbered as
+    the legs (:func:`check_force_channels`).
+
+    Raises
+    ------
+    DataError
+    """
+    check_distinct_experiments(datasets, [d.name for d in datasets])
+    check_excitation(datasets, platform)
+    check_force_channels(datasets, platform)
+
+
+__all__ = ["CHANNEL_ORDER_FIT", "CHANNEL_ORDER_GAIN", "check_experiment_set",
+           "check_force_channels", "force_channel_correlation"]
