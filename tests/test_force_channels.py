@@ -10,6 +10,7 @@ and a renumbering is applied here, independently of the check.
 from __future__ import annotations
 
 import json
+from importlib import resources
 
 import numpy as np
 import pytest
@@ -21,6 +22,7 @@ from stewartid.datasets.dataset import Dataset, write_dataset
 from stewartid.datasets.set_checks import check_force_channels, force_channel_correlation
 from stewartid.errors import DataError
 from stewartid.model.linearization import nominal_matrices
+from stewartid.platform import load_platform
 
 
 def experiments(platform):
@@ -56,6 +58,18 @@ def test_renumbered_channels_are_named_with_their_mapping(paper, legs, named, ma
                                         rf"the legs: {named} \(mean correlation .* "
                                         rf"--columns {mapping} "):
         check_force_channels(renumbered(experiments(paper), legs), paper)
+
+
+def test_an_electric_logs_current_channels_are_named_as_currents():
+    """An electric platform's log holds motor currents i1..i6: the message and the mapping name
+    them. The model data carry no screw friction, which the check's prediction adds (80 N a
+    leg): the legs are told apart all the same."""
+    with resources.as_file(resources.files("stewartid") / "data/electric.toml") as path:
+        electric = load_platform(path)
+    with pytest.raises(DataError, match=r"^the current channels are numbered differently from "
+                                        r"the legs: i1 follows leg 2, i2 follows leg 1 .* "
+                                        r"--columns i2=i1,i1=i2 "):
+        check_force_channels(renumbered(experiments(electric), [1, 0, 2, 3, 4, 5]), electric)
 
 
 def test_heave_alone_cannot_tell_the_legs_apart(paper):
