@@ -25,6 +25,8 @@ CHANNEL_ORDER_GAIN = 0.5
 #: ... and when the renumbered channels follow their legs at least this well (mean correlation).
 CHANNEL_ORDER_FIT = 0.3
 
+#: Numberings whose scores differ by less than this tie (the correlations' noise).
+CHANNEL_TIE = 0.05
 #: Rows per experiment the correlations take (an evenly strided subset of the excitation
 #: check's): a correlation's noise is then a few hundredths.
 CHANNEL_ROWS = 1000
@@ -81,9 +83,11 @@ def check_force_channels(datasets: Sequence[Dataset], platform: Platform) -> Non
     if not found:
         return
     scores = sum(r[np.arange(6), _NUMBERINGS].sum(axis=1) for r in found) / len(found)
-    best = int(np.argmax(scores))
-    if scores[best] - scores[0] < CHANNEL_ORDER_GAIN or scores[best] < 6 * CHANNEL_ORDER_FIT:
+    if scores.max() - scores[0] < CHANNEL_ORDER_GAIN or scores.max() < 6 * CHANNEL_ORDER_FIT:
         return
+    # numberings a symmetric motion cannot tell apart tie: the one that moves fewest channels
+    near = np.flatnonzero(scores >= scores.max() - CHANNEL_TIE)
+    best = int(near[np.argmin((_NUMBERINGS[near] != np.arange(6)).sum(axis=1))])
     legs = _NUMBERINGS[best]
     # an electric actuator's log holds motor currents i1..i6, read as forces
     column, kind = ("i", "current") if platform.actuator.kind == "electric" else ("f", "force")
@@ -112,5 +116,6 @@ def check_experiment_set(datasets: Sequence[Dataset], platform: Platform) -> Non
     check_force_channels(datasets, platform)
 
 
-__all__ = ["CHANNEL_ORDER_FIT", "CHANNEL_ORDER_GAIN", "CHANNEL_ROWS", "check_experiment_set",
+__all__ = ["CHANNEL_ORDER_FIT", "CHANNEL_ORDER_GAIN", "CHANNEL_ROWS", "CHANNEL_TIE",
+           "check_experiment_set",
            "check_force_channels", "force_channel_correlation"]
