@@ -171,6 +171,12 @@ MISTAKES = {
                     r"carry 0 times the weight .*\(8.397e\+04 N\); force channels unplugged"),
     "one force channel zero": (lambda f: f.assign(f3=0.0),
                                "column f3 carries 0 times its static load"),
+    # the total then carries 4/6 of the weight: the channel is named, not the unit or the file
+    "two force channels zero": (lambda f: f.assign(f2=0.0, f5=0.0),
+                                "column f[25] carries 0 times its static load"),
+    "one force channel of the opposite sign": (
+        lambda f: f.assign(f4=-f.f4),
+        r"column f4 carries -1 times its static load, .* map f4 with scale = -1"),
     "forces in kN": (lambda f: f.assign(**{c: f[c] / 1e3 for c in FORCES}),
                      "forces in kN. map them with --columns f1..f6=:kN"),
     "forces of the opposite sign": (lambda f: f.assign(**{c: -f[c] for c in FORCES}),

@@ -250,15 +250,25 @@ def check_static_balance(pose: np.ndarray, forces: np.ndarray, platform: Platfor
     if abs(ratio + 1.0) <= BALANCE_ERROR:
         raise DataError(f"{what}; positive must extend the leg: map {hints['columns']} with "
                         "scale = -1 (docs/logs.md).")
+    # each leg against the others before the total: one reversed or dead channel moves the
+    # total too (a reversed one to 2/3 of the weight), where the unit or the file is not at fault
+    static = np.linalg.solve(np.transpose(leg_jacobian, (0, 2, 1)), gravity[..., None])[..., 0]
+    shares = forces.mean(axis=0) / static.mean(axis=0)
+    typical = float(np.median(shares))
+    if typical > 0:
+        shares = shares / typical
+        leg = int(np.argmax(np.abs(shares - 1.0)))
+        column = f"{hints['columns'][0]}{leg + 1}"
+        if abs(shares[leg] + 1.0) <= LEG_BALANCE_ERROR:
+            raise DataError(f"{where}: column {column} carries {shares[leg]:.3g} times its static "
+                            f"load, the other legs about their share; positive must extend the "
+                            f"leg: map {column} with scale = -1 (docs/logs.md).")
+        if abs(shares[leg] - 1.0) > LEG_BALANCE_ERROR:
+            raise DataError(f"{where}: column {column} carries {shares[leg]:.3g} times its static "
+                            "load, the other legs about their share; check that channel "
+                            "(unplugged, unit, sign).")
     if not carried[0] <= ratio <= carried[1]:
         raise DataError(f"{what}; {hints['unit']}?")
-    static = np.linalg.solve(np.transpose(leg_jacobian, (0, 2, 1)), gravity[..., None])[..., 0]
-    shares = forces.mean(axis=0) / static.mean(axis=0) / ratio
-    leg = int(np.argmax(np.abs(shares - 1.0)))
-    if abs(shares[leg] - 1.0) > LEG_BALANCE_ERROR:
-        raise DataError(f"{where}: column {hints['columns'][0]}{leg + 1} carries "
-                        f"{shares[leg]:.3g} times its static load, the other legs about their "
-                        "share; check that channel (unplugged, unit, sign).")
     if carried == PHYSICAL_CARRIED_WEIGHT:
         return
     if ratio > 1.0 + BALANCE_WARNING:
