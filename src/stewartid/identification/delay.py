@@ -334,6 +334,8 @@ def check_given_delay(datasets: Sequence[Dataset], seconds: float) -> None:
     ConfigError
         Naming the delay, the line and its period, and the unit.
     """
+    if seconds == 0:
+        return
     dominant = max(estimate_frequency(d.pose, d.sample_rate) for d in datasets)
     if abs(seconds) < GIVEN_DELAY_PERIODS / dominant:
         return
