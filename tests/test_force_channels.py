@@ -103,3 +103,12 @@ def test_cli_refuses_in_one_line_and_the_mapping_it_names_reads_the_log_as_numbe
         results[label] = json.loads(out.read_text())
     assert results["swapped"]["M"] == results["as"]["M"]
     assert results["swapped"]["B"] == results["as"]["B"]
+
+
+def test_compare_methods_refuses_them_before_any_fit(paper):
+    """The Python entry point checks the experiment set as the command does."""
+    from stewartid.comparison import compare_methods
+
+    with pytest.raises(DataError, match=r"f1 follows leg 2, f2 follows leg 1 .* "
+                                        r"--columns f2=f1,f1=f2 "):
+        compare_methods(renumbered(experiments(paper), [1, 0, 2, 3, 4, 5]), paper, methods="ls")

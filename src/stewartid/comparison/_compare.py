@@ -31,6 +31,7 @@ from stewartid.comparison._runs import (
 from stewartid.datasets.alignment import align_forces
 from stewartid.datasets.dataset import Dataset
 from stewartid.datasets.plausibility import check_identified
+from stewartid.datasets.set_checks import check_experiment_set
 from stewartid.errors import ConfigError, StewartidError
 from stewartid.identification import registry
 from stewartid.identification.averaging import AveragingPolicy, average_experiments
@@ -430,7 +431,10 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
     Raises
     ------
     StewartidError
-        Bad settings, or no method could be applied (the first method's message).
+        Bad settings, experiments that fail the checks before any fit (one given twice, a DOF
+        left unexcited, force channels numbered differently from the legs:
+        :func:`~stewartid.datasets.set_checks.check_experiment_set`), or no method could be
+        applied (the first method's message).
     """
     started = time.perf_counter()
     check_jobs(jobs)
@@ -438,7 +442,9 @@ def compare_methods(experiments: Sequence[Dataset | str | Path], platform: Platf
         platform = load_platform(platform)
     if not (isinstance(folds, int | np.integer) and folds >= 2):
         raise ConfigError(f"the validation needs at least 2 folds; got {folds!r}.")
-    averaged = average_experiments(_experiments(experiments, platform), averaging)
+    experiments = _experiments(experiments, platform)
+    check_experiment_set(experiments, platform)
+    averaged = average_experiments(experiments, averaging)
     alignment = align_experiments(averaged.experiments, platform, delay, jobs)
     datasets = alignment.experiments
     records = _experiments(validate or (), platform)
