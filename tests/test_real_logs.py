@@ -229,6 +229,22 @@ def test_identified_matrices_far_from_nominal(example_platform):
         check_identified(M @ rotation, B, example_platform)
 
 
+def test_a_negative_damping_beyond_noise_is_an_error(example_platform):
+    """A passive mechanism only dissipates: a Bt diagonal entry five standard errors below zero
+    is refused, naming the forces leading the motion; within its noise it only warns."""
+    from stewartid.datasets.plausibility import check_identified
+    from stewartid.model.linearization import nominal_matrices
+
+    M, B = nominal_matrices(example_platform)
+    flipped = B.copy()
+    flipped[2, 2] = -0.5 * B[2, 2]
+    with pytest.raises(DataError, match=r"^ls: identified Bt\(3,3\) = .* a negative damping, "
+                                        r"which no passive platform has; the forces lead"):
+        check_identified(M, flipped, example_platform, "ls", std_B=0.05 * np.abs(B))
+    with pytest.warns(DataWarning, match=r"Bt\(3,3\) = .* is -0.5 times the nominal"):
+        check_identified(M, flipped, example_platform, "ls", std_B=0.2 * np.abs(B))
+
+
 def test_a_method_blind_to_friction_is_told_its_damping_holds_the_friction(example_platform):
     """Method A's Bt, inflated by the Coulomb friction it does not model, is not blamed on
     the units; a Bt far below the nominal one, or an inflated Bt of a method that models

@@ -83,7 +83,8 @@ def plausibility_check(platform: Platform) -> Callable[[IdentificationResult], N
 
     def check(result: IdentificationResult) -> None:
         check_identified(result.M, result.B, platform, result.method,
-                         not (models_friction(result) or friction_immune(result)))
+                         not (models_friction(result) or friction_immune(result)),
+                         result.std_errors_B)
 
     return check
 

@@ -44,6 +44,9 @@ LEG_BALANCE_ERROR = 0.5
 NOMINAL_WARNING_FACTOR = 2.0
 #: Identified diagonal of Mt beyond this factor of the nominal one: an error (units).
 NOMINAL_ERROR_FACTOR = 10.0
+#: Identified diagonal of Bt this many standard errors below zero: an error (the mechanism
+#: only dissipates; Gaussian noise puts one of six entries there once in 500,000 fits).
+NEGATIVE_DAMPING_SE = 5.0
 
 #: Samples used by the checks (an evenly strided subset keeps them fast on long logs).
 CHECK_SAMPLES = 2000
@@ -293,14 +296,17 @@ def check_dataset(pose: np.ndarray, lengths: np.ndarray, forces: np.ndarray,
 
 
 def check_identified(M: np.ndarray, B: np.ndarray, platform: Platform,
-                     method: str | None = None, friction_blind: bool = False) -> None:
+                     method: str | None = None, friction_blind: bool = False,
+                     std_B: np.ndarray | None = None) -> None:
     """Identified Mt, Bt (6, 6) against the description's nominal ones; ``method`` is named in the
-    messages; ``friction_blind`` (Method A) explains a high Bt as Coulomb friction taken for damping.
+    messages; ``friction_blind`` (Method A) explains a high Bt as Coulomb friction taken for damping;
+    ``std_B`` (6, 6), Bt's standard errors, lets a negative damping be told from noise.
 
     Raises
     ------
     DataError
-        A diagonal Mt entry beyond :data:`NOMINAL_ERROR_FACTOR` of nominal.
+        A diagonal Mt entry beyond :data:`NOMINAL_ERROR_FACTOR` of nominal, or a diagonal Bt
+        entry more than :data:`NEGATIVE_DAMPING_SE` of its standard errors below zero.
 
     Warns
     -----
@@ -310,6 +316,15 @@ def check_identified(M: np.ndarray, B: np.ndarray, platform: Platform,
     nominal = dict(zip(("Mt", "Bt"), nominal_matrices(platform), strict=True))
     hint = ("check the units (t s, x..z m, rx..rz rad, f N), the friction model and "
             "--platform (docs/logs.md)")
+    if std_B is not None:
+        scores = np.diag(B) / np.where(np.diag(std_B) > 0, np.diag(std_B), np.inf)
+        worst = int(np.argmin(scores))
+        if scores[worst] < -NEGATIVE_DAMPING_SE:
+            raise DataError(
+                f"{f'{method}: ' if method else ''}identified Bt({worst + 1},{worst + 1}) = "
+                f"{B[worst, worst]:.5g} ± {std_B[worst, worst]:.2g}: a negative damping, which "
+                "no passive platform has; the forces lead the motion (a pose or length channel "
+                "logged late: --delay with a negative value), or the time runs backwards.")
     for label, identified in (("Mt", M), ("Bt", B)):
         reference = np.diag(nominal[label])
         values = np.diag(identified)
