@@ -40,6 +40,9 @@ CARRIED_WEIGHT = (1.0 - BALANCE_ERROR, 5.0)
 PHYSICAL_CARRIED_WEIGHT = (0.5, 5.0)
 #: A single leg's mean force may differ from its static share by this fraction.
 LEG_BALANCE_ERROR = 0.5
+#: Forces that carry no weight but vary by more than this fraction of the legs' static loads
+#: (median over the legs) follow the motion: channels zeroed at rest, not unplugged.
+TARED_VARIATION = 0.005
 #: Identified diagonal of Mt or Bt beyond this factor of the nominal one: a warning.
 NOMINAL_WARNING_FACTOR = 2.0
 #: Identified diagonal of Mt beyond this factor of the nominal one: an error (units).
@@ -248,14 +251,23 @@ def check_static_balance(pose: np.ndarray, forces: np.ndarray, platform: Platfor
         raise DataError(f"{what}; {hints['kilo']}.")
     if currents and abs(ratio / 1000.0 - 1.0) <= BALANCE_ERROR:
         raise DataError(f"{what}; currents in mA? map them with --columns i1..i6=:mA.")
+    static = np.linalg.solve(np.transpose(leg_jacobian, (0, 2, 1)), gravity[..., None])[..., 0]
     if abs(ratio) < 0.02:
+        # zeroed at rest, the channels still follow the motion; unplugged, they do not
+        loads = static.mean(axis=0)
+        varying = float(np.median(forces.std(axis=0) / np.abs(loads)))
+        if varying > TARED_VARIATION:
+            offsets = ", ".join(f"{hints['columns'][0]}{k + 1} {load:.5g}"
+                                for k, load in enumerate(loads))
+            raise DataError(f"{what}, but vary with the motion ({100 * varying:.2g} % of the "
+                            "legs' static loads): zeroed at rest? give each channel its static "
+                            f"load as offset in a mapping file (N: {offsets}; docs/logs.md).")
         raise DataError(f"{what}; {hints['unplugged']}?")
     if abs(ratio + 1.0) <= BALANCE_ERROR:
         raise DataError(f"{what}; positive must extend the leg: map {hints['columns']} with "
                         "scale = -1 (docs/logs.md).")
     # each leg against the others before the total: one reversed or dead channel moves the
     # total too (a reversed one to 2/3 of the weight), where the unit or the file is not at fault
-    static = np.linalg.solve(np.transpose(leg_jacobian, (0, 2, 1)), gravity[..., None])[..., 0]
     shares = forces.mean(axis=0) / static.mean(axis=0)
     typical = float(np.median(shares))
     if typical > 0:
