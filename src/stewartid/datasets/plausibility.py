@@ -247,21 +247,24 @@ def check_static_balance(pose: np.ndarray, forces: np.ndarray, platform: Platfor
         hints = _FORCE_HINTS
         what = (f"{where}: the forces f1..f6 carry {ratio:.3g} times the weight of platform "
                 f"'{platform.name}' ({weight:.4g} N)")
-    if abs(ratio * 1000.0 - 1.0) <= BALANCE_ERROR:
-        raise DataError(f"{what}; {hints['kilo']}.")
-    if currents and abs(ratio / 1000.0 - 1.0) <= BALANCE_ERROR:
-        raise DataError(f"{what}; currents in mA? map them with --columns i1..i6=:mA.")
     static = np.linalg.solve(np.transpose(leg_jacobian, (0, 2, 1)), gravity[..., None])[..., 0]
     if abs(ratio) < 0.02:
         # zeroed at rest, the channels still follow the motion; unplugged, they do not
         loads = static.mean(axis=0)
         varying = float(np.median(forces.std(axis=0) / np.abs(loads)))
         if varying > TARED_VARIATION:
-            offsets = ", ".join(f"{hints['columns'][0]}{k + 1} {load:.5g}"
+            # a current channel's offset is in amperes: its load over the force constant
+            unit, scale = ("A", 1.0 / platform.actuator.force_constant) if currents else ("N", 1.0)
+            offsets = ", ".join(f"{hints['columns'][0]}{k + 1} {scale * load:.5g}"
                                 for k, load in enumerate(loads))
             raise DataError(f"{what}, but vary with the motion ({100 * varying:.2g} % of the "
                             "legs' static loads): zeroed at rest? give each channel its static "
-                            f"load as offset in a mapping file (N: {offsets}; docs/logs.md).")
+                            f"load as offset in a mapping file ({unit}: {offsets}; docs/logs.md).")
+    if abs(ratio * 1000.0 - 1.0) <= BALANCE_ERROR:
+        raise DataError(f"{what}; {hints['kilo']}.")
+    if currents and abs(ratio / 1000.0 - 1.0) <= BALANCE_ERROR:
+        raise DataError(f"{what}; currents in mA? map them with --columns i1..i6=:mA.")
+    if abs(ratio) < 0.02:
         raise DataError(f"{what}; {hints['unplugged']}?")
     if abs(ratio + 1.0) <= BALANCE_ERROR:
         raise DataError(f"{what}; positive must extend the leg: map {hints['columns']} with "
