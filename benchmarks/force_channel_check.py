@@ -19,27 +19,15 @@ import argparse
 import time
 import warnings
 
-import numpy as np
-
 from stewartid.datasets import read_experiments
 from stewartid.datasets.dataset import Dataset
-from stewartid.datasets.set_checks import (
-    _NUMBERINGS,
-    check_force_channels,
-    force_channel_correlation,
-)
+from stewartid.datasets.set_checks import check_force_channels, numbering_scores
 from stewartid.errors import DataError
 from stewartid.platform import load_platform
 
 #: Renumberings applied: channel k holds leg RENUMBERINGS[name][k]'s force.
 RENUMBERINGS = {"swap 1-2": [1, 0, 2, 3, 4, 5], "swap 1-4": [3, 1, 2, 0, 4, 5],
                 "rotation": [5, 0, 1, 2, 3, 4], "reversed": [5, 4, 3, 2, 1, 0]}
-
-
-def scores(data: list[Dataset], platform) -> np.ndarray:
-    """Every numbering's summed correlation, mean over the experiments (the check's score)."""
-    found = [r for r in (force_channel_correlation(d, platform) for d in data) if r is not None]
-    return sum(r[np.arange(6), _NUMBERINGS].sum(axis=1) for r in found) / len(found)
 
 
 def renumbered(data: list[Dataset], legs: list[int]) -> list[Dataset]:
@@ -60,13 +48,14 @@ def main() -> None:
         column = "i" if platform.actuator.kind == "electric" else "f"
         data = read_experiments(folder, platform, payload_unknown=True)
         start = time.perf_counter()
-        found = scores(data, platform)
+        found = numbering_scores(data, platform)
         spent = time.perf_counter() - start
         cells = []
         for legs in RENUMBERINGS.values():
-            moved = scores(renumbered(data, legs), platform)
+            records = renumbered(data, legs)
+            moved = numbering_scores(records, platform)
             try:
-                check_force_channels(renumbered(data, legs), platform)
+                check_force_channels(records, platform)
                 verdict = "not named"
             except DataError as exc:
                 # the named numbering undoes the renumbering: channel k follows leg legs[k]

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Sequence
+from functools import lru_cache
 
 import numpy as np
 
@@ -31,8 +32,8 @@ CHANNEL_TIE = 0.05
 #: check's): a correlation's noise is then a few hundredths.
 CHANNEL_ROWS = 1000
 
-#: Every numbering of six channels, the logged one first.
-_NUMBERINGS = np.array(list(itertools.permutations(range(6))))
+#: Every numbering of six channels (channel k holds leg NUMBERINGS[n, k]), the logged one first.
+NUMBERINGS = np.array(list(itertools.permutations(range(6))))
 
 
 def force_channel_correlation(dataset: Dataset, platform: Platform) -> np.ndarray | None:
@@ -42,16 +43,22 @@ def force_channel_correlation(dataset: Dataset, platform: Platform) -> np.ndarra
     :func:`~stewartid.datasets.excitation.motion_rows` (means removed: the mean load and
     Coulomb friction's mean do not enter; gravity's share moving between the legs as the
     platform tilts does, which slow motion is dominated by); None for a record without motion.
-    A channel or leg that does not vary correlates 0.
+    A channel or leg that does not vary correlates 0. Computed once per record and platform.
     """
-    return _correlation(dataset, platform, *nominal_matrices(platform))
+    return dataset.derived(("force channel correlation", platform),
+                           lambda record: _correlation(record, platform))
 
 
-def _correlation(dataset: Dataset, platform: Platform, M: np.ndarray,
-                 B: np.ndarray) -> np.ndarray | None:
+@lru_cache(maxsize=4)
+def _nominal(platform: Platform) -> tuple[np.ndarray, np.ndarray]:
+    return nominal_matrices(platform)
+
+
+def _correlation(dataset: Dataset, platform: Platform) -> np.ndarray | None:
     found = motion_rows(dataset, platform)
     if found is None:
         return None
+    M, B = _nominal(platform)
     every = slice(None, None, max(1, -(-len(found.rows) // CHANNEL_ROWS)))
     rows, velocity, acceleration = found.rows[every], found.velocity[every], found.acceleration[every]
     # the pose-only leg terms of the static balance check: no mass matrix, no compiled kernel
@@ -68,27 +75,36 @@ def _correlation(dataset: Dataset, platform: Platform, M: np.ndarray,
     return np.divide(products, norms, out=np.zeros((6, 6)), where=norms > 0)
 
 
+def numbering_scores(datasets: Sequence[Dataset], platform: Platform) -> np.ndarray | None:
+    """Every numbering of the channels (as :data:`NUMBERINGS`, the logged one first) scored by
+    its channels' summed :func:`force_channel_correlation` with their legs, mean over the
+    experiments; None where no experiment moves."""
+    found = [r for r in (force_channel_correlation(d, platform) for d in datasets)
+             if r is not None]
+    if not found:
+        return None
+    return sum(r[np.arange(6), NUMBERINGS].sum(axis=1) for r in found) / len(found)
+
+
 def check_force_channels(datasets: Sequence[Dataset], platform: Platform) -> None:
     """Refuse force channels numbered differently from the legs: the numbering of the channels
-    whose varying parts follow the predicted leg forces best
-    (:func:`force_channel_correlation`, summed over the experiments) against the logged one.
+    whose varying parts follow the predicted leg forces best (:func:`numbering_scores`) against
+    the logged one.
 
     Raises
     ------
     DataError
         Naming the channels, the legs they follow and the ``--columns`` mapping.
     """
-    model = nominal_matrices(platform)
-    found = [r for r in (_correlation(d, platform, *model) for d in datasets) if r is not None]
-    if not found:
+    scores = numbering_scores(datasets, platform)
+    if scores is None:
         return
-    scores = sum(r[np.arange(6), _NUMBERINGS].sum(axis=1) for r in found) / len(found)
     if scores.max() - scores[0] < CHANNEL_ORDER_GAIN or scores.max() < 6 * CHANNEL_ORDER_FIT:
         return
     # numberings a symmetric motion cannot tell apart tie: the one that moves fewest channels
     near = np.flatnonzero(scores >= scores.max() - CHANNEL_TIE)
-    best = int(near[np.argmin((_NUMBERINGS[near] != np.arange(6)).sum(axis=1))])
-    legs = _NUMBERINGS[best]
+    best = int(near[np.argmin((NUMBERINGS[near] != np.arange(6)).sum(axis=1))])
+    legs = NUMBERINGS[best]
     # an electric actuator's log holds motor currents i1..i6, read as forces
     column, kind = ("i", "current") if platform.actuator.kind == "electric" else ("f", "force")
     moved = [k for k in range(6) if legs[k] != k]
@@ -116,6 +132,6 @@ def check_experiment_set(datasets: Sequence[Dataset], platform: Platform) -> Non
     check_force_channels(datasets, platform)
 
 
-__all__ = ["CHANNEL_ORDER_FIT", "CHANNEL_ORDER_GAIN", "CHANNEL_ROWS", "CHANNEL_TIE",
-           "check_experiment_set",
-           "check_force_channels", "force_channel_correlation"]
+__all__ = ["CHANNEL_ORDER_FIT", "CHANNEL_ORDER_GAIN", "CHANNEL_ROWS", "CHANNEL_TIE", "NUMBERINGS",
+           "check_experiment_set", "check_force_channels", "force_channel_correlation",
+           "numbering_scores"]
